@@ -1,0 +1,14 @@
+"""`drillfric fleet` (INTERFACE.md) — not built yet."""
+
+from __future__ import annotations
+
+import click
+
+from .common import UserError
+
+
+@click.command("fleet", context_settings={"ignore_unknown_options": True})
+@click.argument("args", nargs=-1, type=click.UNPROCESSED)
+def command(args) -> None:
+    """Not built yet."""
+    raise UserError("'drillfric fleet' is not built yet in this version")

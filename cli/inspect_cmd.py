@@ -1,0 +1,14 @@
+"""`drillfric inspect` (INTERFACE.md) — not built yet."""
+
+from __future__ import annotations
+
+import click
+
+from .common import UserError
+
+
+@click.command("inspect", context_settings={"ignore_unknown_options": True})
+@click.argument("args", nargs=-1, type=click.UNPROCESSED)
+def command(args) -> None:
+    """Not built yet."""
+    raise UserError("'drillfric inspect' is not built yet in this version")

@@ -1,0 +1,52 @@
+"""The ``drillfric`` command group (INTERFACE.md): run, simulate, td, inspect, fleet, report."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from drillfric import __version__
+
+from .common import RunContext, user_errors
+
+
+class _Group(click.Group):
+    """Command group whose sub-commands turn library errors into one readable line."""
+
+    def invoke(self, ctx: click.Context):
+        with user_errors():
+            return super().invoke(ctx)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="drillfric")
+@click.option("--debug", is_flag=True, help="Show full tracebacks on errors.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bars or chatter (nightly jobs).")
+@click.pass_context
+def cli(ctx: click.Context, debug: bool, quiet: bool) -> None:
+    """drillfric — downhole friction factors and bit speed from rig surface data.
+
+    Estimates static and kinetic friction factors (μ_s, μ_k) and the downhole bit speed
+    with the adaptive observer of Aarsnes et al. (JPSE 2019), refined by a batch fit.
+    """
+    ctx.obj = RunContext(debug=debug, quiet=quiet)
+
+
+def _register() -> None:
+    from . import fleet_cmd, inspect_cmd, report_cmd, run_cmd, simulate_cmd, td_cmd
+
+    for module in (run_cmd, simulate_cmd, td_cmd, inspect_cmd, fleet_cmd, report_cmd):
+        cli.add_command(module.command)
+
+
+_register()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point."""
+    cli.main(args=argv if argv is not None else sys.argv[1:], prog_name="drillfric")
+
+
+if __name__ == "__main__":
+    main()

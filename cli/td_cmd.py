@@ -1,0 +1,14 @@
+"""`drillfric td` (INTERFACE.md) — not built yet."""
+
+from __future__ import annotations
+
+import click
+
+from .common import UserError
+
+
+@click.command("td", context_settings={"ignore_unknown_options": True})
+@click.argument("args", nargs=-1, type=click.UNPROCESSED)
+def command(args) -> None:
+    """Not built yet."""
+    raise UserError("'drillfric td' is not built yet in this version")

@@ -1,0 +1,448 @@
+"""Well configuration: one declarative schema, a validating TOML loader, precedence.
+
+Every key of the well configuration file (``NAME.toml`` / ``well.toml``, see
+INTERFACE.md) is declared once in :data:`SCHEMA` with its type, unit, default, allowed
+range and help text. The loader validates types and ranges and rejects unknown keys by
+name and file; ``docs/configuration.md`` is generated from the same declaration
+(:func:`schema_markdown`, checked by ``tests/test_config.py``).
+
+Precedence: command line > config file > defaults (:func:`load_config` ``overrides``).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from drillfric.errors import ConfigError
+
+_NUM = (int, float)
+
+
+@dataclass(frozen=True)
+class Key:
+    """One configuration key.
+
+    Attributes
+    ----------
+    name : str
+        Key name inside its table, with its unit as suffix (``mud_density_kg_m3``).
+    type : type or tuple of types
+        Accepted TOML value types (``float`` keys accept integers).
+    default : Any
+        Value used when the key is absent (``None``: no default, optional).
+    unit : str
+        Unit in words for the documentation ("" for dimensionless / text).
+    help : str
+        One-line description.
+    min, max : float, optional
+        Inclusive numeric range (``min_exclusive`` for strictly positive values).
+    choices : tuple, optional
+        Allowed values for text keys.
+    """
+
+    name: str
+    type: Any
+    default: Any
+    unit: str
+    help: str
+    min: float | None = None
+    max: float | None = None
+    min_exclusive: bool = False
+    choices: tuple | None = None
+
+    def validate(self, value: Any, where: str, file: str | None) -> Any:
+        """Return ``value`` checked (and ints widened to float) or raise ConfigError."""
+        types = self.type if isinstance(self.type, tuple) else (self.type,)
+        if float in types and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if isinstance(value, bool) and bool not in types or not isinstance(value, types):
+            wanted = " or ".join(_TYPE_NAMES.get(t, t.__name__) for t in types)
+            raise ConfigError(f"key '{where}' must be {wanted}, got {value!r}", file=file,
+                              fix=f"write e.g. {where.split('.')[-1]} = {_example(self)}")
+        if self.choices is not None and value not in self.choices:
+            raise ConfigError(f"key '{where}' must be one of {', '.join(map(repr, self.choices))}"
+                              f", got {value!r}", file=file)
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            low_bad = self.min is not None and (
+                value <= self.min if self.min_exclusive else value < self.min)
+            if low_bad or (self.max is not None and value > self.max):
+                raise ConfigError(f"key '{where}' = {value} is outside {self.range_text()}",
+                                  file=file)
+        return value
+
+    def range_text(self) -> str:
+        """Allowed range in words, e.g. ``(0, 2]`` or ``≥ 0``."""
+        if self.min is None and self.max is None:
+            return ""
+        lo = "" if self.min is None else ("(" if self.min_exclusive else "[") + f"{self.min:g}"
+        hi = "" if self.max is None else f"{self.max:g}]"
+        if self.max is None:
+            return ("> " if self.min_exclusive else "≥ ") + f"{self.min:g}"
+        if self.min is None:
+            return f"≤ {self.max:g}"
+        return f"{lo}, {hi}"
+
+
+_TYPE_NAMES = {float: "a number", int: "an integer", str: "text", bool: "true/false",
+               list: "a list", dict: "a table"}
+
+
+def _example(key: Key) -> str:
+    if key.choices:
+        return repr(key.choices[0]).replace("'", '"')
+    if key.default is not None:
+        return repr(key.default).replace("'", '"').replace("True", "true").replace(
+            "False", "false")
+    return {float: "1.0", int: "1", str: '"..."', list: "[]"}.get(
+        key.type if not isinstance(key.type, tuple) else key.type[0], "...")
+
+
+def _positive(name, default, unit, help_, **kw):
+    return Key(name, float, default, unit, help_, min=0.0, min_exclusive=True, **kw)
+
+
+#: Table name -> keys. ``string.sections`` is an array of tables with :data:`SECTION_KEYS`.
+SCHEMA: dict[str, tuple[Key, ...]] = {
+    "well": (
+        Key("name", str, None, "", "Well name used in outputs (default: the data file's stem)."),
+        Key("data", str, None, "", "Surface data file, relative to the config "
+            "(directory wells: well.toml names its files)."),
+    ),
+    "survey": (
+        Key("file", str, None, "", "Survey file (MD, inclination, azimuth), relative to the "
+            "config. Without a survey the well is assumed vertical."),
+    ),
+    "fluid": (
+        Key("mud_density_kg_m3", float, 1200.0, "kg/m³", "Mud density in the annulus "
+            "(outside the string).", min=0.0, max=7849.0),
+        Key("inner_mud_density_kg_m3", float, None, "kg/m³", "Mud density inside the string "
+            "(default: same as mud_density_kg_m3).", min=0.0, max=7849.0),
+    ),
+    "rig": (
+        _positive("top_drive_inertia_kg_m2", 2900.0, "kg·m²", "Top-drive rotating inertia "
+                  "I_TD (A&S 2018 measured 2900)."),
+        Key("torque_kind", str, "motor", "", "What the logged surface torque is: 'motor' "
+            "(drive torque τ_m) or 'string' (already inertia-corrected, τ(0) = τ_m − I_TD "
+            "dω₀/dt).", choices=("motor", "string")),
+    ),
+    "model": (
+        Key("omega_c_rad_s", float, None, "rad/s", "Static/kinetic switching speed ω_c "
+            "(default 1.0 rad/s; give this or omega_c_rpm).", min=0.0, min_exclusive=True),
+        Key("omega_c_rpm", float, None, "RPM", "Static/kinetic switching speed ω_c in RPM "
+            "(alternative to omega_c_rad_s).", min=0.0, min_exclusive=True),
+        Key("k_t_per_s", float, 0.1, "1/s", "Viscous damping rate k_t of the torsional "
+            "model (THEORY §3, eq. 2–3).", min=0.0),
+        Key("cells", int, 500, "", "Number of cells of the torsional model (the paper: 500).",
+            min=20, max=200000),
+        _positive("element_length_m", 2.0, "m", "Element length of the soft-string "
+                  "torque-and-drag march (THEORY §2).", max=30.0),
+        Key("friction", float, 0.25, "", "Friction factor used by torque-and-drag when no "
+            "other is given (td without --friction).", min=0.0, max=2.0),
+        Key("casing_shoe_md_m", float, None, "m", "Measured depth of the last casing shoe; "
+            "with friction_cased/friction_open the T&D friction differs above/below.", min=0.0),
+        Key("friction_cased", float, None, "", "T&D friction factor inside casing.",
+            min=0.0, max=2.0),
+        Key("friction_open", float, None, "", "T&D friction factor in open hole.",
+            min=0.0, max=2.0),
+    ),
+    "observer": (
+        Key("gains", str, "backstepping", "", "Gain design: closed-form 'backstepping' "
+            "(THEORY §5.1) or steady-state 'kalman'.", choices=("backstepping", "kalman")),
+        Key("law", str, "corrected", "", "Adaptation law: 'corrected' (drillfric) or 'paper' "
+            "(eqs. 42–43 exactly as printed, for comparison).", choices=("corrected", "paper")),
+        Key("kappa1", float, 1.0, "", "Fraction κ₁ of the top-side reflection cancelled.",
+            min=0.0, max=2.0, min_exclusive=True),
+        _positive("lambda0_per_s", 10.0, "1/s", "Bandwidth λ₀ of the top-drive injection."),
+        Key("poles_per_s", list, [1.0, 1.5], "1/s", "The two poles z, p placed for the "
+            "downhole error (ω_L, d)."),
+        Key("starts", list, [[0.3, 0.2], [0.6, 0.4], [0.9, 0.1]], "", "Initial guesses "
+            "[[μ_s, μ_k], ...] advanced together in one pass."),
+        _positive("mu_max", 1.5, "", "Physical clamp on the estimated friction factors."),
+        Key("interpolation", str, "linear", "", "Measurements between samples: 'linear' "
+            "(default, one sample of lag) or 'hold' (the paper's zero-order hold).",
+            choices=("linear", "hold")),
+        _positive("output_rate_hz", 10.0, "Hz", "Rate of estimates.parquet rows."),
+    ),
+    "segmentation": (
+        _positive("rotating_rpm", 5.0, "RPM", "Surface speed above which the string counts "
+                  "as rotating."),
+        _positive("min_segment_s", 30.0, "s", "Shortest rotating segment that is estimated; "
+                  "shorter ones are kept as 'skipped'."),
+        _positive("on_bottom_m", 0.5, "m", "Bit within this distance of hole depth counts "
+                  "as on bottom."),
+        _positive("wob_on_bottom_N", 10e3, "N", "WOB above which the bit counts as on bottom "
+                  "when depths are missing."),
+        _positive("max_gap_s", 10.0, "s", "A gap in the time base longer than this splits a "
+                  "segment."),
+    ),
+    "simulate": (
+        Key("bit_depth_m", float, None, "m", "Bit depth of a single-stand simulation "
+            "(default: the survey's last station).", min=0.0, min_exclusive=True),
+        Key("rpm", float, 60.0, "RPM", "Constant surface speed set-point after the ramp.",
+            min=0.0),
+        Key("mu_s", float, 0.6, "", "True static friction factor.", min=0.0, max=2.0),
+        Key("mu_k", float, 0.3, "", "True kinetic friction factor.", min=0.0, max=2.0),
+        _positive("kp_Nms_rad", 38e3, "N·m·s/rad", "PI speed controller proportional gain."),
+        Key("ki_Nm_rad", float, 100e3, "N·m/rad", "PI speed controller integral gain.",
+            min=0.0),
+        Key("rpm_noise", float, 0.0, "RPM", "Gaussian noise on the recorded surface speed.",
+            min=0.0),
+        Key("torque_noise_Nm", float, 0.0, "N·m", "Gaussian noise on the recorded torque.",
+            min=0.0),
+    ),
+}
+
+#: Keys of each ``[[string.sections]]`` entry (top-down; the first fills up to the bit).
+SECTION_KEYS: tuple[Key, ...] = (
+    Key("name", str, "", "", "Section name (e.g. '5 7/8in DP')."),
+    _positive("od_m", None, "m", "Body outside diameter."),
+    Key("id_m", float, None, "m", "Inside diameter (< od_m).", min=0.0),
+    _positive("length_m", None, "m", "Length; omit for the first (top) section, whose length "
+              "follows from the bit depth."),
+    _positive("tool_joint_od_m", None, "m", "Tool-joint OD; contact radius = "
+              "tool_joint_od_m/2 (default od_m/2)."),
+    _positive("linear_mass_kg_m", None, "kg/m", "Adjusted mass per metre including tool "
+              "joints (default: steel area × steel density)."),
+    _positive("shear_modulus_Pa", 79.3e9, "Pa", "Shear modulus G."),
+    _positive("steel_density_kg_m3", 7850.0, "kg/m³", "Steel density ρ."),
+)
+
+#: Documented default drill string, used (and reported as assumed) when a config has none:
+#: the A&S 2018 drill pipe, 5in heavy-weight and 8in collars (CASES.md).
+DEFAULT_SECTIONS: tuple[dict, ...] = (
+    {"name": "5 7/8in DP (assumed)", "od_m": 0.146529, "id_m": 0.123024,
+     "tool_joint_od_m": 0.1778, "linear_mass_kg_m": 41.41},
+    {"name": "5in HWDP (assumed)", "od_m": 0.127, "id_m": 0.0762, "length_m": 110.0,
+     "tool_joint_od_m": 0.1651, "linear_mass_kg_m": 74.5},
+    {"name": "8in collars (assumed)", "od_m": 0.2032, "id_m": 0.0714, "length_m": 120.0},
+)
+
+#: Channel keys accepted in ``[channels]`` (canonical names without the unit suffix).
+CHANNEL_KEYS = ("time", "surface_rpm", "surface_torque", "hookload", "bit_depth",
+                "hole_depth", "wob", "block_position", "bit_rpm", "standpipe_pressure",
+                "flow_in", "flow_out", "pump_rate")
+_CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list}
+
+
+@dataclass(frozen=True)
+class Config:
+    """Effective well configuration (defaults < file < command line).
+
+    Attributes
+    ----------
+    values : dict
+        ``{table: {key: value}}`` for every table of :data:`SCHEMA` (absent keys hold their
+        default, possibly ``None``).
+    sections : tuple of dict
+        ``[[string.sections]]`` entries, top-down, each with every :data:`SECTION_KEYS` key.
+    channels : dict
+        ``{channel_key: {"column": ..., "unit": ..., "mnemonics": [...]}}`` overrides.
+    source : Path or None
+        The file the configuration came from.
+    assumed : tuple of str
+        Human-readable notes of what was assumed by default (shown loudly in outputs).
+    """
+
+    values: dict
+    sections: tuple
+    channels: dict
+    source: Path | None = None
+    assumed: tuple = field(default_factory=tuple)
+
+    def __getitem__(self, dotted: str) -> Any:
+        table, key = dotted.split(".")
+        return self.values[table][key]
+
+    @property
+    def omega_c_rad_s(self) -> float:
+        """Static/kinetic switching speed ω_c [rad/s] (from either model key; default 1)."""
+        from drillfric.units import RPM_TO_RAD_S
+
+        if self["model.omega_c_rad_s"] is not None:
+            return self["model.omega_c_rad_s"]
+        if self["model.omega_c_rpm"] is not None:
+            return self["model.omega_c_rpm"] * RPM_TO_RAD_S
+        return 1.0
+
+    @property
+    def inner_mud_density_kg_m3(self) -> float:
+        """Mud density inside the string [kg/m³] (defaults to the annulus density)."""
+        inner = self["fluid.inner_mud_density_kg_m3"]
+        return self["fluid.mud_density_kg_m3"] if inner is None else inner
+
+    def to_dict(self) -> dict:
+        """Plain-data effective configuration, as written into summary.json."""
+        out = {t: dict(v) for t, v in self.values.items()}
+        out["string"] = {"sections": [dict(s) for s in self.sections]}
+        out["channels"] = {k: dict(v) for k, v in self.channels.items()}
+        return out
+
+
+def _table(raw: dict, table: str, keys: tuple[Key, ...], file: str | None,
+           prefix: str) -> dict:
+    if not isinstance(raw, dict):
+        raise ConfigError(f"'{prefix}' must be a table", file=file, fix=f"write [{prefix}]")
+    known = {k.name: k for k in keys}
+    for name in raw:
+        if name not in known:
+            close = ", ".join(sorted(known))
+            raise ConfigError(f"unknown key '{prefix}.{name}'", file=file,
+                              fix=f"remove it or use one of: {close}")
+    return {k.name: (k.validate(raw[k.name], f"{prefix}.{k.name}", file) if k.name in raw
+                     else k.default) for k in keys}
+
+
+def _sections(raw: Any, file: str | None) -> tuple[dict, ...]:
+    if not isinstance(raw, list) or not raw:
+        raise ConfigError("'string.sections' must be a non-empty array of tables", file=file,
+                          fix="write one [[string.sections]] table per section, top-down")
+    out = []
+    for i, entry in enumerate(raw, start=1):
+        sec = _table(entry, "string.sections", SECTION_KEYS, file, f"string.sections[{i}]")
+        where = f"string.sections[{i}]"
+        if sec["od_m"] is None or sec["id_m"] is None:
+            raise ConfigError(f"{where} needs od_m and id_m", file=file)
+        if sec["id_m"] >= sec["od_m"]:
+            raise ConfigError(f"{where}: id_m ({sec['id_m']}) must be smaller than od_m "
+                              f"({sec['od_m']})", file=file, fix="check the pipe dimensions")
+        if i > 1 and sec["length_m"] is None:
+            raise ConfigError(f"{where} needs length_m (only the top section may omit it)",
+                              file=file)
+        out.append(sec)
+    return tuple(out)
+
+
+def _channels(raw: Any, file: str | None) -> dict:
+    if not isinstance(raw, dict):
+        raise ConfigError("'channels' must be a table", file=file)
+    out = {}
+    for name, spec in raw.items():
+        if name not in CHANNEL_KEYS:
+            raise ConfigError(f"unknown channel '{name}' in [channels]", file=file,
+                              fix=f"use one of: {', '.join(CHANNEL_KEYS)}")
+        if isinstance(spec, (str, int)) and not isinstance(spec, bool):
+            spec = {"column": spec}
+        if not isinstance(spec, dict):
+            raise ConfigError(f"channels.{name} must be a table like "
+                              f'{{ column = "SRPM", unit = "rpm" }}', file=file)
+        for key, value in spec.items():
+            if key not in _CHANNEL_FIELDS:
+                raise ConfigError(f"unknown key 'channels.{name}.{key}'", file=file,
+                                  fix="use column, unit or mnemonics")
+            if not isinstance(value, _CHANNEL_FIELDS[key]) or isinstance(value, bool):
+                raise ConfigError(f"channels.{name}.{key} has the wrong type ({value!r})",
+                                  file=file)
+        out[name] = dict(spec)
+    return out
+
+
+def read_toml(path: str | Path) -> dict:
+    """Read a TOML file, turning syntax errors into one-line ConfigErrors."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError("config file not found", file=path, fix="check the path")
+    try:
+        with path.open("rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"not valid TOML ({exc})", file=path) from exc
+    except UnicodeDecodeError as exc:
+        raise ConfigError("not a text file", file=path) from exc
+
+
+def config_from_dict(raw: dict, *, file: str | Path | None = None,
+                     overrides: dict[str, Any] | None = None) -> Config:
+    """Validate a raw configuration mapping and apply ``overrides``.
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed TOML (may be empty).
+    file : str or Path, optional
+        Where ``raw`` came from, for messages.
+    overrides : dict, optional
+        ``{"table.key": value}`` from the command line (``None`` values are ignored).
+    """
+    fname = None if file is None else str(file)
+    allowed = set(SCHEMA) | {"string", "channels"}
+    for table in raw:
+        if table not in allowed:
+            raise ConfigError(f"unknown table or key '{table}'", file=fname,
+                              fix=f"use one of: {', '.join(sorted(allowed))}")
+    values = {t: _table(raw.get(t, {}), t, keys, fname, t) for t, keys in SCHEMA.items()}
+    string = raw.get("string", {})
+    if not isinstance(string, dict) or set(string) - {"sections"}:
+        raise ConfigError("[string] only holds [[string.sections]]", file=fname)
+    assumed = []
+    if "sections" in string:
+        sections = _sections(string["sections"], fname)
+    else:
+        sections = _sections([dict(s) for s in DEFAULT_SECTIONS], "built-in default")
+        assumed.append("drill string: typical 5 7/8in DP + 110 m 5in HWDP + 120 m 8in collars")
+    channels = _channels(raw.get("channels", {}), fname)
+    for dotted, value in (overrides or {}).items():
+        if value is None:
+            continue
+        table, key = dotted.split(".")
+        spec = {k.name: k for k in SCHEMA[table]}[key]
+        values[table][key] = spec.validate(value, dotted, "command line")
+    if values["model"]["omega_c_rad_s"] is not None and values["model"]["omega_c_rpm"] is not None:
+        raise ConfigError("give either model.omega_c_rad_s or model.omega_c_rpm, not both",
+                          file=fname)
+    if raw.get("rig", {}).get("top_drive_inertia_kg_m2") is None:
+        assumed.append("top-drive inertia 2900 kg·m² (A&S 2018)")
+    if "fluid" not in raw:
+        assumed.append("mud density 1200 kg/m³")
+    return Config(values=values, sections=sections, channels=channels,
+                  source=None if file is None else Path(file), assumed=tuple(assumed))
+
+
+def load_config(path: str | Path | None = None, *,
+                overrides: dict[str, Any] | None = None) -> Config:
+    """Load a well configuration TOML (or only defaults when ``path`` is None)."""
+    raw = {} if path is None else read_toml(path)
+    return config_from_dict(raw, file=path, overrides=overrides)
+
+
+def schema_markdown() -> str:
+    """Render the configuration reference (docs/configuration.md) from :data:`SCHEMA`."""
+    lines = ["# Configuration reference", "",
+             "Generated from `drillfric.config.SCHEMA` (`python -m drillfric.config > "
+             "docs/configuration.md`); a test fails when this file and the schema differ.",
+             "", "A well configuration is a TOML file (`NAME.toml` beside the data, "
+             "`well.toml` in a well directory, or `--config FILE`). Precedence: command line "
+             "> config file > defaults. Unknown keys are an error naming the key and file.", ""]
+
+    def rows(keys):
+        out = ["| key | type | unit | default | range | description |",
+               "|---|---|---|---|---|---|"]
+        for k in keys:
+            types = k.type if isinstance(k.type, tuple) else (k.type,)
+            tname = "/".join(t.__name__ for t in types)
+            rng = k.range_text() or (" / ".join(k.choices) if k.choices else "")
+            default = "—" if k.default is None else f"`{k.default}`"
+            out.append(f"| `{k.name}` | {tname} | {k.unit} | {default} | {rng} | {k.help} |")
+        return out
+
+    for table, keys in SCHEMA.items():
+        lines += [f"## [{table}]", ""] + rows(keys) + [""]
+    lines += ["## [[string.sections]]", "",
+              "Top-down array of tables; the first section's length follows from the bit "
+              "depth. Without any, the default string below is assumed (and reported).", ""]
+    lines += rows(SECTION_KEYS) + ["", "Default string:", ""]
+    lines += [f"- {s['name']}: OD {s['od_m']} m, ID {s['id_m']} m"
+              + (f", {s['length_m']} m" if "length_m" in s else ", fills to the bit")
+              for s in DEFAULT_SECTIONS]
+    lines += ["", "## [channels]", "",
+              "Maps canonical channels to columns of the data file and their units, e.g. "
+              '`surface_torque = { column = "STOR", unit = "kN.m" }`. A column may be a name or '
+              "a 0-based index (headerless files). `mnemonics = [...]` adds names to recognise.",
+              "", "Channel keys: " + ", ".join(f"`{c}`" for c in CHANNEL_KEYS), ""]
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(schema_markdown(), end="")

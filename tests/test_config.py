@@ -1,0 +1,102 @@
+"""Configuration schema: validation, precedence, and the generated reference doc."""
+
+from __future__ import annotations
+
+import pytest
+
+from drillfric.config import SCHEMA, SECTION_KEYS, config_from_dict, load_config, schema_markdown
+from drillfric.errors import ConfigError
+from tests.conftest import REPO
+
+
+def test_docs_configuration_matches_schema():
+    """docs/configuration.md is generated from SCHEMA and must not drift (datasette practice)."""
+    doc = (REPO / "docs" / "configuration.md").read_text(encoding="utf-8")
+    assert doc == schema_markdown(), "run: python -m drillfric.config > docs/configuration.md"
+
+
+def test_every_key_documented():
+    for keys in list(SCHEMA.values()) + [SECTION_KEYS]:
+        for key in keys:
+            assert key.help.strip(), key.name
+
+
+def test_defaults_and_assumptions_reported():
+    cfg = load_config()
+    assert cfg["model.cells"] == 500
+    assert cfg.omega_c_rad_s == 1.0
+    assert any("drill string" in a for a in cfg.assumed)
+
+
+def test_interface_example_loads(tmp_path):
+    """The example of INTERFACE.md must load unchanged (binding keys)."""
+    text = '''
+[well]
+name = "A-12"
+[fluid]
+mud_density_kg_m3 = 1200.0
+[rig]
+top_drive_inertia_kg_m2 = 2900.0
+torque_kind = "motor"
+[model]
+omega_c_rad_s = 1.0
+k_t_per_s = 0.1
+[[string.sections]]
+name = "5 7/8in DP"
+od_m = 0.146529
+id_m = 0.123024
+tool_joint_od_m = 0.1778
+linear_mass_kg_m = 41.41
+shear_modulus_Pa = 61.0e9
+[[string.sections]]
+name = "8in collars"
+od_m = 0.2096
+id_m = 0.0714
+length_m = 56.7
+[channels]
+surface_rpm = { column = "SRPM", unit = "rpm" }
+surface_torque = { column = "STOR", unit = "kN.m" }
+bit_depth = { column = "BITDEP", unit = "m" }
+'''
+    path = tmp_path / "a12.toml"
+    path.write_text(text)
+    cfg = load_config(path)
+    assert cfg["well.name"] == "A-12"
+    assert len(cfg.sections) == 2 and cfg.sections[1]["length_m"] == 56.7
+    assert cfg.channels["surface_torque"] == {"column": "STOR", "unit": "kN.m"}
+    assert not any("drill string" in a for a in cfg.assumed)
+
+
+@pytest.mark.parametrize("raw, words", [
+    ({"model": {"cellz": 3}}, "unknown key 'model.cellz'"),
+    ({"modle": {}}, "unknown table or key 'modle'"),
+    ({"model": {"cells": "many"}}, "must be an integer"),
+    ({"model": {"k_t_per_s": -1.0}}, "outside"),
+    ({"rig": {"torque_kind": "vfd"}}, "must be one of"),
+    ({"rig": {"top_drive_inertia_kg_m2": 0.0}}, "outside"),
+    ({"fluid": {"mud_density_kg_m3": 9000.0}}, "outside"),
+    ({"string": {"sections": [{"od_m": 0.1, "id_m": 0.2}]}}, "must be smaller than od_m"),
+    ({"string": {"sections": [{"od_m": 0.2, "id_m": 0.1}, {"od_m": 0.2, "id_m": 0.1}]}},
+     "needs length_m"),
+    ({"channels": {"rpmm": "X"}}, "unknown channel 'rpmm'"),
+    ({"model": {"omega_c_rad_s": 1.0, "omega_c_rpm": 10.0}}, "not both"),
+])
+def test_bad_config_one_line(raw, words):
+    with pytest.raises(ConfigError) as info:
+        config_from_dict(raw, file="w.toml")
+    message = str(info.value)
+    assert words in message and "w.toml" in message and "\n" not in message
+
+
+def test_precedence_command_line_over_file_over_default(tmp_path):
+    path = tmp_path / "w.toml"
+    path.write_text("[model]\ncells = 800\nk_t_per_s = 0.2\n")
+    cfg = load_config(path, overrides={"model.cells": 1000, "model.k_t_per_s": None})
+    assert cfg["model.cells"] == 1000  # command line wins
+    assert cfg["model.k_t_per_s"] == 0.2  # file over default
+    assert cfg["rig.top_drive_inertia_kg_m2"] == 2900.0  # default
+
+
+def test_integer_accepted_for_float(tmp_path):
+    cfg = config_from_dict({"fluid": {"mud_density_kg_m3": 1100}})
+    assert isinstance(cfg["fluid.mud_density_kg_m3"], float)

@@ -1,0 +1,44 @@
+"""The built wheel installs into a clean virtual environment and its CLI runs from outside.
+
+The clean environment gets the wheel only; third-party dependencies come from this test
+environment's site-packages through a .pth path (which does not activate the editable
+install's finder), so the check is of our packaging — ``cli/`` and ``templates/``
+installed inside the ``drillfric`` namespace — without re-downloading numba and friends.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import sysconfig
+import venv
+from pathlib import Path
+
+from tests.conftest import REPO
+
+
+def _run(cmd, **kw):
+    return subprocess.run(cmd, check=True, capture_output=True, text=True, **kw)
+
+
+def test_wheel_installs_and_runs_outside_repo(tmp_path: Path):
+    dist = tmp_path / "dist"
+    _run([sys.executable, "-m", "pip", "wheel", str(REPO), "--no-deps", "--no-build-isolation",
+          "-w", str(dist)])
+    wheel = next(dist.glob("drillfric-*.whl"))
+    env = tmp_path / "env"
+    venv.create(env, with_pip=False)
+    py = env / "bin" / "python"
+    site = Path(_run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"]
+                     ).stdout.strip())
+    (site / "deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    _run([sys.executable, "-m", "pip", "--python", str(py), "install", "--no-deps", str(wheel)])
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    where = _run([str(py), "-c", "import drillfric, drillfric.cli, drillfric.templates; "
+                  "print(drillfric.__file__)"], cwd=outside).stdout
+    assert str(env) in where, f"imported from outside the clean env: {where}"
+    out = _run([str(env / "bin" / "drillfric"), "--help"], cwd=outside).stdout
+    assert "simulate" in out and "fleet" in out
+    bare = subprocess.run([str(py), "-c", "import cli"], cwd=outside, capture_output=True)
+    assert bare.returncode != 0, "a bare top-level package 'cli' must not be installed"
