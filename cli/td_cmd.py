@@ -1,14 +1,212 @@
-"""`drillfric td` (INTERFACE.md) — not built yet."""
+"""`drillfric td` (INTERFACE.md): soft-string torque and drag at one bit depth, or a broomstick.
+
+Thin layer: resolve the well (config, survey), build the options into library calls of
+:mod:`drillfric.torque_drag`, print a summary or JSON, write the table / plot.
+"""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import click
+import numpy as np
 
-from .common import UserError
+from drillfric.errors import InputError
+
+from .common import UserError, echo, warn
+
+_TABLE_SUFFIXES = (".csv", ".parquet")
+_PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+_DEFAULT_FRICTIONS = (0.1, 0.2, 0.3, 0.4, 0.5)
 
 
-@click.command("td", context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def command(args) -> None:
-    """Not built yet."""
-    raise UserError("'drillfric td' is not built yet in this version")
+def _load(target: Path, config: str | None, survey: str | None, overrides: dict):
+    """(Config, WellPath or None) for a .toml configuration, a data file or a well directory.
+
+    A configuration's ``[survey] file`` is relative to the configuration; ``--config`` and
+    ``--survey`` override. Other targets are resolved like every command does
+    (:func:`drillfric.io.well.resolve_well`: sidecars, HDF5 bundles, directories).
+    """
+    from drillfric.config import load_config, read_toml
+    from drillfric.io.survey import read_survey
+
+    if target.suffix.lower() == ".toml":
+        if not target.is_file():
+            raise InputError("config file not found", file=target, fix="check the path")
+        cfg_path = Path(config) if config else target
+        name = read_toml(cfg_path).get("survey", {}).get("file")
+        survey_path = Path(survey) if survey else (
+            None if name is None else cfg_path.parent / name)
+        cfg = load_config(cfg_path, overrides=overrides)
+        return cfg, None if survey_path is None else read_survey(survey_path)
+    from drillfric.io.well import _load_config, _load_survey, resolve_well
+
+    _, cfg_path, survey_path = resolve_well(target, config=config, survey=survey)
+    return _load_config(cfg_path, None, overrides), _load_survey(survey_path)
+
+
+def _floats(text: str | None, what: str) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        if ":" in text:
+            start, stop, step = (float(v) for v in text.split(":"))
+            if step <= 0 or stop < start:
+                raise ValueError
+            return list(np.arange(start, stop + 0.5 * step, step))
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise UserError(f"--{what}: expected comma-separated numbers or START:STOP:STEP, got "
+                        f"'{text}'") from None
+
+
+def _check_out(out: Path | None, suffixes: tuple[str, ...]) -> None:
+    if out is not None and out.suffix.lower() not in suffixes:
+        raise UserError(f"{out}: unsupported output type '{out.suffix}' — use "
+                        f"{' or '.join(suffixes)}")
+
+
+def _write_table(frame, out: Path) -> None:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if out.suffix.lower() == ".parquet":
+        frame.to_parquet(out, index=False)
+    else:
+        frame.to_csv(out, index=False)
+
+
+@click.command("td")
+@click.argument("well_or_config", type=click.Path(path_type=Path))
+@click.option("--bit-depth", type=float, help="Bit measured depth [m] (default: end of survey).")
+@click.option("--friction", type=float, help="Friction factor μ (default: from the config, "
+              "per hole section when casing_shoe_md_m is set).")
+@click.option("--load-case", default="rotating_off_bottom", show_default=True,
+              type=click.Choice(["rotating_off_bottom", "rotating_on_bottom", "pick_up",
+                                 "slack_off", "rotating_pick_up", "rotating_slack_off",
+                                 "sliding"]))
+@click.option("--wob", type=float, default=0.0, show_default=True,
+              help="Weight on bit [N] (on-bottom cases).")
+@click.option("--bit-torque", type=float, default=0.0, show_default=True,
+              help="Torque on bit [N·m] (on-bottom cases).")
+@click.option("--rpm", type=float, default=0.0, help="Rotary speed [RPM] (combined motion).")
+@click.option("--axial-speed", type=float, default=0.0,
+              help="Trip speed [m/s] (combined motion).")
+@click.option("--element-length", type=float, help="Element length [m] (default: config).")
+@click.option("--out", type=click.Path(path_type=Path),
+              help="Profile (or broomstick table) file, .csv or .parquet.")
+@click.option("--broomstick", is_flag=True, help="Hook load and torque versus bit depth for "
+              "a family of friction factors (table to --out, plot beside it or to --plot).")
+@click.option("--frictions", help="Broomstick friction factors, e.g. 0.1,0.2,0.3 "
+              "(default 0.1–0.5).")
+@click.option("--depths", help="Broomstick bit depths [m]: comma list or START:STOP:STEP "
+              "(default: 50 depths from the BHA length to the bit depth).")
+@click.option("--plot", type=click.Path(path_type=Path),
+              help="Broomstick plot file (.png/.svg/.pdf; default: --out with .png).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--config", type=click.Path(), help="Well configuration (overrides sidecars).")
+@click.option("--survey", type=click.Path(), help="Survey file (overrides the config's).")
+def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm, axial_speed,
+            element_length, out, broomstick, frictions, depths, plot, as_json, config,
+            survey) -> None:
+    """Soft-string torque and drag (THEORY.md §2) for WELL_OR_CONFIG.
+
+    WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file) or a well on
+    disk (INTERFACE.md). Without a survey the hole is vertical and --bit-depth is required.
+    """
+    overrides = {"model.friction": friction, "model.element_length_m": element_length}
+    cfg, path = _load(well_or_config, config, survey, overrides)
+    if bit_depth is None:
+        if path is None:
+            raise UserError("no survey: give --bit-depth (the hole is taken as vertical)")
+        bit_depth = path.md_max_m
+    for note in cfg.assumed:
+        if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
+            warn(f"assumed {note}")
+    if path is None:
+        warn("no survey: vertical hole assumed")
+    kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
+    if broomstick:
+        _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
+    else:
+        _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw)
+
+
+def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> None:
+    from drillfric.torque_drag import config_friction, solve_config
+
+    _check_out(out, _TABLE_SUFFIXES)
+    result = solve_config(cfg, path, bit_depth, friction=friction, load_case=load_case, **kw)
+    mu = config_friction(cfg, friction)
+    summary = {"bit_depth_m": result.bit_depth_m,
+               "friction_factor": None if callable(mu) else float(mu),
+               "load_case": load_case, "surface_torque_Nm": result.surface_torque_Nm,
+               "hookload_N": result.hookload_N, "T_N_Nm": result.T_N_Nm,
+               "wob_N": kw["wob_N"], "bit_torque_Nm": kw["bit_torque_Nm"],
+               "max_normal_force_N_m": float(result.normal_force_N_m.max()),
+               "mud_density_kg_m3": cfg["fluid.mud_density_kg_m3"],
+               "element_length_m": cfg["model.element_length_m"],
+               "elements": int(result.fc_Nm_m.size), "assumed": list(cfg.assumed)}
+    if callable(mu):
+        summary["friction_by_section"] = {"casing_shoe_md_m": mu.shoe_md_m,
+                                          "cased": mu.cased, "open_hole": mu.open_hole}
+    if out is not None:
+        _write_table(result.to_frame(), out)
+    if as_json:
+        click.echo(json.dumps(summary, indent=2))
+        return
+    mu_text = (f"{summary['friction_factor']:g}" if summary["friction_factor"] is not None
+               else f"{mu.cased:g} cased above {mu.shoe_md_m:g} m, {mu.open_hole:g} open hole")
+    echo(f"bit depth        {result.bit_depth_m:10.1f} m   ({load_case}, μ = {mu_text})")
+    echo(f"hook load        {result.hookload_N / 1e3:10.1f} kN  (effective, no block weight)")
+    echo(f"surface torque   {result.surface_torque_Nm / 1e3:10.2f} kN·m")
+    echo(f"T_N = ∫F_c dx    {result.T_N_Nm / 1e3:10.2f} kN·m per unit friction factor")
+    echo(f"max side force   {summary['max_normal_force_N_m']:10.1f} N/m")
+    if out is not None:
+        echo(f"profile written to {out}")
+
+
+def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw) -> None:
+    from drillfric.drillstring import build_string
+    from drillfric.torque_drag import broomstick, broomstick_figure, config_friction
+    from drillfric.wellpath import vertical
+
+    _check_out(out, _TABLE_SUFFIXES)
+    if plot is None and out is not None:
+        plot = out.with_suffix(".png")
+    _check_out(plot, _PLOT_SUFFIXES)
+    mus = _floats(frictions, "frictions") or list(_DEFAULT_FRICTIONS)
+    if any(m < 0 or m > 2 for m in mus):
+        raise UserError(f"--frictions must lie in [0, 2], got {mus}")
+    string = build_string(cfg.sections, bit_depth)
+    bha_m = string.bit_depth_m - string.bha_top_m
+    grid = _floats(depths, "depths")
+    if grid is None:
+        grid = list(np.linspace(max(bha_m + 1.0, bit_depth / 50), bit_depth, 50))
+    path = vertical(max(grid)) if path is None else path
+    cases = ["rotating_off_bottom", "pick_up", "slack_off"]
+    if kw["wob_N"] > 0 or kw["bit_torque_Nm"] != 0:
+        cases.append("rotating_on_bottom")
+    if callable(config_friction(cfg)):
+        warn("broomstick uses one friction factor per curve; cased/open-hole values ignored")
+    table = broomstick(path, cfg.sections, grid, mus, cases,
+                       mud_out_kg_m3=cfg["fluid.mud_density_kg_m3"],
+                       mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
+                       element_length_m=cfg["model.element_length_m"], **kw)
+    if out is not None:
+        _write_table(table, out)
+    if plot is not None:
+        plot.parent.mkdir(parents=True, exist_ok=True)
+        broomstick_figure(table).savefig(plot, dpi=120)
+    if as_json:
+        click.echo(table.to_json(orient="records", indent=2))
+        return
+    echo(f"broomstick: {len(grid)} depths × {len(mus)} friction factors × {len(cases)} "
+         f"load cases ({grid[0]:.0f}–{grid[-1]:.0f} m)")
+    last = table[table["bit_depth_m"] == table["bit_depth_m"].max()]
+    for row in last.itertuples():
+        echo(f"  at {row.bit_depth_m:7.1f} m  μ = {row.friction_factor:4.2f}  "
+             f"{row.load_case:20s} hook load {row.hookload_N / 1e3:8.1f} kN  "
+             f"torque {row.surface_torque_Nm / 1e3:6.2f} kN·m")
+    for target in (out, plot):
+        if target is not None:
+            echo(f"written {target}")

@@ -177,6 +177,24 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "when depths are missing."),
         _positive("max_gap_s", 10.0, "s", "A gap in the time base longer than this splits a "
                   "segment."),
+        _positive("kind_dwell_s", 20.0, "s", "A change between on and off bottom must last "
+                  "this long to split a rotating segment (shorter excursions are absorbed)."),
+        _positive("slips_hookload_N", None, "N", "Hook load below which the string is in the "
+                  "slips (above the empty-hook weight, below the lightest string weight); "
+                  "without it no in-slips detection."),
+        _positive("trip_speed_m_s", 0.1, "m/s", "Bit (or block) speed above which a "
+                  "non-rotating string off bottom counts as tripping."),
+        _positive("max_rop_m_h", 300.0, "m/h", "Fastest drilling: a bit going below the "
+                  "known hole depth faster than this is running into existing hole (off "
+                  "bottom)."),
+        _positive("pumps_on_Pa", 1.0e6, "Pa", "Standpipe pressure above which the pumps count "
+                  "as on (used when neither flow in nor pump rate is recorded)."),
+        _positive("pumps_on_spm", 10.0, "1/min", "Pump rate above which the pumps count as "
+                  "on (used when flow in is not recorded)."),
+        _positive("pumps_on_m3_s", 0.002, "m³/s", "Flow in above which the pumps count as on."),
+        Key("start_bit_depth_m", float, None, "m", "Bit depth at the first sample when bit "
+            "depth is reckoned from block position (without it segment depths are unknown).",
+            min=0.0),
     ),
     "simulate": (
         Key("bit_depth_m", float, None, "m", "Bit depth of a single-stand simulation "
@@ -192,6 +210,27 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             min=0.0),
         Key("torque_noise_Nm", float, 0.0, "N·m", "Gaussian noise on the recorded torque.",
             min=0.0),
+        _positive("duration_s", 120.0, "s", "Simulated time of a single-stand run; with a "
+                  "scenario, the rotating time of stands that do not give their own."),
+        _positive("rate_hz", 100.0, "Hz", "Recording rate of the simulated surface data."),
+        _positive("ramp_s", 10.0, "s", "Time of the set-point ramp from rest to `rpm`."),
+        Key("seed", int, 0, "", "Seed of the measurement noise.", min=0),
+        Key("scenario", str, None, "", "Scenario file of several stands (TOML, relative to the "
+            "config; see docs/simulator.md). Without it: one stand."),
+        Key("rpm_resolution", float, 0.0, "RPM", "Quantisation step of the recorded surface "
+            "speed (0: none).", min=0.0),
+        Key("torque_resolution_Nm", float, 0.0, "N·m", "Quantisation step of the recorded "
+            "torque (0: none).", min=0.0),
+        Key("hookload_noise_N", float, 0.0, "N", "Gaussian noise on the recorded hook load.",
+            min=0.0),
+        Key("wob_N", float, 0.0, "N", "Weight on bit of a single-stand run (> 0: bit on "
+            "bottom with the Coulomb bit-torque model).", min=0.0),
+        Key("bit_mu", float, 0.3, "", "Bit friction coefficient μ_bit of the bit-torque model "
+            "T_bit = μ_bit·WOB·D_bit/3.", min=0.0, max=2.0),
+        _positive("bit_diameter_m", 0.2159, "m", "Bit diameter D_bit (bit-torque model and "
+                  "hole size)."),
+        Key("off_bottom_m", float, 5.0, "m", "Distance of the bit above hole bottom in "
+            "off-bottom stands (recorded hole depth = bit depth + this).", min=0.0),
     ),
 }
 

@@ -170,6 +170,20 @@ class DrillString:
         values = np.array([getattr(s, attribute) for s in self.sections], dtype=float)
         return values[self.section_index(md_m)]
 
+    def buoyed_weight_N_m(self, md_m, mud_out_kg_m3: float, mud_in_kg_m3: float) -> np.ndarray:
+        """Buoyed weight per metre [N/m] at measured depths (THEORY.md §2 step 1).
+
+        Examples
+        --------
+        >>> a = Section("a", .2, .1, 10., .1, 50.)
+        >>> s = DrillString((a, Section("b", .3, .1, 5., .15, 90.)))
+        >>> bool(s.buoyed_weight_N_m([1.0], 0.0, 0.0)[0] == a.air_weight_N_m)
+        True
+        """
+        values = np.array([s.buoyed_weight_N_m(mud_out_kg_m3, mud_in_kg_m3)
+                           for s in self.sections])
+        return values[self.section_index(md_m)]
+
 
 def build_string(entries, bit_depth_m: float) -> DrillString:
     """Resolve configured sections for a bit depth: the top section fills the rest.

@@ -121,6 +121,8 @@ class WellPath:
             raise InputError(f"measured depth {md.min():.1f}–{md.max():.1f} m is outside the "
                              f"survey ({lo:.1f}–{hi:.1f} m)",
                              fix="extend the survey to the bit depth")
+        if len(self.md_m) == 1:  # a lone station: only its own depth is on the path
+            return np.zeros(md.size, dtype=int), np.zeros(md.size)
         k = np.clip(np.searchsorted(self.md_m, md, side="right") - 1, 0, len(self.md_m) - 2)
         frac = np.clip((md - self.md_m[k]) / (self.md_m[k + 1] - self.md_m[k]), 0.0, 1.0)
         return k, frac
@@ -139,15 +141,28 @@ class WellPath:
     def position(self, md_m) -> np.ndarray:
         """(north, east, tvd) [m] at measured depths, on the circular arcs, shape (n, 3)."""
         k, frac = self._locate(md_m)
+        start = np.stack([self.north_m, self.east_m, self.tvd_m], axis=1)[k]
+        if len(self.md_m) == 1:
+            return start
         t = unit_tangent(self.inc_rad, self.azi_rad)
         beta_part = frac * self.dogleg_rad[k]
         ds = frac * np.diff(self.md_m)[k]
         tf = self.tangent(md_m)
-        start = np.stack([self.north_m, self.east_m, self.tvd_m], axis=1)[k]
         return start + (ds * ratio_factor(beta_part) / 2.0)[:, None] * (t[k] + tf)
 
     def at(self, md_m) -> dict[str, np.ndarray]:
-        """Inclination, azimuth [rad], TVD, north, east [m] at measured depths (arc-consistent)."""
+        """Inclination, azimuth [rad], TVD, north, east [m] at measured depths (arc-consistent).
+
+        Examples
+        --------
+        A 90° build over 300 m is a quarter circle of radius 2·300/π ≈ 190.99 m; half-way
+        the hole is at 45° and sin 45° of the radius deeper:
+
+        >>> p = minimum_curvature([0.0, 300.0], [0.0, np.pi / 2], [0.0, 0.0])
+        >>> mid = p.at(150.0)
+        >>> round(float(np.degrees(mid["inc_rad"][0])), 9), round(float(mid["tvd_m"][0]), 3)
+        (45.0, 135.047)
+        """
         t = self.tangent(md_m)
         pos = self.position(md_m)
         inc = np.arctan2(np.hypot(t[:, 0], t[:, 1]), t[:, 2])

@@ -1,0 +1,356 @@
+"""Channel recognition: the one mnemonic table, and the mapping of source columns to channels.
+
+Every canonical surface channel of INTERFACE.md is declared once in :data:`CHANNELS` (its
+``[channels]`` key, canonical column with unit suffix, quantity, unit assumed when the file
+states none, and the mnemonics recognised). :func:`map_channels` matches a file's columns to
+these channels and decides each channel's source unit, in this order of precedence:
+
+1. ``[channels]`` in the well configuration (``column``, ``unit``, extra ``mnemonics``);
+2. the unit stated by the file (``TORQUE [kN.m]``, ``Torque (ft.lbf)``, a units row, LAS or
+   HDF5 unit attributes, a trailing unit word like ``Average Surface Torque kN.m``);
+3. the canonical suffix (``surface_torque_Nm`` is in N·m, as ``drillfric simulate`` writes);
+4. the documented default of :data:`CHANNELS` (reported as ``source = "default"``).
+
+A unit stated in ``[channels]`` that disagrees with the file's own is an error
+(inconsistent unit), as is a unit of the wrong kind (``klbf`` for a torque).
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from dataclasses import dataclass
+
+import pint
+
+from drillfric.errors import InputError
+from drillfric.units import UREG, parse_unit
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One canonical surface channel.
+
+    Attributes
+    ----------
+    key : str
+        Key in ``[channels]`` (canonical name without the unit suffix).
+    name : str
+        Canonical column name with its unit suffix (``surface_torque_Nm``).
+    kind : str
+        Quantity, for messages (``torque``).
+    unit : str
+        Unit of the canonical column (pint expression; ``surface_rpm`` stays in RPM).
+    default_unit : str
+        Unit assumed when neither the file nor the configuration states one.
+    mnemonics : tuple of str
+        Names recognised in files (compared case-, space- and punctuation-insensitively).
+    required : bool
+        Whether a well without this channel is rejected.
+    """
+
+    key: str
+    name: str
+    kind: str
+    unit: str
+    default_unit: str
+    mnemonics: tuple[str, ...]
+    required: bool = False
+
+
+#: The mnemonic table (the only one): canonical channels in output column order.
+CHANNELS: tuple[Channel, ...] = (
+    Channel("time", "time_s", "time", "second", "s",
+            ("TIME", "DATETIME", "DATE_TIME", "TIMESTAMP", "TIME_S", "ETIM", "ELAPSED TIME",
+             "TIM", "DATE TIME", "RIG TIME"), required=True),
+    Channel("surface_rpm", "surface_rpm", "rotary speed", "revolution/minute", "rpm",
+            ("RPM", "SRPM", "TDRPM", "RPMA", "RPMS", "TDS", "ROTARY SPEED", "TOP DRIVE SPEED",
+             "AVERAGE ROTARY SPEED", "SURFACE RPM", "SURFACE ROTARY SPEED", "TOP DRIVE RPM",
+             "TD SPEED", "TD RPM", "ROTARY RPM", "RPM SURFACE"), required=True),
+    Channel("surface_torque", "surface_torque_Nm", "torque", "newton*meter", "kN.m",
+            ("TORQUE", "STOR", "TQA", "TDTORQUE", "TORQ", "TQ", "SURFACE TORQUE",
+             "TOP DRIVE TORQUE", "AVERAGE SURFACE TORQUE", "TD TORQUE", "ROTARY TORQUE",
+             "STQ", "TDTQ"), required=True),
+    Channel("hookload", "hookload_N", "force", "newton", "kN",
+            ("HKLD", "HKLA", "HKL", "HOOKLOAD", "HOOK LOAD", "AVERAGE HOOKLOAD",
+             "AVERAGE HOOK LOAD", "HKLX")),
+    Channel("bit_depth", "bit_depth_m", "length", "meter", "m",
+            ("BITDEP", "DBTM", "BDEP", "BIT DEPTH", "BIT POSITION", "DEPTH BIT")),
+    Channel("hole_depth", "hole_depth_m", "length", "meter", "m",
+            ("DMEA", "HDTH", "HOLE DEPTH", "HOLEDEPTH", "DEPTH HOLE", "HOLE DEPTH MD")),
+    Channel("wob", "wob_N", "force", "newton", "kN",
+            ("WOB", "SWOB", "WOBA", "WEIGHT ON BIT", "SURFACE WOB")),
+    Channel("block_position", "block_position_m", "length", "meter", "m",
+            ("BPOS", "BLKPOS", "BLOCK POSITION", "BLOCK HEIGHT", "BLOCK", "HOOK POSITION")),
+    Channel("bit_rpm", "bit_rpm", "rotary speed", "revolution/minute", "rpm",
+            ("BITRPM", "DRPM", "BIT RPM", "DOWNHOLE RPM", "BIT SPEED")),
+    Channel("standpipe_pressure", "standpipe_pressure_Pa", "pressure", "pascal", "kPa",
+            ("SPP", "SPPA", "SPPR", "STANDPIPE PRESSURE", "AVERAGE STANDPIPE PRESSURE",
+             "PUMP PRESSURE")),
+    Channel("flow_in", "flow_in_m3_s", "flow rate", "meter**3/second", "L/min",
+            ("FLOWIN", "MFIA", "TFLO", "FLOW IN", "MUD FLOW IN", "FLOW IN RATE")),
+    Channel("flow_out", "flow_out_pct", "percentage", "percent", "%",
+            ("FLOWOUT", "MFOP", "FLOW OUT", "FLOW OUT PERCENT", "RETURN FLOW")),
+    Channel("pump_rate", "pump_rate_spm", "pump rate", "1/minute", "spm",
+            ("SPM", "TSPM", "TOTAL SPM", "PUMP RATE", "STROKE RATE", "TOTAL STROKE RATE")),
+)
+
+BY_KEY: dict[str, Channel] = {c.key: c for c in CHANNELS}
+BY_NAME: dict[str, Channel] = {c.name: c for c in CHANNELS}
+
+#: Unit spellings that neither pint nor drillfric.units parse (flow, pump rate, scaled).
+_EXTRA_UNITS = {
+    "spm": "1/minute", "stk/min": "1/minute", "strokes/min": "1/minute",
+    "1/min": "1/minute", "gpm": "gallon/minute", "lpm": "liter/minute",
+    "l/min": "liter/minute", "m3/min": "meter**3/minute", "m3/s": "meter**3/second",
+    "bbl/min": "oil_barrel/minute", "pct": "percent", "psia": "psi", "psig": "psi",
+    # scaled spellings that drillfric.units maps to expressions pint rejects as units
+    "kft.lbf": "kilofoot*force_pound", "kft-lbf": "kilofoot*force_pound",
+    "dan": "decanewton",
+}
+
+#: Unit as spelled in the canonical suffix of each channel (``surface_torque_Nm`` → N.m).
+SUFFIX_UNITS = {"time": "s", "surface_rpm": "rpm", "surface_torque": "N.m", "hookload": "N",
+                "bit_depth": "m", "hole_depth": "m", "wob": "N", "block_position": "m",
+                "bit_rpm": "rpm", "standpipe_pressure": "Pa", "flow_in": "m3/s",
+                "flow_out": "%", "pump_rate": "spm"}
+
+_UNIT_IN_NAME = re.compile(r"^\s*(?P<name>.*?)\s*[\[(](?P<unit>[^\])]*)[\])]\s*$")
+
+
+def normalise(name: str) -> str:
+    """Comparison form of a mnemonic: upper case, letters and digits only.
+
+    Examples
+    --------
+    >>> normalise("Top Drive Speed")
+    'TOPDRIVESPEED'
+    """
+    return re.sub(r"[^0-9A-Z]", "", str(name).upper())
+
+
+def split_unit(header: str) -> tuple[str, str | None]:
+    """Split ``"TORQUE [kN.m]"`` or ``"Torque (ft.lbf)"`` into name and unit.
+
+    Examples
+    --------
+    >>> split_unit("Torque (ft.lbf)")
+    ('Torque', 'ft.lbf')
+    >>> split_unit("SRPM")
+    ('SRPM', None)
+    """
+    match = _UNIT_IN_NAME.match(str(header))
+    if match and match["name"]:
+        return match["name"], match["unit"].strip() or None
+    return str(header), None
+
+
+def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
+    """Factor turning values in ``unit`` into the canonical unit of ``channel``.
+
+    Raises
+    ------
+    InputError
+        Unknown unit, or a unit of the wrong kind (an inconsistent unit).
+
+    Examples
+    --------
+    >>> round(factor("ft.lbf", BY_KEY["surface_torque"]), 6)
+    1.355818
+    >>> round(factor("klbf", BY_KEY["hookload"]), 3)
+    4448.222
+    """
+    spelled = _EXTRA_UNITS.get(unit.strip().lower().replace(" ", ""), unit)
+    try:
+        source = parse_unit(spelled)
+    except InputError as exc:
+        raise InputError(f"unknown unit '{unit}' for {channel.name}", file=file,
+                         fix=f'state it in [channels], e.g. {channel.key} = '
+                             f'{{ unit = "{channel.default_unit}" }}') from exc
+    try:
+        return float(UREG.Quantity(1.0, source).to(channel.unit).magnitude)
+    except pint.errors.DimensionalityError as exc:
+        raise InputError(f"unit '{unit}' of {channel.name} is not a {channel.kind} unit",
+                         file=file, fix=f'give a {channel.kind} unit, e.g. {channel.key} = '
+                                        f'{{ unit = "{channel.default_unit}" }}') from exc
+
+
+@dataclass(frozen=True)
+class Mapping:
+    """Where one channel comes from.
+
+    Attributes
+    ----------
+    channel : Channel
+    column : str
+        Source column label (its position as text for headerless files).
+    unit : str
+        Source unit as found or assumed.
+    source : str
+        ``"config"``, ``"header"``, ``"units row"``, ``"name suffix"`` or ``"default"``.
+    factor : float
+        Multiplier from the source unit to the canonical unit.
+    """
+
+    channel: Channel
+    column: str
+    unit: str
+    source: str
+    factor: float
+
+
+def _rank(column: str, channel: Channel, extra: tuple[str, ...]) -> tuple[tuple, str | None]:
+    """Match rank of ``column`` for ``channel`` (``()`` = no match) and a unit in its name.
+
+    The canonical name beats any mnemonic; among mnemonics the earlier in the list wins
+    (``[channels]`` extra mnemonics come first), so a file with both HKLD and HKLA maps HKLD.
+    """
+    if column == channel.name:
+        return (3, 0), None
+    names = [normalise(m) for m in extra + channel.mnemonics]
+    base, unit = split_unit(column)
+    if normalise(base) in names:
+        return (2, -names.index(normalise(base))), unit
+    words = str(column).split()
+    head = normalise(" ".join(words[:-1]))
+    if len(words) > 1 and head in names:
+        try:  # a trailing unit word, as in "Average Surface Torque kN.m"
+            factor(words[-1], channel)
+        except InputError:
+            return (), None
+        return (1, -names.index(head)), words[-1]
+    return (), None
+
+
+def _find_column(columns: list[str], channel: Channel, spec: dict,
+                 file: str | None) -> tuple[str | None, str | None]:
+    """The column a channel maps to (from ``[channels]`` or mnemonics) and the unit in its name."""
+    wanted = spec.get("column")
+    if wanted is not None:
+        if isinstance(wanted, int):
+            if not 0 <= wanted < len(columns):
+                raise InputError(f"[channels] {channel.key} column {wanted} does not exist "
+                                 f"(the file has {len(columns)} columns, 0-based)", file=file,
+                                 fix="use a 0-based column index below the column count")
+            return columns[wanted], None
+        if wanted in columns:
+            return wanted, split_unit(wanted)[1]
+        by_base = [c for c in columns if split_unit(c)[0] == wanted]
+        if len(by_base) == 1:
+            return by_base[0], split_unit(by_base[0])[1]
+        raise InputError(f"[channels] {channel.key} column '{wanted}' not found; columns "
+                         f"are: {', '.join(map(str, columns))}", file=file,
+                         fix="use one of the listed column names (or a 0-based index)")
+    extra = tuple(spec.get("mnemonics", ()))
+    ranked = [(rank, col, unit) for col in columns
+              for rank, unit in [_rank(col, channel, extra)] if rank]
+    if not ranked:
+        return None, None
+    best = max(r[0] for r in ranked)
+    top = [r for r in ranked if r[0] == best]
+    if len(top) > 1:
+        names = " and ".join(f"'{r[1]}'" for r in top)
+        raise InputError(f"columns {names} both look like {channel.name}", file=file,
+                         fix=f'choose one in [channels], e.g. {channel.key} = '
+                             f'{{ column = "{top[0][1]}" }}')
+    return top[0][1], top[0][2]
+
+
+def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: dict,
+              spec: dict, file: str | None) -> tuple[str, str]:
+    """Source unit of a mapped column and where it came from (precedence in module doc)."""
+    stated = name_unit or file_units.get(column)
+    stated_source = "header" if name_unit else file_units.get(("source", column), "header")
+    if stated is None and column == channel.name:
+        stated, stated_source = SUFFIX_UNITS[channel.key], "name suffix"
+    configured = spec.get("unit")
+    if configured is not None:
+        if stated is not None and not _same_unit(stated, configured, channel, file):
+            raise InputError(f"inconsistent unit for {channel.name}: column '{column}' says "
+                             f"'{stated}' but [channels] says '{configured}'", file=file,
+                             fix=f"remove unit from [channels] {channel.key} or correct it")
+        return configured, "config"
+    if stated is not None:
+        return stated, stated_source
+    return channel.default_unit, "default"
+
+
+def _same_unit(a: str, b: str, channel: Channel, file: str | None) -> bool:
+    fa, fb = factor(a, channel, file=file), factor(b, channel, file=file)
+    return abs(fa - fb) <= 1e-9 * max(abs(fa), abs(fb))
+
+
+def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
+                 file: str | None = None) -> dict[str, Mapping]:
+    """Match source columns to canonical channels.
+
+    Parameters
+    ----------
+    columns : list of str
+        Source column labels in file order (``"0"``, ``"1"``, … for headerless files).
+    file_units : dict
+        Units the file states per column (``{column: unit}``) plus, optionally,
+        ``{("source", column): "units row"}`` to say where they came from.
+    config_channels : dict
+        The ``[channels]`` table of the configuration (``Config.channels``).
+    file : str, optional
+        File name for messages.
+
+    Returns
+    -------
+    dict
+        ``{channel key: Mapping}`` for every channel found, in :data:`CHANNELS` order.
+
+    Raises
+    ------
+    InputError
+        A required channel is missing (the message lists the columns found and the
+        ``[channels]`` line that would map one), two columns claim one channel, or a unit
+        is unknown, of the wrong kind or inconsistent.
+    """
+    out: dict[str, Mapping] = {}
+    for channel in CHANNELS:
+        spec = config_channels.get(channel.key, {})
+        column, name_unit = _find_column(columns, channel, spec, file)
+        if column is None:
+            if channel.required:
+                raise _missing(channel, columns, [m.column for m in out.values()], file)
+            continue
+        unit, source = _unit_for(channel, column, name_unit, file_units, spec, file)
+        try:
+            scale = factor(unit, channel, file=file)
+        except InputError:
+            if channel.key != "time":
+                raise
+            scale = float("nan")  # e.g. "yyyy-mm-dd hh:mm:ss" over a timestamp column
+        out[channel.key] = Mapping(channel, column, unit, source, scale)
+    return out
+
+
+def _missing(channel: Channel, columns: list[str], used: list[str],
+             file: str | None) -> InputError:
+    free = [c for c in columns if c not in used] or list(columns)
+    headerless = all(str(c).isdigit() for c in columns)
+    if headerless:
+        example = f"{free[0]}" if free else "0"
+    else:
+        close = difflib.get_close_matches(channel.key.replace("_", " "),
+                                          [split_unit(c)[0].lower() for c in free], n=1)
+        pick = next((c for c in free if close and split_unit(c)[0].lower() == close[0]),
+                    free[0] if free else "NAME")
+        example = f'"{pick}"'
+    shown = ", ".join(map(str, columns)) if columns else "(none)"
+    return InputError(f"required channel {channel.name} not found; columns found: {shown}",
+                      file=file, fix=f"map one in the well config, e.g. [channels] {channel.key} = "
+                                     f'{{ column = {example}, unit = "{channel.default_unit}" }}')
+
+
+def mnemonics_markdown() -> str:
+    """The mnemonic table of docs/ingestion.md, rendered from :data:`CHANNELS`."""
+    lines = ["| `[channels]` key | column | unit | default source unit | required | "
+             "mnemonics |", "|---|---|---|---|---|---|"]
+    for c in CHANNELS:
+        names = ", ".join(f"`{m}`" for m in c.mnemonics)
+        lines.append(f"| `{c.key}` | `{c.name}` | {SUFFIX_UNITS[c.key]} | {c.default_unit} | "
+                     f"{'yes' if c.required else ''} | {names} |")
+    return "\n".join(lines)

@@ -1,0 +1,338 @@
+"""Directional-survey readers: CSV (any delimiter), Parquet and the fixed-width Volve text.
+
+A survey is a table of stations: measured depth, inclination and azimuth, optionally with
+the operator's own TVD, north/east offsets and dogleg severity. :func:`read_survey_table`
+returns it in the canonical columns of INTERFACE.md (``md_m, inc_deg, azi_deg`` plus
+``tvd_m, north_m, east_m, dls_deg_30m`` when the file has them), validated, in file order;
+:func:`read_survey` turns it into a :class:`~drillfric.wellpath.WellPath` by minimum
+curvature (THEORY.md §1). The sidecar a pipeline writes and reads is ``NAME.survey.csv``
+with the columns ``md_m,inc_deg,azi_deg`` (:func:`write_survey`).
+
+Recognised layouts
+------------------
+- A header row of column names: ``MD``/``Measured Depth``/``DEPTH``, ``INC``/``Incl``/
+  ``Inclination``, ``AZI``/``Azim``/``Azimuth``, ``TVD``/``TVDKB``, ``Y_Offset_NS``/``NS``/
+  ``North``, ``X_Offset_EW``/``EW``/``East``, ``DLS``; units either in the name
+  (``MD (ft)``, ``MD [m]``, ``md_ft``, ``inc_deg``) or in a units row under the header
+  (``m RKB``, ``deg``, ``deg/30m``). Without a unit, depths are metres and angles degrees.
+- Delimiters ``,`` ``;`` tab ``|`` or runs of spaces (fixed width); ``;``/tab files may use a
+  decimal comma. LF, CRLF and old-Mac CR-only line endings.
+- Parquet with the same column names.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from drillfric.errors import InputError
+from drillfric.units import conversion_factor
+from drillfric.wellpath import WellPath, minimum_curvature
+
+#: Columns of the survey sidecar ``NAME.survey.csv`` (INTERFACE.md).
+SIDECAR_COLUMNS = ("md_m", "inc_deg", "azi_deg")
+
+#: Canonical column -> accepted names, lower-cased with everything but letters and digits
+#: removed (so ``X_Offset_EW``, ``x-offset ew`` and ``XOFFSETEW`` are the same name).
+_ALIASES: dict[str, frozenset[str]] = {
+    "md": frozenset({"md", "measureddepth", "mdepth", "depth", "dept", "dmea", "mdrkb", "mdkb"}),
+    "inc": frozenset({"inc", "incl", "inclination", "dev", "devi", "deviation"}),
+    "azi": frozenset({"azi", "azim", "azimuth", "az", "azm", "hazi", "azit", "azimuthtrue",
+                      "trueazimuth"}),
+    "tvd": frozenset({"tvd", "tvdkb", "tvdrkb", "tvdrt", "tvddf", "trueverticaldepth"}),
+    "north": frozenset({"north", "ns", "nsoffset", "yoffsetns", "northoffset", "localns"}),
+    "east": frozenset({"east", "ew", "ewoffset", "xoffsetew", "eastoffset", "localew"}),
+    "dls": frozenset({"dls", "doglegseverity"}),
+}
+_KIND = {"md": "length", "inc": "angle", "azi": "angle", "tvd": "length", "north": "length",
+         "east": "length", "dls": "dls"}
+_OUT = {"md": "md_m", "inc": "inc_deg", "azi": "azi_deg", "tvd": "tvd_m", "north": "north_m",
+        "east": "east_m", "dls": "dls_deg_30m"}
+_DEFAULT_UNIT = {"length": "m", "angle": "deg", "dls": "deg/30m"}
+_REQUIRED = ("md", "inc", "azi")
+_NULLS = (-999.25, -9999.0, -999.0)
+_TEXT_EXT = {".csv", ".txt", ".tsv", ".dat", ".prn", ".asc"}
+_PARQUET_EXT = {".parquet", ".pq"}
+_FIX_NAMES = "name the columns MD, INC, AZI (or md_m, inc_deg, azi_deg)"
+
+
+def read_survey_table(path) -> pd.DataFrame:
+    """Read a survey file into canonical columns, validated, in file order.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV/text (``.csv .txt .tsv .dat .prn .asc``) or Parquet (``.parquet .pq``) file.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``md_m`` [m], ``inc_deg`` [°], ``azi_deg`` [°], and ``tvd_m``, ``north_m``,
+        ``east_m`` [m], ``dls_deg_30m`` [°/30 m] when the file has them.
+
+    Raises
+    ------
+    InputError
+        Missing, empty or unreadable file; unknown extension; missing columns (the message
+        lists the columns found); unknown units; missing values; depths not strictly
+        increasing; inclination outside 0–180° or azimuth outside 0–360°.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("survey file not found", file=path,
+                         fix="check the path (or the [survey] file key of the config)")
+    ext = path.suffix.lower()
+    if ext in _PARQUET_EXT:
+        names, units, data = _parquet_columns(path)
+    elif ext in _TEXT_EXT:
+        names, units, data = _text_columns(path)
+    else:
+        raise InputError(f"unknown survey file extension '{path.suffix}'", file=path,
+                         fix="give a .csv, .txt or .parquet survey")
+    table = _canonical(names, units, data, path)
+    _validate(table, path)
+    return table
+
+
+def read_survey(path, *, tie_in=None) -> WellPath:
+    """Read a survey file and compute its well path by minimum curvature (THEORY.md §1).
+
+    Parameters
+    ----------
+    path : str or Path
+        Survey file (see :func:`read_survey_table`).
+    tie_in : tuple of float, optional
+        (tvd, north, east) [m] of the first station. Default: the file's own TVD and
+        offsets at the first station when it lists a TVD there (operator surveys such as
+        Volve start below the rotary table at the operator's tie-in point; offsets the file
+        lacks are 0), else a vertical hole above the first station, i.e. (md₀, 0, 0).
+
+    Returns
+    -------
+    WellPath
+    """
+    return wellpath_from_table(read_survey_table(path), tie_in=tie_in)
+
+
+def wellpath_from_table(table: pd.DataFrame, *, tie_in=None) -> WellPath:
+    """Well path of a canonical survey table (see :func:`read_survey` for ``tie_in``)."""
+    if tie_in is None:
+        tie_in = _file_tie_in(table)
+    return minimum_curvature(table["md_m"].to_numpy(float),
+                             np.radians(table["inc_deg"].to_numpy(float)),
+                             np.radians(table["azi_deg"].to_numpy(float)), tie_in=tie_in)
+
+
+def _file_tie_in(table: pd.DataFrame) -> tuple[float, float, float] | None:
+    """(tvd, north, east) the file lists at its first station; missing offsets are 0."""
+    first = table.iloc[0]
+    tvd, north, east = (float(first.get(c, np.nan)) for c in ("tvd_m", "north_m", "east_m"))
+    if not np.isfinite(tvd):
+        return None
+    return tvd, north if np.isfinite(north) else 0.0, east if np.isfinite(east) else 0.0
+
+
+def survey_table_from_frame(frame: pd.DataFrame, *, file=None) -> pd.DataFrame:
+    """Canonical, validated survey table from an in-memory frame (e.g. an HDF5 ``/survey``).
+
+    Column names are recognised as in a file header (units in the name allowed).
+    """
+    names = [str(c) for c in frame.columns]
+    data = [frame[c].to_numpy() for c in frame.columns]
+    table = _canonical(names, [None] * len(names), data, file)
+    _validate(table, file)
+    return table
+
+
+def write_survey(path, well_path: WellPath) -> None:
+    """Write the stations of ``well_path`` as a ``md_m,inc_deg,azi_deg`` CSV sidecar."""
+    pd.DataFrame({"md_m": well_path.md_m, "inc_deg": np.degrees(well_path.inc_rad),
+                  "azi_deg": np.degrees(well_path.azi_rad)}).to_csv(
+        path, index=False, float_format="%.10g")
+
+
+# --------------------------------------------------------------------------------- parsing
+
+def _parquet_columns(path: Path):
+    try:
+        frame = pd.read_parquet(path)
+    except Exception as exc:  # pyarrow raises several types for corrupt files
+        raise InputError(f"cannot read Parquet survey ({type(exc).__name__})", file=path,
+                         fix="re-export the survey as Parquet or CSV") from exc
+    return [str(c) for c in frame.columns], [None] * frame.shape[1], \
+        [frame[c].to_numpy() for c in frame.columns]
+
+
+def _text_columns(path: Path):
+    """Header names, units row (or Nones) and raw string columns of a text survey."""
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
+    lines = [ln for ln in text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+             if ln.strip()]
+    if not lines:
+        raise InputError("survey file is empty", file=path,
+                         fix="export the survey with a header row MD, INC, AZI and its stations")
+    delim = _delimiter(lines[0])
+    header = _split(lines[0], delim)
+    if all(_is_number(f) for f in header):
+        raise InputError("survey file has no header row", file=path,
+                         fix=f"add a header row; {_FIX_NAMES}")
+    units: list[str | None] = [None] * len(header)
+    body = lines[1:]
+    if body and not all(_is_number(f) or not f.strip() for f in _split(body[0], delim)):
+        units = _units_row(lines[0], body[0], delim, len(header))
+        body = body[1:]
+    rows = [_split(ln, delim) for ln in body]
+    cols = []
+    for j in range(len(header)):
+        cols.append(np.array([r[j] if j < len(r) else "" for r in rows], dtype=object))
+    return header, units, cols
+
+
+def _delimiter(line: str) -> str | None:
+    """The delimiter of a header line; ``None`` means runs of whitespace (fixed width)."""
+    counts = {d: line.count(d) for d in (",", ";", "\t", "|")}
+    best = max(counts, key=counts.get)
+    return best if counts[best] else None
+
+
+def _split(line: str, delim: str | None) -> list[str]:
+    if delim is None:
+        return line.split()
+    return [f.strip().strip('"').strip("'") for f in line.split(delim)]
+
+
+def _units_row(header_line: str, units_line: str, delim: str | None, n: int) -> list:
+    """Units under the header; fixed-width units (``m RKB``) are cut at the header columns."""
+    if delim is not None:
+        units = _split(units_line, delim)
+    else:
+        starts = [m.start() for m in re.finditer(r"\S+", header_line)]
+        ends = starts[1:] + [None]
+        units = [units_line[a:b].strip() for a, b in zip(starts, ends, strict=True)]
+    units = (units + [""] * n)[:n]
+    return [u or None for u in units]
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text.replace(",", "."))
+    except ValueError:
+        return False
+    return True
+
+
+def _name_and_unit(name: str) -> tuple[str | None, str | None]:
+    """Canonical key and unit embedded in a column name (``MD (ft)``, ``md_ft``, ``TVD``)."""
+    m = re.fullmatch(r"\s*(.*?)\s*[\[(]\s*(.*?)\s*[\])]\s*", name)
+    if m:
+        return _key(m.group(1)), m.group(2)
+    key = _key(name)
+    if key is not None:
+        return key, None
+    parts = name.strip().split("_")
+    for i in range(len(parts) - 1, 0, -1):
+        key = _key("_".join(parts[:i]))
+        if key is not None:
+            return key, "/".join(parts[i:]) if len(parts) - i > 1 else parts[i]
+    return None, None
+
+
+def _key(name: str) -> str | None:
+    flat = re.sub(r"[^a-z0-9]", "", name.lower())
+    return next((k for k, names in _ALIASES.items() if flat in names), None)
+
+
+# ----------------------------------------------------------------------------- conversion
+
+def _canonical(names, units, data, file) -> pd.DataFrame:
+    found: dict[str, tuple[int, str | None]] = {}
+    for j, name in enumerate(names):
+        key, unit = _name_and_unit(name)
+        if key is not None and key not in found:
+            found[key] = (j, units[j] or unit)
+    missing = [k for k in _REQUIRED if k not in found]
+    if missing:
+        shown = ", ".join(repr(n) for n in names) or "none"
+        raise InputError(f"survey has no {'/'.join(_OUT[k] for k in missing)} column "
+                         f"(columns found: {shown})", file=file, fix=_FIX_NAMES)
+    out = {}
+    for key in _OUT:
+        if key in found:
+            j, unit = found[key]
+            values = _numbers(data[j], names[j], file)
+            out[_OUT[key]] = values * _factor(unit, _KIND[key], names[j], file)
+    return pd.DataFrame(out)
+
+
+def _numbers(column, name: str, file) -> np.ndarray:
+    """Floats of a column; empty cells and the nulls -999.25/-9999/-999 become NaN."""
+    text = pd.Series(column, dtype=object).astype(str).str.strip()
+    text = text.str.replace(",", ".", regex=False)
+    blank = text.isin(["", "nan", "NaN", "None", "<NA>"])
+    values = pd.to_numeric(text.mask(blank), errors="coerce").to_numpy(float, copy=True)
+    bad = np.isnan(values) & ~blank.to_numpy()
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"column '{name}' has a non-numeric value '{text[k]}' at station "
+                         f"{k + 1}", file=file, fix="remove the text from the survey stations")
+    values[np.isin(values, _NULLS)] = np.nan
+    return values
+
+
+def _factor(unit: str | None, kind: str, name: str, file) -> float:
+    """Factor to m (lengths), degrees (angles) or °/30 m (DLS) from the unit spelling."""
+    unit = (unit or _DEFAULT_UNIT[kind]).strip()
+    try:
+        if kind == "length":
+            return conversion_factor(unit.split()[0], "length")
+        if kind == "angle":
+            return float(np.degrees(conversion_factor(unit, "angle")))
+        m = re.fullmatch(r"\s*([^/]+?)\s*/\s*([0-9.]*)\s*([A-Za-z]+)\s*", unit.replace("°", "deg"))
+        if m is None:
+            raise InputError(f"unknown unit '{unit}'")
+        per = float(m.group(2) or 1.0) * conversion_factor(m.group(3), "length")
+        return float(np.degrees(conversion_factor(m.group(1), "angle"))) * 30.0 / per
+    except InputError as exc:
+        raise InputError(f"column '{name}': {exc.problem}", file=file,
+                         fix="use m or ft for depths, deg or rad for angles, deg/30m or "
+                             "deg/100ft for DLS") from exc
+
+
+def _validate(table: pd.DataFrame, file) -> None:
+    if len(table) == 0:
+        raise InputError("survey has no stations", file=file,
+                         fix="export the survey with its stations under the header")
+    if len(table) < 2:
+        raise InputError("survey has a single station", file=file,
+                         fix="give at least two stations (surface and bit depth)")
+    for col in SIDECAR_COLUMNS:
+        nan = np.isnan(table[col].to_numpy())
+        if nan.any():
+            k = int(np.argmax(nan))
+            raise InputError(f"survey station {k + 1} has no {col} value", file=file,
+                             fix="fill or remove the incomplete station")
+    md = table["md_m"].to_numpy()
+    step = np.diff(md)
+    if np.any(step <= 0):
+        k = int(np.argmax(step <= 0)) + 1
+        raise InputError(f"survey depths not increasing at station {k + 1} "
+                         f"(MD {md[k - 1]:g} m then {md[k]:g} m)", file=file,
+                         fix="sort the survey by MD and remove duplicate stations")
+    _check_range(table["inc_deg"].to_numpy(), 180.0, "inclination", file)
+    _check_range(table["azi_deg"].to_numpy(), 360.0, "azimuth", file)
+
+
+def _check_range(values: np.ndarray, top: float, what: str, file) -> None:
+    bad = (values < 0.0) | (values > top)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"{what} {values[k]:g}° at station {k + 1} is outside 0–{top:g}°",
+                         file=file, fix=f"check the {what} column and its unit (degrees "
+                                        "unless the header says rad)")

@@ -1,0 +1,249 @@
+"""Time base of rig surface data: seconds from the first sample, order, duplicates, gaps, rate.
+
+Rig recorders log absolute timestamps (ISO 8601) or elapsed seconds, with jittered spacing,
+repeated rows and outages. Here time becomes ``time_s`` [s] from the first sample (the
+absolute time of ``time_s = 0`` is kept as ``origin`` when known); a timestamp that goes
+backwards is an error naming the row; a row repeating the previous timestamp is dropped
+(the first is kept) and counted; gaps and the nominal rate come from the sample spacing.
+
+:class:`TimeTracker` carries the state across chunks so that a file read in several
+chunks gives exactly the same ``time_s`` as the file read at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from drillfric.errors import InputError
+from drillfric.io.readers import NULL_VALUES
+
+
+@dataclass(frozen=True)
+class TimeBase:
+    """Summary of a well's time base.
+
+    Attributes
+    ----------
+    rows : int
+        Rows kept (after dropping duplicates and rows without a time).
+    t_start_s, t_end_s : float
+        First and last ``time_s`` [s].
+    rate_hz : float
+        Nominal sample rate [Hz]: 1 / median spacing (robust to jitter and gaps);
+        0 for fewer than two rows.
+    gaps : tuple of (float, float)
+        ``(start_s, end_s)`` of every spacing longer than ``max(max_gap_s, 5 / rate_hz)``.
+    duplicates_dropped : int
+        Rows dropped because they repeat the previous row's timestamp.
+    origin : pandas.Timestamp or None
+        Absolute time of ``time_s = 0`` when the file has absolute timestamps.
+    untimed_dropped : int
+        Rows dropped because their time was empty or a null marker.
+    source_start_s : float or None
+        The file's own numeric time of the first sample [s] (``time_s`` starts at 0).
+    """
+
+    rows: int
+    t_start_s: float
+    t_end_s: float
+    rate_hz: float
+    gaps: tuple[tuple[float, float], ...]
+    duplicates_dropped: int
+    origin: pd.Timestamp | None
+    untimed_dropped: int = 0
+    source_start_s: float | None = None
+
+
+def nominal_rate_hz(time_s: np.ndarray) -> float:
+    """Nominal sample rate [Hz] = 1 / median positive spacing (0 below two samples).
+
+    Examples
+    --------
+    >>> nominal_rate_hz(np.array([0.0, 0.9, 2.1, 3.0, 3.9]))
+    1.1111111111111112
+    """
+    dt = np.diff(np.asarray(time_s, dtype=float))
+    dt = dt[dt > 0]
+    return float(1.0 / np.median(dt)) if dt.size else 0.0
+
+
+def find_gaps(time_s: np.ndarray, max_gap_s: float,
+              rate_hz: float) -> tuple[tuple[float, float], ...]:
+    """Spacings longer than ``max(max_gap_s, 5 / rate_hz)`` as ``(start_s, end_s)`` pairs.
+
+    Five nominal periods keep jitter (spacings of 0–2 s at 1 Hz) from counting as gaps.
+
+    Examples
+    --------
+    >>> find_gaps(np.array([0.0, 1.0, 2.0, 30.0, 31.0]), 10.0, 1.0)
+    ((2.0, 30.0),)
+    """
+    time_s = np.asarray(time_s, dtype=float)
+    limit = max(max_gap_s, 5.0 / rate_hz) if rate_hz > 0 else max_gap_s
+    idx = np.flatnonzero(np.diff(time_s) > limit)
+    return tuple((float(time_s[i]), float(time_s[i + 1])) for i in idx)
+
+
+def summarize(time_s: np.ndarray, *, max_gap_s: float, duplicates_dropped: int = 0,
+              untimed_dropped: int = 0, origin: pd.Timestamp | None = None,
+              source_start_s: float | None = None) -> TimeBase:
+    """:class:`TimeBase` of an already checked, increasing ``time_s`` [s]."""
+    time_s = np.asarray(time_s, dtype=float)
+    rate = nominal_rate_hz(time_s)
+    return TimeBase(rows=int(time_s.size),
+                    t_start_s=float(time_s[0]) if time_s.size else 0.0,
+                    t_end_s=float(time_s[-1]) if time_s.size else 0.0,
+                    rate_hz=rate, gaps=find_gaps(time_s, max_gap_s, rate),
+                    duplicates_dropped=duplicates_dropped, origin=origin,
+                    untimed_dropped=untimed_dropped, source_start_s=source_start_s)
+
+
+class TimeTracker:
+    """Turns the time column of successive chunks into checked ``time_s`` [s].
+
+    Parameters
+    ----------
+    factor : float
+        Seconds per unit of a numeric time column (1 for seconds).
+    file, column : str
+        For messages.
+    """
+
+    def __init__(self, factor: float, *, file: str | None = None, column: str = "time"):
+        self.factor = factor
+        self.file = file
+        self.column = column
+        self.origin: pd.Timestamp | None = None
+        self.source_start_s: float | None = None
+        self.duplicates = 0
+        self.untimed = 0
+        self._rows_seen = 0
+        self._last: float | None = None
+        self._absolute: bool | None = None
+
+    def step(self, values: pd.Series) -> tuple[np.ndarray, np.ndarray]:
+        """Check one chunk's time column.
+
+        Returns
+        -------
+        time_s : ndarray
+            Seconds from the first sample for the rows kept.
+        keep : ndarray of bool
+            Which rows of the chunk are kept (time present, not a repeat).
+
+        Raises
+        ------
+        InputError
+            A time that goes backwards (naming its data row) or cannot be read.
+        """
+        seconds = self._seconds(values)
+        valid = np.isfinite(seconds)
+        self.untimed += int((~valid).sum())
+        rows = np.flatnonzero(valid)
+        t = seconds[valid]
+        previous = np.concatenate([[self._last if self._last is not None else -np.inf], t[:-1]])
+        back = np.flatnonzero(t < previous)
+        if back.size:
+            i = back[0]
+            row = self._rows_seen + rows[i] + 1
+            raise InputError(f"time goes backwards at data row {row} ({self._show(t[i])} "
+                             f"after {self._show(previous[i])})", file=self.file,
+                             fix="sort the file by time or remove the out-of-order rows")
+        repeat = t == previous
+        self.duplicates += int(repeat.sum())
+        keep = np.zeros(len(seconds), dtype=bool)
+        keep[rows[~repeat]] = True
+        if t.size:
+            self._last = float(t[-1])
+        self._rows_seen += len(seconds)
+        return seconds[keep], keep
+
+    def _show(self, t: float) -> str:
+        if self.origin is not None:
+            return str(self.origin + pd.Timedelta(seconds=float(t)))
+        return f"{t + (self.source_start_s or 0.0):g} s"
+
+    def _seconds(self, values: pd.Series) -> np.ndarray:
+        """Seconds from the first sample (the origin is set by the first valid value)."""
+        numeric = _as_number(values)
+        absolute = numeric is None or (bool(self._absolute) and bool(np.isnan(numeric).all()))
+        if self._absolute is not None and absolute != self._absolute:
+            raise InputError(f"time column '{self.column}' mixes numbers and timestamps "
+                             f"near data row {self._rows_seen + 1}", file=self.file,
+                             fix="write every time as seconds or every time as a timestamp")
+        self._absolute = absolute
+        if absolute:
+            stamps = self._timestamps(values)
+            if self.origin is None and stamps.notna().any():
+                self.origin = stamps[stamps.notna()].iloc[0]
+            if self.origin is None:
+                return np.full(len(values), np.nan)
+            return ((stamps - self.origin) / pd.Timedelta(seconds=1)).to_numpy(
+                dtype=float, na_value=np.nan)
+        if not np.isfinite(self.factor):
+            raise InputError(f"time column '{self.column}' holds numbers but its unit is not "
+                             "a time unit", file=self.file,
+                             fix='state it in the config: [channels] time = { unit = "s" }')
+        seconds = numeric * self.factor
+        if self.source_start_s is None and np.isfinite(seconds).any():
+            self.source_start_s = float(seconds[np.isfinite(seconds)][0])
+        return seconds - (self.source_start_s or 0.0)
+
+    def _timestamps(self, values: pd.Series) -> pd.Series:
+        if pd.api.types.is_datetime64_any_dtype(values):
+            return values.reset_index(drop=True)
+        text = values.astype("string").str.strip()
+        try:
+            return pd.to_datetime(text, format="ISO8601").reset_index(drop=True)
+        except (ValueError, TypeError):
+            stamps = pd.to_datetime(text, format="ISO8601", errors="coerce")
+            bad = np.flatnonzero(stamps.isna().to_numpy() & _present(text))
+            row = self._rows_seen + (bad[0] if bad.size else 0) + 1
+            shown = text.iloc[bad[0]] if bad.size else ""
+            raise InputError(f"time column '{self.column}': cannot read '{shown}' at data row "
+                             f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
+                             fix="write times as seconds or like 2024-05-01T12:00:00") from None
+
+
+def _as_number(values: pd.Series) -> np.ndarray | None:
+    """Numeric time as float with nulls → NaN, or None when the column holds timestamps."""
+    if pd.api.types.is_datetime64_any_dtype(values):
+        return None
+    if pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values):
+        out = values.to_numpy(dtype=float, na_value=np.nan)
+    else:
+        text = values.astype("string").str.strip()
+        out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+        unread = np.isnan(out) & _present(text)
+        if unread.any():
+            return None
+    out = out.copy()
+    out[np.isin(out, NULL_VALUES)] = np.nan
+    return out
+
+
+def _present(text: pd.Series) -> np.ndarray:
+    """Which entries of a text column hold something (not missing, not blank)."""
+    return (text.fillna("") != "").to_numpy(dtype=bool)
+
+
+def spacing_summary(time_s: np.ndarray) -> dict[str, float]:
+    """Sample spacing statistics [s] (min, 5th percentile, median, 95th percentile, max).
+
+    Shows jitter at a glance: a 1 Hz recorder with 0–2 s spacing has median 1 and a wide
+    5–95 % band. Empty for fewer than two samples.
+
+    Examples
+    --------
+    >>> spacing_summary(np.array([0.0, 1.0, 2.0]))["median"]
+    1.0
+    """
+    dt = np.diff(np.asarray(time_s, dtype=float))
+    if not dt.size:
+        return {}
+    p05, median, p95 = np.percentile(dt, [5, 50, 95])
+    return {"min": float(dt.min()), "p05": float(p05), "median": float(median),
+            "p95": float(p95), "max": float(dt.max())}

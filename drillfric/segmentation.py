@@ -1,0 +1,462 @@
+"""Rig-state classification and segmentation of surface data into rotating stands.
+
+Implements part 1 of the ``drillfric run`` job (issue 6): every sample gets a rig state
+from whatever channels exist, and the rotating stretches are cut into segments (stands,
+sections) that carry their kind (on/off bottom), bit depth, duration and a status. The
+friction estimation of Aarsnes et al. (JPSE 2019) runs per segment: a segment is one
+load case (THEORY.md §2 item 5: bit boundary off bottom, or on bottom with WOB) at one
+string length.
+
+Rules and thresholds (config table ``[segmentation]``) are documented in
+docs/segmentation.md; the agreement with published rig-state labels is in
+docs/parts/validation_segmentation.md.
+
+The classifier is causal (each sample depends on the past only, through a small carried
+state) and segments depend only on the samples between two non-rotating samples or time
+gaps, so :class:`Segmenter` reproduces :func:`segment` exactly on data fed in chunks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numba import njit
+
+from drillfric.config import Config
+from drillfric.errors import InputError
+
+#: Rig states, coded by their position (``np.int8``). ``sliding_on_bottom`` (on bottom with
+#: the pumps on but no surface rotation: motor drilling) is drillfric's addition.
+RIG_STATES = ("rotating_off_bottom", "rotating_on_bottom", "in_slips", "tripping", "idle",
+              "unknown", "sliding_on_bottom")
+(ROTATING_OFF_BOTTOM, ROTATING_ON_BOTTOM, IN_SLIPS, TRIPPING, IDLE, UNKNOWN,
+ SLIDING_ON_BOTTOM) = range(len(RIG_STATES))
+#: States that make hole ("drilling"): on bottom, rotating or sliding.
+DRILLING_STATES = (ROTATING_ON_BOTTOM, SLIDING_ON_BOTTOM)
+#: Segment kind of each rotating state (INTERFACE.md ``kind`` values).
+KINDS = {ROTATING_OFF_BOTTOM: "off_bottom_rotating", ROTATING_ON_BOTTOM: "on_bottom_rotating"}
+
+#: How the bit depth is known: measured channel, reckoned from the block, or not at all.
+_DEPTH_CHANNEL, _DEPTH_BLOCK, _DEPTH_NONE = 0, 1, 2
+#: Time constant of the first-order smoothing of the bit speed [s].
+_SPEED_TAU_S = 5.0
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One rotating stretch of the record (a stand or part of one).
+
+    Attributes
+    ----------
+    id : int
+        Running number, 1-based, in time order.
+    kind : str
+        ``"off_bottom_rotating"`` or ``"on_bottom_rotating"``.
+    t_start_s, t_end_s : float
+        Times of the first and the last sample of the segment [s].
+    i_start, i_end : int
+        Row indices of the input, ``i_end`` exclusive.
+    bit_depth_m : float
+        Median bit depth over the segment [m] (NaN when the depth is not known).
+    bit_depth_min_m, bit_depth_max_m : float
+        Range of the bit depth over the segment [m] (NaN when not known).
+    duration_s : float
+        ``t_end_s - t_start_s`` [s].
+    status : str
+        ``"ok"`` or ``"skipped"``.
+    message : str
+        Why the segment is skipped ("" when ok).
+    """
+
+    id: int
+    kind: str
+    t_start_s: float
+    t_end_s: float
+    i_start: int
+    i_end: int
+    bit_depth_m: float
+    bit_depth_min_m: float
+    bit_depth_max_m: float
+    duration_s: float
+    status: str
+    message: str
+
+
+# ----------------------------------------------------------------------------------------
+# Classification
+
+
+@njit(cache=True)
+def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_N, pumps,
+                     depth_mode, rotating_rpm, slips_N, on_bottom_m, wob_on_N, trip_m_s,
+                     max_rop_m_s, carry):  # pragma: no cover - compiled; see classify()
+    """Causal per-sample rig state; updates ``carry`` in place (see :func:`classify`).
+
+    ``carry`` = [previous time, previous block position, previous bit depth, hole depth,
+    started flag, smoothed downward bit speed]; ``pumps`` is 1 on, 0 off, -1 unknown.
+    """
+    n = time_s.size
+    states = np.empty(n, np.int8)
+    bit_out = np.empty(n)
+    t_prev, block_prev, bit_prev = carry[0], carry[1], carry[2]
+    hole, have_prev, v_down = carry[3], carry[4], carry[5]
+    for i in range(n):
+        in_slips = hookload_N[i] < slips_N  # False for NaN hook load or no threshold (NaN)
+        bit = bit_prev
+        if depth_mode == _DEPTH_CHANNEL:
+            if not np.isnan(bit_in_m[i]):
+                bit = bit_in_m[i]
+        elif depth_mode == _DEPTH_BLOCK:
+            if not np.isnan(block_m[i]):
+                # the string moves with the block only while it hangs from the hook
+                if not np.isnan(block_prev) and not in_slips:
+                    bit = bit + block_prev - block_m[i]
+                block_prev = block_m[i]
+        dt = time_s[i] - t_prev
+        if have_prev > 0 and dt > 0.0 and not np.isnan(bit) and not np.isnan(bit_prev):
+            # first-order smoothing of the bit speed (time jitter, depth quantisation)
+            v_down += ((bit - bit_prev) / dt - v_down) * min(1.0, dt / _SPEED_TAU_S)
+        if depth_mode != _DEPTH_NONE:
+            if depth_mode == _DEPTH_CHANNEL and not np.isnan(hole_in_m[i]):
+                hole = hole_in_m[i]
+            elif np.isnan(hole) or bit > hole:
+                hole = bit
+        if depth_mode != _DEPTH_NONE and not np.isnan(bit):
+            # going down faster than any drilling: running into hole that was already there
+            on_bottom = hole - bit <= on_bottom_m and v_down <= max_rop_m_s
+        else:
+            on_bottom = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
+        if np.isnan(rpm[i]) or np.isnan(time_s[i]):
+            state = UNKNOWN
+        elif in_slips:
+            state = IN_SLIPS
+        elif rpm[i] > rotating_rpm:
+            state = ROTATING_ON_BOTTOM if on_bottom else ROTATING_OFF_BOTTOM
+        elif on_bottom and pumps[i] != 0:
+            state = SLIDING_ON_BOTTOM  # pumps on, or not recorded
+        elif abs(v_down) > trip_m_s:
+            state = TRIPPING
+        else:
+            state = IDLE
+        states[i] = state
+        bit_out[i] = bit
+        if not np.isnan(time_s[i]):
+            t_prev = time_s[i]
+            have_prev = 1.0
+        bit_prev = bit
+    carry[0], carry[1], carry[2] = t_prev, block_prev, bit_prev
+    carry[3], carry[4], carry[5] = hole, have_prev, v_down
+    return states, bit_out
+
+
+def _column(frame: pd.DataFrame, name: str) -> np.ndarray:
+    """Column as float64, or all-NaN when the channel is not recorded."""
+    if name in frame:
+        return frame[name].to_numpy(dtype=float)
+    return np.full(len(frame), np.nan)
+
+
+def _pumps(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
+    """Pumps on (1), off (0) or not known (-1), from flow in, pump rate, else SPP."""
+    for column, key in (("flow_in_m3_s", "pumps_on_m3_s"), ("pump_rate_spm", "pumps_on_spm"),
+                        ("standpipe_pressure_Pa", "pumps_on_Pa")):
+        if column in frame:
+            values = frame[column].to_numpy(dtype=float)
+            on = np.where(values > cfg[f"segmentation.{key}"], 1, 0).astype(np.int8)
+            on[np.isnan(values)] = -1
+            return on
+    return np.full(len(frame), -1, np.int8)
+
+
+def _depth_mode(frame: pd.DataFrame) -> int:
+    if "bit_depth_m" in frame:
+        return _DEPTH_CHANNEL
+    if "block_position_m" in frame:
+        return _DEPTH_BLOCK
+    return _DEPTH_NONE
+
+
+def _new_carry(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
+    start = cfg["segmentation.start_bit_depth_m"]
+    bit0 = 0.0 if _depth_mode(frame) == _DEPTH_BLOCK else np.nan
+    if start is not None and _depth_mode(frame) == _DEPTH_BLOCK:
+        bit0 = start
+    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0])
+
+
+def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
+    """States and bit depth [m] of a chunk, continuing from ``carry`` (updated)."""
+    missing = [name for name in ("time_s", "surface_rpm") if name not in frame]
+    if missing:
+        raise InputError(f"no {' or '.join(missing)} channel to segment",
+                         fix="map the time and surface speed columns in [channels]")
+    slips = cfg["segmentation.slips_hookload_N"]
+    states, bit = _classify_kernel(
+        _column(frame, "time_s"), _column(frame, "surface_rpm"),
+        _column(frame, "hookload_N"), _column(frame, "bit_depth_m"),
+        _column(frame, "hole_depth_m"), _column(frame, "block_position_m"),
+        _column(frame, "wob_N"), _pumps(frame, cfg), _depth_mode(frame),
+        float(cfg["segmentation.rotating_rpm"]), np.nan if slips is None else float(slips),
+        float(cfg["segmentation.on_bottom_m"]), float(cfg["segmentation.wob_on_bottom_N"]),
+        float(cfg["segmentation.trip_speed_m_s"]),
+        float(cfg["segmentation.max_rop_m_h"]) / 3600.0, carry)
+    absolute = (_depth_mode(frame) == _DEPTH_CHANNEL
+                or cfg["segmentation.start_bit_depth_m"] is not None)
+    return states, bit if absolute else np.full(len(frame), np.nan)
+
+
+def classify(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
+    """Rig state of every sample (codes into :data:`RIG_STATES`).
+
+    Rules, in order of precedence (thresholds from ``cfg["segmentation.*"]``, see
+    docs/segmentation.md):
+
+    1. ``unknown`` when the surface speed is null;
+    2. ``in_slips`` when hook load < ``slips_hookload_N`` (string weight off the hook);
+    3. rotating (``surface_rpm`` > ``rotating_rpm``): ``rotating_on_bottom`` when on bottom,
+       else ``rotating_off_bottom``;
+    4. not rotating: ``sliding_on_bottom`` when on bottom with the pumps on (or pumps not
+       recorded), ``tripping`` when the smoothed bit speed exceeds ``trip_speed_m_s``,
+       else ``idle``.
+
+    On bottom means hole depth − bit depth ≤ ``on_bottom_m`` while the bit does not go down
+    faster than ``max_rop_m_h`` (bit speed smoothed to first order, time constant
+    :data:`_SPEED_TAU_S`). The bit depth is the
+    ``bit_depth_m`` channel, else it is reckoned from ``block_position_m`` (the bit moves
+    with the block except while in the slips); the hole depth is ``hole_depth_m``, else
+    the running maximum of the bit depth. Without either depth channel, on bottom means
+    ``wob_N`` > ``wob_on_bottom_N``; with neither, rotating samples count as off bottom.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Canonical surface channels (SI): ``time_s``, ``surface_rpm`` [RPM] and any of
+        ``surface_torque_Nm``, ``hookload_N``, ``bit_depth_m``, ``hole_depth_m``,
+        ``wob_N``, ``block_position_m``, ``standpipe_pressure_Pa``, ``flow_in_m3_s``,
+        ``pump_rate_spm`` (NaN for nulls).
+    cfg : Config
+        Configuration (table ``[segmentation]``).
+
+    Returns
+    -------
+    numpy.ndarray of int8
+        State code per sample.
+    """
+    return _classify(frame, cfg, _new_carry(frame, cfg))[0]
+
+
+# ----------------------------------------------------------------------------------------
+# Segmentation
+
+
+def _pieces(t: np.ndarray, states: np.ndarray, max_gap_s: float) -> list[tuple[int, int]]:
+    """Row ranges [start, end) of rotating stretches, split at long gaps and null runs.
+
+    A stretch is a run of rotating or unknown samples; it is split where consecutive
+    samples are more than ``max_gap_s`` apart and where a run of unknown samples lasts
+    more than ``max_gap_s`` (between the rotating samples around it). Unknown samples at
+    either end are trimmed; bridged unknown samples stay inside (the segment is then
+    skipped for nulls).
+    """
+    rotating = (states == ROTATING_OFF_BOTTOM) | (states == ROTATING_ON_BOTTOM)
+    rot_idx = np.flatnonzero(rotating)
+    if rot_idx.size == 0:
+        return []
+    known_other = ~rotating & (states != UNKNOWN)
+    # between consecutive rotating samples: cut if a known non-rotating sample lies between,
+    # or the time between them exceeds max_gap_s (gap or long null run)
+    n_other = np.concatenate(([0], np.cumsum(known_other)))
+    between_other = n_other[rot_idx[1:]] - n_other[rot_idx[:-1] + 1] > 0
+    with np.errstate(invalid="ignore"):
+        too_far = t[rot_idx[1:]] - t[rot_idx[:-1]] > max_gap_s
+    cut = np.flatnonzero(between_other | too_far)
+    starts = np.concatenate(([rot_idx[0]], rot_idx[cut + 1]))
+    ends = np.concatenate((rot_idx[cut] + 1, [rot_idx[-1] + 1]))
+    return list(zip(starts.tolist(), ends.tolist(), strict=True))
+
+
+def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int, int, bool]]:
+    """Cut one piece into runs of constant kind with a minimum dwell (hysteresis).
+
+    ``on`` is the on-bottom flag per sample (unknown samples already carry the previous
+    flag). Runs shorter than ``dwell_s`` (first to last sample, plus one sample interval)
+    take the kind of the run before them (the first run: of the run after it); then equal
+    neighbours merge. Returns (start, end, on_bottom) with indices relative to the piece.
+    """
+    change = np.flatnonzero(on[1:] != on[:-1]) + 1
+    bounds = np.concatenate(([0], change, [on.size]))
+    runs = [[int(a), int(b), bool(on[a])] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    if len(runs) == 1:
+        return [tuple(runs[0])]
+    dt = np.diff(t)
+    step = float(np.median(dt)) if dt.size else 0.0
+
+    def duration(run):
+        return t[run[1] - 1] - t[run[0]] + step
+
+    for k, run in enumerate(runs):
+        if duration(run) < dwell_s:
+            run[2] = runs[k - 1][2] if k > 0 else None
+    # leading short runs take the kind of the first long run (or stay as they are)
+    first_kind = next((r[2] for r in runs if r[2] is not None), bool(on[0]))
+    merged: list[list] = []
+    for run in runs:
+        kind = first_kind if run[2] is None else run[2]
+        if merged and merged[-1][2] == kind:
+            merged[-1][1] = run[1]
+        else:
+            merged.append([run[0], run[1], kind])
+    return [tuple(r) for r in merged]
+
+
+def _status(duration_s: float, n_null: dict[str, int], min_s: float) -> tuple[str, str]:
+    nulls = [f"{name} ({count} samples)" for name, count in n_null.items() if count]
+    if nulls:
+        return "skipped", "nulls in " + ", ".join(nulls)
+    if duration_s < min_s:
+        return "skipped", f"too short: {duration_s:.0f} s < {min_s:.0f} s"
+    return "ok", ""
+
+
+def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) -> list[Segment]:
+    """Segments of a block of samples (row indices shifted by ``offset``)."""
+    dwell = float(cfg["segmentation.kind_dwell_s"])
+    min_s = float(cfg["segmentation.min_segment_s"])
+    on = pd.Series(np.where(states == ROTATING_ON_BOTTOM, 1.0,
+                            np.where(states == ROTATING_OFF_BOTTOM, 0.0, np.nan)))
+    on = on.ffill().to_numpy() > 0.5  # unknown samples keep the previous kind
+    out: list[Segment] = []
+    for a, b in _pieces(t, states, float(cfg["segmentation.max_gap_s"])):
+        for ra, rb, on_bottom in _kind_runs(t[a:b], on[a:b], dwell):
+            i0, i1 = a + ra, a + rb
+            depth = bit[i0:i1]
+            finite = depth[np.isfinite(depth)]
+            t0, t1 = float(t[i0]), float(t[i1 - 1])
+            n_null = {name: int(np.count_nonzero(mask[i0:i1])) for name, mask in nulls.items()}
+            status, message = _status(t1 - t0, n_null, min_s)
+            out.append(Segment(
+                id=first_id + len(out),
+                kind=KINDS[ROTATING_ON_BOTTOM if on_bottom else ROTATING_OFF_BOTTOM],
+                t_start_s=t0, t_end_s=t1, i_start=offset + i0, i_end=offset + i1,
+                bit_depth_m=float(np.median(finite)) if finite.size else float("nan"),
+                bit_depth_min_m=float(finite.min()) if finite.size else float("nan"),
+                bit_depth_max_m=float(finite.max()) if finite.size else float("nan"),
+                duration_s=t1 - t0, status=status, message=message))
+    return out
+
+
+def _nulls(frame: pd.DataFrame) -> dict[str, np.ndarray]:
+    """Null masks of the channels the estimation needs."""
+    return {name: np.isnan(_column(frame, name))
+            for name in ("surface_rpm", "surface_torque_Nm") if name in frame}
+
+
+def segment(frame: pd.DataFrame, cfg: Config, *, states: np.ndarray | None = None
+            ) -> list[Segment]:
+    """Cut the rotating stretches of a record into segments (stands, sections).
+
+    A segment is a maximal run of rotating samples (``rotating_off_bottom`` /
+    ``rotating_on_bottom``), split where rotation stops (any other known state), where
+    consecutive samples are more than ``max_gap_s`` apart, where nulls of the surface speed
+    last longer than ``max_gap_s``, and where the kind (on/off bottom) changes for at least
+    ``kind_dwell_s`` (shorter excursions keep the current kind). Segments with nulls in the
+    surface speed or torque, or shorter than ``min_segment_s``, are kept with status
+    ``"skipped"`` and the reason.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Canonical surface channels (see :func:`classify`).
+    cfg : Config
+        Configuration (table ``[segmentation]``).
+    states : numpy.ndarray, optional
+        Precomputed :func:`classify` output (the bit depth is still reckoned here).
+
+    Returns
+    -------
+    list of Segment
+        In time order, ids from 1.
+    """
+    computed, bit = _classify(frame, cfg, _new_carry(frame, cfg))
+    if states is not None and len(states) != len(frame):
+        raise ValueError(f"states has {len(states)} values for {len(frame)} rows")
+    states = computed if states is None else np.asarray(states, dtype=np.int8)
+    return _segments(_column(frame, "time_s"), states, bit, _nulls(frame), cfg, 0, 1)
+
+
+class Segmenter:
+    """Streaming :func:`segment`: feed chunks of rows, get segments as they complete.
+
+    The classifier carries its state across chunks, and only the rows after the last
+    point where no later data can change a segment (a known non-rotating sample or a time
+    gap longer than ``max_gap_s``) are kept, so the segments are identical to
+    ``segment(pd.concat(chunks), cfg)`` while memory stays bounded by the longest rotating
+    stretch.
+
+    Parameters
+    ----------
+    cfg : Config
+        Configuration (table ``[segmentation]``).
+
+    Examples
+    --------
+    Rotation from t = 20 s to t = 79 s, fed in two chunks:
+
+    >>> from drillfric.config import load_config
+    >>> rpm = np.r_[np.zeros(20), np.full(60, 60.0), np.zeros(20)]
+    >>> frame = pd.DataFrame({"time_s": np.arange(100.0), "surface_rpm": rpm,
+    ...                       "surface_torque_Nm": 100.0 * rpm})
+    >>> seg = Segmenter(load_config())
+    >>> done = seg.feed(frame.iloc[:50]) + seg.feed(frame.iloc[50:]) + seg.close()
+    >>> [(s.kind, s.i_start, s.i_end, s.duration_s, s.status) for s in done]
+    [('off_bottom_rotating', 20, 80, 59.0, 'ok')]
+    """
+
+    def __init__(self, cfg: Config):
+        self._cfg = cfg
+        self._carry: np.ndarray | None = None
+        self._buffer: dict[str, np.ndarray] = {}
+        self._offset = 0  # row index of the first buffered row
+        self._next_id = 1
+
+    def feed(self, chunk: pd.DataFrame) -> list[Segment]:
+        """Consume the next rows; return the segments completed by them (maybe none)."""
+        if self._carry is None:
+            self._carry = _new_carry(chunk, self._cfg)
+        states, bit = _classify(chunk, self._cfg, self._carry)
+        new = {"t": _column(chunk, "time_s"), "states": states, "bit": bit}
+        new.update({f"null:{k}": v for k, v in _nulls(chunk).items()})
+        self._buffer = {k: np.concatenate((self._buffer[k], v)) if self._buffer else v
+                        for k, v in new.items()}
+        return self._emit(final=False)
+
+    def close(self) -> list[Segment]:
+        """Return the segments still open at the end of the data."""
+        return self._emit(final=True)
+
+    def _safe_cut(self) -> int:
+        """Last buffer index before which no later data can change a segment."""
+        t, states = self._buffer["t"], self._buffer["states"]
+        rotating = (states == ROTATING_OFF_BOTTOM) | (states == ROTATING_ON_BOTTOM)
+        other = np.flatnonzero(~rotating & (states != UNKNOWN))
+        with np.errstate(invalid="ignore"):
+            gaps = np.flatnonzero(np.diff(t) > self._cfg["segmentation.max_gap_s"]) + 1
+        candidates = np.concatenate((other, gaps))
+        return int(candidates.max()) if candidates.size else 0
+
+    def _emit(self, final: bool) -> list[Segment]:
+        if not self._buffer:
+            return []
+        cut = len(self._buffer["t"]) if final else self._safe_cut()
+        if cut == 0:
+            return []
+        part = {k: v[:cut] for k, v in self._buffer.items()}
+        nulls = {k.split(":", 1)[1]: v for k, v in part.items() if k.startswith("null:")}
+        out = _segments(part["t"], part["states"], part["bit"], nulls, self._cfg,
+                        self._offset, self._next_id)
+        self._next_id += len(out)
+        self._offset += cut
+        self._buffer = {k: v[cut:] for k, v in self._buffer.items()}
+        return out

@@ -1,0 +1,136 @@
+"""`drillfric inspect`: the table, --json keys of INTERFACE.md, and one-line errors (exit 2)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import h5py
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+GOOD = "TIME,SRPM,STOR [kN.m],HKLD [klbf]\n0,60,10,100\n0.2,61,11,101\n0.4,62,-999.25,102\n"
+
+
+def _inspect(*args):
+    return CliRunner().invoke(cli, ["inspect", *map(str, args)])
+
+
+@pytest.fixture
+def good(tmp_path) -> Path:
+    (tmp_path / "w.csv").write_text(GOOD)
+    return tmp_path / "w.csv"
+
+
+def test_table(good):
+    result = _inspect(good)
+    assert result.exit_code == 0, result.output
+    out = result.output
+    for text in ("surface_torque_Nm", "STOR [kN.m]", "kN.m", "1 (33.3%)", "rows       3",
+                 "5 Hz nominal", "survey     none", "segments   1 rotating: 0 usable"):
+        assert text in out
+
+
+def test_json_keys(good):
+    result = _inspect(good, "--json")
+    doc = json.loads(result.output)
+    assert {"channels", "rows", "t_start_s", "t_end_s", "rate_hz", "gaps", "survey"} <= set(doc)
+    assert doc["channels"]["surface_rpm"]["column"] == "SRPM"
+    assert doc["channels"]["surface_torque_Nm"]["unit"] == "kN.m"
+    assert doc["channels"]["hookload_N"]["max"] == pytest.approx(102 * 4448.2216152605)
+    assert (doc["rows"], doc["t_start_s"], doc["gaps"], doc["survey"]) == (3, 0.0, [], None)
+    assert doc["t_end_s"] == pytest.approx(0.4) and doc["rate_hz"] == pytest.approx(5.0)
+    # 0.4 s of rotation at 60 RPM: one rotating segment, too short to estimate.
+    assert [(g["kind"], g["status"]) for g in doc["segments"]] == [
+        ("off_bottom_rotating", "skipped")]
+
+
+def test_json_survey_summary(good, tmp_path):
+    pytest.importorskip("drillfric.io.survey")
+    (tmp_path / "w.survey.csv").write_text("md_m,inc_deg,azi_deg\n0,0,0\n800,10,0\n1200,20,0\n")
+    doc = json.loads(_inspect(good, "--json").output)
+    assert doc["survey"]["stations"] == 3 and doc["survey"]["md_max_m"] == 1200.0
+
+
+def test_dsats_acceptance(real_data):
+    path = real_data / "dsats_1hz" / "SampleData1.csv"
+    result = _inspect(path, "--config", EXAMPLES / "dsats_1hz.toml")
+    assert result.exit_code == 0, result.output
+    lines = {ln.split()[0]: ln for ln in result.output.splitlines() if ln.strip()}
+    assert "ft.lbf" in lines["surface_torque_Nm"] and "N.m" in lines["surface_torque_Nm"]
+    assert "klbf" in lines["hookload_N"] and "1458 (2.9%)" in lines["hookload_N"]
+    assert "1 Hz nominal" in lines["rate"] and "0.31–1.69 s" in lines["rate"]
+    doc = json.loads(_inspect(path, "--config", EXAMPLES / "dsats_1hz.toml", "--json").output)
+    assert doc["channels"]["surface_torque_Nm"]["null_count"] == 1458
+
+
+# ------------------------------------------------------------------ bad input → exit 2
+def _bad_cases(tmp_path):
+    """(name, path, extra args, text expected in the one-line message)."""
+    cases = []
+    (tmp_path / "empty.csv").write_text("")
+    cases.append(("empty", "empty.csv", [], "file is empty"))
+    cases.append(("missing", "nope.csv", [], "file not found"))
+    (tmp_path / "w.xlsx").write_text("x")
+    cases.append(("extension", "w.xlsx", [], "unknown file extension '.xlsx'"))
+    (tmp_path / "notorque.csv").write_text("TIME,RPM,HOOK\n0,1,2\n1,1,2\n")
+    cases.append(("channel", "notorque.csv", [], "[channels] surface_torque = { column = "))
+    (tmp_path / "unit.csv").write_text("TIME,RPM,TORQUE [blorps]\n0,1,2\n1,1,2\n")
+    cases.append(("unknown unit", "unit.csv", [], "unknown unit 'blorps'"))
+    (tmp_path / "kind.csv").write_text("TIME,RPM,TORQUE [klbf]\n0,1,2\n1,1,2\n")
+    cases.append(("wrong-kind unit", "kind.csv", [], "is not a torque unit"))
+    (tmp_path / "incons.csv").write_text("TIME,RPM,TORQUE [kN.m]\n0,1,2\n1,1,2\n")
+    (tmp_path / "incons.toml").write_text('[channels]\nsurface_torque = { unit = "ft.lbf" }\n')
+    cases.append(("inconsistent unit", "incons.csv", [], "inconsistent unit"))
+    (tmp_path / "back.csv").write_text("TIME,RPM,TORQUE\n0,1,2\n1,1,2\n0.5,1,2\n")
+    cases.append(("backwards", "back.csv", [], "time goes backwards at data row 3"))
+    frame = pd.DataFrame({"time_s": [0.0, 1.0], "surface_rpm": [1.0, 1.0],
+                          "surface_torque_Nm": [1.0, 1.0]})
+    pq.write_table(pa.Table.from_pandas(frame), tmp_path / "t.parquet")
+    data = (tmp_path / "t.parquet").read_bytes()
+    (tmp_path / "t.parquet").write_bytes(data[:-20])
+    cases.append(("truncated parquet", "t.parquet", [], "truncated or corrupt"))
+    frame.to_hdf(tmp_path / "t.h5", key="surface", format="table")
+    data = (tmp_path / "t.h5").read_bytes()
+    (tmp_path / "t.h5").write_bytes(data[: len(data) // 3])
+    cases.append(("truncated hdf5", "t.h5", [], "truncated or corrupt"))
+    with h5py.File(tmp_path / "nosurf.h5", "w") as h5:
+        h5["a"], h5["b"] = [1.0], [2.0]
+    cases.append(("hdf5 without /surface", "nosurf.h5", [], "no '/surface' table"))
+    (tmp_path / "ok.csv").write_text(GOOD)
+    (tmp_path / "badkey.toml").write_text("[fluid]\nmud_densty = 1.0\n")
+    cases.append(("unknown config key", "ok.csv", ["--config", tmp_path / "badkey.toml"],
+                  "unknown key 'fluid.mud_densty'"))
+    (tmp_path / "badtype.toml").write_text('[fluid]\nmud_density_kg_m3 = "heavy"\n')
+    cases.append(("config key type", "ok.csv", ["--config", tmp_path / "badtype.toml"],
+                  "must be a number"))
+    (tmp_path / "chan.toml").write_text('[channels]\ntorque = { column = "STOR" }\n')
+    cases.append(("unknown channel key", "ok.csv", ["--config", tmp_path / "chan.toml"],
+                  "unknown channel 'torque'"))
+    cases.append(("missing config", "ok.csv", ["--config", tmp_path / "none.toml"],
+                  "config file not found"))
+    return cases
+
+
+def test_every_bad_input_is_one_line_exit_2(tmp_path):
+    for name, file, extra, expected in _bad_cases(tmp_path):
+        result = _inspect(tmp_path / file, *extra)
+        message = result.output.strip()
+        assert result.exit_code == 2, (name, result.output)
+        assert "Traceback" not in result.output and len(message.splitlines()) == 1, name
+        assert expected in message, (name, message)
+        named = str(tmp_path / file) if "--config" not in extra else str(extra[1])
+        assert named in message or "command line" in message, (name, message)
+
+
+def test_bad_survey_through_inspect(good, tmp_path):
+    pytest.importorskip("drillfric.io.survey")
+    (tmp_path / "s.csv").write_text("md_m,inc_deg,azi_deg\n0,0,0\n500,200,0\n")
+    result = _inspect(good, "--survey", tmp_path / "s.csv")
+    assert result.exit_code == 2 and "s.csv" in result.output
+    assert len(result.output.strip().splitlines()) == 1
