@@ -1,14 +1,27 @@
-"""`drillfric report` (INTERFACE.md) — not built yet."""
+"""`drillfric report RESULT_DIR [--pdf]` (INTERFACE.md): rebuild the reports of a result dir.
+
+Thin layer over :func:`drillfric.report.write_well_report`, which reads only the files of
+the result directory (so reports can be rebuilt after an upgrade, or with a PDF later).
+"""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
-from .common import UserError
+from .common import echo
 
 
-@click.command("report", context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def command(args) -> None:
-    """Not built yet."""
-    raise UserError("'drillfric report' is not built yet in this version")
+@click.command("report")
+@click.argument("result_dir", type=click.Path(path_type=Path))
+@click.option("--pdf/--no-pdf", default=False, show_default=True,
+              help="Also write report.pdf (matplotlib only, a page per section).")
+def command(result_dir: Path, pdf: bool) -> None:
+    """Rebuild report.html (and report.pdf) of RESULT_DIR, an OUT/NAME of 'drillfric run'."""
+    from drillfric.report import write_well_report
+
+    html = write_well_report(result_dir, pdf=pdf)
+    echo(f"report: {html}")
+    if pdf:
+        echo(f"report: {html.with_name('report.pdf')}")

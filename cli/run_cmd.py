@@ -1,14 +1,90 @@
-"""`drillfric run` (INTERFACE.md) — not built yet."""
+"""`drillfric run` — the main job (INTERFACE.md): friction factors per stand + report."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
-from .common import UserError
+from drillfric.errors import DrillfricError
+
+from .common import UserError, context, echo, progress, warn
 
 
-@click.command("run", context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def command(args) -> None:
-    """Not built yet."""
-    raise UserError("'drillfric run' is not built yet in this version")
+def parse_starts(text: str | None) -> list[tuple[float, float]] | None:
+    """``"0.3:0.2,0.6:0.4"`` → [(0.3, 0.2), (0.6, 0.4)] (μ_s:μ_k pairs)."""
+    if not text:
+        return None
+    try:
+        pairs = [tuple(float(v) for v in item.split(":")) for item in text.split(",")]
+    except ValueError:
+        pairs = []
+    if not pairs or any(len(p) != 2 or p[1] > p[0] or p[1] < 0 for p in pairs):
+        raise UserError(f"--starts '{text}' must be MU_S:MU_K pairs with 0 ≤ MU_K ≤ MU_S, "
+                        "e.g. --starts 0.3:0.2,0.6:0.4")
+    return pairs
+
+
+def _fmt(value, spec=".3f") -> str:
+    return "—" if value is None else format(value, spec)
+
+
+def _describe(result) -> str:
+    s = result.summary
+    c = s["counts"]
+    mu_s = _fmt(s["mu_s"]) if s["mu_s"] is not None else (
+        f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
+        else "not identifiable")
+    return (f"{result.name}: {c['segments']} segments ({c['estimated']} estimated, "
+            f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed); "
+            f"μ_k = {_fmt(s['mu_k'])}, μ_s = {mu_s}")
+
+
+@click.command("run")
+@click.argument("wells", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--out", "out", type=click.Path(path_type=Path), default=Path("drillfric-out"),
+              show_default=True, help="Output directory; each well goes to OUT/NAME.")
+@click.option("--config", type=click.Path(path_type=Path), help="Well configuration (TOML), "
+              "overrides the NAME.toml sidecar.")
+@click.option("--survey", type=click.Path(path_type=Path), help="Survey file, overrides the "
+              "NAME.survey.* sidecar.")
+@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation.")
+@click.option("--starts", help="Observer starts MU_S:MU_K,... (overrides observer.starts).")
+@click.option("--pdf/--no-pdf", default=False, help="Also write report.pdf.")
+@click.option("--workers", type=int, default=1, show_default=True,
+              help="Wells processed in parallel (local processes).")
+def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
+    """Estimate friction factors (μ_s, μ_k) and bit speed, stand by stand, for each WELL.
+
+    WELL is a data file (.parquet, .csv, .h5, .las) with optional NAME.toml and
+    NAME.survey.csv sidecars, an HDF5 bundle, or a directory with well.toml.
+    """
+    from drillfric.pipeline import run_well
+
+    if rate is not None and rate <= 0:
+        raise UserError(f"--rate must be positive, got {rate}")
+    if workers < 1:
+        raise UserError(f"--workers must be at least 1, got {workers}")
+    pairs = parse_starts(starts)
+    failures = 0
+    unreadable = 0
+    for well in wells:
+        try:
+            with progress(f"{well.name}", total=1.0) as advance:
+                result = run_well(well, out, config=config, survey=survey, rate_hz=rate,
+                                  starts=pairs, pdf=pdf, progress=advance)
+        except DrillfricError as exc:
+            if context().debug or len(wells) == 1:
+                raise
+            click.secho(f"error: {exc.message}", err=True, fg="red")
+            unreadable += 1
+            continue
+        for note in result.summary["assumed"]:
+            warn(f"{result.name}: assumed {note} — the numbers are indicative")
+        echo(_describe(result))
+        echo(f"report: {result.report}")
+        failures += result.failed
+    if unreadable == len(wells):
+        raise UserError("no well could be read")
+    if failures or unreadable:
+        raise SystemExit(1)

@@ -1,14 +1,135 @@
-"""`drillfric simulate` (INTERFACE.md) — not built yet."""
+"""`drillfric simulate` (INTERFACE.md): synthetic surface data with ground truth.
+
+Thin layer: options become configuration overrides (command line > file > defaults), the
+survey and scenario are resolved, :func:`drillfric.simulate.simulate` runs the plant stand
+by stand, :func:`drillfric.io.writers.write_well` writes the data file and its sidecars.
+"""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 
-from .common import UserError
+from .common import echo, progress, warn
 
 
-@click.command("simulate", context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def command(args) -> None:
-    """Not built yet."""
-    raise UserError("'drillfric simulate' is not built yet in this version")
+def _overrides(**options) -> dict:
+    keys = {"duration": "simulate.duration_s", "rate": "simulate.rate_hz",
+            "mu_s": "simulate.mu_s", "mu_k": "simulate.mu_k",
+            "bit_depth": "simulate.bit_depth_m", "rpm": "simulate.rpm", "seed": "simulate.seed",
+            "rpm_noise": "simulate.rpm_noise", "torque_noise": "simulate.torque_noise_Nm",
+            "wob": "simulate.wob_N", "cells": "simulate.cells"}
+    return {keys[k]: v for k, v in options.items() if v is not None}
+
+
+def _load(config: Path, overrides: dict, omega_c_rpm: float | None):
+    from drillfric.config import load_config, read_toml
+
+    cfg = load_config(config, overrides=overrides)
+    if omega_c_rpm is not None:
+        key = "model.omega_c_rpm" if cfg["model.omega_c_rpm"] is not None or \
+            cfg["model.omega_c_rad_s"] is None else "model.omega_c_rad_s"
+        from drillfric.units import RPM_TO_RAD_S
+
+        value = omega_c_rpm if key.endswith("rpm") else omega_c_rpm * RPM_TO_RAD_S
+        cfg = load_config(config, overrides=overrides | {key: value})
+    return cfg, read_toml(config)
+
+
+def _survey(config: Path, raw: dict, survey: Path | None):
+    from drillfric.io.survey import read_survey
+
+    name = raw.get("survey", {}).get("file")
+    path = survey if survey is not None else (None if name is None else config.parent / name)
+    return path, None if path is None else read_survey(path)
+
+
+def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool):
+    """The scenario file (--scenario, else the config's), or one stand.
+
+    ``single`` (--bit-depth given without --scenario) ignores the config's scenario.
+    """
+    from drillfric import simulate as sim
+    from drillfric.errors import ConfigError
+
+    name = None if single else cfg["simulate.scenario"]
+    path = scenario if scenario is not None else (None if name is None
+                                                  else config.parent / name)
+    base = sim.base_stand(cfg)
+    if path is not None:
+        return path, sim.load_scenario(path, base)
+    depth = cfg["simulate.bit_depth_m"]
+    if depth is None:
+        if well_path is None:
+            raise ConfigError("no bit depth: give --bit-depth, simulate.bit_depth_m, a survey "
+                              "or a scenario", file=config)
+        depth = well_path.md_max_m
+    return None, sim.single_stand(cfg, depth)
+
+
+@click.command("simulate")
+@click.argument("config", type=click.Path(path_type=Path))
+@click.option("--out", "out", required=True, type=click.Path(path_type=Path),
+              help="Output data file: .parquet, .csv, .h5 or .hdf5 (sidecars written beside).")
+@click.option("--duration", type=float, help="Simulated seconds of a single stand "
+              "(with --scenario: default rotating time of each stand).")
+@click.option("--rate", type=float, help="Recording rate [Hz] (default 100).")
+@click.option("--mu-s", type=float, help="True static friction factor.")
+@click.option("--mu-k", type=float, help="True kinetic friction factor.")
+@click.option("--omega-c-rpm", type=float, help="Static/kinetic switching speed ω_c [RPM].")
+@click.option("--bit-depth", type=float, help="Bit depth of a single stand [m] "
+              "(default: simulate.bit_depth_m, else the end of the survey); without "
+              "--scenario it overrides the configuration's scenario.")
+@click.option("--rpm", type=float, help="Surface speed set-point after the ramp [RPM].")
+@click.option("--wob", type=float, help="Weight on bit of a single stand [N] (> 0: on bottom).")
+@click.option("--seed", type=int, help="Seed of the measurement noise.")
+@click.option("--rpm-noise", type=float, help="Gaussian surface-speed noise [RPM].")
+@click.option("--torque-noise", type=float, help="Gaussian torque noise [N·m].")
+@click.option("--cells", type=int, help="Cells of the simulated (true) string model "
+              "(default simulate.cells = 2500).")
+@click.option("--scenario", type=click.Path(path_type=Path),
+              help="Scenario TOML of several stands (docs/simulator.md).")
+@click.option("--survey", type=click.Path(path_type=Path),
+              help="Survey file (overrides the configuration's [survey] file).")
+def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bit_depth, rpm,
+            wob, seed, rpm_noise, torque_noise, cells, scenario, survey) -> None:
+    """Simulate surface data with ground truth from the torsional plant (THEORY §3).
+
+    Writes OUT with time_s, surface_rpm, surface_torque_Nm, hookload_N, bit_depth_m,
+    hole_depth_m, bit_rpm and string_torque_Nm (noise-free truth), plus OUT's sidecars
+    NAME.toml, NAME.survey.csv and NAME.truth.json, so that `drillfric run OUT` reads it
+    directly.
+    """
+    import pandas as pd
+
+    from drillfric import simulate as sim
+    from drillfric.io.writers import data_format, write_well
+    from drillfric.wellpath import vertical
+
+    data_format(out)
+    overrides = _overrides(duration=duration, rate=rate, mu_s=mu_s, mu_k=mu_k,
+                           bit_depth=bit_depth, rpm=rpm, seed=seed, rpm_noise=rpm_noise,
+                           torque_noise=torque_noise, wob=wob, cells=cells)
+    cfg, raw = _load(config, overrides, omega_c_rpm)
+    survey_path, well_path = _survey(config, raw, survey)
+    _, plan = _scenario(cfg, config, scenario, well_path,
+                        single=bit_depth is not None and scenario is None)
+    sim.check_depths(plan, well_path, survey_path)
+    with progress("simulating", plan.total_s) as advance:
+        result = sim.simulate(cfg, well_path, plan, progress=advance)
+    for note in result.notes:
+        warn(note)
+    well_path = well_path or vertical(max(s.bit_depth_m for s in plan.stands))
+    keep = tuple(p for p in (config, survey_path) if p is not None)
+    written = write_well(out, pd.DataFrame(result.columns), config=cfg.to_dict(),
+                         survey=well_path, truth=result.truth(), keep=keep)
+    rows = len(result.columns["time_s"])
+    echo(f"wrote {out}: {rows} rows, {plan.total_s:.0f} s at {result.rate_hz:g} Hz, "
+         f"{len(plan.stands)} stand(s), μ_s = {result.settings.mu_s:g}, "
+         f"μ_k = {result.settings.mu_k:g}")
+    for s in result.stands:
+        echo(f"  stand {s.index}: bit {s.bit_depth_m:g} m, {s.start} to {s.rpm:g} RPM, "
+             f"T_N = {s.T_N_Nm / 1e3:.1f} kN·m, bit stuck {100 * s.bit_stuck_fraction:.0f} % "
+             f"of the rotating time")
+    echo("sidecars: " + ", ".join(str(p) for k, p in written.items() if k != "data"))

@@ -149,8 +149,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             min=0.0, max=2.0),
     ),
     "observer": (
-        Key("gains", str, "backstepping", "", "Gain design: closed-form 'backstepping' "
-            "(THEORY §5.1) or steady-state 'kalman'.", choices=("backstepping", "kalman")),
+        Key("gains", str, "kalman", "", "Gain design: steady-state 'kalman' (default; far less "
+            "driven by measurement noise, docs/validation.md) or the closed-form "
+            "'backstepping' of THEORY §5.1.", choices=("backstepping", "kalman")),
         Key("law", str, "corrected", "", "Adaptation law: 'corrected' (drillfric) or 'paper' "
             "(eqs. 42–43 exactly as printed, for comparison).", choices=("corrected", "paper")),
         Key("kappa1", float, 1.0, "", "Fraction κ₁ of the top-side reflection cancelled.",
@@ -165,10 +166,23 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "(default, one sample of lag) or 'hold' (the paper's zero-order hold).",
             choices=("linear", "hold")),
         _positive("output_rate_hz", 10.0, "Hz", "Rate of estimates.parquet rows."),
+        _positive("starts_window_s", 300.0, "s", "The starts run together over this first part "
+                  "of each segment (they converge within it); the seeded pass covers all."),
+        _positive("deadlock_s", 15.0, "s", "Deadlock guard: an estimated BHA stuck this long "
+                  "while the top drive turns releases μ̂_s to μ̂_k (THEORY §6.1)."),
+    ),
+    "batch": (
+        _positive("window_s", 600.0, "s", "The batch refinement (THEORY §6.4) fits the first "
+                  "this-many seconds of each segment (the mean-torque match needs minutes; "
+                  "creep start-ups are at the start)."),
     ),
     "segmentation": (
-        _positive("rotating_rpm", 5.0, "RPM", "Surface speed above which the string counts "
-                  "as rotating."),
+        _positive("rotating_rpm", 2.0, "RPM", "Surface speed above which the string starts "
+                  "to count as rotating."),
+        _positive("rotating_stop_rpm", 1.0, "RPM", "Surface speed below which rotation ends "
+                  "(hysteresis: noise at standstill does not chatter; a creep stays whole)."),
+        _positive("min_rotation_s", 2.0, "s", "Rotation shorter than this is speed noise and "
+                  "not listed as a segment at all."),
         _positive("min_segment_s", 30.0, "s", "Shortest rotating segment that is estimated; "
                   "shorter ones are kept as 'skipped'."),
         _positive("on_bottom_m", 0.5, "m", "Bit within this distance of hole depth counts "
@@ -210,6 +224,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             min=0.0),
         Key("torque_noise_Nm", float, 0.0, "N·m", "Gaussian noise on the recorded torque.",
             min=0.0),
+        Key("cells", int, 2500, "", "Cells of the simulated (true) string: finer than the "
+            "estimator's model.cells, since creep torque is not grid-converged on coarse "
+            "grids (THEORY §6.4: dx ≤ MD/1000).", min=20, max=200000),
         _positive("duration_s", 120.0, "s", "Simulated time of a single-stand run; with a "
                   "scenario, the rotating time of stands that do not give their own."),
         _positive("rate_hz", 100.0, "Hz", "Recording rate of the simulated surface data."),

@@ -90,18 +90,22 @@ class Segment:
 
 @njit(cache=True)
 def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_N, pumps,
-                     depth_mode, rotating_rpm, slips_N, on_bottom_m, wob_on_N, trip_m_s,
-                     max_rop_m_s, carry):  # pragma: no cover - compiled; see classify()
+                     depth_mode, rotating_rpm, stop_rpm, slips_N, on_bottom_m, wob_on_N,
+                     trip_m_s, max_rop_m_s, carry):  # pragma: no cover - compiled; see classify()
     """Causal per-sample rig state; updates ``carry`` in place (see :func:`classify`).
 
     ``carry`` = [previous time, previous block position, previous bit depth, hole depth,
-    started flag, smoothed downward bit speed]; ``pumps`` is 1 on, 0 off, -1 unknown.
+    started flag, smoothed downward bit speed, rotating latch]; ``pumps`` is 1 on, 0 off,
+    -1 unknown. Rotation has hysteresis: it starts above ``rotating_rpm`` and lasts until
+    the speed drops below ``stop_rpm`` (speed noise at standstill does not chatter, and a
+    slow creep start-up stays inside its segment).
     """
     n = time_s.size
     states = np.empty(n, np.int8)
     bit_out = np.empty(n)
     t_prev, block_prev, bit_prev = carry[0], carry[1], carry[2]
     hole, have_prev, v_down = carry[3], carry[4], carry[5]
+    turning = carry[6] > 0
     for i in range(n):
         in_slips = hookload_N[i] < slips_N  # False for NaN hook load or no threshold (NaN)
         bit = bit_prev
@@ -128,11 +132,13 @@ def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_
             on_bottom = hole - bit <= on_bottom_m and v_down <= max_rop_m_s
         else:
             on_bottom = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
+        if not np.isnan(rpm[i]):
+            turning = rpm[i] > (stop_rpm if turning else rotating_rpm)
         if np.isnan(rpm[i]) or np.isnan(time_s[i]):
             state = UNKNOWN
         elif in_slips:
             state = IN_SLIPS
-        elif rpm[i] > rotating_rpm:
+        elif turning:
             state = ROTATING_ON_BOTTOM if on_bottom else ROTATING_OFF_BOTTOM
         elif on_bottom and pumps[i] != 0:
             state = SLIDING_ON_BOTTOM  # pumps on, or not recorded
@@ -148,6 +154,7 @@ def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_
         bit_prev = bit
     carry[0], carry[1], carry[2] = t_prev, block_prev, bit_prev
     carry[3], carry[4], carry[5] = hole, have_prev, v_down
+    carry[6] = 1.0 if turning else 0.0
     return states, bit_out
 
 
@@ -183,7 +190,7 @@ def _new_carry(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
     bit0 = 0.0 if _depth_mode(frame) == _DEPTH_BLOCK else np.nan
     if start is not None and _depth_mode(frame) == _DEPTH_BLOCK:
         bit0 = start
-    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0])
+    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0, 0.0])
 
 
 def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
@@ -198,7 +205,10 @@ def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
         _column(frame, "hookload_N"), _column(frame, "bit_depth_m"),
         _column(frame, "hole_depth_m"), _column(frame, "block_position_m"),
         _column(frame, "wob_N"), _pumps(frame, cfg), _depth_mode(frame),
-        float(cfg["segmentation.rotating_rpm"]), np.nan if slips is None else float(slips),
+        float(cfg["segmentation.rotating_rpm"]),
+        min(float(cfg["segmentation.rotating_stop_rpm"]),
+            float(cfg["segmentation.rotating_rpm"])),
+        np.nan if slips is None else float(slips),
         float(cfg["segmentation.on_bottom_m"]), float(cfg["segmentation.wob_on_bottom_N"]),
         float(cfg["segmentation.trip_speed_m_s"]),
         float(cfg["segmentation.max_rop_m_h"]) / 3600.0, carry)
@@ -335,6 +345,8 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
             finite = depth[np.isfinite(depth)]
             t0, t1 = float(t[i0]), float(t[i1 - 1])
             n_null = {name: int(np.count_nonzero(mask[i0:i1])) for name, mask in nulls.items()}
+            if t1 - t0 < float(cfg["segmentation.min_rotation_s"]):
+                continue  # a blip of speed noise, not rotation
             status, message = _status(t1 - t0, n_null, min_s)
             out.append(Segment(
                 id=first_id + len(out),
@@ -431,6 +443,12 @@ class Segmenter:
         self._buffer = {k: np.concatenate((self._buffer[k], v)) if self._buffer else v
                         for k, v in new.items()}
         return self._emit(final=False)
+
+    @property
+    def pending_from(self) -> int:
+        """Row index of the first row not yet assigned to an emitted segment (rows before it
+        are final and may be dropped by the caller)."""
+        return self._offset
 
     def close(self) -> list[Segment]:
         """Return the segments still open at the end of the data."""

@@ -1,0 +1,653 @@
+"""Batch refinement of the friction factors (the "speed-driven fit"), THEORY.md §6.4.
+
+The plant of THEORY §3 is driven at x = 0 by the measured top-drive speed (lightly
+smoothed, interpolated to the model step), α(0) = 2ω₀(t) − β(0), starting at rest with no
+twist; its output is the string torque at the top τ(0) = ζ(ω₀ − β(0)), compared with the
+measured string torque τ_s = τ_m − I_TD dω̄₀/dt. From that model:
+
+- μ_k matches the **mean** string torque over the rotating samples (the first 30 s after
+  the top drive first exceeds ω_c in each rotating run are left out; data and model each
+  averaged over whole torque cycles) by a secant root find with a bounded slope that
+  returns a point it evaluated (the mean jitters between runs because stick-slip is
+  chaotic), with the model in the data's regime (§6.4);
+- μ_s is fitted only where the data hold it, on creep start-ups logged at ≥ 2 Hz
+  (:mod:`drillfric.creep`, §6.3): a bounded 1-D minimisation of the smoothed torque misfit
+  over the creep at Δx ≤ MD/1000, refitted with twice (then four times) the cells and
+  reported only once it moves less than 3 %;
+- otherwise μ_s is not identifiable; in stick-slip a lower bound comes from the stick-slip
+  onset, the highest μ_s of a 0.02 grid below which the model's bit never sticks, and none
+  is given where sticking is not monotone in μ_s ("bistable_regime", §6.2, §6.4).
+
+Only the needed parts of a record are simulated: each rotating run (from just before its
+start) for μ_k, the first 90 s of rotation of one run for the onset scan, and each creep
+(from the preceding rest) for μ_s. Everything is SI (rad/s, N·m, m, s).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+from scipy.signal import savgol_filter
+
+from drillfric import torsional
+from drillfric.creep import find_creeps, rotating_runs, smooth
+from drillfric.drillstring import DrillString
+from drillfric.errors import InputError
+
+MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
+PRE_ROLL_S = 2.0  #: model starts this long before a run or creep leaves rest [s]
+DRIVE_SMOOTH_S = 0.2  #: light smoothing of the speed that drives the model [s]
+TORQUE_SMOOTH_S = 1.0  #: smoothing of torques compared in the creep misfit [s]
+CREEP_DRIVE_SMOOTH_S = 4.0  #: smoothing of the speed driving a creep (keeps its angle) [s]
+STICK_SLIP_FLUCTUATION = 0.1  #: data stick-slip when std/mean of the smoothed torque exceeds
+STUCK_FRACTION = 0.01  #: the model's bit sticks when this share of samples is near rest
+REST_BIT = 0.1  #: the bit is near rest below this fraction of ω_c
+SCAN_STEP = 0.02  #: μ_s grid step of the onset scan (THEORY §6.4)
+SCAN_CONFIRM = 3  #: grid points above the first sticking one that must stick too
+SCAN_ROTATION_S = 90.0  #: rotation simulated per onset-scan point (30 s skipped + 60 s) [s]
+MU_MAX = 1.5  #: upper end of every friction search [-]
+CREEP_CELLS_PER_MD = 1000  #: creep fits at Δx ≤ MD/1000 (THEORY §6.4)
+CREEP_CONVERGENCE = 0.03  #: relative move allowed when the creep fit doubles its cells
+CREEP_MAX_S = 60.0  #: longest creep window fitted [s]
+CREEP_LEVELS = 3  #: creep fits at MD/1000, then doubled cells at most twice
+CREEP_STENCIL = 0.04  #: relative half-width of the parabola of a creep refit
+#: Slowest logging rate for a creep fit [Hz]: the twist is the integral of the logged speed,
+#: and its noise (σ√(Δt·T)) moved μ_s by +17…+33 % at 1 Hz with 0.5 RPM noise, ±6 % at 5 Hz
+#: (docs/parts/validation_batch.md).
+MIN_CREEP_RATE_HZ = 2.0
+PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
+MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
+_GRID_SPREAD = 0.05  # make_grid may take up to 5 % fewer cells than requested (rounding)
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Friction factors of one record from the speed-driven fit (THEORY §6.4).
+
+    Attributes
+    ----------
+    mu_k : float or None
+        Kinetic friction factor [-] (None without usable rotation).
+    mu_k_method : str
+        "mean_torque".
+    mu_s : float or None
+        Static friction factor [-], a number only where the data identify it.
+    mu_s_identifiable : bool
+    mu_s_lower_bound : float or None
+        Lower bound on μ_s from the stick-slip onset [-], where the data support one.
+    mu_s_method : str
+        "creep_fit", "stick_slip_onset" or "none".
+    creep_segments : tuple of (float, float)
+        Creeps used for μ_s, (t_start_s, t_end_s) [s].
+    flags : tuple of str
+        e.g. "bistable_regime", "creep_not_grid_converged", "mu_k_not_converged",
+        "no_rotation", "rotation_too_short", "regime_mismatch", "creep_fit_at_bound",
+        "creep_rate_too_low", "stick_slip_not_reproduced".
+    runs : int
+        Model runs spent.
+    messages : tuple of str
+        One line per notable decision, for the report.
+    details : dict
+        Traces: residuals of the μ_k search, the onset scan, the creep fits, T_N, cells.
+    """
+
+    mu_k: float | None
+    mu_k_method: str
+    mu_s: float | None
+    mu_s_identifiable: bool
+    mu_s_lower_bound: float | None
+    mu_s_method: str
+    creep_segments: tuple[tuple[float, float], ...]
+    flags: tuple[str, ...]
+    runs: int
+    messages: tuple[str, ...]
+    details: dict = field(default_factory=dict)
+
+
+def measured_string_torque(time_s, surface_rad_s, torque_Nm, torque_kind: str,
+                           top_drive_inertia_kg_m2: float, smooth_s: float = 1.0) -> np.ndarray:
+    """String torque at the top from the logged torque [N·m] (THEORY §3 top drive, §6.4).
+
+    τ_s = τ_m − I_TD·dω̄₀/dt for a motor torque (eq. 7 of the paper), with ω̄₀ the top-drive
+    speed smoothed over ``smooth_s`` (a Savitzky–Golay derivative: least-squares quadratic
+    over the window, exact for ramps, also at the ends); a logged string torque is returned
+    unchanged.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s], increasing.
+    surface_rad_s : array_like
+        Top-drive speed ω₀ [rad/s].
+    torque_Nm : array_like
+        Logged surface torque [N·m].
+    torque_kind : str
+        "motor" or "string" (``rig.torque_kind``).
+    top_drive_inertia_kg_m2 : float
+        I_TD [kg·m²].
+    smooth_s : float
+        Smoothing of ω₀ before differentiating [s].
+
+    Examples
+    --------
+    >>> t = [0.0, 1.0, 2.0, 3.0]
+    >>> measured_string_torque(t, [0.0, 1.0, 2.0, 3.0], [10.0] * 4, "motor", 2.0, 0.0).tolist()
+    [8.0, 8.0, 8.0, 8.0]
+    """
+    tau = np.array(torque_Nm, dtype=float)
+    if torque_kind == "string":
+        return tau
+    if torque_kind != "motor":
+        raise InputError(f"unknown torque kind '{torque_kind}'",
+                         fix="set rig.torque_kind to 'motor' or 'string'")
+    t = np.asarray(time_s, dtype=float)
+    w = np.asarray(surface_rad_s, dtype=float)
+    dt = float(np.median(np.diff(t)))
+    n = int(round(smooth_s / dt)) // 2 * 2 + 1
+    if n < 5 or n > t.size:
+        return tau - top_drive_inertia_kg_m2 * np.gradient(w, t)
+    dw = savgol_filter(w, n, polyorder=2, deriv=1, delta=dt, mode="interp")
+    return tau - top_drive_inertia_kg_m2 * dw
+
+
+@dataclass(frozen=True)
+class _Data:
+    """A record on a uniform time base, with the series the fits compare."""
+
+    t: np.ndarray  # [s]
+    dt: float  # [s]
+    drive: np.ndarray  # lightly smoothed ω₀ [rad/s]
+    creep_drive: np.ndarray  # ω₀ smoothed over CREEP_DRIVE_SMOOTH_S [rad/s]
+    w_bar: np.ndarray  # ω₀ smoothed over TORQUE_SMOOTH_S [rad/s]
+    tau: np.ndarray  # measured string torque [N·m]
+    tau_bar: np.ndarray  # smoothed string torque [N·m]
+
+    def index(self, t_s: float) -> int:
+        return int(np.clip(np.searchsorted(self.t, t_s - 1e-9 * self.dt), 0, self.t.size - 1))
+
+
+def _prepare(time_s, surface_rad_s, torque_Nm, torque_kind, itd) -> tuple[_Data, list[str]]:
+    t = np.asarray(time_s, dtype=float)
+    w = np.asarray(surface_rad_s, dtype=float)
+    tau = np.asarray(torque_Nm, dtype=float)
+    if t.ndim != 1 or w.shape != t.shape or tau.shape != t.shape:
+        raise InputError("batch refinement needs equal-length time, speed and torque series")
+    ok = np.isfinite(t) & np.isfinite(w) & np.isfinite(tau)
+    t, w, tau = t[ok], w[ok], tau[ok]
+    if t.size < 3 or np.any(np.diff(t) <= 0):
+        raise InputError("batch refinement needs at least 3 samples at increasing times",
+                         fix="sort the record by time and drop duplicate samples")
+    notes = [] if ok.all() else [f"{int((~ok).sum())} samples with missing values dropped"]
+    dt = float(np.median(np.diff(t)))
+    if np.max(np.abs(np.diff(t) - dt)) > 0.01 * dt:
+        grid = t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt)) + 1)
+        w, tau, t = np.interp(grid, t, w), np.interp(grid, t, tau), grid
+        notes.append(f"irregular sampling resampled to {1 / dt:g} Hz")
+    tau_s = measured_string_torque(t, w, tau, torque_kind, itd, TORQUE_SMOOTH_S)
+    data = _Data(t=t, dt=dt, drive=smooth(w, dt, DRIVE_SMOOTH_S),
+                 creep_drive=smooth(w, dt, CREEP_DRIVE_SMOOTH_S),
+                 w_bar=smooth(w, dt, max(TORQUE_SMOOTH_S, 3 * dt)), tau=tau_s,
+                 tau_bar=smooth(tau_s, dt, TORQUE_SMOOTH_S))
+    return data, notes
+
+
+@dataclass(frozen=True)
+class _Window:
+    """Simulate samples [sim0, end] from rest; compare over ``used`` (sample indices)."""
+
+    sim0: int
+    end: int
+    used: np.ndarray
+    creep: bool = False  # driven by the creep-smoothed speed
+
+
+class _Model:
+    """The speed-driven plant on grids of any resolution; counts its runs (THEORY §6.4)."""
+
+    def __init__(self, string, fc_fn, omega_c, k_t, itd, data: _Data, progress):
+        self.string, self.fc_fn, self.data = string, fc_fn, data
+        self.omega_c, self.k_t, self.itd = omega_c, k_t, itd
+        self.progress = progress
+        self.runs = 0
+        self._grids: dict[int, tuple[torsional.Grid, np.ndarray]] = {}
+
+    def grid(self, cells: int) -> tuple[torsional.Grid, np.ndarray]:
+        if cells not in self._grids:
+            g = torsional.make_grid(self.string, cells)
+            fc = np.broadcast_to(np.asarray(self.fc_fn(g.x_m), dtype=float), g.x_m.shape)
+            self._grids[cells] = (g, np.ascontiguousarray(fc))
+        return self._grids[cells]
+
+    def t_n(self, cells: int) -> float:
+        g, fc = self.grid(cells)
+        return float(np.sum(fc * g.dx_true_m))
+
+    def simulate(self, win: _Window, mu_s: float, mu_k: float,
+                 cells: int) -> tuple[np.ndarray, np.ndarray]:
+        """String torque [N·m] and bit speed [rad/s] at samples sim0..end."""
+        d = self.data
+        g, fc = self.grid(cells)
+        plant = torsional.Plant(g, fc, mu_s=mu_s, mu_k=mu_k, omega_c_rad_s=self.omega_c,
+                                k_t_per_s=self.k_t, top_drive_inertia_kg_m2=self.itd)
+        speed = d.creep_drive if win.creep else d.drive
+        drive = torsional.Drive("speed", speed[win.sim0:win.end + 1], d.dt, d.t[win.sim0])
+        t = d.t[win.sim0:win.end + 1]
+        rec, _ = torsional.run(plant, drive, t[-1] - t[0], 1.0 / d.dt,
+                               torsional.State.rest(g, float(t[0])))
+        self.runs += 1
+        if self.progress is not None:
+            self.progress(1.0)
+        return (np.interp(t, rec.time_s, rec.string_torque_Nm),
+                np.interp(t, rec.time_s, rec.bit_rad_s))
+
+
+def _fluctuation(tau_bar: np.ndarray) -> float:
+    """std/|mean| of a smoothed torque: the stick-slip measure of the data [-]."""
+    mean = abs(float(np.mean(tau_bar)))
+    return float(np.std(tau_bar)) / mean if mean > 0 else 0.0
+
+
+def _sticks(bit_rad_s: np.ndarray, omega_c: float) -> bool:
+    """Whether the model's bit sticks: a share of samples near rest (THEORY §6.4)."""
+    return bool(np.mean(np.abs(bit_rad_s) <= REST_BIT * omega_c) >= STUCK_FRACTION)
+
+
+def _mu_k_windows(data: _Data, omega_c: float) -> tuple[list[_Window], list[str]]:
+    """One window per rotating run with samples ≥ MU_K_SKIP_S after first exceeding ω_c."""
+    pre = int(round(PRE_ROLL_S / data.dt))
+    wins, notes = [], []
+    for i0, i1 in rotating_runs(data.w_bar, omega_c):
+        fast = np.flatnonzero(data.w_bar[i0:i1 + 1] > omega_c)
+        if fast.size == 0:
+            continue
+        first = data.index(data.t[i0 + fast[0]] + MU_K_SKIP_S)
+        if first >= i1:
+            notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s shorter than "
+                         f"{MU_K_SKIP_S:.0f} s after reaching ω_c: not used for μ_k")
+            continue
+        wins.append(_Window(max(0, i0 - pre), i1, np.arange(first, i1 + 1)))
+    return wins, notes
+
+
+def _secant(residual: Callable[[float], float], x0: float, slope0: float, lo: float,
+            hi: float, tol: float) -> tuple[float, float, list[tuple[float, float]]]:
+    """Root of a jittery monotone residual by secant steps with a bounded slope.
+
+    The slope is kept within [0.5, 2]·``slope0`` so that jitter cannot throw a step far
+    away; the point returned is the evaluated one with the smallest |residual| (§6.4).
+    """
+    trace = [(x0, residual(x0))]
+    slope = slope0
+    while len(trace) < MU_K_MAX_RUNS and abs(trace[-1][1]) > tol:
+        x, r = trace[-1]
+        x_new = float(np.clip(x - r / slope, lo, hi))
+        if x_new == x:
+            break
+        trace.append((x_new, residual(x_new)))
+        secant = (trace[-1][1] - r) / (x_new - x)
+        slope = float(np.clip(secant, 0.5 * slope0, 2.0 * slope0))
+    best = min(trace, key=lambda p: abs(p[1]))
+    return best[0], best[1], trace
+
+
+def whole_cycles(tau_Nm, dt_s: float) -> slice:
+    """Samples spanning whole torque cycles: from the first to the last upward crossing of
+    the 1-s smoothed torque through its mean (all samples with fewer than two crossings).
+
+    A mean over a fractional number of stick-slip cycles carries up to half a cycle's swing
+    divided by the cycle count; cutting both ends at the same phase removes that term
+    (it cut the jitter of the model's mean from 150 to 60 N·m on 49-s windows, §6.4).
+
+    Examples
+    --------
+    >>> x = np.sin(np.linspace(0.0, 5.5 * np.pi, 100))  # 2.75 cycles: 2 whole ones
+    >>> s = whole_cycles(x, 1.0)
+    >>> (s.start, s.stop)
+    (1, 73)
+    """
+    x = np.asarray(tau_Nm, dtype=float)
+    xb = smooth(x, dt_s, TORQUE_SMOOTH_S)
+    up = np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
+    return slice(int(up[0]), int(up[-1])) if up.size >= 2 else slice(0, x.size)
+
+
+def _cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
+    """Mean over the whole cycles of each window, pooled [N·m]."""
+    return float(np.mean(np.concatenate([x[whole_cycles(x, dt_s)] for x in series])))
+
+
+def _pooled_mean(model: _Model, wins: list[_Window], mu_s: float, mu_k: float,
+                 cells: int) -> tuple[float, np.ndarray]:
+    """Whole-cycle mean model torque over the used samples of all windows, and the bits'
+    speeds there."""
+    taus, bits = [], []
+    for w in wins:
+        tau, bit = model.simulate(w, mu_s, mu_k, cells)
+        taus.append(tau[w.used - w.sim0])
+        bits.append(bit[w.used - w.sim0])
+    return _cycle_mean(taus, model.data.dt), np.concatenate(bits)
+
+
+def _fit_mu_k(model: _Model, wins, target_Nm: float, mu_s_of: Callable[[float], float],
+              x0: float, cells: int) -> tuple[float, float, list, bool]:
+    """μ_k matching the mean torque; returns (μ_k, residual, trace, model bit sticks)."""
+    t_n = model.t_n(cells)
+    sticks = {}
+
+    def residual(mu_k: float) -> float:
+        mean, bit = _pooled_mean(model, wins, max(mu_s_of(mu_k), mu_k), mu_k, cells)
+        sticks[mu_k] = _sticks(bit, model.omega_c)
+        return mean - target_Nm
+
+    tol = max(0.01 * abs(target_Nm), 50.0)  # the chaotic jitter of the mean (§6.4)
+    mu_k, res, trace = _secant(residual, x0, t_n, 1e-3, MU_MAX, tol)
+    return mu_k, res, trace, sticks[mu_k]
+
+
+def _onset_scan(model: _Model, win: _Window, mu_k: float,
+                cells: int) -> tuple[float | None, bool, list]:
+    """Lower bound on μ_s from the stick-slip onset (THEORY §6.2, §6.4).
+
+    Scans μ_s = μ_k + 0.02 j upward until the model's bit sticks, then checks that the next
+    :data:`SCAN_CONFIRM` points stick too. Returns (bound, bistable, scan): the bound is the
+    highest grid value at which the model does not stick (μ_k itself when the first point
+    sticks), None when sticking is not monotone (bistable) or never happens.
+    """
+    scan, first = [], None
+    mu_s = mu_k
+    while mu_s + SCAN_STEP <= MU_MAX + 1e-9:
+        mu_s = round(mu_s + SCAN_STEP, 10)
+        _, bit = model.simulate(win, mu_s, mu_k, cells)
+        stuck = _sticks(bit[win.used - win.sim0], model.omega_c)
+        scan.append((mu_s, stuck))
+        if stuck and first is None:
+            first = len(scan) - 1
+        if not stuck and first is not None:
+            return None, True, scan
+        if first is not None and len(scan) - 1 - first >= SCAN_CONFIRM:
+            break
+    if first is None:
+        return None, False, scan
+    return (scan[first - 1][0] if first > 0 else mu_k), False, scan
+
+
+def _creep_cells(string: DrillString, cells: int) -> int:
+    """Cells giving Δx ≤ MD/1000 in every section (at least ``cells``)."""
+    c = np.array([s.wave_speed_m_s for s in string.sections])
+    travel = sum(s.length_m / s.wave_speed_m_s for s in string.sections)
+    need = CREEP_CELLS_PER_MD * float(c.max()) * travel / string.bit_depth_m
+    return max(cells, int(np.ceil(need / (1.0 - _GRID_SPREAD))) + 1)
+
+
+def _creep_windows(data: _Data, creeps) -> list[_Window]:
+    """Creeps simulated from rest; the drive is smoothed over a few seconds: during a creep
+    the speed is low and steady, the twist is its integral (which a centred moving average
+    keeps), and jitter in the drive moves the creep torque by several % (noise 0.5 RPM).
+    The fit stops half a smoothing window before the creep ends (the drive is blurred
+    there by the following ramp)."""
+    pre = int(round((PRE_ROLL_S + CREEP_DRIVE_SMOOTH_S / 2) / data.dt))
+    wins = []
+    for t0, t1 in creeps:
+        i0 = data.index(t0)
+        i1 = data.index(min(t1 - CREEP_DRIVE_SMOOTH_S / 2, t0 + CREEP_MAX_S))
+        wins.append(_Window(max(0, i0 - pre), i1, np.arange(i0, i1 + 1), creep=True))
+    return wins
+
+
+def _creep_misfit(model: _Model, wins, mu_k: float, cells: int) -> Callable[[float], float]:
+    """Mean squared difference of the 1-s smoothed torques over the creeps [N²·m²]."""
+    d = model.data
+
+    def misfit(mu_s: float) -> float:
+        err = []
+        for w in wins:
+            tau, _ = model.simulate(w, mu_s, min(mu_k, mu_s), cells)
+            tau_bar = smooth(tau, d.dt, TORQUE_SMOOTH_S)
+            err.append(tau_bar[w.used - w.sim0] - d.tau_bar[w.used])
+        return float(np.mean(np.concatenate(err) ** 2))
+
+    return misfit
+
+
+def _fit_creep(model: _Model, wins, mu_k: float, cells: int, lo: float,
+               hi: float) -> tuple[float, int]:
+    """μ_s minimising the smoothed torque misfit over the creeps (THEORY §6.3–6.4):
+    bounded 1-D minimisation (Brent) on [lo, hi]; returns (μ_s, runs)."""
+    start = model.runs
+    res = minimize_scalar(_creep_misfit(model, wins, mu_k, cells), bounds=(lo, hi),
+                          method="bounded", options={"xatol": 2e-3 * hi})
+    return float(res.x), model.runs - start
+
+
+def parabola_vertex(x, j, curvature: float | None = None) -> tuple[float, float]:
+    """Vertex and curvature a of J(x) = a(x − v)² + c through three equally spaced points
+    (x₀, x₁, x₂), or through the outer two when ``curvature`` is given (J(x₁) unused).
+    A non-convex parabola (a ≤ 0) returns (x₁, a).
+
+    Examples
+    --------
+    >>> parabola_vertex([0.0, 1.0, 2.0], [4.0, 1.0, 0.0])
+    (2.0, 1.0)
+    >>> parabola_vertex([0.0, 1.0, 2.0], [4.0, float("nan"), 0.0], 1.0)
+    (2.0, 1.0)
+    """
+    x0, x1, x2 = (float(v) for v in x)
+    j0, j1, j2 = (float(v) for v in j)
+    h = 0.5 * (x2 - x0)
+    a = (j0 - 2.0 * j1 + j2) / (2.0 * h * h) if curvature is None else float(curvature)
+    if a <= 0.0:  # not convex: no minimum, the caller falls back to a bounded search
+        return x1, a
+    return x1 - (j2 - j0) / (4.0 * a * h), a
+
+
+def _refit_creep(model: _Model, wins, mu_k: float, cells: int, centre: float, lo: float,
+                 hi: float, curvature: float | None) -> tuple[float, int, float | None]:
+    """μ_s near ``centre`` on a finer grid; returns (μ_s, runs, misfit curvature).
+
+    The vertex of the misfit parabola through centre·(1 ± 4 %): with the curvature of the
+    previous grid (it changed by < 5 % between 2290 and 4573 cells in the validation) two
+    runs suffice, else the centre is evaluated too (3 runs). A vertex outside ±8 % or a
+    non-convex parabola falls back to :func:`_fit_creep` on ±10 %. The misfit of a creep is
+    smooth in μ_s (no stick-slip, no chaos)."""
+    start = model.runs
+    misfit = _creep_misfit(model, wins, mu_k, cells)
+    x = centre * np.array([1.0 - CREEP_STENCIL, 1.0, 1.0 + CREEP_STENCIL])
+    if x[0] >= lo and x[2] <= hi:
+        j = np.array([misfit(x[0]), np.nan if curvature else misfit(centre), misfit(x[2])])
+        vertex, a = parabola_vertex(x, j, curvature)
+        if a > 0 and abs(vertex / centre - 1.0) <= 2 * CREEP_STENCIL:
+            return vertex, model.runs - start, a
+    mu, _ = _fit_creep(model, wins, mu_k, cells, max(lo, 0.9 * centre), min(hi, 1.1 * centre))
+    return mu, model.runs - start, None
+
+
+def _as_fc_fn(fc_Nm_m) -> Callable[[np.ndarray], np.ndarray]:
+    if callable(fc_Nm_m):
+        return fc_Nm_m
+    value = float(fc_Nm_m)
+    return lambda x: np.full(np.shape(x), value)
+
+
+def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
+           omega_c_rad_s: float, k_t_per_s: float, top_drive_inertia_kg_m2: float,
+           torque_kind: str = "motor", cells: int = 500, mu_s_seed: float | None = None,
+           progress: Callable[[float], None] | None = None) -> BatchResult:
+    """Refine μ_k and μ_s of one record with the speed-driven model (THEORY §6.4).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s] (resampled to a uniform base when irregular).
+    surface_rad_s : array_like
+        Measured top-drive speed ω₀ [rad/s].
+    torque_Nm : array_like
+        Logged surface torque [N·m], of kind ``torque_kind``.
+    string : DrillString
+        The string at this record's bit depth.
+    fc_Nm_m : callable or float
+        F_c(x) [N·m/m], a function of measured depth [m] (e.g. ``TDResult.fc_at`` from
+        torque and drag, THEORY §2), or a constant.
+    omega_c_rad_s : float
+        Static/kinetic switching speed ω_c [rad/s].
+    k_t_per_s : float
+        Viscous damping rate k_t [1/s].
+    top_drive_inertia_kg_m2 : float
+        I_TD [kg·m²].
+    torque_kind : str
+        "motor" (τ_m, inertia removed here) or "string".
+    cells : int
+        Cells of the μ_k model (the creep fit uses at least MD/1000 resolution).
+    mu_s_seed : float, optional
+        μ_s used by the model while fitting μ_k on stick-slip data (default 2.5·μ_k).
+    progress : callable, optional
+        Called with 1.0 after each model run.
+
+    Returns
+    -------
+    BatchResult
+    """
+    data, messages = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
+                              top_drive_inertia_kg_m2)
+    model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
+                   top_drive_inertia_kg_m2, data, progress)
+    flags: list[str] = []
+    details: dict = {"cells": cells, "T_N_Nm": model.t_n(cells)}
+    creeps = find_creeps(data.t, data.drive, omega_c_rad_s, torque_Nm=data.tau,
+                         smooth_s=TORQUE_SMOOTH_S)
+    details["creeps_found"] = creeps
+    wins, notes = _mu_k_windows(data, omega_c_rad_s)
+    messages += notes
+    mu_k = None
+    stick_slip = False
+    if wins:
+        used = np.concatenate([w.used for w in wins])
+        target = _cycle_mean([data.tau[w.used] for w in wins], data.dt)
+        fluct = _fluctuation(data.tau_bar[used])
+        stick_slip = fluct > STICK_SLIP_FLUCTUATION
+        details.update(mean_torque_Nm=target, torque_fluctuation=fluct, stick_slip=stick_slip)
+        mu_k = _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flags,
+                           messages)
+    elif any(np.any(data.w_bar[i0:i1 + 1] > omega_c_rad_s)
+             for i0, i1 in rotating_runs(data.w_bar, omega_c_rad_s)):
+        flags.append("rotation_too_short")
+    else:
+        flags.append("no_rotation")
+    mu_s, bound, method, used_creeps = None, None, "none", ()
+    if creeps and 1.0 / data.dt < MIN_CREEP_RATE_HZ:
+        flags.append("creep_rate_too_low")
+        messages.append(f"creep start-up found but logged at {1 / data.dt:g} Hz: the creep "
+                        f"fit needs ≥ {MIN_CREEP_RATE_HZ:g} Hz (speed noise integrated into "
+                        "the twist); μ_s not fitted")
+    elif mu_k is not None and creeps:
+        mu_s, used_creeps = _creep_stage(model, data, creeps, mu_k, cells, details, flags,
+                                         messages)
+        if mu_s is not None:
+            method = "creep_fit"
+            if stick_slip and abs(mu_s / details["mu_s_model"] - 1.0) > 0.2:
+                mu_k = _refit_mu_k(model, wins, target, mu_s, mu_k, cells, details, messages)
+    if mu_s is None and mu_k is not None and stick_slip:
+        bound = _bound_stage(model, wins, mu_k, cells, details, flags, messages)
+        method = "stick_slip_onset" if bound is not None else "none"
+    if mu_s is None and not stick_slip and mu_k is not None:
+        messages.append("no stick-slip and no creep start-up: μ_s is not in the data; a creep "
+                        "break-over from rest (below ω_c for 10–30 s) would make it measurable")
+    return BatchResult(mu_k=mu_k, mu_k_method="mean_torque", mu_s=mu_s,
+                       mu_s_identifiable=mu_s is not None, mu_s_lower_bound=bound,
+                       mu_s_method=method, creep_segments=tuple(used_creeps),
+                       flags=tuple(flags), runs=model.runs, messages=tuple(messages),
+                       details=details)
+
+
+def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flags, messages):
+    """μ_k by mean-torque matching with the model in the data's regime (THEORY §6.4)."""
+    d = model.data
+    used = np.concatenate([w.used for w in wins])
+    string_inertia = float(np.sum(model.grid(cells)[0].rho_j_kg_m
+                                  * model.grid(cells)[0].dx_true_m))
+    viscous = model.k_t * string_inertia * float(np.mean(d.w_bar[used]))
+    x0 = float(np.clip((target - viscous) / model.t_n(cells), 0.01, 1.0))
+    ratios = (PROVISIONAL_RATIO, 4.0) if stick_slip else (1.0,)
+    for ratio in ratios:
+        def mu_s_of(mu_k, ratio=ratio):
+            return max(ratio * mu_k, mu_s_seed or 0.0) if stick_slip else mu_k
+        mu_k, res, trace, sticks = _fit_mu_k(model, wins, target, mu_s_of, x0, cells)
+        details.update(mu_k_trace=trace, mu_k_residual_Nm=res, mu_s_model=mu_s_of(mu_k))
+        if sticks == stick_slip:
+            break
+        x0 = mu_k
+    if sticks != stick_slip:
+        flags.append("regime_mismatch")
+        messages.append("the model could not be put in the data's regime "
+                        f"({'stick-slip' if stick_slip else 'steady rotation'}); μ_k may be "
+                        "biased by a few %")
+    if abs(res) > 0.02 * abs(target):
+        flags.append("mu_k_not_converged")
+        messages.append(f"mean torque matched only to {res:+.0f} N·m of {target:.0f} N·m")
+    return mu_k
+
+
+def _refit_mu_k(model, wins, target, mu_s, mu_k, cells, details, messages):
+    """μ_k again with the creep μ_s in the model (same regime, better static part)."""
+    new, res, trace, _ = _fit_mu_k(model, wins, target, lambda _: mu_s, mu_k, cells)
+    if abs(res) <= max(abs(details["mu_k_residual_Nm"]), 0.02 * abs(target)):
+        details.update(mu_k_trace=details["mu_k_trace"] + trace, mu_k_residual_Nm=res,
+                       mu_s_model=mu_s)
+        messages.append(f"μ_k refitted with the creep μ_s = {mu_s:.3f}")
+        return min(new, mu_s)
+    return mu_k
+
+
+def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages):
+    """μ_s from the creeps at Δx ≤ MD/1000, refitted with doubled cells until it moves
+    less than :data:`CREEP_CONVERGENCE` (THEORY §6.4); None when it never settles."""
+    wins = _creep_windows(data, creeps)
+    n = _creep_cells(model.string, cells)
+    lo = max(mu_k, 0.02)
+    mu, runs = _fit_creep(model, wins, mu_k, n, lo, MU_MAX)
+    fits = [(model.grid(n)[0].n_cells, mu, runs)]
+    details["creep_fits"] = fits
+    if min(mu - lo, MU_MAX - mu) < 0.01 * (MU_MAX - lo):
+        flags.append("creep_fit_at_bound")
+        messages.append(f"creep fit ran to its search bound (μ_s = {mu:.3f}): not reported")
+        return None, ()
+    curvature = None
+    for _ in range(CREEP_LEVELS - 1):
+        n *= 2
+        new, runs, curvature = _refit_creep(model, wins, mu_k, n, mu, lo, MU_MAX, curvature)
+        fits.append((model.grid(n)[0].n_cells, new, runs))
+        move, mu = abs(new - mu) / new, new
+        details["creep_grid_move"] = move
+        if move < CREEP_CONVERGENCE:
+            messages.append(f"μ_s = {mu:.3f} from {len(creeps)} creep start-up(s) "
+                            f"({fits[-1][0]} cells; {100 * move:.1f} % change from "
+                            f"{fits[-2][0]})")
+            return mu, tuple(creeps)
+    flags.append("creep_not_grid_converged")
+    messages.append("creep μ_s not grid-converged (" + ", ".join(
+        f"{m:.3f} at {c} cells" for c, m, _ in fits) + "): not reported")
+    return None, ()
+
+
+def _bound_stage(model, wins, mu_k, cells, details, flags, messages):
+    """Stick-slip-onset lower bound on μ_s over the first 90 s of rotation of one run."""
+    w = max(wins, key=lambda w: w.used.size)
+    last = min(w.end, w.used[0] + int(round((SCAN_ROTATION_S - MU_K_SKIP_S) / model.data.dt)))
+    scan_win = _Window(w.sim0, last, w.used[w.used <= last])
+    bound, bistable, scan = _onset_scan(model, scan_win, mu_k, cells)
+    details["onset_scan"] = scan
+    if bistable:
+        flags.append("bistable_regime")
+        messages.append("whether the model sticks is not monotone in μ_s near the onset: "
+                        "no lower bound given")
+    elif bound is None:
+        flags.append("stick_slip_not_reproduced")
+        messages.append(f"the model does not stick-slip for μ_s ≤ {MU_MAX}: no lower bound")
+    else:
+        weak = " (the model sticks for any μ_s above μ_k: no more than μ_s ≥ μ_k)" \
+            if bound == mu_k else ""
+        messages.append(f"μ_s not identifiable (stick-slip, no creep); μ_s ≥ {bound:.2f} from "
+                        f"the stick-slip onset{weak}")
+    return bound

@@ -1,0 +1,294 @@
+"""Friction factors and bit speed of one rotating segment: observer, batch fit, observer.
+
+The chain of issue 5 (THEORY.md §5–§6), for one segment at one bit depth:
+
+1. torque and drag at the bit depth gives F_c(x) (THEORY §2);
+2. the adaptive observer runs from every configured start (plus the previous segment's
+   estimates, the warm start) over the first ``observer.starts_window_s`` of the segment,
+   giving the online estimates, their spread and settling;
+3. the batch refinement (speed-driven fit, THEORY §6.4) gives μ_k (mean-torque match) and
+   μ_s where the data identify it (creep) or a lower bound (stick-slip onset);
+4. the observer runs once more, over the whole segment, seeded with the refined factors:
+   the bit-speed estimate and the μ_k time series.
+
+The numbers reported are the batch ones when it succeeds (``method`` = "batch"), the
+observer consensus otherwise ("observer"); which is which is recorded.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from drillfric import batch, torque_drag, torsional
+from drillfric.diagnostics import Diagnostics, diagnose
+from drillfric.drillstring import build_string
+from drillfric.errors import DrillfricError
+from drillfric.gains import gains_from_config
+from drillfric.observer import Measurements, Observer, ObserverRecord, ObserverState, observe
+from drillfric.units import RPM_TO_RAD_S
+from drillfric.wellpath import WellPath, vertical
+
+
+#: Batch flags under which a stick-slip-onset bound on μ_s is not reported (THEORY §6.4: a
+#: bound above the truth is a false claim; prefer none).
+UNRELIABLE_BOUND = frozenset({"regime_mismatch", "bistable_regime",
+                              "stick_slip_not_reproduced"})
+#: Relative difference between batch and observer μ_k beyond which a segment is not
+#: converged (on synthetic truths they agree within ~10 %: docs/validation.md).
+DISAGREEMENT = 0.5
+
+
+class SkipSegment(DrillfricError):
+    """The segment holds nothing to estimate (not a failure): kept as "skipped"."""
+
+
+@dataclass(frozen=True)
+class SegmentData:
+    """The samples of one segment, in SI (rpm only in the name).
+
+    Attributes
+    ----------
+    time_s, surface_rpm, surface_torque_Nm : ndarray
+    bit_depth_m : float
+        Bit depth of the segment [m].
+    kind : str
+        Segment kind ("off_bottom_rotating", "on_bottom_rotating").
+    wob_N : float
+        Median weight on bit [N] (0 off bottom).
+    bit_rpm : ndarray or None
+        Downhole truth when the input has it (validation).
+    """
+
+    time_s: np.ndarray
+    surface_rpm: np.ndarray
+    surface_torque_Nm: np.ndarray
+    bit_depth_m: float
+    kind: str = "off_bottom_rotating"
+    wob_N: float = 0.0
+    bit_rpm: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class SegmentEstimate:
+    """Estimates and diagnostics of one segment (a row of segments.parquet + traces).
+
+    Attributes
+    ----------
+    mu_s, mu_k : float or None
+        Reported friction factors [-] (μ_s only where identified).
+    mu_s_identifiable : bool
+    mu_s_lower_bound : float or None
+    mu_s_spread, mu_k_spread : float or None
+        Spread of the observer's starts [-].
+    converged : bool
+    method : str
+        "batch" or "observer".
+    settling_time_s : float or None
+    residual_rms_rpm : float
+    stick_slip_severity : float
+    stuck_fraction : float
+    mu_k_observer, mu_s_observer : float
+        Observer consensus (first pass) [-].
+    mu_td : float or None
+        Static torque-and-drag back-calculated friction factor [-] (cross-check).
+    T_N_Nm : float
+        ∫F_c dx at this depth [N·m].
+    flags : tuple of str
+    messages : tuple of str
+    starts : ndarray, shape (S, 2)
+        Observer starts (μ_s, μ_k); the seeded final pass is start S.
+    first, final : ObserverRecord
+        Observer records of the first pass (all starts) and the seeded pass.
+    bit_rms_error_rpm : float or None
+        RMS error of the estimated bit speed when the truth is known [RPM].
+    """
+
+    mu_s: float | None
+    mu_k: float | None
+    mu_s_identifiable: bool
+    mu_s_lower_bound: float | None
+    mu_s_spread: float | None
+    mu_k_spread: float | None
+    converged: bool
+    method: str
+    settling_time_s: float | None
+    residual_rms_rpm: float
+    stick_slip_severity: float
+    stuck_fraction: float
+    mu_k_observer: float
+    mu_s_observer: float
+    mu_td: float | None
+    T_N_Nm: float
+    flags: tuple
+    messages: tuple
+    starts: np.ndarray
+    first: ObserverRecord = field(repr=False)
+    final: ObserverRecord = field(repr=False)
+    bit_rms_error_rpm: float | None = None
+    td: torque_drag.TDResult | None = field(default=None, repr=False)
+
+
+def _path_for(path: WellPath | None, bit_depth_m: float) -> WellPath:
+    if path is None:
+        return vertical(bit_depth_m)
+    if bit_depth_m > path.md_max_m + 1e-6:
+        raise DrillfricError(f"the survey ends at {path.md_max_m:.1f} m, above the bit at "
+                             f"{bit_depth_m:.1f} m", fix="extend the survey to the bit depth")
+    return path
+
+
+def build_observer(cfg, string, td: torque_drag.TDResult, cells: int) -> Observer:
+    """Observer for this string and F_c profile from the configuration (THEORY §5)."""
+    grid = torsional.make_grid(string, cells)
+    plant = torsional.Plant(grid, td.fc_at(grid.x_m), 0.0, 0.0, cfg.omega_c_rad_s,
+                            cfg["model.k_t_per_s"], cfg["rig.top_drive_inertia_kg_m2"])
+    n_pipe = int(grid.section_start[1])
+    gains = gains_from_config(cfg, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s)
+    return Observer(plant, gains, law=cfg["observer.law"], mu_max=cfg["observer.mu_max"],
+                    deadlock_s=cfg["observer.deadlock_s"],
+                    hold=cfg["observer.interpolation"] == "hold")
+
+
+def _starts(cfg, warm, mu_max) -> np.ndarray:
+    starts = [list(s) for s in cfg["observer.starts"]]
+    if warm is not None and all(v is not None for v in warm):
+        starts.append([max(warm[0], warm[1]), warm[1]])
+    out = np.clip(np.asarray(starts, dtype=float), 0.0, mu_max)
+    out[:, 0] = np.maximum(out[:, 0], out[:, 1])
+    return out
+
+
+def _seed_mu_s(result: batch.BatchResult, mu_k: float) -> float:
+    """μ_s for the seeded observer pass: identified, else the batch model's regime value."""
+    for value in (result.mu_s, result.details.get("mu_s_model"), result.mu_s_lower_bound):
+        if value is not None:
+            return max(float(value), mu_k)
+    return mu_k
+
+
+def _td_cross_check(path, string, cfg, data: SegmentData, td, meas: Measurements):
+    """Static friction factor from the mean rotating string torque (T&D back-calculation)."""
+    rotating = np.abs(meas.surface_rad_s) > 2.0 * cfg.omega_c_rad_s
+    if rotating.sum() < 10:
+        return None
+    torque = batch.measured_string_torque(
+        meas.t0_s + meas.dt_s * np.arange(meas.surface_rad_s.size), meas.surface_rad_s,
+        meas.motor_torque_Nm, "motor", cfg["rig.top_drive_inertia_kg_m2"])
+    try:
+        return float(torque_drag.back_calculate_friction(
+            path, string, surface_torque_Nm=float(np.mean(torque[rotating])),
+            load_case="rotating_off_bottom", mud_out_kg_m3=cfg["fluid.mud_density_kg_m3"],
+            mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
+            element_length_m=cfg["model.element_length_m"]))
+    except DrillfricError:
+        return None
+
+
+def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
+                     warm: tuple | None = None, rate_hz: float | None = None,
+                     output_rate_hz: float | None = None, progress=None) -> SegmentEstimate:
+    """Estimate μ_s, μ_k and the bit speed of one rotating segment (issue 5 chain).
+
+    Parameters
+    ----------
+    cfg : Config
+    path : WellPath or None
+        Well path (vertical when None).
+    data : SegmentData
+    warm : (μ_s, μ_k), optional
+        Previous segment's estimates, added as a start (warm start across windows).
+    rate_hz : float, optional
+        Resample the input to this rate first (``run --rate``).
+    output_rate_hz : float, optional
+        Rate of the observer records (default ``observer.output_rate_hz``).
+    progress : callable, optional
+        Called with a fraction of the segment's work as it advances.
+    """
+    tick = progress or (lambda amount: None)
+    path = _path_for(path, data.bit_depth_m)
+    string = build_string(cfg.sections, data.bit_depth_m)
+    on_bottom = data.kind == "on_bottom_rotating"
+    td = torque_drag.solve_config(cfg, path, data.bit_depth_m,
+                                  load_case="rotating_on_bottom" if on_bottom
+                                  else "rotating_off_bottom", wob_N=data.wob_N)
+    if td.T_N_Nm < 1.0:
+        raise SkipSegment(f"no side force on the string at {data.bit_depth_m:.0f} m (T_N = "
+                          f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
+                          "torque", fix="give the well's survey")
+    itd = cfg["rig.top_drive_inertia_kg_m2"]
+    meas = Measurements.from_samples(data.time_s, data.surface_rpm * RPM_TO_RAD_S,
+                                     data.surface_torque_Nm, torque_kind=cfg["rig.torque_kind"],
+                                     top_drive_inertia_kg_m2=itd, rate_hz=rate_hz)
+    observer = build_observer(cfg, string, td, cfg["model.cells"])
+    out_rate = output_rate_hz or cfg["observer.output_rate_hz"]
+    starts = _starts(cfg, warm, observer.mu_max)
+    state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
+                                      t_s=meas.t0_s)
+    window_end = min(meas.t_end_s, meas.t0_s + cfg["observer.starts_window_s"])
+    first, _ = observe(observer, meas, state, output_rate_hz=out_rate, t_end_s=window_end)
+    diag: Diagnostics = diagnose(first, cfg.omega_c_rad_s)
+    tick(0.3)
+    n_fit = min(meas.surface_rad_s.size, int(cfg["batch.window_s"] / meas.dt_s) + 1)
+    t_meas = meas.t0_s + meas.dt_s * np.arange(n_fit)
+    refined = batch.refine(t_meas, meas.surface_rad_s[:n_fit], meas.motor_torque_Nm[:n_fit],
+                           string=string,
+                           fc_Nm_m=td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
+                           k_t_per_s=cfg["model.k_t_per_s"], top_drive_inertia_kg_m2=itd,
+                           torque_kind="motor", cells=cfg["model.cells"])
+    tick(0.5)
+    flags = [f"observer_{f}" for f in diag.flags] + list(refined.flags)
+    messages = list(refined.messages)
+    bound = refined.mu_s_lower_bound
+    if bound is not None and UNRELIABLE_BOUND.intersection(refined.flags):
+        bound = None
+        messages.append("μ_s lower bound withheld: the model does not reproduce the data's "
+                        "stick-slip regime")
+    if refined.mu_k is not None:
+        mu_k, method = refined.mu_k, "batch"
+        converged = "mu_k_not_converged" not in refined.flags
+        if abs(mu_k / max(diag.mu_k, 1e-6) - 1.0) > DISAGREEMENT:
+            converged = False
+            flags.append("estimators_disagree")
+            messages.append(f"batch μ_k = {mu_k:.3f} and observer μ_k = {diag.mu_k:.3f} "
+                            "disagree: not converged")
+    else:
+        mu_k, method, converged = diag.mu_k, "observer", diag.converged
+        messages.append("batch refinement gave no μ_k: observer consensus reported")
+    seed = np.array([[_seed_mu_s(refined, mu_k), mu_k]])
+    final, _ = observe(observer, meas,
+                       ObserverState.from_starts(observer, seed,
+                                                 omega0_rad_s=meas.surface_rad_s[0],
+                                                 t_s=meas.t0_s), output_rate_hz=out_rate)
+    final_diag = diagnose(final, cfg.omega_c_rad_s)
+    tick(0.2)
+    if on_bottom:
+        flags.append("bit_torque_in_friction")
+        messages.append("on bottom: the bit torque is not separated, friction is apparent")
+    return SegmentEstimate(
+        mu_s=refined.mu_s, mu_k=mu_k, mu_s_identifiable=refined.mu_s_identifiable,
+        mu_s_lower_bound=bound, mu_s_spread=diag.mu_s_spread,
+        mu_k_spread=diag.mu_k_spread, converged=bool(converged), method=method,
+        settling_time_s=diag.settling_time_s, residual_rms_rpm=final_diag.residual_rms_rpm,
+        stick_slip_severity=final_diag.stick_slip_severity,
+        stuck_fraction=final_diag.stuck_fraction, mu_k_observer=diag.mu_k,
+        mu_s_observer=diag.mu_s, mu_td=_td_cross_check(path, string, cfg, data, td, meas),
+        T_N_Nm=observer.plant.T_N_Nm, flags=tuple(dict.fromkeys(flags)),
+        messages=tuple(messages), starts=starts, first=first, final=final,
+        bit_rms_error_rpm=_bit_error(final, data), td=td)
+
+
+def _bit_error(final: ObserverRecord, data: SegmentData) -> float | None:
+    if data.bit_rpm is None or not np.all(np.isfinite(data.bit_rpm)):
+        return None
+    truth = np.interp(final.time_s, data.time_s, data.bit_rpm)
+    return float(np.sqrt(np.mean((final.bit_rad_s_est[:, 0] / RPM_TO_RAD_S - truth) ** 2)))
+
+
+def check_segment(data: SegmentData, cfg) -> None:
+    """Raise SkipSegment when a segment has too little to estimate from."""
+    if data.time_s.size < 20:
+        raise SkipSegment(f"only {data.time_s.size} samples")
+    if np.nanmax(np.abs(data.surface_rpm)) * RPM_TO_RAD_S <= cfg.omega_c_rad_s:
+        raise SkipSegment("the top drive never turns faster than ω_c")

@@ -1,0 +1,110 @@
+"""Plain-NumPy twins of :mod:`drillfric.kernels` (THEORY.md §3.1).
+
+Same argument lists and the same arithmetic, written with whole-array NumPy operations and
+a Python loop over time steps: the oracle of the kernel tests (agreement to round-off) and
+the baseline of ``benchmarks/bench_plant.py``. Not for production use (slow).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_MODE_PI, _MODE_TORQUE, _MODE_SPEED = 0, 1, 2
+
+
+def drive_value(u, u_t0, u_dt, t):
+    """Linear interpolation of a uniform series at time t, held beyond its ends."""
+    s = (t - u_t0) / u_dt
+    if s <= 0.0:
+        return float(u[0])
+    if s >= u.size - 1:
+        return float(u[-1])
+    i = int(s)
+    return float(u[i] + (s - i) * (u[i + 1] - u[i]))
+
+
+def transport(a, b, a_new, b_new, w_a, w_b, section_start, junction_z, alpha_top, omega_top,
+              bit_cap_rel):
+    """Step 1: shift α down and β up, section ends from boundaries and junctions.
+
+    Also fills ``w_a``/``w_b``: ω^k at the foot of the α/β characteristic of each cell
+    (the neighbour above/below, the interface speed at section ends).
+    """
+    w = 0.5 * (a + b)
+    a_new[1:] = a[:-1]
+    b_new[:-1] = b[1:]
+    w_a[1:] = w[:-1]
+    w_b[:-1] = w[1:]
+    first = section_start[1:-1]
+    last = first - 1
+    z = junction_z
+    a_new[first] = (2.0 * a[last] - (1.0 - z) * b[first]) / (1.0 + z)
+    b_new[last] = ((1.0 - z) * a[last] + 2.0 * z * b[first]) / (1.0 + z)
+    w_a[first] = w_b[last] = 0.5 * (a[last] + b_new[last])
+    a_new[0] = alpha_top
+    w_a[0] = omega_top
+    al = a[-1]
+    b_new[-1] = al - 2.0 * min(max(al, -bit_cap_rel), bit_cap_rel)
+    w_b[-1] = 0.5 * (al + b_new[-1])
+
+
+def damp_and_friction(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, mu_s, mu_k, omega_c):
+    """Steps 2–3: viscous term along the characteristics and friction inclusion, in place."""
+    w_old = 0.5 * (a + b)
+    an = a_new - kt_dt * w_a
+    bn = b_new - kt_dt * w_b
+    w = 0.5 * (an + bn)
+    cap = np.where(np.abs(w_old) <= omega_c, mu_s, mu_k) * fcap
+    d = np.minimum(np.maximum(w, -cap), cap)
+    a_new[:] = an - d
+    b_new[:] = bn - d
+
+
+def motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_itd):
+    """Motor torque τ_m at step k [N·m] (PI, prescribed torque or prescribed speed)."""
+    if mode == _MODE_PI:
+        return kp * (u_now - omega0) + ki * integral
+    if mode == _MODE_TORQUE:
+        return u_now
+    return tau0 + (u_next - u_now) / (dt * inv_itd)
+
+
+def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, dt,
+              kt_dt, mu_s, mu_k, omega_c, bit_cap_rel, inv_itd, mode, u, u_t0, u_dt, kp, ki,
+              times, out):
+    """NumPy twin of :func:`drillfric.kernels.run_plant` (same arguments and effects)."""
+    a, b = alpha.copy(), beta.copy()
+    a2, b2 = alpha.copy(), beta.copy()
+    w_a, w_b = np.empty_like(a), np.empty_like(a)
+    omega0, integral = float(top[0]), float(top[1])
+    r, eps = 0, 1e-9 * dt
+    prev = np.zeros(4)
+    for k in range(n_steps + 1):
+        t = t0 + k * dt
+        u_now = drive_value(u, u_t0, u_dt, t)
+        u_next = u_now
+        if mode == _MODE_SPEED:
+            omega0 = u_now
+            u_next = drive_value(u, u_t0, u_dt, t + dt)
+        tau0 = zeta[0] * (omega0 - b[0])
+        tau_m = motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_itd)
+        cur = np.array([omega0, tau_m, tau0, 0.5 * (a[-1] + b[-1])])
+        while r < times.size and times[r] <= t + eps:
+            f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
+            out[r] = prev + f * (cur - prev)
+            r += 1
+        prev = cur
+        if k == n_steps:
+            break
+        transport(a, b, a2, b2, w_a, w_b, section_start, junction_z, 2.0 * omega0 - b[0],
+                  omega0, bit_cap_rel)
+        damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, mu_s, mu_k, omega_c)
+        if mode == _MODE_PI:
+            integral += dt * (u_now - omega0)
+        if mode != _MODE_SPEED:
+            omega0 += dt * inv_itd * (tau_m - tau0)
+        a, a2 = a2, a
+        b, b2 = b2, b
+    alpha[:] = a
+    beta[:] = b
+    top[0], top[1] = omega0, integral

@@ -1,0 +1,93 @@
+"""Plain-NumPy twin of :func:`drillfric.observer_kernels.run_observer` (THEORY.md §5).
+
+Same arguments and effects, built from the plant twin's whole-array steps
+(:mod:`drillfric.kernels_numpy`) with a Python loop over time steps and starts: the oracle
+of the observer kernel tests and the baseline of ``benchmarks/bench_observer.py``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drillfric.kernels_numpy import damp_and_friction, transport
+from drillfric.observer_kernels import LAW_PAPER
+
+
+def measured_value(u, t0, dt, t, hold):
+    """Measurement at time t: linear interpolation or zero-order hold, held at the ends."""
+    s = (t - t0) / dt
+    if s <= 0.0:
+        return float(u[0])
+    if s >= u.size - 1:
+        return float(u[-1])
+    i = int(s)
+    return float(u[i]) if hold else float(u[i] + (s - i) * (u[i + 1] - u[i]))
+
+
+def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
+    """Adaptation (42)–(44); see :func:`drillfric.observer_kernels.adapt`."""
+    if stuck:
+        if law == LAW_PAPER:
+            mu_s -= dt * l_s * e
+    else:
+        mu_k += dt * l_k * e
+    mu_k = min(max(mu_k, 0.0), mu_max)
+    return min(max(mu_s, mu_k), mu_max), mu_k
+
+
+def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
+                 junction_z, zeta, fcap, dt, kt_dt, omega_c, bit_cap_rel, inv_itd,
+                 w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s,
+                 law, mu_max, deadlock_s, omega_turn, times, out):
+    """NumPy twin of :func:`drillfric.observer_kernels.run_observer`."""
+    n_start, n = alpha.shape
+    n_pipe = int(section_start[1])
+    a, b = alpha.copy(), beta.copy()
+    a2, b2 = alpha.copy(), beta.copy()
+    e_last = omega0 - measured_value(w_meas, m_t0, m_dt, t0, hold)
+    w_bha = 0.5 * (a[:, n_pipe:] + b[:, n_pipe:]).mean(axis=1) if n > n_pipe \
+        else np.zeros(n_start)
+    r, eps = 0, 1e-9 * dt
+    for k in range(n_steps + 1):
+        t = t0 + k * dt
+        while r < times.size and times[r] <= t + eps:
+            out[r] = np.stack([mu_s, mu_k, omega0, 0.5 * (a[:, -1] + b[:, -1]), w_bha, e_last],
+                              axis=1)
+            r += 1
+        if k == n_steps:
+            break
+        wm = measured_value(w_meas, m_t0, m_dt, t, hold)
+        taum = measured_value(tau_meas, m_t0, m_dt, t, hold)
+        e = omega0 - wm
+        w_a, w_b = np.empty(n), np.empty(n)
+        for s in range(n_start):
+            transport(a[s], b[s], a2[s], b2[s], w_a, w_b, section_start, junction_z,
+                      2.0 * omega0[s] - b[s, 0] - P0 * e[s], omega0[s], bit_cap_rel)
+            if section_start.size > 2:
+                b2[s, n_pipe - 1] -= P1 * e[s]
+            damp_and_friction(a[s], b[s], a2[s], b2[s], w_a, w_b, kt_dt, fcap, mu_s[s],
+                              mu_k[s], omega_c)
+        a2 -= inj_a[None, :] * e[:, None]
+        b2 -= inj_b[None, :] * e[:, None]
+        w_bha = 0.5 * (a2[:, n_pipe:] + b2[:, n_pipe:]).mean(axis=1) if n > n_pipe \
+            else np.zeros(n_start)
+        tau0 = zeta[0] * (omega0 - b[:, 0])
+        omega0 += dt * inv_itd * (taum - tau0) - dt * p0 * e
+        for s in range(n_start):
+            stuck = abs(w_bha[s]) <= omega_c
+            mu_s[s], mu_k[s] = adapt(mu_s[s], mu_k[s], e[s], stuck, l_s, l_k, dt, law, mu_max)
+            if stuck and abs(wm) > omega_turn:
+                guard[s, 0] += dt
+                if guard[s, 0] > deadlock_s:
+                    if mu_s[s] <= mu_k[s] * (1.0 + 1e-9):
+                        mu_k[s] *= 0.8
+                    mu_s[s] = mu_k[s]
+                    guard[s, 0] = 0.0
+                    guard[s, 1] += 1.0
+            else:
+                guard[s, 0] = 0.0
+        e_last = e
+        a, a2 = a2, a
+        b, b2 = b2, b
+    alpha[:] = a
+    beta[:] = b

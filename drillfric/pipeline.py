@@ -1,0 +1,350 @@
+"""``drillfric run``: one well, stand by stand (issue 6).
+
+ingest (streamed in chunks) → segment into rotating stands → per segment: torque and drag
+at its bit depth, observer from the configured starts (warm-started from the previous
+segment), batch refinement, seeded observer pass (:mod:`drillfric.estimate`) → outputs of
+INTERFACE.md (summary.json, estimates.parquet, segments.parquet, report) written atomically.
+
+Memory stays bounded: only the rows of the segment being assembled are held (rows the
+segmenter has finished with are dropped), and estimates are appended to Parquet per segment.
+Library code: no printing; progress goes through a callback.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from drillfric import __version__
+from drillfric.errors import DrillfricError
+from drillfric.estimate import (
+    SegmentData,
+    SegmentEstimate,
+    SkipSegment,
+    check_segment,
+    estimate_segment,
+)
+from drillfric.io.well import iter_surface, load_setup, resolve_well
+from drillfric.outputs import (
+    EstimatesWriter,
+    atomic_directory,
+    file_sha256,
+    write_json,
+    write_segments,
+)
+from drillfric.segmentation import Segment, Segmenter
+from drillfric.units import RPM_TO_RAD_S
+from drillfric.wellpath import WellPath
+
+#: Bit depth assumed when neither the log, the config nor a survey gives one [m].
+DEFAULT_BIT_DEPTH_M = 2500.0
+#: Seconds of data before a segment handed to the estimator, so that a start-up (and a
+#: creep break-over) is seen from rest.
+PREROLL_S = 5.0
+_KEEP = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N", "bit_rpm")
+
+
+@dataclass
+class RunResult:
+    """What a run produced (the CLI turns it into a summary line and an exit code).
+
+    Attributes
+    ----------
+    name : str
+    out_dir : Path
+        OUT/NAME, complete.
+    summary : dict
+        Contents of summary.json.
+    failed : int
+        Segments whose estimation failed.
+    """
+
+    name: str
+    out_dir: Path
+    summary: dict
+    failed: int = 0
+    warnings: list = field(default_factory=list)
+
+    @property
+    def report(self) -> Path:
+        """Path of report.html."""
+        return self.out_dir / "report.html"
+
+
+def _bit_depth_default(cfg, survey: WellPath | None, assumed: list) -> float:
+    if cfg["simulate.bit_depth_m"] is not None:
+        return cfg["simulate.bit_depth_m"]
+    if survey is not None:
+        assumed.append(f"bit depth {survey.md_max_m:.0f} m (the survey's last station): the "
+                       "log has no bit depth")
+        return survey.md_max_m
+    assumed.append(f"bit depth {DEFAULT_BIT_DEPTH_M:.0f} m: neither the log nor a survey "
+                   "gives one")
+    return DEFAULT_BIT_DEPTH_M
+
+
+def _segment_data(rows: pd.DataFrame, seg: Segment, fallback_depth: float) -> SegmentData:
+    depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
+    wob = float(np.nanmedian(rows["wob_N"])) if "wob_N" in rows and \
+        rows["wob_N"].notna().any() else 0.0
+    truth = rows["bit_rpm"].to_numpy(float) if "bit_rpm" in rows else None
+    return SegmentData(rows["time_s"].to_numpy(float), rows["surface_rpm"].to_numpy(float),
+                       rows["surface_torque_Nm"].to_numpy(float), float(depth), kind=seg.kind,
+                       wob_N=max(wob, 0.0), bit_rpm=truth)
+
+
+def _segment_row(seg: Segment, est: SegmentEstimate | None, status: str, message: str,
+                 depth: float) -> dict:
+    row = {"id": seg.id, "kind": seg.kind, "t_start_s": seg.t_start_s,
+           "t_end_s": seg.t_end_s, "bit_depth_m": depth, "mu_s": None, "mu_k": None,
+           "mu_s_identifiable": False, "mu_s_lower_bound": None, "mu_s_spread": None,
+           "mu_k_spread": None, "converged": False, "method": "none",
+           "settling_time_s": None, "residual_rms_rpm": None, "stick_slip_severity": None,
+           "status": status, "message": message, "duration_s": seg.duration_s}
+    if est is not None:
+        row.update({k: getattr(est, k) for k in (
+            "mu_s", "mu_k", "mu_s_identifiable", "mu_s_lower_bound", "mu_s_spread",
+            "mu_k_spread", "converged", "method", "settling_time_s", "residual_rms_rpm",
+            "stick_slip_severity", "stuck_fraction", "mu_k_observer", "mu_s_observer",
+            "mu_td", "T_N_Nm", "bit_rms_error_rpm")})
+        row["flags"] = list(est.flags)
+        row["starts"] = est.starts.tolist()  # start_id i of estimates.parquet; len = seeded
+        row["message"] = "; ".join([message] * bool(message) + list(est.messages))
+    return row
+
+
+def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
+                    omega_c: float) -> pd.DataFrame:
+    """estimates.parquet rows of one segment: every start, then the seeded pass."""
+    frames = []
+    for rec, offset in ((est.first, 0), (est.final, est.starts.shape[0])):
+        n_t, n_s = rec.mu_k.shape
+        measured = np.interp(rec.time_s, data.time_s, data.surface_rpm)
+        cols = {
+            "time_s": np.repeat(rec.time_s, n_s),
+            "segment_id": np.full(n_t * n_s, seg_id, dtype=np.int32),
+            "start_id": np.tile(np.arange(n_s, dtype=np.int16) + offset, n_t),
+            "mu_s": rec.mu_s.ravel(), "mu_k": rec.mu_k.ravel(),
+            "surface_rpm": np.repeat(measured, n_s),
+            "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
+            "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,
+            "bit_stuck": (np.abs(rec.bha_rad_s_est) <= omega_c).ravel(),
+            "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S}
+        if data.bit_rpm is not None:
+            cols["bit_rpm"] = np.repeat(np.interp(rec.time_s, data.time_s, data.bit_rpm), n_s)
+        frames.append(pd.DataFrame(cols))
+    return pd.concat(frames, ignore_index=True)
+
+
+def _profile_frame(seg_id: int, est: SegmentEstimate, step_m: float = 10.0) -> pd.DataFrame:
+    """Torque-and-drag profile of a segment every ~``step_m`` (profiles.parquet)."""
+    td = est.td
+    keep = np.unique(np.r_[np.arange(0, td.md_m.size - 1, max(1, int(step_m // max(
+        np.diff(td.md_m).mean(), 1e-9)))), td.md_m.size - 2])
+    return pd.DataFrame({"segment_id": np.int32(seg_id), "md_m": td.md_m[keep],
+                         "inc_deg": np.degrees(td.inc_rad[keep]),
+                         "tension_N": td.tension_N[keep], "torque_Nm": td.torque_Nm[keep],
+                         "normal_force_N_m": td.normal_force_N_m[keep],
+                         "fc_Nm_m": td.fc_Nm_m[keep]})
+
+
+def consensus(rows: list[dict]) -> dict:
+    """Well-level friction factors from the segments (never a made-up value).
+
+    μ_k: median over converged, off-bottom segments with status ok; μ_s: median over the
+    segments that identify it; otherwise the median of the segments' lower bounds (each is
+    claimed valid, so the median is too, and one unreliable segment cannot set it).
+    """
+    ok = [r for r in rows if r["status"] == "ok" and r["kind"] == "off_bottom_rotating"]
+    mu_k = [r["mu_k"] for r in ok if r["converged"] and r["mu_k"] is not None]
+    mu_s = [r["mu_s"] for r in ok if r["mu_s_identifiable"] and r["mu_s"] is not None]
+    bounds = [r["mu_s_lower_bound"] for r in ok if r["mu_s_lower_bound"] is not None]
+    return {"mu_k": float(np.median(mu_k)) if mu_k else None,
+            "mu_s": float(np.median(mu_s)) if mu_s else None,
+            "mu_s_lower_bound": None if mu_s or not bounds else float(np.median(bounds))}
+
+
+def run_well(path, out_root, *, config=None, survey=None, overrides=None,
+             rate_hz: float | None = None, starts=None, pdf: bool = False,
+             progress: Callable[[float], None] | None = None,
+             chunk_rows: int = 200_000) -> RunResult:
+    """Run the whole estimation on one well and write OUT/NAME atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        The well (data file, HDF5 bundle or directory; INTERFACE.md).
+    out_root : str or Path
+        Output directory; results go to ``out_root/NAME``.
+    config, survey : path, optional
+        Overrides of the sidecar configuration and survey.
+    overrides : dict, optional
+        ``{"table.key": value}`` from the command line.
+    rate_hz : float, optional
+        Resample the input to this rate before estimation.
+    starts : list of (μ_s, μ_k), optional
+        Observer starts (overrides ``observer.starts``).
+    pdf : bool
+        Also write report.pdf.
+    progress : callable, optional
+        Called with the fraction of the input rows processed since the last call.
+
+    Raises
+    ------
+    DrillfricError
+        Unreadable input or configuration (nothing is written).
+    """
+    t_wall = time.perf_counter()
+    data_path, config_path, survey_path = resolve_well(path, config=config, survey=survey)
+    overrides = dict(overrides or {})
+    if starts is not None:
+        overrides["observer.starts"] = [list(map(float, s)) for s in starts]
+    cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
+    name = cfg["well.name"] or (Path(path).name if Path(path).is_dir() else data_path.stem)
+    assumed = list(cfg.assumed)
+    if well_path is None:
+        assumed.append("vertical well: no survey found")
+    fallback_depth = None
+    total_rows = _count_rows(data_path)
+    segmenter = Segmenter(cfg)
+    rows_out: list[dict] = []
+    profiles: list[pd.DataFrame] = []
+    warm = None
+    failed = 0
+    buffer = pd.DataFrame()
+    buffer_start = 0
+    n_rows = 0
+    has_truth = None
+    final = Path(out_root) / name
+    with atomic_directory(final) as tmp:
+        writer = None
+        try:
+            def handle(done: list[Segment]):
+                nonlocal warm, failed, fallback_depth, writer
+                for seg in done:
+                    lo = seg.i_start - buffer_start
+                    times = buffer["time_s"].to_numpy()
+                    lo = max(int(np.searchsorted(times[:lo], times[lo] - PREROLL_S)), 0) \
+                        if lo > 0 else 0
+                    rows = buffer.iloc[lo: seg.i_end - buffer_start]
+                    if fallback_depth is None and not np.isfinite(seg.bit_depth_m):
+                        fallback_depth = _bit_depth_default(cfg, well_path, assumed)
+                    depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
+                    if seg.status != "ok":
+                        rows_out.append(_segment_row(seg, None, seg.status, seg.message,
+                                                     depth))
+                        continue
+                    data = _segment_data(rows, seg, depth)
+                    try:
+                        check_segment(data, cfg)
+                        est = estimate_segment(cfg, well_path, data, warm=warm,
+                                               rate_hz=rate_hz)
+                    except SkipSegment as exc:
+                        rows_out.append(_segment_row(seg, None, "skipped", exc.problem,
+                                                     depth))
+                        continue
+                    except DrillfricError as exc:
+                        failed += 1
+                        rows_out.append(_segment_row(seg, None, "failed", exc.problem,
+                                                     depth))
+                        continue
+                    if writer is None:
+                        writer = EstimatesWriter(tmp / "estimates.parquet",
+                                                 data.bit_rpm is not None)
+                    writer.write(_estimate_frame(seg.id, est, data, cfg.omega_c_rad_s))
+                    rows_out.append(_segment_row(seg, est, "ok", "", depth))
+                    profiles.append(_profile_frame(seg.id, est))
+                    if est.converged:
+                        warm = (est.mu_s if est.mu_s is not None else est.mu_s_observer,
+                                est.mu_k)
+
+            for chunk in iter_surface(path, config=config, survey=survey,
+                                      chunk_rows=chunk_rows):
+                if has_truth is None:
+                    has_truth = "bit_rpm" in chunk
+                keep = chunk[[c for c in _KEEP if c in chunk]]
+                buffer = pd.concat([buffer, keep], ignore_index=True) if len(buffer) else \
+                    keep.reset_index(drop=True)
+                n_rows += len(chunk)
+                handle(segmenter.feed(chunk))
+                drop = segmenter.pending_from - buffer_start
+                if drop > 0:
+                    buffer = buffer.iloc[drop:].reset_index(drop=True)
+                    buffer_start += drop
+                if progress:
+                    progress(len(chunk) / max(total_rows, 1))
+            handle(segmenter.close())
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            EstimatesWriter(tmp / "estimates.parquet", bool(has_truth)).close()
+        summary = _summary(name, cfg, rows_out, assumed, data_path, config_path, survey_path,
+                           n_rows, rate_hz, time.perf_counter() - t_wall)
+        write_json(tmp / "summary.json", summary)
+        write_segments(tmp / "segments.parquet", rows_out)
+        if profiles:
+            pd.concat(profiles, ignore_index=True).to_parquet(tmp / "profiles.parquet",
+                                                              index=False)
+        if well_path is not None:
+            pd.DataFrame(well_path.at(well_path.md_m)).to_parquet(tmp / "wellpath.parquet",
+                                                                 index=False)
+        report_problem = _write_report(tmp, pdf)
+        if report_problem:
+            summary["warnings"] = [report_problem]
+            write_json(tmp / "summary.json", summary)
+    return RunResult(name, final, summary, failed, assumed + ([report_problem] * bool(
+        report_problem)))
+
+
+def _write_report(result_dir: Path, pdf: bool) -> str | None:
+    """Write the report; a failure is a warning, not a lost run (the results stand)."""
+    from drillfric.report import write_well_report
+
+    try:
+        write_well_report(result_dir, pdf=pdf)
+    except Exception as exc:  # noqa: BLE001 — the estimates are written; say what failed
+        return f"report not written: {type(exc).__name__}: {exc}"
+    return None
+
+
+def _summary(name, cfg, rows, assumed, data_path, config_path, survey_path, n_rows, rate_hz,
+             wall_s) -> dict:
+    files = {"data": data_path, "config": config_path, "survey": survey_path}
+    inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
+              for k, p in files.items()
+              if p is not None and Path(p).is_file()}
+    inputs.update(rows=n_rows, resampled_rate_hz=rate_hz)
+    n_ok = sum(r["status"] == "ok" for r in rows)
+    n_conv = sum(r["status"] == "ok" and r["converged"] for r in rows)
+    return {"well": name, "drillfric_version": __version__, **consensus(rows),
+            "segments": rows, "inputs": inputs, "config": cfg.to_dict(),
+            "assumed": assumed, "indicative": bool(assumed),
+            "counts": {"segments": len(rows), "estimated": n_ok, "converged": n_conv,
+                       "skipped": sum(r["status"] == "skipped" for r in rows),
+                       "failed": sum(r["status"] == "failed" for r in rows)},
+            "run_time_s": wall_s}
+
+
+def _count_rows(data_path: Path) -> int:
+    """Row count for the progress bar: Parquet metadata, else a fast line count."""
+    suffix = data_path.suffix.lower()
+    try:
+        if suffix == ".parquet":
+            import pyarrow.parquet as pq
+
+            return pq.ParquetFile(data_path).metadata.num_rows
+        if suffix == ".csv":
+            count = 0
+            with open(data_path, "rb") as fh:
+                while block := fh.read(1 << 22):
+                    count += block.count(b"\n") or block.count(b"\r")
+            return count
+    except OSError:
+        return 0
+    return 0

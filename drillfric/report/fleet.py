@@ -1,0 +1,98 @@
+"""The fleet report (``fleet.html``): one row per well, friction logs overlaid, failures first."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from urllib.parse import quote
+
+from drillfric import __version__
+
+from .data import segments_frame
+from .figures import fleet_friction_figure
+from .render import environment, figure_uri, fmt, mu_s_text, now_utc
+from .well import _write_text
+
+
+def _worst(segments: list[dict]) -> dict:
+    """Worst diagnostics of a well's segments (largest residual, spread, severity; counts)."""
+    ok = [s for s in segments if s.get("status") == "ok"]
+
+    def largest(key: str) -> float | None:
+        values = [float(s[key]) for s in ok if isinstance(s.get(key), int | float)
+                  and math.isfinite(float(s[key]))]
+        return max(values) if values else None
+
+    return {"residual": fmt(largest("residual_rms_rpm"), ".2f"),
+            "spread": fmt(largest("mu_k_spread")),
+            "severity": fmt(largest("stick_slip_severity"), ".2f"),
+            "unconverged": sum(not s.get("converged") for s in ok),
+            "failed": sum(s.get("status") == "failed" for s in segments)}
+
+
+def _link(out_dir: Path, result_dir) -> str | None:
+    """Relative URL of a well's report.html from ``out_dir`` (percent-encoded), or None.
+
+    ``result_dir`` may be absolute, relative to ``out_dir``, or relative to the working
+    directory (e.g. ``OUT/NAME`` when ``out_dir`` is ``OUT``).
+    """
+    if result_dir is None:
+        return None
+    target = Path(result_dir)
+    if not target.is_absolute() and not (out_dir / target).exists() and target.exists():
+        target = target.resolve()  # relative to the working directory, not to out_dir
+    if target.is_absolute():
+        try:
+            target = Path(os.path.relpath(target, Path(out_dir).resolve()))
+        except ValueError:  # another drive (Windows): an absolute file URL then
+            return (target / "report.html").as_uri()
+    return "./" + quote((target / "report.html").as_posix())
+
+
+def _row(out_dir: Path, well: dict) -> dict:
+    summary = well.get("summary") or {}
+    counts = summary.get("counts") or {}
+    status = str(well.get("status", "failed"))
+    return {"well": str(well.get("well", "?")), "status": status,
+            "message": str(well.get("message") or ""),
+            "segments": counts.get("segments", "—"), "estimated": counts.get("estimated", "—"),
+            "converged": counts.get("converged", "—"),
+            "mu_k": fmt(summary.get("mu_k")),
+            "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
+                              summary.get("mu_s_lower_bound")) if summary else "—",
+            "indicative": bool(summary.get("indicative")),
+            "worst": _worst(summary.get("segments") or []),
+            "link": _link(out_dir, well.get("result_dir")) if summary else None}
+
+
+def write_fleet_report(out_dir: Path, wells: list[dict]) -> Path:
+    """Write ``out_dir/fleet.html``: the morning overview of many wells.
+
+    Parameters
+    ----------
+    out_dir : Path
+        Fleet output directory (links to the wells' reports are relative to it).
+    wells : list of dict
+        One per well: ``{"well": str, "status": "ok"|"failed"|"skipped", "message": str,
+        "result_dir": Path or None (relative link target), "summary": dict or None
+        (summary.json)}``.
+
+    Returns
+    -------
+    Path
+        The path of fleet.html.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rows = [_row(out_dir, w) for w in wells]
+    logs = [(str(w.get("well", "?")), segments_frame(w["summary"].get("segments") or []))
+            for w in wells if w.get("summary") and w["summary"].get("segments")]
+    figure = figure_uri(fleet_friction_figure(logs))
+    counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
+    html = environment().get_template("fleet_report.html.j2").render(
+        rows=rows, failed=[r for r in rows if r["status"] == "failed"], counts=counts,
+        figure=figure, version=__version__, built=now_utc())
+    out = out_dir / "fleet.html"
+    _write_text(out, html)
+    return out

@@ -1,0 +1,421 @@
+"""Distributed torsional drill-string model (the "plant"), THEORY.md §3 and §3.1.
+
+Implements the wave model of Aarsnes & Shor (JPSE 163, 2018) as used in Aarsnes et al.
+(JPSE 179, 2019, Section 2 and Appendix A), with the errata of THEORY.md §3 (viscous term
+of eq. 11, free bit end of eq. 40). The string is cut into sections with their own polar
+moment, shear modulus and density; the Riemann invariants α = ω + τ/ζ and β = ω − τ/ζ
+(eq. 8) are carried on one cell array over the whole string. The time step Δt is common and
+every section gets cells of length Δx_i = c_i·Δt, so the Courant number is exactly 1 in
+every section: the upwind transport is an exact shift (THEORY §3.1).
+
+Layers: :func:`make_grid` (cells from a :class:`~drillfric.drillstring.DrillString`),
+:class:`Plant` (grid + friction, damping, top-drive and bit parameters, as plain arrays),
+:class:`Drive` (how the top drive is driven), :func:`run` (advance and record, calling the
+numba kernel of :mod:`drillfric.kernels` or its NumPy twin), and small physical helpers
+(:func:`energy`, :func:`gravity_fc`). Everything is SI: rad/s, N·m, m, s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from drillfric.drillstring import G_ACCEL, DrillString
+from drillfric.errors import ModelError
+
+#: Top-drive modes of the kernel: PI speed control on a set-point series, a prescribed
+#: motor-torque series, or a prescribed top-drive speed (the speed-driven model of §6.4).
+DRIVE_MODES = {"pi": 0, "torque": 1, "speed": 2}
+#: Columns of the record array returned by the kernels.
+RECORD_COLUMNS = ("surface_rad_s", "motor_torque_Nm", "string_torque_Nm", "bit_rad_s")
+_CANDIDATE_SPREAD = 0.05  # the cell count may move ±5 % from the request to reduce rounding
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Cells of the Courant-1 discretisation (THEORY §3.1).
+
+    Attributes
+    ----------
+    dt_s : float
+        Common time step Δt [s].
+    section_start : ndarray of int
+        First cell of each section, plus the total cell count at the end (length n_sec + 1).
+    length_m : ndarray
+        True section lengths [m].
+    model_length_m : ndarray
+        Modelled section lengths n_i·c_i·Δt [m].
+    wave_speed_m_s : ndarray
+        Wave speed c_i of each section [m/s].
+    x_m : ndarray
+        True measured depth of each cell centre [m] (cells spread evenly over the true
+        section), where F_c(x) is evaluated.
+    dx_true_m : ndarray
+        True length represented by each cell, L_i/n_i [m].
+    zeta_Nms : ndarray
+        Line impedance ζ of each cell [N·m·s/rad].
+    rho_j_kg_m : ndarray
+        ρ·J of each cell [kg·m] (rotational inertia per metre).
+    """
+
+    dt_s: float
+    section_start: np.ndarray
+    length_m: np.ndarray
+    model_length_m: np.ndarray
+    wave_speed_m_s: np.ndarray
+    x_m: np.ndarray
+    dx_true_m: np.ndarray
+    zeta_Nms: np.ndarray
+    rho_j_kg_m: np.ndarray
+
+    @property
+    def n_cells(self) -> int:
+        """Total number of cells."""
+        return int(self.section_start[-1])
+
+    @property
+    def rounding_m(self) -> np.ndarray:
+        """Modelled minus true length of each section [m] (whole cells of c_i·Δt)."""
+        return self.model_length_m - self.length_m
+
+    @property
+    def travel_time_s(self) -> float:
+        """Time for a wave to travel from the top drive to the bit, n·Δt [s]."""
+        return self.n_cells * self.dt_s
+
+    @property
+    def junction_z(self) -> np.ndarray:
+        """Impedance ratio Z = ζ_b/ζ_a at each junction, top-down (THEORY §3)."""
+        first = self.section_start[1:-1]
+        return self.zeta_Nms[first] / self.zeta_Nms[first - 1]
+
+    @property
+    def dx_model_m(self) -> np.ndarray:
+        """Modelled cell length c_i·Δt of each cell [m]."""
+        counts = np.diff(self.section_start)
+        return np.repeat(self.wave_speed_m_s * self.dt_s, counts)
+
+
+def _section_cells(travel_s: np.ndarray, dt: float) -> np.ndarray:
+    return np.maximum(1, np.rint(travel_s / dt)).astype(np.int64)
+
+
+def make_grid(string: DrillString, cells: int = 500) -> Grid:
+    """Cut a drill string into Courant-1 cells (THEORY §3.1).
+
+    Δt is chosen so that the string holds about ``cells`` cells; each section gets
+    n_i = round(L_i/(c_i Δt)) ≥ 1 cells of length c_i·Δt. Among cell totals within ±5 %
+    of ``cells`` the one with the smallest impedance-weighted rounding Σ ζ_i·|n_i c_i Δt − L_i|
+    is taken (short BHA sections otherwise carry the largest relative error); the rounding
+    that remains is reported in :attr:`Grid.rounding_m`.
+
+    Parameters
+    ----------
+    string : DrillString
+        Sections top-down, lengths summing to the bit depth.
+    cells : int
+        Requested number of cells (the paper: 500).
+
+    Returns
+    -------
+    Grid
+
+    Examples
+    --------
+    >>> from drillfric.drillstring import Section
+    >>> s = DrillString((Section("dp", 0.15, 0.12, 1000.0, 0.075, 40.0, 79.3e9),))
+    >>> g = make_grid(s, cells=100)
+    >>> g.n_cells, bool(abs(g.rounding_m[0]) < 1e-9)
+    (100, True)
+    """
+    if cells < 1:
+        raise ModelError(f"the torsional model needs at least one cell, got {cells}")
+    secs = string.sections
+    length = np.array([s.length_m for s in secs], dtype=float)
+    c = np.array([s.wave_speed_m_s for s in secs], dtype=float)
+    zeta = np.array([s.impedance_Nms for s in secs], dtype=float)
+    rho_j = np.array([s.steel_density_kg_m3 * s.polar_moment_m4 for s in secs], dtype=float)
+    travel = length / c
+    total = float(travel.sum())
+    spread = max(1, int(cells * _CANDIDATE_SPREAD))
+    best = None
+    for n_try in range(max(len(secs), cells - spread), cells + spread + 1):
+        dt = total / n_try
+        n = _section_cells(travel, dt)
+        cost = float(np.sum(zeta * np.abs(n * c * dt - length)) / np.sum(zeta * length))
+        key = (round(cost, 9), abs(n_try - cells))
+        if best is None or key < best[0]:
+            best = (key, dt, n)
+    _, dt, counts = best
+    start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    sec_of_cell = np.repeat(np.arange(len(secs)), counts)
+    local = np.arange(start[-1]) - start[sec_of_cell]
+    top = np.concatenate([[0.0], np.cumsum(length)])[:-1]
+    dx_true = (length / counts)[sec_of_cell]
+    return Grid(dt_s=float(dt), section_start=start, length_m=length,
+                model_length_m=counts * c * dt, wave_speed_m_s=c,
+                x_m=top[sec_of_cell] + (local + 0.5) * dx_true, dx_true_m=dx_true,
+                zeta_Nms=zeta[sec_of_cell], rho_j_kg_m=rho_j[sec_of_cell])
+
+
+def gravity_fc(string: DrillString, inc_rad, x_m) -> np.ndarray:
+    """Gravity-only Coulomb torque capacity F_c = r_c·g·ρ·A·sin I [N·m/m] (A&S 2018).
+
+    The normal force of A&S 2018 (steel weight only, no buoyancy, no tension–curvature
+    term; THEORY §2, last paragraph), times the contact radius.
+
+    Parameters
+    ----------
+    string : DrillString
+    inc_rad : callable or array_like
+        Inclination [rad] at ``x_m`` (a callable is evaluated at ``x_m``).
+    x_m : array_like
+        Measured depths [m].
+    """
+    x = np.asarray(x_m, dtype=float)
+    inc = inc_rad(x) if callable(inc_rad) else np.asarray(inc_rad, dtype=float)
+    area = string.along("steel_area_m2", x)
+    rho = string.along("steel_density_kg_m3", x)
+    rc = string.along("contact_radius_m", x)
+    return rc * G_ACCEL * rho * area * np.sin(inc)
+
+
+@dataclass(frozen=True)
+class Plant:
+    """Everything the kernel needs, as plain arrays and numbers (THEORY §3).
+
+    Attributes
+    ----------
+    grid : Grid
+    fc_Nm_m : ndarray
+        Coulomb torque capacity per unit length per unit friction F_c at the cell centres
+        [N·m/m] (from torque and drag, THEORY §2).
+    mu_s, mu_k : float
+        Static and kinetic friction factors [-].
+    omega_c_rad_s : float
+        Static/kinetic switching speed ω_c [rad/s].
+    k_t_per_s : float
+        Viscous damping rate k_t [1/s].
+    top_drive_inertia_kg_m2 : float
+        I_TD [kg·m²].
+    bit_torque_cap_Nm : float
+        Coulomb bit torque magnitude T_bit = μ_bit·WOB·r_bit [N·m]; 0 is a free bit (off
+        bottom). See :func:`bit_torque_cap`.
+    """
+
+    grid: Grid
+    fc_Nm_m: np.ndarray
+    mu_s: float
+    mu_k: float
+    omega_c_rad_s: float
+    k_t_per_s: float = 0.0
+    top_drive_inertia_kg_m2: float = 2900.0
+    bit_torque_cap_Nm: float = 0.0
+
+    def __post_init__(self):
+        if self.top_drive_inertia_kg_m2 <= 0:
+            raise ModelError(f"top-drive inertia must be positive, got "
+                             f"{self.top_drive_inertia_kg_m2} kg·m²",
+                             fix="set rig.top_drive_inertia_kg_m2 > 0")
+        if self.omega_c_rad_s <= 0:
+            raise ModelError(f"ω_c must be positive, got {self.omega_c_rad_s} rad/s",
+                             fix="set model.omega_c_rad_s (or omega_c_rpm) > 0")
+        if self.mu_k < 0 or self.mu_s < 0 or self.mu_k > self.mu_s:
+            raise ModelError(f"need 0 ≤ μ_k ≤ μ_s, got μ_s = {self.mu_s}, μ_k = {self.mu_k}",
+                             fix="the kinetic friction factor cannot exceed the static one")
+        if self.k_t_per_s < 0 or self.bit_torque_cap_Nm < 0:
+            raise ModelError("viscous damping and bit torque must be ≥ 0")
+        if np.shape(self.fc_Nm_m) != (self.grid.n_cells,) or np.any(
+                ~np.isfinite(self.fc_Nm_m)) or np.any(np.asarray(self.fc_Nm_m) < 0):
+            raise ModelError("F_c must be one finite, non-negative value per cell")
+
+    @property
+    def fcap_rad_s(self) -> np.ndarray:
+        """Speed change friction can impose on a cell in one step, per unit μ [rad/s].
+
+        F_c·(L_i/L_i^model)·Δt/(ρJ): the step-3 cap μ·F_c of THEORY §3.1 in speed units.
+        The factor L_i/L_i^model keeps the total capacity Σ = ∫F_c dx of the true string
+        despite the length rounding.
+        """
+        g = self.grid
+        return self.fc_Nm_m * (g.dx_true_m / g.dx_model_m) * g.dt_s / g.rho_j_kg_m
+
+    @property
+    def T_N_Nm(self) -> float:
+        """T_N = ∫F_c dx over the modelled string [N·m] (A&S 2018 eq. 27 per unit μ)."""
+        return float(np.sum(self.fc_Nm_m * self.grid.dx_true_m))
+
+
+def bit_torque_cap(bit_mu: float, wob_N: float, bit_diameter_m: float) -> float:
+    """Bit torque magnitude T_bit = μ_bit·WOB·D_bit/3 [N·m] (uniform contact over the face).
+
+    The bit is a Coulomb element at x = L: |τ_bit| ≤ T_bit while the bit is stuck,
+    τ_bit = T_bit·sign(ω_bit) while it turns. With a rigid-face PDC assumption of uniform
+    pressure the mean friction radius is D/3.
+
+    Examples
+    --------
+    >>> bit_torque_cap(0.3, 60e3, 0.2159)
+    1295.4
+    """
+    return float(bit_mu * wob_N * bit_diameter_m / 3.0)
+
+
+@dataclass(frozen=True)
+class Drive:
+    """How the top drive is driven, as a uniformly sampled series (linear in between).
+
+    Attributes
+    ----------
+    kind : str
+        "pi" (PI speed control on a set-point series [rad/s]), "torque" (prescribed motor
+        torque [N·m]) or "speed" (prescribed top-drive speed [rad/s]).
+    values : ndarray
+        The series; held constant beyond its ends.
+    dt_s : float
+        Sample interval of ``values`` [s].
+    t0_s : float
+        Time of ``values[0]`` [s].
+    kp_Nms_rad, ki_Nm_rad : float
+        PI gains (A&S 2018: 38e3 N·m·s/rad and 100e3 N·m/rad).
+    """
+
+    kind: str
+    values: np.ndarray
+    dt_s: float
+    t0_s: float = 0.0
+    kp_Nms_rad: float = 38e3
+    ki_Nm_rad: float = 100e3
+
+    def __post_init__(self):
+        if self.kind not in DRIVE_MODES:
+            raise ModelError(f"unknown drive kind '{self.kind}'",
+                             fix=f"use one of {', '.join(DRIVE_MODES)}")
+        if self.dt_s <= 0 or np.size(self.values) < 1:
+            raise ModelError("a drive series needs at least one value and dt_s > 0")
+
+
+@dataclass
+class State:
+    """Mutable plant state between calls.
+
+    Attributes
+    ----------
+    alpha, beta : ndarray
+        Riemann invariants of every cell [rad/s] (eq. 8).
+    top : ndarray
+        [ω₀ (top-drive speed, rad/s), ∫(ω_ref − ω₀)dt (PI integral, rad)].
+    t_s : float
+        Time of the state [s].
+    """
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    top: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    t_s: float = 0.0
+
+    @classmethod
+    def rest(cls, grid: Grid, t_s: float = 0.0) -> State:
+        """String at rest with no twist."""
+        return cls(np.zeros(grid.n_cells), np.zeros(grid.n_cells), np.zeros(2), t_s)
+
+    @property
+    def omega_rad_s(self) -> np.ndarray:
+        """Angular velocity ω = (α + β)/2 of every cell [rad/s]."""
+        return 0.5 * (self.alpha + self.beta)
+
+    def torque_Nm(self, grid: Grid) -> np.ndarray:
+        """Torque τ = ζ(α − β)/2 of every cell [N·m]."""
+        return 0.5 * grid.zeta_Nms * (self.alpha - self.beta)
+
+
+@dataclass(frozen=True)
+class Record:
+    """Outputs at the requested rate, linearly interpolated between model steps.
+
+    Attributes
+    ----------
+    time_s : ndarray
+    surface_rad_s : ndarray
+        Top-drive speed ω₀ [rad/s].
+    motor_torque_Nm : ndarray
+        Motor torque τ_m [N·m].
+    string_torque_Nm : ndarray
+        String torque at the top τ(0) = ζ(ω₀ − β(0)) [N·m] (= τ_m − I_TD dω₀/dt).
+    bit_rad_s : ndarray
+        Bit speed: ω of the last cell [rad/s].
+    """
+
+    time_s: np.ndarray
+    surface_rad_s: np.ndarray
+    motor_torque_Nm: np.ndarray
+    string_torque_Nm: np.ndarray
+    bit_rad_s: np.ndarray
+
+
+def energy(grid: Grid, state: State, top_drive_inertia_kg_m2: float = 0.0) -> float:
+    """Mechanical energy of the string (+ top drive) [J] (THEORY §3).
+
+    Per cell ρJω²/2 + τ²/(2JG) over Δx = c Δt equals ζ·Δt·(α² + β²)/4; the top drive adds
+    I_TD·ω₀²/2.
+    """
+    string = 0.25 * grid.dt_s * float(np.sum(grid.zeta_Nms * (state.alpha**2 + state.beta**2)))
+    return string + 0.5 * top_drive_inertia_kg_m2 * float(state.top[0]) ** 2
+
+
+def record_times(t_start_s: float, duration_s: float, rate_hz: float) -> np.ndarray:
+    """Sample times t_start + r/rate for r = 0 … floor(duration·rate) [s]."""
+    n = int(np.floor(duration_s * rate_hz * (1 + 1e-12))) + 1
+    return t_start_s + np.arange(n) / rate_hz
+
+
+def kernel_args(plant: Plant, drive: Drive) -> tuple:
+    """Plain-array arguments shared by the numba kernel and its NumPy twin (in order)."""
+    g = plant.grid
+    return (g.section_start, g.junction_z, g.zeta_Nms, plant.fcap_rad_s, g.dt_s,
+            plant.k_t_per_s * g.dt_s, plant.mu_s, plant.mu_k, plant.omega_c_rad_s,
+            plant.bit_torque_cap_Nm / g.zeta_Nms[-1], 1.0 / plant.top_drive_inertia_kg_m2,
+            DRIVE_MODES[drive.kind], np.ascontiguousarray(drive.values, dtype=float),
+            drive.t0_s, drive.dt_s, drive.kp_Nms_rad, drive.ki_Nm_rad)
+
+
+def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
+        state: State | None = None, *, backend: str = "numba") -> tuple[Record, State]:
+    """Advance the plant for ``duration_s`` and record at ``rate_hz`` (THEORY §3.1).
+
+    Parameters
+    ----------
+    plant : Plant
+    drive : Drive
+    duration_s : float
+        Simulated time [s] (> 0).
+    rate_hz : float
+        Recording rate [Hz] (> 0); records are interpolated linearly between model steps.
+    state : State, optional
+        Initial state (default: at rest, no twist, at t = 0). Not modified.
+    backend : str
+        "numba" (compiled kernel) or "numpy" (the twin, for tests and benchmarks).
+
+    Returns
+    -------
+    (Record, State)
+        The records from ``state.t_s`` to ``state.t_s + duration_s`` and the final state.
+    """
+    if not duration_s > 0 or not rate_hz > 0:
+        raise ModelError(f"duration and rate must be positive, got {duration_s} s, "
+                         f"{rate_hz} Hz")
+    state = State.rest(plant.grid) if state is None else state
+    alpha, beta, top = state.alpha.copy(), state.beta.copy(), state.top.copy()
+    times = record_times(state.t_s, duration_s, rate_hz)
+    n_steps = int(np.ceil(duration_s / plant.grid.dt_s * (1 - 1e-12)))
+    out = np.empty((times.size, len(RECORD_COLUMNS)))
+    if backend == "numba":
+        from drillfric.kernels import run_plant
+    elif backend == "numpy":
+        from drillfric.kernels_numpy import run_plant
+    else:
+        raise ModelError(f"unknown backend '{backend}'", fix="use 'numba' or 'numpy'")
+    run_plant(alpha, beta, top, state.t_s, n_steps, *kernel_args(plant, drive), times, out)
+    rec = Record(times, *(out[:, k] for k in range(out.shape[1])))
+    return rec, State(alpha, beta, top, state.t_s + n_steps * plant.grid.dt_s)

@@ -1,0 +1,313 @@
+"""`drillfric simulate`: scenarios, noise, files and sidecars, one-line errors (exit 2)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric import simulate as sim
+from drillfric import torsional as T
+from drillfric.config import config_from_dict, load_config
+from drillfric.errors import ConfigError
+from drillfric.io.writers import dumps_toml
+from drillfric.wellpath import minimum_curvature
+
+RPM = np.pi / 30.0
+
+CONFIG = """
+[rig]
+top_drive_inertia_kg_m2 = 2900.0
+[model]
+cells = 120
+[simulate]
+mu_s = 0.6
+mu_k = 0.3
+rate_hz = 20.0
+duration_s = 30.0
+rpm = 50.0
+[[string.sections]]
+name = "dp"
+od_m = 0.146529
+id_m = 0.123024
+[[string.sections]]
+name = "collars"
+od_m = 0.2032
+id_m = 0.0714
+length_m = 120.0
+"""
+
+SURVEY = "md_m,inc_deg,azi_deg\n0,0,0\n500,0,0\n1000,30,20\n2000,30,20\n"
+
+SCENARIO = """
+connection_s = 20.0
+[defaults]
+duration_s = 60.0
+rpm = 40.0
+[[stand]]
+bit_depth_m = 1500.0
+start = "creep"
+[[stand]]
+bit_depth_m = 1530.0
+rpm = 60.0
+"""
+
+
+@pytest.fixture
+def well(tmp_path) -> Path:
+    """A config with a survey beside it, as users write them."""
+    (tmp_path / "w.survey.csv").write_text(SURVEY)
+    cfg = tmp_path / "w.toml"
+    cfg.write_text('[survey]\nfile = "w.survey.csv"\n' + CONFIG)
+    (tmp_path / "s.toml").write_text(SCENARIO)
+    return cfg
+
+
+def invoke(*args):
+    return CliRunner().invoke(cli, ["--quiet", "simulate", *map(str, args)])
+
+
+# ------------------------------------------------------------------------------ scenario
+
+def test_creep_start_shape(tmp_path):
+    """THEORY §6.3 creep: 0 → 5 RPM in 5 s, hold 30 s, then ramp to the set-point."""
+    stand = sim.Stand(2000.0, duration_s=100.0, rpm=40.0, start="creep", idle_s=5.0)
+    k = stand.knots()
+    np.testing.assert_allclose(k[:6], [[0, 0], [5, 0], [10, 5], [40, 5], [50, 40], [105, 40]])
+    assert k[-1, 0] == stand.total_s == 5 + 100 + 5 + 10
+
+
+def test_scenario_file_defaults_and_overrides(well):
+    cfg = load_config(well)
+    scen = sim.load_scenario(well.parent / "s.toml", sim.base_stand(cfg))
+    assert [s.bit_depth_m for s in scen.stands] == [1500.0, 1530.0]
+    assert [s.rpm for s in scen.stands] == [40.0, 60.0]
+    assert scen.stands[0].start == "creep" and scen.stands[1].start == "ramp"
+    assert scen.connection_s == 20.0
+    assert scen.total_s == pytest.approx(2 * (5 + 60 + 15) + 20)
+
+
+@pytest.mark.parametrize("text, word", [
+    ("[[stand]]\nrpm = 40.0\n", "bit_depth_m"),
+    ("[[stand]]\nbit_depth_m = 1.0\nspeed = 3\n", "unknown key 'speed'"),
+    ("[[stand]]\nbit_depth_m = 1000.0\nstart = 'jump'\n", "start"),
+    ("[[stand]]\nbit_depth_m = 1000.0\nduration_s = 5.0\n", "start-up"),
+    ("pause = 3\n[[stand]]\nbit_depth_m = 1000.0\n", "unknown key 'pause'"),
+    ("[[stand]]\nbit_depth_m = 1000.0\nsetpoint_rpm = [[1, 2]]\n", "setpoint_rpm"),
+])
+def test_bad_scenarios_name_the_problem(tmp_path, text, word):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=word):
+        sim.load_scenario(path, sim.Stand(float("nan")))
+
+
+def test_explicit_setpoint_with_a_step():
+    """A repeated knot time is a step; values between knots are linear."""
+    t = np.array([0.0, 1.0, 1.0, 2.0])
+    v = np.array([0.0, 1.0, 3.0, 3.0])
+    out = sim._interp_steps(np.array([0.5, 0.999, 1.0, 1.5, 5.0]), t, v)
+    np.testing.assert_allclose(out, [0.5, 0.999, 3.0, 3.0, 3.0])
+
+
+# ----------------------------------------------------------------------------- pipeline
+
+@pytest.fixture(scope="module")
+def two_stands():
+    cfg = config_from_dict({"simulate": {"rate_hz": 20.0, "mu_s": 0.6, "mu_k": 0.3,
+                                         "cells": 120}})
+    path = minimum_curvature([0.0, 500.0, 1000.0, 2000.0], np.radians([0, 0, 30, 30]),
+                             np.radians([0, 0, 20, 20]))
+    scen = sim.Scenario((sim.Stand(1500.0, duration_s=60.0, rpm=40.0, start="creep"),
+                         sim.Stand(1530.0, duration_s=60.0, rpm=60.0)), 20.0)
+    return cfg, path, scen, sim.simulate(cfg, path, scen)
+
+
+def test_columns_time_base_and_connection(two_stands):
+    cfg, _, scen, result = two_stands
+    c = result.columns
+    assert set(c) == {"time_s", "surface_rpm", "surface_torque_Nm", "hookload_N",
+                      "bit_depth_m", "hole_depth_m", "bit_rpm", "string_torque_Nm"}
+    dt = np.diff(c["time_s"])
+    np.testing.assert_allclose(dt, 1 / 20.0, atol=1e-9)
+    assert c["time_s"][-1] == pytest.approx(scen.total_s)
+    s1, s2 = result.stands
+    conn = (c["time_s"] > s1.t_end_s) & (c["time_s"] < s2.t_start_s)
+    assert conn.sum() == 20 * 20 - 1
+    assert np.all(c["surface_rpm"][conn] == 0) and np.all(c["surface_torque_Nm"][conn] == 0)
+    assert np.all(c["hookload_N"][conn] == 0)
+    assert np.all(np.diff(c["bit_depth_m"][conn]) > 0)
+    np.testing.assert_allclose(c["hole_depth_m"] - c["bit_depth_m"], 5.0)
+
+
+def test_creep_hold_and_stick_slip_truth(two_stands):
+    _, _, _, result = two_stands
+    c, s1 = result.columns, result.stands[0]
+    hold = (c["time_s"] > s1.t_rotation_start_s + 10) & (c["time_s"] < s1.creep_end_s)
+    np.testing.assert_allclose(c["surface_rpm"][hold], 5.0, atol=0.2)
+    assert s1.hookload_N > 0 and s1.T_N_Nm > 0
+    assert s1.cells == pytest.approx(120, abs=6)
+    truth = result.truth()
+    assert truth["mu_s"] == 0.6 and truth["mu_k"] == 0.3
+    json.dumps(truth)
+
+
+def test_noise_is_seeded_and_quantised():
+    cols = {"surface_rpm": np.full(20000, 40.0), "surface_torque_Nm": np.full(20000, 1e4),
+            "hookload_N": np.full(20000, 5e5)}
+    a, b, c = (dict(cols) for _ in range(3))
+    sim.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=1).apply(a)
+    sim.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=1).apply(b)
+    sim.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=2).apply(c)
+    np.testing.assert_array_equal(a["surface_rpm"], b["surface_rpm"])
+    assert not np.array_equal(a["surface_rpm"], c["surface_rpm"])
+    # standard error of a 20 000-sample sd is 0.5 %; quantisation adds step²/12
+    assert np.std(a["surface_torque_Nm"]) == pytest.approx(np.hypot(200, 10 / 12**0.5),
+                                                           rel=0.03)
+    np.testing.assert_allclose(a["surface_torque_Nm"] / 10.0,
+                               np.round(a["surface_torque_Nm"] / 10.0), atol=1e-9)
+
+
+def test_bit_on_bottom_adds_bit_torque():
+    """Coulomb bit (docs/simulator.md): steady torque gains T_bit = μ_bit·WOB·D/3."""
+    p = sim.well_b_plant(cells=200, k_t_per_s=0.5, mu_s=0.2, mu_k=0.2)
+    cap = T.bit_torque_cap(0.3, 80e3, 0.2159)
+    on = T.Plant(p.grid, p.fc_Nm_m, p.mu_s, p.mu_k, p.omega_c_rad_s, p.k_t_per_s,
+                 bit_torque_cap_Nm=cap)
+    drive = T.Drive("pi", np.array([0.0, 60 * RPM]), 10.0)
+    off_rec, _ = T.run(p, drive, 80.0, 5.0)
+    on_rec, _ = T.run(on, drive, 80.0, 5.0)
+    gained = on_rec.motor_torque_Nm[-1] - off_rec.motor_torque_Nm[-1]
+    assert gained == pytest.approx(cap, rel=0.01)
+
+
+# ------------------------------------------------------------------------------ CLI
+
+@pytest.mark.parametrize("ext", ["csv", "parquet", "h5"])
+def test_cli_writes_data_and_sidecars_that_read_back(well, tmp_path, ext):
+    out = tmp_path / "out" / f"sim.{ext}"
+    result = invoke(well, "--out", out, "--duration", 20, "--bit-depth", 1500, "--rpm", 40,
+                    "--mu-s", 0.5, "--mu-k", 0.3, "--rpm-noise", 0.5, "--seed", 3)
+    assert result.exit_code == 0, result.output
+    frame = pd.read_csv(out) if ext == "csv" else (
+        pd.read_parquet(out) if ext == "parquet" else pd.read_hdf(out, "surface"))
+    assert list(frame.columns)[:3] == ["time_s", "surface_rpm", "surface_torque_Nm"]
+    assert len(frame) == 20 * 20 + 1
+    cfg = load_config(out.with_suffix(".toml"))
+    assert cfg["simulate.mu_s"] == 0.5 and cfg["survey.file"] == "sim.survey.csv"
+    assert [s["name"] for s in cfg.sections] == ["dp", "collars"]
+    survey = pd.read_csv(out.parent / "sim.survey.csv")
+    assert list(survey.columns) == ["md_m", "inc_deg", "azi_deg"]
+    assert survey["md_m"].iloc[-1] == 2000.0
+    truth = json.loads((out.parent / "sim.truth.json").read_text())
+    assert truth["mu_s"] == 0.5 and truth["stands"][0]["bit_depth_m"] == 1500.0
+    if ext == "parquet":
+        meta = pq.read_schema(out).metadata
+        assert json.loads(meta[b"drillfric.truth"])["mu_k"] == 0.3
+    if ext == "h5":
+        with h5py.File(out) as h5:
+            assert {"surface", "survey", "config"} <= set(h5)
+            assert "mu_s = 0.5" in h5["config"][()].decode()
+
+
+def test_cli_output_is_read_by_ingestion(well, tmp_path):
+    """`drillfric run FILE` consumes the result: the well loader finds data and sidecars."""
+    from drillfric.io.well import load_well
+
+    out = tmp_path / "sim.csv"
+    assert invoke(well, "--out", out, "--duration", 15, "--bit-depth", 1500).exit_code == 0
+    data = load_well(out)
+    assert data.survey is not None and data.survey.md_max_m == 2000.0
+    for name in ("surface_rpm", "surface_torque_Nm", "hookload_N", "bit_depth_m", "bit_rpm"):
+        assert name in data.surface.columns
+    assert data.surface["surface_rpm"].iloc[-1] == pytest.approx(60.0, abs=30.0)
+
+
+def test_cli_scenario_keeps_input_sidecars(well, tmp_path):
+    """Writing NAME.csv beside its own NAME.toml/NAME.survey.csv (the demo) keeps them."""
+    cfg = well.parent / "w.toml"
+    before = cfg.read_text()
+    result = invoke(cfg, "--out", well.parent / "w.csv", "--scenario", well.parent / "s.toml")
+    assert result.exit_code == 0, result.output
+    assert cfg.read_text() == before
+    assert (well.parent / "w.survey.csv").read_text() == SURVEY
+    assert len(pd.read_csv(well.parent / "w.csv")) > 1000
+
+
+def _one_line_error(result):
+    assert result.exit_code == 2, result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "Traceback" not in result.output
+    return lines[0]
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--duration", "0"], "duration_s"),
+    (["--rate", "-5"], "rate_hz"),
+    (["--mu-s", "0.3", "--mu-k", "0.5"], "μ_k"),
+    (["--omega-c-rpm", "0"], "omega_c"),
+    (["--bit-depth", "2500"], "deeper than the survey"),
+])
+def test_cli_bad_input_one_line_exit_2(well, tmp_path, args, word):
+    line = _one_line_error(invoke(well, "--out", tmp_path / "x.csv", *args))
+    assert word in line
+
+
+def test_cli_zero_inertia_and_deep_stand(well, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(well.read_text().replace("2900.0", "0.0"))
+    assert "top_drive_inertia" in _one_line_error(invoke(bad, "--out", tmp_path / "x.csv"))
+    deep = tmp_path / "deep.toml"
+    deep.write_text("[[stand]]\nbit_depth_m = 1500.0\n[[stand]]\nbit_depth_m = 2600.0\n")
+    line = _one_line_error(invoke(well, "--out", tmp_path / "x.csv", "--scenario", deep))
+    assert "stand 2" in line and "deeper than the survey" in line
+
+
+def test_cli_rejects_unknown_output_type(well, tmp_path):
+    assert ".xlsx" in _one_line_error(invoke(well, "--out", tmp_path / "x.xlsx"))
+
+
+def test_toml_round_trip_of_effective_config(well, tmp_path):
+    """The sidecar writer's TOML reads back to the same configuration (channels included)."""
+    path = tmp_path / "c.toml"
+    path.write_text(well.read_text() + '[channels]\nsurface_rpm = { column = "SRPM", '
+                    'unit = "rpm" }\nhookload = "HKLD"\n')
+    cfg = load_config(path)
+    text = dumps_toml(cfg.to_dict())
+    again = config_from_dict(__import__("tomllib").loads(text))
+    assert again.values == cfg.values and again.sections == cfg.sections
+    assert again.channels == cfg.channels == {"surface_rpm": {"column": "SRPM", "unit": "rpm"},
+                                              "hookload": {"column": "HKLD"}}
+
+
+def test_cli_bit_depth_overrides_configured_scenario(well, tmp_path):
+    """--bit-depth without --scenario: one stand, even if [simulate] names a scenario."""
+    cfg = tmp_path / "with_scenario.toml"
+    cfg.write_text(well.read_text().replace("[simulate]\n", '[simulate]\nscenario = "s.toml"\n'))
+    out = tmp_path / "one.csv"
+    assert invoke(cfg, "--out", out, "--bit-depth", 1400, "--duration", 10).exit_code == 0
+    truth = json.loads((tmp_path / "one.truth.json").read_text())
+    assert [s["bit_depth_m"] for s in truth["stands"]] == [1400.0]
+    assert invoke(cfg, "--out", out).exit_code == 0
+    truth = json.loads((tmp_path / "one.truth.json").read_text())
+    assert [s["bit_depth_m"] for s in truth["stands"]] == [1500.0, 1530.0]
+
+
+def test_on_bottom_stand_records_wob_and_hole_depth():
+    """A stand with WOB: T&D on-bottom load case, Coulomb bit, wob_N column, bit at bottom."""
+    cfg = config_from_dict({"model": {"cells": 100}, "simulate": {"rate_hz": 10.0}})
+    scen = sim.Scenario((sim.Stand(1200.0, duration_s=30.0, rpm=60.0, wob_N=50e3),), 0.0)
+    off = sim.simulate(cfg, None, sim.Scenario((sim.Stand(1200.0, duration_s=30.0, rpm=60.0),),
+                                               0.0))
+    on = sim.simulate(cfg, None, scen)
+    c = on.columns
+    assert "wob_N" in c and "wob_N" not in off.columns
+    np.testing.assert_array_equal(c["hole_depth_m"], c["bit_depth_m"])
+    assert on.stands[0].hookload_N < off.stands[0].hookload_N - 49e3
