@@ -6,7 +6,7 @@ noise 0.5 RPM and 200 N·m. Estimators: the full chain (`estimate_segment`: obse
 4 starts spanning μ_s 0.2–0.9, μ_k 0.05–0.4 → batch → seeded observer), and the observer
 alone with the paper's printed laws (backstepping gains, eqs. 42–43) from the same starts.
 
-Run: ``python benchmarks/validate_estimation.py > docs/parts/validation_estimation.md``
+Run: ``python benchmarks/validate_estimation.py`` (its table is in docs/validation.md)
 (about 5–10 minutes on one core).
 """
 

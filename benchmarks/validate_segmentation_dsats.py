@@ -11,7 +11,7 @@ Run from the repository root (the data are read in place, never copied)::
 
     python benchmarks/validate_segmentation_dsats.py [DATA_DIR]
 
-DATA_DIR defaults to ../shared/data/real/dsats_1hz. Results: docs/parts/validation_segmentation.md.
+DATA_DIR defaults to ../shared/data/real/dsats_1hz. Results: docs/validation.md.
 """
 
 from __future__ import annotations

@@ -1,14 +1,100 @@
-"""`drillfric fleet` (INTERFACE.md) — not built yet."""
+"""`drillfric fleet` (INTERFACE.md, docs/fleet.md): every well of a directory or manifest.
+
+Thin layer over :func:`drillfric.fleet.run_many`: a progress bar over wells, one line per
+failed well, a closing summary line. SIGTERM (and Ctrl-C) stop the run cleanly: finished
+wells stay recorded in OUT/manifest.json, no half-written well directory is left, and the
+next run completes the rest. Exit codes: 0 all ok, 1 some wells or segments failed, 2 bad
+usage or no well readable, 128+signal when interrupted.
+"""
 
 from __future__ import annotations
 
+import os
+import signal
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
 import click
 
-from .common import UserError
+from .common import UserError, echo, progress
 
 
-@click.command("fleet", context_settings={"ignore_unknown_options": True})
-@click.argument("args", nargs=-1, type=click.UNPROCESSED)
-def command(args) -> None:
-    """Not built yet."""
-    raise UserError("'drillfric fleet' is not built yet in this version")
+def _default_workers() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
+        (os.cpu_count() or 1)
+
+
+@contextmanager
+def _sigterm_interrupts():
+    """Turn SIGTERM into KeyboardInterrupt for the duration of the run; yield the signal."""
+    received: list[int] = []
+
+    def handler(signum, frame):
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _closing_line(result) -> str:
+    ok, skipped, failed = (result.count(s) for s in ("ok", "skipped", "failed"))
+    total = len(result.wells)
+    if skipped == total:
+        return (f"fleet: all {total} wells skipped (unchanged since the last run; --force to "
+                f"redo them) — {result.out_root}")
+    parts = [f"{ok} processed", f"{skipped} skipped (unchanged)", f"{failed} failed"]
+    if result.failed_segments:
+        parts.append(f"{result.failed_segments} segments failed")
+    return (f"fleet: {total} wells — {', '.join(parts)} in {result.wall_s:.1f} s — "
+            f"{result.manifest}")
+
+
+@click.command("fleet")
+@click.argument("source", metavar="DIR_OR_MANIFEST", type=click.Path(path_type=Path))
+@click.option("--out", "out", required=True, type=click.Path(path_type=Path),
+              help="Output directory: OUT/NAME per well, manifest.json, "
+                   "fleet_summary.parquet, fleet.html.")
+@click.option("--scheduler", metavar="ADDRESS", help="Dask scheduler (tcp://HOST:PORT); "
+              "the inputs and OUT must be on storage its workers share.")
+@click.option("--workers", type=int, help="Local worker processes (default: all cores).")
+@click.option("--force", is_flag=True, help="Redo every well, even unchanged ones.")
+@click.option("--config", type=click.Path(path_type=Path),
+              help="Configuration (TOML) for every well, overriding NAME.toml sidecars "
+                   "(not a config a manifest names).")
+def command(source: Path, out: Path, scheduler, workers, force, config) -> None:
+    """Run every well of DIR_OR_MANIFEST (a directory of wells, or a .csv/.json manifest
+    with columns well, data, config, survey), skipping wells unchanged since their last run.
+    """
+    from drillfric.fleet import discover, run_many
+
+    if workers is not None and workers < 1:
+        raise UserError(f"--workers must be at least 1, got {workers}")
+    if config is not None and not config.is_file():
+        raise UserError(f"{config}: config file not found — fix: check the --config path")
+    specs = discover(source, config=config)
+    with _sigterm_interrupts() as received:
+        try:
+            with progress(f"fleet ({len(specs)} wells)", total=len(specs)) as advance:
+                result = run_many(specs, out, workers=workers or _default_workers(),
+                                  scheduler=scheduler, force=force, progress=advance)
+        except KeyboardInterrupt:
+            signum = received[0] if received else signal.SIGINT
+            click.secho(f"interrupted: finished wells are recorded in {out / 'manifest.json'}"
+                        "; run the same command again to complete the rest", err=True,
+                        fg="yellow")
+            sys.exit(128 + signum)
+    for well in result.wells:
+        if well.status == "failed":
+            click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
+    for note in result.notes:
+        click.secho(f"note: {note}", err=True)
+    echo(_closing_line(result))
+    if result.count("failed") == len(result.wells):
+        raise UserError("no well could be processed (see the errors above)")
+    if result.count("failed") or result.failed_segments:
+        sys.exit(1)

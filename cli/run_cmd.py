@@ -66,6 +66,9 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
     if workers < 1:
         raise UserError(f"--workers must be at least 1, got {workers}")
     pairs = parse_starts(starts)
+    if workers > 1 and len(wells) > 1:
+        _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers)
+        return
     failures = 0
     unreadable = 0
     for well in wells:
@@ -87,4 +90,24 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
     if unreadable == len(wells):
         raise UserError("no well could be read")
     if failures or unreadable:
+        raise SystemExit(1)
+
+
+def _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers) -> None:
+    """Several wells on local worker processes, through the fleet executor (always redone)."""
+    from drillfric.fleet import WellSpec, run_many
+
+    specs = [WellSpec(Path(w), config=config, survey=survey) for w in wells]
+    overrides = {"observer.starts": [list(p) for p in pairs]} if pairs else None
+    with progress(f"run ({len(specs)} wells)", total=len(specs)) as advance:
+        result = run_many(specs, out, workers=workers, force=True, progress=advance,
+                          overrides=overrides, rate_hz=rate, pdf=pdf)
+    for well in result.wells:
+        if well.status == "failed":
+            click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
+        elif well.result_dir is not None:
+            echo(f"{well.well}: report: {Path(well.result_dir) / 'report.html'}")
+    if result.count("failed") == len(result.wells):
+        raise UserError("no well could be read")
+    if result.count("failed") or result.failed_segments:
         raise SystemExit(1)

@@ -56,7 +56,7 @@ CREEP_LEVELS = 3  #: creep fits at MD/1000, then doubled cells at most twice
 CREEP_STENCIL = 0.04  #: relative half-width of the parabola of a creep refit
 #: Slowest logging rate for a creep fit [Hz]: the twist is the integral of the logged speed,
 #: and its noise (σ√(Δt·T)) moved μ_s by +17…+33 % at 1 Hz with 0.5 RPM noise, ±6 % at 5 Hz
-#: (docs/parts/validation_batch.md).
+#: (docs/validation.md).
 MIN_CREEP_RATE_HZ = 2.0
 PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
 MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find

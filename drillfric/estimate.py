@@ -30,7 +30,6 @@ from drillfric.observer import Measurements, Observer, ObserverRecord, ObserverS
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, vertical
 
-
 #: Batch flags under which a stick-slip-onset bound on μ_s is not reported (THEORY §6.4: a
 #: bound above the truth is a false claim; prefer none).
 UNRELIABLE_BOUND = frozenset({"regime_mismatch", "bistable_regime",
@@ -241,7 +240,10 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     flags = [f"observer_{f}" for f in diag.flags] + list(refined.flags)
     messages = list(refined.messages)
     bound = refined.mu_s_lower_bound
-    if bound is not None and UNRELIABLE_BOUND.intersection(refined.flags):
+    if bound is not None and on_bottom:
+        bound = None
+        messages.append("μ_s lower bound withheld on bottom: the bit drives the torque swings")
+    elif bound is not None and UNRELIABLE_BOUND.intersection(refined.flags):
         bound = None
         messages.append("μ_s lower bound withheld: the model does not reproduce the data's "
                         "stick-slip regime")

@@ -156,12 +156,13 @@ def _profile_frame(seg_id: int, est: SegmentEstimate, step_m: float = 10.0) -> p
 def consensus(rows: list[dict]) -> dict:
     """Well-level friction factors from the segments (never a made-up value).
 
-    μ_k: median over converged, off-bottom segments with status ok; μ_s: median over the
-    segments that identify it; otherwise the median of the segments' lower bounds (each is
+    Only converged, off-bottom segments with status ok count. μ_k: their median; μ_s: the
+    median over those that identify it; otherwise the median of their lower bounds (each is
     claimed valid, so the median is too, and one unreliable segment cannot set it).
     """
-    ok = [r for r in rows if r["status"] == "ok" and r["kind"] == "off_bottom_rotating"]
-    mu_k = [r["mu_k"] for r in ok if r["converged"] and r["mu_k"] is not None]
+    ok = [r for r in rows if r["status"] == "ok" and r["kind"] == "off_bottom_rotating"
+          and r["converged"]]
+    mu_k = [r["mu_k"] for r in ok if r["mu_k"] is not None]
     mu_s = [r["mu_s"] for r in ok if r["mu_s_identifiable"] and r["mu_s"] is not None]
     bounds = [r["mu_s_lower_bound"] for r in ok if r["mu_s_lower_bound"] is not None]
     return {"mu_k": float(np.median(mu_k)) if mu_k else None,

@@ -9,7 +9,7 @@ string length.
 
 Rules and thresholds (config table ``[segmentation]``) are documented in
 docs/segmentation.md; the agreement with published rig-state labels is in
-docs/parts/validation_segmentation.md.
+docs/validation.md.
 
 The classifier is causal (each sample depends on the past only, through a small carried
 state) and segments depend only on the samples between two non-rotating samples or time

@@ -114,3 +114,21 @@ def test_survey_ending_above_the_bit_fails_segments(tmp_path):
 def test_bad_starts_option(tmp_path):
     result = CliRunner().invoke(cli, ["run", str(DEMO / "demo.csv"), "--starts", "0.2:0.5"])
     assert result.exit_code == 2 and "MU_S:MU_K" in result.output
+
+
+def test_several_wells_on_two_workers(tmp_path):
+    """`run A B --workers 2` goes through the fleet executor: both wells complete."""
+    for name in ("a", "b"):
+        shutil.copy(DEMO / "demo.csv", tmp_path / f"{name}.csv")
+        shutil.copy(DEMO / "demo.survey.csv", tmp_path / f"{name}.survey.csv")
+        text = (DEMO / "demo.toml").read_text()
+        text = text.replace('name = "demo"', f'name = "{name}"').replace(
+            'data = "demo.csv"', f'data = "{name}.csv"').replace(
+            'file = "demo.survey.csv"', f'file = "{name}.survey.csv"')
+        (tmp_path / f"{name}.toml").write_text(text)
+    result = CliRunner().invoke(cli, ["run", str(tmp_path / "a.csv"), str(tmp_path / "b.csv"),
+                                      "--out", str(tmp_path / "o"), "--workers", "2"])
+    assert result.exit_code == 0, result.output
+    for name in ("a", "b"):
+        summary = json.loads((tmp_path / "o" / name / "summary.json").read_text())
+        assert summary["well"] == name and summary["counts"]["estimated"] == 4

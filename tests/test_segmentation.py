@@ -381,7 +381,7 @@ def dsats_result():
 
 
 def test_dsats_drilling_agreement(dsats_result):
-    """Regression guard at the measured values (docs/parts/validation_segmentation.md).
+    """Regression guard at the measured values (docs/validation.md).
 
     The thresholds were tuned on the first half (t < 25 000 s): 95.0 % agreement there.
     On all the data 88.8 %: the held-out half holds three stretches labelled 8 that show
@@ -396,6 +396,6 @@ def test_dsats_drilling_agreement(dsats_result):
 
 
 @pytest.mark.xfail(strict=True, reason="acceptance target (issue 6) not met on the whole "
-                   "record: 88.8 %; see docs/parts/validation_segmentation.md")
+                   "record: 88.8 %; see docs/validation.md")
 def test_dsats_drilling_agreement_meets_acceptance(dsats_result):
     assert dsats_result["all"]["accuracy"] >= 0.90

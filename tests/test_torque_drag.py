@@ -339,7 +339,7 @@ def test_johancsik_example3_against_semi_analytic_solution():
     """Johancsik et al. 1984 Example 3 (CASES.md) at μ = 0.39, against closed forms.
 
     The paper's printed loads are not available here (numbers we get are recorded in
-    docs/parts/validation_torque_drag.md). What is exact on this well: the hold is straight
+    docs/validation.md). What is exact on this well: the hold is straight
     (slant formula per element) and the build is a planar arc where the string is
     tension-dominated, so the soft-string equations become a linear ODE integrated here by
     quadrature; the vertical part adds w·L. The march is first order in the element size
@@ -514,7 +514,7 @@ def test_volve_f5_apparent_friction_in_plausible_band(real_data):
     """Real data (../shared/data/real README): Volve F-5 survey, USROP F-5 on-bottom torque.
 
     String and BHA are not published: 5½" DP + 150 m 6¾" collars and the bit torque are
-    assumptions (docs/parts/validation_torque_drag.md), so this is a plausibility band, not
+    assumptions (docs/validation.md), so this is a plausibility band, not
     a validated truth: 0.1–0.3 for the 5–95 % range of the per-10-m apparent friction.
     """
     mus = f5_back_calculated_frictions(real_data)

@@ -234,7 +234,7 @@ def test_stick_slip_torque_swing_well_b(well_b):
     That is an upper estimate: the string is released progressively from the top (THEORY
     §6.2) and the top drive keeps sliding, so the torque never climbs to μ_s∫F_c dx.
     Re-running A&S's published algorithm on Well B gives 0.72 of the estimate; this model
-    0.5–0.6 (docs/parts/validation_simulator.md). Accept [0.45, 1.0], require real
+    0.5–0.6 (docs/validation.md). Accept [0.45, 1.0], require real
     stick-slip (bit stuck part of the time, peaks above twice the set-point).
     """
     plant, rec = well_b

@@ -44,8 +44,8 @@ def test_volve_survey_matches_operator(real_data, well):
     within 0.05°/30 m (issue 2 acceptance).
 
     The file prints angles to 0.01°, TVD and DLS to 0.01 and offsets to 0.001, so the same
-    method reproduces it to ~0.005 m / ~0.005°/30 m (measured: docs/parts/
-    validation_wellpath.md). The operator evidently computed from unrounded angles: over
+    method reproduces it to ~0.005 m / ~0.005°/30 m (measured:
+    docs/validation.md). The operator evidently computed from unrounded angles: over
     F-12's 10 m stations the ±0.005° rounding moves DLS by up to 0.03°/30 m and the offsets
     drift by a random walk of rounding (0.010 m). A method error shows up at once: balanced
     tangential (RF = 1) misses by 0.07–0.72 m on these wells. The surveys start at
@@ -91,7 +91,7 @@ def test_p130_cr_only_survey(real_data):
     at 2.5°), so it ignores the ~0.42 m that the 2–3° upper hole loses. From 459.8 m on the
     file's TVD has decimals; tied in there, our TVD follows it within 0.2 m: MD and TVD are
     printed to 0.1 m, i.e. ±0.05 m each at a station and at the tie-in station
-    (measured max 0.16 m, RMS 0.09 m; docs/parts/validation_wellpath.md).
+    (measured max 0.16 m, RMS 0.09 m; docs/validation.md).
     """
     f = real_data / "volve_surveys" / "P-130_deviation_survey.csv"
     raw = f.read_bytes()

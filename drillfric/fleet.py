@@ -1,0 +1,626 @@
+"""``drillfric fleet``: many wells, incremental and fault-isolated (issue 8, docs/fleet.md).
+
+The unit of work is a well: :func:`process_well` runs :func:`drillfric.pipeline.run_well`
+on a worker, which writes OUT/NAME itself (temporary directory + rename, so a well directory
+is either complete or absent). The client only prepares tasks (input hashes, effective
+configuration hash), collects small result records and keeps ``OUT/manifest.json``.
+
+Execution: one code path through :class:`dask.distributed.Client` — a ``LocalCluster`` of
+worker processes by default, an existing cluster with ``scheduler``; ``workers=1`` without
+a scheduler runs in this process (nothing to start). A task whose worker died is
+rescheduled by Dask and, if Dask gives up (``KilledWorker``), resubmitted by the client up
+to :data:`MAX_ATTEMPTS` times. With a remote scheduler the inputs and OUT must be on storage
+that every worker and the client see under the same absolute paths.
+
+Library code: no printing, no signal handlers (the CLI turns SIGTERM into
+``KeyboardInterrupt``; :func:`run_many` then records what finished and re-raises).
+"""
+
+from __future__ import annotations
+
+import csv
+import fcntl
+import hashlib
+import json
+import os
+import shutil
+import socket
+import time
+import uuid
+import warnings
+from collections.abc import Callable, Iterator
+from contextlib import closing, contextmanager
+from dataclasses import dataclass, field, replace
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pandas as pd
+
+from drillfric import __version__
+from drillfric.errors import DrillfricError, InputError
+from drillfric.outputs import file_sha256, jsonable, write_json
+
+MANIFEST = "manifest.json"
+SUMMARY = "fleet_summary.parquet"
+REPORT = "fleet.html"
+#: Attempts of a well whose worker died (Dask's own rescheduling comes on top).
+MAX_ATTEMPTS = 3
+#: Seconds between two saves of the manifest while wells complete (always saved at the end).
+SAVE_EVERY_S = 2.0
+#: Seconds to wait for a ``--scheduler`` to answer.
+CONNECT_TIMEOUT_S = 20
+_LOCK = ".fleet.lock"
+_DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las")
+_SIDECAR_TAGS = (".survey", ".truth")
+_MANIFEST_COLUMNS = ("well", "data", "config", "survey")
+
+
+# --------------------------------------------------------------------------- discovery
+@dataclass(frozen=True)
+class WellSpec:
+    """A well to process: a data file, an HDF5 bundle or a well directory (INTERFACE.md).
+
+    Attributes
+    ----------
+    data : Path
+        What ``drillfric run`` accepts as WELL.
+    name : str or None
+        Output name (OUT/NAME); None: the configuration's ``well.name``, else the stem.
+    config, survey : Path or None
+        Overrides of the sidecars (``--config``, manifest columns).
+    """
+
+    data: Path
+    name: str | None = None
+    config: Path | None = None
+    survey: Path | None = None
+
+
+def discover(source, *, config=None) -> list[WellSpec]:
+    """The wells of a directory or of a manifest file (CSV or JSON).
+
+    A directory holds data files with their sidecars (``NAME.toml``, ``NAME.survey.csv``,
+    ``NAME.truth.json`` are not wells) and well directories (holding ``well.toml``).
+    A manifest has columns/keys ``well, data, config, survey`` (``data`` required; relative
+    paths are relative to the manifest). ``config`` (``--config``) applies to every well
+    that does not name its own.
+
+    Raises
+    ------
+    InputError
+        Missing source, unreadable manifest, or no well found.
+    """
+    source = Path(source)
+    if not source.exists():
+        raise InputError("not found", file=source, fix="give a directory of wells or a "
+                         "manifest (.csv/.json with columns well, data, config, survey)")
+    if source.is_dir():
+        specs = _discover_dir(source)
+    else:
+        specs = _read_manifest(source)
+    if not specs:
+        raise InputError("no wells found", file=source,
+                         fix=f"put data files ({', '.join(_DATA_EXT)}) or well directories "
+                             "(with well.toml) there")
+    if config is not None:
+        specs = [s if s.config is not None else replace(s, config=Path(config)) for s in specs]
+    return specs
+
+
+def _discover_dir(folder: Path) -> list[WellSpec]:
+    specs = []
+    for path in sorted(folder.iterdir()):
+        if path.name.startswith("."):
+            continue
+        if path.is_dir():
+            if (path / "well.toml").is_file():
+                specs.append(WellSpec(path))
+        elif path.suffix.lower() in _DATA_EXT and not path.stem.endswith(_SIDECAR_TAGS):
+            specs.append(WellSpec(path))
+    return specs
+
+
+def _read_manifest(path: Path) -> list[WellSpec]:
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".csv":
+            with open(path, newline="", encoding="utf-8") as fh:
+                rows = list(csv.DictReader(fh))
+        elif suffix == ".json":
+            rows = json.loads(path.read_text(encoding="utf-8"))
+            rows = rows.get("wells", rows) if isinstance(rows, dict) else rows
+        else:
+            raise InputError("a fleet manifest must be .csv or .json", file=path,
+                             fix="give a directory of wells or a .csv/.json manifest")
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, csv.Error) as exc:
+        raise InputError(f"unreadable manifest ({exc})", file=path,
+                         fix="write a CSV/JSON list with columns well, data, config, "
+                             "survey") from None
+    if not isinstance(rows, list) or any(not isinstance(r, dict) or not r.get("data")
+                                         for r in rows):
+        raise InputError("every manifest entry needs a 'data' path", file=path,
+                         fix=f"use columns {', '.join(_MANIFEST_COLUMNS)} (data required)")
+
+    def where(value) -> Path | None:
+        return None if not value else (path.parent / str(value)).resolve()
+
+    return [WellSpec(where(r["data"]), r.get("well") or None, where(r.get("config")),
+                     where(r.get("survey"))) for r in rows]
+
+
+# --------------------------------------------------------------------------- the task
+@dataclass(frozen=True)
+class WellTask:
+    """What a worker receives: plain, picklable, absolute paths."""
+
+    name: str
+    data: str
+    config: str | None
+    survey: str | None
+    out_root: str
+    overrides: dict
+    rate_hz: float | None = None
+    pdf: bool = False
+
+
+def process_well(task: WellTask) -> dict:
+    """Run one well on a worker and return its small result record (never raises).
+
+    The worker writes OUT/NAME itself (atomically). The record carries the status, the
+    message of a failure, the summary, timings and where it ran.
+    """
+    from drillfric.pipeline import run_well
+
+    started = _now()
+    t0 = time.perf_counter()
+    record = {"status": "failed", "message": "", "summary": None, "out_dir": None,
+              "failed_segments": 0}
+    try:
+        result = run_well(task.data, task.out_root, config=task.config, survey=task.survey,
+                          overrides=task.overrides, rate_hz=task.rate_hz, pdf=task.pdf)
+        record.update(status="ok", summary=jsonable(result.summary),
+                      out_dir=str(result.out_dir), failed_segments=result.failed)
+    except DrillfricError as exc:
+        record["message"] = exc.message
+    except Exception as exc:  # noqa: BLE001 — one bad well must not spoil the night
+        record["message"] = f"internal error: {type(exc).__name__}: {exc}"
+    record.update(started_utc=started, finished_utc=_now(),
+                  task_s=time.perf_counter() - t0, worker=f"{socket.gethostname()}:"
+                  f"{os.getpid()}", worker_version=__version__)
+    return record
+
+
+def _now() -> str:
+    return datetime.now(UTC).isoformat(timespec="seconds")
+
+
+# --------------------------------------------------------------------------- preparation
+@dataclass(frozen=True)
+class _Job:
+    """A well after preparation: its task and fingerprint, or why it cannot run."""
+
+    name: str
+    task: WellTask | None
+    fingerprint: dict
+    error: str = ""
+
+
+def _prepare(spec: WellSpec, out_root: Path, overrides: dict, options: dict,
+             known: dict) -> _Job:
+    """Resolve files, hash them (reusing hashes of unchanged size and mtime), hash config."""
+    from drillfric.io.well import load_setup, resolve_well
+
+    fallback = spec.name or spec.data.stem
+    try:
+        files = resolve_well(spec.data, config=spec.config, survey=spec.survey)
+        over = dict(overrides) | ({"well.name": spec.name} if spec.name else {})
+        cfg, _ = load_setup(spec.data, config=spec.config, survey=spec.survey, overrides=over)
+        name = cfg["well.name"] or (spec.data.name if spec.data.is_dir() else files[0].stem)
+        inputs = {role: _file_stamp(p, known) for role, p in zip(("data", "config", "survey"),
+                                                                 files, strict=True) if p}
+    except DrillfricError as exc:
+        return _Job(fallback, None, {}, exc.message)
+    except OSError as exc:
+        return _Job(fallback, None, {}, f"{exc.filename}: cannot read ({exc.strerror})")
+    effective = json.dumps(jsonable({"config": cfg.to_dict(), "options": options}),
+                           sort_keys=True, default=str)
+    fingerprint = {"inputs": inputs, "drillfric_version": __version__,
+                   "config_sha256": hashlib.sha256(effective.encode()).hexdigest()}
+    task = WellTask(name, str(Path(spec.data).resolve()), _abs(spec.config),
+                    _abs(spec.survey), str(out_root.resolve()), over | {"well.name": name},
+                    options.get("rate_hz"), options.get("pdf", False))
+    return _Job(name, task, fingerprint)
+
+
+def _abs(path) -> str | None:
+    return None if path is None else str(Path(path).resolve())
+
+
+def _file_stamp(path: Path, known: dict) -> dict:
+    stat = path.stat()
+    key = str(path.resolve())
+    stamp = {"path": key, "size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
+    old = known.get(key)
+    if old and old.get("size") == stat.st_size and old.get("mtime_ns") == stat.st_mtime_ns:
+        return stamp | {"sha256": old["sha256"]}
+    return stamp | {"sha256": file_sha256(path)}
+
+
+def _same(fingerprint: dict, entry: dict | None) -> bool:
+    """True when ``entry`` (manifest) was an ok run of the same inputs, config, version."""
+    if not entry or entry.get("status") != "ok":
+        return False
+
+    def digests(fp):
+        return {role: f["sha256"] for role, f in fp.get("inputs", {}).items()}
+
+    outputs = entry.get("outputs", {}).get("summary")
+    return (outputs is not None and Path(outputs).is_file()
+            and digests(fingerprint) == digests(entry)
+            and fingerprint["config_sha256"] == entry.get("config_sha256")
+            and fingerprint["drillfric_version"] == entry.get("drillfric_version"))
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class WellOutcome:
+    """One well of a fleet run.
+
+    Attributes
+    ----------
+    well : str
+    status : str
+        ``"ok"`` (processed now), ``"skipped"`` (unchanged since an ok run) or ``"failed"``.
+    message : str
+        Why it failed (one line).
+    result_dir : Path or None
+    summary : dict or None
+        summary.json of the well.
+    failed_segments : int
+    task_s : float
+        Time inside the task (0 when skipped) [s].
+    attempts : int
+    """
+
+    well: str
+    status: str
+    message: str = ""
+    result_dir: Path | None = None
+    summary: dict | None = None
+    failed_segments: int = 0
+    task_s: float = 0.0
+    attempts: int = 0
+
+
+@dataclass(frozen=True)
+class FleetResult:
+    """A fleet run: outcomes in input order and the fleet files written."""
+
+    out_root: Path
+    wells: tuple[WellOutcome, ...]
+    wall_s: float
+    manifest: Path
+    summary: Path
+    report: Path | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def count(self, status: str) -> int:
+        """Wells with this status."""
+        return sum(w.status == status for w in self.wells)
+
+    @property
+    def failed_segments(self) -> int:
+        """Failed segments over the wells that ran or were skipped."""
+        return sum(w.failed_segments for w in self.wells)
+
+
+class _Manifest:
+    """OUT/manifest.json: one entry per well, saved atomically (throttled while running)."""
+
+    def __init__(self, out_root: Path):
+        self.path = out_root / MANIFEST
+        try:
+            self.data = json.loads(self.path.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError):
+            self.data = {}
+        if not isinstance(self.data, dict) or not isinstance(self.data.get("wells"), dict):
+            self.data = {"wells": {}}  # unreadable: every well runs again
+        self._saved = 0.0
+
+    @property
+    def wells(self) -> dict:
+        return self.data["wells"]
+
+    def known_files(self) -> dict:
+        """path → stamp of every input file recorded (to reuse hashes)."""
+        return {f["path"]: f for e in self.wells.values()
+                for f in e.get("inputs", {}).values() if "sha256" in f}
+
+    def save(self, *, now: bool = True) -> None:
+        if not now and time.monotonic() - self._saved < SAVE_EVERY_S:
+            return
+        self.data.update(drillfric_version=__version__, updated_utc=_now())
+        tmp = self.path.with_name(f".{MANIFEST}.tmp-{os.getpid()}")
+        write_json(tmp, self.data)
+        os.replace(tmp, self.path)
+        self._saved = time.monotonic()
+
+
+# --------------------------------------------------------------------------- execution
+def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | None = None,
+             force: bool = False, progress: Callable[[float], None] | None = None,
+             overrides: dict | None = None, rate_hz: float | None = None,
+             pdf: bool = False) -> FleetResult:
+    """Process wells in parallel, skipping those unchanged since their last ok run.
+
+    Parameters
+    ----------
+    wells : list of WellSpec
+    out_root : str or Path
+        OUT: well directories, manifest.json, fleet_summary.parquet, fleet.html.
+    workers : int
+        Local worker processes (ignored with ``scheduler``); with 1 (or one well to do)
+        the wells run in this process.
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``); OUT and the inputs must be on
+        storage shared with its workers.
+    force : bool
+        Redo every well.
+    progress : callable, optional
+        Called with 1 for every well finished or skipped.
+    overrides : dict, optional
+        ``{"table.key": value}`` for every well.
+    rate_hz, pdf
+        As for ``drillfric run``.
+
+    Raises
+    ------
+    DrillfricError
+        OUT is locked by another fleet run or cannot be created.
+    KeyboardInterrupt
+        Re-raised after the manifest is saved (finished wells stay recorded).
+    """
+    t0 = time.perf_counter()
+    out_root = Path(out_root)
+    advance = progress or (lambda amount=1.0: None)
+    options = {"rate_hz": rate_hz, "pdf": pdf}
+    with _locked(out_root):
+        _remove_stale(out_root)
+        manifest = _Manifest(out_root)
+        known = manifest.known_files()
+        jobs = _unique([_prepare(s, out_root, overrides or {}, options, known) for s in wells])
+        outcomes: dict[str, WellOutcome] = {}
+        todo = []
+        for job in jobs:
+            entry = manifest.wells.get(job.name)
+            if job.task is None:
+                outcomes[job.name] = _record(manifest, job, {"status": "failed",
+                                                             "message": job.error}, 0)
+                advance(1.0)
+            elif not force and _same(job.fingerprint, entry):
+                outcomes[job.name] = _skipped(job.name, entry)
+                advance(1.0)
+            else:
+                todo.append(job)
+        try:
+            with closing(_execute(todo, workers=workers, scheduler=scheduler)) as done:
+                for job, rec, attempts in done:
+                    outcomes[job.name] = _record(manifest, job, rec, attempts)
+                    manifest.save(now=False)
+                    advance(1.0)
+        finally:
+            manifest.save()
+            if scheduler is None:  # local workers are gone: what they left is stale
+                _remove_stale(out_root)
+        ordered = tuple(outcomes[j.name] for j in jobs)
+        summary = _write_summary(out_root, ordered)
+        report, notes = _write_report(out_root, ordered)
+    return FleetResult(out_root, ordered, time.perf_counter() - t0, manifest.path, summary,
+                       report, notes)
+
+
+def _unique(jobs: list[_Job]) -> list[_Job]:
+    """Two wells writing to the same OUT/NAME: the second one fails with a clear message."""
+    seen: set[str] = set()
+    out = []
+    for job in jobs:
+        if job.name in seen:
+            job = _Job(f"{job.name} ({job.task.data if job.task else '?'})", None, {},
+                       f"another well of this fleet is also named '{job.name}' — give it its "
+                       "own [well] name or a 'well' column in a manifest")
+        seen.add(job.name)
+        out.append(job)
+    return out
+
+
+def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int) -> WellOutcome:
+    entry = {**job.fingerprint, "status": rec["status"], "message": rec["message"],
+             "attempts": attempts, "failed_segments": rec.get("failed_segments", 0),
+             **{k: rec[k] for k in ("started_utc", "finished_utc", "task_s", "worker")
+                if k in rec}}
+    if "worker_version" in rec:  # a worker on another version: redo it next time
+        entry["drillfric_version"] = rec["worker_version"]
+    if rec.get("out_dir"):
+        out = Path(rec["out_dir"])
+        entry["outputs"] = {"dir": str(out), "summary": str(out / "summary.json"),
+                            "estimates": str(out / "estimates.parquet"),
+                            "segments": str(out / "segments.parquet"),
+                            "report": str(out / "report.html")}
+        if not (out / "summary.json").is_file():
+            entry.update(status="failed", message=f"{out}: the worker wrote its result where "
+                         "this machine cannot see it — fix: put OUT on storage shared by the "
+                         "client and every worker")
+    manifest.wells[job.name] = entry
+    return WellOutcome(job.name, entry["status"], entry["message"],
+                       Path(rec["out_dir"]) if entry["status"] == "ok" else None,
+                       rec.get("summary") if entry["status"] == "ok" else None,
+                       entry["failed_segments"], rec.get("task_s", 0.0), attempts)
+
+
+def _skipped(name: str, entry: dict) -> WellOutcome:
+    out = Path(entry["outputs"]["dir"])
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    return WellOutcome(name, "skipped", "unchanged since the last run", out, summary,
+                       entry.get("failed_segments", 0))
+
+
+def _execute(jobs: list[_Job], *, workers: int,
+             scheduler: str | None) -> Iterator[tuple[_Job, dict, int]]:
+    """Yield (job, record, attempts) as wells finish, in completion order."""
+    if not jobs:
+        return
+    if scheduler is None and min(workers, len(jobs)) <= 1:
+        for job in jobs:
+            yield job, process_well(job.task), 1
+        return
+    from distributed import as_completed
+
+    with _client(min(workers, len(jobs)), scheduler) as client:
+        token = uuid.uuid4().hex[:8]
+
+        def submit(job: _Job, attempt: int):
+            return client.submit(process_well, job.task, pure=False,
+                                 key=f"drillfric-well-{job.name}-{token}-{attempt}")
+
+        pending = {submit(job, 1): (job, 1) for job in jobs}
+        queue = as_completed(list(pending))
+        try:
+            for future in queue:
+                job, attempt = pending.pop(future)
+                rec, retry = _outcome(future)
+                if retry and attempt < MAX_ATTEMPTS:
+                    again = submit(job, attempt + 1)
+                    pending[again] = (job, attempt + 1)
+                    queue.add(again)
+                    continue
+                yield job, rec, attempt
+        finally:
+            client.cancel(list(pending))
+
+
+def _outcome(future) -> tuple[dict, bool]:
+    """The task's record, or a failed record and whether a retry makes sense."""
+    from distributed import KilledWorker
+
+    try:
+        return future.result(), False
+    except KilledWorker as exc:
+        return {"status": "failed", "message": f"worker died while processing ({exc})"}, True
+    except Exception as exc:  # noqa: BLE001 — e.g. drillfric missing on a remote worker
+        return {"status": "failed", "message": f"task failed on the cluster: "
+                f"{type(exc).__name__}: {exc}"}, False
+
+
+@contextmanager
+def _client(workers: int, scheduler: str | None):
+    """A Dask client: to ``scheduler``, or to a local cluster of worker processes."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"cannot reach the Dask scheduler ({exc})", file=scheduler,
+                             fix="check the address (tcp://HOST:PORT) and that the "
+                                 "scheduler runs") from None
+        with client:
+            yield client
+        return
+    import dask
+    from distributed.utils import get_mp_context
+
+    with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}), \
+            warnings.catch_warnings():
+        # The scheduler's health endpoint falls back to a free port when 8787 is taken.
+        warnings.filterwarnings("ignore", message="Port .* is already in use")
+        # Workers fork from a server that imported distributed and the pipeline once
+        # (docs/fleet.md: start-up measured faster than spawning each worker).
+        get_mp_context().set_forkserver_preload(["distributed", "drillfric.pipeline"])
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                          dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
+                Client(cluster) as client:
+            yield client
+
+
+@contextmanager
+def _locked(out_root: Path):
+    """Hold OUT/.fleet.lock: one fleet run at a time per output directory."""
+    try:
+        out_root.mkdir(parents=True, exist_ok=True)
+        fh = open(out_root / _LOCK, "w")  # held (locked) for the whole run
+    except OSError as exc:
+        raise InputError(f"cannot write the output directory ({exc.strerror})",
+                         file=out_root, fix="choose a writable --out") from None
+    try:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise InputError("another fleet run is writing to this directory", file=out_root,
+                             fix="wait for it to finish or use another --out") from None
+        yield
+    finally:
+        fh.close()
+
+
+def _remove_stale(out_root: Path) -> None:
+    """Remove temporary directories left by an interrupted run (never a finished well)."""
+    for path in out_root.glob(".*"):
+        if ".tmp-" not in path.name and ".old-" not in path.name:
+            continue
+        if path.is_dir():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink(missing_ok=True)
+
+
+# --------------------------------------------------------------------------- fleet files
+_WELL_COLUMNS = ("well", "well_status", "well_message", "well_mu_s", "well_mu_k",
+                 "well_mu_s_lower_bound", "segment_id")
+
+
+def summary_frame(outcomes) -> pd.DataFrame:
+    """fleet_summary.parquet: one row per well and segment (a failed well: one row).
+
+    Segment columns keep their summary.json names (``mu_s``, ``status``, …); well-level
+    columns are prefixed ``well_``.
+    """
+    rows = []
+    for o in outcomes:
+        base = {"well": o.well, "well_status": o.status, "well_message": o.message,
+                "result_dir": None if o.result_dir is None else str(o.result_dir)}
+        s = o.summary or {}
+        base.update(well_mu_s=s.get("mu_s"), well_mu_k=s.get("mu_k"),
+                    well_mu_s_lower_bound=s.get("mu_s_lower_bound"),
+                    drillfric_version=s.get("drillfric_version"))
+        segments = s.get("segments") or [{}]
+        for seg in segments:
+            seg = {k: v for k, v in seg.items() if not isinstance(v, (list, dict))}
+            rows.append(base | {"segment_id": seg.pop("id", None)} | seg)
+    frame = pd.DataFrame(rows)
+    if "segment_id" in frame:
+        frame["segment_id"] = frame["segment_id"].astype("Int64")
+    return frame
+
+
+def _write_summary(out_root: Path, outcomes) -> Path:
+    path = out_root / SUMMARY
+    tmp = out_root / f".{SUMMARY}.tmp-{os.getpid()}"
+    summary_frame(outcomes).to_parquet(tmp, index=False)
+    os.replace(tmp, path)
+    return path
+
+
+def _write_report(out_root: Path, outcomes) -> tuple[Path | None, tuple[str, ...]]:
+    """OUT/fleet.html through the report package (when it provides a fleet report)."""
+    from drillfric import report
+
+    if not hasattr(report, "write_fleet_report"):
+        return None, ("fleet.html not written: this version has no fleet report",)
+    items = [{"well": o.well, "status": o.status, "message": o.message,
+              "result_dir": o.result_dir, "summary": o.summary} for o in outcomes]
+    try:
+        return report.write_fleet_report(out_root, items), ()
+    except Exception as exc:  # noqa: BLE001 — the night's results are already written
+        return None, (f"fleet.html not written: {type(exc).__name__}: {exc}",)

@@ -1,0 +1,239 @@
+"""`drillfric fleet` on local workers (issue 8): discovery, incremental manifest, fault
+isolation, SIGTERM. Real components: wells come from `drillfric simulate`, runs go through
+the CLI (in-process, or as a subprocess where a signal is sent)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric.errors import InputError
+from drillfric.fleet import WellSpec, discover, run_many
+
+REPO = Path(__file__).resolve().parents[1]
+#: Files of a complete well directory (INTERFACE.md "Outputs of run").
+WELL_FILES = ("summary.json", "estimates.parquet", "segments.parquet", "report.html")
+#: Per-well friction truth of the synthetic wells (μ_s, μ_k).
+TRUTH = {"w1": (0.5, 0.21), "w2": (0.5, 0.23), "w3": (0.5, 0.25)}
+
+
+def make_wells(folder: Path, *, corrupt: bool = True) -> Path:
+    """Three small simulated wells (60 s at 10 Hz, 50 cells: ~2-3 s to run each) and a
+    corrupt CSV.
+
+    The demo configuration without its scenario and well name, so each well is a single
+    off-bottom stand named after its file.
+    """
+    folder.mkdir(parents=True, exist_ok=True)
+    demo = REPO / "examples" / "demo"
+    text = (demo / "demo.toml").read_text(encoding="utf-8")
+    keep = [ln for ln in text.splitlines()
+            if not ln.startswith(("scenario", "data =", 'name = "demo"'))]
+    config = folder.parent / f"{folder.name}.sim.toml"
+    config.write_text("\n".join(keep) + "\n", encoding="utf-8")
+    shutil.copy(demo / "demo.survey.csv", folder.parent / "demo.survey.csv")
+    runner = CliRunner()
+    for i, (name, (mu_s, mu_k)) in enumerate(TRUTH.items()):
+        result = runner.invoke(cli, [
+            "-q", "simulate", str(config), "--out", str(folder / f"{name}.csv"),
+            "--duration", "60", "--rate", "10", "--mu-s", str(mu_s), "--mu-k", str(mu_k),
+            "--bit-depth", "1500", "--cells", "50", "--seed", str(i + 1)])
+        assert result.exit_code == 0, result.output
+    if corrupt:
+        (folder / "bad.csv").write_bytes(b"time,rpm,torque\n1,2,3\ngarbage,\x00\x01,zz\n")
+    return folder
+
+
+def fleet(*args: str):
+    """Run `drillfric fleet ARGS` in this process; returns the click result."""
+    return CliRunner().invoke(cli, ["fleet", *map(str, args)])
+
+
+def manifest(out: Path) -> dict:
+    return json.loads((out / "manifest.json").read_text(encoding="utf-8"))["wells"]
+
+
+def assert_complete(out: Path) -> None:
+    """Every visible well directory of OUT is complete (no half-written well)."""
+    for path in out.iterdir():
+        if path.is_dir() and not path.name.startswith("."):
+            missing = [f for f in WELL_FILES if not (path / f).is_file()]
+            assert not missing, f"{path} lacks {missing}"
+
+
+@pytest.fixture(scope="module")
+def good_wells(tmp_path_factory) -> Path:
+    """Three simulated wells and a manifest CSV listing them (relative paths)."""
+    folder = make_wells(tmp_path_factory.mktemp("fleet") / "wells", corrupt=False)
+    lines = ["well,data,config,survey"] + [f"{n},wells/{n}.csv,," for n in TRUTH]
+    (folder.parent / "fleet.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return folder
+
+
+# --------------------------------------------------------------------------- discovery
+def test_discover_directory_skips_sidecars_and_hidden_files(tmp_path):
+    for name in ("a.csv", "a.toml", "a.survey.csv", "a.truth.json", "b.parquet",
+                 ".hidden.csv", "notes.txt.bak"):
+        (tmp_path / name).write_text("x")
+    (tmp_path / "dirwell").mkdir()
+    (tmp_path / "dirwell" / "well.toml").write_text("")
+    (tmp_path / "empty_dir").mkdir()
+    found = [s.data.name for s in discover(tmp_path)]
+    assert found == ["a.csv", "b.parquet", "dirwell"]
+
+
+def test_discover_manifest_resolves_relative_paths(tmp_path):
+    (tmp_path / "m.json").write_text(json.dumps(
+        [{"well": "A-1", "data": "d/a.csv", "config": "c.toml"}, {"data": "/abs/b.csv"}]))
+    specs = discover(tmp_path / "m.json", config=tmp_path / "all.toml")
+    assert specs == [WellSpec((tmp_path / "d/a.csv").resolve(), "A-1",
+                              (tmp_path / "c.toml").resolve(), None),
+                     WellSpec(Path("/abs/b.csv"), None, tmp_path / "all.toml", None)]
+
+
+@pytest.mark.parametrize("content", ["well,config\nA,c.toml\n", "not,a\n\x00"])
+def test_discover_bad_manifest_is_one_input_error(tmp_path, content):
+    path = tmp_path / "m.csv"
+    path.write_text(content)
+    with pytest.raises(InputError, match="data"):
+        discover(path)
+
+
+def test_nothing_to_run_is_exit_2(tmp_path):
+    result = fleet(tmp_path, "--out", tmp_path / "out")
+    assert result.exit_code == 2
+    assert "no wells found" in result.output
+    assert fleet(tmp_path / "missing", "--out", tmp_path / "out").exit_code == 2
+
+
+def test_all_wells_unreadable_is_exit_2(tmp_path):
+    (tmp_path / "bad.csv").write_text("garbage\n\x00\n")
+    result = fleet(tmp_path, "--out", tmp_path / "out", "--workers", "1")
+    assert result.exit_code == 2
+    assert "error: bad:" in result.output
+    assert manifest(tmp_path / "out")["bad"]["status"] == "failed"
+
+
+def test_wells_that_cannot_be_prepared_fail_alone(tmp_path):
+    """Missing files and two wells with one output name fail before any worker starts."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    for folder in ("a", "b"):
+        (tmp_path / folder / "x.csv").write_text("garbage\n")
+    specs = [WellSpec(tmp_path / "missing.csv"), WellSpec(tmp_path / "a" / "x.csv"),
+             WellSpec(tmp_path / "b" / "x.csv"), WellSpec(tmp_path / "a" / "x.csv", "y")]
+    result = run_many(specs, tmp_path / "out", workers=1)
+    status = [(w.well, w.status) for w in result.wells]
+    assert status == [("missing", "failed"), ("x", "failed"),
+                      (f"x ({(tmp_path / 'b' / 'x.csv').resolve()})", "failed"), ("y", "failed")]
+    assert "file not found" in result.wells[0].message
+    assert "time_s not found" in result.wells[1].message  # ran, and failed on its data
+    assert "also named 'x'" in result.wells[2].message
+    assert result.wells[3].attempts == 1 and "time_s not found" in result.wells[3].message
+    assert len(manifest(tmp_path / "out")) == 4
+
+
+# --------------------------------------------------------------------------- incremental
+def test_incremental_skip_append_and_force(good_wells, tmp_path):
+    """Second run skips everything and says so; appended data reprocesses only that well."""
+    out = tmp_path / "out"
+    source = good_wells.parent / "fleet.csv"
+    first = fleet(source, "--out", out, "--workers", "1")
+    assert first.exit_code == 0, first.output
+    entries = manifest(out)
+    assert {e["status"] for e in entries.values()} == {"ok"}
+    for name, entry in entries.items():
+        assert set(entry["inputs"]) == {"data", "config", "survey"}
+        assert entry["drillfric_version"] and len(entry["config_sha256"]) == 64
+        assert entry["task_s"] > 0 and Path(entry["outputs"]["dir"]) == out / name
+    assert_complete(out)
+    stamps = {n: (out / n / "summary.json").stat().st_mtime_ns for n in TRUTH}
+
+    second = fleet(source, "--out", out, "--workers", "1")
+    assert second.exit_code == 0
+    assert "all 3 wells skipped" in second.output
+    assert stamps == {n: (out / n / "summary.json").stat().st_mtime_ns for n in TRUTH}
+
+    data = good_wells / "w2.csv"
+    frame = pd.read_csv(data)
+    later = frame.assign(time_s=frame["time_s"] + frame["time_s"].iloc[-1] + 0.1)
+    later.to_csv(data, mode="a", header=False, index=False)
+    third = fleet(source, "--out", out, "--workers", "1")
+    assert third.exit_code == 0
+    assert "1 processed, 2 skipped" in third.output
+    after = {n: (out / n / "summary.json").stat().st_mtime_ns for n in TRUTH}
+    assert [n for n in TRUTH if after[n] != stamps[n]] == ["w2"]
+    summary = json.loads((out / "w2" / "summary.json").read_text())
+    assert summary["inputs"]["rows"] == 2 * len(frame)
+
+    rows = pd.read_parquet(out / "fleet_summary.parquet")
+    assert set(rows["well"]) == set(TRUTH) and rows["segment_id"].notna().all()
+    assert (rows.groupby("well").size() == [
+        len(json.loads((out / n / "summary.json").read_text())["segments"])
+        for n in sorted(TRUTH)]).all()
+
+    doc = json.loads((out / "manifest.json").read_text())
+    doc["wells"]["w3"]["drillfric_version"] = "0.0.0"  # as if an older drillfric ran it
+    (out / "manifest.json").write_text(json.dumps(doc))
+    upgraded = fleet(source, "--out", out, "--workers", "1")
+    assert "1 processed, 2 skipped" in upgraded.output
+    assert manifest(out)["w3"]["drillfric_version"] != "0.0.0"
+
+    forced = run_many([WellSpec(good_wells / "w1.csv")], out, workers=1, force=True)
+    assert [w.status for w in forced.wells] == ["ok"]
+    assert (out / "w1" / "summary.json").stat().st_mtime_ns != after["w1"]
+
+
+# --------------------------------------------------------------------------- interruption
+def test_sigterm_leaves_no_partial_well_and_rerun_completes(good_wells, tmp_path):
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "drillfric.cli.main", "-q", "fleet", str(good_wells),
+           "--out", str(out), "--workers", "2"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 90
+        while not any(".tmp-" in p.name for p in out.glob(".w*")):  # a well is being written
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "interrupted" in err
+    assert_complete(out)
+    done = [n for n, e in manifest(out).items() if e["status"] == "ok"]
+    assert len(done) < len(TRUTH)
+
+    rerun = fleet(good_wells, "--out", out, "--workers", "1")
+    assert rerun.exit_code == 0, rerun.output
+    assert f"{len(TRUTH) - len(done)} processed, {len(done)} skipped" in rerun.output
+    assert_complete(out)
+    assert not [p.name for p in out.iterdir() if ".tmp-" in p.name or ".old-" in p.name]
+    assert {n for n, e in manifest(out).items() if e["status"] == "ok"} == set(TRUTH)
+
+
+def test_second_fleet_run_on_same_out_is_refused(good_wells, tmp_path):
+    import fcntl
+
+    out = tmp_path / "out"
+    out.mkdir()
+    with open(out / ".fleet.lock", "w") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        result = fleet(good_wells, "--out", out)
+    assert result.exit_code == 2
+    assert "another fleet run" in result.output
+    assert os.listdir(out) == [".fleet.lock"]
