@@ -270,7 +270,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         messages.append("on bottom: the bit torque is not separated, friction is apparent")
     return SegmentEstimate(
         mu_s=refined.mu_s, mu_k=mu_k, mu_s_identifiable=refined.mu_s_identifiable,
-        mu_s_lower_bound=bound, mu_s_spread=diag.mu_s_spread,
+        mu_s_lower_bound=bound, mu_s_spread=_mu_s_spread(cfg, refined, diag),
         mu_k_spread=diag.mu_k_spread, converged=bool(converged), method=method,
         settling_time_s=diag.settling_time_s, residual_rms_rpm=final_diag.residual_rms_rpm,
         stick_slip_severity=final_diag.stick_slip_severity,
@@ -279,6 +279,17 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         T_N_Nm=observer.plant.T_N_Nm, flags=tuple(dict.fromkeys(flags)),
         messages=tuple(messages), starts=starts, first=first, final=final,
         bit_rms_error_rpm=_bit_error(final, data), td=td)
+
+
+def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | None:
+    """Uncertainty of the reported μ_s [-]: the creep fit's change on grid refinement.
+
+    The observer starts' μ_s spread means something only under the paper's law; with the
+    default law each start holds its μ̂_s, so that "spread" would restate the starts.
+    """
+    if refined.mu_s is not None and "creep_grid_move" in refined.details:
+        return float(refined.details["creep_grid_move"] * refined.mu_s)
+    return diag.mu_s_spread if cfg["observer.law"] == "paper" else None
 
 
 def _bit_error(final: ObserverRecord, data: SegmentData) -> float | None:
