@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from drillfric.kernels import advance_cells, inflows
+from drillfric.kernels import advance_cells, drive_value, inflows
 
 #: Columns of the observer record, per start.
 OBS_COLUMNS = ("mu_s", "mu_k", "surface_rad_s_est", "bit_rad_s_est", "bha_rad_s_est",
@@ -28,16 +28,10 @@ LAW_CORRECTED, LAW_PAPER = 0, 1
 def measured_value(u, t0, dt, t, hold):
     """A uniformly sampled measurement at time t: linear interpolation, or the last sample
     (zero-order hold, as in the paper) when ``hold`` is true; held beyond the ends."""
+    if not hold:
+        return drive_value(u, t0, dt, t)
     s = (t - t0) / dt
-    n = u.size
-    if s <= 0.0:
-        return u[0]
-    if s >= n - 1:
-        return u[n - 1]
-    i = int(s)
-    if hold:
-        return u[i]
-    return u[i] + (s - i) * (u[i + 1] - u[i])
+    return u[min(max(int(s), 0), u.size - 1)] if s > 0.0 else u[0]
 
 
 @njit(cache=True)

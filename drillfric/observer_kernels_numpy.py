@@ -9,19 +9,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from drillfric.kernels_numpy import damp_and_friction, transport
+from drillfric.kernels_numpy import damp_and_friction, drive_value, transport
 from drillfric.observer_kernels import LAW_PAPER
 
 
 def measured_value(u, t0, dt, t, hold):
     """Measurement at time t: linear interpolation or zero-order hold, held at the ends."""
+    if not hold:
+        return drive_value(u, t0, dt, t)
     s = (t - t0) / dt
-    if s <= 0.0:
-        return float(u[0])
-    if s >= u.size - 1:
-        return float(u[-1])
-    i = int(s)
-    return float(u[i]) if hold else float(u[i] + (s - i) * (u[i + 1] - u[i]))
+    return float(u[min(max(int(s), 0), u.size - 1)]) if s > 0.0 else float(u[0])
 
 
 def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):

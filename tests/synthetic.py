@@ -17,6 +17,19 @@ from drillfric.wellpath import WellPath, minimum_curvature
 
 RPM = np.pi / 30.0
 
+#: A&S 2018 drill pipe and the Well A collar sections (CASES.md), G = 61 / 67 GPa.
+AS_SECTIONS = [
+    {"name": "DP", "od_m": 0.146529, "id_m": 0.123024, "shear_modulus_Pa": 61e9},
+    {"name": "c1", "od_m": 0.150167, "id_m": 0.096799, "length_m": 76.32,
+     "shear_modulus_Pa": 67e9},
+    {"name": "c2", "od_m": 0.206375, "id_m": 0.0762, "length_m": 10.24,
+     "shear_modulus_Pa": 67e9},
+    {"name": "c3", "od_m": 0.150167, "id_m": 0.096799, "length_m": 95.4,
+     "shear_modulus_Pa": 67e9},
+    {"name": "c4", "od_m": 0.222392, "id_m": 0.095964, "length_m": 48.5,
+     "shear_modulus_Pa": 67e9},
+]
+
 
 def build_and_hold(kop_m: float, hold_deg: float, td_m: float,
                    build_deg_30m: float = 3.0) -> WellPath:

@@ -23,6 +23,7 @@ def test_version():
 def test_cli_reference_is_current():
     """docs/cli.md is generated from --help and must not drift (datasette practice)."""
     from drillfric.cli.reference import reference
+
     from tests.conftest import REPO
 
     doc = (REPO / "docs" / "cli.md").read_text(encoding="utf-8")

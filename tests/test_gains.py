@@ -28,19 +28,8 @@ from drillfric.gains import (
     top_reflection,
 )
 from drillfric.lumped import Injection, LumpedParams
+from tests.synthetic import AS_SECTIONS
 
-#: A&S 2018 drill pipe and the Well A collar sections (CASES.md), G = 61 / 67 GPa.
-AS_SECTIONS = [
-    {"name": "DP", "od_m": 0.146529, "id_m": 0.123024, "shear_modulus_Pa": 61e9},
-    {"name": "c1", "od_m": 0.150167, "id_m": 0.096799, "length_m": 76.32,
-     "shear_modulus_Pa": 67e9},
-    {"name": "c2", "od_m": 0.206375, "id_m": 0.0762, "length_m": 10.24,
-     "shear_modulus_Pa": 67e9},
-    {"name": "c3", "od_m": 0.150167, "id_m": 0.096799, "length_m": 95.4,
-     "shear_modulus_Pa": 67e9},
-    {"name": "c4", "od_m": 0.222392, "id_m": 0.095964, "length_m": 48.5,
-     "shear_modulus_Pa": 67e9},
-]
 T_N = 40e3  # a plausible ∫F_c dx for a 2500 m build-and-hold well [N·m]
 TUNINGS = [Tuning(), Tuning(0.5, 15.0, 0.5, 2.0), Tuning(1.5, 8.0, 1.0, 1.2)]
 

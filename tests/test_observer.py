@@ -143,3 +143,18 @@ def test_bad_measurements_and_starts(steady):
     obs = make_observer(steady, config(), cells=100)
     with pytest.raises(ModelError, match="μ_k ≤ μ_s"):
         ObserverState.from_starts(obs, [[0.1, 0.3]])
+
+
+@pytest.mark.parametrize("hold", [False, True])
+def test_measurement_interpolation(hold):
+    """Linear interpolation (default) or the paper's zero-order hold, held at both ends;
+    compiled kernel and twin agree."""
+    from drillfric import observer_kernels, observer_kernels_numpy
+
+    u = np.array([0.0, 10.0, 20.0])
+    times = [-1.0, 0.0, 0.25, 0.5, 0.999, 1.0, 1.5, 3.0]
+    linear = [0.0, 0.0, 2.5, 5.0, 9.99, 10.0, 15.0, 20.0]
+    held = [0.0, 0.0, 0.0, 0.0, 0.0, 10.0, 10.0, 20.0]
+    for t, want in zip(times, held if hold else linear, strict=True):
+        for module in (observer_kernels, observer_kernels_numpy):
+            assert module.measured_value(u, 0.0, 1.0, t, hold) == pytest.approx(want)
