@@ -166,6 +166,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "(default, one sample of lag) or 'hold' (the paper's zero-order hold).",
             choices=("linear", "hold")),
         _positive("output_rate_hz", 10.0, "Hz", "Rate of estimates.parquet rows."),
+        _positive("speed_noise_rpm", 0.5, "RPM", "Standard deviation of the logged top-drive "
+                  "speed's noise per sample; with the logging interval it sets the Kalman "
+                  "design's measurement noise."),
         _positive("starts_window_s", 300.0, "s", "The starts run together over this first part "
                   "of each segment (they converge within it); the seeded pass covers all."),
         _positive("deadlock_s", 15.0, "s", "Deadlock guard: an estimated BHA stuck this long "

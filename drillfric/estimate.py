@@ -34,6 +34,9 @@ from drillfric.wellpath import WellPath, vertical
 #: bound above the truth is a false claim; prefer none).
 UNRELIABLE_BOUND = frozenset({"regime_mismatch", "bistable_regime",
                               "stick_slip_not_reproduced"})
+#: Friction factors usually seen with steel in mud-filled hole; outside, a segment is flagged
+#: ``outside_typical_range`` (check string, survey, torque units) but not changed.
+TYPICAL_MU = (0.05, 0.8)
 #: Relative difference between batch and observer μ_k beyond which a segment is not
 #: converged (on synthetic truths they agree within ~10 %: docs/validation.md).
 DISAGREEMENT = 0.5
@@ -138,13 +141,16 @@ def _path_for(path: WellPath | None, bit_depth_m: float) -> WellPath:
     return path
 
 
-def build_observer(cfg, string, td: torque_drag.TDResult, cells: int) -> Observer:
-    """Observer for this string and F_c profile from the configuration (THEORY §5)."""
+def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
+                   sample_dt_s: float | None = None) -> Observer:
+    """Observer for this string and F_c profile from the configuration (THEORY §5);
+    ``sample_dt_s`` is the logging interval of the measurements [s]."""
     grid = torsional.make_grid(string, cells)
     plant = torsional.Plant(grid, td.fc_at(grid.x_m), 0.0, 0.0, cfg.omega_c_rad_s,
                             cfg["model.k_t_per_s"], cfg["rig.top_drive_inertia_kg_m2"])
     n_pipe = int(grid.section_start[1])
-    gains = gains_from_config(cfg, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s)
+    gains = gains_from_config(cfg, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s,
+                              sample_dt_s)
     return Observer(plant, gains, law=cfg["observer.law"], mu_max=cfg["observer.mu_max"],
                     deadlock_s=cfg["observer.deadlock_s"],
                     hold=cfg["observer.interpolation"] == "hold")
@@ -220,7 +226,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     meas = Measurements.from_samples(data.time_s, data.surface_rpm * RPM_TO_RAD_S,
                                      data.surface_torque_Nm, torque_kind=cfg["rig.torque_kind"],
                                      top_drive_inertia_kg_m2=itd, rate_hz=rate_hz)
-    observer = build_observer(cfg, string, td, cfg["model.cells"])
+    observer = build_observer(cfg, string, td, cfg["model.cells"], sample_dt_s=meas.dt_s)
     out_rate = output_rate_hz or cfg["observer.output_rate_hz"]
     starts = _starts(cfg, warm, observer.mu_max)
     state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
@@ -258,6 +264,12 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     else:
         mu_k, method, converged = diag.mu_k, "observer", diag.converged
         messages.append("batch refinement gave no μ_k: observer consensus reported")
+    if not TYPICAL_MU[0] <= mu_k <= TYPICAL_MU[1]:
+        flags.append("outside_typical_range")
+        messages.append(f"μ_k = {mu_k:.3f} is outside the range usually seen ({TYPICAL_MU[0]}–"
+                        f"{TYPICAL_MU[1]}): check the string, the survey and the torque units")
+    if "creep_fit_at_bound" in refined.flags:
+        messages.append(_creep_advice(string, td.T_N_Nm, mu_k, refined, meas))
     seed = np.array([[_seed_mu_s(refined, mu_k), mu_k]])
     final, _ = observe(observer, meas,
                        ObserverState.from_starts(observer, seed,
@@ -279,6 +291,28 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         T_N_Nm=observer.plant.T_N_Nm, flags=tuple(dict.fromkeys(flags)),
         messages=tuple(messages), starts=starts, first=first, final=final,
         bit_rms_error_rpm=_bit_error(final, data), td=td)
+
+
+def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,
+                  meas: Measurements) -> str:
+    """Why a creep did not identify μ_s: the wind-up time it would have needed.
+
+    Under uniform friction the torque falls linearly from the top, so winding the string up
+    to break-free takes a twist μ_s·T_N·L/(2GJ) [rad] (pipe G, J; THEORY §3, §6.3), turned at
+    the creep speed; μ_s ≈ 2μ_k is assumed for the estimate.
+    """
+    pipe = string.sections[0]
+    twist = 2.0 * mu_k * T_N_Nm * string.bit_depth_m / (
+        2.0 * pipe.shear_modulus_Pa * pipe.polar_moment_m4)
+    t0, t1 = refined.details.get("creeps_found", [(meas.t0_s, meas.t0_s)])[0]
+    t = meas.t0_s + meas.dt_s * np.arange(meas.surface_rad_s.size)
+    inside = (t >= t0) & (t <= t1)
+    speed = float(np.mean(meas.surface_rad_s[inside])) if inside.any() else 0.0
+    if speed <= 0:
+        return "the creep did not identify μ_s"
+    return (f"the creep ({t1 - t0:.0f} s at {speed / RPM_TO_RAD_S:.1f} RPM) ended before the "
+            f"string was wound up to break free: at this depth that takes about "
+            f"{twist / speed:.0f} s of creep (for μ_s ≈ 2μ_k) — hold the creep longer")
 
 
 def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | None:

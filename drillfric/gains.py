@@ -381,7 +381,8 @@ def tuning_from_config(cfg) -> Tuning:
                   z_per_s=float(poles[0]), p_per_s=float(poles[1]))
 
 
-def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float) -> Gains:
+def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float,
+                      sample_dt_s: float | None = None) -> Gains:
     """Observer gains of the design selected by ``observer.gains`` (THEORY.md §5.1).
 
     Parameters
@@ -397,9 +398,18 @@ def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float)
         Pipe cell centres of the observer grid [m].
     dt_s : float
         Observer time step [s].
+    sample_dt_s : float, optional
+        Logging interval of the measured speed [s]: the Kalman design's measurement-noise
+        intensity is σ²·Δt_log with σ = ``observer.speed_noise_rpm`` (white noise of that
+        standard deviation per sample), so slower logs get a gentler injection. Default:
+        the 100 Hz value of :class:`KalmanNoise`.
     """
     params = LumpedParams.from_string(string, cfg["rig.top_drive_inertia_kg_m2"],
                                       k_t_per_s=cfg["model.k_t_per_s"])
     if cfg["observer.gains"] == "kalman":
-        return kalman_gains(params, x_m, T_N_Nm, dt_s)
+        noise = KalmanNoise()
+        if sample_dt_s is not None:
+            sigma = cfg["observer.speed_noise_rpm"] * np.pi / 30.0
+            noise = KalmanNoise(speed_psd=sigma**2 * sample_dt_s)
+        return kalman_gains(params, x_m, T_N_Nm, dt_s, noise=noise)
     return backstepping_gains(params, tuning_from_config(cfg), x_m, T_N_Nm)

@@ -370,3 +370,18 @@ def test_kalman_noise_is_a_tuning_knob():
     quiet = kalman_gains(p, x, T_N, 0.02, noise=KalmanNoise(speed_psd=2.7e-6))
     base = kalman_gains(p, x, T_N, 0.02)
     assert quiet.p0 > base.p0 and abs(quiet.p_d) > abs(base.p_d)
+
+
+def test_kalman_injection_follows_the_logging_interval():
+    """R = σ²·Δt_log: a 5 Hz log (20× the noise intensity of 100 Hz) gets a gentler
+    top-drive injection and friction adaptation than a 100 Hz one."""
+    from drillfric.config import config_from_dict
+    from drillfric.drillstring import build_string
+    from drillfric.gains import gains_from_config
+
+    cfg = config_from_dict({"string": {"sections": AS_SECTIONS}, "model": {"k_t_per_s": 0.1}})
+    string = build_string(cfg.sections, 2500.0)
+    x = np.linspace(1.0, string.bha_top_m - 1.0, 200)
+    fast = gains_from_config(cfg, string, 50e3, x, 1e-3, sample_dt_s=0.01)
+    slow = gains_from_config(cfg, string, 50e3, x, 1e-3, sample_dt_s=0.2)
+    assert slow.p0 < fast.p0 and slow.l_k < fast.l_k

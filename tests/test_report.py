@@ -433,3 +433,14 @@ def test_report_command_bad_directory_is_one_line_exit_2(tmp_path, make):
     assert done.exit_code == 2
     assert len(done.output.strip().splitlines()) == 1
     assert "Traceback" not in done.output
+
+
+
+def test_mu_s_advice_only_when_not_identified(demo, tmp_path):
+    """Without an identified μ_s the report tells drillers how to make it measurable
+    (THEORY §6: a creep break-over); with one it does not."""
+    for identified in (True, False):
+        out = copy_result(demo, tmp_path / str(identified),
+                          lambda s, v=identified: s.update(mu_s=0.6 if v else None))
+        html = write_well_report(out).read_text(encoding="utf-8")
+        assert ("creep break-over" in html) is (not identified)

@@ -63,6 +63,7 @@ def _header(data: ResultData) -> dict:
         "mu_k": fmt(summary.get("mu_k")),
         "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                           summary.get("mu_s_lower_bound")),
+        "mu_s_identified": summary.get("mu_s") is not None,
         "counts": summary.get("counts") or {}, "assumed": [str(a) for a in
                                                            summary.get("assumed") or []],
         "indicative": bool(summary.get("indicative", bool(summary.get("assumed")))),
