@@ -444,24 +444,24 @@ def parabola_vertex(x, j, curvature: float | None = None) -> tuple[float, float]
 
 
 def _refit_creep(model: _Model, wins, mu_k: float, cells: int, centre: float, lo: float,
-                 hi: float, curvature: float | None) -> tuple[float, int, float | None]:
-    """μ_s near ``centre`` on a finer grid; returns (μ_s, runs, misfit curvature).
+                 hi: float) -> tuple[float, int]:
+    """μ_s near ``centre`` on a finer grid; returns (μ_s, runs).
 
-    The vertex of the misfit parabola through centre·(1 ± 4 %): with the curvature of the
-    previous grid (it changed by < 5 % between 2290 and 4573 cells in the validation) two
-    runs suffice, else the centre is evaluated too (3 runs). A vertex outside ±8 % or a
-    non-convex parabola falls back to :func:`_fit_creep` on ±10 %. The misfit of a creep is
-    smooth in μ_s (no stick-slip, no chaos)."""
+    The vertex of the misfit parabola through centre·(1 ± 4 %), all three points evaluated
+    on this grid (borrowing the previous grid's curvature saved a run but the curvature
+    changes by ~30 % between 2290 and 4573 cells, and it hid non-convexity). A vertex
+    outside ±8 % or a non-convex parabola falls back to :func:`_fit_creep` on ±10 %. The
+    misfit of a creep is smooth in μ_s (no stick-slip, no chaos)."""
     start = model.runs
     misfit = _creep_misfit(model, wins, mu_k, cells)
     x = centre * np.array([1.0 - CREEP_STENCIL, 1.0, 1.0 + CREEP_STENCIL])
     if x[0] >= lo and x[2] <= hi:
-        j = np.array([misfit(x[0]), np.nan if curvature else misfit(centre), misfit(x[2])])
-        vertex, a = parabola_vertex(x, j, curvature)
+        j = np.array([misfit(x[0]), misfit(centre), misfit(x[2])])
+        vertex, a = parabola_vertex(x, j)
         if a > 0 and abs(vertex / centre - 1.0) <= 2 * CREEP_STENCIL:
-            return vertex, model.runs - start, a
+            return vertex, model.runs - start
     mu, _ = _fit_creep(model, wins, mu_k, cells, max(lo, 0.9 * centre), min(hi, 1.1 * centre))
-    return mu, model.runs - start, None
+    return mu, model.runs - start
 
 
 def _as_fc_fn(fc_Nm_m) -> Callable[[np.ndarray], np.ndarray]:
@@ -613,10 +613,9 @@ def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages):
         flags.append("creep_fit_at_bound")
         messages.append(f"creep fit ran to its search bound (μ_s = {mu:.3f}): not reported")
         return None, ()
-    curvature = None
     for _ in range(CREEP_LEVELS - 1):
         n *= 2
-        new, runs, curvature = _refit_creep(model, wins, mu_k, n, mu, lo, MU_MAX, curvature)
+        new, runs = _refit_creep(model, wins, mu_k, n, mu, lo, MU_MAX)
         fits.append((model.grid(n)[0].n_cells, new, runs))
         move, mu = abs(new - mu) / new, new
         details["creep_grid_move"] = move

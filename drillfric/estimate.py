@@ -37,6 +37,8 @@ UNRELIABLE_BOUND = frozenset({"regime_mismatch", "bistable_regime",
 #: Friction factors usually seen with steel in mud-filled hole; outside, a segment is flagged
 #: ``outside_typical_range`` (check string, survey, torque units) but not changed.
 TYPICAL_MU = (0.05, 0.8)
+#: Largest cell of the batch fit's model [m] (THEORY §6.4).
+BATCH_MAX_DX_M = 5.0
 #: Relative difference between batch and observer μ_k beyond which a segment is not
 #: converged (on synthetic truths they agree within ~10 %: docs/validation.md).
 DISAGREEMENT = 0.5
@@ -165,6 +167,12 @@ def _starts(cfg, warm, mu_max) -> np.ndarray:
     return out
 
 
+def _batch_cells(cfg, bit_depth_m: float) -> int:
+    """Cells of the speed-driven fit: ``model.cells``, refined to Δx ≤ 5 m (THEORY §6.4:
+    at 10 m the fit was biased by 10–14 %)."""
+    return max(int(cfg["model.cells"]), int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
+
+
 def _seed_mu_s(result: batch.BatchResult, mu_k: float) -> float:
     """μ_s for the seeded observer pass: identified, else the batch model's regime value."""
     for value in (result.mu_s, result.details.get("mu_s_model"), result.mu_s_lower_bound):
@@ -241,7 +249,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                            string=string,
                            fc_Nm_m=td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
                            k_t_per_s=cfg["model.k_t_per_s"], top_drive_inertia_kg_m2=itd,
-                           torque_kind="motor", cells=cfg["model.cells"])
+                           torque_kind="motor", cells=_batch_cells(cfg, data.bit_depth_m))
     tick(0.5)
     flags = [f"observer_{f}" for f in diag.flags] + list(refined.flags)
     messages = list(refined.messages)

@@ -232,7 +232,8 @@ def _mesh(path: WellPath, string: DrillString, element_length_m: float, mud_out:
     nodes = nodes[np.concatenate([[True], np.diff(nodes) > _MIN_ELEMENT_M])]
     nodes[0], nodes[-1] = 0.0, bit  # the bit is the largest node; a near-duplicate was dropped
     top = path.md_m[0]
-    # above the first station the hole is taken as having the first station's direction
+    # above the first station (only with a tie-in: minimum_curvature otherwise adds a
+    # surface station) the hole is taken as having the first station's direction
     tangent = path.tangent(np.clip(nodes, top, None))
     mid = 0.5 * (nodes[1:] + nodes[:-1])
     weight = string.buoyed_weight_N_m(mid, mud_out, mud_in) * np.diff(nodes)

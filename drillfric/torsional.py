@@ -243,7 +243,8 @@ class Plant:
 
     @property
     def T_N_Nm(self) -> float:
-        """T_N = ∫F_c dx over the modelled string [N·m] (A&S 2018 eq. 27 per unit μ)."""
+        """T_N = ∫F_c dx over the true string (cell lengths L_i/n_i) [N·m] (A&S 2018 eq. 27
+        per unit μ)."""
         return float(np.sum(self.fc_Nm_m * self.grid.dx_true_m))
 
 

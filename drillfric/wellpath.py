@@ -181,8 +181,9 @@ def minimum_curvature(md_m, inc_rad, azi_rad, *, tie_in=None) -> WellPath:
     inc_rad, azi_rad : array_like
         Station inclination [0, π] and azimuth [rad].
     tie_in : tuple of float, optional
-        (tvd, north, east) [m] of the first station. Default: the hole above the first
-        station is vertical, i.e. (md₀, 0, 0).
+        (tvd, north, east) [m] of the first station. Default: a survey starting below the
+        surface gets a vertical station at MD 0 prepended (the hole above the first station
+        is the minimum-curvature arc from vertical at the surface).
 
     Returns
     -------
@@ -191,7 +192,8 @@ def minimum_curvature(md_m, inc_rad, azi_rad, *, tie_in=None) -> WellPath:
     Raises
     ------
     InputError
-        Depths not strictly increasing or angles out of range.
+        Depths not strictly increasing, angles out of range, or a 180° dogleg (no unique
+        arc).
 
     Examples
     --------
@@ -213,8 +215,17 @@ def minimum_curvature(md_m, inc_rad, azi_rad, *, tie_in=None) -> WellPath:
                          fix="sort the survey by MD and remove duplicate stations")
     if np.any((inc < 0) | (inc > np.pi)):
         raise InputError("inclination outside 0–180°", fix="check the inclination column")
+    if tie_in is None and md[0] > 0.0:
+        # the hole above the first station: a minimum-curvature arc from vertical at the
+        # surface, so positions and tangents (torque and drag) describe the same path
+        md, inc, azi = np.r_[0.0, md], np.r_[0.0, inc], np.r_[azi[0], azi]
     t = unit_tangent(inc, azi)
     beta = dogleg(t[:-1], t[1:])
+    if np.any(np.pi - beta < 1e-6):
+        bad = int(np.argmax(np.pi - beta < 1e-6))
+        raise InputError(f"the survey reverses direction between MD {md[bad]:g} and "
+                         f"{md[bad + 1]:g} m (dogleg 180°): no unique minimum-curvature arc",
+                         fix="check the inclination and azimuth of those stations")
     disp = (np.diff(md) / 2.0 * ratio_factor(beta))[:, None] * (t[:-1] + t[1:])
     tvd0, n0, e0 = (md[0], 0.0, 0.0) if tie_in is None else tie_in
     pos = np.vstack([[n0, e0, tvd0], np.array([n0, e0, tvd0]) + np.cumsum(disp, axis=0)])

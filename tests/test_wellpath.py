@@ -89,9 +89,11 @@ def test_at_station_depths_reproduces_stations(rows):
     assume(np.all(dogleg(t[:-1], t[1:]) < np.pi - 0.05))  # near-reversal: RF blows up
     path = minimum_curvature(md, inc, azi)
     got = path.at(md)
-    np.testing.assert_allclose(got["tvd_m"], path.tvd_m, atol=1e-9 * md[-1])
-    np.testing.assert_allclose(got["north_m"], path.north_m, atol=1e-9 * md[-1])
-    np.testing.assert_allclose(got["east_m"], path.east_m, atol=1e-9 * md[-1])
+    own = slice(path.md_m.size - md.size, None)  # a surface station may be prepended
+    np.testing.assert_allclose(path.md_m[own], md)
+    np.testing.assert_allclose(got["tvd_m"], path.tvd_m[own], atol=1e-9 * md[-1])
+    np.testing.assert_allclose(got["north_m"], path.north_m[own], atol=1e-9 * md[-1])
+    np.testing.assert_allclose(got["east_m"], path.east_m[own], atol=1e-9 * md[-1])
     np.testing.assert_allclose(path.tangent(md), t, atol=1e-12)
     np.testing.assert_allclose(got["inc_rad"], inc, atol=1e-9)
     # azimuth is undefined on vertical stations; compare on the unit circle elsewhere
@@ -134,7 +136,8 @@ def test_ratio_factor_is_continuous_across_the_switch():
 def test_quarter_circle_build():
     """A 90° build over Δs: radius R = 2Δs/π, ΔTVD = ΔN = R (closed-form arc)."""
     ds = 300.0
-    path = minimum_curvature([1000.0, 1000.0 + ds], [0.0, np.pi / 2], [0.0, 0.0])
+    path = minimum_curvature([1000.0, 1000.0 + ds], [0.0, np.pi / 2], [0.0, 0.0],
+                             tie_in=(1000.0, 0.0, 0.0))
     radius = 2 * ds / np.pi
     assert path.tvd_m[-1] - 1000.0 == pytest.approx(radius, rel=1e-12)
     assert path.north_m[-1] == pytest.approx(radius, rel=1e-12)
@@ -174,3 +177,20 @@ def test_single_station_path():
     assert got["inc_rad"][0] == pytest.approx(0.3, rel=1e-12)
     with pytest.raises(InputError, match="outside the survey"):
         path.position([501.0])
+
+
+def test_survey_starting_below_surface_is_one_path():
+    """Without a tie-in, a survey starting below MD 0 gets a vertical surface station, so
+    positions and tangents (used by torque and drag) describe the same arc above it."""
+    path = minimum_curvature([300.0, 1000.0], np.radians([30.0, 30.0]), [0.0, 0.0])
+    assert path.md_m[0] == 0.0 and path.inc_rad[0] == 0.0
+    mid = path.at([150.0])
+    assert 0.0 < mid["inc_rad"][0] < np.radians(30.0)  # on the arc, not at 30°
+    chord = np.hypot(path.tvd_m[1], path.north_m[1])
+    assert chord < 300.0 and path.tvd_m[1] < 300.0
+
+
+def test_reversal_has_no_unique_arc():
+    """A 180° dogleg has no unique minimum-curvature plane: an input error, not a guess."""
+    with pytest.raises(InputError, match="dogleg 180°"):
+        minimum_curvature([0.0, 100.0], np.radians([90.0, 90.0]), np.radians([0.0, 180.0]))

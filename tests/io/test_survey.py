@@ -207,9 +207,10 @@ def test_frame_reader():
 
 
 def test_default_tie_in_without_positions(tmp_path):
-    """Without TVD in the file, the hole above the first station is taken as vertical."""
+    """Without TVD in the file, a vertical surface station is added above the first one."""
     path = read_survey(_write(tmp_path, "s.csv", "MD,INC,AZI\n100,0,0\n200,0,0\n"))
-    assert path.tvd_m.tolist() == [100.0, 200.0]
+    assert path.md_m.tolist() == [0.0, 100.0, 200.0]
+    assert path.tvd_m.tolist() == [0.0, 100.0, 200.0]
 
 
 # ----------------------------------------------------------------------------- bad input
@@ -255,4 +256,4 @@ def test_tie_in_from_file_tvd_only(tmp_path):
     path = read_survey(_write(tmp_path, "s.csv", "MD,INC,AZI,TVD\n100,0,0,99.5\n200,0,0,\n"))
     assert path.tvd_m.tolist() == [99.5, 199.5]
     path = read_survey(_write(tmp_path, "t.csv", "MD,INC,AZI,TVD\n100,0,0,\n200,0,0,199\n"))
-    assert path.tvd_m.tolist() == [100.0, 200.0]
+    assert path.tvd_m.tolist() == [0.0, 100.0, 200.0]  # no TVD₀: surface station added
