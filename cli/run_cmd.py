@@ -66,6 +66,7 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
     if workers < 1:
         raise UserError(f"--workers must be at least 1, got {workers}")
     pairs = parse_starts(starts)
+    _check_unique_names(wells, config)
     if workers > 1 and len(wells) > 1:
         _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers)
         return
@@ -111,3 +112,21 @@ def _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers) -> None
         raise UserError("no well could be read")
     if result.count("failed") or result.failed_segments:
         raise SystemExit(1)
+
+
+def _check_unique_names(wells, config) -> None:
+    """Two wells with one name would overwrite each other's OUT/NAME: refuse up front."""
+    from drillfric.pipeline import well_name
+
+    if len(wells) < 2:
+        return
+    seen: dict[str, Path] = {}
+    for well in wells:
+        try:
+            name = well_name(well, config=config)
+        except DrillfricError:
+            continue  # unreadable wells are reported when they are run
+        if name in seen:
+            raise UserError(f"{seen[name]} and {well} would both write OUT/{name} — fix: give "
+                            "them distinct [well] name values or file names")
+        seen[name] = well

@@ -20,6 +20,8 @@ TAIL_FRACTION = 0.3
 SETTLE_BAND = 0.05
 #: Absolute floor of that band [-] (small friction factors).
 SETTLE_FLOOR = 0.01
+#: Start-up excluded from the stick-slip statistics [s] (at most 30 % of the window).
+STARTUP_S = 30.0
 
 
 @dataclass(frozen=True)
@@ -40,10 +42,10 @@ class Diagnostics:
     residual_rms_rpm : float
         RMS of the innovation ω̂₀ − ω₀ over the tail, all starts [RPM].
     stuck_fraction : float
-        Fraction of samples whose estimated BHA speed is within ±ω_c [-].
+        Fraction of samples after the start-up whose estimated BHA speed is within ±ω_c [-].
     stick_slip_severity : float
-        (max − min)/(2·mean) of the estimated bit speed (1st/99th percentiles) [-]; > 1 means
-        the bit stops (full stick-slip), 0 is steady rotation.
+        (max − min)/(2·mean) of the estimated bit speed after the start-up (1st/99th
+        percentiles) [-]; > 1 means the bit stops (full stick-slip), 0 is steady rotation.
     flags : tuple of str
     """
 
@@ -57,6 +59,13 @@ class Diagnostics:
     stuck_fraction: float
     stick_slip_severity: float
     flags: tuple = field(default_factory=tuple)
+
+
+def settled_mask(time_s: np.ndarray) -> np.ndarray:
+    """Samples after the start-up (rest, ramp): from min(:data:`STARTUP_S`, 30 % of the
+    window) after its start."""
+    span = time_s[-1] - time_s[0]
+    return time_s >= time_s[0] + min(STARTUP_S, 0.3 * span)
 
 
 def tail_mask(time_s: np.ndarray, fraction: float = TAIL_FRACTION) -> np.ndarray:
@@ -124,11 +133,13 @@ def diagnose(record, omega_c_rad_s: float) -> Diagnostics:
     if np.any(record.deadlock_events > 0):
         flags.append("deadlock_averted")
     best = int(np.argmin(np.abs(mu_k_tail - mu_k)))
-    bit = record.bit_rad_s_est[:, best]
+    late = settled_mask(record.time_s)
+    bit = record.bit_rad_s_est[late, best]
     return Diagnostics(
         mu_k=mu_k, mu_s=mu_s, mu_k_spread=spread_k, mu_s_spread=float(np.ptp(mu_s_tail)),
         settling_time_s=settle, converged=bool(converged),
         residual_rms_rpm=float(np.sqrt(np.mean(record.residual_rad_s[tail] ** 2))
                                / RPM_TO_RAD_S),
-        stuck_fraction=float(np.mean(np.abs(record.bha_rad_s_est[:, best]) <= omega_c_rad_s)),
+        stuck_fraction=float(np.mean(np.abs(record.bha_rad_s_est[late, best])
+                                     <= omega_c_rad_s)),
         stick_slip_severity=stick_slip_severity(bit), flags=tuple(flags))

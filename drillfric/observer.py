@@ -102,6 +102,11 @@ class Measurements:
     motor_torque_Nm: np.ndarray
 
     @property
+    def time_s(self) -> np.ndarray:
+        """Sample times [s]."""
+        return self.t0_s + self.dt_s * np.arange(self.surface_rad_s.size)
+
+    @property
     def t_end_s(self) -> float:
         """Time of the last sample [s]."""
         return self.t0_s + (self.surface_rad_s.size - 1) * self.dt_s

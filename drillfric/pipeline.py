@@ -46,6 +46,8 @@ DEFAULT_BIT_DEPTH_M = 2500.0
 #: Seconds of data before a segment handed to the estimator, so that a start-up (and a
 #: creep break-over) is seen from rest.
 PREROLL_S = 5.0
+#: ``start_id`` of the final observer pass seeded with the batch-refined factors.
+SEEDED_START_ID = -1
 _KEEP = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N", "bit_rpm")
 
 
@@ -88,6 +90,41 @@ def _bit_depth_default(cfg, survey: WellPath | None, assumed: list) -> float:
     return DEFAULT_BIT_DEPTH_M
 
 
+def _preroll_start(buffer: pd.DataFrame, lo: int, floor: int) -> int:
+    """First buffer row handed to the estimator for a segment starting at row ``lo``.
+
+    Up to :data:`PREROLL_S` earlier (the start-up seen from rest), but not before ``floor``
+    (the end of the previous segment) and only after the last null of speed or torque.
+    """
+    if lo <= floor:
+        return lo
+    t = buffer["time_s"].to_numpy()
+    start = floor + int(np.searchsorted(t[floor:lo], t[lo] - PREROLL_S))
+    pre = buffer.iloc[start:lo]
+    bad = ~(np.isfinite(pre["surface_rpm"].to_numpy(float))
+            & np.isfinite(pre["surface_torque_Nm"].to_numpy(float)))
+    if bad.any():
+        start += int(np.flatnonzero(bad)[-1]) + 1
+    return start
+
+
+def _rows_done(buffer: pd.DataFrame, pending: int) -> int:
+    """How many leading buffer rows no segment can need any more: those before the
+    segmenter's pending row, less the pre-roll a segment starting there may take."""
+    if pending <= 0:
+        return 0
+    t = buffer["time_s"].to_numpy()
+    ref = t[pending] if pending < t.size else t[-1]
+    return int(np.searchsorted(t[:pending], ref - PREROLL_S))
+
+
+def well_name(path, *, config=None) -> str:
+    """The name a well's results go under (OUT/NAME): ``[well] name`` or the file stem."""
+    data_path, _, _ = resolve_well(path, config=config)
+    cfg, _ = load_setup(path, config=config)
+    return cfg["well.name"] or (Path(path).name if Path(path).is_dir() else data_path.stem)
+
+
 def _segment_data(rows: pd.DataFrame, seg: Segment, fallback_depth: float) -> SegmentData:
     depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
     wob = float(np.nanmedian(rows["wob_N"])) if "wob_N" in rows and \
@@ -113,16 +150,17 @@ def _segment_row(seg: Segment, est: SegmentEstimate | None, status: str, message
             "stick_slip_severity", "stuck_fraction", "mu_k_observer", "mu_s_observer",
             "mu_td", "T_N_Nm", "bit_rms_error_rpm")})
         row["flags"] = list(est.flags)
-        row["starts"] = est.starts.tolist()  # start_id i of estimates.parquet; len = seeded
+        row["starts"] = est.starts.tolist()  # start_id i of estimates.parquet (−1: seeded)
         row["message"] = "; ".join([message] * bool(message) + list(est.messages))
     return row
 
 
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
                     omega_c: float) -> pd.DataFrame:
-    """estimates.parquet rows of one segment: every start, then the seeded pass."""
+    """estimates.parquet rows of one segment: every start (``start_id`` 0…), then the pass
+    seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`)."""
     frames = []
-    for rec, offset in ((est.first, 0), (est.final, est.starts.shape[0])):
+    for rec, offset in ((est.first, 0), (est.final, SEEDED_START_ID)):
         n_t, n_s = rec.mu_k.shape
         measured = np.interp(rec.time_s, data.time_s, data.surface_rpm)
         cols = {
@@ -206,7 +244,7 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
     if starts is not None:
         overrides["observer.starts"] = [list(map(float, s)) for s in starts]
     cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
-    name = cfg["well.name"] or (Path(path).name if Path(path).is_dir() else data_path.stem)
+    name = well_name(path, config=config)
     assumed = list(cfg.assumed)
     if well_path is None:
         assumed.append("vertical well: no survey found")
@@ -219,6 +257,7 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
     failed = 0
     buffer = pd.DataFrame()
     buffer_start = 0
+    last_end = 0  # row after the last emitted segment: the next pre-roll starts no earlier
     n_rows = 0
     has_truth = None
     final = Path(out_root) / name
@@ -226,13 +265,12 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
         writer = None
         try:
             def handle(done: list[Segment]):
-                nonlocal warm, failed, fallback_depth, writer
+                nonlocal warm, failed, fallback_depth, writer, last_end
                 for seg in done:
-                    lo = seg.i_start - buffer_start
-                    times = buffer["time_s"].to_numpy()
-                    lo = max(int(np.searchsorted(times[:lo], times[lo] - PREROLL_S)), 0) \
-                        if lo > 0 else 0
+                    lo = _preroll_start(buffer, seg.i_start - buffer_start,
+                                        max(last_end - buffer_start, 0))
                     rows = buffer.iloc[lo: seg.i_end - buffer_start]
+                    last_end = seg.i_end
                     if fallback_depth is None and not np.isfinite(seg.bit_depth_m):
                         fallback_depth = _bit_depth_default(cfg, well_path, assumed)
                     depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
@@ -260,9 +298,8 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                     writer.write(_estimate_frame(seg.id, est, data, cfg.omega_c_rad_s))
                     rows_out.append(_segment_row(seg, est, "ok", "", depth))
                     profiles.append(_profile_frame(seg.id, est))
-                    if est.converged:
-                        warm = (est.mu_s if est.mu_s is not None else est.mu_s_observer,
-                                est.mu_k)
+                    if est.converged and seg.kind == "off_bottom_rotating":
+                        warm = (est.mu_s_seed, est.mu_k)
 
             for chunk in iter_surface(path, config=config, survey=survey,
                                       chunk_rows=chunk_rows):
@@ -273,12 +310,12 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                     keep.reset_index(drop=True)
                 n_rows += len(chunk)
                 handle(segmenter.feed(chunk))
-                drop = segmenter.pending_from - buffer_start
+                drop = _rows_done(buffer, segmenter.pending_from - buffer_start)
                 if drop > 0:
                     buffer = buffer.iloc[drop:].reset_index(drop=True)
                     buffer_start += drop
-                if progress:
-                    progress(len(chunk) / max(total_rows, 1))
+                if progress and total_rows:
+                    progress(len(chunk) / total_rows)
             handle(segmenter.close())
         finally:
             if writer is not None:

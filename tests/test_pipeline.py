@@ -132,3 +132,56 @@ def test_several_wells_on_two_workers(tmp_path):
     for name in ("a", "b"):
         summary = json.loads((tmp_path / "o" / name / "summary.json").read_text())
         assert summary["well"] == name and summary["counts"]["estimated"] == 4
+
+
+def _segments_of(out_dir):
+    summary = json.loads((out_dir / "summary.json").read_text())
+    return [(s["id"], s["status"], s["mu_s_identifiable"], s["mu_k"], s["mu_s"])
+            for s in summary["segments"]]
+
+
+def test_results_do_not_depend_on_chunking(demo_run, tmp_path):
+    """Streaming must not change the answer: small chunks (boundaries inside stands and
+    inside the pre-roll) give exactly the segments of a one-chunk run (a regression: the
+    pre-roll used to be dropped at chunk boundaries, losing the creep and μ_s)."""
+    from drillfric.pipeline import run_well
+
+    run_well(DEMO / "demo.csv", tmp_path, chunk_rows=3770)
+    assert _segments_of(tmp_path / "demo") == _segments_of(demo_run[0])
+
+
+def test_nulls_just_before_a_stand(tmp_path):
+    """Nulls in the seconds before a stand (inside its pre-roll) do not fail the stand."""
+    frame = pd.read_csv(DEMO / "demo.csv")
+    before_second = (frame["time_s"] > 262.0) & (frame["time_s"] < 264.5)
+    frame.loc[before_second, ["surface_rpm", "surface_torque_Nm"]] = np.nan
+    frame.to_csv(tmp_path / "demo.csv", index=False)
+    for name in ("demo.toml", "demo.survey.csv"):
+        shutil.copy(DEMO / name, tmp_path / name)
+    result = CliRunner().invoke(cli, ["run", str(tmp_path / "demo.csv"), "--out",
+                                      str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "o" / "demo" / "summary.json").read_text())
+    assert [s["status"] for s in summary["segments"]] == ["ok"] * 4
+
+
+def test_resampled_to_5_hz(tmp_path, truth):
+    """`run --rate 5` (issue 5/6: test 5 Hz logs) still finds the stands and μ_k."""
+    result = CliRunner().invoke(cli, ["run", str(DEMO / "demo.csv"), "--out", str(tmp_path),
+                                      "--rate", "5"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "demo" / "summary.json").read_text())
+    assert summary["inputs"]["resampled_rate_hz"] == 5.0
+    assert abs(summary["mu_k"] / truth["mu_k"] - 1) <= 0.05
+
+
+def test_two_wells_with_one_name_are_refused(tmp_path):
+    for sub in ("a", "b"):
+        (tmp_path / sub).mkdir()
+        for name in ("demo.csv", "demo.toml", "demo.survey.csv", "demo.scenario.toml"):
+            shutil.copy(DEMO / name, tmp_path / sub / name)
+    result = CliRunner().invoke(cli, ["run", str(tmp_path / "a" / "demo.csv"),
+                                      str(tmp_path / "b" / "demo.csv"), "--out",
+                                      str(tmp_path / "o")])
+    assert result.exit_code == 2 and "would both write OUT/demo" in result.output
+    assert not (tmp_path / "o").exists()

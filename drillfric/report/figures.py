@@ -188,7 +188,7 @@ def _mu_points(ax, rows: pd.DataFrame, col: str, spread: str, converged: np.ndar
 def segment_figure(est: pd.DataFrame, segment: dict) -> Figure:
     """One segment: μ per start vs time, surface RPM measured vs estimated, bit RPM.
 
-    The final observer pass (``start_id == len(starts)``, seeded with the batch-refined
+    The final observer pass (``start_id == -1``, seeded with the batch-refined
     factors) is drawn in black and gives the estimated speeds; the starts are thin lines.
     Time where the estimated bit is stuck (|ω_BHA| ≤ ω_c) is shaded. Measured downhole
     bit speed is drawn dashed when the input had it.
@@ -202,8 +202,7 @@ def segment_figure(est: pd.DataFrame, segment: dict) -> Figure:
     """
     fig = _new(7.2, hspace=0.45)
     ax_mu, ax_rpm, ax_bit = fig.subplots(3, 1, sharex=True)
-    n_starts = len(segment.get("starts") or [])
-    final_id = n_starts if (est["start_id"] == n_starts).any() else int(est["start_id"].max())
+    final_id = -1  # the pass seeded with the batch-refined factors (pipeline.SEEDED_START_ID)
     for start_id, rows in est.groupby("start_id", sort=True):
         final = start_id == final_id
         if not final:  # μ moves slowly: a few hundred points per start are plenty
