@@ -45,11 +45,10 @@ def warn(message: str) -> None:
 @contextmanager
 def user_errors():
     """Translate library exceptions into one-line CLI errors (tracebacks only with --debug)."""
-    debug = context().debug
     try:
         yield
     except DrillfricError as exc:
-        if debug:
+        if _debug():
             raise
         raise UserError(exc.message) from None
     except (click.ClickException, click.exceptions.Exit, click.exceptions.Abort):
@@ -57,11 +56,17 @@ def user_errors():
     except KeyboardInterrupt:
         raise
     except Exception as exc:  # noqa: BLE001 — last line of defence: no traceback for users
-        if debug:
+        if _debug():
             raise
-        err = click.ClickException(f"internal error: {type(exc).__name__}: {exc} "
-                                   f"(rerun with --debug for the traceback)")
-        raise err from None
+        raise UserError(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug "
+                        "for the traceback)") from None
+
+
+def _debug() -> bool:
+    """--debug, read when an error happens (the group's options are parsed by then)."""
+    import sys
+
+    return context().debug or "--debug" in sys.argv[1:]
 
 
 @contextmanager

@@ -7,8 +7,6 @@ import json
 import click
 import numpy as np
 
-from .common import echo
-
 
 @click.command("inspect")
 @click.argument("well", type=click.Path(path_type=str))
@@ -31,7 +29,7 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
     if as_json:
         click.echo(json.dumps(summary, indent=2))
     else:
-        echo(render(summary))
+        click.echo(render(summary))  # the result: printed even with --quiet
 
 
 def summarize(data) -> dict:

@@ -42,7 +42,8 @@ def _describe(result) -> str:
 
 @click.command("run")
 @click.argument("wells", nargs=-1, required=True, type=click.Path(path_type=Path))
-@click.option("--out", "out", type=click.Path(path_type=Path), default=Path("drillfric-out"),
+@click.option("--out", "out", type=click.Path(path_type=Path, file_okay=False),
+              default=Path("drillfric-out"),
               show_default=True, help="Output directory; each well goes to OUT/NAME.")
 @click.option("--config", type=click.Path(path_type=Path), help="Well configuration (TOML), "
               "overrides the NAME.toml sidecar.")
@@ -81,6 +82,13 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
             if context().debug or len(wells) == 1:
                 raise
             click.secho(f"error: {exc.message}", err=True, fg="red")
+            unreadable += 1
+            continue
+        except Exception as exc:  # noqa: BLE001 — one well's bug must not stop the others
+            if context().debug or len(wells) == 1:
+                raise
+            click.secho(f"error: {well}: internal error: {type(exc).__name__}: {exc}",
+                        err=True, fg="red")
             unreadable += 1
             continue
         for note in result.summary["assumed"]:

@@ -156,11 +156,11 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
         return
     mu_text = (f"{summary['friction_factor']:g}" if summary["friction_factor"] is not None
                else f"{mu.cased:g} cased above {mu.shoe_md_m:g} m, {mu.open_hole:g} open hole")
-    echo(f"bit depth        {result.bit_depth_m:10.1f} m   ({load_case}, μ = {mu_text})")
-    echo(f"hook load        {result.hookload_N / 1e3:10.1f} kN  (effective, no block weight)")
-    echo(f"surface torque   {result.surface_torque_Nm / 1e3:10.2f} kN·m")
-    echo(f"T_N = ∫F_c dx    {result.T_N_Nm / 1e3:10.2f} kN·m per unit friction factor")
-    echo(f"max side force   {summary['max_normal_force_N_m']:10.1f} N/m")
+    click.echo(f"bit depth        {result.bit_depth_m:10.1f} m   ({load_case}, μ = {mu_text})")
+    click.echo(f"hook load        {result.hookload_N / 1e3:10.1f} kN  (effective, no block weight)")
+    click.echo(f"surface torque   {result.surface_torque_Nm / 1e3:10.2f} kN·m")
+    click.echo(f"T_N = ∫F_c dx    {result.T_N_Nm / 1e3:10.2f} kN·m per unit friction factor")
+    click.echo(f"max side force   {summary['max_normal_force_N_m']:10.1f} N/m")
     if out is not None:
         echo(f"profile written to {out}")
 

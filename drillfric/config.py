@@ -398,6 +398,30 @@ def _channels(raw: Any, file: str | None) -> dict:
     return out
 
 
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check_observer_lists(observer: dict, file: str | None) -> None:
+    """List-valued keys: ``starts`` = [[μ_s, μ_k], ...] with 0 ≤ μ_k ≤ μ_s, ``poles_per_s``
+    = two positive numbers."""
+    starts = observer["starts"]
+    for i, pair in enumerate(starts, start=1):
+        ok = (isinstance(pair, list) and len(pair) == 2 and all(map(_is_number, pair))
+              and 0 <= pair[1] <= pair[0])
+        if not ok:
+            raise ConfigError(f"observer.starts[{i}] = {pair!r} must be [μ_s, μ_k] numbers with "
+                              "0 ≤ μ_k ≤ μ_s", file=file,
+                              fix="e.g. starts = [[0.3, 0.2], [0.6, 0.4]]")
+    if not starts:
+        raise ConfigError("observer.starts is empty", file=file,
+                          fix="e.g. starts = [[0.3, 0.2], [0.6, 0.4]]")
+    poles = observer["poles_per_s"]
+    if len(poles) != 2 or not all(_is_number(p) and p > 0 for p in poles):
+        raise ConfigError(f"observer.poles_per_s = {poles!r} must be two positive numbers "
+                          "[z, p] in 1/s", file=file, fix="e.g. poles_per_s = [1.0, 1.5]")
+
+
 def read_toml(path: str | Path) -> dict:
     """Read a TOML file, turning syntax errors into one-line ConfigErrors."""
     path = Path(path)
@@ -448,6 +472,11 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
         table, key = dotted.split(".")
         spec = {k.name: k for k in SCHEMA[table]}[key]
         values[table][key] = spec.validate(value, dotted, "command line")
+    _check_observer_lists(values["observer"], fname)
+    if values["segmentation"]["rotating_stop_rpm"] > values["segmentation"]["rotating_rpm"]:
+        raise ConfigError("segmentation.rotating_stop_rpm must not exceed rotating_rpm "
+                          "(rotation starts above rotating_rpm and ends below the stop speed)",
+                          file=fname, fix="e.g. rotating_rpm = 2.0, rotating_stop_rpm = 1.0")
     if values["model"]["omega_c_rad_s"] is not None and values["model"]["omega_c_rpm"] is not None:
         raise ConfigError("give either model.omega_c_rad_s or model.omega_c_rpm, not both",
                           file=fname)

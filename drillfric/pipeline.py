@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric import __version__
-from drillfric.errors import DrillfricError
+from drillfric.errors import DrillfricError, InputError
 from drillfric.estimate import (
     SegmentData,
     SegmentEstimate,
@@ -29,6 +29,7 @@ from drillfric.estimate import (
     check_segment,
     estimate_segment,
 )
+from drillfric.io.timebase import check_plausible_rate
 from drillfric.io.well import iter_surface, load_setup, resolve_well
 from drillfric.outputs import (
     EstimatesWriter,
@@ -126,6 +127,10 @@ def well_name(path, *, config=None) -> str:
 
 
 def _segment_data(rows: pd.DataFrame, seg: Segment, fallback_depth: float) -> SegmentData:
+    """The estimator's samples: rows with both speed and torque (the few nulls a segment
+    may hold are bridged when the measurements are put on a uniform grid)."""
+    rows = rows[np.isfinite(rows["surface_rpm"].to_numpy(float))
+                & np.isfinite(rows["surface_torque_Nm"].to_numpy(float))]
     depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
     wob = float(np.nanmedian(rows["wob_N"])) if "wob_N" in rows and \
         rows["wob_N"].notna().any() else 0.0
@@ -305,6 +310,7 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                                       chunk_rows=chunk_rows):
                 if has_truth is None:
                     has_truth = "bit_rpm" in chunk
+                    check_plausible_rate(chunk["time_s"].to_numpy(), file=data_path)
                 keep = chunk[[c for c in _KEEP if c in chunk]]
                 buffer = pd.concat([buffer, keep], ignore_index=True) if len(buffer) else \
                     keep.reset_index(drop=True)
@@ -317,6 +323,9 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                 if progress and total_rows:
                     progress(len(chunk) / total_rows)
             handle(segmenter.close())
+            if n_rows == 0:
+                raise InputError("no data rows", file=data_path,
+                                 fix="check that the file holds samples below its header")
         finally:
             if writer is not None:
                 writer.close()

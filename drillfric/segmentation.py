@@ -321,12 +321,21 @@ def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int,
     return [tuple(r) for r in merged]
 
 
-def _status(duration_s: float, n_null: dict[str, int], min_s: float) -> tuple[str, str]:
+#: Largest fraction of null speed/torque samples a segment may have; fewer are bridged by
+#: interpolation (a dropped sample here and there is normal in rig logs).
+MAX_NULL_FRACTION = 0.05
+
+
+def _status(duration_s: float, n_null: dict[str, int], n_rows: int,
+            min_s: float) -> tuple[str, str]:
     nulls = [f"{name} ({count} samples)" for name, count in n_null.items() if count]
-    if nulls:
-        return "skipped", "nulls in " + ", ".join(nulls)
     if duration_s < min_s:
         return "skipped", f"too short: {duration_s:.0f} s < {min_s:.0f} s"
+    if any(count > MAX_NULL_FRACTION * n_rows for count in n_null.values()):
+        return "skipped", ("nulls in " + ", ".join(nulls) + f": more than "
+                           f"{MAX_NULL_FRACTION:.0%} of the samples")
+    if nulls:
+        return "ok", "nulls bridged by interpolation: " + ", ".join(nulls)
     return "ok", ""
 
 
@@ -347,7 +356,7 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
             n_null = {name: int(np.count_nonzero(mask[i0:i1])) for name, mask in nulls.items()}
             if t1 - t0 < float(cfg["segmentation.min_rotation_s"]):
                 continue  # a blip of speed noise, not rotation
-            status, message = _status(t1 - t0, n_null, min_s)
+            status, message = _status(t1 - t0, n_null, i1 - i0, min_s)
             out.append(Segment(
                 id=first_id + len(out),
                 kind=KINDS[ROTATING_ON_BOTTOM if on_bottom else ROTATING_OFF_BOTTOM],

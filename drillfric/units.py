@@ -61,7 +61,16 @@ _ALIASES = {
     "ppg": "pound_per_gallon",
     "lbm/gal": "pound_per_gallon",
     "ft": "foot",
+    "f": "foot",  # LAS depth unit
     "feet": "foot",
+    "klb": "kilopound_force",
+    "klbs": "kilopound_force",
+    "kftlb": "kilofoot*force_pound",
+    "ms": "millisecond",  # not megasiemens
+    "min": "minute",
+    "hr": "hour",
+    "kpa": "kilopascal",
+    "mpa": "megapascal",
     "m": "meter",
     "s": "second",
     "sec": "second",
@@ -110,14 +119,17 @@ def parse_unit(text: str) -> pint.Unit:
     """
     key = text.strip().lower().replace(" ", "")
     expr = _ALIASES.get(key)
-    if expr is None:
-        expr = re.sub(r"(?<=[A-Za-z])\.(?=[A-Za-z])", "*", text.strip())
-    try:
-        return UREG.parse_units(expr)
-    except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError,
-            AttributeError, TypeError, ValueError) as exc:
-        raise InputError(f"unknown unit '{text}'",
-                         fix="use a unit such as rpm, kN.m, ft.lbf, klbf, m, ft") from exc
+    candidates = [expr] if expr is not None else [
+        re.sub(r"(?<=[A-Za-z])\.(?=[A-Za-z])", "*", spelled)
+        for spelled in (text.strip(), text.strip().lower())]  # LAS headers are upper case
+    for candidate in candidates:
+        try:
+            return UREG.parse_units(candidate)
+        except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError,
+                AttributeError, TypeError, ValueError):
+            continue
+    raise InputError(f"unknown unit '{text}'",
+                     fix="use a unit such as rpm, kN.m, ft.lbf, klbf, m, ft")
 
 
 def conversion_factor(unit: str, kind: str) -> float:

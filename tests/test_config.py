@@ -80,6 +80,11 @@ bit_depth = { column = "BITDEP", unit = "m" }
      "needs length_m"),
     ({"channels": {"rpmm": "X"}}, "unknown channel 'rpmm'"),
     ({"model": {"omega_c_rad_s": 1.0, "omega_c_rpm": 10.0}}, "not both"),
+    ({"observer": {"starts": [[0.3]]}}, "observer.starts[1]"),
+    ({"observer": {"starts": [[0.3, "x"]]}}, "observer.starts[1]"),
+    ({"observer": {"starts": [[0.2, 0.6]]}}, "0 ≤ μ_k ≤ μ_s"),
+    ({"observer": {"poles_per_s": ["a", "b"]}}, "two positive numbers"),
+    ({"segmentation": {"rotating_rpm": 1.0, "rotating_stop_rpm": 5.0}}, "rotating_stop_rpm"),
 ])
 def test_bad_config_one_line(raw, words):
     with pytest.raises(ConfigError) as info:

@@ -109,6 +109,9 @@ _EXTRA_UNITS = {
     "dan": "decanewton",
 }
 
+#: Per-minute spellings that mean RPM on a rotation channel (strokes per minute elsewhere).
+_PER_MINUTE = frozenset({"1/min", "u/min", "min-1", "min^-1", "1/minute", "rev/min"})
+
 #: Unit as spelled in the canonical suffix of each channel (``surface_torque_Nm`` → N.m).
 SUFFIX_UNITS = {"time": "s", "surface_rpm": "rpm", "surface_torque": "N.m", "hookload": "N",
                 "bit_depth": "m", "hole_depth": "m", "wob": "N", "block_position": "m",
@@ -160,7 +163,10 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     >>> round(factor("klbf", BY_KEY["hookload"]), 3)
     4448.222
     """
-    spelled = _EXTRA_UNITS.get(unit.strip().lower().replace(" ", ""), unit)
+    key = unit.strip().lower().replace(" ", "")
+    spelled = _EXTRA_UNITS.get(key, unit)
+    if key in _PER_MINUTE and "revolution" in channel.unit:
+        spelled = "revolution/minute"  # 1/min, U/min, min-1: the European spellings of RPM
     try:
         source = parse_unit(spelled)
     except InputError as exc:

@@ -87,6 +87,22 @@ def find_gaps(time_s: np.ndarray, max_gap_s: float,
     return tuple((float(time_s[i]), float(time_s[i + 1])) for i in idx)
 
 
+#: Plausible sampling of rig surface data [Hz]: outside it the time column is almost surely
+#: in another unit (Excel serial days, milliseconds read as seconds).
+PLAUSIBLE_RATE_HZ = (1.0 / 120.0, 5000.0)
+
+
+def check_plausible_rate(time_s: np.ndarray, *, file=None, column: str = "time") -> None:
+    """Raise InputError when the median sample spacing is not that of a rig log."""
+    rate = nominal_rate_hz(np.asarray(time_s, dtype=float))
+    lo, hi = PLAUSIBLE_RATE_HZ
+    if np.isfinite(rate) and rate > 0 and not lo <= rate <= hi:
+        raise InputError(f"time column '{column}' gives {rate:.3g} samples per second, not a "
+                         "rig log's (0.008–5000 Hz): probably another unit (Excel days, ms)",
+                         file=file, fix='state it in [channels], e.g. time = { unit = "ms" }, '
+                                        "or export the time in seconds")
+
+
 def summarize(time_s: np.ndarray, *, max_gap_s: float, duplicates_dropped: int = 0,
               untimed_dropped: int = 0, origin: pd.Timestamp | None = None,
               source_start_s: float | None = None) -> TimeBase:
@@ -196,16 +212,18 @@ class TimeTracker:
         if pd.api.types.is_datetime64_any_dtype(values):
             return values.reset_index(drop=True)
         text = values.astype("string").str.strip()
-        try:
-            return pd.to_datetime(text, format="ISO8601").reset_index(drop=True)
-        except (ValueError, TypeError):
-            stamps = pd.to_datetime(text, format="ISO8601", errors="coerce")
-            bad = np.flatnonzero(stamps.isna().to_numpy() & _present(text))
-            row = self._rows_seen + (bad[0] if bad.size else 0) + 1
-            shown = text.iloc[bad[0]] if bad.size else ""
-            raise InputError(f"time column '{self.column}': cannot read '{shown}' at data row "
-                             f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
-                             fix="write times as seconds or like 2024-05-01T12:00:00") from None
+        for utc in (False, True):  # several UTC offsets (a daylight-saving change): to UTC
+            try:
+                return pd.to_datetime(text, format="ISO8601", utc=utc).reset_index(drop=True)
+            except (ValueError, TypeError):
+                continue
+        stamps = pd.to_datetime(text, format="ISO8601", errors="coerce", utc=True)
+        bad = np.flatnonzero(stamps.isna().to_numpy() & _present(text))
+        row = self._rows_seen + (bad[0] if bad.size else 0) + 1
+        shown = text.iloc[bad[0]] if bad.size else ""
+        raise InputError(f"time column '{self.column}': cannot read '{shown}' at data row "
+                         f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
+                         fix="write times as seconds or like 2024-05-01T12:00:00")
 
 
 def _as_number(values: pd.Series) -> np.ndarray | None:

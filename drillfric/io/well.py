@@ -32,7 +32,7 @@ from drillfric.config import Config, config_from_dict, load_config, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.io.channels import Mapping, map_channels
 from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
-from drillfric.io.timebase import TimeBase, TimeTracker, summarize
+from drillfric.io.timebase import TimeBase, TimeTracker, check_plausible_rate, summarize
 from drillfric.wellpath import WellPath
 
 #: Rows per chunk of :func:`iter_surface` (a few tens of MB for a dozen channels).
@@ -355,6 +355,7 @@ def load_well(path, *, config=None, survey=None, overrides=None,
     if surface.empty:
         raise InputError("no data rows with a time", file=data_path,
                          fix="give a file with data rows (and a readable time column)")
+    check_plausible_rate(surface["time_s"].to_numpy(), file=data_path)
     timebase = summarize(surface["time_s"].to_numpy(), max_gap_s=cfg["segmentation.max_gap_s"],
                          duplicates_dropped=tracker.duplicates, untimed_dropped=tracker.untimed,
                          origin=tracker.origin, source_start_s=tracker.source_start_s)
