@@ -30,7 +30,7 @@ from drillfric.estimate import (
     estimate_segment,
 )
 from drillfric.io.timebase import check_plausible_rate
-from drillfric.io.well import iter_surface, load_setup, resolve_well
+from drillfric.io.well import assumed_units, iter_surface, load_setup, resolve_well
 from drillfric.outputs import (
     EstimatesWriter,
     atomic_directory,
@@ -250,7 +250,7 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
         overrides["observer.starts"] = [list(map(float, s)) for s in starts]
     cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
     name = well_name(path, config=config)
-    assumed = list(cfg.assumed)
+    assumed = list(cfg.assumed) + assumed_units(path, cfg, config=config)
     if well_path is None:
         assumed.append("vertical well: no survey found")
     fallback_depth = None

@@ -259,9 +259,29 @@ def _numeric(values: pd.Series) -> np.ndarray:
     if pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values):
         out = values.to_numpy(dtype=float, na_value=np.nan).copy()
     else:
-        out = pd.to_numeric(values.astype("string").str.strip(), errors="coerce").to_numpy(
-            dtype=float, na_value=np.nan)
+        out = _text_numbers(values.astype("string").str.strip())
     out[np.isin(out, NULL_VALUES)] = np.nan
+    return out
+
+
+_DECIMAL_COMMA = r"^-?(?:\d{1,3}(?:\.\d{3})+|\d+),\d+$"  # 17.730,5 or 1234,5
+
+
+def _text_numbers(text: pd.Series) -> np.ndarray:
+    """Numbers from text; a column read as text because of one bad token may still use a
+    decimal comma (and thousands dots), which are read as such (only the bad cell is NaN).
+
+    Examples
+    --------
+    >>> _text_numbers(pd.Series(["1,5", "17.730,25", "***", "2.5"], dtype="string")).tolist()
+    [1.5, 17730.25, nan, 2.5]
+    """
+    out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+    comma = text.str.fullmatch(_DECIMAL_COMMA).fillna(False).to_numpy(dtype=bool)
+    if comma.any():
+        fixed = text[comma].str.replace(".", "", regex=False).str.replace(",", ".", regex=False)
+        out[comma] = pd.to_numeric(fixed, errors="coerce").to_numpy(dtype=float,
+                                                                    na_value=np.nan)
     return out
 
 
@@ -397,3 +417,12 @@ def load_setup(path, *, config=None, survey=None,
     _, config_path, survey_path = resolve_well(
         path, config=None if isinstance(config, Config) else config, survey=survey)
     return _load_config(config_path, config, overrides), _load_survey(survey_path)
+
+
+def assumed_units(path, cfg: Config, *, config=None) -> list[str]:
+    """Channels whose unit nothing stated (file, config or name): the documented default
+    was assumed — for the run summary's ``assumed`` list. Reads only the file's header."""
+    data_path, _, _ = resolve_well(path, config=None if isinstance(config, Config) else config)
+    _, mappings = _open(data_path, cfg)
+    return [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — nothing "
+            "in the file or the config says" for m in mappings.values() if m.source == "default"]

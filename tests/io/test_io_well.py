@@ -176,3 +176,17 @@ def test_load_setup_reads_config_and_survey_only(csv_well, tmp_path):
 def test_iter_surface_fails_at_the_call_for_a_bad_well(tmp_path):
     with pytest.raises(InputError, match="file not found"):
         iter_surface(tmp_path / "missing.csv")
+
+
+def test_decimal_comma_column_with_a_bad_token_keeps_its_numbers(tmp_path):
+    """A semicolon/decimal-comma log where one torque cell is garbage: pandas reads that
+    column as text; only the bad cell may become NaN, not the whole column (review find)."""
+    from drillfric.io.well import load_well
+
+    lines = ["TIME;SRPM;STOR [kN.m]"] + [f"{i};60,5;{10 + i % 3},25" for i in range(50)]
+    lines[20] = "19;60,5;***"
+    path = tmp_path / "w.csv"
+    path.write_text("\n".join(lines) + "\n")
+    torque = load_well(path).surface["surface_torque_Nm"].to_numpy()
+    assert np.isnan(torque).sum() == 1
+    assert np.nanmax(torque) == pytest.approx(12.25e3)
