@@ -64,13 +64,15 @@ class Key:
                               fix=f"write e.g. {where.split('.')[-1]} = {_example(self)}")
         if self.choices is not None and value not in self.choices:
             raise ConfigError(f"key '{where}' must be one of {', '.join(map(repr, self.choices))}"
-                              f", got {value!r}", file=file)
+                              f", got {value!r}", file=file,
+                              fix=f"write e.g. {where.split('.')[-1]} = {_example(self)}")
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             low_bad = self.min is not None and (
                 value <= self.min if self.min_exclusive else value < self.min)
             if low_bad or (self.max is not None and value > self.max):
                 raise ConfigError(f"key '{where}' = {value} is outside {self.range_text()}",
-                                  file=file)
+                                  file=file, fix=f"give a value {self.range_text()}"
+                                                 + (f" [{self.unit}]" if self.unit else ""))
         return value
 
     def range_text(self) -> str:
@@ -431,7 +433,9 @@ def read_toml(path: str | Path) -> dict:
         with path.open("rb") as fh:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"not valid TOML ({exc})", file=path) from exc
+        raise ConfigError(f"not valid TOML ({exc})", file=path,
+                          fix="check the line it names (quotes around text, = between key "
+                              "and value)") from exc
     except UnicodeDecodeError as exc:
         raise ConfigError("not a text file", file=path) from exc
 
