@@ -175,6 +175,18 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "of each segment (they converge within it); the seeded pass covers all."),
         _positive("deadlock_s", 15.0, "s", "Deadlock guard: an estimated BHA stuck this long "
                   "while the top drive turns releases μ̂_s to μ̂_k (THEORY §6.1)."),
+        Key("ensemble_members", int, 7, "", "Members of the final pass seeded with the "
+            "batch-refined factors; the estimated bit speed is their mean and min–max its "
+            "band (the stick-slip cycle is chaotic: members drift apart in phase; weighted by "
+            "how well each matches the surface speed lately, their mean tracks the bit better "
+            "than any one, docs/validation.md). 1 = one observer.",
+            min=1, max=32),
+        Key("ensemble_spread", float, 0.15, "", "Relative half-width of μ_s across the "
+            "ensemble members: μ_s·(1 ± spread), the uncertainty of the refined μ_s.",
+            min=0.0, max=0.5),
+        Key("adapt_final", bool, False, "", "Keep adapting μ̂ in the final pass. Off by "
+            "default: the batch factors are the better estimates (±2 % vs ±10 %, THEORY §6) "
+            "and adaptation through a creep break-over can drive μ̂_k to μ_s."),
     ),
     "batch": (
         _positive("window_s", 600.0, "s", "The batch refinement (THEORY §6.4) fits the first "

@@ -8,8 +8,9 @@ The chain of issue 5 (THEORY.md §5–§6), for one segment at one bit depth:
    giving the online estimates, their spread and settling;
 3. the batch refinement (speed-driven fit, THEORY §6.4) gives μ_k (mean-torque match) and
    μ_s where the data identify it (creep) or a lower bound (stick-slip onset);
-4. the observer runs once more, over the whole segment, seeded with the refined factors:
-   the bit-speed estimate and the μ_k time series.
+4. the observer runs once more, over the whole segment, seeded with the refined factors
+   (held, not adapted, by default) as a small ensemble spread over the uncertainty of μ_s:
+   the bit-speed estimate is the ensemble mean, with the members' min–max as its band.
 
 The numbers reported are the batch ones when it succeeds (``method`` = "batch"), the
 observer consensus otherwise ("observer"); which is which is recorded.
@@ -17,7 +18,7 @@ observer consensus otherwise ("observer"); which is which is recorded.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -26,7 +27,15 @@ from drillfric.diagnostics import Diagnostics, diagnose, settled_mask
 from drillfric.drillstring import build_string
 from drillfric.errors import DrillfricError
 from drillfric.gains import gains_from_config
-from drillfric.observer import Measurements, Observer, ObserverRecord, ObserverState, observe
+from drillfric.observer import (
+    BitSpeedEstimate,
+    Measurements,
+    Observer,
+    ObserverRecord,
+    ObserverState,
+    ensemble_bit_speed,
+    observe,
+)
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, vertical
 
@@ -107,10 +116,13 @@ class SegmentEstimate:
     starts : ndarray, shape (S, 2)
         Observer starts (μ_s, μ_k); the seeded final pass is start S.
     first, final : ObserverRecord
-        Observer records of the first pass (all starts) and the seeded pass.
+        Observer records of the first pass (all starts) and the seeded pass (one start per
+        ensemble member, the seed first; :func:`drillfric.observer.ensemble_bit_speed`).
     mu_s_seed : float
         μ_s the seeded pass used (identified, else the batch model's regime value or bound);
         the next segment's warm start.
+    bit : BitSpeedEstimate
+        Bit speed of the seeded ensemble (weighted mean and band).
     bit_rms_error_rpm : float or None
         RMS error of the estimated bit speed when the truth is known [RPM].
     """
@@ -136,6 +148,7 @@ class SegmentEstimate:
     starts: np.ndarray
     first: ObserverRecord = field(repr=False)
     final: ObserverRecord = field(repr=False)
+    bit: BitSpeedEstimate | None = field(default=None, repr=False)
     bit_rms_error_rpm: float | None = None
     td: torque_drag.TDResult | None = field(default=None, repr=False)
     mu_s_seed: float | None = None
@@ -186,6 +199,30 @@ def _seed_mu_s(result: batch.BatchResult, mu_k: float) -> float:
         if value is not None:
             return max(float(value), mu_k)
     return mu_k
+
+
+def ensemble_starts(mu_s: float, mu_k: float, members: int, spread: float,
+                    mu_max: float) -> np.ndarray:
+    """Ensemble of (μ_s, μ_k) for the final pass: μ_s·(1 + δ) for δ evenly spaced over
+    [−spread, +spread], the seed (δ = 0) first, each kept within [μ_k, μ_max] [-]."""
+    offsets = np.linspace(-spread, spread, members) if members > 1 else np.zeros(1)
+    offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]
+    mu_s_members = np.clip(mu_s * (1.0 + offsets), mu_k, mu_max)
+    return np.column_stack([mu_s_members, np.full(members, mu_k)])
+
+
+def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: float, *,
+                adapt: bool, output_rate_hz: float) -> ObserverRecord:
+    """The observer over the whole segment from the refined factors, as an ensemble
+    (``observer.ensemble_members``, ``observer.ensemble_spread``); μ̂ held unless ``adapt``."""
+    if not adapt:
+        observer = replace(observer, gains=replace(observer.gains, l_k=0.0, l_s=0.0))
+    members = ensemble_starts(mu_s, mu_k, cfg["observer.ensemble_members"],
+                              cfg["observer.ensemble_spread"], observer.mu_max)
+    state = ObserverState.from_starts(observer, members, omega0_rad_s=meas.surface_rad_s[0],
+                                      t_s=meas.t0_s)
+    final, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz)
+    return final
 
 
 def _td_cross_check(path, string, cfg, data: SegmentData, td, meas: Measurements):
@@ -292,11 +329,10 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     if "creep_fit_at_bound" in refined.flags:
         messages.append(_creep_advice(string, td.T_N_Nm, mu_k, refined, meas))
     seed_s = _seed_mu_s(refined, mu_k)
-    seed = np.array([[seed_s, mu_k]])
-    final, _ = observe(observer, meas,
-                       ObserverState.from_starts(observer, seed,
-                                                 omega0_rad_s=meas.surface_rad_s[0],
-                                                 t_s=meas.t0_s), output_rate_hz=out_rate)
+    final = _final_pass(cfg, observer, meas, seed_s, mu_k, adapt=method == "observer" or
+                        cfg["observer.adapt_final"], output_rate_hz=out_rate)
+    bit = ensemble_bit_speed(final, _memory_s(observer, meas),
+                             cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S)
     final_diag = diagnose(final, cfg.omega_c_rad_s)
     tick(0.2)
     if on_bottom:
@@ -312,7 +348,8 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         mu_s_observer=diag.mu_s, mu_td=_td_cross_check(path, string, cfg, data, td, meas),
         T_N_Nm=observer.plant.T_N_Nm, flags=tuple(dict.fromkeys(flags)),
         messages=tuple(messages), starts=starts, first=first, final=final,
-        bit_rms_error_rpm=_bit_error(final, data), td=td, mu_s_seed=seed_s)
+        bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=td,
+        mu_s_seed=seed_s)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,
@@ -348,13 +385,19 @@ def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | 
     return diag.mu_s_spread if cfg["observer.law"] == "paper" else None
 
 
-def _bit_error(final: ObserverRecord, data: SegmentData) -> float | None:
+def _memory_s(observer: Observer, meas: Measurements) -> float:
+    """Memory of the ensemble weights [s]: a wave round trip 2L/c (one Courant-1 step per
+    cell each way), at least two logging intervals."""
+    return max(2.0 * observer.plant.grid.n_cells * observer.plant.grid.dt_s, 2.0 * meas.dt_s)
+
+
+def _bit_error(time_s: np.ndarray, bit: BitSpeedEstimate, data: SegmentData) -> float | None:
     """RMS error of the estimated bit speed after the start-up [RPM] (truth known)."""
     if data.bit_rpm is None or not np.all(np.isfinite(data.bit_rpm)):
         return None
-    late = settled_mask(final.time_s)
-    truth = np.interp(final.time_s[late], data.time_s, data.bit_rpm)
-    error = final.bit_rad_s_est[late, 0] / RPM_TO_RAD_S - truth
+    late = settled_mask(time_s)
+    truth = np.interp(time_s[late], data.time_s, data.bit_rpm)
+    error = bit.rad_s[late] / RPM_TO_RAD_S - truth
     return float(np.sqrt(np.mean(error**2)))
 
 

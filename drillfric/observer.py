@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import lfilter
 
 from drillfric.errors import InputError, ModelError
 from drillfric.gains import Gains
@@ -297,3 +298,54 @@ def observe(observer: Observer, meas: Measurements, state: ObserverState, *,
     record = ObserverRecord(times, *(out[:, :, c] for c in range(len(OBS_COLUMNS))),
                             deadlock_events=new.guard[:, 1].copy())
     return record, new
+
+
+
+@dataclass(frozen=True)
+class BitSpeedEstimate:
+    """Bit speed from an ensemble of observer members, at the record's times [rad/s].
+
+    Attributes
+    ----------
+    rad_s : ndarray, shape (R,)
+        The estimate: the members' mean weighted by how well each matches the measured
+        top-drive speed lately (:func:`ensemble_bit_speed`).
+    low_rad_s, high_rad_s : ndarray, shape (R,)
+        The members' minimum and maximum (the band).
+    """
+
+    rad_s: np.ndarray
+    low_rad_s: np.ndarray
+    high_rad_s: np.ndarray
+
+
+def ensemble_bit_speed(record: ObserverRecord, memory_s: float,
+                       noise_rad_s: float) -> BitSpeedEstimate:
+    """Bit speed of an ensemble of observer members (the starts of ``record``).
+
+    In stick-slip the members' cycles drift apart in phase (the cycle is chaotic, THEORY
+    §6.2) and a member that has drifted shows it in its innovation e = ω̂₀ − ω₀ about one
+    wave round trip later. Each member is weighted by 1/(ē² + σ²), ē² the mean square of
+    its innovation over the last ``memory_s`` (exponential memory) and σ the measurement
+    noise ``noise_rad_s``: members that match the surface lately count most; when none is
+    distinguishable from noise all count equally (docs/validation.md measures the gain).
+
+    Parameters
+    ----------
+    record : ObserverRecord
+        One start per member; uniform record times.
+    memory_s : float
+        Memory of the innovation average [s] (a wave round trip 2L/c is the natural one).
+    noise_rad_s : float
+        Standard deviation of the measured top-drive speed [rad/s].
+    """
+    bit = record.bit_rad_s_est
+    if record.time_s.size > 1:
+        step = min(float(record.time_s[1] - record.time_s[0]) / memory_s, 1.0)
+        e2 = record.residual_rad_s ** 2
+        mean_e2 = lfilter([step], [1.0, step - 1.0], e2, axis=0, zi=(1.0 - step) * e2[:1])[0]
+    else:
+        mean_e2 = np.zeros_like(bit)
+    weight = 1.0 / (mean_e2 + noise_rad_s ** 2 + 1e-30)
+    return BitSpeedEstimate((weight * bit).sum(axis=1) / weight.sum(axis=1), bit.min(axis=1),
+                            bit.max(axis=1))

@@ -31,6 +31,7 @@ from drillfric.estimate import (
 )
 from drillfric.io.timebase import check_plausible_rate
 from drillfric.io.well import assumed_units, iter_surface, load_setup, resolve_well
+from drillfric.observer import ObserverRecord
 from drillfric.outputs import (
     EstimatesWriter,
     atomic_directory,
@@ -163,25 +164,52 @@ def _segment_row(seg: Segment, est: SegmentEstimate | None, status: str, message
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
                     omega_c: float) -> pd.DataFrame:
     """estimates.parquet rows of one segment: every start (``start_id`` 0…), then the pass
-    seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`)."""
-    frames = []
-    for rec, offset in ((est.first, 0), (est.final, SEEDED_START_ID)):
-        n_t, n_s = rec.mu_k.shape
-        measured = np.interp(rec.time_s, data.time_s, data.surface_rpm)
-        cols = {
-            "time_s": np.repeat(rec.time_s, n_s),
-            "segment_id": np.full(n_t * n_s, seg_id, dtype=np.int32),
-            "start_id": np.tile(np.arange(n_s, dtype=np.int16) + offset, n_t),
-            "mu_s": rec.mu_s.ravel(), "mu_k": rec.mu_k.ravel(),
-            "surface_rpm": np.repeat(measured, n_s),
-            "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
-            "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,
-            "bit_stuck": (np.abs(rec.bha_rad_s_est) <= omega_c).ravel(),
-            "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S}
-        if data.bit_rpm is not None:
-            cols["bit_rpm"] = np.repeat(np.interp(rec.time_s, data.time_s, data.bit_rpm), n_s)
-        frames.append(pd.DataFrame(cols))
-    return pd.concat(frames, ignore_index=True)
+    seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): the
+    weighted mean of its ensemble members (``est.bit``), their min–max bit speed as
+    ``bit_rpm_est_min/max`` (NaN on the starts' rows), the bit stuck where most members are.
+    """
+    frames = [_record_frame(seg_id, est.first, 0, data)]
+    final = est.final
+    seeded = _record_frame(seg_id, _member_mean(final), SEEDED_START_ID, data)
+    seeded["bit_rpm_est"] = est.bit.rad_s / RPM_TO_RAD_S
+    seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
+    seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
+    frames.append(seeded)
+    frame = pd.concat(frames, ignore_index=True)
+    frame["bit_stuck"] = np.r_[(np.abs(est.first.bha_rad_s_est) <= omega_c).ravel(),
+                               np.mean(np.abs(final.bha_rad_s_est) <= omega_c, axis=1) > 0.5]
+    return frame
+
+
+def _member_mean(record: ObserverRecord) -> ObserverRecord:
+    """One-start record holding the seed member's μ and the members' mean speeds."""
+    mean = lambda a: a.mean(axis=1, keepdims=True)  # noqa: E731
+    return ObserverRecord(record.time_s, record.mu_s[:, :1], record.mu_k[:, :1],
+                          mean(record.surface_rad_s_est), mean(record.bit_rad_s_est),
+                          mean(record.bha_rad_s_est), mean(record.residual_rad_s),
+                          record.deadlock_events[:1])
+
+
+def _record_frame(seg_id: int, rec: ObserverRecord, offset: int,
+                  data: SegmentData) -> pd.DataFrame:
+    """Rows of one observer record, one per time and start (``start_id`` from ``offset``)."""
+    n_t, n_s = rec.mu_k.shape
+    measured = np.interp(rec.time_s, data.time_s, data.surface_rpm)
+    cols = {
+        "time_s": np.repeat(rec.time_s, n_s),
+        "segment_id": np.full(n_t * n_s, seg_id, dtype=np.int32),
+        "start_id": np.tile(np.arange(n_s, dtype=np.int16) + offset, n_t),
+        "mu_s": rec.mu_s.ravel(), "mu_k": rec.mu_k.ravel(),
+        "surface_rpm": np.repeat(measured, n_s),
+        "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
+        "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,
+        "bit_stuck": np.zeros(n_t * n_s, dtype=bool),
+        "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S,
+        "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
+        "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}
+    if data.bit_rpm is not None:
+        cols["bit_rpm"] = np.repeat(np.interp(rec.time_s, data.time_s, data.bit_rpm), n_s)
+    return pd.DataFrame(cols)
 
 
 def _profile_frame(seg_id: int, est: SegmentEstimate, step_m: float = 10.0) -> pd.DataFrame:

@@ -88,6 +88,25 @@ def test_mu_s_honest(demo_run, truth):
     assert identified == creeps
 
 
+def test_bit_speed_in_severe_stick_slip(demo_run):
+    """Issue 5: estimated bit speed RMS error ≤ 35 RPM in severe stick-slip (the demo's
+    stands: severity 2–3, bit stuck 51–63 %; logged at 20 Hz, between the issue's 100 and
+    5 Hz). The seeded ensemble's min–max band holds the true bit speed most of the time
+    (docs/bit_speed.md: 90 % on the demo; 75 % asked here, a band that misses the bit a
+    quarter of the time would be misleading)."""
+    out = demo_run[0]
+    summary = json.loads((out / "summary.json").read_text())
+    for seg in summary["segments"]:
+        if seg["status"] == "ok" and seg["stick_slip_severity"] > 1.0:
+            assert seg["bit_rms_error_rpm"] <= 35.0, seg
+    est = pd.read_parquet(out / "estimates.parquet")
+    seeded = est[est["start_id"] == -1]
+    inside = seeded["bit_rpm"].between(seeded["bit_rpm_est_min"] - 1.0,
+                                       seeded["bit_rpm_est_max"] + 1.0)
+    assert inside.mean() >= 0.75
+    assert est.loc[est["start_id"] >= 0, "bit_rpm_est_min"].isna().all()
+
+
 def test_unreadable_input_is_one_line(tmp_path):
     bad = tmp_path / "w.csv"
     bad.write_text("a,b\n1,2\n")

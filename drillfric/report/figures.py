@@ -189,7 +189,8 @@ def segment_figure(est: pd.DataFrame, segment: dict) -> Figure:
     """One segment: μ per start vs time, surface RPM measured vs estimated, bit RPM.
 
     The final observer pass (``start_id == -1``, seeded with the batch-refined
-    factors) is drawn in black and gives the estimated speeds; the starts are thin lines.
+    factors) is drawn in black and gives the estimated speeds (its ensemble's weighted mean,
+    with the members' min–max bit speed as a band); the starts are thin lines.
     Time where the estimated bit is stuck (|ω_BHA| ≤ ω_c) is shaded. Measured downhole
     bit speed is drawn dashed when the input had it.
 
@@ -225,6 +226,10 @@ def segment_figure(est: pd.DataFrame, segment: dict) -> Figure:
     stuck = best["bit_stuck"].to_numpy(bool)
     ax_bit.fill_between(time, 0, 1, where=stuck, transform=ax_bit.get_xaxis_transform(),
                         color=STUCK_COLOR, step="mid", label="estimated stuck")
+    if "bit_rpm_est_min" in best and best["bit_rpm_est_min"].notna().any():
+        ax_bit.fill_between(time, best["bit_rpm_est_min"], best["bit_rpm_est_max"],
+                            color=MU_K_COLOR, alpha=0.18, linewidth=0,
+                            label="ensemble band (min–max)")
     ax_bit.plot(time, best["bit_rpm_est"], color=MU_K_COLOR, linewidth=1.0,
                 label="estimated")
     if "bit_rpm" in best and best["bit_rpm"].notna().any():
