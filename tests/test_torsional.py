@@ -101,6 +101,109 @@ def test_junction_reflection_and_transmission_coefficients():
     assert z == pytest.approx(s.sections[1].impedance_Nms / s.sections[0].impedance_Nms)
 
 
+def _junction_string(lower_od):
+    """1000 m of 5 7/8in pipe over 300 m of a section with another OD (Z ≠ 1)."""
+    return DrillString((section("dp", 0.146529, 0.123024, 1000.0),
+                        section("low", lower_od, 0.6 * lower_od, 300.0, 67e9)))
+
+
+@pytest.mark.parametrize("lower_od", [0.2096, 0.11])
+def test_junction_mirror_case_beta_from_below(lower_od):
+    """THEORY §3 eqs. (12)–(14), the other direction: a β wave arriving from the lower
+    section (α_a = 0) is transmitted as β_a = 2Zβ_b/(1+Z) and reflected as
+    α_b = −(1 − Z)β_b/(1+Z), Z = ζ_b/ζ_a, for a stiffer (Z > 1, collars) and a softer (Z < 1)
+    lower section. Energy flux is conserved across the junction:
+    ζ_aβ_a² + ζ_bα_b² = ζ_bβ_b². One step of the exact formulas: rel 1e-15 (round-off).
+    """
+    s = _junction_string(lower_od)
+    g = T.make_grid(s, 300)
+    first = int(g.section_start[1])
+    z = g.junction_z[0]
+    assert (z > 1.0) == (lower_od > 0.15)
+    state = T.State.rest(g)
+    state.beta[first] = 1.0
+    state = steps(frictionless(g), clamp_top(), 1, state)
+    beta_a, alpha_b = state.beta[first - 1], state.alpha[first]
+    assert beta_a == pytest.approx(2.0 * z / (1.0 + z), rel=1e-15)
+    assert alpha_b == pytest.approx(-(1.0 - z) / (1.0 + z), rel=1e-15)
+    za, zb = g.zeta_Nms[first - 1], g.zeta_Nms[first]
+    assert za * beta_a**2 + zb * alpha_b**2 == pytest.approx(zb, rel=1e-14)
+    assert np.count_nonzero(state.alpha) == 1 and np.count_nonzero(state.beta) == 1
+
+
+@pytest.mark.parametrize("direction", ["alpha", "beta"])
+def test_unit_impedance_junction_passes_a_pulse_unchanged(direction):
+    """Z = 1 (THEORY §3.1): the junction formulas give α_b = α_a and β_a = β_b exactly, so a
+    pulse crosses in either direction bit-identically and nothing is reflected."""
+    two = DrillString((section("a", 0.15, 0.12, 600.0), section("b", 0.15, 0.12, 900.0)))
+    g = T.make_grid(two, 300)
+    first = int(g.section_start[1])
+    assert g.junction_z[0] == 1.0
+    state = T.State.rest(g)
+    if direction == "alpha":
+        state.alpha[first - 3: first] = [0.3, -1.7, 2.9]
+    else:
+        state.beta[first: first + 3] = [0.3, -1.7, 2.9]
+    state = steps(frictionless(g), clamp_top(), 3, state)
+    if direction == "alpha":
+        np.testing.assert_array_equal(state.alpha[first: first + 3], [0.3, -1.7, 2.9])
+        assert not np.any(state.beta)
+    else:
+        np.testing.assert_array_equal(state.beta[first - 3: first], [0.3, -1.7, 2.9])
+        assert not np.any(state.alpha)
+
+
+@pytest.mark.parametrize("end", ["clamped", "free"])
+def test_bit_reflection_clamped_and_free(end):
+    """THEORY §3, bit boundary (and erratum E2 on eq. 40). A square speed pulse (α = 1 over
+    m cells: ω = 1/2, τ = ζ/2) runs into the bit.
+
+    Clamped bit — a stuck bit whose Coulomb cap T_bit exceeds the wave's torque, so
+    β = α − 2τ_bit/ζ = −α (the paper's printed eq. 40): the reflection carries the speed
+    inverted (ω = −1/2) and the torque with the same sign (τ = +ζ/2); where incident and
+    reflected overlap the speed is 0 and the torque doubled (ζ). Free bit (off bottom,
+    β = α): speed keeps its sign and doubles in the overlap, torque inverts and cancels.
+    Exact shifts of exact values: compared bit-for-bit.
+    """
+    g = T.make_grid(DrillString((section("dp", 0.146529, 0.123024, 1000.0),
+                                 section("dc", 0.2096, 0.0714, 200.0, 67e9))), 300)
+    n, m = g.n_cells, 10
+    zeta = g.zeta_Nms[-1]
+    cap = 1e12 if end == "clamped" else 0.0
+    plant = T.Plant(g, np.zeros(n), 0.0, 0.0, 1.0, 0.0, bit_torque_cap_Nm=cap)
+    state = T.State.rest(g)
+    state.alpha[n - m:] = 1.0
+    half = steps(plant, clamp_top(), m // 2, state)
+    overlap = slice(n - m // 2, n)
+    omega = half.omega_rad_s[overlap]
+    torque = half.torque_Nm(g)[overlap]
+    sign = -1.0 if end == "clamped" else 1.0
+    np.testing.assert_array_equal(omega, 0.0 if end == "clamped" else 1.0)
+    np.testing.assert_array_equal(torque, zeta if end == "clamped" else 0.0)
+    full = steps(plant, clamp_top(), m // 2, half)
+    np.testing.assert_array_equal(full.beta[n - m:], sign)
+    np.testing.assert_array_equal(full.alpha[n - m:], 0.0)
+    np.testing.assert_array_equal(full.omega_rad_s[n - m:], sign * 0.5)
+    np.testing.assert_array_equal(full.torque_Nm(g)[n - m:], -sign * 0.5 * zeta)
+
+
+def test_coulomb_bit_holds_below_its_cap_and_slips_above():
+    """THEORY §3 bit: τ(L) = ζ·clamp(α, ±T_bit/ζ). An incident wave whose clamped-end
+    torque ζα stays within T_bit reflects as from a clamped end (β = −α); a stronger one
+    slips the bit with τ(L) = T_bit exactly, β = α − 2T_bit/ζ."""
+    g = T.make_grid(DrillString((section("dp", 0.146529, 0.123024, 1000.0),)), 100)
+    n, zeta = g.n_cells, g.zeta_Nms[-1]
+    cap = 2.0 * zeta  # T_bit/ζ = 2 rad/s
+    plant = T.Plant(g, np.zeros(n), 0.0, 0.0, 1.0, 0.0, bit_torque_cap_Nm=cap)
+    for a_in, b_out in ((1.5, -1.5), (3.0, 3.0 - 4.0)):
+        state = T.State.rest(g)
+        state.alpha[-1] = a_in
+        out = steps(plant, clamp_top(), 1, state)
+        assert out.beta[-1] == pytest.approx(b_out, rel=1e-15)
+        assert 0.5 * zeta * (a_in - out.beta[-1]) == pytest.approx(min(zeta * a_in, cap),
+                                                                   rel=1e-15)
+
+
 def test_unit_impedance_junction_is_transparent():
     """Z = 1: the junction formulas reduce to α_b = α_a, β_a = β_b (bit-identical states).
 
