@@ -335,29 +335,41 @@ def test_stick_slip_torque_swing_well_b(well_b):
     """A&S 2018 eqs. 30, 34: swing ≈ 2(1 − μ_k/μ_s)·μ_s∫F_c dx if the whole string sticks.
 
     That is an upper estimate: the string is released progressively from the top (THEORY
-    §6.2) and the top drive keeps sliding, so the torque never climbs to μ_s∫F_c dx.
-    Re-running A&S's published algorithm on Well B gives 0.72 of the estimate; this model
-    0.5–0.6 (docs/validation.md). Accept [0.45, 1.0], require real
-    stick-slip (bit stuck part of the time, peaks above twice the set-point).
+    §6.2) and the top drive keeps sliding, so the torque never climbs to μ_s∫F_c dx (max
+    0.74–0.76 μ_sT_N here). Statistics over 60–300 s, as in docs/validation.md.
+
+    The swing (max − min of a chaotic cycle sequence) is set by the single most extreme
+    cycle; it is not a stable property of the model: over 14 runs (grids 400–2000 cells,
+    I_TD ±1 %/±3 %, k_t ±5 %, set-point ±1 RPM) it spans 0.36–0.54 of the estimate with the
+    trapezoidal top drive and 0.39–0.54 with the old explicit one (60-s windows: 0.32–0.54).
+    The former lower bound 0.45 over 60–120 s sat at the median of that spread and passed by
+    chance (0.54; the same code with I_TD 1 % off gave 0.36). So the lower bound here only
+    says "a substantial swing" (0.3, below every value measured), the physics is the upper
+    bound, and stick-slip itself is required directly: bit stuck part of the time (0.62–0.66
+    measured; > 0.2) and peaks above twice the set-point (5–7× measured).
+
+    The mean torque is the stable statistic (THEORY §6.4 fits μ_k on it): μ_k∫F_c dx, +1.0 %
+    viscous k_tΩ∫ρJ dx, plus the share of stuck cells holding more than μ_kF_c; 1.026–1.033
+    μ_kT_N in the same 14 runs, so 5 % (formerly 10 %).
     """
     plant, rec = well_b
     m = rec.time_s > 60.0
     swing = np.ptp(rec.motor_torque_Nm[m])
     estimate = 2.0 * (plant.mu_s - plant.mu_k) * plant.T_N_Nm
-    assert 0.45 * estimate < swing < estimate
+    assert 0.3 * estimate < swing < estimate
     bit = rec.bit_rad_s[m]
     assert np.mean(np.abs(bit) < 0.05) > 0.2
     assert bit.max() > 2 * 40 * RPM
-    assert np.mean(rec.motor_torque_Nm[m]) == pytest.approx(plant.mu_k * plant.T_N_Nm, rel=0.1)
+    assert np.mean(rec.motor_torque_Nm[m]) == pytest.approx(plant.mu_k * plant.T_N_Nm, rel=0.05)
 
 
 @pytest.fixture(scope="module")
 def well_b():
-    """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 120 s."""
+    """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
     from drillfric.simulate import well_b_plant
 
     plant = well_b_plant()
-    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0), 120.0, 100.0)
+    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0), 300.0, 100.0)
     return plant, rec
 
 
