@@ -12,7 +12,10 @@ observer (THEORY §5, a copy of this plant plus injections) reuses:
 - :func:`advance_cells` — steps 1–3 fused in one vectorised pass over the
   cells (exact shift);
 - :func:`drive_value`, :func:`motor_torque`, :func:`top_drive_step` — the top-drive input
-  (PI on a set-point series, prescribed torque, or prescribed speed) and step 4;
+  (PI on a set-point series, prescribed torque, or prescribed speed) and step 4, taken
+  trapezoidally and solved *before* step 1 because the top inflow α(0) = 2ω̄₀ − β(0) uses
+  the step-mean speed ω̄₀ = (ω₀^k + ω₀^(k+1))/2 (docs/theory.md erratum E11: the explicit
+  step 4 of THEORY §3.1 adds energy at every step);
 - :func:`run_plant` — many steps in one call, recording at the requested times by linear
   interpolation between steps (no Python loop over time steps).
 
@@ -20,7 +23,8 @@ Array layout: one contiguous cell array for α and one for β over the whole str
 ``section_start`` (first cell of each section + total), per-cell ``zeta`` and ``fcap``
 (speed change friction can impose in one step per unit μ, F_c·Δt/(ρJ) [rad/s]).
 The plain-NumPy twin with the same argument list is :mod:`drillfric.kernels_numpy`.
-For an observer: ``alpha_top`` of :func:`inflows` is an argument (pass 2ω̂₀ − β̂(0) − P₀e);
+For an observer: ``alpha_top`` of :func:`inflows` is an argument (pass
+ω̂₀^k + ω̂₀^(k+1) − β̂(0) − P₀e with ω̂₀^(k+1) from :func:`top_drive_step`);
 ``b_in[0]`` after :func:`inflows` is the β reflected into the pipe at the pipe/BHA junction
 (add −P₁e there before :func:`advance_cells`); per-cell injections go on ``a_new``,
 ``b_new`` afterwards.
@@ -54,9 +58,11 @@ def inflows(a, b, section_start, junction_z, alpha_top, omega_top, bit_cap_rel, 
 
     Fills ``a_in[s]`` (α entering section s at its top), ``b_in[s]`` (β entering it at its
     bottom) and ``w_in[s]``, ``w_in[s + 1]`` (ω at the section's top and bottom interfaces,
-    used by the viscous term of the end cells). The top boundary α(0) = 2ω₀ − β(0) (eq. 15)
-    is passed in as ``alpha_top`` with ``omega_top`` = ω₀; a junction between an upper
-    section (last cell α_a) and a lower one (first cell β_b) with Z = ζ_b/ζ_a gives
+    used by the viscous term of the end cells). The top boundary α(0) = 2ω̄₀ − β(0) (eq. 15)
+    is passed in as ``alpha_top`` with ``omega_top`` = ω̄₀, the top-drive speed averaged
+    over the step (:func:`top_drive_step`; for a prescribed speed, ω₀ at step k); a
+    junction between an upper section (last cell α_a) and a lower one (first cell β_b)
+    with Z = ζ_b/ζ_a gives
     α_b = [2α_a − (1 − Z)β_b]/(1 + Z) and β_a = [(1 − Z)α_a + 2Zβ_b]/(1 + Z) (eqs. 12–14,
     38–39); the bit gives β = α − 2τ_bit/ζ with τ_bit = ζ·clamp(α, ±T_bit/ζ) (Coulomb bit,
     solved exactly; ``bit_cap_rel`` = T_bit/ζ [rad/s]; 0 is the free end β = α, erratum of
@@ -153,9 +159,27 @@ def motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_it
 
 
 @njit(cache=True, inline="always")
-def top_drive_step(omega0, tau_m, tau0, dt, inv_itd):
-    """Step 4 of THEORY §3.1, eq. (7): ω₀ + (Δt/I_TD)(τ_m − τ(0)) [rad/s]."""
-    return omega0 + dt * inv_itd * (tau_m - tau0)
+def top_drive_step(omega0, beta0, q, accel_dt):
+    """Step 4 of THEORY §3.1, eq. (7), trapezoidal (docs/theory.md erratum E11) [rad/s].
+
+    Eq. (7), I_TD dω₀/dt = τ_m − τ(0), with τ(0) = ζ_pipe(ω(0) − β(0)) (eq. 15), over one
+    step: β(0) is the β of cell 0 at step k — under Courant-1 transport exactly the wave
+    leaving the string through x = 0 during [t_k, t_k+1] — and the boundary speed is the
+    step mean ω̄₀ = (ω₀^k + ω₀^(k+1))/2, which is also what enters the string through
+    α(0) = 2ω̄₀ − β(0) (eq. 15). Solving
+    ω₀^(k+1) = ω₀^k + (Δt/I_TD)(τ_m − ζ(ω̄₀ − β(0))) for ω₀^(k+1):
+
+        ω₀^(k+1) = [(1 − q)ω₀^k + 2q β(0) + Δt τ_m/I_TD] / (1 + q),   q = ζΔt/(2 I_TD).
+
+    The string gains Δt·ω̄₀·ζ(ω̄₀ − β(0)) through α(0) and the top drive loses exactly that,
+    so string + top-drive energy changes by Δt·ω̄₀·τ_m only (conserved for τ_m = 0; the
+    explicit Euler step ω₀ + (Δt/I_TD)(τ_m − ζ(ω₀ − β(0))) adds ½ζa₀Δt²(β(0) − ω₀)² every
+    step). Unconditionally stable (|1 − q|/(1 + q) < 1) and second-order; the top drive of
+    :mod:`drillfric.lumped` uses the trapezoidal rule too. ``accel_dt`` = Δt·τ_m/I_TD
+    (the observer adds −Δt p₀ e). Callers form the inflow α(0) = ω₀^k + ω₀^(k+1) − β(0)
+    (= 2ω̄₀ − β(0)).
+    """
+    return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
 
 
 @njit(cache=True)
@@ -165,7 +189,11 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     """Advance ``n_steps`` steps from time ``t0`` and record at ``times`` (THEORY §3.1).
 
     ``alpha``, ``beta`` (cells) and ``top`` = [ω₀, PI integral] are updated in place.
-    ``out[r]`` receives (ω₀, τ_m, τ(0), ω_bit) at ``times[r]``, linearly interpolated
+    Per step: τ_m from the state at step k (held over the step), ω₀^(k+1) by the trapezoidal
+    :func:`top_drive_step` (except for a prescribed speed), then steps 1–3 with the top
+    inflow α(0) = 2ω̄₀ − β(0) (erratum E11).
+    ``out[r]`` receives (ω₀, τ_m, τ(0) = ζ(ω₀ − β(0)), ω_bit) at ``times[r]`` (step values,
+    τ(0) from ω₀ and β(0) at the step), linearly interpolated
     between the bracketing steps; ``times`` must lie in [t0, t0 + n_steps·dt].
     Argument order: see :func:`drillfric.torsional.kernel_args`.
     """
@@ -180,6 +208,7 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     omega0 = top[0]
     integral = top[1]
     zeta0 = zeta[0]
+    q_td = 0.5 * zeta0 * dt * inv_itd
     n_rec = times.size
     r = 0
     eps = 1e-9 * dt
@@ -204,14 +233,17 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
         p0, p1, p2, p3 = omega0, tau_m, tau0, w_bit
         if k == n_steps:
             break
-        inflows(a, b, section_start, junction_z, 2.0 * omega0 - b[0], omega0, bit_cap_rel,
-                a_in, b_in, w_in)
+        omega_next = omega0
+        if mode != _MODE_SPEED:
+            omega_next = top_drive_step(omega0, b[0], q_td, dt * inv_itd * tau_m)
+        omega_bar = 0.5 * (omega0 + omega_next)
+        inflows(a, b, section_start, junction_z, 2.0 * omega_bar - b[0], omega_bar,
+                bit_cap_rel, a_in, b_in, w_in)
         advance_cells(a, b, a2, b2, section_start, a_in, b_in, w_in, kt_dt, fcap, mu_s, mu_k,
                       omega_c)
         if mode == _MODE_PI:
             integral += dt * (u_now - omega0)
-        if mode != _MODE_SPEED:
-            omega0 = top_drive_step(omega0, tau_m, tau0, dt, inv_itd)
+        omega0 = omega_next
         a, a2 = a2, a
         b, b2 = b2, b
     if n_steps % 2 == 1:

@@ -69,6 +69,12 @@ def motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_it
     return tau0 + (u_next - u_now) / (dt * inv_itd)
 
 
+def top_drive_step(omega0, beta0, q, accel_dt):
+    """Trapezoidal step 4 (docs/theory.md E11); see :func:`drillfric.kernels.top_drive_step`:
+    [(1 − q)ω₀ + 2qβ(0) + Δtτ_m/I_TD]/(1 + q), q = ζΔt/(2I_TD) (works on arrays too)."""
+    return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
+
+
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, dt,
               kt_dt, mu_s, mu_k, omega_c, bit_cap_rel, inv_itd, mode, u, u_t0, u_dt, kp, ki,
               times, out):
@@ -77,6 +83,7 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     a2, b2 = alpha.copy(), beta.copy()
     w_a, w_b = np.empty_like(a), np.empty_like(a)
     omega0, integral = float(top[0]), float(top[1])
+    q_td = 0.5 * zeta[0] * dt * inv_itd
     r, eps = 0, 1e-9 * dt
     prev = np.zeros(4)
     for k in range(n_steps + 1):
@@ -96,13 +103,16 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
         prev = cur
         if k == n_steps:
             break
-        transport(a, b, a2, b2, w_a, w_b, section_start, junction_z, 2.0 * omega0 - b[0],
-                  omega0, bit_cap_rel)
+        omega_next = omega0
+        if mode != _MODE_SPEED:
+            omega_next = top_drive_step(omega0, b[0], q_td, dt * inv_itd * tau_m)
+        omega_bar = 0.5 * (omega0 + omega_next)
+        transport(a, b, a2, b2, w_a, w_b, section_start, junction_z, 2.0 * omega_bar - b[0],
+                  omega_bar, bit_cap_rel)
         damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, mu_s, mu_k, omega_c)
         if mode == _MODE_PI:
             integral += dt * (u_now - omega0)
-        if mode != _MODE_SPEED:
-            omega0 += dt * inv_itd * (tau_m - tau0)
+        omega0 = float(omega_next)
         a, a2 = a2, a
         b, b2 = b2, b
     alpha[:] = a

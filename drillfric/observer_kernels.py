@@ -5,7 +5,7 @@ junction, friction and top-drive steps, called from there) plus output injection
 innovation e = ω̂₀ − ω₀ and the friction adaptation laws. Several starts (initial guesses of
 μ_s, μ_k) advance together in one pass: the start is an extra state dimension (rows of the
 α, β arrays), not an extra run. The plain-NumPy twin is
-:func:`drillfric.kernels_numpy_observer.run_observer`.
+:func:`drillfric.observer_kernels_numpy.run_observer`.
 
 [1] U.J.F. Aarsnes, J. Auriol, F. Di Meglio, R.J. Shor, "Estimating friction factors while
     drilling", JPSE 179 (2019) 80–91.
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from drillfric.kernels import advance_cells, drive_value, inflows
+from drillfric.kernels import advance_cells, drive_value, inflows, top_drive_step
 
 #: Columns of the observer record, per start.
 OBS_COLUMNS = ("mu_s", "mu_k", "surface_rad_s_est", "bit_rad_s_est", "bha_rad_s_est",
@@ -64,11 +64,14 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
     ``omega0`` (S,) top-drive speed ω̂₀, ``mu_s``, ``mu_k`` (S,), ``guard`` (S, 2) =
     [time the BHA has been stuck while the top drive turns, deadlock interventions].
 
-    Per step and start (THEORY §5): e = ω̂₀ − ω₀(t); top boundary α̂(0) = 2ω̂₀ − β̂(0) − P₀e
-    (eq. 37); β̂ reflected into the pipe at the pipe/BHA junction −P₁e (eq. 38); plant steps
+    Per step and start (THEORY §5): e = ω̂₀ − ω₀(t); top drive (eq. 32) with the plant's
+    trapezoidal coupling (:func:`drillfric.kernels.top_drive_step`, docs/theory.md E11)
+    and the injection held over the step,
+    ω̂₀' = [(1 − q)ω̂₀ + 2qβ̂(0) + Δtτ_m/I_TD − Δt p₀ e]/(1 + q), q = ζΔt/(2I_TD);
+    top boundary α̂(0) = ω̂₀ + ω̂₀' − β̂(0) − P₀e (eq. 37, 2ω̄̂₀ with the step-mean speed);
+    β̂ reflected into the pipe at the pipe/BHA junction −P₁e (eq. 38); plant steps
     1–3 with μ̂_s, μ̂_k; every cell α̂ −= inj_a·e, β̂ −= inj_b·e, where inj = Δt·(p_α, p_β) on
-    the pipe (eqs. 33–34) and Δt·p₁ on both invariants of the BHA (eqs. 35–36); top drive
-    ω̂₀ += Δt/I_TD (τ_m − τ̂(0)) − Δt p₀ e (eq. 32);
+    the pipe (eqs. 33–34) and Δt·p₁ on both invariants of the BHA (eqs. 35–36);
     adaptation (42)–(44) on the BHA speed. Deadlock guard: when the estimated BHA has been
     stuck for ``deadlock_s`` while the measured top drive turns faster than ``omega_turn``,
     μ̂_s drops to μ̂_k (and μ̂_k by 20 % if μ̂_s already was there).
@@ -85,7 +88,7 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
     a_in = np.empty(n_sec)
     b_in = np.empty(n_sec)
     w_in = np.empty(n_sec + 1)
-    zeta0 = zeta[0]
+    q_td = 0.5 * zeta[0] * dt * inv_itd
     n_bha = n - n_pipe
     n_rec = times.size
     r = 0
@@ -122,8 +125,11 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
             a2 = buf_a[nxt, s]
             b2 = buf_b[nxt, s]
             e = omega0[s] - wm
-            inflows(a, b, section_start, junction_z, 2.0 * omega0[s] - b[0] - P0 * e,
-                    omega0[s], bit_cap_rel, a_in, b_in, w_in)
+            omega_next = top_drive_step(omega0[s], b[0], q_td,
+                                        dt * inv_itd * taum - dt * p0 * e)
+            omega_bar = 0.5 * (omega0[s] + omega_next)
+            inflows(a, b, section_start, junction_z, 2.0 * omega_bar - b[0] - P0 * e,
+                    omega_bar, bit_cap_rel, a_in, b_in, w_in)
             if n_sec > 1:
                 b_in[0] -= P1 * e
             advance_cells(a, b, a2, b2, section_start, a_in, b_in, w_in, kt_dt, fcap,
@@ -135,8 +141,7 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
             for j in range(n_pipe, n):
                 acc += a2[j] + b2[j]
             w_bha = 0.5 * acc / max(n_bha, 1)
-            tau0 = zeta0 * (omega0[s] - b[0])
-            omega0[s] += dt * inv_itd * (taum - tau0) - dt * p0 * e
+            omega0[s] = omega_next
             stuck = abs(w_bha) <= omega_c
             mu_s[s], mu_k[s] = adapt(mu_s[s], mu_k[s], e, stuck, l_s, l_k, dt, law, mu_max)
             if stuck and abs(wm) > omega_turn:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drillfric.kernels_numpy import damp_and_friction, drive_value, transport
+from drillfric.kernels_numpy import damp_and_friction, drive_value, top_drive_step, transport
 from drillfric.observer_kernels import LAW_PAPER
 
 
@@ -56,10 +56,13 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
         wm = measured_value(w_meas, m_t0, m_dt, t, hold)
         taum = measured_value(tau_meas, m_t0, m_dt, t, hold)
         e = omega0 - wm
+        omega_next = top_drive_step(omega0, b[:, 0], 0.5 * zeta[0] * dt * inv_itd,
+                                    dt * inv_itd * taum - dt * p0 * e)
+        omega_bar = 0.5 * (omega0 + omega_next)
         w_a, w_b = np.empty(n), np.empty(n)
         for s in range(n_start):
             transport(a[s], b[s], a2[s], b2[s], w_a, w_b, section_start, junction_z,
-                      2.0 * omega0[s] - b[s, 0] - P0 * e[s], omega0[s], bit_cap_rel)
+                      2.0 * omega_bar[s] - b[s, 0] - P0 * e[s], omega_bar[s], bit_cap_rel)
             if section_start.size > 2:
                 b2[s, n_pipe - 1] -= P1 * e[s]
             damp_and_friction(a[s], b[s], a2[s], b2[s], w_a, w_b, kt_dt, fcap, mu_s[s],
@@ -68,8 +71,7 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
         b2 -= inj_b[None, :] * e[:, None]
         w_bha = 0.5 * (a2[:, n_pipe:] + b2[:, n_pipe:]).mean(axis=1) if n > n_pipe \
             else np.zeros(n_start)
-        tau0 = zeta[0] * (omega0 - b[:, 0])
-        omega0 += dt * inv_itd * (taum - tau0) - dt * p0 * e
+        omega0[:] = omega_next
         for s in range(n_start):
             stuck = abs(w_bha[s]) <= omega_c
             mu_s[s], mu_k[s] = adapt(mu_s[s], mu_k[s], e[s], stuck, l_s, l_k, dt, law, mu_max)

@@ -101,6 +101,109 @@ def test_junction_reflection_and_transmission_coefficients():
     assert z == pytest.approx(s.sections[1].impedance_Nms / s.sections[0].impedance_Nms)
 
 
+def _junction_string(lower_od):
+    """1000 m of 5 7/8in pipe over 300 m of a section with another OD (Z ≠ 1)."""
+    return DrillString((section("dp", 0.146529, 0.123024, 1000.0),
+                        section("low", lower_od, 0.6 * lower_od, 300.0, 67e9)))
+
+
+@pytest.mark.parametrize("lower_od", [0.2096, 0.11])
+def test_junction_mirror_case_beta_from_below(lower_od):
+    """THEORY §3 eqs. (12)–(14), the other direction: a β wave arriving from the lower
+    section (α_a = 0) is transmitted as β_a = 2Zβ_b/(1+Z) and reflected as
+    α_b = −(1 − Z)β_b/(1+Z), Z = ζ_b/ζ_a, for a stiffer (Z > 1, collars) and a softer (Z < 1)
+    lower section. Energy flux is conserved across the junction:
+    ζ_aβ_a² + ζ_bα_b² = ζ_bβ_b². One step of the exact formulas: rel 1e-15 (round-off).
+    """
+    s = _junction_string(lower_od)
+    g = T.make_grid(s, 300)
+    first = int(g.section_start[1])
+    z = g.junction_z[0]
+    assert (z > 1.0) == (lower_od > 0.15)
+    state = T.State.rest(g)
+    state.beta[first] = 1.0
+    state = steps(frictionless(g), clamp_top(), 1, state)
+    beta_a, alpha_b = state.beta[first - 1], state.alpha[first]
+    assert beta_a == pytest.approx(2.0 * z / (1.0 + z), rel=1e-15)
+    assert alpha_b == pytest.approx(-(1.0 - z) / (1.0 + z), rel=1e-15)
+    za, zb = g.zeta_Nms[first - 1], g.zeta_Nms[first]
+    assert za * beta_a**2 + zb * alpha_b**2 == pytest.approx(zb, rel=1e-14)
+    assert np.count_nonzero(state.alpha) == 1 and np.count_nonzero(state.beta) == 1
+
+
+@pytest.mark.parametrize("direction", ["alpha", "beta"])
+def test_unit_impedance_junction_passes_a_pulse_unchanged(direction):
+    """Z = 1 (THEORY §3.1): the junction formulas give α_b = α_a and β_a = β_b exactly, so a
+    pulse crosses in either direction bit-identically and nothing is reflected."""
+    two = DrillString((section("a", 0.15, 0.12, 600.0), section("b", 0.15, 0.12, 900.0)))
+    g = T.make_grid(two, 300)
+    first = int(g.section_start[1])
+    assert g.junction_z[0] == 1.0
+    state = T.State.rest(g)
+    if direction == "alpha":
+        state.alpha[first - 3: first] = [0.3, -1.7, 2.9]
+    else:
+        state.beta[first: first + 3] = [0.3, -1.7, 2.9]
+    state = steps(frictionless(g), clamp_top(), 3, state)
+    if direction == "alpha":
+        np.testing.assert_array_equal(state.alpha[first: first + 3], [0.3, -1.7, 2.9])
+        assert not np.any(state.beta)
+    else:
+        np.testing.assert_array_equal(state.beta[first - 3: first], [0.3, -1.7, 2.9])
+        assert not np.any(state.alpha)
+
+
+@pytest.mark.parametrize("end", ["clamped", "free"])
+def test_bit_reflection_clamped_and_free(end):
+    """THEORY §3, bit boundary (and erratum E2 on eq. 40). A square speed pulse (α = 1 over
+    m cells: ω = 1/2, τ = ζ/2) runs into the bit.
+
+    Clamped bit — a stuck bit whose Coulomb cap T_bit exceeds the wave's torque, so
+    β = α − 2τ_bit/ζ = −α (the paper's printed eq. 40): the reflection carries the speed
+    inverted (ω = −1/2) and the torque with the same sign (τ = +ζ/2); where incident and
+    reflected overlap the speed is 0 and the torque doubled (ζ). Free bit (off bottom,
+    β = α): speed keeps its sign and doubles in the overlap, torque inverts and cancels.
+    Exact shifts of exact values: compared bit-for-bit.
+    """
+    g = T.make_grid(DrillString((section("dp", 0.146529, 0.123024, 1000.0),
+                                 section("dc", 0.2096, 0.0714, 200.0, 67e9))), 300)
+    n, m = g.n_cells, 10
+    zeta = g.zeta_Nms[-1]
+    cap = 1e12 if end == "clamped" else 0.0
+    plant = T.Plant(g, np.zeros(n), 0.0, 0.0, 1.0, 0.0, bit_torque_cap_Nm=cap)
+    state = T.State.rest(g)
+    state.alpha[n - m:] = 1.0
+    half = steps(plant, clamp_top(), m // 2, state)
+    overlap = slice(n - m // 2, n)
+    omega = half.omega_rad_s[overlap]
+    torque = half.torque_Nm(g)[overlap]
+    sign = -1.0 if end == "clamped" else 1.0
+    np.testing.assert_array_equal(omega, 0.0 if end == "clamped" else 1.0)
+    np.testing.assert_array_equal(torque, zeta if end == "clamped" else 0.0)
+    full = steps(plant, clamp_top(), m // 2, half)
+    np.testing.assert_array_equal(full.beta[n - m:], sign)
+    np.testing.assert_array_equal(full.alpha[n - m:], 0.0)
+    np.testing.assert_array_equal(full.omega_rad_s[n - m:], sign * 0.5)
+    np.testing.assert_array_equal(full.torque_Nm(g)[n - m:], -sign * 0.5 * zeta)
+
+
+def test_coulomb_bit_holds_below_its_cap_and_slips_above():
+    """THEORY §3 bit: τ(L) = ζ·clamp(α, ±T_bit/ζ). An incident wave whose clamped-end
+    torque ζα stays within T_bit reflects as from a clamped end (β = −α); a stronger one
+    slips the bit with τ(L) = T_bit exactly, β = α − 2T_bit/ζ."""
+    g = T.make_grid(DrillString((section("dp", 0.146529, 0.123024, 1000.0),)), 100)
+    n, zeta = g.n_cells, g.zeta_Nms[-1]
+    cap = 2.0 * zeta  # T_bit/ζ = 2 rad/s
+    plant = T.Plant(g, np.zeros(n), 0.0, 0.0, 1.0, 0.0, bit_torque_cap_Nm=cap)
+    for a_in, b_out in ((1.5, -1.5), (3.0, 3.0 - 4.0)):
+        state = T.State.rest(g)
+        state.alpha[-1] = a_in
+        out = steps(plant, clamp_top(), 1, state)
+        assert out.beta[-1] == pytest.approx(b_out, rel=1e-15)
+        assert 0.5 * zeta * (a_in - out.beta[-1]) == pytest.approx(min(zeta * a_in, cap),
+                                                                   rel=1e-15)
+
+
 def test_unit_impedance_junction_is_transparent():
     """Z = 1: the junction formulas reduce to α_b = α_a, β_a = β_b (bit-identical states).
 
@@ -140,6 +243,77 @@ def test_energy_conserved_without_friction_and_damping(n_sec, seed):
     e0 = T.energy(g, state)
     out = steps(frictionless(g), clamp_top(), 10_000, state)
     assert T.energy(g, out) == pytest.approx(e0, rel=1e-11)
+
+
+def free_top():
+    """Top drive free: no motor torque, its inertia coupled to the string (eq. 7)."""
+    return T.Drive("torque", np.array([0.0]), 1.0)
+
+
+@settings(max_examples=10, deadline=None)
+@given(n_sec=st.integers(1, 4), seed=st.integers(0, 2**31 - 1),
+       i_td=st.floats(50.0, 5000.0), backend=st.sampled_from(["numba", "numpy"]))
+def test_energy_conserved_with_free_top_drive(n_sec, seed, i_td, backend):
+    """THEORY §3 eq. (7) with τ_m = 0, no friction, k_t = 0, free bit: the total energy
+    ½∫ρJω² dx + ½∫τ²/(GJ) dx + ½I_TDω₀² of the continuum is constant.
+
+    The top-drive coupling of docs/theory.md erratum E11 (trapezoidal ω₀ update with the
+    boundary value α(0) = 2ω̄₀ − β(0)) conserves the discrete energy exactly, so the check
+    is to round-off: rel 1e-10 after 20 000 steps (round-off drifts up to ~2e-16 per step;
+    measured ≤ 4e-12 over 36 draws). The explicit Euler step 4 of THEORY §3.1 adds
+    ½ζa₀Δt²(β(0) − ω₀)² every step: +3.2 % in 100 s for a random state on the A&S string,
+    and it is unstable for a₀Δt > 2 (light top drive, stiff pipe: ×10³⁴ here at I_TD = 50).
+    """
+    rng = np.random.default_rng(seed)
+    s = _random_string(rng.uniform(30.0, 800.0, n_sec), rng.uniform(0.1, 0.25, n_sec),
+                       rng.uniform(60e9, 80e9, n_sec))
+    g = T.make_grid(s, 150)
+    plant = T.Plant(g, np.zeros(g.n_cells), 0.0, 0.0, 1.0, 0.0, i_td)
+    state = T.State(rng.normal(size=g.n_cells), rng.normal(size=g.n_cells),
+                    np.array([rng.normal(), 0.0]))
+    e0 = T.energy(g, state, i_td)
+    n = 20_000 if backend == "numba" else 2_000
+    out = steps(plant, free_top(), n, state)
+    assert T.energy(g, out, i_td) == pytest.approx(e0, rel=1e-10)
+
+
+def test_energy_after_motor_torque_stops_is_constant():
+    """Spin the A&S string up with 20 kN·m for 5 s, then τ_m = 0 (no friction, k_t = 0,
+    free bit): from then on the energy of string + top drive must stay constant (THEORY §3
+    eq. 7; docs/theory.md E11). Tolerance rel 1e-10 over 200 s (1.1·10⁵ steps): round-off
+    of the ω₀ update drifts ~1e-16 per step on this nearly rigid rotation (measured −1.4e-11
+    at the end). With the explicit step 4 of THEORY §3.1 it grew by +1.2e-4.
+    """
+    g = T.make_grid(two_section_string(), 500)
+    plant = T.Plant(g, np.zeros(g.n_cells), 0.0, 0.0, 1.0, 0.0, 2900.0)
+    drive = T.Drive("torque", np.array([20e3, 20e3, 0.0]), 5.0)
+    _, state = T.run(plant, drive, 10.0, 10.0)
+    energies = [T.energy(g, state, 2900.0)]
+    for _ in range(10):
+        _, state = T.run(plant, drive, 20.0, 10.0, state)
+        energies.append(T.energy(g, state, 2900.0))
+    assert energies[0] > 1e6
+    np.testing.assert_allclose(energies, energies[0], rtol=1e-10)
+
+
+def test_motor_work_equals_energy_change():
+    """Discrete work–energy identity of the trapezoidal top-drive coupling (docs/theory.md
+    E11): E^N − E^0 = Σ_k Δt·τ_m^k·(ω₀^k + ω₀^{k+1})/2 exactly, for any motor torque (no
+    friction, k_t = 0, free bit). Recorded at every step; rel 1e-10 covers the round-off of
+    the step-time interpolation of the records (measured 1e-13; the explicit coupling of
+    THEORY §3.1 step 4 misses by −7.5e-5)."""
+    g = T.make_grid(two_section_string(), 200)
+    plant = T.Plant(g, np.zeros(g.n_cells), 0.0, 0.0, 1.0, 0.0, 2900.0)
+    t = np.arange(0.0, 12.0, 0.5)
+    drive = T.Drive("torque", 15e3 * np.sin(t) + 5e3 * np.cos(3.1 * t), 0.5)
+    n = 4000
+    start = T.State.rest(g)
+    rec, out = T.run(plant, drive, n * g.dt_s, 1.0 / g.dt_s, start)
+    assert rec.time_s.size == n + 1
+    w, q = rec.surface_rad_s, rec.motor_torque_Nm
+    work = float(np.sum(g.dt_s * q[:-1] * 0.5 * (w[:-1] + w[1:])))
+    assert T.energy(g, out, 2900.0) == pytest.approx(work, rel=1e-10)
+    assert work > 1e4
 
 
 @settings(max_examples=10, deadline=None)
@@ -232,29 +406,41 @@ def test_stick_slip_torque_swing_well_b(well_b):
     """A&S 2018 eqs. 30, 34: swing ≈ 2(1 − μ_k/μ_s)·μ_s∫F_c dx if the whole string sticks.
 
     That is an upper estimate: the string is released progressively from the top (THEORY
-    §6.2) and the top drive keeps sliding, so the torque never climbs to μ_s∫F_c dx.
-    Re-running A&S's published algorithm on Well B gives 0.72 of the estimate; this model
-    0.5–0.6 (docs/validation.md). Accept [0.45, 1.0], require real
-    stick-slip (bit stuck part of the time, peaks above twice the set-point).
+    §6.2) and the top drive keeps sliding, so the torque never climbs to μ_s∫F_c dx (max
+    0.74–0.76 μ_sT_N here). Statistics over 60–300 s, as in docs/validation.md.
+
+    The swing (max − min of a chaotic cycle sequence) is set by the single most extreme
+    cycle; it is not a stable property of the model: over 14 runs (grids 400–2000 cells,
+    I_TD ±1 %/±3 %, k_t ±5 %, set-point ±1 RPM) it spans 0.36–0.54 of the estimate with the
+    trapezoidal top drive and 0.39–0.54 with the old explicit one (60-s windows: 0.32–0.54).
+    The former lower bound 0.45 over 60–120 s sat at the median of that spread and passed by
+    chance (0.54; the same code with I_TD 1 % off gave 0.36). So the lower bound here only
+    says "a substantial swing" (0.3, below every value measured), the physics is the upper
+    bound, and stick-slip itself is required directly: bit stuck part of the time (0.62–0.66
+    measured; > 0.2) and peaks above twice the set-point (5–7× measured).
+
+    The mean torque is the stable statistic (THEORY §6.4 fits μ_k on it): μ_k∫F_c dx, +1.0 %
+    viscous k_tΩ∫ρJ dx, plus the share of stuck cells holding more than μ_kF_c; 1.026–1.033
+    μ_kT_N in the same 14 runs, so 5 % (formerly 10 %).
     """
     plant, rec = well_b
     m = rec.time_s > 60.0
     swing = np.ptp(rec.motor_torque_Nm[m])
     estimate = 2.0 * (plant.mu_s - plant.mu_k) * plant.T_N_Nm
-    assert 0.45 * estimate < swing < estimate
+    assert 0.3 * estimate < swing < estimate
     bit = rec.bit_rad_s[m]
     assert np.mean(np.abs(bit) < 0.05) > 0.2
     assert bit.max() > 2 * 40 * RPM
-    assert np.mean(rec.motor_torque_Nm[m]) == pytest.approx(plant.mu_k * plant.T_N_Nm, rel=0.1)
+    assert np.mean(rec.motor_torque_Nm[m]) == pytest.approx(plant.mu_k * plant.T_N_Nm, rel=0.05)
 
 
 @pytest.fixture(scope="module")
 def well_b():
-    """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 120 s."""
+    """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
     from drillfric.simulate import well_b_plant
 
     plant = well_b_plant()
-    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0), 120.0, 100.0)
+    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0), 300.0, 100.0)
     return plant, rec
 
 
