@@ -175,7 +175,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "of each segment (they converge within it); the seeded pass covers all."),
         _positive("deadlock_s", 15.0, "s", "Deadlock guard: an estimated BHA stuck this long "
                   "while the top drive turns releases μ̂_s to μ̂_k (THEORY §6.1)."),
-        Key("ensemble_members", int, 7, "", "Members of the final pass seeded with the "
+        Key("ensemble_members", int, 5, "", "Members of the final pass seeded with the "
             "batch-refined factors; the estimated bit speed is their mean and min–max its "
             "band (the stick-slip cycle is chaotic: members drift apart in phase; weighted by "
             "how well each matches the surface speed lately, their mean tracks the bit better "
