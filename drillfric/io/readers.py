@@ -32,6 +32,10 @@ _DELIMITERS = (",", ";", "\t", "|")
 _SNIFF_BYTES = 1 << 16
 _NUMBER = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 _DATE = re.compile(r"^\d{4}-\d{2}-\d{2}([ T]\d{2}:\d{2}(:\d{2}(\.\d*)?)?)?")
+#: LAS index curves that make a log depth-indexed (LAS 2.0 names the depth index DEPT).
+_DEPTH_INDEX = frozenset({"DEPT", "DEPTH", "MD", "DMEA", "TVD"})
+#: Units of a depth index as LAS headers spell them.
+_DEPTH_UNITS = frozenset({"M", "FT", "F", "METER", "METERS", "METRE", "METRES", "FEET"})
 
 
 @dataclass(frozen=True)
@@ -50,6 +54,8 @@ class RawSource:
         from (``"units row"``, ``"header"``) for :func:`drillfric.io.channels.map_channels`.
     rows : int or None
         Row count when known without reading the data.
+    depth_index : str or None
+        The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
     """
 
     path: Path
@@ -58,6 +64,7 @@ class RawSource:
     units: dict
     rows: int | None
     _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
+    depth_index: str | None = None
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
@@ -434,4 +441,13 @@ def _open_las(path: Path) -> RawSource:
         for start in range(0, len(frame), chunk_rows):
             yield frame.iloc[start:start + chunk_rows].reset_index(drop=True)
 
-    return RawSource(path, "las", columns, units, len(frame), read)
+    return RawSource(path, "las", columns, units, len(frame), read,
+                     depth_index=_depth_index(las.curves[0]) if las.curves else None)
+
+
+def _depth_index(curve) -> str | None:
+    """``"DEPT [M]"`` when a LAS index curve is a depth (by mnemonic or length unit)."""
+    unit = (curve.unit or "").strip().upper()
+    if curve.mnemonic.strip().upper() in _DEPTH_INDEX or unit in _DEPTH_UNITS:
+        return f"{curve.mnemonic} [{curve.unit}]" if curve.unit else curve.mnemonic
+    return None

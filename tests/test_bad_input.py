@@ -1,0 +1,55 @@
+"""Bad input through the CLI: one line naming the file, the problem and the fix; exit 2 and
+nothing half-written — or, for a run that can go on, a clear warning (docs/ingestion.md)."""
+
+from __future__ import annotations
+
+import json
+
+import lasio
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+
+def _invoke(*args):
+    return CliRunner().invoke(cli, [str(a) for a in args])
+
+
+def _one_line_error(result, name: str) -> str:
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and name in lines[0], result.output
+    return lines[0]
+
+
+# ------------------------------------------------------------------ depth-indexed LAS
+def _las(path, *, time_curve: bool):
+    las = lasio.LASFile()
+    las.append_curve("DEPT", np.arange(2000.0, 2010.0, 0.5), unit="M")
+    if time_curve:
+        las.append_curve("ETIM", np.arange(20.0), unit="S")
+    las.append_curve("SRPM", np.full(20, 60.0), unit="RPM")
+    las.append_curve("STOR", np.full(20, 12.0), unit="KN.M")
+    las.write(str(path), version=2.0)
+    return path
+
+
+@pytest.mark.parametrize("command", ["inspect", "run"])
+def test_depth_indexed_las_is_refused_in_one_line(tmp_path, command):
+    path = _las(tmp_path / "depth.las", time_curve=False)
+    args = [command, path] + (["--out", tmp_path / "out"] if command == "run" else [])
+    line = _one_line_error(_invoke(*args), "depth.las")
+    assert "depth-indexed" in line and "DEPT" in line and "time-indexed" in line
+    assert "[channels] time" in line  # the fix when the file has a time curve by another name
+    assert not (tmp_path / "out").exists()
+
+
+def test_depth_indexed_las_with_a_time_curve_uses_it(tmp_path):
+    path = _las(tmp_path / "depth.las", time_curve=True)
+    result = _invoke("inspect", path, "--json")
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.output)
+    assert doc["channels"]["time_s"]["column"] == "ETIM"
+    assert doc["rows"] == 20 and doc["rate_hz"] == pytest.approx(1.0)
