@@ -24,6 +24,35 @@ def _one_line_error(result, name: str) -> str:
     return lines[0]
 
 
+# ------------------------------------------------------------------ nothing half-written
+def test_unreadable_input_leaves_no_output_directory(tmp_path):
+    """Time going backwards is found while streaming, after OUT would have been created:
+    OUT (and its missing parents) must not be left behind empty."""
+    bad = tmp_path / "w.csv"
+    bad.write_text("time_s,surface_rpm,surface_torque_Nm\n0,60,10\n2,60,10\n1,60,10\n")
+    result = _invoke("run", bad, "--out", tmp_path / "new" / "out")
+    assert "time goes backwards" in _one_line_error(result, "w.csv")
+    assert not (tmp_path / "new").exists()
+
+
+def test_unreadable_input_keeps_an_existing_output_directory(tmp_path):
+    """An OUT that existed before the run stays, untouched (and empty)."""
+    bad = tmp_path / "w.csv"
+    bad.write_text("time_s,surface_rpm,surface_torque_Nm\n")
+    (tmp_path / "out").mkdir()
+    _one_line_error(_invoke("run", bad, "--out", tmp_path / "out"), "w.csv")
+    assert list((tmp_path / "out").iterdir()) == []
+
+
+@pytest.mark.parametrize("command", [["simulate"], ["td", "--bit-depth", "1000"]])
+def test_simulate_and_td_with_a_bad_config_write_nothing(tmp_path, command):
+    (tmp_path / "bad.toml").write_text("[fluid]\nmud_densty = 1200.0\n")
+    result = _invoke(command[0], tmp_path / "bad.toml", *command[1:],
+                     "--out", tmp_path / "new" / "x.csv")
+    assert "unknown key 'fluid.mud_densty'" in _one_line_error(result, "bad.toml")
+    assert not (tmp_path / "new").exists()
+
+
 # ------------------------------------------------------------------ depth-indexed LAS
 def _las(path, *, time_curve: bool):
     las = lasio.LASFile()
