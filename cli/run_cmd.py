@@ -103,14 +103,15 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
 
 
 def _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers) -> None:
-    """Several wells on local worker processes, through the fleet executor (always redone)."""
+    """Several wells on local worker processes, through the fleet executor (always redone;
+    OUT gets the wells' directories only, none of the fleet files)."""
     from drillfric.fleet import WellSpec, run_many
 
     specs = [WellSpec(Path(w), config=config, survey=survey) for w in wells]
     overrides = {"observer.starts": [list(p) for p in pairs]} if pairs else None
     with progress(f"run ({len(specs)} wells)", total=len(specs)) as advance:
         result = run_many(specs, out, workers=workers, force=True, progress=advance,
-                          overrides=overrides, rate_hz=rate, pdf=pdf)
+                          overrides=overrides, rate_hz=rate, pdf=pdf, fleet_files=False)
     for well in result.wells:
         if well.status == "failed":
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")

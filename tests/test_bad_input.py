@@ -44,6 +44,18 @@ def test_unreadable_input_keeps_an_existing_output_directory(tmp_path):
     assert list((tmp_path / "out").iterdir()) == []
 
 
+def test_unreadable_wells_on_workers_leave_no_output_directory(tmp_path):
+    """`run A B --workers 2`: both unreadable (found on the workers), no OUT appears."""
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.csv").write_text(
+            "time_s,surface_rpm,surface_torque_Nm\n0,60,10\n2,60,10\n1,60,10\n")
+    result = _invoke("run", tmp_path / "a.csv", tmp_path / "b.csv", "--workers", 2,
+                     "--out", tmp_path / "out")
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "a.csv" in result.output and "b.csv" in result.output
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("command", [["simulate"], ["td", "--bit-depth", "1000"]])
 def test_simulate_and_td_with_a_bad_config_write_nothing(tmp_path, command):
     (tmp_path / "bad.toml").write_text("[fluid]\nmud_densty = 1200.0\n")
