@@ -49,7 +49,8 @@ def _describe(result) -> str:
               "overrides the NAME.toml sidecar.")
 @click.option("--survey", type=click.Path(path_type=Path), help="Survey file, overrides the "
               "NAME.survey.* sidecar.")
-@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation.")
+@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation "
+              "(not above the data's own rate: a higher HZ is ignored with a warning).")
 @click.option("--starts", help="Observer starts MU_S:MU_K,... (overrides observer.starts).")
 @click.option("--pdf/--no-pdf", default=False, help="Also write report.pdf.")
 @click.option("--workers", type=int, default=1, show_default=True,
@@ -93,6 +94,8 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
             continue
         for note in result.summary["assumed"]:
             warn(f"{result.name}: assumed {note} — the numbers are indicative")
+        for note in result.warnings:
+            warn(f"{result.name}: {note}")
         echo(_describe(result))
         echo(f"report: {result.report}")
         failures += result.failed
@@ -116,6 +119,8 @@ def _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers) -> None
         if well.status == "failed":
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
         elif well.result_dir is not None:
+            for note in (well.summary or {}).get("warnings", []):
+                warn(f"{well.well}: {note}")
             echo(f"{well.well}: report: {Path(well.result_dir) / 'report.html'}")
     if result.count("failed") == len(result.wells):
         raise UserError("no well could be read")

@@ -94,3 +94,36 @@ def test_depth_indexed_las_with_a_time_curve_uses_it(tmp_path):
     doc = json.loads(result.output)
     assert doc["channels"]["time_s"]["column"] == "ETIM"
     assert doc["rows"] == 20 and doc["rate_hz"] == pytest.approx(1.0)
+
+
+# ------------------------------------------------------------------ --rate above the data's
+def _idle_log(path, rate_hz: float, seconds: float = 60.0):
+    t = np.arange(0.0, seconds, 1.0 / rate_hz)
+    lines = ["time_s,surface_rpm,surface_torque_Nm"] + [f"{v:g},0,0" for v in t]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_rate_above_the_data_rate_warns_and_uses_the_data_rate(tmp_path):
+    log = _idle_log(tmp_path / "w.csv", rate_hz=1.0)
+    result = CliRunner().invoke(
+        cli, ["run", str(log), "--out", str(tmp_path / "o"), "--rate", "5"])
+    assert result.exit_code == 0, result.output
+    warning = [ln for ln in result.stderr.splitlines() if "5 Hz" in ln]
+    assert len(warning) == 1 and "above the data's logging rate (1 Hz)" in warning[0]
+    assert "not upsampled" in warning[0]
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    assert any("not upsampled" in w for w in summary["warnings"])
+    assert summary["inputs"]["requested_rate_hz"] == 5.0
+    assert summary["inputs"]["resampled_rate_hz"] is None  # the data's own rate
+    assert "not upsampled" in (tmp_path / "o" / "w" / "report.html").read_text()
+
+
+def test_rate_below_the_data_rate_is_used_silently(tmp_path):
+    log = _idle_log(tmp_path / "w.csv", rate_hz=10.0)
+    result = CliRunner().invoke(
+        cli, ["run", str(log), "--out", str(tmp_path / "o"), "--rate", "5"])
+    assert result.exit_code == 0, result.output
+    assert "upsampled" not in result.stderr
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    assert summary["warnings"] == [] and summary["inputs"]["resampled_rate_hz"] == 5.0
