@@ -30,7 +30,13 @@ from drillfric.estimate import (
     estimate_segment,
 )
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
-from drillfric.io.well import assumed_units, iter_surface, load_setup, resolve_well
+from drillfric.io.well import (
+    assumed_units,
+    channel_mappings,
+    iter_surface,
+    load_setup,
+    resolve_well,
+)
 from drillfric.outputs import (
     EstimatesWriter,
     atomic_directory,
@@ -284,7 +290,9 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
         overrides["observer.starts"] = [list(map(float, s)) for s in starts]
     cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
     name = well_name(path, config=config)
-    assumed = list(cfg.assumed) + assumed_units(path, cfg, config=config)
+    mappings = channel_mappings(path, cfg, config=config)
+    assumed = list(cfg.assumed) + assumed_units(mappings)
+    torque_channel = mappings["surface_torque_Nm"]
     warnings: list[str] = []
     rate_used = rate_hz
     if well_path is None:
@@ -323,14 +331,15 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                     try:
                         check_segment(data, cfg)
                         est = estimate_segment(cfg, well_path, data, warm=warm,
-                                               rate_hz=rate_used)
+                                               rate_hz=rate_used,
+                                               torque_channel=torque_channel)
                     except SkipSegment as exc:
                         rows_out.append(_segment_row(seg, None, "skipped", exc.problem,
                                                      depth))
                         continue
                     except DrillfricError as exc:
                         failed += 1
-                        rows_out.append(_segment_row(seg, None, "failed", exc.problem,
+                        rows_out.append(_segment_row(seg, None, "failed", exc.message,
                                                      depth))
                         continue
                     if writer is None:

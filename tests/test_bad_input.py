@@ -4,12 +4,17 @@ nothing half-written — or, for a run that can go on, a clear warning (docs/ing
 from __future__ import annotations
 
 import json
+import shutil
 
 import lasio
 import numpy as np
 import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
+
+from tests.conftest import REPO
+
+DEMO = REPO / "examples" / "demo"
 
 
 def _invoke(*args):
@@ -127,3 +132,53 @@ def test_rate_below_the_data_rate_is_used_silently(tmp_path):
     assert "upsampled" not in result.stderr
     summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
     assert summary["warnings"] == [] and summary["inputs"]["resampled_rate_hz"] == 5.0
+
+
+# ------------------------------------------------------------------ torque in the wrong unit
+def _demo_with_torque(tmp_path, header: str, scale: float):
+    """The demo well with its torque column renamed to ``header`` and values × ``scale``."""
+    lines = (DEMO / "demo.csv").read_text().splitlines()
+    columns = lines[0].split(",")
+    k = columns.index("surface_torque_Nm")
+    columns[k] = header
+    rows = []
+    for line in lines[1:]:
+        fields = line.split(",")
+        fields[k] = f"{float(fields[k]) * scale:.8g}"
+        rows.append(",".join(fields))
+    (tmp_path / "w.csv").write_text("\n".join([",".join(columns)] + rows) + "\n")
+    shutil.copy(DEMO / "demo.toml", tmp_path / "w.toml")
+    shutil.copy(DEMO / "demo.survey.csv", tmp_path / "demo.survey.csv")
+    return tmp_path / "w.csv"
+
+
+def _failed_segments(tmp_path, result):
+    assert result.exit_code == 1, result.output  # segments failed, the run completed
+    summary = json.loads((tmp_path / "o" / "demo" / "summary.json").read_text())
+    rotating = [s for s in summary["segments"] if s["message"] != "" or s["status"] != "ok"]
+    failed = [s for s in summary["segments"] if s["status"] == "failed"]
+    assert len(failed) == 4 and failed == rotating  # every stand of the demo
+    assert summary["mu_k"] is None  # never a made-up value
+    return failed
+
+
+def test_torque_in_kNm_labelled_Nm_fails_its_segments(tmp_path):
+    """Values in kN·m under a header that says N·m: 1000 times below any friction."""
+    well = _demo_with_torque(tmp_path, "STOR [N.m]", 1e-3)
+    failed = _failed_segments(tmp_path, _invoke("run", well, "--out", tmp_path / "o"))
+    for seg in failed:
+        msg = seg["message"]
+        assert "surface torque 1/" in msg and "of the bottom of the torque-and-drag range" in msg
+        assert f"at {seg['bit_depth_m']:.0f} m" in msg and "for μ 0.02–1.5" in msg
+        assert "if the log is in kN.m, correct the unit in the file" in msg
+
+
+def test_torque_in_Nm_read_as_default_kNm_fails_its_segments(tmp_path):
+    """A torque column without a unit is read in kN·m (the documented default): a log in
+    N·m then reads 1000 times too high, and the fix is a [channels] unit."""
+    well = _demo_with_torque(tmp_path, "TORQUE", 1.0)
+    failed = _failed_segments(tmp_path, _invoke("run", well, "--out", tmp_path / "o"))
+    for seg in failed:
+        assert "x the top of the torque-and-drag range" in seg["message"]
+        assert "read as kN.m (default)" in seg["message"]
+        assert 'set [channels] surface_torque = { unit = "N.m" }' in seg["message"]

@@ -426,10 +426,16 @@ def load_setup(path, *, config=None, survey=None,
     return _load_config(config_path, config, overrides), _load_survey(survey_path)
 
 
-def assumed_units(path, cfg: Config, *, config=None) -> list[str]:
-    """Channels whose unit nothing stated (file, config or name): the documented default
-    was assumed — for the run summary's ``assumed`` list. Reads only the file's header."""
+def channel_mappings(path, cfg: Config, *, config=None) -> dict[str, Mapping]:
+    """How each channel of a well's data file is read (column, unit and where the unit came
+    from), keyed by canonical name. Reads only the file's header."""
     data_path, _, _ = resolve_well(path, config=None if isinstance(config, Config) else config)
     _, mappings = _open(data_path, cfg)
+    return {m.channel.name: m for m in mappings.values()}
+
+
+def assumed_units(mappings: dict[str, Mapping]) -> list[str]:
+    """Channels whose unit nothing stated (file, config or name): the documented default
+    was assumed — for the run summary's ``assumed`` list."""
     return [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — nothing "
             "in the file or the config says" for m in mappings.values() if m.source == "default"]
