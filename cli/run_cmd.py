@@ -49,7 +49,8 @@ def _describe(result) -> str:
               "overrides the NAME.toml sidecar.")
 @click.option("--survey", type=click.Path(path_type=Path), help="Survey file, overrides the "
               "NAME.survey.* sidecar.")
-@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation.")
+@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation "
+              "(not above the data's own rate: a higher HZ is ignored with a warning).")
 @click.option("--starts", help="Observer starts MU_S:MU_K,... (overrides observer.starts).")
 @click.option("--pdf/--no-pdf", default=False, help="Also write report.pdf.")
 @click.option("--workers", type=int, default=1, show_default=True,
@@ -93,6 +94,8 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
             continue
         for note in result.summary["assumed"]:
             warn(f"{result.name}: assumed {note} — the numbers are indicative")
+        for note in result.warnings:
+            warn(f"{result.name}: {note}")
         echo(_describe(result))
         echo(f"report: {result.report}")
         failures += result.failed
@@ -103,18 +106,21 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
 
 
 def _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers) -> None:
-    """Several wells on local worker processes, through the fleet executor (always redone)."""
+    """Several wells on local worker processes, through the fleet executor (always redone;
+    OUT gets the wells' directories only, none of the fleet files)."""
     from drillfric.fleet import WellSpec, run_many
 
     specs = [WellSpec(Path(w), config=config, survey=survey) for w in wells]
     overrides = {"observer.starts": [list(p) for p in pairs]} if pairs else None
     with progress(f"run ({len(specs)} wells)", total=len(specs)) as advance:
         result = run_many(specs, out, workers=workers, force=True, progress=advance,
-                          overrides=overrides, rate_hz=rate, pdf=pdf)
+                          overrides=overrides, rate_hz=rate, pdf=pdf, fleet_files=False)
     for well in result.wells:
         if well.status == "failed":
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
         elif well.result_dir is not None:
+            for note in (well.summary or {}).get("warnings", []):
+                warn(f"{well.well}: {note}")
             echo(f"{well.well}: report: {Path(well.result_dir) / 'report.html'}")
     if result.count("failed") == len(result.wells):
         raise UserError("no well could be read")

@@ -29,7 +29,7 @@ import time
 import uuid
 import warnings
 from collections.abc import Callable, Iterator
-from contextlib import closing, contextmanager
+from contextlib import closing, contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
@@ -38,7 +38,7 @@ import pandas as pd
 
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
-from drillfric.outputs import file_sha256, jsonable, write_json
+from drillfric.outputs import file_sha256, jsonable, missing_dirs, remove_empty, write_json
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"
@@ -294,13 +294,14 @@ class WellOutcome:
 
 @dataclass(frozen=True)
 class FleetResult:
-    """A fleet run: outcomes in input order and the fleet files written."""
+    """A fleet run: outcomes in input order and the fleet files written (None: not written,
+    as for ``drillfric run`` on several workers)."""
 
     out_root: Path
     wells: tuple[WellOutcome, ...]
     wall_s: float
-    manifest: Path
-    summary: Path
+    manifest: Path | None
+    summary: Path | None
     report: Path | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
 
@@ -315,12 +316,15 @@ class FleetResult:
 
 
 class _Manifest:
-    """OUT/manifest.json: one entry per well, saved atomically (throttled while running)."""
+    """OUT/manifest.json: one entry per well, saved atomically (throttled while running).
 
-    def __init__(self, out_root: Path):
-        self.path = out_root / MANIFEST
+    Without ``out_root`` the manifest lives in memory only (``drillfric run``).
+    """
+
+    def __init__(self, out_root: Path | None):
+        self.path = None if out_root is None else out_root / MANIFEST
         try:
-            self.data = json.loads(self.path.read_text(encoding="utf-8"))
+            self.data = json.loads(self.path.read_text(encoding="utf-8")) if self.path else {}
         except (OSError, json.JSONDecodeError):
             self.data = {}
         if not isinstance(self.data, dict) or not isinstance(self.data.get("wells"), dict):
@@ -337,7 +341,7 @@ class _Manifest:
                 for f in e.get("inputs", {}).values() if "sha256" in f}
 
     def save(self, *, now: bool = True) -> None:
-        if not now and time.monotonic() - self._saved < SAVE_EVERY_S:
+        if self.path is None or (not now and time.monotonic() - self._saved < SAVE_EVERY_S):
             return
         self.data.update(drillfric_version=__version__, updated_utc=_now())
         tmp = self.path.with_name(f".{MANIFEST}.tmp-{os.getpid()}")
@@ -350,7 +354,7 @@ class _Manifest:
 def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | None = None,
              force: bool = False, progress: Callable[[float], None] | None = None,
              overrides: dict | None = None, rate_hz: float | None = None,
-             pdf: bool = False) -> FleetResult:
+             pdf: bool = False, fleet_files: bool = True) -> FleetResult:
     """Process wells in parallel, skipping those unchanged since their last ok run.
 
     Parameters
@@ -372,6 +376,10 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
         ``{"table.key": value}`` for every well.
     rate_hz, pdf
         As for ``drillfric run``.
+    fleet_files : bool
+        Keep the fleet's bookkeeping in OUT: the lock, manifest.json (so unchanged wells
+        are skipped next time), fleet_summary.parquet and fleet.html. False for
+        ``drillfric run --workers N``: OUT then holds the wells' directories only.
 
     Raises
     ------
@@ -384,9 +392,11 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
     out_root = Path(out_root)
     advance = progress or (lambda amount=1.0: None)
     options = {"rate_hz": rate_hz, "pdf": pdf}
-    with _locked(out_root):
-        _remove_stale(out_root)
-        manifest = _Manifest(out_root)
+    created = missing_dirs(out_root)  # without fleet files: removed again if left empty
+    with _locked(out_root) if fleet_files else nullcontext():
+        if fleet_files:
+            _remove_stale(out_root)
+        manifest = _Manifest(out_root if fleet_files else None)
         known = manifest.known_files()
         jobs = _unique([_prepare(s, out_root, overrides or {}, options, known) for s in wells])
         outcomes: dict[str, WellOutcome] = {}
@@ -411,10 +421,14 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
         finally:
             manifest.save()
             if scheduler is None:  # local workers are gone: what they left is stale
-                _remove_stale(out_root)
+                _remove_stale(out_root, None if fleet_files else {j.name for j in jobs})
         ordered = tuple(outcomes[j.name] for j in jobs)
-        summary = _write_summary(out_root, ordered)
-        report, notes = _write_report(out_root, ordered)
+        summary, report, notes = None, None, ()
+        if fleet_files:
+            summary = _write_summary(out_root, ordered)
+            report, notes = _write_report(out_root, ordered)
+        else:
+            remove_empty(created)  # several workers may each have made OUT for a failed well
     return FleetResult(out_root, ordered, time.perf_counter() - t0, manifest.path, summary,
                        report, notes)
 
@@ -564,10 +578,13 @@ def _locked(out_root: Path):
         fh.close()
 
 
-def _remove_stale(out_root: Path) -> None:
-    """Remove temporary directories left by an interrupted run (never a finished well)."""
+def _remove_stale(out_root: Path, names: set[str] | None = None) -> None:
+    """Remove temporary directories left by an interrupted run (never a finished well);
+    with ``names``, only those of these wells."""
     for path in out_root.glob(".*"):
         if ".tmp-" not in path.name and ".old-" not in path.name:
+            continue
+        if names is not None and path.name[1:].rsplit(".", 1)[0] not in names:
             continue
         if path.is_dir():
             shutil.rmtree(path, ignore_errors=True)

@@ -29,8 +29,14 @@ from drillfric.estimate import (
     check_segment,
     estimate_segment,
 )
-from drillfric.io.timebase import check_plausible_rate
-from drillfric.io.well import assumed_units, iter_surface, load_setup, resolve_well
+from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
+from drillfric.io.well import (
+    assumed_units,
+    channel_mappings,
+    iter_surface,
+    load_setup,
+    resolve_well,
+)
 from drillfric.observer import ObserverRecord
 from drillfric.outputs import (
     EstimatesWriter,
@@ -50,6 +56,9 @@ DEFAULT_BIT_DEPTH_M = 2500.0
 PREROLL_S = 5.0
 #: ``start_id`` of the final observer pass seeded with the batch-refined factors.
 SEEDED_START_ID = -1
+#: Relative margin by which a requested rate may exceed the data's nominal rate (timing
+#: jitter) before it counts as upsampling.
+RATE_MARGIN = 0.01
 _KEEP = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N", "bit_rpm")
 
 
@@ -66,6 +75,8 @@ class RunResult:
         Contents of summary.json.
     failed : int
         Segments whose estimation failed.
+    warnings : list of str
+        What the user should know about the run (also ``summary["warnings"]``).
     """
 
     name: str
@@ -118,6 +129,34 @@ def _rows_done(buffer: pd.DataFrame, pending: int) -> int:
     t = buffer["time_s"].to_numpy()
     ref = t[pending] if pending < t.size else t[-1]
     return int(np.searchsorted(t[:pending], ref - PREROLL_S))
+
+
+def effective_rate(rate_hz: float | None, time_s: np.ndarray) -> tuple[float | None, str | None]:
+    """The rate to resample to [Hz] and, when it differs from ``rate_hz``, why.
+
+    A requested rate above the data's nominal rate would only interpolate between logged
+    samples (upsampling invents nothing the observer could use, and costs time): the data
+    are then estimated at their own rate (None) and a warning says so.
+
+    Parameters
+    ----------
+    rate_hz : float or None
+        Requested rate (``run --rate``) [Hz].
+    time_s : ndarray
+        Sample times of (the start of) the log [s].
+
+    Examples
+    --------
+    >>> effective_rate(5.0, np.arange(10.0))[0] is None
+    True
+    >>> effective_rate(0.5, np.arange(10.0))
+    (0.5, None)
+    """
+    data_rate = nominal_rate_hz(time_s)
+    if rate_hz is None or data_rate <= 0 or rate_hz <= data_rate * (1.0 + RATE_MARGIN):
+        return rate_hz, None
+    return None, (f"requested rate {rate_hz:g} Hz is above the data's logging rate "
+                  f"({data_rate:.3g} Hz): estimated at the data's rate, not upsampled")
 
 
 def well_name(path, *, config=None) -> str:
@@ -258,7 +297,8 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
     overrides : dict, optional
         ``{"table.key": value}`` from the command line.
     rate_hz : float, optional
-        Resample the input to this rate before estimation.
+        Resample the input to this rate before estimation; a rate above the data's own is
+        not used (:func:`effective_rate`: a warning in ``summary["warnings"]``).
     starts : list of (μ_s, μ_k), optional
         Observer starts (overrides ``observer.starts``).
     pdf : bool
@@ -278,7 +318,11 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
         overrides["observer.starts"] = [list(map(float, s)) for s in starts]
     cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
     name = well_name(path, config=config)
-    assumed = list(cfg.assumed) + assumed_units(path, cfg, config=config)
+    mappings = channel_mappings(path, cfg, config=config)
+    assumed = list(cfg.assumed) + assumed_units(mappings)
+    torque_channel = mappings["surface_torque_Nm"]
+    warnings: list[str] = []
+    rate_used = rate_hz
     if well_path is None:
         assumed.append("vertical well: no survey found")
     fallback_depth = None
@@ -315,14 +359,15 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                     try:
                         check_segment(data, cfg)
                         est = estimate_segment(cfg, well_path, data, warm=warm,
-                                               rate_hz=rate_hz)
+                                               rate_hz=rate_used,
+                                               torque_channel=torque_channel)
                     except SkipSegment as exc:
                         rows_out.append(_segment_row(seg, None, "skipped", exc.problem,
                                                      depth))
                         continue
                     except DrillfricError as exc:
                         failed += 1
-                        rows_out.append(_segment_row(seg, None, "failed", exc.problem,
+                        rows_out.append(_segment_row(seg, None, "failed", exc.message,
                                                      depth))
                         continue
                     if writer is None:
@@ -339,6 +384,8 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                 if has_truth is None:
                     has_truth = "bit_rpm" in chunk
                     check_plausible_rate(chunk["time_s"].to_numpy(), file=data_path)
+                    rate_used, note = effective_rate(rate_hz, chunk["time_s"].to_numpy())
+                    warnings += [note] * bool(note)
                 keep = chunk[[c for c in _KEEP if c in chunk]]
                 buffer = pd.concat([buffer, keep], ignore_index=True) if len(buffer) else \
                     keep.reset_index(drop=True)
@@ -360,7 +407,8 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
         if writer is None:
             EstimatesWriter(tmp / "estimates.parquet", bool(has_truth)).close()
         summary = _summary(name, cfg, rows_out, assumed, data_path, config_path, survey_path,
-                           n_rows, rate_hz, time.perf_counter() - t_wall)
+                           n_rows, rate_hz, rate_used, time.perf_counter() - t_wall)
+        summary["warnings"] = list(warnings)
         write_json(tmp / "summary.json", summary)
         write_segments(tmp / "segments.parquet", rows_out)
         if profiles:
@@ -371,10 +419,9 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
                                                                  index=False)
         report_problem = _write_report(tmp, pdf)
         if report_problem:
-            summary["warnings"] = [report_problem]
+            summary["warnings"].append(report_problem)
             write_json(tmp / "summary.json", summary)
-    return RunResult(name, final, summary, failed, assumed + ([report_problem] * bool(
-        report_problem)))
+    return RunResult(name, final, summary, failed, summary["warnings"])
 
 
 def _write_report(result_dir: Path, pdf: bool) -> str | None:
@@ -389,12 +436,12 @@ def _write_report(result_dir: Path, pdf: bool) -> str | None:
 
 
 def _summary(name, cfg, rows, assumed, data_path, config_path, survey_path, n_rows, rate_hz,
-             wall_s) -> dict:
+             rate_used, wall_s) -> dict:
     files = {"data": data_path, "config": config_path, "survey": survey_path}
     inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
               for k, p in files.items()
               if p is not None and Path(p).is_file()}
-    inputs.update(rows=n_rows, resampled_rate_hz=rate_hz)
+    inputs.update(rows=n_rows, resampled_rate_hz=rate_used, requested_rate_hz=rate_hz)
     n_ok = sum(r["status"] == "ok" for r in rows)
     n_conv = sum(r["status"] == "ok" and r["converged"] for r in rows)
     return {"well": name, "drillfric_version": __version__, **consensus(rows),

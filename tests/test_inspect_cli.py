@@ -57,6 +57,37 @@ def test_json_survey_summary(good, tmp_path):
     assert doc["survey"]["stations"] == 3 and doc["survey"]["md_max_m"] == 1200.0
 
 
+RIG_HEADER = ("# Rig: Example 7   Well: A-12\n# Exported 2024-05-01 12:00, depth ref. RKB\n"
+              "#\n\n")
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"], ids=["LF", "CRLF", "CR"])
+def test_csv_comment_lines_are_skipped(tmp_path, newline):
+    """A rig header block of # lines (and a blank line) above the header, comments between
+    the header and the units row and among the data: all skipped, the units row kept."""
+    text = (RIG_HEADER + "TIME;SRPM;STOR;Pump #1\n# units below\ns;rpm;kN.m;spm\n"
+            "0,0;60;10,5;80\n# bit change\n0,5;61;11;80\n   # note, 3 fields; 1; 2\n"
+            "1,0;62;12;81\n")
+    path = tmp_path / "w.csv"
+    path.write_bytes(text.replace("\n", newline).encode())
+    (tmp_path / "w.toml").write_text('[channels]\npump_rate = { column = "Pump #1" }\n')
+    result = _inspect(path, "--json")
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.output)
+    torque = doc["channels"]["surface_torque_Nm"]
+    assert (torque["column"], torque["unit"]) == ("STOR", "kN.m")
+    assert doc["channels"]["pump_rate_spm"]["column"] == "Pump #1"  # '#' inside a line stays
+    assert (doc["rows"], doc["t_end_s"]) == (3, 1.0)
+    assert (torque["min"], torque["max"]) == (10.5e3, 12e3)
+
+
+def test_csv_of_comments_only_is_one_line(tmp_path):
+    (tmp_path / "w.csv").write_text(RIG_HEADER)
+    result = _inspect(tmp_path / "w.csv")
+    assert result.exit_code == 2 and "only blank or # comment lines" in result.output
+    assert len(result.output.strip().splitlines()) == 1
+
+
 def test_dsats_acceptance(real_data):
     path = real_data / "dsats_1hz" / "SampleData1.csv"
     result = _inspect(path, "--config", EXAMPLES / "dsats_1hz.toml")

@@ -151,6 +151,8 @@ def test_several_wells_on_two_workers(tmp_path):
     for name in ("a", "b"):
         summary = json.loads((tmp_path / "o" / name / "summary.json").read_text())
         assert summary["well"] == name and summary["counts"]["estimated"] == 4
+    # OUT holds the wells' results only: no fleet files, lock or manifest (INTERFACE.md)
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["a", "b"]
 
 
 def _segments_of(out_dir):

@@ -262,6 +262,21 @@ def _find_column(columns: list[str], channel: Channel, spec: dict,
     return top[0][1], top[0][2]
 
 
+def find_column(columns: list[str], key: str, config_channels: dict, *,
+                file: str | None = None) -> str | None:
+    """The column channel ``key`` maps to (``[channels]`` or its mnemonics), or None.
+
+    Examples
+    --------
+    >>> find_column(["DEPT", "ETIM", "SRPM"], "time", {})
+    'ETIM'
+    >>> find_column(["DEPT", "SRPM"], "time", {}) is None
+    True
+    """
+    channel = BY_KEY[key]
+    return _find_column(columns, channel, config_channels.get(key, {}), file)[0]
+
+
 def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: dict,
               spec: dict, file: str | None) -> tuple[str, str]:
     """Source unit of a mapped column and where it came from (precedence in module doc)."""

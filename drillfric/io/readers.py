@@ -12,6 +12,7 @@ Every failure to read becomes an :class:`~drillfric.errors.InputError` naming th
 
 from __future__ import annotations
 
+import io
 import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -31,6 +32,10 @@ _DELIMITERS = (",", ";", "\t", "|")
 _SNIFF_BYTES = 1 << 16
 _NUMBER = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 _DATE = re.compile(r"^\d{4}-\d{2}-\d{2}([ T]\d{2}:\d{2}(:\d{2}(\.\d*)?)?)?")
+#: LAS index curves that make a log depth-indexed (LAS 2.0 names the depth index DEPT).
+_DEPTH_INDEX = frozenset({"DEPT", "DEPTH", "MD", "DMEA", "TVD"})
+#: Units of a depth index as LAS headers spell them.
+_DEPTH_UNITS = frozenset({"M", "FT", "F", "METER", "METERS", "METRE", "METRES", "FEET"})
 
 
 @dataclass(frozen=True)
@@ -49,6 +54,8 @@ class RawSource:
         from (``"units row"``, ``"header"``) for :func:`drillfric.io.channels.map_channels`.
     rows : int or None
         Row count when known without reading the data.
+    depth_index : str or None
+        The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
     """
 
     path: Path
@@ -57,6 +64,7 @@ class RawSource:
     units: dict
     rows: int | None
     _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
+    depth_index: str | None = None
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
@@ -184,12 +192,12 @@ def sniff_csv(path: Path) -> CsvLayout:
     """
     with path.open("rb") as fh:
         text, encoding = _decode(fh.read(_SNIFF_BYTES))
-    lines = [ln for ln in re.split(r"\r\n|\r|\n", text) if ln.strip()]
+    lines = [ln for ln in re.split(r"\r\n|\r|\n", text) if ln.strip() and not _is_comment(ln)]
     if len(lines) > 1 and len(text.encode(encoding)) >= _SNIFF_BYTES:
         lines = lines[:-1]  # the last line may be cut by the sniff window
     lines = lines[:50]
     if not lines:
-        raise InputError("file holds no data (only blank lines)", file=path,
+        raise InputError("file holds no data (only blank or # comment lines)", file=path,
                          fix="give a file with data rows")
     delimiter = max(_DELIMITERS, key=lambda d: _delimiter_score(lines, d))
     rows = [[f.strip().strip('"') for f in ln.split(delimiter)] for ln in lines]
@@ -214,6 +222,62 @@ def sniff_csv(path: Path) -> CsvLayout:
     return CsvLayout(delimiter, decimal, header, units_row, columns, units, encoding)
 
 
+def _is_comment(line: str) -> bool:
+    """A comment line: its first non-blank character is ``#`` (a rig header block, a note).
+
+    Examples
+    --------
+    >>> _is_comment("  # Rig: Example 1"), _is_comment("12.5,#3")
+    (True, False)
+    """
+    return line.lstrip().startswith("#")
+
+
+_LINE_END = re.compile(r"(?<=\n)|(?<=\r)(?!\n)")
+
+
+class _CommentFree(io.TextIOBase):
+    """A text file as pandas should see it: without comment lines and leading blank lines.
+
+    pandas reads it through :meth:`read`; whole lines are handed on (a partial last line,
+    or a final ``\\r`` that may start a ``\\r\\n``, waits for the next block), and a block
+    without ``#`` passes unchanged, so a file without comments costs one substring search
+    per block. Leading blank lines go too, so that ``skiprows`` counts the header and the
+    units row only.
+    """
+
+    def __init__(self, fh):
+        self._fh = fh
+        self._tail = ""
+        self._top = True  # before the first line of content
+
+    def readable(self) -> bool:
+        return True
+
+    def read(self, size: int | None = -1) -> str:
+        """Up to about ``size`` characters of whole, comment-free lines ("" at the end)."""
+        while True:
+            block = self._fh.read(size if size and size > 0 else -1)
+            text, self._tail = self._tail + block, ""
+            if block:
+                # a final "\r" waits: it may be the first half of "\r\n"
+                cut = max(text.rfind("\n"), text.rfind("\r", 0, len(text) - 1)) + 1
+                text, self._tail = text[:cut], text[cut:]
+            text = self._clean(text)
+            if text or not block:
+                return text
+
+    def _clean(self, text: str) -> str:
+        if not self._top and "#" not in text:
+            return text
+        lines = [ln for ln in _LINE_END.split(text) if ln and not _is_comment(ln)]
+        if self._top:
+            while lines and not lines[0].strip():
+                lines.pop(0)
+            self._top = not lines
+        return "".join(lines)
+
+
 def _delimiter_score(lines: list[str], delimiter: str) -> tuple[int, int]:
     counts = [ln.count(delimiter) for ln in lines]
     consistent = sum(c == counts[0] for c in counts)
@@ -222,15 +286,16 @@ def _delimiter_score(lines: list[str], delimiter: str) -> tuple[int, int]:
 
 def _open_csv(path: Path) -> RawSource:
     layout = sniff_csv(path)
-    kwargs = dict(sep=layout.delimiter, decimal=layout.decimal, encoding=layout.encoding,
-                  header=None, names=layout.columns, skipinitialspace=True,
+    kwargs = dict(sep=layout.delimiter, decimal=layout.decimal, header=None,
+                  names=layout.columns, skipinitialspace=True,
                   skiprows=(1 + layout.units_row) if layout.header else 0,
                   na_values=[str(v) for v in NULL_VALUES], skip_blank_lines=True,
                   index_col=False)
 
     def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
         try:
-            with pd.read_csv(path, chunksize=chunk_rows, **kwargs) as reader:
+            with open(path, encoding=layout.encoding, newline="") as fh, \
+                    pd.read_csv(_CommentFree(fh), chunksize=chunk_rows, **kwargs) as reader:
                 yield from reader
         except (pd.errors.ParserError, ValueError, UnicodeDecodeError) as exc:
             first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
@@ -376,4 +441,13 @@ def _open_las(path: Path) -> RawSource:
         for start in range(0, len(frame), chunk_rows):
             yield frame.iloc[start:start + chunk_rows].reset_index(drop=True)
 
-    return RawSource(path, "las", columns, units, len(frame), read)
+    return RawSource(path, "las", columns, units, len(frame), read,
+                     depth_index=_depth_index(las.curves[0]) if las.curves else None)
+
+
+def _depth_index(curve) -> str | None:
+    """``"DEPT [M]"`` when a LAS index curve is a depth (by mnemonic or length unit)."""
+    unit = (curve.unit or "").strip().upper()
+    if curve.mnemonic.strip().upper() in _DEPTH_INDEX or unit in _DEPTH_UNITS:
+        return f"{curve.mnemonic} [{curve.unit}]" if curve.unit else curve.mnemonic
+    return None

@@ -30,7 +30,7 @@ import pandas as pd
 
 from drillfric.config import Config, config_from_dict, load_config, read_toml
 from drillfric.errors import ConfigError, InputError
-from drillfric.io.channels import Mapping, map_channels
+from drillfric.io.channels import Mapping, find_column, map_channels
 from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
 from drillfric.io.timebase import TimeBase, TimeTracker, check_plausible_rate, summarize
 from drillfric.wellpath import WellPath
@@ -251,6 +251,13 @@ def _load_survey(survey_path: Path | None) -> WellPath | None:
 # --------------------------------------------------------------------------- surface data
 def _open(data_path: Path, cfg: Config) -> tuple[RawSource, dict[str, Mapping]]:
     raw = open_source(data_path)
+    if raw.depth_index is not None and find_column(raw.columns, "time", cfg.channels,
+                                                   file=str(data_path)) is None:
+        raise InputError(f"depth-indexed LAS log (index curve {raw.depth_index}) without a "
+                         "time curve; drillfric needs time-indexed logs", file=data_path,
+                         fix="export the time-based log (1 s or faster) from the rig's "
+                             "recorder, or map a time curve of this file with [channels] "
+                             'time = { column = "NAME", unit = "s" }')
     return raw, map_channels(raw.columns, raw.units, cfg.channels, file=str(data_path))
 
 
@@ -419,10 +426,16 @@ def load_setup(path, *, config=None, survey=None,
     return _load_config(config_path, config, overrides), _load_survey(survey_path)
 
 
-def assumed_units(path, cfg: Config, *, config=None) -> list[str]:
-    """Channels whose unit nothing stated (file, config or name): the documented default
-    was assumed — for the run summary's ``assumed`` list. Reads only the file's header."""
+def channel_mappings(path, cfg: Config, *, config=None) -> dict[str, Mapping]:
+    """How each channel of a well's data file is read (column, unit and where the unit came
+    from), keyed by canonical name. Reads only the file's header."""
     data_path, _, _ = resolve_well(path, config=None if isinstance(config, Config) else config)
     _, mappings = _open(data_path, cfg)
+    return {m.channel.name: m for m in mappings.values()}
+
+
+def assumed_units(mappings: dict[str, Mapping]) -> list[str]:
+    """Channels whose unit nothing stated (file, config or name): the documented default
+    was assumed — for the run summary's ``assumed`` list."""
     return [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — nothing "
             "in the file or the config says" for m in mappings.values() if m.source == "default"]

@@ -67,6 +67,7 @@ def _header(data: ResultData) -> dict:
         "counts": summary.get("counts") or {}, "assumed": [str(a) for a in
                                                            summary.get("assumed") or []],
         "indicative": bool(summary.get("indicative", bool(summary.get("assumed")))),
+        "warnings": [str(w) for w in summary.get("warnings") or []],
         "config": config_rows(summary.get("config") or {}),
     }
 
@@ -111,6 +112,7 @@ def _header_lines(head: dict) -> list[tuple[str, str]]:
         lines += [(f"input {kind}", path), ("sha256", sha)]
     lines += [("rows", fmt(head["rows"], ".0f")), ("resampled to [Hz]", fmt(head["rate_hz"]))]
     lines += [("ASSUMED", a) for a in head["assumed"]] or [("assumed", "nothing")]
+    lines += [("WARNING", w) for w in head["warnings"]]
     return lines
 
 

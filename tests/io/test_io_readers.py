@@ -91,6 +91,23 @@ def test_csv_headerless_with_channel_indexes(tmp_path):
     assert w.timebase.source_start_s == 0.5 and w.surface["time_s"].iloc[0] == 0.0
 
 
+@pytest.mark.parametrize("size", [1, 2, 3, 5, 8, 13, 64])
+def test_csv_comment_filter_at_any_block_boundary(size):
+    """pandas reads in blocks; comment lines, CRLF pairs and partial lines split across
+    any block boundary give the same text: the file without comment or leading blank
+    lines, nothing else changed."""
+    import io
+
+    from drillfric.io.readers import _CommentFree
+
+    text = ("# rig\r\n\r\n#\rTIME,RPM\r\n0,1\r\n#x,y\n1,2\r3,4\n  # z\r\n\n5,6\r\n"
+            "# end")
+    expected = "TIME,RPM\r\n0,1\r\n1,2\r3,4\n\n5,6\r\n"
+    stream = _CommentFree(io.StringIO(text, newline=""))
+    pieces = iter(lambda: stream.read(size), "")
+    assert "".join(pieces) == expected
+
+
 def test_csv_ragged_rows_are_an_input_error(tmp_path):
     p = _write_text(tmp_path / "a.csv", "TIME,RPM,TORQUE\n0,1,2\n1,2,3,4,5,6\n")
     with pytest.raises(InputError, match="a.csv: cannot parse"):

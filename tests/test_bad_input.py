@@ -1,0 +1,184 @@
+"""Bad input through the CLI: one line naming the file, the problem and the fix; exit 2 and
+nothing half-written — or, for a run that can go on, a clear warning (docs/ingestion.md)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import lasio
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from tests.conftest import REPO
+
+DEMO = REPO / "examples" / "demo"
+
+
+def _invoke(*args):
+    return CliRunner().invoke(cli, [str(a) for a in args])
+
+
+def _one_line_error(result, name: str) -> str:
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and name in lines[0], result.output
+    return lines[0]
+
+
+# ------------------------------------------------------------------ nothing half-written
+def test_unreadable_input_leaves_no_output_directory(tmp_path):
+    """Time going backwards is found while streaming, after OUT would have been created:
+    OUT (and its missing parents) must not be left behind empty."""
+    bad = tmp_path / "w.csv"
+    bad.write_text("time_s,surface_rpm,surface_torque_Nm\n0,60,10\n2,60,10\n1,60,10\n")
+    result = _invoke("run", bad, "--out", tmp_path / "new" / "out")
+    assert "time goes backwards" in _one_line_error(result, "w.csv")
+    assert not (tmp_path / "new").exists()
+
+
+def test_unreadable_input_keeps_an_existing_output_directory(tmp_path):
+    """An OUT that existed before the run stays, untouched (and empty)."""
+    bad = tmp_path / "w.csv"
+    bad.write_text("time_s,surface_rpm,surface_torque_Nm\n")
+    (tmp_path / "out").mkdir()
+    _one_line_error(_invoke("run", bad, "--out", tmp_path / "out"), "w.csv")
+    assert list((tmp_path / "out").iterdir()) == []
+
+
+def test_unreadable_wells_on_workers_leave_no_output_directory(tmp_path):
+    """`run A B --workers 2`: both unreadable (found on the workers), no OUT appears."""
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.csv").write_text(
+            "time_s,surface_rpm,surface_torque_Nm\n0,60,10\n2,60,10\n1,60,10\n")
+    result = _invoke("run", tmp_path / "a.csv", tmp_path / "b.csv", "--workers", 2,
+                     "--out", tmp_path / "out")
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "a.csv" in result.output and "b.csv" in result.output
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", [["simulate"], ["td", "--bit-depth", "1000"]])
+def test_simulate_and_td_with_a_bad_config_write_nothing(tmp_path, command):
+    (tmp_path / "bad.toml").write_text("[fluid]\nmud_densty = 1200.0\n")
+    result = _invoke(command[0], tmp_path / "bad.toml", *command[1:],
+                     "--out", tmp_path / "new" / "x.csv")
+    assert "unknown key 'fluid.mud_densty'" in _one_line_error(result, "bad.toml")
+    assert not (tmp_path / "new").exists()
+
+
+# ------------------------------------------------------------------ depth-indexed LAS
+def _las(path, *, time_curve: bool):
+    las = lasio.LASFile()
+    las.append_curve("DEPT", np.arange(2000.0, 2010.0, 0.5), unit="M")
+    if time_curve:
+        las.append_curve("ETIM", np.arange(20.0), unit="S")
+    las.append_curve("SRPM", np.full(20, 60.0), unit="RPM")
+    las.append_curve("STOR", np.full(20, 12.0), unit="KN.M")
+    las.write(str(path), version=2.0)
+    return path
+
+
+@pytest.mark.parametrize("command", ["inspect", "run"])
+def test_depth_indexed_las_is_refused_in_one_line(tmp_path, command):
+    path = _las(tmp_path / "depth.las", time_curve=False)
+    args = [command, path] + (["--out", tmp_path / "out"] if command == "run" else [])
+    line = _one_line_error(_invoke(*args), "depth.las")
+    assert "depth-indexed" in line and "DEPT" in line and "time-indexed" in line
+    assert "[channels] time" in line  # the fix when the file has a time curve by another name
+    assert not (tmp_path / "out").exists()
+
+
+def test_depth_indexed_las_with_a_time_curve_uses_it(tmp_path):
+    path = _las(tmp_path / "depth.las", time_curve=True)
+    result = _invoke("inspect", path, "--json")
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.output)
+    assert doc["channels"]["time_s"]["column"] == "ETIM"
+    assert doc["rows"] == 20 and doc["rate_hz"] == pytest.approx(1.0)
+
+
+# ------------------------------------------------------------------ --rate above the data's
+def _idle_log(path, rate_hz: float, seconds: float = 60.0):
+    t = np.arange(0.0, seconds, 1.0 / rate_hz)
+    lines = ["time_s,surface_rpm,surface_torque_Nm"] + [f"{v:g},0,0" for v in t]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_rate_above_the_data_rate_warns_and_uses_the_data_rate(tmp_path):
+    log = _idle_log(tmp_path / "w.csv", rate_hz=1.0)
+    result = CliRunner().invoke(
+        cli, ["run", str(log), "--out", str(tmp_path / "o"), "--rate", "5"])
+    assert result.exit_code == 0, result.output
+    warning = [ln for ln in result.stderr.splitlines() if "5 Hz" in ln]
+    assert len(warning) == 1 and "above the data's logging rate (1 Hz)" in warning[0]
+    assert "not upsampled" in warning[0]
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    assert any("not upsampled" in w for w in summary["warnings"])
+    assert summary["inputs"]["requested_rate_hz"] == 5.0
+    assert summary["inputs"]["resampled_rate_hz"] is None  # the data's own rate
+    assert "not upsampled" in (tmp_path / "o" / "w" / "report.html").read_text()
+
+
+def test_rate_below_the_data_rate_is_used_silently(tmp_path):
+    log = _idle_log(tmp_path / "w.csv", rate_hz=10.0)
+    result = CliRunner().invoke(
+        cli, ["run", str(log), "--out", str(tmp_path / "o"), "--rate", "5"])
+    assert result.exit_code == 0, result.output
+    assert "upsampled" not in result.stderr
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    assert summary["warnings"] == [] and summary["inputs"]["resampled_rate_hz"] == 5.0
+
+
+# ------------------------------------------------------------------ torque in the wrong unit
+def _demo_with_torque(tmp_path, header: str, scale: float):
+    """The demo well with its torque column renamed to ``header`` and values × ``scale``."""
+    lines = (DEMO / "demo.csv").read_text().splitlines()
+    columns = lines[0].split(",")
+    k = columns.index("surface_torque_Nm")
+    columns[k] = header
+    rows = []
+    for line in lines[1:]:
+        fields = line.split(",")
+        fields[k] = f"{float(fields[k]) * scale:.8g}"
+        rows.append(",".join(fields))
+    (tmp_path / "w.csv").write_text("\n".join([",".join(columns)] + rows) + "\n")
+    shutil.copy(DEMO / "demo.toml", tmp_path / "w.toml")
+    shutil.copy(DEMO / "demo.survey.csv", tmp_path / "demo.survey.csv")
+    return tmp_path / "w.csv"
+
+
+def _failed_segments(tmp_path, result):
+    assert result.exit_code == 1, result.output  # segments failed, the run completed
+    summary = json.loads((tmp_path / "o" / "demo" / "summary.json").read_text())
+    rotating = [s for s in summary["segments"] if s["message"] != "" or s["status"] != "ok"]
+    failed = [s for s in summary["segments"] if s["status"] == "failed"]
+    assert len(failed) == 4 and failed == rotating  # every stand of the demo
+    assert summary["mu_k"] is None  # never a made-up value
+    return failed
+
+
+def test_torque_in_kNm_labelled_Nm_fails_its_segments(tmp_path):
+    """Values in kN·m under a header that says N·m: 1000 times below any friction."""
+    well = _demo_with_torque(tmp_path, "STOR [N.m]", 1e-3)
+    failed = _failed_segments(tmp_path, _invoke("run", well, "--out", tmp_path / "o"))
+    for seg in failed:
+        msg = seg["message"]
+        assert "surface torque 1/" in msg and "of the bottom of the torque-and-drag range" in msg
+        assert f"at {seg['bit_depth_m']:.0f} m" in msg and "for μ 0.02–1.5" in msg
+        assert "if the log is in kN.m, correct the unit in the file" in msg
+
+
+def test_torque_in_Nm_read_as_default_kNm_fails_its_segments(tmp_path):
+    """A torque column without a unit is read in kN·m (the documented default): a log in
+    N·m then reads 1000 times too high, and the fix is a [channels] unit."""
+    well = _demo_with_torque(tmp_path, "TORQUE", 1.0)
+    failed = _failed_segments(tmp_path, _invoke("run", well, "--out", tmp_path / "o"))
+    for seg in failed:
+        assert "x the top of the torque-and-drag range" in seg["message"]
+        assert "read as kN.m (default)" in seg["message"]
+        assert 'set [channels] surface_torque = { unit = "N.m" }' in seg["message"]
