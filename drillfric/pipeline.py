@@ -280,7 +280,7 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
     name = well_name(path, config=config)
     assumed = list(cfg.assumed) + assumed_units(path, cfg, config=config)
     if well_path is None:
-        assumed.append("vertical well: no survey found")
+        assumed.append(cfg.no_survey_note)
     fallback_depth = None
     total_rows = _count_rows(data_path)
     segmenter = Segmenter(cfg)
