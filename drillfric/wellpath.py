@@ -266,7 +266,8 @@ def tortuous_vertical(depth_m: float, dls_rad_m: float, *, period_m: float = TOR
     a chain of circular arcs of curvature κ, each in its own plane (as h → 0 it tends to the
     helix, sin I → κP/2π). The soft-string side force per unit length is then
     F_N ≈ √((F·κ)² + (w·sin I)²) with F the tension and w the buoyed weight per metre
-    (§2 step 2; the two terms are orthogonal): F·κ wherever the tension is large.
+    (§2 step 2; the two terms are orthogonal at mid-arc, within ΔA/2 of it at the
+    stations): F·κ wherever the tension is large.
 
     Parameters
     ----------
@@ -291,7 +292,7 @@ def tortuous_vertical(depth_m: float, dls_rad_m: float, *, period_m: float = TOR
 
     Examples
     --------
-    1°/30 m with the default period: a helix of inclination ≈ 1.6° and radius ≈ 1.3 m;
+    1°/30 m with the default period: a helix of inclination ≈ 1.6° and radius ≈ 1.3 m:
 
     >>> p = tortuous_vertical(1000.0, np.radians(1.0) / 30.0)
     >>> dls_deg_30m = np.degrees(p.dls_rad_m) * 30.0
