@@ -68,7 +68,8 @@ def summarize(data) -> dict:
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
         "max_gap_s": data.config["segmentation.max_gap_s"],
-        "assumed": list(data.config.assumed),
+        "assumed": list(data.config.assumed) + (
+            [data.config.no_survey_note] if data.survey is None else []),
         "segments": [_segment(seg) for seg in segment(data.surface, data.config)],
     }
 
@@ -123,7 +124,7 @@ def render(s: dict) -> str:
     lines.append(f"gaps       {len(gaps)} longer than {limit:.3g} s" + (f": {shown}" if gaps
                                                                         else ""))
     sv = s["survey"]
-    lines.append("survey     none — a vertical well is assumed" if sv is None else
+    lines.append("survey     none — a vertical well is assumed (see below)" if sv is None else
                  f"survey     {sv['stations']} stations to {sv['md_max_m']:.1f} m MD, "
                  f"max inclination {sv['inc_max_deg']:.1f}°, TVD {sv['tvd_max_m']:.1f} m")
     lines.append(_segments_line(s["segments"]))

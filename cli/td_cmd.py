@@ -111,24 +111,31 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
     """Soft-string torque and drag (THEORY.md §2) for WELL_OR_CONFIG.
 
     WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file) or a well on
-    disk (INTERFACE.md). Without a survey the hole is vertical and --bit-depth is required.
+    disk (INTERFACE.md). Without a survey the hole is vertical with the nominal tortuosity
+    survey.tortuosity_deg_30m, and --bit-depth is required.
     """
     overrides = {"model.friction": friction, "model.element_length_m": element_length}
     cfg, path = _load(well_or_config, config, survey, overrides)
     if bit_depth is None:
         if path is None:
-            raise UserError("no survey: give --bit-depth (the hole is taken as vertical)")
+            raise UserError("no survey: give --bit-depth (the hole is taken as vertical, with "
+                            "the nominal tortuosity survey.tortuosity_deg_30m)")
         bit_depth = path.md_max_m
     for note in cfg.assumed:
         if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
             warn(f"assumed {note}")
     if path is None:
-        warn("no survey: vertical hole assumed")
+        warn(f"assumed {cfg.no_survey_note}")
     kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
     if broomstick:
         _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
     else:
         _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw)
+
+
+def _assumed(cfg, path) -> list[str]:
+    """Assumed defaults of a td run: the configuration's and, without a survey, the hole."""
+    return list(cfg.assumed) + ([cfg.no_survey_note] if path is None else [])
 
 
 def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> None:
@@ -145,7 +152,7 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
                "max_normal_force_N_m": float(result.normal_force_N_m.max()),
                "mud_density_kg_m3": cfg["fluid.mud_density_kg_m3"],
                "element_length_m": cfg["model.element_length_m"],
-               "elements": int(result.fc_Nm_m.size), "assumed": list(cfg.assumed)}
+               "elements": int(result.fc_Nm_m.size), "assumed": _assumed(cfg, path)}
     if callable(mu):
         summary["friction_by_section"] = {"casing_shoe_md_m": mu.shoe_md_m,
                                           "cased": mu.cased, "open_hole": mu.open_hole}
@@ -168,7 +175,7 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
 def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw) -> None:
     from drillfric.drillstring import build_string
     from drillfric.torque_drag import broomstick, broomstick_figure, config_friction
-    from drillfric.wellpath import vertical
+    from drillfric.wellpath import no_survey_path
 
     _check_out(out, _TABLE_SUFFIXES)
     if plot is None and out is not None:
@@ -182,7 +189,7 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
     grid = _floats(depths, "depths")
     if grid is None:
         grid = list(np.linspace(max(bha_m + 1.0, bit_depth / 50), bit_depth, 50))
-    path = vertical(max(grid)) if path is None else path
+    path = no_survey_path(max(grid), cfg.tortuosity_rad_m) if path is None else path
     cases = ["rotating_off_bottom", "pick_up", "slack_off"]
     if kw["wob_N"] > 0 or kw["bit_torque_Nm"] != 0:
         cases.append("rotating_on_bottom")

@@ -115,7 +115,14 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
     ),
     "survey": (
         Key("file", str, None, "", "Survey file (MD, inclination, azimuth), relative to the "
-            "config. Without a survey the well is assumed vertical."),
+            "config. Without a survey the well is assumed vertical, with the nominal "
+            "tortuosity below."),
+        Key("tortuosity_deg_30m", float, 1.0, "°/30 m", "Nominal tortuosity of the path "
+            "assumed when there is no survey: a vertical hole wound into a helix (300 m "
+            "period) whose dogleg severity is this everywhere, so the string gets side force "
+            "(docs/torque_drag.md). An assumption: friction factors then scale about as "
+            "1/tortuosity and are indicative. 0 = exactly vertical (no side force: rotating "
+            "segments are skipped). Ignored when a survey is given.", min=0.0, max=10.0),
     ),
     "fluid": (
         Key("mud_density_kg_m3", float, 1200.0, "kg/m³", "Mud density in the annulus "
@@ -339,6 +346,23 @@ class Config:
         if self["model.omega_c_rpm"] is not None:
             return self["model.omega_c_rpm"] * RPM_TO_RAD_S
         return 1.0
+
+    @property
+    def tortuosity_rad_m(self) -> float:
+        """Nominal tortuosity of the path assumed without a survey [rad/m] (0: vertical)."""
+        import math
+
+        return math.radians(self["survey.tortuosity_deg_30m"]) / 30.0
+
+    @property
+    def no_survey_note(self) -> str:
+        """What is assumed about the hole when there is no survey (for the assumed list)."""
+        tortuosity = self["survey.tortuosity_deg_30m"]
+        if tortuosity == 0:
+            return "vertical well: no survey found"
+        text = f"{tortuosity:.1f}" if round(tortuosity, 1) == tortuosity else f"{tortuosity:g}"
+        return (f"a vertical well with a nominal tortuosity of {text}°/30 m, no survey found "
+                "(survey.tortuosity_deg_30m; friction factors scale about as 1/tortuosity)")
 
     @property
     def inner_mud_density_kg_m3(self) -> float:

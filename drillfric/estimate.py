@@ -37,7 +37,7 @@ from drillfric.observer import (
     observe,
 )
 from drillfric.units import RPM_TO_RAD_S
-from drillfric.wellpath import WellPath, vertical
+from drillfric.wellpath import WellPath, no_survey_path
 
 #: Batch flags under which a stick-slip-onset bound on μ_s is not reported (THEORY §6.4: a
 #: bound above the truth is a false claim; prefer none).
@@ -168,9 +168,10 @@ class SegmentEstimate:
     mu_s_seed: float | None = None
 
 
-def _path_for(path: WellPath | None, bit_depth_m: float) -> WellPath:
+def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
+    """The survey's path, or without one the assumed tortuous vertical path to the bit."""
     if path is None:
-        return vertical(bit_depth_m)
+        return no_survey_path(bit_depth_m, cfg.tortuosity_rad_m)
     if bit_depth_m > path.md_max_m + 1e-6:
         raise DrillfricError(f"the survey ends at {path.md_max_m:.1f} m, above the bit at "
                              f"{bit_depth_m:.1f} m", fix="extend the survey to the bit depth")
@@ -267,7 +268,8 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     ----------
     cfg : Config
     path : WellPath or None
-        Well path (vertical when None).
+        Well path; None: no survey, a vertical hole with the nominal tortuosity
+        ``survey.tortuosity_deg_30m`` (exactly vertical when it is 0).
     data : SegmentData
     warm : (μ_s, μ_k), optional
         Previous segment's estimates, added as a start (warm start across windows).
@@ -289,7 +291,9 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         The segment cannot be estimated (survey above the bit, implausible torque scale).
     """
     tick = progress or (lambda amount: None)
-    path = _path_for(path, data.bit_depth_m)
+    fix = "give the well's survey" + (
+        "" if path is not None else " (or a nominal survey.tortuosity_deg_30m > 0)")
+    path = _path_for(cfg, path, data.bit_depth_m)
     string = build_string(cfg.sections, data.bit_depth_m)
     on_bottom = data.kind == "on_bottom_rotating"
     td = torque_drag.solve_config(cfg, path, data.bit_depth_m,
@@ -298,7 +302,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     if td.T_N_Nm < 1.0:
         raise SkipSegment(f"no side force on the string at {data.bit_depth_m:.0f} m (T_N = "
                           f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
-                          "torque", fix="give the well's survey")
+                          "torque", fix=fix)
     check_torque_scale(data, td.T_N_Nm, cfg.omega_c_rad_s, torque_channel=torque_channel)
     itd = cfg["rig.top_drive_inertia_kg_m2"]
     meas = Measurements.from_samples(data.time_s, data.surface_rpm * RPM_TO_RAD_S,

@@ -324,7 +324,7 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
     warnings: list[str] = []
     rate_used = rate_hz
     if well_path is None:
-        assumed.append("vertical well: no survey found")
+        assumed.append(cfg.no_survey_note)
     fallback_depth = None
     total_rows = _count_rows(data_path)
     segmenter = Segmenter(cfg)

@@ -27,7 +27,7 @@ from numba import njit
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import ModelError
 from drillfric.units import RPM_TO_RAD_S
-from drillfric.wellpath import WellPath, vertical
+from drillfric.wellpath import WellPath, no_survey_path
 
 #: Load cases (THEORY.md §2 step 3): σ is the axial share of the friction (+1 pulling out,
 #: −1 running in, 0 rotating), the torque share is the tangential one.
@@ -399,13 +399,15 @@ def solve_config(cfg, path: WellPath | None, bit_depth_m: float, **kw) -> TDResu
     ----------
     cfg : drillfric.config.Config
     path : WellPath or None
-        Hole geometry (vertical to the bit when None).
+        Hole geometry. None: no survey, the assumed path to the bit — vertical with the
+        nominal tortuosity ``survey.tortuosity_deg_30m``
+        (:func:`drillfric.wellpath.no_survey_path`; exactly vertical when it is 0).
     bit_depth_m : float
         Bit measured depth [m].
     **kw
         Passed to :func:`solve` (``friction`` overrides the configured friction).
     """
-    path = vertical(bit_depth_m) if path is None else path
+    path = no_survey_path(bit_depth_m, cfg.tortuosity_rad_m) if path is None else path
     string = build_string(cfg.sections, bit_depth_m)
     kw = dict(kw)
     kw["friction"] = config_friction(cfg, kw.get("friction"))

@@ -234,5 +234,98 @@ def minimum_curvature(md_m, inc_rad, azi_rad, *, tie_in=None) -> WellPath:
 
 
 def vertical(depth_m: float) -> WellPath:
-    """A vertical well path from surface to ``depth_m`` [m] (the default without a survey)."""
+    """An exactly vertical well path from surface to ``depth_m`` [m] (no side force)."""
     return minimum_curvature([0.0, float(depth_m)], [0.0, 0.0], [0.0, 0.0])
+
+
+#: Helix period of the assumed tortuous path [m]: long against the 30 m of a survey
+#: interval, so a survey of the path at 30 m reads 98 % of its curvature (sinc(π·30/300)).
+TORTUOUS_PERIOD_M = 300.0
+#: Station spacing of the assumed tortuous path [m] (12° of azimuth per station).
+TORTUOUS_STATION_M = 10.0
+
+
+def tortuous_vertical(depth_m: float, dls_rad_m: float, *, period_m: float = TORTUOUS_PERIOD_M,
+                      station_m: float = TORTUOUS_STATION_M) -> WellPath:
+    """A nominally vertical hole with constant tortuosity: a helix about the vertical.
+
+    Real "vertical" holes are tortuous; in an exactly vertical one the soft-string side
+    force is zero (THEORY.md §2) and friction cannot act on the torque. This is the path
+    assumed when a well has no survey: constant inclination I, azimuth turning uniformly,
+    A(s) = 2π s/P, so that the curvature is the same everywhere.
+
+    Curvature of the helix: with t(s) = (sin I cos A, sin I sin A, cos I) (THEORY.md §1),
+    dt/ds = sin I·(2π/P)·(−sin A, cos A, 0), so κ = |dt/ds| = (2π/P)·sin I. The path is
+    built from stations every h = ``station_m`` (ΔA = 2π h/P); between two stations the
+    minimum-curvature dogleg (§1) is β = 2·atan2(|t₂ − t₁|, |t₂ + t₁|) with
+    |t₂ − t₁| = 2 sin I sin(ΔA/2), i.e. sin(β/2) = sin I·sin(ΔA/2). Choosing
+
+        sin I = sin(κh/2) / sin(ΔA/2)
+
+    makes the dogleg severity β/h of every interval exactly κ = ``dls_rad_m``: the path is
+    a chain of circular arcs of curvature κ, each in its own plane (as h → 0 it tends to the
+    helix, sin I → κP/2π). The soft-string side force per unit length is then
+    F_N ≈ √((F·κ)² + (w·sin I)²) with F the tension and w the buoyed weight per metre
+    (§2 step 2; the two terms are orthogonal at mid-arc, within ΔA/2 of it at the
+    stations): F·κ wherever the tension is large.
+
+    Parameters
+    ----------
+    depth_m : float
+        Deepest measured depth the path must reach [m]; it ends at the first station at or
+        below it.
+    dls_rad_m : float
+        Tortuosity: dogleg severity κ of every interval [rad/m], > 0.
+    period_m : float
+        Helix period P [m] (one full turn of azimuth).
+    station_m : float
+        Station spacing h [m].
+
+    Returns
+    -------
+    WellPath
+
+    Raises
+    ------
+    ValueError
+        A non-positive input, or a curvature too large for the period (sin I > 1).
+
+    Examples
+    --------
+    1°/30 m with the default period: a helix of inclination ≈ 1.6° and radius ≈ 1.3 m:
+
+    >>> p = tortuous_vertical(1000.0, np.radians(1.0) / 30.0)
+    >>> dls_deg_30m = np.degrees(p.dls_rad_m) * 30.0
+    >>> round(float(dls_deg_30m.min()), 9), round(float(dls_deg_30m.max()), 9)
+    (1.0, 1.0)
+    >>> round(float(np.degrees(p.inc_rad[0])), 2)
+    1.59
+    """
+    depth, kappa = float(depth_m), float(dls_rad_m)
+    if not (depth > 0 and kappa > 0 and period_m > 0 and station_m > 0):
+        raise ValueError("depth, tortuosity, period and station spacing must be positive")
+    d_azi = 2.0 * np.pi * station_m / period_m
+    sin_inc = np.sin(kappa * station_m / 2.0) / np.sin(d_azi / 2.0)
+    if not sin_inc <= 1.0:
+        raise ValueError(f"tortuosity {kappa:.3g} rad/m is too large for a {period_m:g} m "
+                         "helix period")
+    n = int(np.ceil(depth / station_m - 1e-9))
+    k = np.arange(n + 1)
+    inc = np.full(k.size, np.arcsin(sin_inc))
+    return minimum_curvature(k * station_m, inc, k * d_azi)
+
+
+def no_survey_path(depth_m: float, tortuosity_rad_m: float) -> WellPath:
+    """The path assumed when a well has no survey, to ``depth_m`` [m].
+
+    :func:`tortuous_vertical` with dogleg severity ``tortuosity_rad_m`` [rad/m]; exactly
+    :func:`vertical` when it is 0 (then the soft-string side force is zero, THEORY.md §2).
+
+    Examples
+    --------
+    >>> no_survey_path(500.0, 0.0).inc_rad.tolist()
+    [0.0, 0.0]
+    """
+    if tortuosity_rad_m == 0:
+        return vertical(depth_m)
+    return tortuous_vertical(depth_m, tortuosity_rad_m)

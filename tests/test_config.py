@@ -85,6 +85,7 @@ bit_depth = { column = "BITDEP", unit = "m" }
     ({"observer": {"starts": [[0.2, 0.6]]}}, "0 ≤ μ_k ≤ μ_s"),
     ({"observer": {"poles_per_s": ["a", "b"]}}, "two positive numbers"),
     ({"segmentation": {"rotating_rpm": 1.0, "rotating_stop_rpm": 5.0}}, "rotating_stop_rpm"),
+    ({"survey": {"tortuosity_deg_30m": -0.5}}, "outside [0, 10]"),
 ])
 def test_bad_config_one_line(raw, words):
     with pytest.raises(ConfigError) as info:
@@ -105,3 +106,17 @@ def test_precedence_command_line_over_file_over_default(tmp_path):
 def test_integer_accepted_for_float(tmp_path):
     cfg = config_from_dict({"fluid": {"mud_density_kg_m3": 1100}})
     assert isinstance(cfg["fluid.mud_density_kg_m3"], float)
+
+
+def test_no_survey_tortuosity_default_and_note():
+    """Without a survey the hole is vertical with a nominal 1°/30 m tortuosity (DLS in
+    rad/m inside, docs/torque_drag.md), and the note says so; 0 restores the plain vertical
+    note."""
+    cfg = load_config()
+    assert cfg["survey.tortuosity_deg_30m"] == 1.0
+    assert cfg.tortuosity_rad_m == pytest.approx(3.141592653589793 / 180.0 / 30.0, rel=1e-15)
+    assert "nominal tortuosity of 1.0°/30 m" in cfg.no_survey_note
+    assert "0.25°/30 m" in config_from_dict(
+        {"survey": {"tortuosity_deg_30m": 0.25}}).no_survey_note
+    zero = config_from_dict({"survey": {"tortuosity_deg_30m": 0}})
+    assert zero.tortuosity_rad_m == 0.0 and zero.no_survey_note == "vertical well: no survey found"

@@ -32,7 +32,8 @@ def test_table(good):
     assert result.exit_code == 0, result.output
     out = result.output
     for text in ("surface_torque_Nm", "STOR [kN.m]", "kN.m", "1 (33.3%)", "rows       3",
-                 "5 Hz nominal", "survey     none", "segments   0 rotating: 0 usable"):
+                 "5 Hz nominal", "survey     none", "segments   0 rotating: 0 usable",
+                 "assumed    a vertical well with a nominal tortuosity of 1.0°/30 m"):
         assert text in out
 
 
@@ -55,6 +56,7 @@ def test_json_survey_summary(good, tmp_path):
     (tmp_path / "w.survey.csv").write_text("md_m,inc_deg,azi_deg\n0,0,0\n800,10,0\n1200,20,0\n")
     doc = json.loads(_inspect(good, "--json").output)
     assert doc["survey"]["stations"] == 3 and doc["survey"]["md_max_m"] == 1200.0
+    assert not any("tortuosity" in note for note in doc["assumed"])  # a survey is real
 
 
 RIG_HEADER = ("# Rig: Example 7   Well: A-12\n# Exported 2024-05-01 12:00, depth ref. RKB\n"

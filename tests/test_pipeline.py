@@ -206,3 +206,49 @@ def test_two_wells_with_one_name_are_refused(tmp_path):
                                       str(tmp_path / "o")])
     assert result.exit_code == 2 and "would both write OUT/demo" in result.output
     assert not (tmp_path / "o").exists()
+
+
+@pytest.fixture(scope="module")
+def first_stand_alone(tmp_path_factory):
+    """The demo's first stand (creep start-up at 2210 m, 0–230 s) as a data file alone: no
+    configuration, no survey — the issue's "nothing but a data file"."""
+    folder = tmp_path_factory.mktemp("alone")
+    frame = pd.read_csv(DEMO / "demo.csv")
+    frame[frame["time_s"] < 230.0].to_csv(folder / "demo.csv", index=False)
+    return folder / "demo.csv"
+
+
+def test_no_survey_assumes_a_tortuous_vertical_well(first_stand_alone, tmp_path, truth):
+    """Without a survey the hole is vertical with the nominal tortuosity (1°/30 m): the
+    stand gets side force and is estimated, and the assumption is said in the terminal,
+    summary.json and the report. The data identify μ_k·T_N (the mean rotating torque), so
+    μ_k ≈ μ_k,true·T_N,true/T_N,assumed — within the 5 % of the μ_k acceptance (the demo's
+    true path is a 50° build-and-hold with T_N,true = 54.7 kN·m at 2210 m)."""
+    result = CliRunner().invoke(cli, ["run", str(first_stand_alone), "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    note = "a vertical well with a nominal tortuosity of 1.0°/30 m, no survey found"
+    assert f"demo: assumed {note}" in result.output and "indicative" in result.output
+    summary = json.loads((tmp_path / "demo" / "summary.json").read_text())
+    assert summary["indicative"] and any(a.startswith(note) for a in summary["assumed"])
+    [seg] = summary["segments"]
+    assert seg["status"] == "ok" and seg["T_N_Nm"] > 0
+    true_tn = truth["stands"][0]["T_N_Nm"]
+    assert seg["mu_k"] == pytest.approx(truth["mu_k"] * true_tn / seg["T_N_Nm"], rel=0.05)
+    html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
+    assert "nominal tortuosity of 1.0°/30 m" in html  # the highlighted assumptions
+    assert "No survey: the well was taken as vertical with a nominal tortuosity" in html
+
+
+def test_no_survey_and_no_tortuosity_skips_as_before(first_stand_alone, tmp_path):
+    """Tortuosity 0 restores the exactly vertical hole: no side force, the stand is skipped
+    with the reason (and the run still completes, exit 0)."""
+    shutil.copy(first_stand_alone, tmp_path / "demo.csv")
+    (tmp_path / "demo.toml").write_text("[survey]\ntortuosity_deg_30m = 0.0\n")
+    result = CliRunner().invoke(cli, ["run", str(tmp_path / "demo.csv"), "--out",
+                                      str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    assert "assumed vertical well: no survey found" in result.output
+    summary = json.loads((tmp_path / "o" / "demo" / "summary.json").read_text())
+    [seg] = summary["segments"]
+    assert seg["status"] == "skipped" and "no side force" in seg["message"]
+    assert summary["mu_k"] is None and summary["counts"]["estimated"] == 0

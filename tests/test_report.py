@@ -125,7 +125,8 @@ def test_well_report_is_self_contained(demo_html):
 
 def test_assumed_defaults_are_highlighted(demo, tmp_path):
     """Every assumed default is listed in the highlighted box; none → no box."""
-    notes = ["vertical well: no survey found", "bit depth 2500 m: neither the log nor a survey"]
+    notes = ["a vertical well with a nominal tortuosity of 1.0°/30 m, no survey found",
+             "bit depth 2500 m: neither the log nor a survey"]
     result = copy_result(demo, tmp_path / "w", lambda s: s.update(assumed=notes,
                                                                   indicative=True))
     (result / "wellpath.parquet").unlink()
@@ -133,7 +134,17 @@ def test_assumed_defaults_are_highlighted(demo, tmp_path):
     box = html.split('id="assumed"')[1].split("</div>")[0]
     assert all(note in box for note in notes)
     assert "indicative" in box
-    assert '<p class="note">No survey: the well was taken as vertical.' in html
+    assert ('<p class="note">No survey: the well was taken as vertical with a nominal '
+            "tortuosity of 1°/30 m") in html
+
+    def untortuous(summary):
+        summary.update(assumed=["vertical well: no survey found"], indicative=True)
+        summary["config"]["survey"]["tortuosity_deg_30m"] = 0.0
+
+    plain = copy_result(demo, tmp_path / "v", untortuous)
+    (plain / "wellpath.parquet").unlink()
+    html = write_well_report(plain).read_text(encoding="utf-8")
+    assert '<p class="note">No survey: the well was taken as vertical.</p>' in html
     assert "indicative: defaults assumed" in html
     assert 'id="assumed"' not in write_well_report(demo).read_text(encoding="utf-8")
 

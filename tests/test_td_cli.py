@@ -171,3 +171,24 @@ def test_other_bad_usage(well, tmp_path):
     no_survey = tmp_path / "ns.toml"
     no_survey.write_text("")
     _one_line_exit_2(invoke(no_survey), "--bit-depth")
+
+
+def test_no_survey_is_vertical_with_the_nominal_tortuosity(tmp_path):
+    """Without a survey td takes the same assumed path as run (vertical, 1°/30 m), warns
+    and lists it in "assumed"; tortuosity 0 is the exactly vertical hole (T_N = 0)."""
+    cfg = tmp_path / "ns.toml"
+    cfg.write_text("[fluid]\nmud_density_kg_m3 = 1200.0\n")
+    result = invoke(cfg, "--bit-depth", 2000, "--json")
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert any("nominal tortuosity of 1.0°/30 m" in a for a in out["assumed"])
+    assert "nominal tortuosity of 1.0°/30 m" in result.stderr
+    assert out["T_N_Nm"] == pytest.approx(solve_config(load_config(cfg), None, 2000.0).T_N_Nm,
+                                          rel=1e-12) and out["T_N_Nm"] > 0
+    broom = invoke(cfg, "--broomstick", "--bit-depth", 2000, "--depths", "1000,2000",
+                   "--json")
+    assert broom.exit_code == 0, broom.output
+    assert all(row["T_N_Nm"] > 0 for row in json.loads(broom.stdout))
+    cfg.write_text("[survey]\ntortuosity_deg_30m = 0.0\n")
+    flat = json.loads(invoke(cfg, "--bit-depth", 2000, "--json").stdout)
+    assert flat["T_N_Nm"] == 0.0 and "vertical well: no survey found" in flat["assumed"]

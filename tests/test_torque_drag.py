@@ -23,7 +23,7 @@ from drillfric.torque_drag import (
     solve,
     solve_config,
 )
-from drillfric.wellpath import minimum_curvature, vertical
+from drillfric.wellpath import minimum_curvature, no_survey_path, vertical
 
 RHO_STEEL = 7850.0
 
@@ -290,8 +290,11 @@ def test_friction_per_hole_section_from_config(tmp_path):
 
 
 def test_solve_config_defaults_to_vertical_and_config_string():
-    cfg = load_config()
+    """Without a survey and with tortuosity 0 the hole is exactly vertical: hook load =
+    buoyed weight of the configured string (rel 1e-12: a sum of ~10³ terms)."""
+    cfg = load_config(overrides={"survey.tortuosity_deg_30m": 0.0})
     res = solve_config(cfg, None, 2000.0)
+    assert res.T_N_Nm == 0.0
     string = build_string(cfg.sections, 2000.0)
     rho = cfg["fluid.mud_density_kg_m3"]
     assert res.hookload_N == pytest.approx(
@@ -521,3 +524,62 @@ def test_volve_f5_apparent_friction_in_plausible_band(real_data):
     assert mus.size > 80
     low, median, high = np.percentile(mus, [5, 50, 95])
     assert 0.1 < low and high < 0.3 and 0.13 < median < 0.22
+
+
+def _tension_from_weight_below(string, md_m, rho, cos_inc):
+    """F(s) = cos I·∫_s^L w ds: effective tension rotating off bottom on a constant-
+    inclination path (THEORY §2 step 3 with σ = 0), section by section [N]."""
+    edges = string.boundaries_m
+    w = [sec.buoyed_weight_N_m(rho, rho) for sec in string.sections]
+    return cos_inc * np.array([sum(wi * max(0.0, hi - max(lo, s))
+                                   for wi, lo, hi in zip(w, edges[:-1], edges[1:],
+                                                         strict=True)) for s in md_m])
+
+
+def test_side_force_on_the_assumed_tortuous_path():
+    """No survey: the assumed path (a helix of DLS κ = 1°/30 m, THEORY §1) gives the
+    soft-string side force of THEORY §2 step 2 in closed form.
+
+    Tension from the buoyed weight below, F = cos I·∫w ds (rel 1e-5: the element-mean
+    inclination inside each 10 m arc dips below the stations' by < 1 %, cos I moves ~1e-6).
+    Side force per metre, with a = F_d·κ (F_d the tension at the element's lower node) and
+    b = w·sin I: the curvature term lies along the arc's normal, the weight term in the
+    vertical plane of the hole; they are orthogonal at mid-arc and the arc's normal tilts by
+    at most ΔA/2 = 6° towards the weight term at the stations, while sin I dips to
+    sin I·cos 6° at mid-arc (the arc is a great circle of the tangent sphere), so
+    a² + (b cos 6°)² − 2ab·sin 6° ≤ F_N² ≤ a² + b² + 2ab·sin 6° (×(1 ± 1e-6) for the chord,
+    (κΔs)²/24 ~ 1e-7). Where the tension dominates (a ≥ 30b, the top two thirds
+    here), F_N = F·κ to r·sin 6° + r²/2 ≤ 4.1e-3 with r = b/a: checked at 5e-3.
+    """
+    cfg = load_config()
+    assert cfg["survey.tortuosity_deg_30m"] == 1.0
+    kappa, bit = np.radians(1.0) / 30.0, 2500.0
+    res = solve_config(cfg, None, bit)
+    path = no_survey_path(bit, kappa)
+    inc = path.inc_rad[0]
+    string = build_string(cfg.sections, bit)
+    rho = cfg["fluid.mud_density_kg_m3"]
+    tension = _tension_from_weight_below(string, res.md_m, rho, np.cos(inc))
+    np.testing.assert_allclose(res.tension_N, tension, rtol=1e-5)
+    mid = 0.5 * (res.md_m[1:] + res.md_m[:-1])
+    a = tension[1:] * kappa
+    b = string.buoyed_weight_N_m(mid, rho, rho) * np.sin(inc)
+    half_turn = np.pi * 10.0 / 300.0  # ΔA/2 of the 10 m stations, 300 m period
+    tilt, dip = np.sin(half_turn), np.cos(half_turn)
+    fn2 = res.normal_force_N_m**2
+    assert np.all(fn2 <= (a**2 + b**2 + 2 * a * b * tilt) * (1 + 1e-6))
+    assert np.all(fn2 >= (a**2 + (b * dip)**2 - 2 * a * b * tilt) * (1 - 1e-6))
+    dominant = a >= 30 * b
+    assert dominant.sum() > 0.6 * dominant.size
+    np.testing.assert_allclose(res.normal_force_N_m[dominant], a[dominant], rtol=5e-3)
+
+
+def test_tortuosity_applies_only_without_a_survey():
+    """A survey's own doglegs are real: the nominal tortuosity changes nothing there
+    (bit-for-bit), while without a survey T_N grows with it (∝ κ where tension dominates)."""
+    heavy = load_config(overrides={"survey.tortuosity_deg_30m": 3.0})
+    none = load_config(overrides={"survey.tortuosity_deg_30m": 0.0})
+    with_survey = [solve_config(c, build_hold(), 3000.0) for c in (heavy, none)]
+    np.testing.assert_array_equal(with_survey[0].fc_Nm_m, with_survey[1].fc_Nm_m)
+    t_n = [solve_config(c, None, 3000.0).T_N_Nm for c in (load_config(), heavy, none)]
+    assert t_n[2] == 0.0 and t_n[1] == pytest.approx(3.0 * t_n[0], rel=0.01)

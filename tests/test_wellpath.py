@@ -13,7 +13,17 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from drillfric.errors import InputError
-from drillfric.wellpath import dogleg, minimum_curvature, ratio_factor, unit_tangent, vertical
+from drillfric.wellpath import (
+    TORTUOUS_PERIOD_M,
+    TORTUOUS_STATION_M,
+    dogleg,
+    minimum_curvature,
+    no_survey_path,
+    ratio_factor,
+    tortuous_vertical,
+    unit_tangent,
+    vertical,
+)
 
 DEG = np.pi / 180.0
 depth = st.floats(1.0, 5000.0)
@@ -152,6 +162,60 @@ def test_vertical_helper():
     path = vertical(2500.0)
     assert path.md_max_m == 2500.0
     np.testing.assert_allclose(path.at([0.0, 1234.5, 2500.0])["tvd_m"], [0.0, 1234.5, 2500.0])
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(5.0, 6000.0), st.floats(0.001, 10.0))
+def test_tortuous_vertical_has_the_tortuosity_everywhere(depth_m, dls_deg_30m):
+    """The path assumed without a survey: every minimum-curvature interval has DLS = the
+    tortuosity, at one constant inclination, the azimuth turning 2π per period (derivation
+    in the docstring). rtol 1e-9: the dogleg is recomputed from unit tangents by §1's atan2
+    form, whose round-off (~1e-16 absolute) is below 1e-10 of the smallest dogleg here."""
+    kappa = dls_deg_30m * DEG / 30.0
+    path = tortuous_vertical(depth_m, kappa)
+    assert depth_m <= path.md_max_m < depth_m + TORTUOUS_STATION_M
+    np.testing.assert_allclose(path.dls_rad_m, kappa, rtol=1e-9)
+    np.testing.assert_allclose(path.inc_rad, path.inc_rad[0], rtol=1e-12)
+    turn = np.unwrap(path.azi_rad)
+    np.testing.assert_allclose(turn - turn[0], 2 * np.pi * path.md_m / TORTUOUS_PERIOD_M,
+                               rtol=1e-12, atol=1e-12)
+
+
+def test_tortuous_vertical_is_a_helix():
+    """The chain of 10 m arcs is the minimum-curvature version of the helix of curvature
+    κ = (2π/P)·sin I. Its inclination is the helix's up to the station-spacing correction
+    sin I = sin(κh/2)/sin(πh/P) = (κP/2π)·(1 + (πh/P)²/6 + …) (1e-5: the next term is
+    ~1e-6). Each interval moves h·RF·sin I·cos(ΔA/2) horizontally, turning ΔA, and
+    h·RF·cos I down (§1 displacement; RF the ratio factor): the plan is a regular polygon
+    whose farthest station is one circumscribed diameter from the surface, and TVD =
+    MD·RF·cos I (both 1e-9: float round-off over a few thousand metres)."""
+    kappa = 1.0 * DEG / 30.0
+    path = tortuous_vertical(3000.0, kappa)
+    h, period = TORTUOUS_STATION_M, TORTUOUS_PERIOD_M
+    x = np.pi * h / period  # ΔA/2
+    sin_i, rf = np.sin(path.inc_rad[0]), ratio_factor(kappa * h)
+    assert sin_i == pytest.approx(kappa * period / (2 * np.pi) * (1 + x**2 / 6), rel=1e-5)
+    side = h * rf * sin_i * np.cos(x)
+    assert np.hypot(path.north_m, path.east_m).max() == pytest.approx(side / np.sin(x),
+                                                                      rel=1e-9)
+    np.testing.assert_allclose(path.tvd_m, path.md_m * rf * np.cos(path.inc_rad[0]),
+                               rtol=1e-9, atol=1e-9)
+
+
+def test_no_survey_path_zero_tortuosity_is_exactly_vertical():
+    """Tortuosity 0 restores the exactly vertical path (no side force, THEORY §2)."""
+    zero, plain = no_survey_path(2345.0, 0.0), vertical(2345.0)
+    for name in ("md_m", "inc_rad", "azi_rad", "tvd_m", "north_m", "east_m", "dogleg_rad"):
+        np.testing.assert_array_equal(getattr(zero, name), getattr(plain, name))
+    tortuous = no_survey_path(2345.0, 1.0 * DEG / 30.0)
+    assert tortuous.dls_rad_m.min() > 0
+
+
+@pytest.mark.parametrize("args", [(0.0, 1e-3), (100.0, 0.0), (100.0, -1e-3), (100.0, 0.05)])
+def test_tortuous_vertical_bad_arguments(args):
+    """Non-positive inputs, or a curvature no helix of the period can have (sin I > 1)."""
+    with pytest.raises(ValueError):
+        tortuous_vertical(*args)
 
 
 @pytest.mark.parametrize("md, inc, problem", [

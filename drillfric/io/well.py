@@ -12,7 +12,7 @@ A well is one of
 
 Precedence: ``--config``/``--survey`` > the configuration's ``[survey] file`` > sidecars
 by name > tables inside an HDF5 file. Without a survey, ``survey`` is None and the
-pipeline assumes a vertical well.
+pipeline assumes a vertical well with the nominal tortuosity ``survey.tortuosity_deg_30m``.
 
 :func:`load_well` reads everything; :func:`iter_surface` streams the same canonical
 columns chunk by chunk with one time origin, so large files never need to fit in memory.
@@ -78,7 +78,8 @@ class WellData:
         Canonical columns (``time_s``, ``surface_rpm``, ``surface_torque_Nm``, … and
         ``timestamp`` when the file has absolute times).
     survey : WellPath or None
-        Well path by minimum curvature; None when no survey was found (assume vertical).
+        Well path by minimum curvature; None when no survey was found (assume vertical,
+        with the nominal tortuosity of :func:`drillfric.wellpath.no_survey_path`).
     config : Config
         Effective configuration.
     channels : dict of str to ChannelInfo

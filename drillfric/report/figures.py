@@ -52,18 +52,21 @@ def _depth_axis(ax) -> None:
     ax.grid(True, color="#dddddd", linewidth=0.6)
 
 
-def wellpath_figure(wellpath: pd.DataFrame | None) -> Figure:
+def wellpath_figure(wellpath: pd.DataFrame | None,
+                    no_survey: str = "No survey: the well was taken as vertical.") -> Figure:
     """Vertical section (along the azimuth to the last station) and plan view of the well.
 
     Parameters
     ----------
     wellpath : DataFrame or None
         wellpath.parquet: ``md_m, tvd_m, north_m, east_m`` [m]. None: no survey.
+    no_survey : str
+        The note drawn instead when there is no survey (what the path was taken to be).
     """
     fig = _new(4.2)
     ax_vs, ax_plan = fig.subplots(1, 2)
     if wellpath is None or wellpath.empty:
-        _note(ax_vs, "No survey: the well was taken as vertical.")
+        _note(ax_vs, no_survey)
         ax_plan.set_axis_off()
         return fig
     north, east = wellpath["north_m"].to_numpy(float), wellpath["east_m"].to_numpy(float)

@@ -72,6 +72,17 @@ def _header(data: ResultData) -> dict:
     }
 
 
+def _no_survey_note(summary: dict) -> str:
+    """What the well path was taken to be without a survey (from the run's configuration)."""
+    survey = (summary.get("config") or {}).get("survey") or {}
+    tortuosity = survey.get("tortuosity_deg_30m")
+    if not tortuosity:
+        return "No survey: the well was taken as vertical."
+    return (f"No survey: the well was taken as vertical with a nominal tortuosity of "
+            f"{tortuosity:g}°/30 m (a helix about the vertical, docs/torque_drag.md); the "
+            "friction factors are indicative.")
+
+
 def _figures(data: ResultData, limit: int) -> tuple[list, list]:
     """``(sections, segments)``: ``(key, title, Figure, note)`` and ``(id, title, Figure, row)``.
 
@@ -79,8 +90,9 @@ def _figures(data: ResultData, limit: int) -> tuple[list, list]:
     """
     seg = data.segments
     no_profile = not figures.profile_depths(seg, data.profiles)
-    main = [("wellpath", "Well path", figures.wellpath_figure(data.wellpath),
-             "No survey: the well was taken as vertical." if data.wellpath is None else None),
+    no_survey = _no_survey_note(data.summary)
+    main = [("wellpath", "Well path", figures.wellpath_figure(data.wellpath, no_survey),
+             no_survey if data.wellpath is None else None),
             ("profiles", "Normal force and F_c profiles",
              figures.profiles_figure(data.profiles, seg),
              "No torque-and-drag profile: no segment was estimated." if no_profile else None),
