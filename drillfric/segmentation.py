@@ -330,7 +330,7 @@ def _status(duration_s: float, n_null: dict[str, int], n_rows: int,
             min_s: float) -> tuple[str, str]:
     nulls = [f"{name} ({count} samples)" for name, count in n_null.items() if count]
     if duration_s < min_s:
-        return "skipped", f"too short: {duration_s:.0f} s < {min_s:.0f} s"
+        return "skipped", f"too short: {duration_s:.3g} s < {min_s:g} s"
     if any(count > MAX_NULL_FRACTION * n_rows for count in n_null.values()):
         return "skipped", ("nulls in " + ", ".join(nulls) + f": more than "
                            f"{MAX_NULL_FRACTION:.0%} of the samples")

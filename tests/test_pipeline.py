@@ -252,3 +252,24 @@ def test_no_survey_and_no_tortuosity_skips_as_before(first_stand_alone, tmp_path
     [seg] = summary["segments"]
     assert seg["status"] == "skipped" and "no side force" in seg["message"]
     assert summary["mu_k"] is None and summary["counts"]["estimated"] == 0
+
+
+def test_dsats_runs_end_to_end(real_data, tmp_path):
+    """Issue 6 acceptance on real data (../shared/data/real/dsats_1hz, 13.9 h at 1 Hz, no
+    truth) with the documented config: segments found and estimated, nothing fails, every
+    converged μ_k inside the usual 0.05–0.8 or flagged, μ_s null (no creep start-up in this
+    log, so not identifiable), a report written (docs/validation.md)."""
+    data = real_data / "dsats_1hz" / "SampleData1.csv"
+    result = CliRunner().invoke(cli, ["-q", "run", str(data), "--config",
+                                      str(REPO / "examples" / "dsats_1hz.toml"),
+                                      "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    (out,) = [p for p in tmp_path.iterdir() if p.is_dir()]
+    summary = json.loads((out / "summary.json").read_text())
+    status = [s["status"] for s in summary["segments"]]
+    assert status.count("failed") == 0 and status.count("ok") >= 20
+    for seg in summary["segments"]:
+        if seg["status"] == "ok" and seg["converged"]:
+            assert 0.05 <= seg["mu_k"] <= 0.8 or "outside_typical_range" in seg["flags"], seg
+    assert summary["mu_k"] is not None and summary["mu_s"] is None
+    assert (out / "report.html").stat().st_size > 0
