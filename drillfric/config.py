@@ -112,6 +112,10 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("name", str, None, "", "Well name used in outputs (default: the data file's stem)."),
         Key("data", str, None, "", "Surface data file, relative to the config "
             "(directory wells: well.toml names its files)."),
+        Key("bit_depth_m", float, None, "m", "Bit depth of every segment when the log has no "
+            "bit-depth channel (and no block reckoning): a single stand or a test at one "
+            "depth. Default: the survey's last station, announced as assumed.", min=0.0,
+            min_exclusive=True),
     ),
     "survey": (
         Key("file", str, None, "", "Survey file (MD, inclination, azimuth), relative to the "

@@ -92,8 +92,12 @@ class RunResult:
 
 
 def _bit_depth_default(cfg, survey: WellPath | None, assumed: list) -> float:
-    if cfg["simulate.bit_depth_m"] is not None:
-        return cfg["simulate.bit_depth_m"]
+    """Bit depth [m] of segments the log gives none for: ``[well] bit_depth_m``, else a
+    simulated well's ``[simulate] bit_depth_m``, else (announced in ``assumed``) the
+    survey's last station or :data:`DEFAULT_BIT_DEPTH_M`."""
+    for key in ("well.bit_depth_m", "simulate.bit_depth_m"):
+        if cfg[key] is not None:
+            return cfg[key]
     if survey is not None:
         assumed.append(f"bit depth {survey.md_max_m:.0f} m (the survey's last station): the "
                        "log has no bit depth")

@@ -273,3 +273,27 @@ def test_dsats_runs_end_to_end(real_data, tmp_path):
             assert 0.05 <= seg["mu_k"] <= 0.8 or "outside_typical_range" in seg["flags"], seg
     assert summary["mu_k"] is not None and summary["mu_s"] is None
     assert (out / "report.html").stat().st_size > 0
+
+
+def test_bit_depth_from_the_well_config(tmp_path):
+    """A log without bit depth takes ``[well] bit_depth_m`` for its segments, and that is a
+    given, not an assumption: nothing about bit depth in ``assumed``. Without it the survey's
+    last station is used and announced."""
+    frame = pd.read_csv(DEMO / "demo.csv")
+    stand = frame[frame["time_s"] < 230.0].drop(columns=["bit_depth_m"])
+    stand.to_csv(tmp_path / "w.csv", index=False)
+    shutil.copy(DEMO / "demo.survey.csv", tmp_path / "w.survey.csv")
+    base = (DEMO / "demo.toml").read_text().replace("demo.survey.csv", "w.survey.csv")
+    base = base[:base.index("\n[simulate]")]  # a field well's config has no [simulate]
+    (tmp_path / "w.toml").write_text(base.replace("[well]", "[well]\nbit_depth_m = 2205.0", 1))
+    result = CliRunner().invoke(cli, ["-q", "run", str(tmp_path / "w.csv"),
+                                      "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "out" / "demo" / "summary.json").read_text())
+    assert [s["bit_depth_m"] for s in summary["segments"]] == [2205.0]
+    assert not any("bit depth" in a for a in summary["assumed"])
+    (tmp_path / "w.toml").write_text(base)
+    result = CliRunner().invoke(cli, ["-q", "run", str(tmp_path / "w.csv"),
+                                      "--out", str(tmp_path / "out2")])
+    summary = json.loads((tmp_path / "out2" / "demo" / "summary.json").read_text())
+    assert any("the survey's last station" in a for a in summary["assumed"])
