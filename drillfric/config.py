@@ -190,7 +190,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "batch-refined factors; the estimated bit speed is their mean and min–max its "
             "band (the stick-slip cycle is chaotic: members drift apart in phase; weighted by "
             "how well each matches the surface speed lately, their mean tracks the bit better "
-            "than any one, docs/validation.md). 1 = one observer.",
+            "than any one, docs/bit_speed.md). 1 = a single observer (μ̂ held unless "
+            "adapt_final).",
             min=1, max=32),
         Key("ensemble_spread", float, 0.15, "", "Relative half-width of μ_s across the "
             "ensemble members: μ_s·(1 ± spread), the uncertainty of the refined μ_s.",

@@ -218,12 +218,25 @@ def _seed_mu_s(result: batch.BatchResult, mu_k: float) -> float:
 
 def ensemble_starts(mu_s: float, mu_k: float, members: int, spread: float,
                     mu_max: float) -> np.ndarray:
-    """Ensemble of (μ_s, μ_k) for the final pass: μ_s·(1 + δ) for δ evenly spaced over
-    [−spread, +spread], the seed (δ = 0) first, each kept within [μ_k, μ_max] [-]."""
+    """Ensemble of (μ_s, μ_k) for the final pass, the seed first [-].
+
+    μ_s·(1 + δ) for δ evenly spaced over [−spread, +spread]; where μ_s ≥ μ_k or μ_s ≤ μ_max
+    cuts that interval, the cut side is compressed into what is left (the seed keeps
+    δ = 0), or, when one side is gone, the members spread over the other side alone.
+    Members never coincide: fewer are returned when the interval is empty (spread 0, or
+    μ_s = μ_k = μ_max).
+    """
+    low = max(-spread, mu_k / mu_s - 1.0) if mu_s > 0 else 0.0
+    high = min(spread, mu_max / mu_s - 1.0) if mu_s > 0 else 0.0
     offsets = np.linspace(-spread, spread, members) if members > 1 else np.zeros(1)
+    if low < 0.0 < high and spread > 0:
+        offsets = np.where(offsets < 0, offsets * (-low / spread), offsets * (high / spread))
+    else:
+        offsets = np.linspace(low, high, members) if members > 1 else np.zeros(1)
+    offsets = np.unique(np.round(offsets, 12))
     offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]
     mu_s_members = np.clip(mu_s * (1.0 + offsets), mu_k, mu_max)
-    return np.column_stack([mu_s_members, np.full(members, mu_k)])
+    return np.column_stack([mu_s_members, np.full(offsets.size, mu_k)])
 
 
 def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: float, *,
@@ -363,7 +376,8 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                         cfg["observer.adapt_final"], output_rate_hz=out_rate)
     bit = ensemble_bit_speed(final, _memory_s(observer, meas),
                              cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S)
-    final_diag = diagnose(final, cfg.omega_c_rad_s)
+    final_diag = diagnose(bit.record(final), cfg.omega_c_rad_s)  # of what is reported
+    stuck = bit.stuck(final, cfg.omega_c_rad_s)[settled_mask(final.time_s)]
     tick(0.2)
     if on_bottom:
         flags.append("bit_torque_in_friction")
@@ -374,7 +388,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         mu_k_spread=diag.mu_k_spread, converged=bool(converged), method=method,
         settling_time_s=diag.settling_time_s, residual_rms_rpm=final_diag.residual_rms_rpm,
         stick_slip_severity=final_diag.stick_slip_severity,
-        stuck_fraction=final_diag.stuck_fraction, mu_k_observer=diag.mu_k,
+        stuck_fraction=float(np.mean(stuck)), mu_k_observer=diag.mu_k,
         mu_s_observer=diag.mu_s, mu_td=_td_cross_check(path, string, cfg, data, td, meas),
         T_N_Nm=observer.plant.T_N_Nm, flags=tuple(dict.fromkeys(flags)),
         messages=tuple(messages), starts=starts, first=first, final=final,

@@ -312,11 +312,29 @@ class BitSpeedEstimate:
         top-drive speed lately (:func:`ensemble_bit_speed`).
     low_rad_s, high_rad_s : ndarray, shape (R,)
         The members' minimum and maximum (the band).
+    weights : ndarray, shape (R, S)
+        The members' weights at each time (rows sum to 1).
     """
 
     rad_s: np.ndarray
     low_rad_s: np.ndarray
     high_rad_s: np.ndarray
+    weights: np.ndarray
+
+    def record(self, members: ObserverRecord) -> ObserverRecord:
+        """The ensemble as one start: the seed member's μ and deadlock count, the weighted
+        mean of every speed and of the innovation (the bit speed is :attr:`rad_s`)."""
+        mean = lambda a: (self.weights * a).sum(axis=1, keepdims=True)  # noqa: E731
+        return ObserverRecord(members.time_s, members.mu_s[:, :1], members.mu_k[:, :1],
+                              mean(members.surface_rad_s_est), self.rad_s[:, None],
+                              mean(members.bha_rad_s_est), mean(members.residual_rad_s),
+                              members.deadlock_events[:1])
+
+    def stuck(self, members: ObserverRecord, omega_c_rad_s: float) -> np.ndarray:
+        """Bit stuck at each time: members whose BHA is in the static band (|ω̂_BHA| ≤ ω_c)
+        carry more than half the weight (R,)."""
+        stuck = np.abs(members.bha_rad_s_est) <= omega_c_rad_s
+        return (self.weights * stuck).sum(axis=1) > 0.5
 
 
 def ensemble_bit_speed(record: ObserverRecord, memory_s: float,
@@ -327,8 +345,10 @@ def ensemble_bit_speed(record: ObserverRecord, memory_s: float,
     §6.2) and a member that has drifted shows it in its innovation e = ω̂₀ − ω₀ about one
     wave round trip later. Each member is weighted by 1/(ē² + σ²), ē² the mean square of
     its innovation over the last ``memory_s`` (exponential memory) and σ the measurement
-    noise ``noise_rad_s``: members that match the surface lately count most; when none is
-    distinguishable from noise all count equally (docs/validation.md measures the gain).
+    noise ``noise_rad_s``: members that match the surface lately count most. σ is a floor
+    (members at the noise level are not told apart); in stick-slip the innovations are
+    several σ and the weights go as 1/ē². A heuristic inverse-mean-square weighting of a
+    fixed grid of members, not a posterior (docs/bit_speed.md measures what it gains).
 
     Parameters
     ----------
@@ -347,5 +367,6 @@ def ensemble_bit_speed(record: ObserverRecord, memory_s: float,
     else:
         mean_e2 = np.zeros_like(bit)
     weight = 1.0 / (mean_e2 + noise_rad_s ** 2 + 1e-30)
-    return BitSpeedEstimate((weight * bit).sum(axis=1) / weight.sum(axis=1), bit.min(axis=1),
-                            bit.max(axis=1))
+    weight /= weight.sum(axis=1, keepdims=True)
+    return BitSpeedEstimate((weight * bit).sum(axis=1), bit.min(axis=1), bit.max(axis=1),
+                            weight)

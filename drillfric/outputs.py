@@ -23,8 +23,8 @@ import pyarrow.parquet as pq
 #: Columns of estimates.parquet (INTERFACE.md), ``bit_rpm`` only with downhole truth.
 ESTIMATE_COLUMNS = ("time_s", "segment_id", "start_id", "mu_s", "mu_k", "surface_rpm",
                     "surface_rpm_est", "bit_rpm_est", "bit_stuck", "residual_rpm")
-#: Added after INTERFACE.md's columns: the band of the seeded ensemble's bit speed (NaN on
-#: the starts' rows).
+#: Written after INTERFACE.md's columns (``bit_rpm`` included): the band of the seeded
+#: ensemble's bit speed (NaN on the starts' rows).
 BAND_COLUMNS = ("bit_rpm_est_min", "bit_rpm_est_max")
 #: Binding keys of each segment in summary.json / segments.parquet (INTERFACE.md).
 SEGMENT_KEYS = ("id", "kind", "t_start_s", "t_end_s", "bit_depth_m", "mu_s", "mu_k",
@@ -110,7 +110,7 @@ class EstimatesWriter:
 
     def __init__(self, path: Path, with_truth: bool):
         self.path = path
-        names = list(ESTIMATE_COLUMNS) + list(BAND_COLUMNS) + (["bit_rpm"] * with_truth)
+        names = list(ESTIMATE_COLUMNS) + (["bit_rpm"] * with_truth) + list(BAND_COLUMNS)
         types = {"segment_id": pa.int32(), "start_id": pa.int16(), "bit_stuck": pa.bool_(),
                  **dict.fromkeys(BAND_COLUMNS, pa.float32())}
         self.schema = pa.schema([(n, types.get(n, pa.float64())) for n in names])

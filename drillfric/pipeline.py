@@ -207,30 +207,18 @@ def _segment_row(seg: Segment, est: SegmentEstimate | None, status: str, message
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
                     omega_c: float) -> pd.DataFrame:
     """estimates.parquet rows of one segment: every start (``start_id`` 0…), then the pass
-    seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): the
-    weighted mean of its ensemble members (``est.bit``), their min–max bit speed as
-    ``bit_rpm_est_min/max`` (NaN on the starts' rows), the bit stuck where most members are.
+    seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): its
+    ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
+    carry most of the weight) with the members' min–max bit speed as
+    ``bit_rpm_est_min/max`` (NaN on the starts' rows).
     """
-    frames = [_record_frame(seg_id, est.first, 0, data)]
-    final = est.final
-    seeded = _record_frame(seg_id, _member_mean(final), SEEDED_START_ID, data)
-    seeded["bit_rpm_est"] = est.bit.rad_s / RPM_TO_RAD_S
+    first = _record_frame(seg_id, est.first, 0, data)
+    first["bit_stuck"] = (np.abs(est.first.bha_rad_s_est) <= omega_c).ravel()
+    seeded = _record_frame(seg_id, est.bit.record(est.final), SEEDED_START_ID, data)
+    seeded["bit_stuck"] = est.bit.stuck(est.final, omega_c)
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
-    frames.append(seeded)
-    frame = pd.concat(frames, ignore_index=True)
-    frame["bit_stuck"] = np.r_[(np.abs(est.first.bha_rad_s_est) <= omega_c).ravel(),
-                               np.mean(np.abs(final.bha_rad_s_est) <= omega_c, axis=1) > 0.5]
-    return frame
-
-
-def _member_mean(record: ObserverRecord) -> ObserverRecord:
-    """One-start record holding the seed member's μ and the members' mean speeds."""
-    mean = lambda a: a.mean(axis=1, keepdims=True)  # noqa: E731
-    return ObserverRecord(record.time_s, record.mu_s[:, :1], record.mu_k[:, :1],
-                          mean(record.surface_rad_s_est), mean(record.bit_rad_s_est),
-                          mean(record.bha_rad_s_est), mean(record.residual_rad_s),
-                          record.deadlock_events[:1])
+    return pd.concat([first, seeded], ignore_index=True)
 
 
 def _record_frame(seg_id: int, rec: ObserverRecord, offset: int,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from drillfric.batch import BatchResult
 from drillfric.drillstring import build_string
@@ -32,8 +33,20 @@ def test_ensemble_members_span_the_mu_s_uncertainty():
     np.testing.assert_allclose(members[0], [0.6, 0.28])
     np.testing.assert_allclose(np.sort(members[:, 0]), [0.54, 0.57, 0.6, 0.63, 0.66])
     assert np.all(members[:, 1] == 0.28)
-    assert np.all(ensemble_starts(0.3, 0.29, 7, 0.2, 1.5)[:, 0] >= 0.29)
     np.testing.assert_allclose(ensemble_starts(0.6, 0.28, 1, 0.1, 1.5), [[0.6, 0.28]])
+    np.testing.assert_allclose(ensemble_starts(0.6, 0.28, 5, 0.0, 1.5), [[0.6, 0.28]])
+
+
+@pytest.mark.parametrize("mu_s, mu_k, mu_max", [(0.30, 0.30, 1.5), (0.32, 0.30, 1.5),
+                                                (1.4, 0.3, 1.5), (0.3, 0.29, 0.31)])
+def test_ensemble_members_stay_distinct_where_the_bounds_cut(mu_s, mu_k, mu_max):
+    """μ_k ≤ μ_s ≤ μ_max cut the spread (e.g. the seed is μ_k when the batch gave no regime
+    value): the members are then compressed into what is left, never duplicated (identical
+    members run identical trajectories: wasted work, one trajectory counted twice)."""
+    members = ensemble_starts(mu_s, mu_k, 5, 0.15, mu_max)
+    assert members[0, 0] == pytest.approx(mu_s)
+    assert np.unique(members[:, 0]).size == len(members) == 5
+    assert np.all((members[:, 0] >= mu_k - 1e-12) & (members[:, 0] <= mu_max + 1e-12))
 
 
 def _record(bit, residual):
@@ -57,6 +70,17 @@ def test_ensemble_weights_favour_the_member_matching_the_surface():
     np.testing.assert_allclose(quiet.rad_s, 7.0)
     np.testing.assert_allclose(quiet.low_rad_s, 5.0)
     np.testing.assert_allclose(quiet.high_rad_s, 9.0)
+
+
+def test_ensemble_weights_start_from_the_first_innovation():
+    """The innovation average starts at the first sample's e² (not at 0, which would give
+    every member the same weight until the memory fills)."""
+    n = 50
+    bit = np.column_stack([np.full(n, 5.0), np.full(n, 9.0)])
+    residual = np.column_stack([np.full(n, 0.05), np.full(n, 1.0)])
+    est = ensemble_bit_speed(_record(bit, residual), memory_s=10.0, noise_rad_s=0.05)
+    np.testing.assert_allclose(est.rad_s[0], est.rad_s[-1], rtol=1e-12)
+    np.testing.assert_allclose(est.weights.sum(axis=1), 1.0)
 
 
 def test_ensemble_weights_forget_old_innovations():

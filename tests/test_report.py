@@ -389,6 +389,19 @@ def test_segment_figure_draws_every_start_and_shades_stuck_time(demo):
     assert shaded and est["bit_stuck"].any()
 
 
+def test_segment_figure_draws_the_ensemble_band(demo, tmp_path):
+    """The seeded pass's min–max bit speed (docs/bit_speed.md) is shaded when the results
+    have it, and results written before the band existed still render, without it."""
+    data = load_result(demo)
+    row = data.segments.set_index("id", drop=False).loc[2]
+    est = segment_estimates(demo, [2])[2]
+    labels = figures.segment_figure(est, row).axes[2].get_legend_handles_labels()[1]
+    assert "ensemble band (min–max)" in labels
+    old = est.drop(columns=["bit_rpm_est_min", "bit_rpm_est_max"])
+    labels = figures.segment_figure(old, row).axes[2].get_legend_handles_labels()[1]
+    assert "ensemble band (min–max)" not in labels and "estimated" in labels
+
+
 def test_estimates_are_decimated_per_start(demo):
     full = pd.read_parquet(demo / "estimates.parquet")
     small = segment_estimates(demo, [1, 2], max_points=100)

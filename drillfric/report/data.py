@@ -15,8 +15,10 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.outputs import BAND_COLUMNS
 
-#: Columns of estimates.parquet a segment figure needs (``bit_rpm`` is added when present).
+#: Columns of estimates.parquet a segment figure needs (the ensemble band and ``bit_rpm``
+#: are added when present: older results have no band).
 ESTIMATE_COLUMNS = ("time_s", "segment_id", "start_id", "mu_s", "mu_k", "surface_rpm",
                     "surface_rpm_est", "bit_rpm_est", "bit_stuck")
 #: Numeric columns of the segments table (None in summary.json becomes NaN).
@@ -121,7 +123,7 @@ def segment_estimates(result_dir: Path, ids: list[int],
 
     try:
         names = pq.read_schema(path).names
-        columns = [c for c in (*ESTIMATE_COLUMNS, "bit_rpm") if c in names]
+        columns = [c for c in (*ESTIMATE_COLUMNS, "bit_rpm", *BAND_COLUMNS) if c in names]
         table = pq.read_table(path, columns=columns,
                               filters=[("segment_id", "in", [int(i) for i in ids])])
     except (OSError, ValueError) as exc:
