@@ -105,7 +105,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
 
     from drillfric import simulate as sim
     from drillfric.io.writers import data_format, write_well
-    from drillfric.wellpath import vertical
+    from drillfric.wellpath import no_survey_path
 
     data_format(out)
     overrides = _overrides(duration=duration, rate=rate, mu_s=mu_s, mu_k=mu_k,
@@ -120,7 +120,12 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
         result = sim.simulate(cfg, well_path, plan, progress=advance)
     for note in result.notes:
         warn(note)
-    well_path = well_path or vertical(max(s.bit_depth_m for s in plan.stands))
+    if well_path is None:  # the path simulate() assumed; written as NAME.survey.csv
+        well_path = no_survey_path(max(s.bit_depth_m for s in plan.stands),
+                                   cfg.tortuosity_rad_m)
+        warn(f"no survey: simulated on a vertical hole with a nominal tortuosity of "
+             f"{cfg['survey.tortuosity_deg_30m']:g}°/30 m (survey.tortuosity_deg_30m), "
+             "written as the output's survey")
     keep = tuple(p for p in (config, survey_path) if p is not None)
     written = write_well(out, pd.DataFrame(result.columns), config=cfg.to_dict(),
                          survey=well_path, truth=result.truth(), keep=keep)

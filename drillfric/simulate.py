@@ -36,7 +36,7 @@ from drillfric.config import Config, read_toml
 from drillfric.drillstring import DrillString, Section, build_string
 from drillfric.errors import ConfigError, InputError, ModelError
 from drillfric.units import RPM_TO_RAD_S
-from drillfric.wellpath import WellPath, vertical
+from drillfric.wellpath import WellPath, no_survey_path
 
 _SERIES_DT_S = 0.01  # [s] sampling of the set-point series handed to the kernel
 _STARTS = ("ramp", "creep")
@@ -469,7 +469,8 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     cfg : Config
         Well configuration (string, mud, rig, model, simulate tables).
     path : WellPath or None
-        Well path (vertical to the deepest stand when None).
+        Well path; when None, the path ``run`` assumes without a survey (vertical with the
+        nominal tortuosity ``survey.tortuosity_deg_30m``) to the deepest stand.
     scenario : Scenario
     rate_hz : float, optional
         Recording rate [Hz] (default ``simulate.rate_hz``).
@@ -488,7 +489,9 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     settings = PlantSettings.from_config(cfg)
     noise = Noise.from_config(cfg) if noise is None else noise
     check_depths(scenario, path, cfg.source)
-    path = vertical(max(s.bit_depth_m for s in scenario.stands)) if path is None else path
+    if path is None:
+        path = no_survey_path(max(s.bit_depth_m for s in scenario.stands),
+                              cfg.tortuosity_rad_m)
     parts, stands, t0 = [], [], 0.0
     for i, stand in enumerate(scenario.stands):
         if i > 0 and scenario.connection_s > 0:

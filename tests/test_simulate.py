@@ -311,3 +311,26 @@ def test_on_bottom_stand_records_wob_and_hole_depth():
     assert "wob_N" in c and "wob_N" not in off.columns
     np.testing.assert_array_equal(c["hole_depth_m"], c["bit_depth_m"])
     assert on.stands[0].hookload_N < off.stands[0].hookload_N - 49e3
+
+
+def test_cli_without_survey_simulates_the_path_run_assumes(tmp_path):
+    """No survey: the plant runs on the path `run` assumes (vertical with the nominal
+    tortuosity, docs/torque_drag.md) — friction acts — and that path is written as the
+    output's survey, so `run` on the output uses the true path. With tortuosity 0 the hole
+    is exactly vertical (T_N = 0, THEORY §2) and the warning says so."""
+    cfg = tmp_path / "v.toml"
+    cfg.write_text(CONFIG)
+    result = CliRunner().invoke(cli, ["simulate", str(cfg), "--out", str(tmp_path / "v.csv"),
+                                      "--duration", "15", "--bit-depth", "1500"])
+    assert result.exit_code == 0, result.output
+    assert "nominal tortuosity of 1°/30 m" in result.output
+    truth = json.loads((tmp_path / "v.truth.json").read_text())
+    assert truth["stands"][0]["T_N_Nm"] > 1e3
+    survey = pd.read_csv(tmp_path / "v.survey.csv")
+    assert survey["inc_deg"].max() == pytest.approx(1.59, abs=0.01)  # a 1°/30 m helix
+    cfg.write_text("[survey]\ntortuosity_deg_30m = 0.0\n" + CONFIG)
+    result = CliRunner().invoke(cli, ["simulate", str(cfg), "--out", str(tmp_path / "w.csv"),
+                                      "--duration", "15", "--bit-depth", "1500"])
+    assert result.exit_code == 0, result.output
+    assert "tortuosity of 0°/30 m" in result.output
+    assert json.loads((tmp_path / "w.truth.json").read_text())["stands"][0]["T_N_Nm"] < 1.0
