@@ -23,8 +23,7 @@ import numpy as np  # noqa: E402
 
 from drillfric import torsional as T  # noqa: E402
 from drillfric.simulate import well_b_plant  # noqa: E402
-
-RPM = np.pi / 30.0
+from drillfric.units import RPM_TO_RAD_S as RPM  # noqa: E402
 
 
 def best_time(plant, drive, seconds, backend, repeats, state):

@@ -68,8 +68,7 @@ def summarize(data) -> dict:
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
         "max_gap_s": data.config["segmentation.max_gap_s"],
-        "assumed": list(data.config.assumed) + (
-            [data.config.no_survey_note] if data.survey is None else []),
+        "assumed": data.config.assumed_with(data.survey),
         "segments": [_segment(seg) for seg in segment(data.surface, data.config)],
     }
 

@@ -121,21 +121,14 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
             raise UserError("no survey: give --bit-depth (the hole is taken as vertical, with "
                             "the nominal tortuosity survey.tortuosity_deg_30m)")
         bit_depth = path.md_max_m
-    for note in cfg.assumed:
+    for note in cfg.assumed_with(path):
         if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
             warn(f"assumed {note}")
-    if path is None:
-        warn(f"assumed {cfg.no_survey_note}")
     kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
     if broomstick:
         _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
     else:
         _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw)
-
-
-def _assumed(cfg, path) -> list[str]:
-    """Assumed defaults of a td run: the configuration's and, without a survey, the hole."""
-    return list(cfg.assumed) + ([cfg.no_survey_note] if path is None else [])
 
 
 def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> None:
@@ -152,7 +145,7 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
                "max_normal_force_N_m": float(result.normal_force_N_m.max()),
                "mud_density_kg_m3": cfg["fluid.mud_density_kg_m3"],
                "element_length_m": cfg["model.element_length_m"],
-               "elements": int(result.fc_Nm_m.size), "assumed": _assumed(cfg, path)}
+               "elements": int(result.fc_Nm_m.size), "assumed": cfg.assumed_with(path)}
     if callable(mu):
         summary["friction_by_section"] = {"casing_shoe_md_m": mu.shoe_md_m,
                                           "cased": mu.cased, "open_hole": mu.open_hole}

@@ -11,6 +11,7 @@ Precedence: command line > config file > defaults (:func:`load_config` ``overrid
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -355,9 +356,12 @@ class Config:
     @property
     def tortuosity_rad_m(self) -> float:
         """Nominal tortuosity of the path assumed without a survey [rad/m] (0: vertical)."""
-        import math
-
         return math.radians(self["survey.tortuosity_deg_30m"]) / 30.0
+
+    def assumed_with(self, survey) -> list[str]:
+        """What a command assumed: :attr:`assumed` and, when ``survey`` is None, the hole
+        (:attr:`no_survey_note`)."""
+        return list(self.assumed) + ([self.no_survey_note] if survey is None else [])
 
     @property
     def no_survey_note(self) -> str:

@@ -26,6 +26,7 @@ from drillfric import lumped
 from drillfric.drillstring import DrillString
 from drillfric.errors import ConfigError, ModelError
 from drillfric.lumped import Injection, LumpedParams
+from drillfric.units import RPM_TO_RAD_S
 
 
 @dataclass(frozen=True)
@@ -409,7 +410,7 @@ def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float,
     if cfg["observer.gains"] == "kalman":
         noise = KalmanNoise()
         if sample_dt_s is not None:
-            sigma = cfg["observer.speed_noise_rpm"] * np.pi / 30.0
+            sigma = cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S
             noise = KalmanNoise(speed_psd=sigma**2 * sample_dt_s)
         return kalman_gains(params, x_m, T_N_Nm, dt_s, noise=noise)
     return backstepping_gains(params, tuning_from_config(cfg), x_m, T_N_Nm)

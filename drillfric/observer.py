@@ -300,7 +300,6 @@ def observe(observer: Observer, meas: Measurements, state: ObserverState, *,
     return record, new
 
 
-
 @dataclass(frozen=True)
 class BitSpeedEstimate:
     """Bit speed from an ensemble of observer members, at the record's times [rad/s].

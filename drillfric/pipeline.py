@@ -212,18 +212,19 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     carry most of the weight) with the members' min–max bit speed as
     ``bit_rpm_est_min/max`` (NaN on the starts' rows).
     """
-    first = _record_frame(seg_id, est.first, 0, data)
-    first["bit_stuck"] = (np.abs(est.first.bha_rad_s_est) <= omega_c).ravel()
-    seeded = _record_frame(seg_id, est.bit.record(est.final), SEEDED_START_ID, data)
-    seeded["bit_stuck"] = est.bit.stuck(est.final, omega_c)
+    first = _record_frame(seg_id, est.first, 0, data,
+                          np.abs(est.first.bha_rad_s_est) <= omega_c)
+    seeded = _record_frame(seg_id, est.bit.record(est.final), SEEDED_START_ID, data,
+                           est.bit.stuck(est.final, omega_c))
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
     return pd.concat([first, seeded], ignore_index=True)
 
 
-def _record_frame(seg_id: int, rec: ObserverRecord, offset: int,
-                  data: SegmentData) -> pd.DataFrame:
-    """Rows of one observer record, one per time and start (``start_id`` from ``offset``)."""
+def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentData,
+                  stuck: np.ndarray) -> pd.DataFrame:
+    """Rows of one observer record, one per time and start (``start_id`` from ``offset``);
+    ``stuck`` is the bit-stuck flag per time and start (R, S) or per time (R,)."""
     n_t, n_s = rec.mu_k.shape
     measured = np.interp(rec.time_s, data.time_s, data.surface_rpm)
     cols = {
@@ -234,7 +235,7 @@ def _record_frame(seg_id: int, rec: ObserverRecord, offset: int,
         "surface_rpm": np.repeat(measured, n_s),
         "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
         "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,
-        "bit_stuck": np.zeros(n_t * n_s, dtype=bool),
+        "bit_stuck": np.asarray(stuck, dtype=bool).ravel(),
         "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S,
         "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
         "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}
@@ -311,12 +312,10 @@ def run_well(path, out_root, *, config=None, survey=None, overrides=None,
     cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
     name = well_name(path, config=config)
     mappings = channel_mappings(path, cfg, config=config)
-    assumed = list(cfg.assumed) + assumed_units(mappings)
+    assumed = cfg.assumed_with(well_path) + assumed_units(mappings)
     torque_channel = mappings["surface_torque_Nm"]
     warnings: list[str] = []
     rate_used = rate_hz
-    if well_path is None:
-        assumed.append(cfg.no_survey_note)
     fallback_depth = None
     total_rows = _count_rows(data_path)
     segmenter = Segmenter(cfg)

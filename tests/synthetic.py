@@ -13,9 +13,8 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.config import config_from_dict
 from drillfric.drillstring import DrillString, build_string
+from drillfric.units import RPM_TO_RAD_S as RPM
 from drillfric.wellpath import WellPath, minimum_curvature
-
-RPM = np.pi / 30.0
 
 #: A&S 2018 drill pipe and the Well A collar sections (CASES.md), G = 61 / 67 GPa.
 AS_SECTIONS = [
