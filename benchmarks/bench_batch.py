@@ -5,7 +5,7 @@ six-section BHA) simulated by the 1500-cell plant in PI mode, noise 0.5 RPM / 20
 (a) stick-slip at 40 RPM after a normal start (μ_k fit + onset scan),
 (b) steady rotation at 100 RPM (μ_k fit only),
 (c) a creep start then 40 RPM (μ_k fit + creep fit at ≥ MD/1000 with the grid check).
-Times are wall-clock of :func:`drillfric.batch.refine` after a warm-up call (numba caches
+Times are wall-clock of :func:`drillfric.estimation.batch.refine` after a warm-up call (numba caches
 compiled), best of ``--repeat``; the machine may be shared, so the single-run cost of the
 500-cell model is printed alongside to compare ratios measured in the same run.
 

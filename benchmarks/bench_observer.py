@@ -14,7 +14,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from drillfric.observer import Measurements, ObserverState, observe  # noqa: E402
+from drillfric.estimation.observer import Measurements, ObserverState, observe  # noqa: E402
 from tests.synthetic import build_and_hold, noisy, simulate  # noqa: E402
 from tests.test_observer import config, make_observer  # noqa: E402
 

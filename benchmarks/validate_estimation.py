@@ -22,8 +22,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from drillfric import torque_drag, torsional  # noqa: E402
 from drillfric.drillstring import build_string  # noqa: E402
-from drillfric.estimate import SegmentData, build_observer, estimate_segment  # noqa: E402
-from drillfric.observer import Measurements, ObserverState, observe  # noqa: E402
+from drillfric.estimation.chain import SegmentData, build_observer, estimate_segment  # noqa: E402
+from drillfric.estimation.observer import Measurements, ObserverState, observe  # noqa: E402
 from tests.synthetic import RPM, build_and_hold, config, noisy  # noqa: E402
 
 STARTS = [[0.2, 0.05], [0.5, 0.2], [0.9, 0.4], [0.9, 0.1]]

@@ -38,7 +38,7 @@ import pandas as pd
 
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
-from drillfric.outputs import file_sha256, jsonable, missing_dirs, remove_empty, write_json
+from drillfric.io.results import file_sha256, jsonable, missing_dirs, remove_empty, write_json
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"

@@ -2,7 +2,7 @@
 
 ingest (streamed in chunks) → segment into rotating stands → per segment: torque and drag
 at its bit depth, observer from the configured starts (warm-started from the previous
-segment), batch refinement, seeded observer pass (:mod:`drillfric.estimate`) → outputs of
+segment), batch refinement, seeded observer pass (:mod:`drillfric.estimation.chain`) → outputs of
 INTERFACE.md (summary.json, estimates.parquet, segments.parquet, report) written atomically.
 
 Memory stays bounded: only the rows of the segment being assembled are held (rows the
@@ -22,12 +22,20 @@ import pandas as pd
 
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
-from drillfric.estimate import (
+from drillfric.estimation.chain import (
     SegmentData,
     SegmentEstimate,
     SkipSegment,
     check_segment,
     estimate_segment,
+)
+from drillfric.estimation.observer import ObserverRecord
+from drillfric.io.results import (
+    EstimatesWriter,
+    atomic_directory,
+    file_sha256,
+    write_json,
+    write_segments,
 )
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
 from drillfric.io.well import (
@@ -36,14 +44,6 @@ from drillfric.io.well import (
     iter_surface,
     load_setup,
     resolve_well,
-)
-from drillfric.observer import ObserverRecord
-from drillfric.outputs import (
-    EstimatesWriter,
-    atomic_directory,
-    file_sha256,
-    write_json,
-    write_segments,
 )
 from drillfric.segmentation import Segment, Segmenter
 from drillfric.units import RPM_TO_RAD_S

@@ -11,7 +11,7 @@ every section: the upwind transport is an exact shift (THEORY §3.1).
 Layers: :func:`make_grid` (cells from a :class:`~drillfric.drillstring.DrillString`),
 :class:`Plant` (grid + friction, damping, top-drive and bit parameters, as plain arrays),
 :class:`Drive` (how the top drive is driven), :func:`run` (advance and record, calling the
-numba kernel of :mod:`drillfric.kernels` or its NumPy twin), and small physical helpers
+numba kernel of :mod:`drillfric.kernels.plant` or its NumPy twin), and small physical helpers
 (:func:`energy`, :func:`gravity_fc`). Everything is SI: rad/s, N·m, m, s.
 """
 
@@ -412,9 +412,9 @@ def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
     n_steps = int(np.ceil(duration_s / plant.grid.dt_s * (1 - 1e-12)))
     out = np.empty((times.size, len(RECORD_COLUMNS)))
     if backend == "numba":
-        from drillfric.kernels import run_plant
+        from drillfric.kernels.plant import run_plant
     elif backend == "numpy":
-        from drillfric.kernels_numpy import run_plant
+        from drillfric.kernels.plant_numpy import run_plant
     else:
         raise ModelError(f"unknown backend '{backend}'", fix="use 'numba' or 'numpy'")
     run_plant(alpha, beta, top, state.t_s, n_steps, *kernel_args(plant, drive), times, out)

@@ -1,4 +1,4 @@
-"""Batch refinement (drillfric.batch, drillfric.creep) against synthetic truths, THEORY §6.
+"""Batch refinement (drillfric.estimation.batch, .creep) against synthetic truths, THEORY §6.
 
 Truths are the plant of THEORY §3 in PI mode (A&S 2018 gains, I_TD = 2900 kg·m²) on a
 finer grid (1500 cells) than the estimator (500 cells for μ_k, ≥ MD/1000 for creeps),
@@ -20,10 +20,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drillfric import batch, torsional
-from drillfric.creep import find_creeps, rotating_runs, smooth
+from drillfric import torsional
 from drillfric.drillstring import DrillString, Section
 from drillfric.errors import InputError
+from drillfric.estimation import batch
+from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
 
 RPM = np.pi / 30.0
 OMEGA_C = 1.0  # [rad/s] THEORY §6 prototypes

@@ -1,14 +1,14 @@
-"""Per-segment estimation helpers (drillfric.estimate) that the end-to-end tests do not pin."""
+"""Per-segment estimation helpers (drillfric.estimation.chain) the end-to-end tests do not pin."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from drillfric.batch import BatchResult
 from drillfric.drillstring import build_string
-from drillfric.estimate import _creep_advice, ensemble_starts
-from drillfric.observer import Measurements, ObserverRecord, ensemble_bit_speed
+from drillfric.estimation.batch import BatchResult
+from drillfric.estimation.chain import _creep_advice, ensemble_starts
+from drillfric.estimation.observer import Measurements, ObserverRecord, ensemble_bit_speed
 from tests.synthetic import RPM, config
 
 

@@ -1,4 +1,4 @@
-"""Observer gains (drillfric.gains) checked by the linear analysis of THEORY.md §5.1–§5.2."""
+"""Observer gains (drillfric.estimation.gains) by the linear analysis of THEORY §5.1–§5.2."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from drillfric import lumped
 from drillfric.config import config_from_dict
 from drillfric.drillstring import build_string
 from drillfric.errors import ConfigError, ModelError
-from drillfric.gains import (
+from drillfric.estimation import lumped
+from drillfric.estimation.gains import (
     Gains,
     KalmanNoise,
     Tuning,
@@ -27,7 +27,7 @@ from drillfric.gains import (
     kalman_gains,
     top_reflection,
 )
-from drillfric.lumped import Injection, LumpedParams
+from drillfric.estimation.lumped import Injection, LumpedParams
 from tests.synthetic import AS_SECTIONS
 
 T_N = 40e3  # a plausible ∫F_c dx for a 2500 m build-and-hold well [N·m]
@@ -377,7 +377,7 @@ def test_kalman_injection_follows_the_logging_interval():
     top-drive injection and friction adaptation than a 100 Hz one."""
     from drillfric.config import config_from_dict
     from drillfric.drillstring import build_string
-    from drillfric.gains import gains_from_config
+    from drillfric.estimation.gains import gains_from_config
 
     cfg = config_from_dict({"string": {"sections": AS_SECTIONS}, "model": {"k_t_per_s": 0.1}})
     string = build_string(cfg.sections, 2500.0)

@@ -1,4 +1,4 @@
-"""Numba kernel vs its plain-NumPy twin (drillfric.kernels vs drillfric.kernels_numpy).
+"""Numba kernel vs its plain-NumPy twin (drillfric.kernels.plant vs drillfric.kernels.plant_numpy).
 
 Both implement THEORY.md §3.1 with the same operations in the same order, so they must agree
 to round-off; 10 000 steps of stick-slip (the most sensitive regime: a cell that sticks in
@@ -10,9 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drillfric import kernels, kernels_numpy
 from drillfric import torsional as T
 from drillfric.drillstring import DrillString, Section
+from drillfric.kernels import plant as kernels
+from drillfric.kernels import plant_numpy as kernels_numpy
 from drillfric.simulate import well_b_plant
 
 RPM = np.pi / 30.0

@@ -1,15 +1,15 @@
-"""Semi-lumped model of THEORY.md §4 and its Courant-1 discretisation (drillfric.lumped)."""
+"""Semi-lumped model of THEORY §4 and its Courant-1 discretisation (drillfric.estimation.lumped)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from drillfric import lumped
 from drillfric.config import config_from_dict
 from drillfric.drillstring import build_string
 from drillfric.errors import ModelError
-from drillfric.lumped import Injection, LumpedParams
+from drillfric.estimation import lumped
+from drillfric.estimation.lumped import Injection, LumpedParams
 from tests.synthetic import AS_SECTIONS
 
 

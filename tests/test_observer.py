@@ -11,8 +11,8 @@ import pytest
 
 from drillfric import torsional
 from drillfric.errors import InputError, ModelError
-from drillfric.gains import gains_from_config
-from drillfric.observer import Measurements, Observer, ObserverState, observe
+from drillfric.estimation.gains import gains_from_config
+from drillfric.estimation.observer import Measurements, Observer, ObserverState, observe
 from tests.synthetic import RPM, build_and_hold, config, noisy, simulate
 
 PATH = build_and_hold(600.0, 50.0, 1600.0)
@@ -149,7 +149,8 @@ def test_bad_measurements_and_starts(steady):
 def test_measurement_interpolation(hold):
     """Linear interpolation (default) or the paper's zero-order hold, held at both ends;
     compiled kernel and twin agree."""
-    from drillfric import observer_kernels, observer_kernels_numpy
+    from drillfric.kernels import observer as observer_kernels
+    from drillfric.kernels import observer_numpy as observer_kernels_numpy
 
     u = np.array([0.0, 10.0, 20.0])
     times = [-1.0, 0.0, 0.25, 0.5, 0.999, 1.0, 1.5, 3.0]

@@ -17,7 +17,7 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.outputs import ESTIMATE_COLUMNS, SEGMENT_KEYS
+from drillfric.io.results import ESTIMATE_COLUMNS, SEGMENT_KEYS
 from tests.conftest import REPO
 
 DEMO = REPO / "examples" / "demo"

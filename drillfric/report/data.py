@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.outputs import BAND_COLUMNS
+from drillfric.io.results import BAND_COLUMNS
 
 #: Columns of estimates.parquet a segment figure needs (the ensemble band and ``bit_rpm``
 #: are added when present: older results have no band).

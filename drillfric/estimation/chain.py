@@ -22,12 +22,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from drillfric import batch, torque_drag, torsional
-from drillfric.diagnostics import Diagnostics, diagnose, settled_mask
+from drillfric import torque_drag, torsional
 from drillfric.drillstring import build_string
 from drillfric.errors import DrillfricError
-from drillfric.gains import gains_from_config
-from drillfric.observer import (
+from drillfric.estimation import batch
+from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
+from drillfric.estimation.gains import gains_from_config
+from drillfric.estimation.observer import (
     BitSpeedEstimate,
     Measurements,
     Observer,
@@ -36,7 +37,7 @@ from drillfric.observer import (
     ensemble_bit_speed,
     observe,
 )
-from drillfric.torque_scale import check_torque_scale
+from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
 
@@ -118,7 +119,7 @@ class SegmentEstimate:
         Observer starts (μ_s, μ_k); the seeded final pass is start S.
     first, final : ObserverRecord
         Observer records of the first pass (all starts) and the seeded pass (one start per
-        ensemble member, the seed first; :func:`drillfric.observer.ensemble_bit_speed`).
+        ensemble member, the seed first; :func:`drillfric.estimation.observer.ensemble_bit_speed`).
     mu_s_seed : float
         μ_s the seeded pass used (identified, else the batch model's regime value or bound);
         the next segment's warm start.

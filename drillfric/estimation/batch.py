@@ -11,7 +11,8 @@ measured string torque τ_s = τ_m − I_TD dω̄₀/dt. From that model:
   returns a point it evaluated (the mean jitters between runs because stick-slip is
   chaotic), with the model in the data's regime (§6.4);
 - μ_s is fitted only where the data hold it, on creep start-ups logged at ≥ 2 Hz
-  (:mod:`drillfric.creep`, §6.3): a bounded 1-D minimisation of the smoothed torque misfit
+  (:mod:`drillfric.estimation.creep`, §6.3): a bounded 1-D minimisation of the smoothed
+  torque misfit
   over the creep at Δx ≤ MD/1000, refitted with twice (then four times) the cells and
   reported only once it moves less than 3 %;
 - otherwise μ_s is not identifiable; in stick-slip a lower bound comes from the stick-slip
@@ -33,9 +34,9 @@ from scipy.optimize import minimize_scalar
 from scipy.signal import savgol_filter
 
 from drillfric import torsional
-from drillfric.creep import find_creeps, rotating_runs, smooth
 from drillfric.drillstring import DrillString
 from drillfric.errors import InputError
+from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
 
 MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
 PRE_ROLL_S = 2.0  #: model starts this long before a run or creep leaves rest [s]

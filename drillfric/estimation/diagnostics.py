@@ -109,7 +109,7 @@ def stick_slip_severity(bit_rad_s: np.ndarray) -> float:
 
 
 def diagnose(record, omega_c_rad_s: float) -> Diagnostics:
-    """Diagnostics of an :class:`~drillfric.observer.ObserverRecord`.
+    """Diagnostics of an :class:`~drillfric.estimation.observer.ObserverRecord`.
 
     Parameters
     ----------

@@ -68,7 +68,7 @@ def check_torque_scale(data, T_N_Nm: float, omega_c_rad_s: float, *,
 
     Parameters
     ----------
-    data : drillfric.estimate.SegmentData
+    data : drillfric.estimation.chain.SegmentData
     T_N_Nm : float
         T_N = ∫F_c dx at the segment's bit depth [N·m].
     omega_c_rad_s : float

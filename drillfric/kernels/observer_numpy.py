@@ -1,7 +1,7 @@
-"""Plain-NumPy twin of :func:`drillfric.observer_kernels.run_observer` (THEORY.md §5).
+"""Plain-NumPy twin of :func:`drillfric.kernels.observer.run_observer` (THEORY.md §5).
 
 Same arguments and effects, built from the plant twin's whole-array steps
-(:mod:`drillfric.kernels_numpy`) with a Python loop over time steps and starts: the oracle
+(:mod:`drillfric.kernels.plant_numpy`) with a Python loop over time steps and starts: the oracle
 of the observer kernel tests and the baseline of ``benchmarks/bench_observer.py``.
 """
 
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from drillfric.kernels_numpy import damp_and_friction, drive_value, top_drive_step, transport
-from drillfric.observer_kernels import LAW_PAPER
+from drillfric.kernels.observer import LAW_PAPER
+from drillfric.kernels.plant_numpy import damp_and_friction, drive_value, top_drive_step, transport
 
 
 def measured_value(u, t0, dt, t, hold):
@@ -22,7 +22,7 @@ def measured_value(u, t0, dt, t, hold):
 
 
 def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
-    """Adaptation (42)–(44); see :func:`drillfric.observer_kernels.adapt`."""
+    """Adaptation (42)–(44); see :func:`drillfric.kernels.observer.adapt`."""
     if stuck:
         if law == LAW_PAPER:
             mu_s -= dt * l_s * e
@@ -36,7 +36,7 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
                  junction_z, zeta, fcap, dt, kt_dt, omega_c, bit_cap_rel, inv_itd,
                  w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s,
                  law, mu_max, deadlock_s, omega_turn, times, out):
-    """NumPy twin of :func:`drillfric.observer_kernels.run_observer`."""
+    """NumPy twin of :func:`drillfric.kernels.observer.run_observer`."""
     n_start, n = alpha.shape
     n_pipe = int(section_start[1])
     a, b = alpha.copy(), beta.copy()

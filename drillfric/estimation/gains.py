@@ -6,7 +6,7 @@ e = ω̂₀ − ω₀ at fixed injection points: the top-drive ODE (p₀), the t
 the pipe invariants (p_α(x), p_β(x)), the pipe/BHA junction (P₁), the BHA speed (p₁) and
 the friction adaptation (l_k, l_s). The paper does not print its gains; the closed form
 here was derived for drillfric on the semi-lumped model of THEORY.md §4
-(:mod:`drillfric.lumped`) and is checked against the exact characteristic function N(s)
+(:mod:`drillfric.estimation.lumped`) and is checked against the exact characteristic function N(s)
 by ``tests/test_gains.py``. The Kalman alternative solves the discrete algebraic Riccati
 equation on the Courant-1 discretisation of the same model and maps the gain back onto
 the same injection points (see docs/observer_gains.md).
@@ -22,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from drillfric import lumped
 from drillfric.drillstring import DrillString
 from drillfric.errors import ConfigError, ModelError
-from drillfric.lumped import Injection, LumpedParams
+from drillfric.estimation import lumped
+from drillfric.estimation.lumped import Injection, LumpedParams
 from drillfric.units import RPM_TO_RAD_S
 
 
@@ -224,7 +224,8 @@ def top_reflection(s, tuning: Tuning):
 
 
 def injection_on_nodes(gains: Gains, params: LumpedParams, n_cells: int) -> Injection:
-    """Gains resampled (linear interpolation) onto the n + 1 nodes of :mod:`drillfric.lumped`."""
+    """Gains resampled (linear interpolation) onto the n + 1 nodes of
+    :mod:`drillfric.estimation.lumped`."""
     x = lumped.nodes_m(params, n_cells)
     return Injection(p0=gains.p0, P0=gains.P0, p_alpha=np.interp(x, gains.x_m, gains.p_alpha),
                      p_beta=np.interp(x, gains.x_m, gains.p_beta), P1=gains.P1, p1=gains.p1,
@@ -314,7 +315,7 @@ def kalman_filter_gain(params: LumpedParams, n_cells: int,
     stabilising solution of the discrete algebraic Riccati equation
     (:func:`scipy.linalg.solve_discrete_are`), solved on the invariant subspace that
     excludes the grid's unobservable λ = −1 mode (:func:`_observable_part`). Returned in the
-    state units of :mod:`drillfric.lumped` (the d row in N·m per rad/s).
+    state units of :mod:`drillfric.estimation.lumped` (the d row in N·m per rad/s).
     """
     a = lumped.transition_matrix(params, Injection.none(n_cells))
     scale = np.ones(lumped.state_size(n_cells))
@@ -334,7 +335,7 @@ def kalman_gains(params: LumpedParams, x_m, T_N_Nm: float, dt_s: float, *,
                  noise: KalmanNoise = KalmanNoise(), max_design_cells: int = 60) -> Gains:
     """Steady-state Kalman gains mapped onto the observer's injection points (THEORY.md §5.1).
 
-    The Riccati equation is solved on the Courant-1 model of :mod:`drillfric.lumped` with
+    The Riccati equation is solved on the Courant-1 model of :mod:`drillfric.estimation.lumped` with
     n = round(t_D/dt_s) pipe cells, capped at ``max_design_cells`` (the noise is scaled
     with the step, so the gain per unit time converges as the grid is refined; the cap
     keeps the dense Riccati solve below a second). Mapping, per unit time: p₀ = L_ω₀/Δt,

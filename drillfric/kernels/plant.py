@@ -22,7 +22,7 @@ observer (THEORY §5, a copy of this plant plus injections) reuses:
 Array layout: one contiguous cell array for α and one for β over the whole string,
 ``section_start`` (first cell of each section + total), per-cell ``zeta`` and ``fcap``
 (speed change friction can impose in one step per unit μ, F_c·Δt/(ρJ) [rad/s]).
-The plain-NumPy twin with the same argument list is :mod:`drillfric.kernels_numpy`.
+The plain-NumPy twin with the same argument list is :mod:`drillfric.kernels.plant_numpy`.
 For an observer: ``alpha_top`` of :func:`inflows` is an argument (pass
 ω̂₀^k + ω̂₀^(k+1) − β̂(0) − P₀e with ω̂₀^(k+1) from :func:`top_drive_step`);
 ``b_in[0]`` after :func:`inflows` is the β reflected into the pipe at the pipe/BHA junction
@@ -175,7 +175,7 @@ def top_drive_step(omega0, beta0, q, accel_dt):
     so string + top-drive energy changes by Δt·ω̄₀·τ_m only (conserved for τ_m = 0; the
     explicit Euler step ω₀ + (Δt/I_TD)(τ_m − ζ(ω₀ − β(0))) adds ½ζa₀Δt²(β(0) − ω₀)² every
     step). Unconditionally stable (|1 − q|/(1 + q) < 1) and second-order; the top drive of
-    :mod:`drillfric.lumped` uses the trapezoidal rule too. ``accel_dt`` = Δt·τ_m/I_TD
+    :mod:`drillfric.estimation.lumped` uses the trapezoidal rule too. ``accel_dt`` = Δt·τ_m/I_TD
     (the observer adds −Δt p₀ e). Callers form the inflow α(0) = ω₀^k + ω₀^(k+1) − β(0)
     (= 2ω̄₀ − β(0)).
     """

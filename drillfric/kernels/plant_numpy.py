@@ -1,4 +1,4 @@
-"""Plain-NumPy twins of :mod:`drillfric.kernels` (THEORY.md §3.1).
+"""Plain-NumPy twins of :mod:`drillfric.kernels.plant` (THEORY.md §3.1).
 
 Same argument lists and the same arithmetic, written with whole-array NumPy operations and
 a Python loop over time steps: the oracle of the kernel tests (agreement to round-off) and
@@ -70,7 +70,7 @@ def motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_it
 
 
 def top_drive_step(omega0, beta0, q, accel_dt):
-    """Trapezoidal step 4 (docs/theory.md E11); see :func:`drillfric.kernels.top_drive_step`:
+    """Trapezoidal step 4 (docs/theory.md E11); see :func:`drillfric.kernels.plant.top_drive_step`:
     [(1 − q)ω₀ + 2qβ(0) + Δtτ_m/I_TD]/(1 + q), q = ζΔt/(2I_TD) (works on arrays too)."""
     return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
 
@@ -78,7 +78,7 @@ def top_drive_step(omega0, beta0, q, accel_dt):
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, dt,
               kt_dt, mu_s, mu_k, omega_c, bit_cap_rel, inv_itd, mode, u, u_t0, u_dt, kp, ki,
               times, out):
-    """NumPy twin of :func:`drillfric.kernels.run_plant` (same arguments and effects)."""
+    """NumPy twin of :func:`drillfric.kernels.plant.run_plant` (same arguments and effects)."""
     a, b = alpha.copy(), beta.copy()
     a2, b2 = alpha.copy(), beta.copy()
     w_a, w_b = np.empty_like(a), np.empty_like(a)

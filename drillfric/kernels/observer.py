@@ -1,11 +1,11 @@
 """Compiled (numba) kernel of the adaptive observer, THEORY.md §5 (eqs. 32–44 of [1]).
 
-The observer is a copy of the Courant-1 plant of :mod:`drillfric.kernels` (same transport,
+The observer is a copy of the Courant-1 plant of :mod:`drillfric.kernels.plant` (same transport,
 junction, friction and top-drive steps, called from there) plus output injection of the
 innovation e = ω̂₀ − ω₀ and the friction adaptation laws. Several starts (initial guesses of
 μ_s, μ_k) advance together in one pass: the start is an extra state dimension (rows of the
 α, β arrays), not an extra run. The plain-NumPy twin is
-:func:`drillfric.observer_kernels_numpy.run_observer`.
+:func:`drillfric.kernels.observer_numpy.run_observer`.
 
 [1] U.J.F. Aarsnes, J. Auriol, F. Di Meglio, R.J. Shor, "Estimating friction factors while
     drilling", JPSE 179 (2019) 80–91.
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from drillfric.kernels import advance_cells, drive_value, inflows, top_drive_step
+from drillfric.kernels.plant import advance_cells, drive_value, inflows, top_drive_step
 
 #: Columns of the observer record, per start.
 OBS_COLUMNS = ("mu_s", "mu_k", "surface_rad_s_est", "bit_rad_s_est", "bha_rad_s_est",
@@ -65,7 +65,7 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
     [time the BHA has been stuck while the top drive turns, deadlock interventions].
 
     Per step and start (THEORY §5): e = ω̂₀ − ω₀(t); top drive (eq. 32) with the plant's
-    trapezoidal coupling (:func:`drillfric.kernels.top_drive_step`, docs/theory.md E11)
+    trapezoidal coupling (:func:`drillfric.kernels.plant.top_drive_step`, docs/theory.md E11)
     and the injection held over the step,
     ω̂₀' = [(1 − q)ω̂₀ + 2qβ̂(0) + Δtτ_m/I_TD − Δt p₀ e]/(1 + q), q = ζΔt/(2I_TD);
     top boundary α̂(0) = ω̂₀ + ω̂₀' − β̂(0) − P₀e (eq. 37, 2ω̄̂₀ with the step-mean speed);

@@ -3,7 +3,7 @@
 A copy of the distributed torsional model (:mod:`drillfric.torsional`, same grid, same
 F_c(x) profile, friction with the current estimates μ̂_s, μ̂_k) corrected by the measured
 top-drive speed ω₀ and driven by the measured motor torque τ_m, with the gains of
-:mod:`drillfric.gains`. Several starts (initial guesses) advance together in one kernel
+:mod:`drillfric.estimation.gains`. Several starts (initial guesses) advance together in one kernel
 pass; the final state warm-starts the next window.
 
 Measurements arrive at the logging rate (1–100 Hz) while the observer steps at Δt. The
@@ -23,8 +23,8 @@ import numpy as np
 from scipy.signal import lfilter
 
 from drillfric.errors import InputError, ModelError
-from drillfric.gains import Gains
-from drillfric.observer_kernels import LAW_CORRECTED, LAW_PAPER, OBS_COLUMNS
+from drillfric.estimation.gains import Gains
+from drillfric.kernels.observer import LAW_CORRECTED, LAW_PAPER, OBS_COLUMNS
 from drillfric.torsional import Plant
 
 _LAWS = {"corrected": LAW_CORRECTED, "paper": LAW_PAPER}
@@ -281,9 +281,9 @@ def observe(observer: Observer, meas: Measurements, state: ObserverState, *,
     out = np.empty((times.size, state.alpha.shape[0], len(OBS_COLUMNS)))
     new = state.copy()
     if backend == "numba":
-        from drillfric.observer_kernels import run_observer
+        from drillfric.kernels.observer import run_observer
     elif backend == "numpy":
-        from drillfric.observer_kernels_numpy import run_observer
+        from drillfric.kernels.observer_numpy import run_observer
     else:
         raise ModelError(f"unknown backend '{backend}'", fix="use 'numba' or 'numpy'")
     run_observer(new.alpha, new.beta, new.omega0, new.mu_s, new.mu_k, new.guard, state.t_s,
