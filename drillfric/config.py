@@ -20,6 +20,15 @@ from typing import Any
 from drillfric.errors import ConfigError
 
 _NUM = (int, float)
+#: Largest physically plausible value of a key by its unit suffix, where the key declares no
+#: maximum of its own: a value beyond is a typo or a wrong unit (a top-drive inertia of 1e300
+#: gives a confident μ_k of 0.01). Generous on purpose: the deepest wells are ~12 km, the
+#: heaviest top drives ~1e4 kg·m², the stiffest steels ~2e11 Pa.
+_PLAUSIBLE_MAX = (("_deg_30m", 30.0), ("_kg_m2", 1e5), ("_kg_m3", 25e3), ("_kg_m", 2e3),
+                  ("_Nms_rad", 1e9), ("_Nm_rad", 1e9), ("_Nm", 1e7), ("_Pa", 1e12),
+                  ("_N", 1e8), ("_m3_s", 10.0), ("_m_s", 100.0), ("_m_h", 1e3),
+                  ("_rad_s", 100.0), ("_rpm", 1e3), ("_per_s", 1e4), ("_hz", 1e5),
+                  ("_spm", 1e3), ("_s", 1e7), ("_m", 15e3))
 
 
 @dataclass(frozen=True)
@@ -54,6 +63,14 @@ class Key:
     min_exclusive: bool = False
     choices: tuple | None = None
 
+    @property
+    def upper(self) -> float | None:
+        """Largest allowed value: ``max``, else the plausible maximum of the unit suffix."""
+        if self.max is not None or self.type not in (float, int):
+            return self.max
+        return next((top for suffix, top in _PLAUSIBLE_MAX if self.name.endswith(suffix)),
+                    None)
+
     def validate(self, value: Any, where: str, file: str | None) -> Any:
         """Return ``value`` checked (and ints widened to float) or raise ConfigError."""
         types = self.type if isinstance(self.type, tuple) else (self.type,)
@@ -68,25 +85,29 @@ class Key:
                               f", got {value!r}", file=file,
                               fix=f"write e.g. {where.split('.')[-1]} = {_example(self)}")
         if isinstance(value, (int, float)) and not isinstance(value, bool):
+            if not math.isfinite(value):
+                raise ConfigError(f"key '{where}' = {value} is not a finite number", file=file,
+                                  fix=f"write e.g. {where.split('.')[-1]} = {_example(self)}")
             low_bad = self.min is not None and (
                 value <= self.min if self.min_exclusive else value < self.min)
-            if low_bad or (self.max is not None and value > self.max):
-                raise ConfigError(f"key '{where}' = {value} is outside {self.range_text()}",
-                                  file=file, fix=f"give a value {self.range_text()}"
-                                                 + (f" [{self.unit}]" if self.unit else ""))
+            if low_bad or (self.upper is not None and value > self.upper):
+                raise ConfigError(f"key '{where}' = {value:.4g} is outside "
+                                  f"{self.range_text()}", file=file,
+                                  fix=f"give a value {self.range_text()}"
+                                      + (f" [{self.unit}]" if self.unit else ""))
         return value
 
     def range_text(self) -> str:
         """Allowed range in words, e.g. ``(0, 2]`` or ``≥ 0``."""
-        if self.min is None and self.max is None:
+        top = self.upper
+        if self.min is None and top is None:
             return ""
         lo = "" if self.min is None else ("(" if self.min_exclusive else "[") + f"{self.min:g}"
-        hi = "" if self.max is None else f"{self.max:g}]"
-        if self.max is None:
+        if top is None:
             return ("> " if self.min_exclusive else "≥ ") + f"{self.min:g}"
         if self.min is None:
-            return f"≤ {self.max:g}"
-        return f"{lo}, {hi}"
+            return f"≤ {top:g}"
+        return f"{lo}, {top:g}]"
 
 
 _TYPE_NAMES = {float: "a number", int: "an integer", str: "text", bool: "true/false",
@@ -275,7 +296,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("bit_mu", float, 0.3, "", "Bit friction coefficient μ_bit of the bit-torque model "
             "T_bit = μ_bit·WOB·D_bit/3.", min=0.0, max=2.0),
         _positive("bit_diameter_m", 0.2159, "m", "Bit diameter D_bit (bit-torque model and "
-                  "hole size)."),
+                  "hole size).", max=1.5),
         Key("off_bottom_m", float, 5.0, "m", "Distance of the bit above hole bottom in "
             "off-bottom stands (recorded hole depth = bit depth + this).", min=0.0),
     ),
@@ -284,12 +305,12 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
 #: Keys of each ``[[string.sections]]`` entry (top-down; the first fills up to the bit).
 SECTION_KEYS: tuple[Key, ...] = (
     Key("name", str, "", "", "Section name (e.g. '5 7/8in DP')."),
-    _positive("od_m", None, "m", "Body outside diameter."),
-    Key("id_m", float, None, "m", "Inside diameter (< od_m).", min=0.0),
+    _positive("od_m", None, "m", "Body outside diameter.", max=1.0),
+    Key("id_m", float, None, "m", "Inside diameter (< od_m).", min=0.0, max=1.0),
     _positive("length_m", None, "m", "Length; omit for the first (top) section, whose length "
               "follows from the bit depth."),
     _positive("tool_joint_od_m", None, "m", "Tool-joint OD; contact radius = "
-              "tool_joint_od_m/2 (default od_m/2)."),
+              "tool_joint_od_m/2 (default od_m/2).", max=1.0),
     _positive("linear_mass_kg_m", None, "kg/m", "Adjusted mass per metre including tool "
               "joints (default: steel area × steel density)."),
     _positive("shear_modulus_Pa", 79.3e9, "Pa", "Shear modulus G."),
@@ -446,7 +467,9 @@ def _channels(raw: Any, file: str | None) -> dict:
 
 
 def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+    """A finite TOML number (NaN and inf are typos in a well configuration)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(
+        value)
 
 
 def _check_observer_lists(observer: dict, file: str | None) -> None:

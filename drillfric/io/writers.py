@@ -5,8 +5,9 @@ canonical columns, and beside it ``NAME.toml`` (a configuration that
 :func:`drillfric.config.load_config` accepts, naming the survey), ``NAME.survey.csv``
 (``md_m, inc_deg, azi_deg``) and ``NAME.truth.json`` (ground truth of a simulation). The
 truth is also stored inside the data file where the format allows: Parquet schema metadata
-key ``drillfric.truth``, HDF5 attribute ``truth`` on ``/surface`` (HDF5 files also get the
-``/survey`` table and the configuration as TOML text in ``/config``). CSV files are plain
+key ``drillfric.truth``, HDF5 attribute ``truth`` on ``/surface`` (HDF5 files, written with
+h5py as groups of 1-D datasets, also get the ``/survey`` group and the configuration as TOML
+text in ``/config``). CSV files are plain
 (no comment lines), so every reader takes them.
 """
 
@@ -69,20 +70,28 @@ def write_table(path: str | Path, frame: pd.DataFrame, truth: dict | None = None
 
 
 def _write_hdf5(path: Path, frame, truth_text, survey, config_toml) -> None:
+    """HDF5 bundle through h5py: ``/surface`` and ``/survey`` groups of 1-D datasets (one per
+    column, the shape :mod:`drillfric.io.hdf5` reads), the truth as a JSON text attribute of
+    ``/surface`` and the configuration as a TOML text dataset ``/config``."""
     import h5py
 
     if path.exists():
         path.unlink()
-    with pd.HDFStore(path, "w", complevel=5, complib="zlib") as store:
-        store.put("surface", frame, format="table", index=False, track_times=False)
+    with h5py.File(path, "w", track_order=True) as h5:
+        _h5_group(h5, "surface", frame)
         if truth_text is not None:
-            store.get_storer("surface").attrs.truth = truth_text
+            h5["surface"].attrs["truth"] = truth_text
         if survey is not None:
-            store.put("survey", survey_frame(survey), format="table", index=False,
-                      track_times=False)
-    if config_toml is not None:
-        with h5py.File(path, "a") as h5:
+            _h5_group(h5, "survey", survey_frame(survey))
+        if config_toml is not None:
             h5.create_dataset("config", data=config_toml)
+
+
+def _h5_group(h5, name: str, frame: pd.DataFrame) -> None:
+    group = h5.create_group(name, track_order=True)
+    for column in frame.columns:
+        group.create_dataset(str(column), data=frame[column].to_numpy(), compression="gzip",
+                             compression_opts=5)
 
 
 def survey_frame(path: WellPath) -> pd.DataFrame:

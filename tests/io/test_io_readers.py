@@ -12,7 +12,8 @@ import pytest
 from io_frames import surface_frame
 
 from drillfric.errors import InputError
-from drillfric.io.readers import open_source, sniff_csv
+from drillfric.io.delimited import sniff_csv
+from drillfric.io.readers import open_source
 from drillfric.io.well import iter_surface, load_well
 
 COLS = ["time_s", "surface_rpm", "surface_torque_Nm"]
@@ -98,7 +99,7 @@ def test_csv_comment_filter_at_any_block_boundary(size):
     lines, nothing else changed."""
     import io
 
-    from drillfric.io.readers import _CommentFree
+    from drillfric.io.delimited import _CommentFree
 
     text = ("# rig\r\n\r\n#\rTIME,RPM\r\n0,1\r\n#x,y\n1,2\r3,4\n  # z\r\n\n5,6\r\n"
             "# end")

@@ -1,0 +1,248 @@
+"""Delimited text logs (CSV, TSV, semicolon, pipe): layout sniffing and chunked reading.
+
+The top of a file tells the delimiter, the decimal mark, whether a header and a units row are
+there, and the text encoding (UTF-8 with or without BOM, UTF-16/32 with a BOM, else Latin-1 of
+old rig exports). Comment lines (``#``) are skipped as pandas reads (:class:`_CommentFree`).
+
+Untrusted files are read in bounded work: a line longer than :data:`MAX_LINE_CHARS` is
+refused (a single huge line would otherwise be buffered and rescanned, quadratic in its
+length), and a file whose top is not text (NUL bytes, control characters) is refused as
+"not a text file" without echoing its bytes (docs/security.md).
+"""
+
+from __future__ import annotations
+
+import codecs
+import io
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from drillfric.errors import InputError
+from drillfric.io.readers import NULL_VALUES, RawSource
+
+#: Longest line read [characters] (documented in docs/ingestion.md): rig exports with a few
+#: hundred channels have lines of a few kB.
+MAX_LINE_CHARS = 1 << 20
+_DELIMITERS = (",", ";", "\t", "|")
+_SNIFF_BYTES = 1 << 16
+_NUMBER = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
+_DATE = re.compile(r"^\d{4}-\d{2}-\d{2}([ T]\d{2}:\d{2}(:\d{2}(\.\d*)?)?)?")
+#: Byte-order marks and the codec they announce (UTF-32 before UTF-16: FF FE 00 00).
+_BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
+         (codecs.BOM_UTF8, "utf-8-sig"), (codecs.BOM_UTF16_LE, "utf-16"),
+         (codecs.BOM_UTF16_BE, "utf-16"))
+#: Largest share of control characters (other than tab, CR, LF) in the text at the top of a
+#: file that is still read as text.
+_MAX_CONTROL_SHARE = 0.01
+_NOT_TEXT_FIX = "give a delimited text export (CSV) of the log, or a Parquet/HDF5/LAS file"
+
+
+@dataclass(frozen=True)
+class CsvLayout:
+    """What :func:`sniff_csv` found at the top of a delimited text file.
+
+    Attributes
+    ----------
+    delimiter, decimal : str
+    header : bool
+        Whether the first line names the columns.
+    units_row : bool
+        Whether the second line holds units.
+    columns : list of str
+    units : dict
+        ``{column: unit}`` from the units row.
+    encoding : str
+    """
+
+    delimiter: str
+    decimal: str
+    header: bool
+    units_row: bool
+    columns: list[str]
+    units: dict
+    encoding: str
+
+
+def _encoding(head: bytes) -> str:
+    """Text encoding from the first bytes: a BOM, else UTF-8 when it decodes, else Latin-1."""
+    for bom, codec in _BOMS:
+        if head.startswith(bom):
+            return codec
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(head) - 3:  # not merely a character cut by the sniff window
+            return "latin-1"  # old rig exports: Windows/Latin-1 text
+    return "utf-8-sig"
+
+
+def _decode(raw: bytes, path: Path) -> tuple[str, str]:
+    """The text at the top of a file and its encoding; InputError when it is not text."""
+    codec = _encoding(raw)
+    text = codecs.getincrementaldecoder(codec)(errors="replace").decode(raw)
+    control = sum(1 for c in text if c < " " and c not in "\t\r\n")
+    if "\x00" in text or control > _MAX_CONTROL_SHARE * max(len(text), 1):
+        raise InputError("not a text file (binary data where delimited text was expected)",
+                         file=path, fix=_NOT_TEXT_FIX)
+    return text, codec
+
+
+def _is_value(text: str) -> bool:
+    """A data value: a number (either decimal mark), a date, or empty."""
+    text = text.strip().strip('"')
+    return text == "" or bool(_NUMBER.match(text)) or bool(_DATE.match(text)) or (
+        text.lower() in {"nan", "null", "-nan"})
+
+
+def sniff_csv(path: Path) -> CsvLayout:
+    """Find delimiter, decimal mark, header and units row from the top of a text file.
+
+    Line endings may be LF, CRLF or CR only. The delimiter is the one of ``, ; TAB |``
+    that splits the first lines into the same, largest number of fields; a decimal comma
+    is recognised when the delimiter is not a comma and values look like ``12,5``.
+    """
+    with path.open("rb") as fh:
+        raw = fh.read(_SNIFF_BYTES)
+        while len(raw) < MAX_LINE_CHARS and not re.search(rb"[\r\n]", raw.lstrip(b"\r\n")):
+            more = fh.read(_SNIFF_BYTES)  # the first line is longer than the window
+            if not more:
+                break
+            raw += more
+    text, encoding = _decode(raw, path)
+    cut = len(raw) >= _SNIFF_BYTES
+    lines = [ln for ln in re.split(r"\r\n|\r|\n", text) if ln.strip() and not _is_comment(ln)]
+    if cut and len(lines) == 1:
+        raise _too_long(path)
+    if len(lines) > 1 and cut:
+        lines = lines[:-1]  # the last line may be cut by the sniff window
+    lines = lines[:50]
+    if not lines:
+        raise InputError("file holds no data (only blank or # comment lines)", file=path,
+                         fix="give a file with data rows")
+    delimiter = max(_DELIMITERS, key=lambda d: _delimiter_score(lines, d))
+    rows = [[f.strip().strip('"') for f in ln.split(delimiter)] for ln in lines]
+    header = not all(_is_value(f) for f in rows[0])
+    units_row = header and len(rows) > 1 and any(f for f in rows[1]) and not any(
+        f and _is_value(f) for f in rows[1])
+    body = rows[(1 + units_row) if header else 0:]
+    decimal = "," if delimiter != "," and any(
+        re.fullmatch(r"[-+]?\d*,\d+", f) for row in body for f in row) else "."
+    n = len(rows[0])
+    columns = [c or f"column {i}" for i, c in enumerate(rows[0])] if header else [
+        str(i) for i in range(max(len(r) for r in rows))]
+    if header and len(set(columns)) < n:
+        raise InputError("duplicate column names in the header", file=path,
+                         fix="give every column a distinct name")
+    units = {}
+    if units_row:
+        for col, unit in zip(columns, rows[1], strict=False):
+            if unit and unit not in {"-", "none", "unitless"}:
+                units[col] = unit.strip("[]()")
+                units[("source", col)] = "units row"
+    return CsvLayout(delimiter, decimal, header, units_row, columns, units, encoding)
+
+
+def _is_comment(line: str) -> bool:
+    """A comment line: its first non-blank character is ``#`` (a rig header block, a note).
+
+    Examples
+    --------
+    >>> _is_comment("  # Rig: Example 1"), _is_comment("12.5,#3")
+    (True, False)
+    """
+    return line.lstrip().startswith("#")
+
+
+_LINE_END = re.compile(r"(?<=\n)|(?<=\r)(?!\n)")
+
+
+class _CommentFree(io.TextIOBase):
+    """A text file as pandas should see it: without comment lines and leading blank lines.
+
+    pandas reads it through :meth:`read`; whole lines are handed on (a partial last line,
+    or a final ``\\r`` that may start a ``\\r\\n``, waits for the next block), and a block
+    without ``#`` passes unchanged, so a file without comments costs one substring search
+    per block. Leading blank lines go too, so that ``skiprows`` counts the header and the
+    units row only.
+    """
+
+    def __init__(self, fh, path: Path | None = None):
+        self._fh = fh
+        self._path = path
+        self._tail = ""
+        self._top = True  # before the first line of content
+
+    def readable(self) -> bool:
+        return True
+
+    def read(self, size: int | None = -1) -> str:
+        """Up to about ``size`` characters of whole, comment-free lines ("" at the end)."""
+        while True:
+            block = self._fh.read(size if size and size > 0 else -1)
+            text, self._tail = self._tail + block, ""
+            if block:
+                # a final "\r" waits: it may be the first half of "\r\n"
+                cut = max(text.rfind("\n"), text.rfind("\r", 0, len(text) - 1)) + 1
+                text, self._tail = text[:cut], text[cut:]
+                if len(self._tail) > MAX_LINE_CHARS:
+                    raise _too_long(self._path)
+            text = self._clean(text)
+            if text or not block:
+                return text
+
+    def _clean(self, text: str) -> str:
+        if not self._top and "#" not in text:
+            return text
+        lines = [ln for ln in _LINE_END.split(text) if ln and not _is_comment(ln)]
+        if self._top:
+            while lines and not lines[0].strip():
+                lines.pop(0)
+            self._top = not lines
+        return "".join(lines)
+
+
+def _delimiter_score(lines: list[str], delimiter: str) -> tuple[int, int]:
+    counts = [ln.count(delimiter) for ln in lines]
+    consistent = sum(c == counts[0] for c in counts)
+    return (min(counts) > 0, consistent * (counts[0] > 0), counts[0])
+
+
+def open_delimited(path: Path) -> RawSource:
+    """Open a delimited text log (layout from :func:`sniff_csv`), read in chunks."""
+    layout = sniff_csv(path)
+    kwargs = dict(sep=layout.delimiter, decimal=layout.decimal, header=None,
+                  names=layout.columns, skipinitialspace=True,
+                  skiprows=(1 + layout.units_row) if layout.header else 0,
+                  na_values=[str(v) for v in NULL_VALUES], skip_blank_lines=True,
+                  index_col=False)
+
+    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+        try:
+            with open(path, encoding=layout.encoding, newline="") as fh, \
+                    pd.read_csv(_CommentFree(fh, path), chunksize=chunk_rows, **kwargs) as reader:
+                yield from reader
+        except (pd.errors.ParserError, ValueError, UnicodeDecodeError) as exc:
+            raise InputError(f"cannot parse as delimited text ({_parser_problem(exc)})",
+                             file=path,
+                             fix="check that every row has the same number of fields") from exc
+
+    return RawSource(path, "csv", layout.columns, layout.units, None, read)
+
+
+
+
+def _too_long(path: Path | None) -> InputError:
+    return InputError(f"a line is longer than {MAX_LINE_CHARS:,} characters: not a log "
+                      "drillfric can read", file=path,
+                      fix="check the export (one sample per line; line breaks LF, CRLF or CR)")
+
+
+def _parser_problem(exc: Exception) -> str:
+    """The parser's complaint without the file text it may quote."""
+    first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    match = re.search(r"Expected \d+ fields in line \d+, saw \d+", first)
+    return match.group(0) if match else type(exc).__name__
