@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import signal
+import sys
+import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -42,6 +45,26 @@ def warn(message: str) -> None:
     click.secho(f"warning: {message}", err=True, fg="yellow")
 
 
+#: Signals received while a command ran (SIGTERM is turned into KeyboardInterrupt).
+RECEIVED: list[int] = []
+
+
+def _terminate(signum, frame):
+    RECEIVED.append(signum)
+    raise KeyboardInterrupt
+
+
+def catch_sigterm() -> None:
+    """Turn SIGTERM into KeyboardInterrupt, so a stopped run cleans up like Ctrl-C (its
+    temporary directory goes, nothing half-written stays)."""
+    signal.signal(signal.SIGTERM, _terminate)
+
+
+def interrupted_exit_code() -> int:
+    """128 + the signal that stopped the command (130 for Ctrl-C, 143 for SIGTERM)."""
+    return 128 + (RECEIVED[-1] if RECEIVED else signal.SIGINT)
+
+
 @contextmanager
 def user_errors():
     """Translate library exceptions into one-line CLI errors (tracebacks only with --debug)."""
@@ -64,8 +87,6 @@ def user_errors():
 
 def _debug() -> bool:
     """--debug, read when an error happens (the group's options are parsed by then)."""
-    import sys
-
     return context().debug or "--debug" in sys.argv[1:]
 
 
@@ -74,9 +95,14 @@ def progress(description: str, total: float | None):
     """A rich progress bar with ETA on stderr; yields ``advance(amount)``. Silent with --quiet.
 
     The library reports progress through a callback; this turns the callback into a bar.
+    Without a terminal (a nightly job's log) a line per 10 % is printed instead.
     """
     if context().quiet:
         yield lambda amount=1.0: None
+        return
+    if not sys.stderr.isatty():
+        with _progress_lines(description, total) as advance:
+            yield advance
         return
     from rich.console import Console
     from rich.progress import (
@@ -93,3 +119,64 @@ def progress(description: str, total: float | None):
     with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
         task = bar.add_task(description, total=total)
         yield lambda amount=1.0: bar.advance(task, amount)
+
+
+@contextmanager
+def _progress_lines(description: str, total: float | None):
+    """Progress as plain lines on stderr, one per 10 % (for logs, no terminal)."""
+    state = {"done": 0.0, "shown": 0, "t0": time.monotonic()}
+
+    def advance(amount: float = 1.0) -> None:
+        state["done"] += amount
+        if not total:
+            return
+        tenth = int(10 * state["done"] / total)
+        if tenth > state["shown"]:
+            state["shown"] = tenth
+            elapsed = time.monotonic() - state["t0"]
+            left = elapsed * (total / state["done"] - 1.0) if state["done"] else 0.0
+            click.echo(f"{description}: {10 * tenth} % ({elapsed:.0f} s, about {left:.0f} s "
+                       "left)", err=True)
+
+    yield advance
+
+
+@contextmanager
+def well_progress(name: str):
+    """Progress within one well's run: yields a callback for
+    :class:`drillfric.pipeline.RunProgress` events — a bar with rows read, segments done and
+    the ETA on a terminal, a line per 10 % on stderr without one, nothing with --quiet."""
+    if context().quiet:
+        yield lambda event: None
+        return
+    if not sys.stderr.isatty():
+        with _progress_lines(name, 1.0) as advance:
+            state = {"fraction": 0.0}
+
+            def line(event) -> None:
+                if event.fraction is not None and event.fraction > state["fraction"]:
+                    advance(event.fraction - state["fraction"])
+                    state["fraction"] = event.fraction
+
+            yield line
+        return
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        TaskProgressColumn,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    columns = [TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(),
+               TextColumn("{task.fields[detail]}"), TimeElapsedColumn(), TimeRemainingColumn()]
+    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(name, total=None, detail="opening")
+
+        def update(event) -> None:
+            bar.update(task, completed=event.rows_done, total=event.rows_total,
+                       detail=f"{event.rows_done:,} rows, {event.segments_done} segments")
+
+        yield update

@@ -10,35 +10,17 @@ usage or no well readable, 128+signal when interrupted.
 from __future__ import annotations
 
 import os
-import signal
 import sys
-from contextlib import contextmanager
 from pathlib import Path
 
 import click
 
-from .common import UserError, echo, progress
+from .common import UserError, echo, interrupted_exit_code, progress
 
 
 def _default_workers() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else \
         (os.cpu_count() or 1)
-
-
-@contextmanager
-def _sigterm_interrupts():
-    """Turn SIGTERM into KeyboardInterrupt for the duration of the run; yield the signal."""
-    received: list[int] = []
-
-    def handler(signum, frame):
-        received.append(signum)
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield received
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def _closing_line(result) -> str:
@@ -63,10 +45,12 @@ def _closing_line(result) -> str:
               "the inputs and OUT must be on storage its workers share.")
 @click.option("--workers", type=int, help="Local worker processes (default: all cores).")
 @click.option("--force", is_flag=True, help="Redo every well, even unchanged ones.")
+@click.option("--report/--no-report", default=True, show_default=True,
+              help="Write each well's report.html (the fleet report is always written).")
 @click.option("--config", type=click.Path(path_type=Path),
               help="Configuration (TOML) for every well, overriding NAME.toml sidecars "
                    "(not a config a manifest names).")
-def command(source: Path, out: Path, scheduler, workers, force, config) -> None:
+def command(source: Path, out: Path, scheduler, workers, force, report, config) -> None:
     """Run every well of DIR_OR_MANIFEST (a directory of wells, or a .csv/.json manifest
     with columns well, data, config, survey), skipping wells unchanged since their last run.
     """
@@ -77,17 +61,16 @@ def command(source: Path, out: Path, scheduler, workers, force, config) -> None:
     if config is not None and not config.is_file():
         raise UserError(f"{config}: config file not found — fix: check the --config path")
     specs = discover(source, config=config)
-    with _sigterm_interrupts() as received:
-        try:
-            with progress(f"fleet ({len(specs)} wells)", total=len(specs)) as advance:
-                result = run_many(specs, out, workers=workers or _default_workers(),
-                                  scheduler=scheduler, force=force, progress=advance)
-        except KeyboardInterrupt:
-            signum = received[0] if received else signal.SIGINT
-            click.secho(f"interrupted: finished wells are recorded in {out / 'manifest.json'}"
-                        "; run the same command again to complete the rest", err=True,
-                        fg="yellow")
-            sys.exit(128 + signum)
+    try:
+        with progress(f"fleet ({len(specs)} wells)", total=len(specs)) as advance:
+            result = run_many(specs, out, workers=workers or _default_workers(),
+                              scheduler=scheduler, force=force, progress=advance,
+                              report=report)
+    except KeyboardInterrupt:
+        click.secho(f"interrupted: finished wells are recorded in {out / 'manifest.json'}"
+                    "; run the same command again to complete the rest", err=True,
+                    fg="yellow")
+        sys.exit(interrupted_exit_code())
     for well in result.wells:
         if well.status == "failed":
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")

@@ -8,15 +8,22 @@ import click
 
 from drillfric import __version__
 
-from .common import RunContext, user_errors
+from .common import RunContext, catch_sigterm, interrupted_exit_code, user_errors
 
 
 class _Group(click.Group):
-    """Command group whose sub-commands turn library errors into one readable line."""
+    """Command group whose sub-commands turn library errors into one readable line, and an
+    interruption (Ctrl-C, SIGTERM) into a clean stop with exit code 128 + signal."""
 
     def invoke(self, ctx: click.Context):
-        with user_errors():
-            return super().invoke(ctx)
+        catch_sigterm()
+        try:
+            with user_errors():
+                return super().invoke(ctx)
+        except KeyboardInterrupt:
+            click.secho("interrupted: nothing half-written was left; run the command again "
+                        "to complete it", err=True, fg="yellow")
+            ctx.exit(interrupted_exit_code())
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

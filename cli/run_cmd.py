@@ -1,4 +1,4 @@
-"""`drillfric run` — the main job (INTERFACE.md): friction factors per stand + report."""
+"""`drillfric run` — the main job (docs/cli.md): friction factors per stand + report."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import click
 
 from drillfric.errors import DrillfricError
 
-from .common import UserError, context, echo, progress, warn
+from .common import UserError, context, echo, warn, well_progress
 
 
 def parse_starts(text: str | None) -> list[tuple[float, float]] | None:
@@ -19,9 +19,9 @@ def parse_starts(text: str | None) -> list[tuple[float, float]] | None:
         pairs = [tuple(float(v) for v in item.split(":")) for item in text.split(",")]
     except ValueError:
         pairs = []
-    if not pairs or any(len(p) != 2 or p[1] > p[0] or p[1] < 0 for p in pairs):
-        raise UserError(f"--starts '{text}' must be MU_S:MU_K pairs with 0 ≤ MU_K ≤ MU_S, "
-                        "e.g. --starts 0.3:0.2,0.6:0.4")
+    if not pairs or any(len(p) != 2 or not 0 <= p[1] <= p[0] for p in pairs):
+        raise UserError(f"--starts '{text[:60]}' must be MU_S:MU_K pairs with 0 ≤ MU_K ≤ "
+                        "MU_S, e.g. --starts 0.3:0.2,0.6:0.4")
     return pairs
 
 
@@ -35,7 +35,7 @@ def _describe(result) -> str:
     mu_s = _fmt(s["mu_s"]) if s["mu_s"] is not None else (
         f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
         else "not identifiable")
-    return (f"{result.name}: {c['segments']} segments ({c['estimated']} estimated, "
+    return (f"{result.well}: {c['segments']} segments ({c['estimated']} estimated, "
             f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed); "
             f"μ_k = {_fmt(s['mu_k'])}, μ_s = {mu_s}")
 
@@ -53,51 +53,38 @@ def _describe(result) -> str:
               "(not above the data's own rate: a higher HZ is ignored with a warning).")
 @click.option("--starts", help="Observer starts MU_S:MU_K,... (overrides observer.starts).")
 @click.option("--pdf/--no-pdf", default=False, help="Also write report.pdf.")
+@click.option("--report/--no-report", default=True, show_default=True,
+              help="Write report.html (--no-report: the result files only).")
 @click.option("--workers", type=int, default=1, show_default=True,
               help="Wells processed in parallel (local processes).")
-def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
+def command(wells, out, config, survey, rate, starts, pdf, report, workers) -> None:
     """Estimate friction factors (μ_s, μ_k) and bit speed, stand by stand, for each WELL.
 
     WELL is a data file (.parquet, .csv, .h5, .las) with optional NAME.toml and
     NAME.survey.csv sidecars, an HDF5 bundle, or a directory with well.toml.
     """
-    from drillfric.pipeline import run_well
-
-    if rate is not None and rate <= 0:
-        raise UserError(f"--rate must be positive, got {rate}")
+    if rate is not None and not rate > 0:
+        raise UserError(f"--rate must be positive, got {rate:.4g}")
     if workers < 1:
         raise UserError(f"--workers must be at least 1, got {workers}")
     pairs = parse_starts(starts)
-    _check_unique_names(wells, config)
+    overrides = {"observer.starts": [list(p) for p in pairs]} if pairs else {}
     if workers > 1 and len(wells) > 1:
-        _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers)
+        _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers)
         return
+    opened, unreadable = _open_all(wells, config, survey, overrides)
     failures = 0
-    unreadable = 0
-    for well in wells:
+    for well in opened:
         try:
-            with progress(f"{well.name}", total=1.0) as advance:
-                result = run_well(well, out, config=config, survey=survey, rate_hz=rate,
-                                  starts=pairs, pdf=pdf, progress=advance)
+            with well_progress(well.name) as tick:
+                result = _run_one(well, out, rate, pdf, report, tick)
         except DrillfricError as exc:
             if context().debug or len(wells) == 1:
                 raise
             click.secho(f"error: {exc.message}", err=True, fg="red")
             unreadable += 1
             continue
-        except Exception as exc:  # noqa: BLE001 — one well's bug must not stop the others
-            if context().debug or len(wells) == 1:
-                raise
-            click.secho(f"error: {well}: internal error: {type(exc).__name__}: {exc}",
-                        err=True, fg="red")
-            unreadable += 1
-            continue
-        for note in result.summary["assumed"]:
-            warn(f"{result.name}: assumed {note} — the numbers are indicative")
-        for note in result.warnings:
-            warn(f"{result.name}: {note}")
-        echo(_describe(result))
-        echo(f"report: {result.report}")
+        _print(result)
         failures += result.failed
     if unreadable == len(wells):
         raise UserError("no well could be read")
@@ -105,42 +92,66 @@ def command(wells, out, config, survey, rate, starts, pdf, workers) -> None:
         raise SystemExit(1)
 
 
-def _run_parallel(wells, out, config, survey, rate, pairs, pdf, workers) -> None:
+def _open_all(wells, config, survey, overrides) -> tuple[list, int]:
+    """Open every well once and refuse, before anything is written, two that would write
+    the same OUT/NAME; returns the opened wells and how many could not be read."""
+    from drillfric.io.results import check_distinct
+    from drillfric.io.well import open_well
+
+    opened, unreadable = [], 0
+    for path in wells:
+        try:
+            opened.append(open_well(path, config=config, survey=survey, overrides=overrides))
+        except DrillfricError as exc:
+            if context().debug or len(wells) == 1:
+                raise
+            click.secho(f"error: {exc.message}", err=True, fg="red")
+            unreadable += 1
+    check_distinct([(w.dir_name, str(w.files.data)) for w in opened])
+    return opened, unreadable
+
+
+def _run_one(well, out, rate, pdf, report, tick):
+    from drillfric.pipeline import run_well
+
+    return run_well(well, out, rate_hz=rate, pdf=pdf, report=report, progress=tick)
+
+
+def _print(result) -> None:
+    """Warnings, the result line and the report's path (only when it was written)."""
+    for note in result.summary["assumed"]:
+        warn(f"{result.well}: assumed {note} — the numbers are indicative")
+    for note in result.warnings:
+        warn(f"{result.well}: {note}")
+    click.echo(_describe(result))  # the result: printed even with --quiet
+    if result.report is not None:
+        echo(f"report: {result.report}")
+    else:
+        echo(f"results: {result.out_dir}")
+
+
+def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers) -> None:
     """Several wells on local worker processes, through the fleet executor (always redone;
     OUT gets the wells' directories only, none of the fleet files)."""
     from drillfric.fleet import WellSpec, run_many
 
+    from .common import progress
+
     specs = [WellSpec(Path(w), config=config, survey=survey) for w in wells]
-    overrides = {"observer.starts": [list(p) for p in pairs]} if pairs else None
     with progress(f"run ({len(specs)} wells)", total=len(specs)) as advance:
         result = run_many(specs, out, workers=workers, force=True, progress=advance,
-                          overrides=overrides, rate_hz=rate, pdf=pdf, fleet_files=False)
+                          overrides=overrides, rate_hz=rate, pdf=pdf, report=report,
+                          fleet_files=False)
     for well in result.wells:
         if well.status == "failed":
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
         elif well.result_dir is not None:
             for note in (well.summary or {}).get("warnings", []):
                 warn(f"{well.well}: {note}")
-            echo(f"{well.well}: report: {Path(well.result_dir) / 'report.html'}")
+            page = Path(well.result_dir) / "report.html"
+            echo(f"{well.well}: " + (f"report: {page}" if page.is_file()
+                                     else f"results: {well.result_dir}"))
     if result.count("failed") == len(result.wells):
         raise UserError("no well could be read")
     if result.count("failed") or result.failed_segments:
         raise SystemExit(1)
-
-
-def _check_unique_names(wells, config) -> None:
-    """Two wells with one name would overwrite each other's OUT/NAME: refuse up front."""
-    from drillfric.pipeline import well_name
-
-    if len(wells) < 2:
-        return
-    seen: dict[str, Path] = {}
-    for well in wells:
-        try:
-            name = well_name(well, config=config)
-        except DrillfricError:
-            continue  # unreadable wells are reported when they are run
-        if name in seen:
-            raise UserError(f"{seen[name]} and {well} would both write OUT/{name} — fix: give "
-                            "them distinct [well] name values or file names")
-        seen[name] = well

@@ -40,10 +40,10 @@ def _load(target: Path, config: str | None, survey: str | None, overrides: dict)
             None if name is None else cfg_path.parent / name)
         cfg = load_config(cfg_path, overrides=overrides)
         return cfg, None if survey_path is None else read_survey(survey_path)
-    from drillfric.io.well import _load_config, _load_survey, resolve_well
+    from drillfric.io.well import open_well
 
-    _, cfg_path, survey_path = resolve_well(target, config=config, survey=survey)
-    return _load_config(cfg_path, None, overrides), _load_survey(survey_path)
+    well = open_well(target, config=config, survey=survey, overrides=overrides, header=False)
+    return well.config, well.survey
 
 
 def _floats(text: str | None, what: str) -> list[float] | None:

@@ -251,7 +251,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "non-rotating string off bottom counts as tripping."),
         _positive("max_rop_m_h", 300.0, "m/h", "Fastest drilling: a bit going below the "
                   "known hole depth faster than this is running into existing hole (off "
-                  "bottom)."),
+                  "bottom). A huge value switches the speed gate off.", max=1e7),
         _positive("pumps_on_Pa", 1.0e6, "Pa", "Standpipe pressure above which the pumps count "
                   "as on (used when neither flow in nor pump rate is recorded)."),
         _positive("pumps_on_spm", 10.0, "1/min", "Pump rate above which the pumps count as "
@@ -331,7 +331,7 @@ DEFAULT_SECTIONS: tuple[dict, ...] = (
 CHANNEL_KEYS = ("time", "surface_rpm", "surface_torque", "hookload", "bit_depth",
                 "hole_depth", "wob", "block_position", "bit_rpm", "standpipe_pressure",
                 "flow_in", "flow_out", "pump_rate")
-_CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list}
+_CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
 
 
 @dataclass(frozen=True)
@@ -458,10 +458,13 @@ def _channels(raw: Any, file: str | None) -> dict:
         for key, value in spec.items():
             if key not in _CHANNEL_FIELDS:
                 raise ConfigError(f"unknown key 'channels.{name}.{key}'", file=file,
-                                  fix="use column, unit or mnemonics")
+                                  fix="use column, unit, scale or mnemonics")
             if not isinstance(value, _CHANNEL_FIELDS[key]) or isinstance(value, bool):
-                raise ConfigError(f"channels.{name}.{key} has the wrong type ({value!r})",
-                                  file=file)
+                raise ConfigError(f"channels.{name}.{key} has the wrong type", file=file,
+                                  fix='e.g. { column = "SRPM", unit = "rpm", scale = -1 }')
+            if key == "scale" and not (_is_number(value) and value != 0):
+                raise ConfigError(f"channels.{name}.scale must be a finite, non-zero number",
+                                  file=file, fix="e.g. scale = -1 for a log of opposite sign")
         out[name] = dict(spec)
     return out
 
@@ -599,7 +602,9 @@ def schema_markdown() -> str:
     lines += ["", "## [channels]", "",
               "Maps canonical channels to columns of the data file and their units, e.g. "
               '`surface_torque = { column = "STOR", unit = "kN.m" }`. A column may be a name or '
-              "a 0-based index (headerless files). `mnemonics = [...]` adds names to recognise.",
+              "a 0-based index (headerless files). `mnemonics = [...]` adds names to recognise; "
+              "`scale` multiplies the values after the unit conversion (`scale = -1` for a "
+              "log of opposite sign).",
               "", "Channel keys: " + ", ".join(f"`{c}`" for c in CHANNEL_KEYS), ""]
     return "\n".join(lines)
 

@@ -50,3 +50,8 @@ class ConfigError(DrillfricError):
 
 class ModelError(DrillfricError):
     """Physically meaningless or unstable model settings (zero inertia, μ_k > μ_s, ...)."""
+
+
+class OutputError(DrillfricError):
+    """Results cannot be written (disk full, read-only, name too long, a file in the way,
+    or a directory drillfric did not write where a result would go)."""

@@ -23,7 +23,6 @@ import fcntl
 import hashlib
 import json
 import os
-import shutil
 import socket
 import time
 import uuid
@@ -38,7 +37,16 @@ import pandas as pd
 
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
-from drillfric.io.results import file_sha256, jsonable, missing_dirs, remove_empty, write_json
+from drillfric.io.results import (
+    check_distinct,
+    file_sha256,
+    jsonable,
+    missing_dirs,
+    remove_empty,
+    remove_stale,
+    write_json,
+)
+from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS, SEGMENT_LIST_FIELDS
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"
@@ -161,14 +169,16 @@ class WellTask:
     overrides: dict
     rate_hz: float | None = None
     pdf: bool = False
+    report: bool = True
 
 
 def process_well(task: WellTask) -> dict:
     """Run one well on a worker and return its small result record (never raises).
 
-    The worker writes OUT/NAME itself (atomically). The record carries the status, the
-    message of a failure, the summary, timings and where it ran.
+    The worker opens the well itself and writes OUT/NAME (atomically). The record carries
+    the status, the message of a failure, the summary, timings and where it ran.
     """
+    from drillfric.io.well import open_well
     from drillfric.pipeline import run_well
 
     started = _now()
@@ -176,8 +186,10 @@ def process_well(task: WellTask) -> dict:
     record = {"status": "failed", "message": "", "summary": None, "out_dir": None,
               "failed_segments": 0}
     try:
-        result = run_well(task.data, task.out_root, config=task.config, survey=task.survey,
-                          overrides=task.overrides, rate_hz=task.rate_hz, pdf=task.pdf)
+        well = open_well(task.data, config=task.config, survey=task.survey,
+                         overrides=task.overrides, name=task.name)
+        result = run_well(well, task.out_root, rate_hz=task.rate_hz, pdf=task.pdf,
+                          report=task.report)
         record.update(status="ok", summary=jsonable(result.summary),
                       out_dir=str(result.out_dir), failed_segments=result.failed)
     except DrillfricError as exc:
@@ -200,36 +212,49 @@ class _Job:
     """A well after preparation: its task and fingerprint, or why it cannot run."""
 
     name: str
+    dir_name: str
     task: WellTask | None
     fingerprint: dict
     error: str = ""
 
 
-def _prepare(spec: WellSpec, out_root: Path, overrides: dict, options: dict,
-             known: dict) -> _Job:
-    """Resolve files, hash them (reusing hashes of unchanged size and mtime), hash config."""
-    from drillfric.io.well import load_setup, resolve_well
+def _open_job(spec: WellSpec, out_root: Path, overrides: dict, options: dict) -> _Job:
+    """Open the well (files, configuration, name) and make its task (no hashing yet)."""
+    from drillfric.io.well import open_well
 
     fallback = spec.name or spec.data.stem
     try:
-        files = resolve_well(spec.data, config=spec.config, survey=spec.survey)
-        over = dict(overrides) | ({"well.name": spec.name} if spec.name else {})
-        cfg, _ = load_setup(spec.data, config=spec.config, survey=spec.survey, overrides=over)
-        name = cfg["well.name"] or (spec.data.name if spec.data.is_dir() else files[0].stem)
-        inputs = {role: _file_stamp(p, known) for role, p in zip(("data", "config", "survey"),
-                                                                 files, strict=True) if p}
+        well = open_well(spec.data, config=spec.config, survey=spec.survey,
+                         overrides=overrides, name=spec.name)
     except DrillfricError as exc:
-        return _Job(fallback, None, {}, exc.message)
+        return _Job(fallback, fallback, None, {}, exc.message)
     except OSError as exc:
-        return _Job(fallback, None, {}, f"{exc.filename}: cannot read ({exc.strerror})")
-    effective = json.dumps(jsonable({"config": cfg.to_dict(), "options": options}),
+        return _Job(fallback, fallback, None, {},
+                    f"{exc.filename}: cannot read ({exc.strerror})")
+    effective = json.dumps(jsonable({"config": well.config.to_dict(), "options": options}),
                            sort_keys=True, default=str)
-    fingerprint = {"inputs": inputs, "drillfric_version": __version__,
+    files = {"data": well.files.data, "config": well.files.config,
+             "survey": well.files.survey}
+    fingerprint = {"inputs": {role: p for role, p in files.items() if p},
+                   "drillfric_version": __version__,
                    "config_sha256": hashlib.sha256(effective.encode()).hexdigest()}
-    task = WellTask(name, str(Path(spec.data).resolve()), _abs(spec.config),
-                    _abs(spec.survey), str(out_root.resolve()), over | {"well.name": name},
-                    options.get("rate_hz"), options.get("pdf", False))
-    return _Job(name, task, fingerprint)
+    task = WellTask(well.name, str(Path(spec.data).resolve()), _abs(spec.config),
+                    _abs(spec.survey), str(out_root.resolve()), dict(overrides),
+                    options.get("rate_hz"), options.get("pdf", False),
+                    options.get("report", True))
+    return _Job(well.name, well.dir_name, task, fingerprint)
+
+
+def _hashed(job: _Job, known: dict) -> _Job:
+    """The job with its input files stamped and hashed (hashes of files unchanged in size
+    and mtime since the manifest recorded them are reused)."""
+    if job.task is None:
+        return job
+    try:
+        inputs = {role: _file_stamp(p, known) for role, p in job.fingerprint["inputs"].items()}
+    except OSError as exc:
+        return replace(job, task=None, error=f"{exc.filename}: cannot read ({exc.strerror})")
+    return replace(job, fingerprint=job.fingerprint | {"inputs": inputs})
 
 
 def _abs(path) -> str | None:
@@ -354,7 +379,7 @@ class _Manifest:
 def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | None = None,
              force: bool = False, progress: Callable[[float], None] | None = None,
              overrides: dict | None = None, rate_hz: float | None = None,
-             pdf: bool = False, fleet_files: bool = True) -> FleetResult:
+             pdf: bool = False, report: bool = True, fleet_files: bool = True) -> FleetResult:
     """Process wells in parallel, skipping those unchanged since their last ok run.
 
     Parameters
@@ -376,6 +401,8 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
         ``{"table.key": value}`` for every well.
     rate_hz, pdf
         As for ``drillfric run``.
+    report : bool
+        Write each well's report (False: ``--no-report``; the fleet report is still written).
     fleet_files : bool
         Keep the fleet's bookkeeping in OUT: the lock, manifest.json (so unchanged wells
         are skipped next time), fleet_summary.parquet and fleet.html. False for
@@ -391,14 +418,17 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
     t0 = time.perf_counter()
     out_root = Path(out_root)
     advance = progress or (lambda amount=1.0: None)
-    options = {"rate_hz": rate_hz, "pdf": pdf}
+    options = {"rate_hz": rate_hz, "pdf": pdf, "report": report}
+    jobs = [_open_job(s, out_root, overrides or {}, options) for s in wells]
+    check_distinct([(j.dir_name, f"well '{j.name}' ({spec.data})")
+                    for j, spec in zip(jobs, wells, strict=True) if j.task is not None])
     created = missing_dirs(out_root)  # without fleet files: removed again if left empty
     with _locked(out_root) if fleet_files else nullcontext():
         if fleet_files:
-            _remove_stale(out_root)
+            remove_stale(out_root)
         manifest = _Manifest(out_root if fleet_files else None)
         known = manifest.known_files()
-        jobs = _unique([_prepare(s, out_root, overrides or {}, options, known) for s in wells])
+        jobs = [_hashed(j, known) for j in jobs]
         outcomes: dict[str, WellOutcome] = {}
         todo = []
         for job in jobs:
@@ -421,30 +451,17 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
         finally:
             manifest.save()
             if scheduler is None:  # local workers are gone: what they left is stale
-                _remove_stale(out_root, None if fleet_files else {j.name for j in jobs})
+                for job in jobs:
+                    remove_stale(out_root, job.dir_name)
         ordered = tuple(outcomes[j.name] for j in jobs)
-        summary, report, notes = None, None, ()
+        summary_path, report_path, notes = None, None, ()
         if fleet_files:
-            summary = _write_summary(out_root, ordered)
-            report, notes = _write_report(out_root, ordered)
+            summary_path = _write_summary(out_root, ordered)
+            report_path, notes = _write_report(out_root, ordered)
         else:
             remove_empty(created)  # several workers may each have made OUT for a failed well
-    return FleetResult(out_root, ordered, time.perf_counter() - t0, manifest.path, summary,
-                       report, notes)
-
-
-def _unique(jobs: list[_Job]) -> list[_Job]:
-    """Two wells writing to the same OUT/NAME: the second one fails with a clear message."""
-    seen: set[str] = set()
-    out = []
-    for job in jobs:
-        if job.name in seen:
-            job = _Job(f"{job.name} ({job.task.data if job.task else '?'})", None, {},
-                       f"another well of this fleet is also named '{job.name}' — give it its "
-                       "own [well] name or a 'well' column in a manifest")
-        seen.add(job.name)
-        out.append(job)
-    return out
+    return FleetResult(out_root, ordered, time.perf_counter() - t0, manifest.path,
+                       summary_path, report_path, notes)
 
 
 def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int) -> WellOutcome:
@@ -578,46 +595,30 @@ def _locked(out_root: Path):
         fh.close()
 
 
-def _remove_stale(out_root: Path, names: set[str] | None = None) -> None:
-    """Remove temporary directories left by an interrupted run (never a finished well);
-    with ``names``, only those of these wells."""
-    for path in out_root.glob(".*"):
-        if ".tmp-" not in path.name and ".old-" not in path.name:
-            continue
-        if names is not None and path.name[1:].rsplit(".", 1)[0] not in names:
-            continue
-        if path.is_dir():
-            shutil.rmtree(path, ignore_errors=True)
-        else:
-            path.unlink(missing_ok=True)
-
-
 # --------------------------------------------------------------------------- fleet files
-_WELL_COLUMNS = ("well", "well_status", "well_message", "well_mu_s", "well_mu_k",
-                 "well_mu_s_lower_bound", "segment_id")
-
-
 def summary_frame(outcomes) -> pd.DataFrame:
     """fleet_summary.parquet: one row per well and segment (a failed well: one row).
 
-    Segment columns keep their summary.json names (``mu_s``, ``status``, …); well-level
-    columns are prefixed ``well_``.
+    Columns: :data:`drillfric.result.FLEET_WELL_COLUMNS` (well level, prefixed ``well_``),
+    then every :class:`~drillfric.result.SegmentRecord` field but ``id`` (as ``segment_id``)
+    under its summary.json name, list fields as JSON text.
     """
+    seg_fields = [f for f in SEGMENT_FIELDS if f != "id"]
     rows = []
     for o in outcomes:
-        base = {"well": o.well, "well_status": o.status, "well_message": o.message,
-                "result_dir": None if o.result_dir is None else str(o.result_dir)}
         s = o.summary or {}
-        base.update(well_mu_s=s.get("mu_s"), well_mu_k=s.get("mu_k"),
-                    well_mu_s_lower_bound=s.get("mu_s_lower_bound"),
-                    drillfric_version=s.get("drillfric_version"))
-        segments = s.get("segments") or [{}]
-        for seg in segments:
-            seg = {k: v for k, v in seg.items() if not isinstance(v, (list, dict))}
-            rows.append(base | {"segment_id": seg.pop("id", None)} | seg)
-    frame = pd.DataFrame(rows)
-    if "segment_id" in frame:
-        frame["segment_id"] = frame["segment_id"].astype("Int64")
+        base = {"well": o.well, "well_status": o.status, "well_message": o.message,
+                "result_dir": None if o.result_dir is None else str(o.result_dir),
+                "well_mu_s": s.get("mu_s"), "well_mu_k": s.get("mu_k"),
+                "well_mu_s_lower_bound": s.get("mu_s_lower_bound"),
+                "drillfric_version": s.get("drillfric_version")}
+        for seg in s.get("segments") or [{}]:
+            row = base | {"segment_id": seg.get("id")}
+            row |= {f: json.dumps(seg[f]) if f in SEGMENT_LIST_FIELDS and f in seg
+                    else seg.get(f) for f in seg_fields}
+            rows.append(row)
+    frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields)
+    frame["segment_id"] = frame["segment_id"].astype("Int64")
     return frame
 
 

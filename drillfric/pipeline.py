@@ -1,12 +1,19 @@
-"""``drillfric run``: one well, stand by stand (issue 6).
+"""``drillfric run``: one well, stand by stand, as a short list of named steps.
 
-ingest (streamed in chunks) → segment into rotating stands → per segment: torque and drag
-at its bit depth, observer from the configured starts (warm-started from the previous
-segment), batch refinement, seeded observer pass (:mod:`drillfric.estimation.chain`) → outputs of
-INTERFACE.md (summary.json, estimates.parquet, segments.parquet, report) written atomically.
+:func:`run_well` takes a well opened once (:func:`drillfric.io.well.open_well`) and
 
-Memory stays bounded: only the rows of the segment being assembled are held (rows the
-segmenter has finished with are dropped), and estimates are appended to Parquet per segment.
+1. **streams** its surface data in chunks, checking the log as it goes
+   (:class:`~drillfric.io.logcheck.LogCheck`), and cuts it into rotating segments with their
+   rows (:class:`~drillfric.segmentation.SegmentStream`);
+2. **estimates** each segment with the chain of :mod:`drillfric.estimation.chain` (torque and
+   drag at its depth, observer starts, batch fit, verdict, seeded ensemble), warm-starting
+   from the previous segment;
+3. **collects** each segment's :class:`~drillfric.result.SegmentRecord` and output rows into
+   a sink — in memory, or appended to the result files as it goes (bounded memory);
+4. **summarises** the well (consensus, counts, what was assumed) and writes the results of
+   docs/outputs.md atomically into ``OUT/NAME`` (:class:`~drillfric.io.results.
+   ResultDirectory`), then the report.
+
 Library code: no printing; progress goes through a callback.
 """
 
@@ -30,71 +37,239 @@ from drillfric.estimation.chain import (
     estimate_segment,
 )
 from drillfric.estimation.observer import ObserverRecord
+from drillfric.io.logcheck import LogCheck
 from drillfric.io.results import (
     EstimatesWriter,
-    atomic_directory,
+    ResultDirectory,
     file_sha256,
     write_json,
     write_segments,
 )
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
-from drillfric.io.well import (
-    assumed_units,
-    channel_mappings,
-    iter_surface,
-    load_setup,
-    resolve_well,
+from drillfric.io.well import CHUNK_ROWS, Well
+from drillfric.result import (
+    ESTIMATE_NAMES,
+    SEEDED_START_ID,
+    Kind,
+    SegmentRecord,
+    Status,
+    segment_columns,
 )
-from drillfric.segmentation import Segment, Segmenter
+from drillfric.segmentation import Segment, SegmentStream
 from drillfric.units import RPM_TO_RAD_S
-from drillfric.wellpath import WellPath
 
 #: Bit depth assumed when neither the log, the config nor a survey gives one [m].
 DEFAULT_BIT_DEPTH_M = 2500.0
-#: Seconds of data before a segment handed to the estimator, so that a start-up (and a
-#: creep break-over) is seen from rest.
-PREROLL_S = 5.0
-#: ``start_id`` of the final observer pass seeded with the batch-refined factors.
-SEEDED_START_ID = -1
 #: Relative margin by which a requested rate may exceed the data's nominal rate (timing
 #: jitter) before it counts as upsampling.
 RATE_MARGIN = 0.01
-_KEEP = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N", "bit_rpm")
 
 
-@dataclass
-class RunResult:
-    """What a run produced (the CLI turns it into a summary line and an exit code).
+@dataclass(frozen=True)
+class RunProgress:
+    """Where a run stands (for a progress bar with an ETA).
 
     Attributes
     ----------
-    name : str
-    out_dir : Path
-        OUT/NAME, complete.
+    rows_done : int
+        Input rows read and, up to the last finished segment, estimated.
+    rows_total : int or None
+        Rows of the input when known cheaply (Parquet metadata, a CSV line count).
+    segments_done : int
+    """
+
+    rows_done: int
+    rows_total: int | None
+    segments_done: int
+
+    @property
+    def fraction(self) -> float | None:
+        """Share of the input done [-], None when the size is not known."""
+        if not self.rows_total:
+            return None
+        return min(self.rows_done / self.rows_total, 1.0)
+
+
+@dataclass
+class WellResult:
+    """What a run of one well produced (the API's return value; the CLI prints from it).
+
+    Attributes
+    ----------
+    well : str
+        The well's name.
     summary : dict
-        Contents of summary.json.
+        summary.json (docs/outputs.md).
+    segments : pandas.DataFrame
+        One row per segment (:class:`~drillfric.result.SegmentRecord` fields).
+    out_dir : Path or None
+        ``OUT/NAME`` when results were written, else None.
     failed : int
         Segments whose estimation failed.
     warnings : list of str
-        What the user should know about the run (also ``summary["warnings"]``).
+        What the user should know (also ``summary["warnings"]``).
     """
 
-    name: str
-    out_dir: Path
+    well: str
     summary: dict
+    segments: pd.DataFrame
+    out_dir: Path | None = None
     failed: int = 0
     warnings: list = field(default_factory=list)
+    _estimates: pd.DataFrame | None = field(default=None, repr=False)
 
     @property
-    def report(self) -> Path:
-        """Path of report.html."""
-        return self.out_dir / "report.html"
+    def estimates(self) -> pd.DataFrame:
+        """estimates.parquet's rows (read from ``out_dir`` when the run wrote them)."""
+        if self._estimates is None and self.out_dir is not None:
+            self._estimates = pd.read_parquet(self.out_dir / "estimates.parquet")
+        return self._estimates if self._estimates is not None else pd.DataFrame(
+            columns=list(ESTIMATE_NAMES))
+
+    @property
+    def report(self) -> Path | None:
+        """report.html when it was written."""
+        path = None if self.out_dir is None else self.out_dir / "report.html"
+        return path if path is not None and path.is_file() else None
 
 
-def _bit_depth_default(cfg, survey: WellPath | None, assumed: list) -> float:
+def run_well(well: Well, out_root=None, *, rate_hz: float | None = None, pdf: bool = False,
+             report: bool = True, progress: Callable[[RunProgress], None] | None = None,
+             chunk_rows: int = CHUNK_ROWS) -> WellResult:
+    """Run the whole estimation on one well; write ``out_root/NAME`` when ``out_root`` is given.
+
+    Parameters
+    ----------
+    well : Well
+        An opened well (:func:`drillfric.io.well.open_well`).
+    out_root : str or Path, optional
+        Output directory; results go to ``out_root/NAME`` atomically. None: results in
+        memory only (nothing written).
+    rate_hz : float, optional
+        Resample the input to this rate before estimation; a rate above the data's own is
+        not used (:func:`effective_rate`: a warning in ``summary["warnings"]``).
+    pdf, report : bool
+        Also write report.pdf; write report.html at all (only with ``out_root``).
+    progress : callable, optional
+        Called with a :class:`RunProgress` as rows are read and segments finish.
+    chunk_rows : int
+        Rows read per chunk.
+
+    Raises
+    ------
+    DrillfricError
+        Unreadable or meaningless input, or results that cannot be written (nothing is
+        written then).
+    """
+    t_wall = time.perf_counter()
+    if out_root is None:
+        return _run(well, _MemorySink(), rate_hz, progress, chunk_rows, t_wall)
+    with ResultDirectory(out_root, well.dir_name, well.name) as tmp:
+        result = _run(well, _DirectorySink(tmp), rate_hz, progress, chunk_rows, t_wall)
+        if report:
+            _write_report(tmp, pdf, result)
+    result.out_dir = Path(out_root) / well.dir_name
+    return result
+
+
+def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
+    """Steps 1–4 into ``sink``."""
+    estimator = _SegmentEstimator(well)
+    check = LogCheck(well)
+    tracker = well.time_tracker()
+    total = _count_rows(well.files.data)
+    stream = SegmentStream(well.config)
+    records: list[SegmentRecord] = []
+    warnings: list[str] = []
+
+    def take(done: list[tuple[Segment, pd.DataFrame]]) -> None:
+        for seg, rows in done:
+            record, frames = estimator.segment(seg, rows)
+            records.append(record)
+            sink.add(record, frames, estimator.has_truth)
+            if progress:
+                progress(RunProgress(seg.i_end, total, len(records)))
+
+    for chunk in well.chunks(chunk_rows, tracker):
+        if check.rows == 0 and len(chunk):
+            estimator.rate_hz = _first_chunk(well, chunk, rate_hz, warnings)
+            estimator.has_truth = "bit_rpm" in chunk
+        check.feed(chunk)
+        take(stream.feed(chunk))
+        if progress:
+            progress(RunProgress(check.rows, total, len(records)))
+    take(stream.close())
+    if check.rows == 0:
+        raise InputError("no data rows", file=well.files.data,
+                         fix="check that the file holds samples below its header")
+    check.finish(tracker.duplicates)
+    warnings += [w for w in (check.nothing_found(len(records)),) if w]
+    summary = summarise(well, records, estimator, check.rows, rate_hz, warnings,
+                        time.perf_counter() - t_wall)
+    sink.finish(well, summary, records)
+    return WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
+                      failed=estimator.failed, warnings=summary["warnings"],
+                      _estimates=sink.estimates())
+
+
+def _first_chunk(well: Well, chunk: pd.DataFrame, rate_hz, warnings: list) -> float | None:
+    """Checks of the first chunk; the rate the estimation resamples to."""
+    check_plausible_rate(chunk["time_s"].to_numpy(), file=well.files.data)
+    rate_used, note = effective_rate(rate_hz, chunk["time_s"].to_numpy())
+    warnings += [note] * bool(note)
+    return rate_used
+
+
+# --------------------------------------------------------------------------- step 2
+class _SegmentEstimator:
+    """Step 2 for every segment of a well, carrying what passes from one to the next (the
+    warm start, the fallback bit depth, the count of failures)."""
+
+    def __init__(self, well: Well):
+        self.well = well
+        self.rate_hz: float | None = None
+        self.has_truth = False
+        self.warm: tuple | None = None
+        self.failed = 0
+        self.fallback_depth: float | None = None
+        self.assumed: list[str] = []
+
+    def segment(self, seg: Segment, rows: pd.DataFrame) -> tuple[SegmentRecord, dict | None]:
+        """The record and output rows (estimates, profile) of one segment."""
+        depth = self._depth(seg)
+        if seg.status != "ok":
+            return _record(seg, depth, Status.SKIPPED, seg.message), None
+        data = _segment_data(rows, seg, depth)
+        cfg = self.well.config
+        try:
+            check_segment(data, cfg)
+            est = estimate_segment(cfg, self.well.survey, data, warm=self.warm,
+                                   rate_hz=self.rate_hz,
+                                   torque_channel=self.well.channels["surface_torque_Nm"])
+        except SkipSegment as exc:
+            return _record(seg, depth, Status.SKIPPED, exc.problem), None
+        except DrillfricError as exc:
+            self.failed += 1
+            return _record(seg, depth, Status.FAILED, exc.message), None
+        if est.converged and seg.kind == Kind.OFF_BOTTOM:
+            self.warm = (est.mu_s_seed, est.mu_k)
+        frames = {"estimates": _estimate_frame(seg.id, est, data, cfg.omega_c_rad_s),
+                  "profile": _profile_frame(seg.id, est)}
+        return _record(seg, depth, Status.OK, seg.message, est), frames
+
+    def _depth(self, seg: Segment) -> float:
+        if np.isfinite(seg.bit_depth_m):
+            return seg.bit_depth_m
+        if self.fallback_depth is None:
+            self.fallback_depth = _bit_depth_default(self.well, self.assumed)
+        return self.fallback_depth
+
+
+def _bit_depth_default(well: Well, assumed: list) -> float:
     """Bit depth [m] of segments the log gives none for: ``[well] bit_depth_m``, else a
     simulated well's ``[simulate] bit_depth_m``, else (announced in ``assumed``) the
     survey's last station or :data:`DEFAULT_BIT_DEPTH_M`."""
+    cfg, survey = well.config, well.survey
     for key in ("well.bit_depth_m", "simulate.bit_depth_m"):
         if cfg[key] is not None:
             return cfg[key]
@@ -105,34 +280,6 @@ def _bit_depth_default(cfg, survey: WellPath | None, assumed: list) -> float:
     assumed.append(f"bit depth {DEFAULT_BIT_DEPTH_M:.0f} m: neither the log nor a survey "
                    "gives one")
     return DEFAULT_BIT_DEPTH_M
-
-
-def _preroll_start(buffer: pd.DataFrame, lo: int, floor: int) -> int:
-    """First buffer row handed to the estimator for a segment starting at row ``lo``.
-
-    Up to :data:`PREROLL_S` earlier (the start-up seen from rest), but not before ``floor``
-    (the end of the previous segment) and only after the last null of speed or torque.
-    """
-    if lo <= floor:
-        return lo
-    t = buffer["time_s"].to_numpy()
-    start = floor + int(np.searchsorted(t[floor:lo], t[lo] - PREROLL_S))
-    pre = buffer.iloc[start:lo]
-    bad = ~(np.isfinite(pre["surface_rpm"].to_numpy(float))
-            & np.isfinite(pre["surface_torque_Nm"].to_numpy(float)))
-    if bad.any():
-        start += int(np.flatnonzero(bad)[-1]) + 1
-    return start
-
-
-def _rows_done(buffer: pd.DataFrame, pending: int) -> int:
-    """How many leading buffer rows no segment can need any more: those before the
-    segmenter's pending row, less the pre-roll a segment starting there may take."""
-    if pending <= 0:
-        return 0
-    t = buffer["time_s"].to_numpy()
-    ref = t[pending] if pending < t.size else t[-1]
-    return int(np.searchsorted(t[:pending], ref - PREROLL_S))
 
 
 def effective_rate(rate_hz: float | None, time_s: np.ndarray) -> tuple[float | None, str | None]:
@@ -163,19 +310,11 @@ def effective_rate(rate_hz: float | None, time_s: np.ndarray) -> tuple[float | N
                   f"({data_rate:.3g} Hz): estimated at the data's rate, not upsampled")
 
 
-def well_name(path, *, config=None) -> str:
-    """The name a well's results go under (OUT/NAME): ``[well] name`` or the file stem."""
-    data_path, _, _ = resolve_well(path, config=config)
-    cfg, _ = load_setup(path, config=config)
-    return cfg["well.name"] or (Path(path).name if Path(path).is_dir() else data_path.stem)
-
-
-def _segment_data(rows: pd.DataFrame, seg: Segment, fallback_depth: float) -> SegmentData:
+def _segment_data(rows: pd.DataFrame, seg: Segment, depth: float) -> SegmentData:
     """The estimator's samples: rows with both speed and torque (the few nulls a segment
     may hold are bridged when the measurements are put on a uniform grid)."""
     rows = rows[np.isfinite(rows["surface_rpm"].to_numpy(float))
                 & np.isfinite(rows["surface_torque_Nm"].to_numpy(float))]
-    depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
     wob = float(np.nanmedian(rows["wob_N"])) if "wob_N" in rows and \
         rows["wob_N"].notna().any() else 0.0
     truth = rows["bit_rpm"].to_numpy(float) if "bit_rpm" in rows else None
@@ -184,24 +323,24 @@ def _segment_data(rows: pd.DataFrame, seg: Segment, fallback_depth: float) -> Se
                        wob_N=max(wob, 0.0), bit_rpm=truth)
 
 
-def _segment_row(seg: Segment, est: SegmentEstimate | None, status: str, message: str,
-                 depth: float) -> dict:
-    row = {"id": seg.id, "kind": seg.kind, "t_start_s": seg.t_start_s,
-           "t_end_s": seg.t_end_s, "bit_depth_m": depth, "mu_s": None, "mu_k": None,
-           "mu_s_identifiable": False, "mu_s_lower_bound": None, "mu_s_spread": None,
-           "mu_k_spread": None, "converged": False, "method": "none",
-           "settling_time_s": None, "residual_rms_rpm": None, "stick_slip_severity": None,
-           "status": status, "message": message, "duration_s": seg.duration_s}
-    if est is not None:
-        row.update({k: getattr(est, k) for k in (
-            "mu_s", "mu_k", "mu_s_identifiable", "mu_s_lower_bound", "mu_s_spread",
-            "mu_k_spread", "converged", "method", "settling_time_s", "residual_rms_rpm",
-            "stick_slip_severity", "stuck_fraction", "mu_k_observer", "mu_s_observer",
-            "mu_td", "T_N_Nm", "bit_rms_error_rpm")})
-        row["flags"] = list(est.flags)
-        row["starts"] = est.starts.tolist()  # start_id i of estimates.parquet (−1: seeded)
-        row["message"] = "; ".join([message] * bool(message) + list(est.messages))
-    return row
+# --------------------------------------------------------------------------- step 3
+def _record(seg: Segment, depth: float, status: Status, message: str,
+            est: SegmentEstimate | None = None) -> SegmentRecord:
+    """A segment's :class:`SegmentRecord` (the estimate's numbers when there is one)."""
+    base = dict(id=seg.id, kind=Kind(seg.kind), t_start_s=seg.t_start_s, t_end_s=seg.t_end_s,
+                bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message)
+    if est is None:
+        return SegmentRecord(**base)
+    return SegmentRecord(**base | dict(
+        message="; ".join([message] * bool(message) + list(est.messages)),
+        mu_s=est.mu_s, mu_k=est.mu_k, mu_s_identifiable=est.mu_s_identifiable,
+        mu_s_lower_bound=est.mu_s_lower_bound, mu_s_spread=est.mu_s_spread,
+        mu_k_spread=est.mu_k_spread, converged=est.converged, method=est.method,
+        settling_time_s=est.settling_time_s, residual_rms_rpm=est.residual_rms_rpm,
+        stick_slip_severity=est.stick_slip_severity, stuck_fraction=est.stuck_fraction,
+        mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
+        T_N_Nm=est.T_N_Nm, bit_rms_error_rpm=est.bit_rms_error_rpm, flags=est.flags,
+        starts=tuple(map(tuple, est.starts.tolist()))))
 
 
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
@@ -256,208 +395,127 @@ def _profile_frame(seg_id: int, est: SegmentEstimate, step_m: float = 10.0) -> p
                          "fc_Nm_m": td.fc_Nm_m[keep]})
 
 
-def consensus(rows: list[dict]) -> dict:
+class _MemorySink:
+    """Collects a run's output rows in memory (the Python API without ``out``)."""
+
+    def __init__(self):
+        self.frames: dict[str, list] = {"estimates": [], "profile": []}
+
+    def add(self, record: SegmentRecord, frames: dict | None, with_truth: bool) -> None:
+        for key, frame in (frames or {}).items():
+            self.frames[key].append(frame)
+
+    def finish(self, well: Well, summary: dict, records) -> None:
+        """Nothing to write."""
+
+    def estimates(self) -> pd.DataFrame | None:
+        parts = self.frames["estimates"]
+        return pd.concat(parts, ignore_index=True) if parts else None
+
+
+class _DirectorySink:
+    """Appends a run's output rows to the result files as segments finish (bounded memory)."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.writer: EstimatesWriter | None = None
+        self.profiles: list[pd.DataFrame] = []
+
+    def add(self, record: SegmentRecord, frames: dict | None, with_truth: bool) -> None:
+        if frames is None:
+            return
+        if self.writer is None:
+            self.writer = EstimatesWriter(self.folder / "estimates.parquet", with_truth)
+        self.writer.write(frames["estimates"])
+        self.profiles.append(frames["profile"])
+
+    def finish(self, well: Well, summary: dict, records) -> None:
+        """Write every result file but the report."""
+        if self.writer is None:
+            self.writer = EstimatesWriter(self.folder / "estimates.parquet", False)
+        self.writer.close()
+        write_json(self.folder / "summary.json", summary)
+        write_segments(self.folder / "segments.parquet", records)
+        if self.profiles:
+            pd.concat(self.profiles, ignore_index=True).to_parquet(
+                self.folder / "profiles.parquet", index=False)
+        if well.survey is not None:
+            pd.DataFrame(well.survey.at(well.survey.md_m)).to_parquet(
+                self.folder / "wellpath.parquet", index=False)
+
+    def estimates(self) -> None:
+        return None  # read back from the file when asked (WellResult.estimates)
+
+
+# --------------------------------------------------------------------------- step 4
+def consensus(records: list[SegmentRecord]) -> dict:
     """Well-level friction factors from the segments (never a made-up value).
 
     Only converged, off-bottom segments with status ok count. μ_k: their median; μ_s: the
     median over those that identify it; otherwise the median of their lower bounds (each is
     claimed valid, so the median is too, and one unreliable segment cannot set it).
     """
-    ok = [r for r in rows if r["status"] == "ok" and r["kind"] == "off_bottom_rotating"
-          and r["converged"]]
-    mu_k = [r["mu_k"] for r in ok if r["mu_k"] is not None]
-    mu_s = [r["mu_s"] for r in ok if r["mu_s_identifiable"] and r["mu_s"] is not None]
-    bounds = [r["mu_s_lower_bound"] for r in ok if r["mu_s_lower_bound"] is not None]
+    ok = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
+          and r.converged]
+    mu_k = [r.mu_k for r in ok if r.mu_k is not None]
+    mu_s = [r.mu_s for r in ok if r.mu_s_identifiable and r.mu_s is not None]
+    bounds = [r.mu_s_lower_bound for r in ok if r.mu_s_lower_bound is not None]
     return {"mu_k": float(np.median(mu_k)) if mu_k else None,
             "mu_s": float(np.median(mu_s)) if mu_s else None,
             "mu_s_lower_bound": None if mu_s or not bounds else float(np.median(bounds))}
 
 
-def run_well(path, out_root, *, config=None, survey=None, overrides=None,
-             rate_hz: float | None = None, starts=None, pdf: bool = False,
-             progress: Callable[[float], None] | None = None,
-             chunk_rows: int = 200_000) -> RunResult:
-    """Run the whole estimation on one well and write OUT/NAME atomically.
-
-    Parameters
-    ----------
-    path : str or Path
-        The well (data file, HDF5 bundle or directory; INTERFACE.md).
-    out_root : str or Path
-        Output directory; results go to ``out_root/NAME``.
-    config, survey : path, optional
-        Overrides of the sidecar configuration and survey.
-    overrides : dict, optional
-        ``{"table.key": value}`` from the command line.
-    rate_hz : float, optional
-        Resample the input to this rate before estimation; a rate above the data's own is
-        not used (:func:`effective_rate`: a warning in ``summary["warnings"]``).
-    starts : list of (μ_s, μ_k), optional
-        Observer starts (overrides ``observer.starts``).
-    pdf : bool
-        Also write report.pdf.
-    progress : callable, optional
-        Called with the fraction of the input rows processed since the last call.
-
-    Raises
-    ------
-    DrillfricError
-        Unreadable input or configuration (nothing is written).
-    """
-    t_wall = time.perf_counter()
-    data_path, config_path, survey_path = resolve_well(path, config=config, survey=survey)
-    overrides = dict(overrides or {})
-    if starts is not None:
-        overrides["observer.starts"] = [list(map(float, s)) for s in starts]
-    cfg, well_path = load_setup(path, config=config, survey=survey, overrides=overrides)
-    name = well_name(path, config=config)
-    mappings = channel_mappings(path, cfg, config=config)
-    assumed = cfg.assumed_with(well_path) + assumed_units(mappings)
-    torque_channel = mappings["surface_torque_Nm"]
-    warnings: list[str] = []
-    rate_used = rate_hz
-    fallback_depth = None
-    total_rows = _count_rows(data_path)
-    segmenter = Segmenter(cfg)
-    rows_out: list[dict] = []
-    profiles: list[pd.DataFrame] = []
-    warm = None
-    failed = 0
-    buffer = pd.DataFrame()
-    buffer_start = 0
-    last_end = 0  # row after the last emitted segment: the next pre-roll starts no earlier
-    n_rows = 0
-    has_truth = None
-    final = Path(out_root) / name
-    with atomic_directory(final) as tmp:
-        writer = None
-        try:
-            def handle(done: list[Segment]):
-                nonlocal warm, failed, fallback_depth, writer, last_end
-                for seg in done:
-                    lo = _preroll_start(buffer, seg.i_start - buffer_start,
-                                        max(last_end - buffer_start, 0))
-                    rows = buffer.iloc[lo: seg.i_end - buffer_start]
-                    last_end = seg.i_end
-                    if fallback_depth is None and not np.isfinite(seg.bit_depth_m):
-                        fallback_depth = _bit_depth_default(cfg, well_path, assumed)
-                    depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth
-                    if seg.status != "ok":
-                        rows_out.append(_segment_row(seg, None, seg.status, seg.message,
-                                                     depth))
-                        continue
-                    data = _segment_data(rows, seg, depth)
-                    try:
-                        check_segment(data, cfg)
-                        est = estimate_segment(cfg, well_path, data, warm=warm,
-                                               rate_hz=rate_used,
-                                               torque_channel=torque_channel)
-                    except SkipSegment as exc:
-                        rows_out.append(_segment_row(seg, None, "skipped", exc.problem,
-                                                     depth))
-                        continue
-                    except DrillfricError as exc:
-                        failed += 1
-                        rows_out.append(_segment_row(seg, None, "failed", exc.message,
-                                                     depth))
-                        continue
-                    if writer is None:
-                        writer = EstimatesWriter(tmp / "estimates.parquet",
-                                                 data.bit_rpm is not None)
-                    writer.write(_estimate_frame(seg.id, est, data, cfg.omega_c_rad_s))
-                    rows_out.append(_segment_row(seg, est, "ok", "", depth))
-                    profiles.append(_profile_frame(seg.id, est))
-                    if est.converged and seg.kind == "off_bottom_rotating":
-                        warm = (est.mu_s_seed, est.mu_k)
-
-            for chunk in iter_surface(path, config=config, survey=survey,
-                                      chunk_rows=chunk_rows):
-                if has_truth is None:
-                    has_truth = "bit_rpm" in chunk
-                    check_plausible_rate(chunk["time_s"].to_numpy(), file=data_path)
-                    rate_used, note = effective_rate(rate_hz, chunk["time_s"].to_numpy())
-                    warnings += [note] * bool(note)
-                keep = chunk[[c for c in _KEEP if c in chunk]]
-                buffer = pd.concat([buffer, keep], ignore_index=True) if len(buffer) else \
-                    keep.reset_index(drop=True)
-                n_rows += len(chunk)
-                handle(segmenter.feed(chunk))
-                drop = _rows_done(buffer, segmenter.pending_from - buffer_start)
-                if drop > 0:
-                    buffer = buffer.iloc[drop:].reset_index(drop=True)
-                    buffer_start += drop
-                if progress and total_rows:
-                    progress(len(chunk) / total_rows)
-            handle(segmenter.close())
-            if n_rows == 0:
-                raise InputError("no data rows", file=data_path,
-                                 fix="check that the file holds samples below its header")
-        finally:
-            if writer is not None:
-                writer.close()
-        if writer is None:
-            EstimatesWriter(tmp / "estimates.parquet", bool(has_truth)).close()
-        summary = _summary(name, cfg, rows_out, assumed, data_path, config_path, survey_path,
-                           n_rows, rate_hz, rate_used, time.perf_counter() - t_wall)
-        summary["warnings"] = list(warnings)
-        write_json(tmp / "summary.json", summary)
-        write_segments(tmp / "segments.parquet", rows_out)
-        if profiles:
-            pd.concat(profiles, ignore_index=True).to_parquet(tmp / "profiles.parquet",
-                                                              index=False)
-        if well_path is not None:
-            pd.DataFrame(well_path.at(well_path.md_m)).to_parquet(tmp / "wellpath.parquet",
-                                                                 index=False)
-        report_problem = _write_report(tmp, pdf)
-        if report_problem:
-            summary["warnings"].append(report_problem)
-            write_json(tmp / "summary.json", summary)
-    return RunResult(name, final, summary, failed, summary["warnings"])
+def summarise(well: Well, records: list[SegmentRecord], estimator: _SegmentEstimator,
+              n_rows: int, rate_hz, warnings: list, wall_s: float) -> dict:
+    """summary.json (docs/outputs.md)."""
+    files = {"data": well.files.data, "config": well.files.config,
+             "survey": well.files.survey}
+    inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
+              for k, p in files.items() if p is not None and Path(p).is_file()}
+    inputs.update(rows=n_rows, resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
+    assumed = well.assumed + estimator.assumed
+    count = {s: sum(r.status is s for r in records) for s in Status}
+    return {"well": well.name, "drillfric_version": __version__, **consensus(records),
+            "segments": [r.to_json() for r in records], "inputs": inputs,
+            "config": well.config.to_dict(), "assumed": assumed, "indicative": bool(assumed),
+            "counts": {"segments": len(records), "estimated": count[Status.OK],
+                       "converged": sum(r.status is Status.OK and r.converged
+                                        for r in records),
+                       "skipped": count[Status.SKIPPED], "failed": count[Status.FAILED]},
+            "run_time_s": wall_s, "warnings": list(warnings)}
 
 
-def _write_report(result_dir: Path, pdf: bool) -> str | None:
-    """Write the report; a failure is a warning, not a lost run (the results stand)."""
+def _write_report(result_dir: Path, pdf: bool, result: WellResult) -> None:
+    """Write the report; a failure to render is a warning, not a lost run (the results
+    stand), and leaves no partial report file; a failure to write (disk) fails the run."""
     from drillfric.report import write_well_report
 
     try:
         write_well_report(result_dir, pdf=pdf)
+    except OSError:
+        raise
     except Exception as exc:  # noqa: BLE001 — the estimates are written; say what failed
-        return f"report not written: {type(exc).__name__}: {exc}"
-    return None
+        for partial in result_dir.glob("report.*"):
+            partial.unlink(missing_ok=True)
+        result.warnings.append(f"report not written: {type(exc).__name__}: {exc}")
+        write_json(result_dir / "summary.json", result.summary)
 
 
-def _summary(name, cfg, rows, assumed, data_path, config_path, survey_path, n_rows, rate_hz,
-             rate_used, wall_s) -> dict:
-    files = {"data": data_path, "config": config_path, "survey": survey_path}
-    inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
-              for k, p in files.items()
-              if p is not None and Path(p).is_file()}
-    inputs.update(rows=n_rows, resampled_rate_hz=rate_used, requested_rate_hz=rate_hz)
-    n_ok = sum(r["status"] == "ok" for r in rows)
-    n_conv = sum(r["status"] == "ok" and r["converged"] for r in rows)
-    return {"well": name, "drillfric_version": __version__, **consensus(rows),
-            "segments": rows, "inputs": inputs, "config": cfg.to_dict(),
-            "assumed": assumed, "indicative": bool(assumed),
-            "counts": {"segments": len(rows), "estimated": n_ok, "converged": n_conv,
-                       "skipped": sum(r["status"] == "skipped" for r in rows),
-                       "failed": sum(r["status"] == "failed" for r in rows)},
-            "run_time_s": wall_s}
-
-
-def _count_rows(data_path: Path) -> int:
+def _count_rows(data_path: Path) -> int | None:
     """Row count for the progress bar: Parquet metadata, else a fast line count."""
     suffix = data_path.suffix.lower()
     try:
-        if suffix == ".parquet":
+        if suffix in (".parquet", ".pq"):
             import pyarrow.parquet as pq
 
             return pq.ParquetFile(data_path).metadata.num_rows
-        if suffix == ".csv":
+        if suffix in (".csv", ".txt", ".tsv"):
             count = 0
             with open(data_path, "rb") as fh:
                 while block := fh.read(1 << 22):
                     count += block.count(b"\n") or block.count(b"\r")
             return count
     except OSError:
-        return 0
-    return 0
+        return None
+    return None
+

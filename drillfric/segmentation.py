@@ -487,3 +487,91 @@ class Segmenter:
         self._offset += cut
         self._buffer = {k: v[cut:] for k, v in self._buffer.items()}
         return out
+
+
+#: Seconds of data before a segment handed to the estimator, so that a start-up (and a creep
+#: break-over) is seen from rest.
+PREROLL_S = 5.0
+#: Columns a segment's rows keep (what estimation and the segment's measured values need).
+SEGMENT_COLUMNS = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N",
+                   "bit_rpm", "hookload_N", "timestamp")
+
+
+class SegmentStream:
+    """Segments with their rows, from chunks of canonical surface data.
+
+    Wraps a :class:`Segmenter` and owns the rows it has not finished with: each segment
+    comes with its rows (:data:`SEGMENT_COLUMNS`) from up to :data:`PREROLL_S` before it —
+    never before the end of the previous segment, and only after the last null of speed or
+    torque — so a start-up is seen from rest. Rows no segment can need are dropped as the
+    stream advances: memory is bounded by the longest rotating stretch.
+
+    Examples
+    --------
+    >>> from drillfric.config import load_config
+    >>> rpm = np.r_[np.zeros(20), np.full(60, 60.0), np.zeros(20)]
+    >>> frame = pd.DataFrame({"time_s": np.arange(100.0), "surface_rpm": rpm,
+    ...                       "surface_torque_Nm": 100.0 * rpm})
+    >>> stream = SegmentStream(load_config())
+    >>> out = stream.feed(frame.iloc[:50]) + stream.feed(frame.iloc[50:]) + stream.close()
+    >>> [(seg.i_start, len(rows), float(rows["time_s"].iloc[0])) for seg, rows in out]
+    [(20, 65, 15.0)]
+    """
+
+    def __init__(self, cfg: Config):
+        self._segmenter = Segmenter(cfg)
+        self._buffer = pd.DataFrame()
+        self._start = 0  # input row index of the first buffered row
+        self._last_end = 0  # input row after the last emitted segment
+
+    def feed(self, chunk: pd.DataFrame) -> list[tuple[Segment, pd.DataFrame]]:
+        """Consume the next rows; return the segments they complete, with their rows."""
+        keep = chunk[[c for c in SEGMENT_COLUMNS if c in chunk]].reset_index(drop=True)
+        self._buffer = pd.concat([self._buffer, keep], ignore_index=True) \
+            if len(self._buffer) else keep
+        out = self._rows(self._segmenter.feed(chunk))
+        drop = _rows_done(self._buffer, self._segmenter.pending_from - self._start)
+        if drop > 0:
+            self._buffer = self._buffer.iloc[drop:].reset_index(drop=True)
+            self._start += drop
+        return out
+
+    def close(self) -> list[tuple[Segment, pd.DataFrame]]:
+        """The segments still open at the end of the data, with their rows."""
+        return self._rows(self._segmenter.close())
+
+    def _rows(self, segments: list[Segment]) -> list[tuple[Segment, pd.DataFrame]]:
+        out = []
+        for seg in segments:
+            lo = _preroll_start(self._buffer, seg.i_start - self._start,
+                                max(self._last_end - self._start, 0))
+            out.append((seg, self._buffer.iloc[lo:seg.i_end - self._start]))
+            self._last_end = seg.i_end
+        return out
+
+
+def _preroll_start(buffer: pd.DataFrame, lo: int, floor: int) -> int:
+    """First buffer row handed on for a segment starting at row ``lo``: up to
+    :data:`PREROLL_S` earlier, not before ``floor`` and after the last null of speed or
+    torque."""
+    if lo <= floor:
+        return lo
+    t = buffer["time_s"].to_numpy()
+    start = floor + int(np.searchsorted(t[floor:lo], t[lo] - PREROLL_S))
+    pre = buffer.iloc[start:lo]
+    bad = ~np.isfinite(pre["surface_rpm"].to_numpy(float))
+    if "surface_torque_Nm" in pre:
+        bad |= ~np.isfinite(pre["surface_torque_Nm"].to_numpy(float))
+    if bad.any():
+        start += int(np.flatnonzero(bad)[-1]) + 1
+    return start
+
+
+def _rows_done(buffer: pd.DataFrame, pending: int) -> int:
+    """How many leading buffer rows no segment can need any more: those before the
+    segmenter's pending row, less the pre-roll a segment starting there may take."""
+    if pending <= 0:
+        return 0
+    t = buffer["time_s"].to_numpy()
+    ref = t[pending] if pending < t.size else t[-1]
+    return int(np.searchsorted(t[:pending], ref - PREROLL_S))

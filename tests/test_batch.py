@@ -13,6 +13,7 @@ The case builders here are also used by benchmarks/validate_batch.py.
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from functools import lru_cache
 
 import numpy as np
@@ -227,7 +228,7 @@ def test_paper_case_stick_slip_mu_k_and_honest_mu_s(paper_stick_slip, rate_hz, t
     identifiable and any lower bound below the truth (issue 5 acceptance)."""
     string, fc, rec = paper_stick_slip
     res = estimate(string, fc, *sample(rec, rate_hz, seed=1))
-    assert res.details["stick_slip"]
+    assert res.details.stick_slip
     assert res.mu_k == pytest.approx(0.187, rel=tol)
     assert res.mu_k_method == "mean_torque"
     assert not res.mu_s_identifiable and res.mu_s is None
@@ -242,11 +243,11 @@ def test_steady_rotation_gives_mu_k_and_no_mu_s_bound():
     calls = []
     res = estimate(string, fc, *sample(rec, 5.0, seed=2), progress=calls.append)
     assert len(calls) == res.runs >= 1
-    assert not res.details["stick_slip"]
+    assert not res.details.stick_slip
     assert res.mu_k == pytest.approx(0.187, rel=0.05)
     assert not res.mu_s_identifiable and res.mu_s_lower_bound is None
     assert res.mu_s_method == "none"
-    json.dumps(res.details)  # goes into summary.json as is
+    json.dumps(asdict(res.details))  # goes into summary.json as is
     t, w, _ = sample(rec, 5.0, seed=2)
     tau_string = rec.string_torque_Nm[::20] + np.random.default_rng(2).normal(0, 200, t.size)
     res = batch.refine(t, w, tau_string, string=string, fc_Nm_m=fc, omega_c_rad_s=OMEGA_C,
@@ -280,7 +281,7 @@ def test_creep_start_identifies_mu_s(mu_s, mu_k, md_m, kop_m, rate_hz):
     assert res.mu_s == pytest.approx(mu_s, rel=0.10)
     assert res.mu_k == pytest.approx(mu_k, rel=0.05)
     assert len(res.creep_segments) == 1 and res.mu_s_lower_bound is None
-    assert res.details["creep_grid_move"] < batch.CREEP_CONVERGENCE
+    assert res.details.creep_grid_move < batch.CREEP_CONVERGENCE
 
 
 @pytest.mark.slow

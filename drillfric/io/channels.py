@@ -344,7 +344,8 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
             if channel.key != "time":
                 raise
             scale = float("nan")  # e.g. "yyyy-mm-dd hh:mm:ss" over a timestamp column
-        out[channel.key] = Mapping(channel, column, unit, source, scale)
+        out[channel.key] = Mapping(channel, column, unit, source,
+                                   scale * float(spec.get("scale", 1.0)))
     return out
 
 

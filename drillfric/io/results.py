@@ -1,18 +1,35 @@
-"""Result files of ``drillfric run`` (INTERFACE.md "Outputs of run"), written atomically.
+"""Result files of ``drillfric run`` written safely: atomic, marked, never outside ``--out``.
 
-A run writes into a hidden temporary directory beside the final one and renames it into
-place at the end, so an interrupted run never leaves a half-written well directory.
+A well's results go to ``OUT/NAME`` (NAME one safe path component, :func:`drillfric.io.well.
+safe_name`). They are written into a hidden temporary directory beside it and renamed into
+place at the end (:class:`ResultDirectory`), so a well directory is complete or absent:
+
+- every directory drillfric writes carries a marker file (:data:`MARKER`); an existing
+  ``OUT/NAME`` is replaced only when it carries the marker — a directory, file or link that
+  drillfric did not write is never replaced or removed;
+- the swap (old result aside, new one in, old one removed) happens under an exclusive lock
+  on OUT, so concurrent writers of one well do not trip over each other;
+- temporary directories of runs that were killed (their process is gone) are removed by the
+  next run of that well; an interrupted run (SIGINT, SIGTERM turned into KeyboardInterrupt
+  by the CLI) removes its own;
+- a failure to write (disk full, read-only, name too long, a file where a directory must
+  go) becomes one :class:`~drillfric.errors.OutputError` naming the path and the fix.
+
+docs/security.md describes the rules; the column schema is :mod:`drillfric.result`.
 """
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import hashlib
 import json
 import math
 import os
 import shutil
-from collections.abc import Iterator
-from contextlib import contextmanager
+import socket
+import time
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -20,17 +37,16 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-#: Columns of estimates.parquet (INTERFACE.md), ``bit_rpm`` only with downhole truth.
-ESTIMATE_COLUMNS = ("time_s", "segment_id", "start_id", "mu_s", "mu_k", "surface_rpm",
-                    "surface_rpm_est", "bit_rpm_est", "bit_stuck", "residual_rpm")
-#: Written after INTERFACE.md's columns (``bit_rpm`` included): the band of the seeded
-#: ensemble's bit speed (NaN on the starts' rows).
-BAND_COLUMNS = ("bit_rpm_est_min", "bit_rpm_est_max")
-#: Binding keys of each segment in summary.json / segments.parquet (INTERFACE.md).
-SEGMENT_KEYS = ("id", "kind", "t_start_s", "t_end_s", "bit_depth_m", "mu_s", "mu_k",
-                "mu_s_identifiable", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
-                "converged", "method", "settling_time_s", "residual_rms_rpm",
-                "stick_slip_severity", "status", "message")
+from drillfric.errors import OutputError
+from drillfric.result import ESTIMATE_COLUMNS, SEGMENT_FIELDS, segment_columns
+
+#: The file that marks a directory as written by drillfric (JSON: version, well, state).
+MARKER = ".drillfric-result"
+#: Age after which a temporary directory of another host counts as abandoned [s] (on
+#: storage shared with a remote cluster, another host's process cannot be asked).
+FOREIGN_STALE_S = 86400.0
+_TMP, _OLD = ".tmp-", ".old-"
+_HOST = hashlib.sha256(socket.gethostname().encode()).hexdigest()[:6]
 
 
 def file_sha256(path: str | Path, block: int = 1 << 20) -> str:
@@ -59,30 +75,210 @@ def jsonable(value):
     return value
 
 
-@contextmanager
-def atomic_directory(final: Path) -> Iterator[Path]:
-    """Yield a temporary directory that replaces ``final`` only if the block succeeds.
+# --------------------------------------------------------------------------- errors
+_FIXES = {
+    errno.ENOSPC: ("no space left on the device", "free disk space or choose another --out"),
+    errno.EDQUOT: ("disk quota exceeded", "free space in your quota or choose another --out"),
+    errno.EFBIG: ("file too large for the file system or a size limit",
+                  "choose another --out (or raise the file-size limit)"),
+    errno.EROFS: ("read-only file system", "choose a writable --out"),
+    errno.EACCES: ("permission denied", "choose a writable --out"),
+    errno.EPERM: ("operation not permitted", "choose a writable --out"),
+    errno.ENAMETOOLONG: ("path too long", "use a shorter --out or well name"),
+    errno.ENOTDIR: ("a file stands where a directory must go",
+                    "remove or rename that file, or choose another --out"),
+    errno.EEXIST: ("a file stands where a directory must go",
+                   "remove or rename that file, or choose another --out"),
+}
 
-    On failure nothing is left behind: the temporary directory is removed, and so are the
-    parent directories this call created (``--out`` of a run whose input was unreadable
-    does not appear as an empty directory).
-    """
-    final = Path(final)
-    created = missing_dirs(final.parent)
-    tmp = final.parent / f".{final.name}.tmp-{os.getpid()}"
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir(parents=True)
+
+def output_error(exc: OSError, where: Path) -> OutputError:
+    """One-line :class:`OutputError` for an OSError met while writing results."""
+    problem, fix = _FIXES.get(exc.errno, (f"cannot write ({exc.strerror or exc})",
+                                          "check --out and the disk"))
+    path = exc.filename or where
+    return OutputError(f"cannot write results: {problem}", file=path, fix=fix)
+
+
+# --------------------------------------------------------------------------- directories
+def _marker(path: Path, well: str, state: str) -> None:
+    from drillfric import __version__
+
+    (path / MARKER).write_text(json.dumps({"drillfric": __version__, "well": well,
+                                           "state": state}) + "\n", encoding="utf-8")
+
+
+def is_result_dir(path: Path) -> bool:
+    """Whether ``path`` is a real directory (not a link) that drillfric wrote: it carries
+    :data:`MARKER`, or (results of versions before the marker) a summary.json of a run."""
+    if not path.is_dir() or path.is_symlink():
+        return False
+    if (path / MARKER).is_file():
+        return True
     try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        remove_empty(created)
-        raise
-    old = final.parent / f".{final.name}.old-{os.getpid()}"
-    if final.exists():
-        os.replace(final, old)
-    os.replace(tmp, final)
-    shutil.rmtree(old, ignore_errors=True)
+        summary = json.loads((path / "summary.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(summary, dict) and {"drillfric_version", "segments"} <= set(summary)
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stale(out_root: Path, dir_name: str | None = None) -> None:
+    """Remove temporary and set-aside directories of ``dir_name`` (all wells when None) left
+    by runs whose process is gone — only those carrying drillfric's marker."""
+    if not out_root.is_dir():
+        return
+    prefix = "." if dir_name is None else f".{dir_name}"
+    for entry in out_root.iterdir():
+        name = entry.name
+        if not name.startswith(prefix) or (_TMP not in name and _OLD not in name):
+            continue
+        head, _, tail = name.rpartition(_TMP if _TMP in name else _OLD)
+        if dir_name is not None and head != f".{dir_name}":
+            continue
+        if _TMP in name and _in_use(entry, tail):
+            continue  # another live run is writing it
+        if is_result_dir(entry):
+            shutil.rmtree(entry, ignore_errors=True)
+
+
+def _token() -> str:
+    """``PID-HOST-RANDOM`` of a temporary directory name."""
+    return f"{os.getpid()}-{_HOST}-{uuid.uuid4().hex[:8]}"
+
+
+def _in_use(entry: Path, tail: str) -> bool:
+    """Whether the run that made a temporary directory may still be writing it."""
+    pid, host, *_ = tail.split("-") + ["", ""]
+    if host != _HOST:  # another machine's run: only abandoned ones are removed
+        try:
+            return time.time() - entry.stat().st_mtime < FOREIGN_STALE_S
+        except OSError:
+            return False
+    return pid.isdigit() and _pid_alive(int(pid))
+
+
+class _Locked:
+    """Exclusive advisory lock on a directory (flock on its descriptor) for a short swap."""
+
+    def __init__(self, folder: Path):
+        self.fd = os.open(folder, os.O_RDONLY)
+
+    def __enter__(self):
+        fcntl.flock(self.fd, fcntl.LOCK_EX)
+        return self
+
+    def __exit__(self, *exc):
+        fcntl.flock(self.fd, fcntl.LOCK_UN)
+        os.close(self.fd)
+
+
+class ResultDirectory:
+    """``with ResultDirectory(out, name, well) as tmp:`` write into ``tmp``; on success it
+    becomes ``out/name`` atomically, on any exception nothing is left behind.
+
+    Parameters
+    ----------
+    out_root : Path
+        ``--out`` (created with its missing parents; removed again when the run fails and
+        they are left empty).
+    dir_name : str
+        A safe path component (:func:`drillfric.io.well.safe_name`).
+    well : str
+        The well's name, recorded in the marker.
+
+    Raises
+    ------
+    OutputError
+        ``out/name`` exists and was not written by drillfric, or writing failed.
+    """
+
+    def __init__(self, out_root, dir_name: str, well: str):
+        self.out_root = Path(out_root)
+        self.final = self.out_root / dir_name
+        self.dir_name = dir_name
+        self.well = well
+        self.tmp: Path | None = None
+        self._created: list[Path] = []
+
+    def __enter__(self) -> Path:
+        self.check_replaceable()
+        try:
+            self._created = missing_dirs(self.out_root)
+            self.out_root.mkdir(parents=True, exist_ok=True)
+            remove_stale(self.out_root, self.dir_name)
+            self.tmp = self.out_root / f".{self.dir_name}{_TMP}{_token()}"
+            self.tmp.mkdir()
+            _marker(self.tmp, self.well, "incomplete")
+        except OSError as exc:
+            self._discard()
+            raise output_error(exc, self.out_root) from None
+        return self.tmp
+
+    def check_replaceable(self) -> None:
+        """Refuse early when ``out/name`` is something drillfric did not write."""
+        if self.out_root.exists() and not self.out_root.is_dir():
+            raise OutputError("cannot write results: a file stands where the output "
+                              "directory must go", file=self.out_root,
+                              fix="remove or rename that file, or choose another --out")
+        if os.path.lexists(self.final) and not is_result_dir(self.final):
+            raise OutputError("exists and was not written by drillfric: not replaced",
+                              file=self.final, fix="move it away or choose another --out")
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is not None:
+            self._discard()
+            if isinstance(exc, OSError) and _is_output_problem(exc, self.out_root):
+                raise output_error(exc, self.final) from None
+            return False
+        try:
+            _marker(self.tmp, self.well, "complete")
+            self._swap()
+        except OSError as err:
+            self._discard()
+            raise output_error(err, self.final) from None
+        except BaseException:
+            self._discard()
+            raise
+        return False
+
+    def _swap(self) -> None:
+        old = self.out_root / f".{self.dir_name}{_OLD}{_token()}"
+        with _Locked(self.out_root):
+            self.check_replaceable()  # another process may have put something there
+            if os.path.lexists(self.final):
+                os.replace(self.final, old)
+            os.replace(self.tmp, self.final)
+        self.tmp = None
+        shutil.rmtree(old, ignore_errors=True)
+
+    def _discard(self) -> None:
+        if self.tmp is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            self.tmp = None
+        remove_empty(self._created)
+
+
+def _is_output_problem(exc: OSError, out_root: Path) -> bool:
+    """An OSError about the results (a path under OUT, or a full/read-only disk), not about
+    an input file."""
+    name = exc.filename
+    if name is not None:
+        try:
+            Path(name).resolve().relative_to(out_root.resolve())
+            return True
+        except ValueError:
+            return False
+    return exc.errno in _FIXES
 
 
 def missing_dirs(path: Path) -> list[Path]:
@@ -105,15 +301,42 @@ def remove_empty(folders: list[Path]) -> None:
             return
 
 
+def check_distinct(outputs: list[tuple[str, str]]) -> None:
+    """Refuse wells of one run or fleet that would write the same ``OUT/NAME``.
+
+    ``outputs`` are (dir_name, what names it: the well's file or manifest row). Names are
+    compared case-insensitively (OUT may be on a case-insensitive file system).
+
+    Raises
+    ------
+    InputError
+        Two wells share an output directory (before anything is written).
+    """
+    from drillfric.errors import InputError
+
+    seen: dict[str, str] = {}
+    for dir_name, source in outputs:
+        key = dir_name.casefold()
+        if key in seen:
+            raise InputError(f"{seen[key]} and {source} would both write OUT/{dir_name}: one "
+                             "well's results would be lost", fix="give each well its own "
+                             "[well] name (or 'well' column in a manifest)")
+        seen[key] = source
+
+
+# --------------------------------------------------------------------------- files
+def arrow_schema(with_truth: bool) -> pa.Schema:
+    """estimates.parquet's schema from :data:`drillfric.result.ESTIMATE_COLUMNS`."""
+    return pa.schema([(c.name, pa.type_for_alias(c.type)) for c in ESTIMATE_COLUMNS
+                      if with_truth or c.name != "bit_rpm"])
+
+
 class EstimatesWriter:
     """Append observer records to estimates.parquet, one row group per segment."""
 
     def __init__(self, path: Path, with_truth: bool):
         self.path = path
-        names = list(ESTIMATE_COLUMNS) + (["bit_rpm"] * with_truth) + list(BAND_COLUMNS)
-        types = {"segment_id": pa.int32(), "start_id": pa.int16(), "bit_stuck": pa.bool_(),
-                 **dict.fromkeys(BAND_COLUMNS, pa.float32())}
-        self.schema = pa.schema([(n, types.get(n, pa.float64())) for n in names])
+        self.schema = arrow_schema(with_truth)
         self._writer = pq.ParquetWriter(path, self.schema, compression="zstd")
 
     def write(self, frame: pd.DataFrame) -> None:
@@ -133,12 +356,7 @@ def write_json(path: Path, payload: dict) -> None:
                     encoding="utf-8")
 
 
-def write_segments(path: Path, segments: list[dict]) -> None:
-    """segments.parquet: the summary's segment table as columns (+ team extras)."""
-    frame = pd.DataFrame([jsonable(s) for s in segments])
-    if frame.empty:
-        frame = pd.DataFrame(columns=list(SEGMENT_KEYS))
-    for col in frame.columns:
-        if frame[col].map(lambda v: isinstance(v, (list, dict))).any():
-            frame[col] = frame[col].map(json.dumps)
+def write_segments(path: Path, records) -> None:
+    """segments.parquet: one row per :class:`~drillfric.result.SegmentRecord`."""
+    frame = pd.DataFrame(segment_columns(records), columns=list(SEGMENT_FIELDS))
     frame.to_parquet(path, index=False)

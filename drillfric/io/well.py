@@ -14,29 +14,40 @@ Precedence: ``--config``/``--survey`` > the configuration's ``[survey] file`` > 
 by name > tables inside an HDF5 file. Without a survey, ``survey`` is None and the
 pipeline assumes a vertical well with the nominal tortuosity ``survey.tortuosity_deg_30m``.
 
-:func:`load_well` reads everything; :func:`iter_surface` streams the same canonical
-columns chunk by chunk with one time origin, so large files never need to fit in memory.
+A well is opened **once** (:func:`open_well`): its files found, its configuration and survey
+read, its data file's header mapped to channels, and its name fixed — into a :class:`Well`
+that ``run``, ``fleet``, ``td`` and ``inspect`` all take. :meth:`Well.chunks` then streams
+the canonical SI columns chunk by chunk with one time origin (large files never need to fit
+in memory) and :meth:`Well.load` reads everything into a :class:`WellData`.
+
+A well's name is data, not a path: :func:`safe_name` makes it one safe path component
+(docs/security.md), the only rule by which an output directory is named.
 """
 
 from __future__ import annotations
 
+import hashlib
 import tomllib
+import unicodedata
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from drillfric.config import Config, config_from_dict, load_config, read_toml
+from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.io.channels import Mapping, find_column, map_channels
 from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
+from drillfric.io.text import printable
 from drillfric.io.timebase import TimeBase, TimeTracker, check_plausible_rate, summarize
 from drillfric.wellpath import WellPath
 
-#: Rows per chunk of :func:`iter_surface` (a few tens of MB for a dozen channels).
+#: Rows per chunk of :meth:`Well.chunks` (a few tens of MB for a dozen channels).
 CHUNK_ROWS = 200_000
+#: Longest output directory name [bytes of UTF-8]; longer names are cut and given a hash.
+MAX_NAME_BYTES = 100
 _SURVEY_EXT = (".csv", ".parquet")
 _HDF5_EXT = (".h5", ".hdf5")
 
@@ -98,8 +109,187 @@ class WellData:
     files: dict[str, Path]
 
 
+@dataclass(frozen=True)
+class WellFiles:
+    """The files of a well on disk.
+
+    Attributes
+    ----------
+    data : Path
+        Surface data file.
+    config, survey : Path or None
+        Configuration and survey files in effect (for an HDF5 bundle, possibly the data
+        file itself: its ``/config`` and ``/survey``).
+    """
+
+    data: Path
+    config: Path | None
+    survey: Path | None
+
+
+@dataclass(frozen=True)
+class Well:
+    """A well opened once: files, effective configuration, well path, channels and name.
+
+    Built by :func:`open_well`; reading the surface data is left to :meth:`chunks` (streamed)
+    or :meth:`load` (whole).
+
+    Attributes
+    ----------
+    name : str
+        The well's name as given (``[well] name``, a manifest's ``well`` column, or the file
+        stem / directory name), made printable (control characters → ``?``).
+    dir_name : str
+        Its output directory name, ``safe_name(name)``: one safe path component.
+    files : WellFiles
+    config : Config
+        Effective configuration (defaults < file < overrides).
+    survey : WellPath or None
+        Well path by minimum curvature; None without a survey.
+    source : RawSource or None
+        The opened data file (header read, data not); None when opened without its header
+        (``open_well(..., header=False)``: commands that need the string and the well path
+        only, like ``td``).
+    mappings : dict of str to Mapping
+        How each channel is read, keyed by ``[channels]`` key (``"time"``, ``"surface_rpm"``…);
+        empty without the header.
+    """
+
+    name: str
+    dir_name: str
+    files: WellFiles
+    config: Config
+    survey: WellPath | None
+    source: RawSource | None = field(default=None, repr=False)
+    mappings: dict[str, Mapping] = field(default_factory=dict, repr=False)
+
+    @property
+    def channels(self) -> dict[str, Mapping]:
+        """The channel mappings keyed by canonical column name (``surface_torque_Nm``)."""
+        return {m.channel.name: m for m in self.mappings.values()}
+
+    @property
+    def assumed(self) -> list[str]:
+        """What was assumed for this well: configuration defaults, the hole without a
+        survey, and channel units nothing stated (docs/ingestion.md)."""
+        units = [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — "
+                 "nothing in the file or the config says"
+                 for m in self.mappings.values() if m.source == "default"]
+        return self.config.assumed_with(self.survey) + units
+
+    def time_tracker(self) -> TimeTracker:
+        """A fresh time-base tracker for one pass over the data (origin, duplicates)."""
+        time = self.mappings["time"]
+        return TimeTracker(time.factor, file=str(self.files.data), column=time.column)
+
+    def chunks(self, chunk_rows: int = CHUNK_ROWS,
+               tracker: TimeTracker | None = None) -> Iterator[pd.DataFrame]:
+        """Stream the surface data as canonical SI chunks with one time origin.
+
+        Yields DataFrames with the columns of :attr:`WellData.surface`; concatenated they
+        equal :meth:`load`'s. Each call reads the file again from the start (pass a
+        :meth:`time_tracker` to read the time base's counts afterwards).
+        """
+        if self.source is None:
+            raise ValueError("well opened without its data file's header (header=False)")
+        tracker = tracker or self.time_tracker()
+        for chunk in self.source.chunks(chunk_rows):
+            yield _convert(chunk, self.mappings, tracker)
+
+    def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
+        """Read the whole surface log into a :class:`WellData` (SI units)."""
+        tracker = self.time_tracker()
+        chunks = list(self.chunks(chunk_rows, tracker))
+        surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
+        if surface.empty:
+            raise InputError("no data rows with a time", file=self.files.data,
+                             fix="give a file with data rows (and a readable time column)")
+        check_plausible_rate(surface["time_s"].to_numpy(), file=self.files.data)
+        timebase = summarize(surface["time_s"].to_numpy(),
+                             max_gap_s=self.config["segmentation.max_gap_s"],
+                             duplicates_dropped=tracker.duplicates,
+                             untimed_dropped=tracker.untimed, origin=tracker.origin,
+                             source_start_s=tracker.source_start_s)
+        files = {k: v for k, v in (("data", self.files.data), ("config", self.files.config),
+                                   ("survey", self.files.survey)) if v is not None}
+        return WellData(name=self.name, surface=surface, survey=self.survey,
+                        config=self.config,
+                        channels=_channel_infos(self.mappings, surface, tracker),
+                        timebase=timebase, files=files)
+
+
+def open_well(path, *, config=None, survey=None, overrides=None, name: str | None = None,
+              header: bool = True) -> Well:
+    """Open a well once: find its files, read its configuration and survey, map its channels.
+
+    Parameters
+    ----------
+    path : str or Path
+        Data file, HDF5 bundle or well directory (docs/ingestion.md "A well on disk").
+    config : str, Path or Config, optional
+        Configuration file (``--config``) or an already built :class:`Config`.
+    survey : str or Path, optional
+        Survey file (``--survey``); the sidecar survey is then not read at all.
+    overrides : dict, optional
+        ``{"table.key": value}`` from the command line.
+    name : str, optional
+        The well's name (a manifest's ``well`` column), overriding ``[well] name``.
+    header : bool
+        Open the data file and map its channels (False: configuration and survey only).
+
+    Raises
+    ------
+    InputError, ConfigError
+        One line naming the file, the problem and the fix.
+    """
+    files, raw = _resolve(path, None if isinstance(config, Config) else config, survey)
+    cfg = _config(files.config, raw, config, overrides)
+    shown = printable(name or cfg["well.name"] or default_name(path, files.data), 4096)
+    source, mappings = _open(files.data, cfg) if header else (None, {})
+    return Well(name=shown, dir_name=safe_name(shown, files.config or files.data),
+                files=files, config=cfg, survey=_load_survey(files.survey), source=source,
+                mappings=mappings)
+
+
+def default_name(path, data_path: Path) -> str:
+    """A well's name when nothing names it: the directory's name (resolved, so ``.`` is the
+    folder it stands for) or the data file's stem."""
+    path = Path(path)
+    return path.resolve().name if path.is_dir() else data_path.stem
+
+
+def safe_name(raw, where=None) -> str:
+    """One safe path component from a well name (docs/security.md).
+
+    Path separators, NUL and control characters become ``_``; leading and trailing dots
+    and blanks go (no ``.``, ``..`` or hidden names); a name longer than
+    :data:`MAX_NAME_BYTES` is cut and ends with a hash of the whole name, so distinct long
+    names stay distinct.
+
+    Raises
+    ------
+    ConfigError
+        Nothing usable is left (e.g. ``"."`` or ``"///"``).
+
+    Examples
+    --------
+    >>> safe_name("../../x"), safe_name("A-12/ST1"), safe_name(".hidden")
+    ('_.._x', 'A-12_ST1', 'hidden')
+    """
+    text = unicodedata.normalize("NFC", str(raw))
+    text = "".join("_" if c in "/\\" or unicodedata.category(c)[0] == "C" else c
+                   for c in text).strip(". \t")
+    if not text or set(text) <= {"_", "."}:
+        raise ConfigError(f"well name '{printable(raw)}' gives no usable directory name",
+                          file=where, fix='name the well, e.g. [well] name = "A-12"')
+    if len(text.encode()) > MAX_NAME_BYTES:
+        digest = hashlib.sha256(str(raw).encode()).hexdigest()[:10]
+        text = text.encode()[:MAX_NAME_BYTES - 11].decode("utf-8", "ignore") + "-" + digest
+    return text
+
+
 # --------------------------------------------------------------------------- resolving
-def resolve_well(path, *, config=None, survey=None) -> tuple[Path, Path | None, Path | None]:
+def resolve_well(path, *, config=None, survey=None) -> WellFiles:
     """Find a well's data, configuration and survey files without reading the data.
 
     Parameters
@@ -111,9 +301,9 @@ def resolve_well(path, *, config=None, survey=None) -> tuple[Path, Path | None, 
 
     Returns
     -------
-    data_path, config_path, survey_path : Path, Path or None, Path or None
-        For an HDF5 bundle, ``config_path``/``survey_path`` may be the HDF5 file itself
-        (meaning its ``/config`` and ``/survey``).
+    WellFiles
+        For an HDF5 bundle, ``config``/``survey`` may be the HDF5 file itself (meaning its
+        ``/config`` and ``/survey``).
 
     Raises
     ------
@@ -121,13 +311,20 @@ def resolve_well(path, *, config=None, survey=None) -> tuple[Path, Path | None, 
         Missing path, unknown extension, a directory without ``well.toml``, or a file a
         configuration names that does not exist.
     """
+    return _resolve(path, config, survey)[0]
+
+
+def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
+    """The files of a well and its raw configuration mapping, each file read once."""
     path = Path(path)
     if not path.exists():
         raise InputError("file not found", file=path, fix="check the path")
     config_path = None if config is None else Path(config)
+    raw = None
     if path.is_dir():
-        data_path, dir_config = _directory_data(path)
-        config_path = config_path or dir_config
+        data_path, dir_config, dir_raw = _directory_data(path)
+        if config_path is None:
+            config_path, raw = dir_config, dir_raw
     else:
         data_format(path)
         data_path = path
@@ -137,20 +334,24 @@ def resolve_well(path, *, config=None, survey=None) -> tuple[Path, Path | None, 
         raise InputError("config file not found", file=config_path, fix="check the path")
     if config_path is None and _h5_has(data_path, "config"):
         config_path = data_path
-    survey_path = Path(survey) if survey is not None else _find_survey(data_path, config_path)
+    if raw is None:
+        raw = _raw_config(config_path)
+    survey_path = Path(survey) if survey is not None else _find_survey(data_path, config_path,
+                                                                       raw)
     if survey_path is not None and not survey_path.is_file():
         raise InputError("survey file not found", file=survey_path, fix="check the path")
-    return data_path, config_path, survey_path
+    return WellFiles(data_path, config_path, survey_path), raw
 
 
-def _directory_data(folder: Path) -> tuple[Path, Path]:
+def _directory_data(folder: Path) -> tuple[Path, Path, dict]:
     well_toml = folder / "well.toml"
     if not well_toml.is_file():
         found = sorted(p.name for p in folder.iterdir() if p.suffix.lower() in FORMATS)
         raise InputError("well directory has no well.toml", file=folder,
                          fix='add well.toml with [well] data = "FILE"'
                              + (f" (data files here: {', '.join(found)})" if found else ""))
-    data = read_toml(well_toml).get("well", {}).get("data")
+    raw = read_toml(well_toml)
+    data = raw.get("well", {}).get("data")
     if not isinstance(data, str):
         raise ConfigError("well.toml does not name its data file", file=well_toml,
                           fix='add [well] data = "surface.parquet" (relative to the folder)')
@@ -159,14 +360,13 @@ def _directory_data(folder: Path) -> tuple[Path, Path]:
         raise InputError("data file named by well.toml not found", file=data_path,
                          fix=f"fix [well] data in {well_toml}")
     data_format(data_path)
-    return data_path, well_toml
+    return data_path, well_toml, raw
 
 
-def _find_survey(data_path: Path, config_path: Path | None) -> Path | None:
-    if config_path is not None and config_path.suffix.lower() == ".toml":
-        named = read_toml(config_path).get("survey", {}).get("file")
-        if isinstance(named, str):
-            return config_path.parent / named
+def _find_survey(data_path: Path, config_path: Path | None, raw: dict) -> Path | None:
+    named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
+    if isinstance(named, str) and config_path is not None:
+        return config_path.parent / named
     stem = data_path.with_suffix("")
     for ext in _SURVEY_EXT:
         candidate = stem.with_name(stem.name + ".survey" + ext)
@@ -189,15 +389,23 @@ def _h5_has(path: Path, key: str) -> bool:
 
 
 # --------------------------------------------------------------------------- config, survey
-def _load_config(config_path: Path | None, config, overrides) -> Config:
+def _raw_config(config_path: Path | None) -> dict:
+    """The configuration mapping of a TOML file or an HDF5 bundle's ``/config`` ({} if none)."""
+    if config_path is None:
+        return {}
+    if config_path.suffix.lower() in _HDF5_EXT:
+        return _h5_config(config_path)
+    return read_toml(config_path)
+
+
+def _config(config_path: Path | None, raw: dict, config, overrides) -> Config:
+    """The effective configuration: ``config`` when it is a built :class:`Config`, else the
+    validated raw mapping with the command line's ``overrides``."""
     if isinstance(config, Config):
         return config
-    if config_path is None:
-        return load_config(None, overrides=overrides)
-    if config_path.suffix.lower() in _HDF5_EXT:
-        return config_from_dict(_h5_config(config_path), file=f"{config_path}:/config",
-                                overrides=overrides)
-    return load_config(config_path, overrides=overrides)
+    where = None if config_path is None else (
+        f"{config_path}:/config" if config_path.suffix.lower() in _HDF5_EXT else config_path)
+    return config_from_dict(raw, file=where, overrides=overrides)
 
 
 def _h5_config(path: Path) -> dict:
@@ -306,96 +514,27 @@ def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
     return pd.DataFrame(out)
 
 
-def _stream(raw: RawSource, mappings: dict[str, Mapping], tracker: TimeTracker,
-            chunk_rows: int) -> Iterator[pd.DataFrame]:
-    for chunk in raw.chunks(chunk_rows):
-        yield _convert(chunk, mappings, tracker)
-
-
 def iter_surface(source, *, config=None, survey=None,
                  chunk_rows: int = CHUNK_ROWS) -> Iterator[pd.DataFrame]:
-    """Stream a well's surface data as canonical SI chunks with one time origin.
+    """Stream a well's surface data as canonical SI chunks (:meth:`Well.chunks`).
 
-    Parameters
-    ----------
-    source : str, Path or WellData
-        A well on disk (read chunk by chunk: Parquet record batches, CSV chunks, HDF5 row
-        slices) or an already loaded well (sliced).
-    config : str, Path or Config, optional
-        Configuration overriding the sidecar (for the ``[channels]`` mapping).
-    survey : str or Path, optional
-        Accepted for symmetry with :func:`load_well` (the survey is not streamed).
-    chunk_rows : int
-        Rows read per chunk; a chunk may be shorter after dropping duplicate timestamps.
-
-    Yields
-    ------
-    pandas.DataFrame
-        The columns of :attr:`WellData.surface`; concatenated they equal it.
+    ``source`` is a :class:`Well`, a loaded :class:`WellData` (sliced) or a well on disk
+    (opened here with ``config`` and ``survey``, so that a bad well fails at the call).
     """
     if isinstance(source, WellData):
-        return _slices(source.surface, chunk_rows)
-    # Files are found and opened now, so that a bad well fails at the call, not mid-loop.
-    data_path, config_path, _ = resolve_well(
-        source, config=None if isinstance(config, Config) else config, survey=survey)
-    cfg = _load_config(config_path, config, None)
-    raw, mappings = _open(data_path, cfg)
-    tracker = TimeTracker(mappings["time"].factor, file=str(data_path),
-                          column=mappings["time"].column)
-    return _stream(raw, mappings, tracker, chunk_rows)
-
-
-def _slices(frame: pd.DataFrame, chunk_rows: int) -> Iterator[pd.DataFrame]:
-    for start in range(0, len(frame), chunk_rows):
-        yield frame.iloc[start:start + chunk_rows].reset_index(drop=True)
+        frame = source.surface
+        return (frame.iloc[a:a + chunk_rows].reset_index(drop=True)
+                for a in range(0, len(frame), chunk_rows))
+    well = source if isinstance(source, Well) else open_well(source, config=config,
+                                                             survey=survey)
+    return well.chunks(chunk_rows)
 
 
 def load_well(path, *, config=None, survey=None, overrides=None,
               chunk_rows: int = CHUNK_ROWS) -> WellData:
-    """Read a well (data, configuration, survey) into SI units.
-
-    Parameters
-    ----------
-    path : str or Path
-        Data file, HDF5 bundle or well directory (INTERFACE.md "A well on disk").
-    config : str, Path or Config, optional
-        Configuration file (``--config``) or an already built :class:`Config`.
-    survey : str or Path, optional
-        Survey file (``--survey``).
-    overrides : dict, optional
-        ``{"table.key": value}`` from the command line.
-    chunk_rows : int
-        Rows per read chunk.
-
-    Raises
-    ------
-    InputError, ConfigError
-        One line naming the file, the problem and the fix.
-    """
-    data_path, config_path, survey_path = resolve_well(
-        path, config=None if isinstance(config, Config) else config, survey=survey)
-    cfg = _load_config(config_path, config, overrides)
-    raw, mappings = _open(data_path, cfg)
-    tracker = TimeTracker(mappings["time"].factor, file=str(data_path),
-                          column=mappings["time"].column)
-    chunks = list(_stream(raw, mappings, tracker, chunk_rows))
-    surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
-    if surface.empty:
-        raise InputError("no data rows with a time", file=data_path,
-                         fix="give a file with data rows (and a readable time column)")
-    check_plausible_rate(surface["time_s"].to_numpy(), file=data_path)
-    timebase = summarize(surface["time_s"].to_numpy(), max_gap_s=cfg["segmentation.max_gap_s"],
-                         duplicates_dropped=tracker.duplicates, untimed_dropped=tracker.untimed,
-                         origin=tracker.origin, source_start_s=tracker.source_start_s)
-    files = {"data": data_path}
-    if config_path is not None or isinstance(config, Config) and config.source is not None:
-        files["config"] = config_path or config.source
-    if survey_path is not None:
-        files["survey"] = survey_path
-    well_name = cfg["well.name"] or (Path(path).name if Path(path).is_dir() else data_path.stem)
-    return WellData(name=well_name, surface=surface, survey=_load_survey(survey_path),
-                    config=cfg, channels=_channel_infos(mappings, surface, tracker),
-                    timebase=timebase, files=files)
+    """Read a well (data, configuration, survey) into SI units: :func:`open_well` then
+    :meth:`Well.load` (parameters as there)."""
+    return open_well(path, config=config, survey=survey, overrides=overrides).load(chunk_rows)
 
 
 def _channel_infos(mappings: dict[str, Mapping], surface: pd.DataFrame,
@@ -412,31 +551,3 @@ def _channel_infos(mappings: dict[str, Mapping], surface: pd.DataFrame,
             unit, source = m.unit, m.source
         out[m.channel.name] = ChannelInfo(m.channel.name, str(m.column), unit, source, nulls)
     return out
-
-
-
-def load_setup(path, *, config=None, survey=None,
-               overrides=None) -> tuple[Config, WellPath | None]:
-    """Configuration and survey of a well without reading its surface data.
-
-    For commands that need the string and the well path but not the log (``td``). Files
-    are found as in :func:`resolve_well`.
-    """
-    _, config_path, survey_path = resolve_well(
-        path, config=None if isinstance(config, Config) else config, survey=survey)
-    return _load_config(config_path, config, overrides), _load_survey(survey_path)
-
-
-def channel_mappings(path, cfg: Config, *, config=None) -> dict[str, Mapping]:
-    """How each channel of a well's data file is read (column, unit and where the unit came
-    from), keyed by canonical name. Reads only the file's header."""
-    data_path, _, _ = resolve_well(path, config=None if isinstance(config, Config) else config)
-    _, mappings = _open(data_path, cfg)
-    return {m.channel.name: m for m in mappings.values()}
-
-
-def assumed_units(mappings: dict[str, Mapping]) -> list[str]:
-    """Channels whose unit nothing stated (file, config or name): the documented default
-    was assumed — for the run summary's ``assumed`` list."""
-    return [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — nothing "
-            "in the file or the config says" for m in mappings.values() if m.source == "default"]

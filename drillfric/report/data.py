@@ -15,17 +15,9 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.results import BAND_COLUMNS
+from drillfric.result import ESTIMATE_NAMES, SEGMENT_FIELDS, SEGMENT_NUMBER_FIELDS
 
-#: Columns of estimates.parquet a segment figure needs (the ensemble band and ``bit_rpm``
-#: are added when present: older results have no band).
-ESTIMATE_COLUMNS = ("time_s", "segment_id", "start_id", "mu_s", "mu_k", "surface_rpm",
-                    "surface_rpm_est", "bit_rpm_est", "bit_stuck")
-#: Numeric columns of the segments table (None in summary.json becomes NaN).
-_NUMERIC = ("t_start_s", "t_end_s", "bit_depth_m", "mu_s", "mu_k", "mu_s_lower_bound",
-            "mu_s_spread", "mu_k_spread", "settling_time_s", "residual_rms_rpm",
-            "stick_slip_severity", "duration_s", "stuck_fraction", "mu_k_observer",
-            "mu_s_observer", "mu_td", "T_N_Nm", "bit_rms_error_rpm")
+_NUMERIC = SEGMENT_NUMBER_FIELDS  # None in summary.json becomes NaN
 
 
 @dataclass(frozen=True)
@@ -55,9 +47,8 @@ class ResultData:
 def segments_frame(rows: list[dict]) -> pd.DataFrame:
     """The ``segments`` list of a summary.json as a table with NaN for missing numbers."""
     frame = pd.DataFrame(rows)
-    for col in ("id", "kind", "status", "message", "method", "converged",
-                "mu_s_identifiable", "flags", "starts"):
-        if col not in frame:
+    for col in SEGMENT_FIELDS:  # older results lack some fields
+        if col not in frame and col not in _NUMERIC:
             frame[col] = pd.Series([None] * len(frame), dtype=object)
     for col in _NUMERIC:
         frame[col] = pd.to_numeric(frame[col], errors="coerce") if col in frame else np.nan
@@ -123,7 +114,7 @@ def segment_estimates(result_dir: Path, ids: list[int],
 
     try:
         names = pq.read_schema(path).names
-        columns = [c for c in (*ESTIMATE_COLUMNS, "bit_rpm", *BAND_COLUMNS) if c in names]
+        columns = [c for c in ESTIMATE_NAMES if c in names]  # older results lack some
         table = pq.read_table(path, columns=columns,
                               filters=[("segment_id", "in", [int(i) for i in ids])])
     except (OSError, ValueError) as exc:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import astuple
 from pathlib import Path
 
 import h5py
@@ -37,7 +38,7 @@ def test_sidecars_found_by_name(csv_well):
     csv_well.with_suffix(".toml").write_text('[well]\nname = "Alpha"\n'
                                              '[segmentation]\nmax_gap_s = 2.0\n')
     (csv_well.parent / "A-12.survey.csv").write_text(SURVEY_CSV)
-    data, cfg, survey = resolve_well(csv_well)
+    data, cfg, survey = astuple(resolve_well(csv_well))
     assert (cfg.name, survey.name) == ("A-12.toml", "A-12.survey.csv")
     pytest.importorskip("drillfric.io.survey")
     w = load_well(csv_well)
@@ -50,7 +51,7 @@ def test_command_line_files_override_sidecars(csv_well, tmp_path):
     other = tmp_path / "other.toml"
     other.write_text('[well]\nname = "explicit"\n')
     (tmp_path / "s.csv").write_text(SURVEY_CSV)
-    _, cfg, survey = resolve_well(csv_well, config=other, survey=tmp_path / "s.csv")
+    _, cfg, survey = astuple(resolve_well(csv_well, config=other, survey=tmp_path / "s.csv"))
     assert (cfg, survey) == (other, tmp_path / "s.csv")
     assert load_well(csv_well, config=other).name == "explicit"
 
@@ -58,7 +59,7 @@ def test_command_line_files_override_sidecars(csv_well, tmp_path):
 def test_config_survey_key_and_overrides(csv_well, tmp_path):
     (tmp_path / "dev.csv").write_text(SURVEY_CSV)
     csv_well.with_suffix(".toml").write_text('[survey]\nfile = "dev.csv"\n')
-    assert resolve_well(csv_well)[2] == tmp_path / "dev.csv"
+    assert resolve_well(csv_well).survey == tmp_path / "dev.csv"
     w = load_well(csv_well, overrides={"segmentation.max_gap_s": 0.1})
     assert w.config["segmentation.max_gap_s"] == 0.1
 
@@ -163,14 +164,16 @@ def test_dsats_sample_with_documented_mapping(real_data):
                                rtol=1e-12)
 
 
-def test_load_setup_reads_config_and_survey_only(csv_well, tmp_path):
-    pytest.importorskip("drillfric.io.survey")
-    from drillfric.io.well import load_setup
+def test_open_without_header_reads_config_and_survey_only(csv_well, tmp_path):
+    """td needs the string and the path only: a data file it cannot map is not read."""
+    from drillfric.io.well import open_well
 
+    csv_well.write_text("a,b\n1,2\n")  # no channel drillfric knows
     csv_well.with_suffix(".toml").write_text('[fluid]\nmud_density_kg_m3 = 1400.0\n')
     (tmp_path / "A-12.survey.csv").write_text(SURVEY_CSV)
-    cfg, path = load_setup(csv_well)
-    assert cfg["fluid.mud_density_kg_m3"] == 1400.0 and path.md_max_m == 1500.0
+    well = open_well(csv_well, header=False)
+    assert well.config["fluid.mud_density_kg_m3"] == 1400.0 and well.survey.md_max_m == 1500.0
+    assert well.source is None and well.mappings == {}
 
 
 def test_iter_surface_fails_at_the_call_for_a_bad_well(tmp_path):

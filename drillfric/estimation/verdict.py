@@ -1,0 +1,171 @@
+"""What a segment's estimates may claim: the rules an engineer is most likely to change.
+
+A pure function of the estimators' results (:class:`Evidence`) to the numbers reported and
+the words beside them (:class:`Verdict`): which μ_k is reported and by which method, whether
+it counts as converged, whether a μ_s lower bound may be shown, and the flags and messages.
+No model runs here — every rule can be tested on its own (tests/test_verdict.py), and
+docs/batch_refinement.md explains each.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from drillfric.result import Flag, Method
+
+#: Batch flags under which a stick-slip-onset bound on μ_s is not reported (docs/theory.md
+#: §6.4: a bound above the truth is a false claim; prefer none).
+UNRELIABLE_BOUND = frozenset({Flag.REGIME_MISMATCH, Flag.BISTABLE_REGIME,
+                              Flag.STICK_SLIP_NOT_REPRODUCED})
+#: Friction factors usually seen with steel in mud-filled hole; outside, a segment is flagged
+#: ``outside_typical_range`` (check string, survey, torque units) but not changed.
+TYPICAL_MU = (0.05, 0.8)
+#: Ratio between batch and observer μ_k (either way) beyond which a segment is not
+#: converged (on synthetic truths the observer consensus is within ~25 %: docs/validation.md).
+DISAGREEMENT = 1.5
+#: Rotation a segment needs to count as converged [s]: the fit skips the first ~30 s of each
+#: run and its mean torque needs about a minute of stick-slip cycles (docs/batch_refinement.md).
+MIN_CONVERGED_ROTATION_S = 90.0
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """What the estimators found for one segment.
+
+    Attributes
+    ----------
+    batch_mu_k : float or None
+        μ_k of the speed-driven fit [-] (None: the fit gave none).
+    batch_flags : tuple of Flag
+    batch_messages : tuple of str
+    mu_s_lower_bound : float or None
+        The fit's stick-slip-onset bound on μ_s [-].
+    mu_s_model : float or None
+        μ_s the fit's model used for μ_k (its regime value) [-].
+    mu_s : float or None
+        μ_s identified by a creep fit [-].
+    observer_mu_k : float
+        Observer consensus μ_k of the starts pass [-].
+    observer_converged : bool
+    observer_flags : tuple of Flag
+    turning_s : float
+        Time the top drive turns faster than ω_c [s].
+    on_bottom : bool
+    """
+
+    batch_mu_k: float | None
+    batch_flags: tuple
+    batch_messages: tuple
+    mu_s_lower_bound: float | None
+    mu_s_model: float | None
+    mu_s: float | None
+    observer_mu_k: float
+    observer_converged: bool
+    observer_flags: tuple
+    turning_s: float
+    on_bottom: bool
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The numbers a segment reports and the words beside them.
+
+    Attributes
+    ----------
+    mu_k : float
+        Reported kinetic friction factor [-].
+    method : Method
+    converged : bool
+    mu_s_lower_bound : float or None
+        Shown bound on μ_s [-] (withheld where unreliable).
+    mu_s_seed : float
+        μ_s for the seeded observer pass: identified, else the fit's regime value, else the
+        bound, else μ_k [-].
+    adapt_final : bool
+        Whether the seeded pass keeps adapting μ̂ (only when the fit gave no μ_k).
+    flags : tuple of Flag
+    messages : tuple of str
+    """
+
+    mu_k: float
+    method: Method
+    converged: bool
+    mu_s_lower_bound: float | None
+    mu_s_seed: float
+    adapt_final: bool
+    flags: tuple
+    messages: tuple
+
+
+def decide(ev: Evidence) -> Verdict:
+    """Apply the rules to one segment's :class:`Evidence`.
+
+    1. μ_k is the batch fit's when it has one (``batch``), else the observer consensus
+       (``observer``, converged only if the observer says so);
+    2. a batch μ_k is not converged when the fit flags ``mu_k_not_converged``, when batch and
+       observer differ by more than :data:`DISAGREEMENT`, or with less than
+       :data:`MIN_CONVERGED_ROTATION_S` of rotation;
+    3. a μ_s lower bound is withheld on bottom (the bit drives the swings) and under the
+       flags of :data:`UNRELIABLE_BOUND`;
+    4. μ_k outside :data:`TYPICAL_MU` is flagged (not changed);
+    5. on bottom the friction is apparent (bit torque included).
+
+    Examples
+    --------
+    >>> ev = Evidence(0.2, (), (), 0.3, 0.5, None, 0.21, True, (), 120.0, False)
+    >>> v = decide(ev)
+    >>> (v.mu_k, v.method.value, v.converged, v.mu_s_lower_bound, v.mu_s_seed)
+    (0.2, 'batch', True, 0.3, 0.5)
+    """
+    flags = list(ev.observer_flags) + list(ev.batch_flags)
+    messages = list(ev.batch_messages)
+    bound = _shown_bound(ev, messages)
+    if ev.batch_mu_k is not None:
+        mu_k, method = ev.batch_mu_k, Method.BATCH
+        converged = _batch_converged(ev, flags, messages)
+    else:
+        mu_k, method, converged = ev.observer_mu_k, Method.OBSERVER, ev.observer_converged
+        messages.append("batch refinement gave no μ_k: observer consensus reported")
+    if not TYPICAL_MU[0] <= mu_k <= TYPICAL_MU[1]:
+        flags.append(Flag.OUTSIDE_TYPICAL_RANGE)
+        messages.append(f"μ_k = {mu_k:.3f} is outside the range usually seen ({TYPICAL_MU[0]}–"
+                        f"{TYPICAL_MU[1]}): check the string, the survey and the torque units")
+    if ev.on_bottom:
+        flags.append(Flag.BIT_TORQUE_IN_FRICTION)
+        messages.append("on bottom: the bit torque is not separated, friction is apparent")
+    seed = next((float(v) for v in (ev.mu_s, ev.mu_s_model, ev.mu_s_lower_bound)
+                 if v is not None), mu_k)
+    return Verdict(mu_k=float(mu_k), method=method, converged=bool(converged),
+                   mu_s_lower_bound=bound, mu_s_seed=max(seed, mu_k),
+                   adapt_final=method is Method.OBSERVER, flags=tuple(dict.fromkeys(flags)),
+                   messages=tuple(messages))
+
+
+def _shown_bound(ev: Evidence, messages: list) -> float | None:
+    if ev.mu_s_lower_bound is None:
+        return None
+    if ev.on_bottom:
+        messages.append("μ_s lower bound withheld on bottom: the bit drives the torque swings")
+        return None
+    if UNRELIABLE_BOUND.intersection(ev.batch_flags):
+        messages.append("μ_s lower bound withheld: the model does not reproduce the data's "
+                        "stick-slip regime")
+        return None
+    return ev.mu_s_lower_bound
+
+
+def _batch_converged(ev: Evidence, flags: list, messages: list) -> bool:
+    converged = Flag.MU_K_NOT_CONVERGED not in ev.batch_flags
+    if abs(np.log(ev.batch_mu_k / max(ev.observer_mu_k, 1e-6))) > np.log(DISAGREEMENT):
+        converged = False
+        flags.append(Flag.ESTIMATORS_DISAGREE)
+        messages.append(f"batch μ_k = {ev.batch_mu_k:.3f} and observer μ_k = "
+                        f"{ev.observer_mu_k:.3f} disagree: not converged")
+    if ev.turning_s < MIN_CONVERGED_ROTATION_S:
+        converged = False
+        flags.append(Flag.TOO_SHORT_TO_CONVERGE)
+        messages.append(f"only {ev.turning_s:.0f} s of rotation (< "
+                        f"{MIN_CONVERGED_ROTATION_S:.0f} s): not converged")
+    return converged

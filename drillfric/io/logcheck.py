@@ -1,0 +1,102 @@
+"""Checks of a surface log as it streams by, so that a run never ends in silence.
+
+A log can be read without error and still give nothing to estimate: a constant time column,
+time in milliseconds labelled as seconds (every sample a gap), a torque column with no
+numbers, a top drive logged with the opposite sign. :class:`LogCheck` watches the canonical
+chunks of a run and says so — an :class:`~drillfric.errors.InputError` naming the channel and
+the fix where the log cannot be meant that way, a warning where a run found nothing to do
+(docs/ingestion.md "No silent empty results").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from drillfric.errors import InputError
+
+
+class LogCheck:
+    """Accumulates what the checks need from every chunk of a run (constant memory).
+
+    Parameters
+    ----------
+    well : drillfric.io.well.Well
+        The well being read (for file, column names and thresholds).
+    """
+
+    def __init__(self, well):
+        self.well = well
+        self.rows = 0
+        self.finite = {"surface_rpm": 0, "surface_torque_Nm": 0}
+        self.turning = 0  # samples with |rpm| above the rotation threshold
+        self.backwards = 0  # of those, turning backwards
+        self.rpm_min = np.inf
+        self.rpm_max = -np.inf
+
+    def feed(self, chunk: pd.DataFrame) -> None:
+        """Take in one canonical chunk (the first one also checks the sample spacing)."""
+        if self.rows == 0 and len(chunk) > 1:
+            self._spacing(chunk["time_s"].to_numpy(float))
+        self.rows += len(chunk)
+        for name in self.finite:
+            if name in chunk:
+                self.finite[name] += int(np.isfinite(chunk[name].to_numpy(float)).sum())
+        rpm = chunk["surface_rpm"].to_numpy(float)
+        rpm = rpm[np.isfinite(rpm)]
+        if rpm.size:
+            fast = np.abs(rpm) > self.well.config["segmentation.rotating_rpm"]
+            self.turning += int(fast.sum())
+            self.backwards += int((rpm[fast] < 0).sum())
+            self.rpm_min = min(self.rpm_min, float(rpm.min()))
+            self.rpm_max = max(self.rpm_max, float(rpm.max()))
+
+    def _spacing(self, time_s: np.ndarray) -> None:
+        """Every sample a gap: almost surely time in ms read as s (or a max_gap_s too small)."""
+        dt = np.diff(time_s)
+        dt = dt[dt > 0]
+        limit = self.well.config["segmentation.max_gap_s"]
+        if dt.size and float(np.median(dt)) > limit:
+            time = self.well.mappings["time"]
+            raise InputError(f"time column '{time.column}' has samples {np.median(dt):.4g} "
+                             f"{time.unit} apart: more than segmentation.max_gap_s "
+                             f"({limit:.4g} s), so every sample would be a gap",
+                             file=self.well.files.data,
+                             fix='if the time is in milliseconds, say so: [channels] time = '
+                                 '{ unit = "ms" }; if the log really is this slow, raise '
+                                 "segmentation.max_gap_s")
+
+    def finish(self, duplicates: int) -> None:
+        """Raise for logs that cannot be meant as read (after the last chunk)."""
+        file = self.well.files.data
+        if self.rows <= 1 and duplicates > 0:
+            time = self.well.mappings["time"]
+            raise InputError(f"time column '{time.column}' holds one value for all "
+                             f"{duplicates + self.rows} rows", file=file,
+                             fix="map the column that holds the sample times in [channels] "
+                                 'time = { column = "..." }')
+        for name, count in self.finite.items():
+            if self.rows and count == 0:
+                m = self.well.channels[name]
+                raise InputError(f"column '{m.column}' ({name}) holds no numbers in any of "
+                                 f"{self.rows} rows", file=file,
+                                 fix=f"map the column that holds {m.channel.kind} in "
+                                     f'[channels] {m.channel.key} = {{ column = "..." }}')
+        if self.turning and self.backwards > 0.9 * self.turning:
+            m = self.well.channels["surface_rpm"]
+            raise InputError(f"surface speed column '{m.column}' turns backwards in "
+                             f"{100 * self.backwards / self.turning:.0f} % of the turning "
+                             f"samples (min {self.rpm_min:.4g} RPM): the log's sign is the "
+                             "opposite of drillfric's (forward rotation positive)",
+                             file=file, fix=f"negate it: [channels] {m.channel.key} = "
+                                            f'{{ column = "{m.column}", scale = -1 }}')
+
+    def nothing_found(self, segments: int) -> str | None:
+        """Why a run found no rotating segment at all (a warning), or None."""
+        if segments:
+            return None
+        threshold = self.well.config["segmentation.rotating_rpm"]
+        top = f"{self.rpm_max:.4g} RPM" if np.isfinite(self.rpm_max) else "no value"
+        return (f"no rotating segment found: the surface speed never exceeds "
+                f"segmentation.rotating_rpm = {threshold:.4g} RPM for "
+                f"segmentation.min_rotation_s (highest: {top}) — nothing was estimated")

@@ -1,0 +1,213 @@
+"""The result of a run, declared once: segments, estimates and the well summary.
+
+Every output that describes a segment — ``summary.json`` ``segments``, ``segments.parquet``,
+the report's tables and ``fleet_summary.parquet`` — is built from :class:`SegmentRecord`;
+every column of ``estimates.parquet`` from :data:`ESTIMATE_COLUMNS`. Units are in the names
+(docs/nomenclature.md) and in each field's metadata; docs/outputs.md is generated from here
+(:func:`outputs_markdown`) and a test keeps the two equal.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field, fields
+from enum import StrEnum
+
+import numpy as np
+
+
+class Status(StrEnum):
+    """What became of a segment."""
+
+    OK = "ok"  #: estimated (the numbers may still be flagged or not converged)
+    SKIPPED = "skipped"  #: nothing to estimate (too short, nulls, no side force)
+    FAILED = "failed"  #: the estimation could not be done (e.g. torque in the wrong unit)
+
+
+class Kind(StrEnum):
+    """The load case of a rotating segment (docs/theory.md §2 item 5)."""
+
+    OFF_BOTTOM = "off_bottom_rotating"
+    ON_BOTTOM = "on_bottom_rotating"
+
+
+class Method(StrEnum):
+    """Which estimator produced a segment's friction factors."""
+
+    BATCH = "batch"  #: the speed-driven fit (docs/theory.md §6.4)
+    OBSERVER = "observer"  #: the adaptive observer's consensus (§5), the fit gave no μ_k
+    NONE = "none"  #: no estimate (skipped or failed)
+
+
+class Flag(StrEnum):
+    """Conditions a reader of a segment's numbers must know (docs/outputs.md)."""
+
+    OBSERVER_NOT_CONVERGED = "observer_not_converged"
+    OBSERVER_DEADLOCK_AVERTED = "observer_deadlock_averted"
+    NO_ROTATION = "no_rotation"
+    ROTATION_TOO_SHORT = "rotation_too_short"
+    REGIME_MISMATCH = "regime_mismatch"
+    MU_K_NOT_CONVERGED = "mu_k_not_converged"
+    CREEP_RATE_TOO_LOW = "creep_rate_too_low"
+    CREEP_FIT_AT_BOUND = "creep_fit_at_bound"
+    CREEP_NOT_GRID_CONVERGED = "creep_not_grid_converged"
+    BISTABLE_REGIME = "bistable_regime"
+    STICK_SLIP_NOT_REPRODUCED = "stick_slip_not_reproduced"
+    ESTIMATORS_DISAGREE = "estimators_disagree"
+    TOO_SHORT_TO_CONVERGE = "too_short_to_converge"
+    OUTSIDE_TYPICAL_RANGE = "outside_typical_range"
+    BIT_TORQUE_IN_FRICTION = "bit_torque_in_friction"
+
+
+#: What each flag means (docs/outputs.md).
+FLAG_MEANINGS = {
+    Flag.OBSERVER_NOT_CONVERGED: "the observer's starts did not agree (spread above tolerance)",
+    Flag.OBSERVER_DEADLOCK_AVERTED: "an observer start stuck while the top drive turned was "
+                                    "released by the deadlock guard",
+    Flag.NO_ROTATION: "the fit window holds no rotation above ω_c",
+    Flag.ROTATION_TOO_SHORT: "no rotating run lasts 30 s after reaching ω_c (μ_k unfitted)",
+    Flag.REGIME_MISMATCH: "the model could not be put in the data's regime (stick-slip or "
+                          "steady): μ_k may be biased by a few %",
+    Flag.MU_K_NOT_CONVERGED: "the mean torque was matched to worse than 2 %",
+    Flag.CREEP_RATE_TOO_LOW: "a creep start-up was found but logged below 2 Hz: μ_s not fitted",
+    Flag.CREEP_FIT_AT_BOUND: "the creep fit ran to its search bound: μ_s not reported",
+    Flag.CREEP_NOT_GRID_CONVERGED: "the creep μ_s moved by more than 3 % on grid refinement: "
+                                   "not reported",
+    Flag.BISTABLE_REGIME: "whether the model sticks is not monotone in μ_s: no lower bound",
+    Flag.STICK_SLIP_NOT_REPRODUCED: "the model does not stick-slip for any μ_s: no lower bound",
+    Flag.ESTIMATORS_DISAGREE: "batch and observer μ_k differ by more than a factor 1.5: not "
+                              "converged",
+    Flag.TOO_SHORT_TO_CONVERGE: "less than 90 s of rotation: not converged",
+    Flag.OUTSIDE_TYPICAL_RANGE: "μ_k outside 0.05–0.8: check string, survey, torque units",
+    Flag.BIT_TORQUE_IN_FRICTION: "on bottom: the bit torque is in the apparent friction",
+}
+
+
+def _f(unit: str, doc: str, default=None, **kw):
+    """A schema field with its unit and meaning."""
+    return field(default=default, metadata={"unit": unit, "doc": doc}, **kw)
+
+
+@dataclass(frozen=True)
+class SegmentRecord:
+    """One segment of a well: a row of ``segments.parquet``, an entry of ``summary.json``.
+
+    The first 18 fields are the binding keys of the interface, in their order; the rest are
+    drillfric's additions. ``None`` is null (JSON) / NaN (Parquet).
+    """
+
+    id: int = _f("", "segment number, 1-based, in time order", 0)
+    kind: Kind = _f("", "load case: off_bottom_rotating or on_bottom_rotating",
+                    Kind.OFF_BOTTOM)
+    t_start_s: float = _f("s", "time of the segment's first sample", 0.0)
+    t_end_s: float = _f("s", "time of the segment's last sample", 0.0)
+    bit_depth_m: float | None = _f("m", "median bit depth (or the assumed depth)")
+    mu_s: float | None = _f("-", "static friction factor, only where the data identify it")
+    mu_k: float | None = _f("-", "kinetic friction factor")
+    mu_s_identifiable: bool = _f("", "whether μ_s is identified by these data", False)
+    mu_s_lower_bound: float | None = _f("-", "lower bound on μ_s where only bounded")
+    mu_s_spread: float | None = _f("-", "uncertainty of μ_s (creep fit's change on grid "
+                                        "refinement)")
+    mu_k_spread: float | None = _f("-", "spread of the observer starts' μ_k")
+    converged: bool = _f("", "whether μ_k is converged (agreeing estimators, ≥ 90 s)", False)
+    method: Method = _f("", "estimator of the numbers: batch, observer or none", Method.NONE)
+    settling_time_s: float | None = _f("s", "time the observer starts took to settle")
+    residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
+    stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated bit "
+                                                "speed")
+    status: Status = _f("", "ok, skipped or failed", Status.OK)
+    message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
+    duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
+    stuck_fraction: float | None = _f("-", "share of the time the estimated bit is stuck")
+    mu_k_observer: float | None = _f("-", "observer consensus μ_k (first pass)")
+    mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass)")
+    mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")
+    T_N_Nm: float | None = _f("N·m", "∫F_c dx at this depth: torque per unit friction factor")
+    bit_rms_error_rpm: float | None = _f("RPM", "RMS error of the bit speed (synthetic truth)")
+    flags: tuple[Flag, ...] = _f("", "conditions to know (Flag)", ())
+    starts: tuple[tuple[float, float], ...] = _f("-", "observer starts (μ_s, μ_k) by start_id",
+                                                 ())
+
+    def to_json(self) -> dict:
+        """Plain JSON values (enums as text, NaN as None), in field order."""
+        return {k: _plain(v) for k, v in asdict(self).items()}
+
+
+#: Field names of :class:`SegmentRecord` in output order.
+SEGMENT_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(SegmentRecord))
+#: The binding keys of the interface (the first fields).
+SEGMENT_KEYS: tuple[str, ...] = SEGMENT_FIELDS[:18]
+#: Fields stored as JSON text in segments.parquet (lists).
+SEGMENT_LIST_FIELDS = ("flags", "starts")
+#: Numeric fields (null is NaN in tables).
+SEGMENT_NUMBER_FIELDS: tuple[str, ...] = tuple(
+    f.name for f in fields(SegmentRecord) if f.type in ("float", "float | None"))
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of ``estimates.parquet``: name (unit suffix), Arrow type, unit, meaning."""
+
+    name: str
+    type: str
+    unit: str
+    doc: str
+
+
+#: Columns of estimates.parquet in order; ``bit_rpm`` only when the input has the truth.
+ESTIMATE_COLUMNS: tuple[Column, ...] = (
+    Column("time_s", "float64", "s", "time of the row"),
+    Column("segment_id", "int32", "", "segment id (segments.parquet)"),
+    Column("start_id", "int16", "", "observer start (0…), −1 for the seeded ensemble pass"),
+    Column("mu_s", "float64", "-", "μ̂_s of the start"),
+    Column("mu_k", "float64", "-", "μ̂_k of the start"),
+    Column("surface_rpm", "float64", "RPM", "measured top-drive speed"),
+    Column("surface_rpm_est", "float64", "RPM", "observer's top-drive speed"),
+    Column("bit_rpm_est", "float64", "RPM", "estimated bit speed"),
+    Column("bit_stuck", "bool", "", "estimated bit in the static band (|ω| ≤ ω_c)"),
+    Column("residual_rpm", "float64", "RPM", "innovation ω̂₀ − ω₀"),
+    Column("bit_rpm", "float64", "RPM", "measured bit speed (synthetic truth only)"),
+    Column("bit_rpm_est_min", "float32", "RPM", "ensemble band: lowest member (seeded rows)"),
+    Column("bit_rpm_est_max", "float32", "RPM", "ensemble band: highest member (seeded rows)"),
+)
+ESTIMATE_NAMES: tuple[str, ...] = tuple(c.name for c in ESTIMATE_COLUMNS)
+#: ``start_id`` of the final observer pass seeded with the batch-refined factors.
+SEEDED_START_ID = -1
+
+
+#: Well-level columns of fleet_summary.parquet (before the segment fields).
+FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "result_dir", "well_mu_s",
+                      "well_mu_k", "well_mu_s_lower_bound", "drillfric_version", "segment_id")
+
+
+def _plain(value):
+    if isinstance(value, StrEnum):
+        return value.value
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def segment_columns(records) -> dict[str, list]:
+    """segments.parquet as columns (list fields as JSON text)."""
+    rows = [r.to_json() for r in records]
+    return {name: [json.dumps(row[name]) if name in SEGMENT_LIST_FIELDS else row[name]
+                   for row in rows] for name in SEGMENT_FIELDS}
+
+
+def outputs_markdown() -> str:
+    """The column reference of docs/outputs.md, rendered from this schema."""
+    lines = ["## segments (summary.json `segments`, segments.parquet)", "",
+             "| field | unit | meaning |", "|---|---|---|"]
+    lines += [f"| `{f.name}` | {f.metadata['unit']} | {f.metadata['doc']} |"
+              for f in fields(SegmentRecord)]
+    lines += ["", "## estimates.parquet", "", "| column | type | unit | meaning |",
+              "|---|---|---|---|"]
+    lines += [f"| `{c.name}` | {c.type} | {c.unit} | {c.doc} |" for c in ESTIMATE_COLUMNS]
+    lines += ["", "## flags", "", "| flag | meaning |", "|---|---|"]
+    lines += [f"| `{f.value}` | {FLAG_MEANINGS[f]} |" for f in Flag]
+    return "\n".join(lines) + "\n"
