@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.channels import CHANNELS, find_column
 from drillfric.io.readers import RawSource
 from drillfric.units import conversion_factor
 
@@ -74,8 +75,6 @@ def _names(channels) -> list[str]:
 
 
 def _rank(frame, rows: int) -> tuple:
-    from drillfric.io.channels import CHANNELS, find_column
-
     names = _names(_scalar_channels(frame))
     found = 0
     for channel in (c for c in CHANNELS if c.required):

@@ -38,6 +38,7 @@ from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import iterparse
 
 from drillfric.errors import InputError
+from drillfric.io.channels import CHANNELS, find_column
 from drillfric.io.readers import RawSource
 from drillfric.units import UREG, conversion_factor, parse_unit
 
@@ -330,8 +331,6 @@ def pick_log(logs: list[LogHeader]) -> LogHeader:
     Ranked by: time-indexed before depth-indexed; most of the required channels (time,
     surface RPM, surface torque) recognised; most channels recognised; most rows.
     """
-    from drillfric.io.channels import CHANNELS, find_column
-
     def found(log: LogHeader, keys) -> int:
         count = 0
         for key in keys:
@@ -486,8 +485,9 @@ def _index_keys(values: pd.Series, header: LogHeader) -> np.ndarray:
     if header.index_curve in header.text_columns:
         stamps = pd.to_datetime(values.astype("string").str.strip(), format="ISO8601",
                                 utc=True, errors="coerce")
-        out = stamps.astype("int64").to_numpy(dtype=float)
-        out[stamps.isna().to_numpy()] = np.nan
+        ns = stamps.dt.tz_convert(None).to_numpy(dtype="datetime64[ns]")
+        out = ns.astype("int64").astype(float)
+        out[np.isnat(ns)] = np.nan
         return out
     return pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
 

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from drillfric.config import config_from_dict
 from drillfric.errors import InputError
 from drillfric.io.channels import map_channels
 from drillfric.io.readers import open_source
@@ -206,6 +207,28 @@ def test_parts_of_one_log_read_in_index_order_without_overlap(tmp_path):
     assert frame["RPM"].tolist() == list(range(9))
 
 
+def test_part_rows_without_an_index_are_kept_for_the_time_base(tmp_path):
+    """A row with an empty time is not an overlap: it is handed on (the time base counts it
+    as untimed) rather than silently dropped."""
+    (tmp_path / "1.xml").write_text(_part(["2024-05-01T12:00:00Z,1", ",2"]))
+    (tmp_path / "2.xml").write_text(_part(["2024-05-01T12:00:01Z,3", ",4"]))
+    frame = pd.concat(list(open_witsml_parts(witsml_log_parts(tmp_path)).chunks()))
+    assert frame["RPM"].tolist() == [1, 2, 3, 4]
+
+
+def test_witsml_131_log_columns_follow_column_index(tmp_path):
+    """WITSML 1.3.1 logs have no mnemonicList: columns are the curves by columnIndex."""
+    curves = "".join(f"<logCurveInfo><mnemonic>{m}</mnemonic><unit>{u}</unit>"
+                     f"<columnIndex>{i}</columnIndex></logCurveInfo>"
+                     for m, u, i in (("TQ", "N.m", 3), ("TIME", "s", 1), ("RPM", "rpm", 2)))
+    body = (f"<log uid='x'><indexType>elapsed time</indexType><indexCurve>TIME</indexCurve>"
+            f"{curves}<logData><data>0,60,5</data><data>1,61,6</data></logData></log>")
+    (tmp_path / "old.xml").write_text(_doc(body))
+    source = open_source(tmp_path / "old.xml")
+    assert source.columns == ["TIME", "RPM", "TQ"] and source.units["TQ"] == "N.m"
+    assert _frame(tmp_path / "old.xml")["TQ"].tolist() == [5, 6]
+
+
 def test_parts_with_a_new_curve_get_the_union_of_columns(tmp_path):
     curves = _curve("TIME", "s") + _curve("RPM", "rpm") + _curve("TQ", "N.m")
     later = _doc(_log(["2,2,20", "3,3,30"], mnemonics="TIME,RPM,TQ", units="s,rpm,N.m",
@@ -301,6 +324,9 @@ def test_tubular_sections_are_top_down_by_decreasing_sequence(tmp_path):
     # 1 lbm/ft = 0.45359237 kg / 0.3048 m (exact definitions)
     assert dp["linear_mass_kg_m"] == pytest.approx(19.5 * 0.45359237 / FT, rel=1e-12)
     assert "linear_mass_kg_m" not in sections[2]
+    # the tables are valid [[string.sections]] of a configuration, kept in order
+    config = config_from_dict({"string": {"sections": sections}})
+    assert [s["name"] for s in config.sections] == [s["name"] for s in sections]
 
 
 def test_tubular_with_impossible_dimensions_is_refused(tmp_path):
