@@ -330,7 +330,8 @@ DEFAULT_SECTIONS: tuple[dict, ...] = (
 #: Channel keys accepted in ``[channels]`` (canonical names without the unit suffix).
 CHANNEL_KEYS = ("time", "surface_rpm", "surface_torque", "hookload", "bit_depth",
                 "hole_depth", "wob", "block_position", "bit_rpm", "standpipe_pressure",
-                "flow_in", "flow_out", "pump_rate")
+                "flow_in", "flow_out", "pump_rate", "surface_torque_min", "surface_torque_max",
+                "surface_rpm_min", "surface_rpm_max", "hookload_min", "hookload_max")
 _CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
 
 

@@ -78,6 +78,11 @@ _ALIASES = {
     "dega": "degree",
     "degrees": "degree",
     "%": "percent",
+    # WITSML 1.x unit spellings (uom attributes, unitList)
+    "lbm": "pound",
+    "lbm/ft": "pound/foot",
+    "ftus": "survey_foot",
+    "hz": "hertz",
 }
 
 #: SI target unit for each kind of quantity drillfric reads.
@@ -126,7 +131,7 @@ def parse_unit(text: str) -> pint.Unit:
         try:
             return UREG.parse_units(candidate)
         except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError,
-                AttributeError, TypeError, ValueError):
+                AttributeError, TypeError, ValueError, AssertionError):  # pint on "#1"
             continue
     raise InputError(f"unknown unit '{text}'",
                      fix="use a unit such as rpm, kN.m, ft.lbf, klbf, m, ft")

@@ -3,7 +3,9 @@
 - :mod:`drillfric.io.channels` — the mnemonic table: which source column is which canonical
   channel, and in which unit.
 - :mod:`drillfric.io.readers` — format readers (Parquet, CSV, HDF5, LAS 2.0) yielding raw
-  chunks with the units the file states.
+  chunks with the units the file states; :mod:`drillfric.io.witsml` (WITSML 1.4.1 logs,
+  trajectories, tubulars), :mod:`drillfric.io.dlis` and :mod:`drillfric.io.excel` for
+  ``.xml``, ``.dlis`` and ``.xlsx``.
 - :mod:`drillfric.io.timebase` — time base checks: order, duplicates, gaps, nominal rate.
 - :mod:`drillfric.io.survey` — survey readers (MD, inclination, azimuth).
 - :mod:`drillfric.io.well` — wells on disk (sidecars, HDF5 bundles, directories), ``load_well``

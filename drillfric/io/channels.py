@@ -58,7 +58,9 @@ class Channel:
     required: bool = False
 
 
-#: The mnemonic table (the only one): canonical channels in output column order.
+#: The mnemonic table (the only one): canonical channels in output column order. Interval
+#: averages (``TORQUE_AVG``) are the channel itself; interval minima and maxima
+#: (``TORQUE_MIN``/``_MAX``, WITS ``HKLX``/``TQX``) are optional channels of their own.
 CHANNELS: tuple[Channel, ...] = (
     Channel("time", "time_s", "time", "second", "s",
             ("TIME", "DATETIME", "DATE_TIME", "TIMESTAMP", "TIME_S", "ETIM", "ELAPSED TIME",
@@ -66,33 +68,48 @@ CHANNELS: tuple[Channel, ...] = (
     Channel("surface_rpm", "surface_rpm", "rotary speed", "revolution/minute", "rpm",
             ("RPM", "SRPM", "TDRPM", "RPMA", "RPMS", "TDS", "ROTARY SPEED", "TOP DRIVE SPEED",
              "AVERAGE ROTARY SPEED", "SURFACE RPM", "SURFACE ROTARY SPEED", "TOP DRIVE RPM",
-             "TD SPEED", "TD RPM", "ROTARY RPM", "RPM SURFACE"), required=True),
+             "TD SPEED", "TD RPM", "ROTARY RPM", "RPM SURFACE", "SURF_RPM", "SURF_RPM_AVG",
+             "RPM_AVG", "SRPM_AVG"), required=True),
     Channel("surface_torque", "surface_torque_Nm", "torque", "newton*meter", "kN.m",
             ("TORQUE", "STOR", "TQA", "TDTORQUE", "TORQ", "TQ", "SURFACE TORQUE",
              "TOP DRIVE TORQUE", "AVERAGE SURFACE TORQUE", "TD TORQUE", "ROTARY TORQUE",
-             "STQ", "TDTQ"), required=True),
+             "STQ", "TDTQ", "TORQUE_AVG", "TQ_AVG", "STOR_AVG"), required=True),
     Channel("hookload", "hookload_N", "force", "newton", "kN",
             ("HKLD", "HKLA", "HKL", "HOOKLOAD", "HOOK LOAD", "AVERAGE HOOKLOAD",
-             "AVERAGE HOOK LOAD", "HKLX")),
+             "AVERAGE HOOK LOAD", "HKLD_AVG", "HKL_AVG", "HOOKLOAD_AVG")),
     Channel("bit_depth", "bit_depth_m", "length", "meter", "m",
             ("BITDEP", "DBTM", "BDEP", "BIT DEPTH", "BIT POSITION", "DEPTH BIT")),
     Channel("hole_depth", "hole_depth_m", "length", "meter", "m",
-            ("DMEA", "HDTH", "HOLE DEPTH", "HOLEDEPTH", "DEPTH HOLE", "HOLE DEPTH MD")),
+            ("DMEA", "HDTH", "HOLE DEPTH", "HOLEDEPTH", "DEPTH HOLE", "HOLE DEPTH MD",
+             "MDEPTH")),
     Channel("wob", "wob_N", "force", "newton", "kN",
-            ("WOB", "SWOB", "WOBA", "WEIGHT ON BIT", "SURFACE WOB")),
+            ("WOB", "SWOB", "WOBA", "WEIGHT ON BIT", "SURFACE WOB", "WOB_AVG")),
     Channel("block_position", "block_position_m", "length", "meter", "m",
             ("BPOS", "BLKPOS", "BLOCK POSITION", "BLOCK HEIGHT", "BLOCK", "HOOK POSITION")),
     Channel("bit_rpm", "bit_rpm", "rotary speed", "revolution/minute", "rpm",
-            ("BITRPM", "DRPM", "BIT RPM", "DOWNHOLE RPM", "BIT SPEED")),
+            ("BITRPM", "DRPM", "BIT RPM", "DOWNHOLE RPM", "BIT SPEED", "BIT_RPM_AVG")),
     Channel("standpipe_pressure", "standpipe_pressure_Pa", "pressure", "pascal", "kPa",
             ("SPP", "SPPA", "SPPR", "STANDPIPE PRESSURE", "AVERAGE STANDPIPE PRESSURE",
-             "PUMP PRESSURE")),
+             "PUMP PRESSURE", "SPP_AVG", "PUMP", "PUMP_AVG")),
     Channel("flow_in", "flow_in_m3_s", "flow rate", "meter**3/second", "L/min",
             ("FLOWIN", "MFIA", "TFLO", "FLOW IN", "MUD FLOW IN", "FLOW IN RATE")),
     Channel("flow_out", "flow_out_pct", "percentage", "percent", "%",
             ("FLOWOUT", "MFOP", "FLOW OUT", "FLOW OUT PERCENT", "RETURN FLOW")),
     Channel("pump_rate", "pump_rate_spm", "pump rate", "1/minute", "spm",
-            ("SPM", "TSPM", "TOTAL SPM", "PUMP RATE", "STROKE RATE", "TOTAL STROKE RATE")),
+            ("SPM", "TSPM", "TOTAL SPM", "PUMP RATE", "STROKE RATE", "TOTAL STROKE RATE",
+             "STRATESUM")),
+    Channel("surface_torque_min", "surface_torque_min_Nm", "torque", "newton*meter", "kN.m",
+            ("TORQUE_MIN", "TQ_MIN", "STOR_MIN", "MIN_TORQUE", "TQMN")),
+    Channel("surface_torque_max", "surface_torque_max_Nm", "torque", "newton*meter", "kN.m",
+            ("TORQUE_MAX", "TQ_MAX", "STOR_MAX", "MAX_TORQUE", "TQX", "TQMX")),
+    Channel("surface_rpm_min", "surface_rpm_min", "rotary speed", "revolution/minute", "rpm",
+            ("SURF_RPM_MIN", "RPM_MIN", "SRPM_MIN", "MIN_RPM")),
+    Channel("surface_rpm_max", "surface_rpm_max", "rotary speed", "revolution/minute", "rpm",
+            ("SURF_RPM_MAX", "RPM_MAX", "SRPM_MAX", "MAX_RPM")),
+    Channel("hookload_min", "hookload_min_N", "force", "newton", "kN",
+            ("HKLD_MIN", "HKL_MIN", "HOOKLOAD_MIN", "MIN_HOOKLOAD")),
+    Channel("hookload_max", "hookload_max_N", "force", "newton", "kN",
+            ("HKLD_MAX", "HKLX", "HKL_MAX", "HOOKLOAD_MAX", "MAX_HOOKLOAD")),
 )
 
 BY_KEY: dict[str, Channel] = {c.key: c for c in CHANNELS}
@@ -116,7 +133,9 @@ _PER_MINUTE = frozenset({"1/min", "u/min", "min-1", "min^-1", "1/minute", "rev/m
 SUFFIX_UNITS = {"time": "s", "surface_rpm": "rpm", "surface_torque": "N.m", "hookload": "N",
                 "bit_depth": "m", "hole_depth": "m", "wob": "N", "block_position": "m",
                 "bit_rpm": "rpm", "standpipe_pressure": "Pa", "flow_in": "m3/s",
-                "flow_out": "%", "pump_rate": "spm"}
+                "flow_out": "%", "pump_rate": "spm", "surface_torque_min": "N.m",
+                "surface_torque_max": "N.m", "surface_rpm_min": "rpm", "surface_rpm_max": "rpm",
+                "hookload_min": "N", "hookload_max": "N"}
 
 _UNIT_IN_NAME = re.compile(r"^\s*(?P<name>.*?)\s*[\[(](?P<unit>[^\])]*)[\])]\s*$")
 
@@ -163,22 +182,45 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     >>> round(factor("klbf", BY_KEY["hookload"]), 3)
     4448.222
     """
-    key = unit.strip().lower().replace(" ", "")
-    spelled = _EXTRA_UNITS.get(key, unit)
-    if key in _PER_MINUTE and "revolution" in channel.unit:
-        spelled = "revolution/minute"  # 1/min, U/min, min-1: the European spellings of RPM
-    try:
-        source = parse_unit(spelled)
-    except InputError as exc:
-        raise InputError(f"unknown unit '{unit}' for {channel.name}", file=file,
-                         fix=f'state it in [channels], e.g. {channel.key} = '
-                             f'{{ unit = "{channel.default_unit}" }}') from exc
+    source = _source_unit(unit, channel, file)
     try:
         return float(UREG.Quantity(1.0, source).to(channel.unit).magnitude)
     except pint.errors.DimensionalityError as exc:
         raise InputError(f"unit '{unit}' of {channel.name} is not a {channel.kind} unit",
                          file=file, fix=f'give a {channel.kind} unit, e.g. {channel.key} = '
                                         f'{{ unit = "{channel.default_unit}" }}') from exc
+
+
+def _source_unit(unit: str, channel: Channel, file: str | None) -> pint.Unit:
+    """The pint unit of a spelling, read as the channel reads it (1/min is RPM on a speed)."""
+    key = unit.strip().lower().replace(" ", "")
+    spelled = _EXTRA_UNITS.get(key, unit)
+    if key in _PER_MINUTE and "revolution" in channel.unit:
+        spelled = "revolution/minute"  # 1/min, U/min, min-1: the European spellings of RPM
+    try:
+        return parse_unit(spelled)
+    except InputError as exc:
+        raise InputError(f"unknown unit '{unit}' for {channel.name}", file=file,
+                         fix=f'state it in [channels], e.g. {channel.key} = '
+                             f'{{ unit = "{channel.default_unit}" }}') from exc
+
+
+def unit_fits(unit: str, channel: Channel) -> bool | None:
+    """Whether ``unit`` measures the quantity of ``channel`` (None: an unknown spelling).
+
+    Examples
+    --------
+    >>> unit_fits("kN.m", BY_KEY["surface_torque"]), unit_fits("rpm", BY_KEY["surface_torque"])
+    (True, False)
+    >>> unit_fits("blorps", BY_KEY["surface_torque"]) is None
+    True
+    """
+    try:
+        source = _source_unit(unit, channel, None)
+    except InputError:
+        return None
+    return (UREG.Quantity(1.0, source).dimensionality
+            == UREG.Quantity(1.0, channel.unit).dimensionality)
 
 
 @dataclass(frozen=True)
@@ -228,9 +270,14 @@ def _rank(column: str, channel: Channel, extra: tuple[str, ...]) -> tuple[tuple,
     return (), None
 
 
-def _find_column(columns: list[str], channel: Channel, spec: dict,
-                 file: str | None) -> tuple[str | None, str | None]:
-    """The column a channel maps to (from ``[channels]`` or mnemonics) and the unit in its name."""
+def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | None,
+                 file_units: dict | None = None) -> tuple[str | None, str | None]:
+    """The column a channel maps to (from ``[channels]`` or mnemonics) and the unit in its name.
+
+    A column found by mnemonic whose stated unit measures another quantity (``FLOWOUT`` in
+    m3/s is a flow rate, not the percentage ``flow_out``) is passed over; a required channel
+    keeps it when no other column fits, so that the unit error names it.
+    """
     wanted = spec.get("column")
     if wanted is not None:
         if isinstance(wanted, int):
@@ -250,6 +297,9 @@ def _find_column(columns: list[str], channel: Channel, spec: dict,
     extra = tuple(spec.get("mnemonics", ()))
     ranked = [(rank, col, unit) for col in columns
               for rank, unit in [_rank(col, channel, extra)] if rank]
+    fitting = [r for r in ranked if _unit_agrees(r[1], r[2], channel, file_units or {}, spec)]
+    if fitting or not channel.required:
+        ranked = fitting
     if not ranked:
         return None, None
     best = max(r[0] for r in ranked)
@@ -260,6 +310,13 @@ def _find_column(columns: list[str], channel: Channel, spec: dict,
                          fix=f'choose one in [channels], e.g. {channel.key} = '
                              f'{{ column = "{top[0][1]}" }}')
     return top[0][1], top[0][2]
+
+
+def _unit_agrees(column: str, name_unit: str | None, channel: Channel, file_units: dict,
+                 spec: dict) -> bool:
+    """False when the unit a file states for ``column`` measures another quantity."""
+    unit = spec.get("unit") or name_unit or file_units.get(column)
+    return channel.key == "time" or not unit or unit_fits(unit, channel) is not False
 
 
 def find_column(columns: list[str], key: str, config_channels: dict, *,
@@ -332,10 +389,10 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
     out: dict[str, Mapping] = {}
     for channel in CHANNELS:
         spec = config_channels.get(channel.key, {})
-        column, name_unit = _find_column(columns, channel, spec, file)
+        column, name_unit = _find_column(columns, channel, spec, file, file_units)
         if column is None:
             if channel.required:
-                raise _missing(channel, columns, [m.column for m in out.values()], file)
+                raise _missing(channel, columns, file_units, config_channels, out, file)
             continue
         unit, source = _unit_for(channel, column, name_unit, file_units, spec, file)
         try:
@@ -349,22 +406,62 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
     return out
 
 
-def _missing(channel: Channel, columns: list[str], used: list[str],
-             file: str | None) -> InputError:
-    free = [c for c in columns if c not in used] or list(columns)
-    headerless = all(str(c).isdigit() for c in columns)
-    if headerless:
-        example = f"{free[0]}" if free else "0"
+def _missing(channel: Channel, columns: list[str], file_units: dict, config_channels: dict,
+             out: dict[str, Mapping], file: str | None) -> InputError:
+    """The error for a missing required channel, with a ``[channels]`` line to map it.
+
+    The line names a column only when one plausibly holds the channel (see
+    :func:`suggest_column`); otherwise a placeholder, never another channel's column.
+    """
+    used = {m.column for m in out.values()}
+    unit = f', unit = "{channel.default_unit}"'
+    if columns and all(str(c).isdigit() for c in columns):  # headerless: nothing to judge by
+        free = [c for c in columns if c not in used]
+        example = free[0] if free else "N"
     else:
-        close = difflib.get_close_matches(channel.key.replace("_", " "),
-                                          [split_unit(c)[0].lower() for c in free], n=1)
-        pick = next((c for c in free if close and split_unit(c)[0].lower() == close[0]),
-                    free[0] if free else "NAME")
-        example = f'"{pick}"'
+        pick = suggest_column(channel, columns, file_units, config_channels, used)
+        example = '"NAME"' if pick is None else f'"{pick}"'
+        if pick is not None and (split_unit(pick)[1] or file_units.get(pick)):
+            unit = ""  # the file states it
     shown = ", ".join(map(str, columns)) if columns else "(none)"
     return InputError(f"required channel {channel.name} not found; columns found: {shown}",
-                      file=file, fix=f"map one in the well config, e.g. [channels] {channel.key} = "
-                                     f'{{ column = {example}, unit = "{channel.default_unit}" }}')
+                      file=file, fix=f"map the column holding the {channel.kind} in the well "
+                                     f"config, e.g. [channels] {channel.key} = "
+                                     f"{{ column = {example}{unit} }}")
+
+
+def suggest_column(channel: Channel, columns: list[str], file_units: dict,
+                   config_channels: dict, used=()) -> str | None:
+    """A column that plausibly holds ``channel``, for a hint, or None.
+
+    Plausible: not mapped to (``used``) nor named like another channel, no stated unit of
+    another quantity, and either a stated unit of the channel's quantity or a name close to
+    one of its mnemonics (difflib ratio ≥ 0.6). A unit match ranks above a name match.
+
+    Examples
+    --------
+    >>> suggest_column(BY_KEY["surface_torque"], ["TIME", "Surface RPM", "HKLD"], {}, {},
+    ...                ["TIME", "Surface RPM"]) is None
+    True
+    >>> suggest_column(BY_KEY["surface_torque"], ["TIME", "RPM", "M1 [kN.m]"], {}, {})
+    'M1 [kN.m]'
+    """
+    claimed = set(used) | {c for c in columns for other in CHANNELS if other is not channel
+                           and _rank(c, other, tuple(config_channels.get(other.key, {})
+                                                     .get("mnemonics", ())))[0]}
+    best = None
+    for column in columns:
+        base, name_unit = split_unit(column)
+        unit = name_unit or file_units.get(column)
+        fits = unit_fits(unit, channel) if unit else None
+        if column in claimed or fits is False:
+            continue
+        likeness = max(difflib.SequenceMatcher(None, normalise(base), normalise(m)).ratio()
+                       for m in channel.mnemonics + (channel.key,))
+        score = (bool(fits), likeness)
+        if (fits or likeness >= 0.6) and (best is None or score > best[0]):
+            best = (score, column)
+    return None if best is None else best[1]
 
 
 def mnemonics_markdown() -> str:

@@ -23,7 +23,8 @@ from drillfric.errors import InputError
 
 #: Extensions of surface data files, by format.
 FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",
-           ".tsv": "csv", ".h5": "hdf5", ".hdf5": "hdf5", ".las": "las"}
+           ".tsv": "csv", ".h5": "hdf5", ".hdf5": "hdf5", ".las": "las", ".xml": "witsml",
+           ".dlis": "dlis", ".xlsx": "excel"}
 #: Values meaning "no value" in rig logs (besides empty fields and NaN).
 NULL_VALUES = (-999.25, -9999.0)
 #: LAS index curves that make a log depth-indexed (LAS 2.0 names the depth index DEPT).
@@ -106,7 +107,8 @@ def open_source(path: str | Path, *, hdf_key: str = "surface") -> RawSource:
         from drillfric.io.delimited import open_delimited
 
         return open_delimited(path)
-    return {"parquet": _open_parquet, "las": _open_las}[fmt](path)
+    return {"parquet": _open_parquet, "las": _open_las, "witsml": _open_witsml,
+            "dlis": _open_dlis, "excel": _open_excel}[fmt](path)
 
 
 # --------------------------------------------------------------------------- Parquet
@@ -169,3 +171,22 @@ def _depth_index(curve) -> str | None:
     if curve.mnemonic.strip().upper() in _DEPTH_INDEX or unit in _DEPTH_UNITS:
         return f"{curve.mnemonic} [{curve.unit}]" if curve.unit else curve.mnemonic
     return None
+
+
+# --------------------------------------------------------------------------- WITSML, DLIS, Excel
+def _open_witsml(path: Path) -> RawSource:
+    from drillfric.io.witsml import open_witsml
+
+    return open_witsml(path)
+
+
+def _open_dlis(path: Path) -> RawSource:
+    from drillfric.io.dlis import open_dlis
+
+    return open_dlis(path)
+
+
+def _open_excel(path: Path) -> RawSource:
+    from drillfric.io.excel import open_excel
+
+    return open_excel(path)

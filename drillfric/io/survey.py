@@ -18,6 +18,8 @@ Recognised layouts
 - Delimiters ``,`` ``;`` tab ``|`` or runs of spaces (fixed width); ``;``/tab files may use a
   decimal comma. LF, CRLF and old-Mac CR-only line endings.
 - Parquet with the same column names.
+- A WITSML 1.4.1 ``<trajectory>`` (``.xml``): its stations' md, incl, azi (and tvd, dispNs,
+  dispEw, dls) in the units of their ``uom`` (:func:`drillfric.io.witsml.trajectory_table`).
 """
 
 from __future__ import annotations
@@ -65,7 +67,8 @@ def read_survey_table(path) -> pd.DataFrame:
     Parameters
     ----------
     path : str or Path
-        CSV/text (``.csv .txt .tsv .dat .prn .asc``) or Parquet (``.parquet .pq``) file.
+        CSV/text (``.csv .txt .tsv .dat .prn .asc``), Parquet (``.parquet .pq``) or WITSML
+        trajectory (``.xml``) file.
 
     Returns
     -------
@@ -89,9 +92,15 @@ def read_survey_table(path) -> pd.DataFrame:
         names, units, data = _parquet_columns(path)
     elif ext in _TEXT_EXT:
         names, units, data = _text_columns(path)
+    elif ext == ".xml":
+        from drillfric.io.witsml import trajectory_table
+
+        table = trajectory_table(path)
+        _validate(table, path)
+        return table
     else:
         raise InputError(f"unknown survey file extension '{path.suffix}'", file=path,
-                         fix="give a .csv, .txt or .parquet survey")
+                         fix="give a .csv, .txt, .parquet or WITSML .xml survey")
     table = _canonical(names, units, data, path)
     _validate(table, path)
     return table

@@ -1,0 +1,729 @@
+"""WITSML 1.4.1 (and 1.3.1) data objects: logs, trajectories and tubulars.
+
+A WITSML file holds one kind of object under a plural root (``logs``, ``trajectorys``,
+``tubulars``, ``bhaRuns``; a singular root such as ``log`` is accepted too), in the
+namespace ``http://www.witsml.org/schemas/1series`` or none. Three kinds are read:
+
+- **log** → a :class:`~drillfric.io.readers.RawSource` (:func:`open_witsml`): columns are the
+  ``logData/mnemonicList`` names in data order (which may differ from the order of the
+  ``logCurveInfo`` elements), units the ``unitList``, values the comma-separated ``data``
+  rows; the log's ``nullValue`` (or a curve's own) becomes NaN. A date-time index stays
+  ISO 8601 text (absolute time, read as UTC by the time base); a depth index makes the
+  source depth-indexed (``depth_index``). Several logs in one file: the one holding the
+  surface channels is read (:func:`pick_log`). A log split over numbered files
+  (``00001.xml``, ``00002.xml`` …) is read as one source by :func:`open_witsml_parts`.
+- **trajectory** → the canonical survey table (:func:`trajectory_table`), read by
+  :func:`drillfric.io.survey.read_survey_table` for ``.xml`` surveys.
+- **tubular** → ``[[string.sections]]`` tables, top-down (:func:`tubular_sections`).
+
+Files are untrusted: they are parsed with defusedxml with any DTD refused (a WITSML file
+never declares one), so entity expansion ("billion laughs") and external entities cannot
+happen; logs are read incrementally (data rows are dropped from the tree once read), so a
+large log is held one chunk at a time. Every failure is an InputError naming the file.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from xml.etree.ElementTree import ParseError
+
+import numpy as np
+import pandas as pd
+import pint
+from defusedxml import DefusedXmlException
+from defusedxml.ElementTree import iterparse
+
+from drillfric.errors import InputError
+from drillfric.io.channels import CHANNELS, find_column
+from drillfric.io.readers import RawSource
+from drillfric.units import UREG, conversion_factor, parse_unit
+
+#: Namespace of WITSML 1.x data objects (1.3.1 and 1.4.1 share it).
+NAMESPACE = "http://www.witsml.org/schemas/1series"
+#: Index types of depth-indexed logs.
+DEPTH_INDEX_TYPES = frozenset({"measured depth", "vertical depth", "length"})
+#: Units meaning "no unit" (the Volve date-time index says "unitless").
+_NO_UNIT = frozenset({"", "unitless", "none", "n/a", "-"})
+#: Trajectory station states whose station is not used.
+_BAD_STATIONS = frozenset({"bad", "rejected"})
+_PART_FILE = re.compile(r"^\d+\.xml$", re.IGNORECASE)
+_FIX_EXPORT = "export the object again from the WITSML store (version 1.4.1)"
+
+
+# --------------------------------------------------------------------------- parsing
+def _local(tag: str) -> str:
+    """Element name without its namespace."""
+    return tag.rsplit("}", 1)[-1]
+
+
+def _events(path: Path, events=("start", "end")) -> Iterator[tuple[str, object]]:
+    """Hardened incremental parse: defusedxml, any DTD refused; errors → InputError."""
+    try:
+        yield from iterparse(str(path), events=events, forbid_dtd=True)
+    except DefusedXmlException as exc:
+        raise InputError("XML declares a DTD or entities, which a WITSML file never does "
+                         "(refused: entity expansion and external entities are unsafe)",
+                         file=path, fix=_FIX_EXPORT) from exc
+    except ParseError as exc:
+        line, column = exc.position
+        raise InputError(f"not well-formed XML (line {line}, column {column}); the file may "
+                         "be truncated", file=path, fix=_FIX_EXPORT) from exc
+
+
+def _tree(path: Path):
+    """Whole element tree of a small object file (trajectory, tubular), hardened."""
+    root = None
+    for _, elem in _events(path, ("start",)):
+        root = elem if root is None else root
+    if root is None:
+        raise InputError("XML file has no root element", file=path, fix=_FIX_EXPORT)
+    return root
+
+
+def _root(path: Path):
+    """The root element, read from the file's first start tag only."""
+    for _, elem in _events(path, ("start",)):
+        return elem
+    raise InputError("XML file has no root element", file=path, fix=_FIX_EXPORT)
+
+
+def object_kind(path) -> str:
+    """Kind of WITSML object a file holds (``"log"``, ``"trajectory"``, ``"tubular"`` …).
+
+    Reads only the root tag: a plural root names its objects (``logs`` → ``"log"``,
+    ``trajectorys`` → ``"trajectory"``), a singular root is the object itself.
+
+    Raises
+    ------
+    InputError
+        Not XML, a DTD, or not a WITSML 1.x object (e.g. WITSML 2.0).
+    """
+    path = Path(path)
+    root = _root(path)
+    _check_namespace(root, path)
+    name = _local(root.tag)
+    return name[:-1] if name.endswith("s") else name
+
+
+def _check_namespace(root, path: Path) -> None:
+    namespace = root.tag[1:].split("}")[0] if root.tag.startswith("{") else ""
+    if namespace not in ("", NAMESPACE):
+        version = "WITSML 2.x" if "energyml" in namespace else "an XML file that is not WITSML"
+        raise InputError(f"{version} (namespace not {NAMESPACE}); drillfric reads WITSML "
+                         "1.3.1/1.4.1 objects", file=path, fix=_FIX_EXPORT)
+
+
+def _measure(elem, name: str, path: Path, *, required: bool = True):
+    """(value, uom) of a measure child such as ``<md uom="m">12.5</md>`` (None if absent)."""
+    child = next((c for c in elem if _local(c.tag) == name), None)
+    if child is None or not (child.text or "").strip():
+        if required:
+            raise InputError(f"{_local(elem.tag)} without {name}", file=path, fix=_FIX_EXPORT)
+        return None
+    try:
+        value = float(child.text)
+    except ValueError as exc:
+        raise InputError(f"{_local(elem.tag)}/{name} is not a number", file=path,
+                         fix=_FIX_EXPORT) from exc
+    uom = child.get("uom")
+    if not uom:
+        raise InputError(f"{_local(elem.tag)}/{name} has no uom attribute", file=path,
+                         fix=_FIX_EXPORT)
+    return value, uom
+
+
+def _text(elem, name: str) -> str | None:
+    child = next((c for c in elem if _local(c.tag) == name), None)
+    return None if child is None or child.text is None else child.text.strip()
+
+
+def _unit_factor(uom: str, kind: str, what: str, path: Path) -> float:
+    try:
+        return conversion_factor(uom, kind)
+    except InputError as exc:
+        raise InputError(f"{what}: {exc.problem}", file=path, fix=_FIX_EXPORT) from exc
+
+
+# --------------------------------------------------------------------------- logs
+@dataclass(frozen=True)
+class LogHeader:
+    """What a WITSML ``<log>`` says about its data, read without keeping the data.
+
+    Attributes
+    ----------
+    position : int
+        0-based position of the log in its file.
+    uid, name : str
+    index_type : str
+        ``"date time"``, ``"measured depth"``, ``"elapsed time"`` … (lower case).
+    index_curve : str
+        Mnemonic of the index column.
+    direction : str
+        ``"increasing"`` or ``"decreasing"``.
+    mnemonics, units : tuple of str
+        Columns in data order and their units (``""`` when none).
+    nulls : tuple
+        Null value per column (text) or None.
+    text_columns : tuple of str
+        Columns kept as text (date-time and string curves, the date-time index).
+    rows : int
+        Number of ``data`` rows.
+    first_index, last_index : str or None
+        Index value of the first and last data row.
+    """
+
+    position: int
+    uid: str
+    name: str
+    index_type: str
+    index_curve: str
+    direction: str
+    mnemonics: tuple[str, ...]
+    units: tuple[str, ...]
+    nulls: tuple[str | None, ...]
+    text_columns: tuple[str, ...]
+    rows: int
+    first_index: str | None
+    last_index: str | None
+
+    @property
+    def depth_indexed(self) -> bool:
+        """Whether the index is a depth."""
+        return self.index_type in DEPTH_INDEX_TYPES
+
+    @property
+    def index_unit(self) -> str:
+        """Unit of the index column (``""`` when none)."""
+        return self.units[self.mnemonics.index(self.index_curve)]
+
+
+class _LogScan:
+    """Accumulates one ``<log>``'s header while its elements stream past."""
+
+    _FIELDS = ("name", "indexType", "indexCurve", "direction", "nullValue")
+
+    def __init__(self, position: int, uid: str):
+        self.position, self.uid = position, uid
+        self.fields: dict[str, str] = {}
+        self.curves: list[dict] = []
+        self.mnemonic_list: list[str] | None = None
+        self.unit_list: list[str] | None = None
+        self.rows = 0
+        self.first_row: str | None = None
+        self.last_row: str | None = None
+
+    def end(self, name: str, parent: str, elem) -> None:
+        text = (elem.text or "").strip()
+        if parent == "log" and name in self._FIELDS:
+            self.fields[name] = text
+        elif parent == "log" and name == "logCurveInfo":
+            self.curves.append({_local(c.tag): (c.text or "").strip() for c in elem})
+        elif parent == "logData" and name == "mnemonicList":
+            self.mnemonic_list = [m.strip() for m in text.split(",")]
+        elif parent == "logData" and name == "unitList":
+            self.unit_list = [u.strip() for u in text.split(",")]
+        elif parent == "logData" and name == "data":
+            self.rows += 1
+            self.first_row = text if self.first_row is None else self.first_row
+            self.last_row = text
+
+    def header(self, path: Path) -> LogHeader:
+        names, units = self._columns(path)
+        curves = {c.get("mnemonic", ""): c for c in self.curves}
+        index_type = self.fields.get("indexType", "").lower()
+        index_curve = self.fields.get("indexCurve") or names[0]
+        if index_curve not in names:
+            raise InputError(f"log index curve '{index_curve}' is not among the data columns",
+                             file=path, fix=_FIX_EXPORT)
+        log_null = self.fields.get("nullValue") or None
+        nulls = tuple(curves.get(n, {}).get("nullValue") or log_null for n in names)
+        dated = index_type.replace(" ", "") == "datetime"
+        text = tuple(n for n in names
+                     if curves.get(n, {}).get("typeLogData", "") in ("date time", "string")
+                     or (n == index_curve and dated))
+        at = names.index(index_curve)
+        return LogHeader(self.position, self.uid, self.fields.get("name", ""), index_type,
+                         index_curve, self.fields.get("direction", "increasing").lower(),
+                         tuple(names), tuple(units), nulls, text, self.rows,
+                         _field(self.first_row, at), _field(self.last_row, at))
+
+    def _columns(self, path: Path) -> tuple[list[str], list[str]]:
+        """Column names in data order and their units (mnemonicList, else logCurveInfo)."""
+        if self.mnemonic_list is not None:
+            names = self.mnemonic_list
+            by_curve = {c.get("mnemonic", ""): c.get("unit", "") for c in self.curves}
+            units = self.unit_list or [by_curve.get(n, "") for n in names]
+        else:  # WITSML 1.3.1: the curves in columnIndex (else document) order
+            order = sorted(self.curves, key=lambda c: _int(c.get("columnIndex"), 0))
+            names = [c.get("mnemonic", "") for c in order]
+            units = [c.get("unit", "") for c in order]
+        if not names or not all(names):
+            raise InputError("log without column mnemonics (no mnemonicList or logCurveInfo)",
+                             file=path, fix=_FIX_EXPORT)
+        if len(units) != len(names):
+            raise InputError(f"log unitList has {len(units)} units for {len(names)} "
+                             "mnemonics", file=path, fix=_FIX_EXPORT)
+        if len(set(names)) < len(names):
+            raise InputError("log mnemonicList repeats a mnemonic", file=path,
+                             fix=_FIX_EXPORT)
+        return names, units
+
+
+def _int(text: str | None, default: int) -> int:
+    try:
+        return int(text)
+    except (TypeError, ValueError):
+        return default
+
+
+def _field(row: str | None, at: int) -> str | None:
+    if row is None:
+        return None
+    fields = row.split(",")
+    return fields[at].strip() if at < len(fields) else None
+
+
+def read_log_headers(path) -> list[LogHeader]:
+    """Headers of every ``<log>`` in a WITSML file (one pass, data rows not kept).
+
+    Raises
+    ------
+    InputError
+        Not WITSML, unsafe XML, malformed, or a file holding no log.
+    """
+    path = Path(path)
+    stack: list = []
+    logs: list[LogHeader] = []
+    scan: _LogScan | None = None
+    for event, elem in _events(path):
+        name = _local(elem.tag)
+        if event == "start":
+            if not stack:
+                _check_namespace(elem, path)
+            if name == "log" and scan is None:
+                scan = _LogScan(len(logs), elem.get("uid", ""))
+            stack.append(elem)
+            continue
+        stack.pop()
+        parent = _local(stack[-1].tag) if stack else ""
+        if scan is not None:
+            scan.end(name, parent, elem)
+        if name == "log" and scan is not None:
+            logs.append(scan.header(path))
+            scan = None
+        if stack and name in ("data", "log", "logCurveInfo"):
+            stack[-1].remove(elem)  # keep memory bounded: read elements leave the tree
+    if not logs:
+        kind = object_kind(path)
+        raise InputError(f"WITSML file holds {kind} objects, not a log", file=path,
+                         fix="give a WITSML log as the surface data (a trajectory is a "
+                             "survey: --survey or [survey] file)")
+    return logs
+
+
+def pick_log(logs: list[LogHeader]) -> LogHeader:
+    """The log to read from a file holding several: the surface channels' log.
+
+    Ranked by: time-indexed before depth-indexed; most of the required channels (time,
+    surface RPM, surface torque) recognised; most channels recognised; most rows.
+    """
+    def found(log: LogHeader, keys) -> int:
+        count = 0
+        for key in keys:
+            try:
+                count += find_column(list(log.mnemonics), key, {}) is not None
+            except InputError:  # two columns claim the channel: it is there
+                count += 1
+        return count
+
+    required = [c.key for c in CHANNELS if c.required]
+    return max(logs, key=lambda log: (not log.depth_indexed, found(log, required),
+                                      found(log, [c.key for c in CHANNELS]), log.rows))
+
+
+def _choose(logs: list[LogHeader], log: str | None, path: Path) -> LogHeader:
+    if log is None:
+        return pick_log(logs)
+    for header in logs:
+        if log in (header.uid, header.name):
+            return header
+    names = ", ".join(f"'{h.name or h.uid}'" for h in logs)
+    raise InputError(f"no log '{log}' in the file (it holds {names})", file=path,
+                     fix="give the uid or name of one of the listed logs")
+
+
+def _row_texts(path: Path, position: int) -> Iterator[str]:
+    """The ``data`` rows of the log at ``position``, streamed (read rows leave the tree)."""
+    stack: list = []
+    seen = -1
+    for event, elem in _events(path):
+        name = _local(elem.tag)
+        if event == "start":
+            seen += name == "log"
+            stack.append(elem)
+            continue
+        stack.pop()
+        if name == "data" and seen == position and stack and _local(stack[-1].tag) == "logData":
+            yield elem.text or ""
+        if name == "log" and seen == position:
+            return
+        if stack and name in ("data", "log", "logCurveInfo"):
+            stack[-1].remove(elem)
+
+
+def _frame(rows: list[str], header: LogHeader, path: Path) -> pd.DataFrame:
+    """One block of ``data`` rows as a frame: numbers as floats, text columns as text."""
+    names = list(header.mnemonics)
+    text = {i: str for i, n in enumerate(names) if n in header.text_columns}
+    try:
+        frame = pd.read_csv(io.StringIO("\n".join(rows)), header=None, dtype=text,
+                            skipinitialspace=True, skip_blank_lines=False)
+    except pd.errors.EmptyDataError:  # only empty <data/> rows
+        frame = pd.DataFrame(index=range(len(rows)))
+    except (pd.errors.ParserError, ValueError) as exc:
+        raise InputError(f"a log data row has more values than the {len(names)} names of "
+                         "its mnemonicList", file=path, fix=_FIX_EXPORT) from exc
+    if frame.shape[1] > len(names):
+        raise InputError(f"log data rows have {frame.shape[1]} values for the {len(names)} "
+                         "names of the mnemonicList", file=path, fix=_FIX_EXPORT)
+    frame = frame.set_axis(names[:frame.shape[1]], axis=1).reindex(columns=names)
+    for column, null in zip(names, header.nulls, strict=True):
+        if null is not None:
+            frame[column] = _without_null(frame[column], null)
+    return frame
+
+
+def _without_null(values: pd.Series, null: str) -> pd.Series:
+    """``values`` with the null value replaced by NaN (compared as numbers when numeric)."""
+    if pd.api.types.is_numeric_dtype(values):
+        try:
+            return values.mask(values == float(null))
+        except ValueError:
+            return values
+    return values.mask(values.astype("string").str.strip() == null.strip())
+
+
+def _chunks(path: Path, header: LogHeader, chunk_rows: int) -> Iterator[pd.DataFrame]:
+    rows: list[str] = []
+    for text in _row_texts(path, header.position):
+        rows.append(text)
+        if len(rows) == chunk_rows:
+            yield _frame(rows, header, path)
+            rows = []
+    if rows:
+        yield _frame(rows, header, path)
+
+
+def _units(header: LogHeader) -> dict:
+    units: dict = {}
+    for column, unit in zip(header.mnemonics, header.units, strict=True):
+        if unit.strip().lower() not in _NO_UNIT and column not in header.text_columns:
+            units[column] = unit.strip()
+            units[("source", column)] = "header"
+    return units
+
+
+def _source(path: Path, header: LogHeader) -> RawSource:
+    depth = None
+    if header.depth_indexed:
+        unit = header.index_unit
+        depth = f"{header.index_curve} [{unit}]" if unit else header.index_curve
+    return RawSource(path, "witsml", list(header.mnemonics), _units(header), header.rows,
+                     lambda n: _chunks(path, header, n), depth_index=depth)
+
+
+def open_witsml(path, *, log: str | None = None) -> RawSource:
+    """Open a WITSML log file as a raw source (header read now, data rows on demand).
+
+    Parameters
+    ----------
+    path : str or Path
+        A WITSML 1.4.1/1.3.1 file holding one or more ``<log>`` objects.
+    log : str, optional
+        uid or name of the log to read; default :func:`pick_log`.
+
+    Raises
+    ------
+    InputError
+        Unsafe or malformed XML, not WITSML 1.x, no log, inconsistent column lists.
+    """
+    path = Path(path)
+    header = _choose(read_log_headers(path), log, path)
+    if header.rows == 0:
+        raise InputError(f"WITSML log '{header.name or header.uid}' has no data rows",
+                         file=path, fix="export the log with its logData")
+    return _source(path, header)
+
+
+# --------------------------------------------------------------------------- multi-file logs
+def witsml_log_parts(folder) -> list[Path]:
+    """The numbered part files of one exported log (``00001.xml``, ``00002.xml`` …), by number.
+
+    WITSML stores export a growing log as numbered chunk files in the log's folder; pass
+    the result to :func:`open_witsml_parts`.
+
+    Raises
+    ------
+    InputError
+        No numbered ``.xml`` file in the folder.
+    """
+    folder = Path(folder)
+    parts = sorted((p for p in folder.iterdir() if _PART_FILE.match(p.name) and p.is_file()),
+                   key=lambda p: int(p.stem))
+    if not parts:
+        raise InputError("no numbered WITSML part files (00001.xml, 00002.xml …) in the "
+                         "folder", file=folder, fix="give the folder of one exported log")
+    return parts
+
+
+def _index_keys(values: pd.Series, header: LogHeader) -> np.ndarray:
+    """Index values as sortable numbers (ns since 1970 for date-time indexes)."""
+    if header.index_curve in header.text_columns:
+        stamps = pd.to_datetime(values.astype("string").str.strip(), format="ISO8601",
+                                utc=True, errors="coerce")
+        ns = stamps.dt.tz_convert(None).to_numpy(dtype="datetime64[ns]")
+        out = ns.astype("int64").astype(float)
+        out[np.isnat(ns)] = np.nan
+        return out
+    return pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
+
+
+def _first_key(header: LogHeader) -> float:
+    key = _index_keys(pd.Series([header.first_index], dtype=object), header)[0]
+    return float(key) if np.isfinite(key) else np.inf
+
+
+def _same_log(headers: list[LogHeader], paths: list[Path]) -> None:
+    first = headers[0]
+    for header, path in zip(headers[1:], paths[1:], strict=True):
+        if first.uid and header.uid and header.uid != first.uid:
+            raise InputError(f"part is log '{header.uid}', the first part is log "
+                             f"'{first.uid}'", file=path,
+                             fix="give the parts of one log only")
+        if (header.index_type, header.index_curve) != (first.index_type, first.index_curve):
+            raise InputError("part has another index than the first part", file=path,
+                             fix="give the parts of one log only")
+
+
+def _merged_units(headers: list[LogHeader], paths: list[Path]) -> tuple[list[str], dict]:
+    columns: list[str] = []
+    units: dict = {}
+    for header, path in zip(headers, paths, strict=True):
+        for column, unit in _units(header).items():
+            if not isinstance(column, tuple) and units.get(column, unit) != unit:
+                raise InputError(f"part gives {column} in '{unit}', an earlier part in "
+                                 f"'{units[column]}'", file=path,
+                                 fix="re-export the log with one unit per curve")
+            units[column] = unit
+        columns += [c for c in header.mnemonics if c not in columns]
+    return columns, units
+
+
+def open_witsml_parts(paths, *, log: str | None = None) -> RawSource:
+    """One raw source from the parts of a log split over several files.
+
+    Parts are read in index order (by their first index value, reversed for a decreasing
+    log), whatever the order of ``paths``; a part's rows whose index does not go past the
+    last index of the parts before it (an overlap) are dropped. Columns are the union of
+    the parts' columns (NaN where a part lacks one).
+
+    Parameters
+    ----------
+    paths : iterable of str or Path
+        Part files, e.g. :func:`witsml_log_parts` of the log's folder.
+    log : str, optional
+        uid or name of the log in each part (default :func:`pick_log`).
+
+    Raises
+    ------
+    InputError
+        A part is unreadable, belongs to another log, or states another unit for a curve.
+    """
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise InputError("no WITSML part files given", fix="give the parts of one log")
+    headers = [_choose(read_log_headers(p), log, p) for p in paths]
+    _same_log(headers, paths)
+    order = sorted(range(len(paths)), key=lambda i: _first_key(headers[i]),
+                   reverse=headers[0].direction == "decreasing")
+    paths, headers = [paths[i] for i in order], [headers[i] for i in order]
+    columns, units = _merged_units(headers, paths)
+    sign = -1.0 if headers[0].direction == "decreasing" else 1.0
+
+    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+        last = -np.inf
+        for path, header in zip(paths, headers, strict=True):
+            reached = last
+            for chunk in _chunks(path, header, chunk_rows):
+                keys = sign * _index_keys(chunk[header.index_curve], header)
+                kept = chunk[~(keys <= last)].reindex(columns=columns)
+                reached = max(reached, float(np.nanmax(keys, initial=-np.inf)))
+                if len(kept):
+                    yield kept.reset_index(drop=True)
+            last = reached
+
+    first = headers[0]
+    depth = f"{first.index_curve} [{first.index_unit}]" if first.depth_indexed else None
+    return RawSource(paths[0], "witsml", columns, units, None, read, depth_index=depth)
+
+
+# --------------------------------------------------------------------------- trajectory
+def _stations(trajectory, path: Path) -> pd.DataFrame:
+    """Stations of one ``<trajectory>`` in canonical columns (md_m, inc_deg, azi_deg …)."""
+    rows = []
+    for station in (s for s in trajectory if _local(s.tag) == "trajectoryStation"):
+        if (_text(station, "statusTrajStation") or "").lower() in _BAD_STATIONS:
+            continue
+        row = {}
+        for name, column, kind in (("md", "md_m", "length"), ("incl", "inc_deg", "angle"),
+                                   ("azi", "azi_deg", "angle"), ("tvd", "tvd_m", "length"),
+                                   ("dispNs", "north_m", "length"),
+                                   ("dispEw", "east_m", "length")):
+            measure = _measure(station, name, path, required=column in ("md_m", "inc_deg",
+                                                                         "azi_deg"))
+            if measure is not None:
+                value = measure[0] * _unit_factor(measure[1], kind, f"station {name}", path)
+                row[column] = np.degrees(value) if kind == "angle" else value
+        dls = _measure(station, "dls", path, required=False)
+        if dls is not None and _dls_factor(dls[1]) is not None:
+            row["dls_deg_30m"] = dls[0] * _dls_factor(dls[1])
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    optional = [c for c in ("tvd_m", "north_m", "east_m", "dls_deg_30m")
+                if c in table and table[c].notna().all()]
+    if table.empty:
+        return table
+    return table[["md_m", "inc_deg", "azi_deg", *optional]].sort_values(
+        "md_m", kind="stable").reset_index(drop=True)
+
+
+def _dls_factor(uom: str) -> float | None:
+    """°/30 m per unit of a dogleg-severity uom (``rad/m``, ``dega/30m``, ``dega/100ft``).
+
+    Examples
+    --------
+    >>> round(_dls_factor("dega/100ft"), 4)
+    0.9843
+    """
+    match = re.fullmatch(r"\s*([A-Za-z]+)\s*/\s*([0-9.]*)\s*([A-Za-z]+)\s*", uom)
+    if match is None:
+        return None
+    try:
+        angle = np.degrees(conversion_factor(match[1], "angle"))
+        per = float(match[2] or 1.0) * conversion_factor(match[3], "length")
+    except (InputError, ValueError):
+        return None
+    return float(angle * 30.0 / per)
+
+
+def trajectory_table(path) -> pd.DataFrame:
+    """The stations of a WITSML trajectory as a canonical survey table.
+
+    Columns ``md_m`` [m], ``inc_deg`` [°], ``azi_deg`` [°], and ``tvd_m``, ``north_m``,
+    ``east_m`` [m], ``dls_deg_30m`` [°/30 m] when every station has them, sorted by MD.
+    Units come from each measure's ``uom`` (``m``, ``ft``, ``rad``, ``dega`` …). Stations
+    marked ``bad`` or ``rejected`` are left out. Several trajectories in one file: the
+    deepest is read. Validation (increasing MD, angle ranges) is the survey reader's.
+
+    Raises
+    ------
+    InputError
+        Unsafe or malformed XML, no trajectory, a station without md/incl/azi or uom.
+    """
+    path = Path(path)
+    root = _tree(path)
+    _check_namespace(root, path)
+    found = [t for t in root.iter() if _local(t.tag) == "trajectory"]
+    if not found:
+        raise InputError(f"WITSML file holds {object_kind(path)} objects, not a trajectory",
+                         file=path, fix="give a WITSML trajectory (or a survey table)")
+    tables = [_stations(t, path) for t in found]
+    best = max(tables, key=lambda t: (t["md_m"].max() if len(t) else -np.inf, len(t)))
+    if best.empty:
+        raise InputError("WITSML trajectory has no stations", file=path,
+                         fix="export the trajectory with its trajectoryStation elements")
+    return best
+
+
+# --------------------------------------------------------------------------- tubular
+def _component(comp, path: Path) -> dict:
+    """One ``tubularComponent`` as a ``[[string.sections]]`` table."""
+    od = _measure(comp, "od", path)
+    inner = _measure(comp, "id", path)
+    length = _measure(comp, "len", path)
+    od_m = od[0] * _unit_factor(od[1], "length", "tubularComponent od", path)
+    section = {"name": "", "od_m": od_m,
+               "id_m": inner[0] * _unit_factor(inner[1], "length", "tubularComponent id", path),
+               "length_m": length[0] * _unit_factor(length[1], "length",
+                                                    "tubularComponent len", path)}
+    kind = _text(comp, "typeTubularComp") or "component"
+    section["name"] = f"{kind} {od_m / 0.0254:.4g}in"
+    if section["length_m"] <= 0 or not 0 <= section["id_m"] < od_m:
+        raise InputError(f"tubular component '{section['name']}' has length "
+                         f"{section['length_m']:g} m, OD {od_m:g} m, ID {section['id_m']:g} m "
+                         "(needs length > 0 and 0 ≤ ID < OD)", file=path, fix=_FIX_EXPORT)
+    mass = _measure(comp, "wtPerLen", path, required=False)
+    if mass is not None and mass[0] > 0:
+        section["linear_mass_kg_m"] = _linear_mass(mass, path)
+    joints = [_measure(c, "od", path, required=False) for c in comp
+              if _local(c.tag) == "connection"]
+    joint_od = max((j[0] * _unit_factor(j[1], "length", "connection od", path)
+                    for j in joints if j is not None), default=0.0)
+    if joint_od > od_m:
+        section["tool_joint_od_m"] = joint_od
+    return section
+
+
+def _linear_mass(measure: tuple[float, str], path: Path) -> float:
+    try:
+        return float(UREG.Quantity(measure[0], parse_unit(measure[1])).to("kg/m").magnitude)
+    except (InputError, pint.errors.DimensionalityError) as exc:
+        raise InputError(f"tubularComponent wtPerLen unit '{measure[1]}' is not a mass per "
+                         "length", file=path, fix=_FIX_EXPORT) from exc
+
+
+def tubular_sections(path, *, uid: str | None = None) -> list[dict]:
+    """A WITSML tubular (the drill string) as ``[[string.sections]]`` tables, top-down.
+
+    WITSML numbers components by ``sequence`` in the order they entered the hole (1 first,
+    i.e. at the bit), so the top-down order is by decreasing sequence; components without
+    a sequence keep their document order, read as the order they entered the hole.
+    Each table has ``name`` (component type and OD in inches), ``od_m``, ``id_m``,
+    ``length_m`` [m], and ``linear_mass_kg_m`` [kg/m] (from ``wtPerLen``) and
+    ``tool_joint_od_m`` [m] (the largest ``connection/od`` above the body OD) when the file
+    gives them. Every section has its length; the configuration lets the top one's length
+    follow from the bit depth instead (drop its ``length_m`` for that).
+
+    Parameters
+    ----------
+    path : str or Path
+        WITSML file holding ``<tubular>`` objects.
+    uid : str, optional
+        uid or name of the tubular when the file holds several.
+
+    Raises
+    ------
+    InputError
+        Unsafe or malformed XML, no tubular (or several and no ``uid``), a component
+        without od/id/len, or with impossible dimensions.
+    """
+    path = Path(path)
+    root = _tree(path)
+    _check_namespace(root, path)
+    tubulars = [t for t in root.iter() if _local(t.tag) == "tubular"
+                and (uid is None or uid in (t.get("uid"), _text(t, "name")))]
+    if len(tubulars) != 1:
+        problem = ("no tubular" if not tubulars else f"{len(tubulars)} tubulars")
+        raise InputError(f"WITSML file holds {problem}" + ("" if uid is None else
+                                                           f" with uid or name '{uid}'"),
+                         file=path, fix="give a file with one tubular, or its uid")
+    comps = [c for c in tubulars[0] if _local(c.tag) == "tubularComponent"]
+    if not comps:
+        raise InputError("WITSML tubular has no tubularComponent", file=path, fix=_FIX_EXPORT)
+    entered = sorted(range(len(comps)),
+                     key=lambda i: (_int(_text(comps[i], "sequence"), 0), i))
+    return [_component(comps[i], path) for i in reversed(entered)]
