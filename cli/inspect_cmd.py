@@ -67,7 +67,7 @@ def summarize(data) -> dict:
         "origin": None if tb.origin is None else tb.origin.isoformat(),
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
-        "max_gap_s": data.config["segmentation.max_gap_s"],
+        "max_gap_s": data.config.segmentation.max_gap_s,
         "assumed": data.config.assumed_with(data.survey),
         "segments": [_segment(seg) for seg in segment(data.surface, data.config)],
     }

@@ -28,8 +28,8 @@ def _load(config: Path, overrides: dict, omega_c_rpm: float | None):
 
     cfg = load_config(config, overrides=overrides)
     if omega_c_rpm is not None:
-        key = "model.omega_c_rpm" if cfg["model.omega_c_rpm"] is not None or \
-            cfg["model.omega_c_rad_s"] is None else "model.omega_c_rad_s"
+        key = "model.omega_c_rpm" if cfg.model.omega_c_rpm is not None or \
+            cfg.model.omega_c_rad_s is None else "model.omega_c_rad_s"
         from drillfric.units import RPM_TO_RAD_S
 
         value = omega_c_rpm if key.endswith("rpm") else omega_c_rpm * RPM_TO_RAD_S
@@ -53,13 +53,13 @@ def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool)
     from drillfric import simulate as sim
     from drillfric.errors import ConfigError
 
-    name = None if single else cfg["simulate.scenario"]
+    name = None if single else cfg.simulate.scenario
     path = scenario if scenario is not None else (None if name is None
                                                   else config.parent / name)
     base = sim.base_stand(cfg)
     if path is not None:
         return path, sim.load_scenario(path, base)
-    depth = cfg["simulate.bit_depth_m"]
+    depth = cfg.simulate.bit_depth_m
     if depth is None:
         if well_path is None:
             raise ConfigError("no bit depth: give --bit-depth, simulate.bit_depth_m, a survey "
@@ -124,7 +124,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
         well_path = no_survey_path(max(s.bit_depth_m for s in plan.stands),
                                    cfg.tortuosity_rad_m)
         warn(f"no survey: simulated on a vertical hole with a nominal tortuosity of "
-             f"{cfg['survey.tortuosity_deg_30m']:g}°/30 m (survey.tortuosity_deg_30m), "
+             f"{cfg.survey.tortuosity_deg_30m:g}°/30 m (survey.tortuosity_deg_30m), "
              "written as the output's survey")
     keep = tuple(p for p in (config, survey_path) if p is not None)
     written = write_well(out, pd.DataFrame(result.columns), config=cfg.to_dict(),

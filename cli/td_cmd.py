@@ -143,8 +143,8 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
                "hookload_N": result.hookload_N, "T_N_Nm": result.T_N_Nm,
                "wob_N": kw["wob_N"], "bit_torque_Nm": kw["bit_torque_Nm"],
                "max_normal_force_N_m": float(result.normal_force_N_m.max()),
-               "mud_density_kg_m3": cfg["fluid.mud_density_kg_m3"],
-               "element_length_m": cfg["model.element_length_m"],
+               "mud_density_kg_m3": cfg.fluid.mud_density_kg_m3,
+               "element_length_m": cfg.model.element_length_m,
                "elements": int(result.fc_Nm_m.size), "assumed": cfg.assumed_with(path)}
     if callable(mu):
         summary["friction_by_section"] = {"casing_shoe_md_m": mu.shoe_md_m,
@@ -189,9 +189,9 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
     if callable(config_friction(cfg)):
         warn("broomstick uses one friction factor per curve; cased/open-hole values ignored")
     table = broomstick(path, cfg.sections, grid, mus, cases,
-                       mud_out_kg_m3=cfg["fluid.mud_density_kg_m3"],
+                       mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
                        mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
-                       element_length_m=cfg["model.element_length_m"], **kw)
+                       element_length_m=cfg.model.element_length_m, **kw)
     if out is not None:
         _write_table(table, out)
     if plot is not None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, make_dataclass
 from pathlib import Path
 from typing import Any
 
@@ -335,9 +335,28 @@ CHANNEL_KEYS = ("time", "surface_rpm", "surface_torque", "hookload", "bit_depth"
 _CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
 
 
+def _table_type(table: str, keys: tuple[Key, ...]) -> type:
+    """A frozen dataclass for one table of :data:`SCHEMA`: one field per key, with its
+    default, and its unit and help in the field metadata (typed access, ``cfg.model.cells``)."""
+    return make_dataclass(
+        f"{table.title()}Settings",
+        [(k.name, k.type if not isinstance(k.type, tuple) else Any,
+          field(default=k.default if not isinstance(k.default, list) else None,
+                metadata={"unit": k.unit, "help": k.help}))
+         for k in keys], frozen=True)
+
+
+#: The typed table of each :data:`SCHEMA` table, generated from it.
+TABLE_TYPES: dict[str, type] = {t: _table_type(t, keys) for t, keys in SCHEMA.items()}
+
+
 @dataclass(frozen=True)
 class Config:
     """Effective well configuration (defaults < file < command line).
+
+    Every table of :data:`SCHEMA` is an attribute with one field per key, generated from the
+    schema: ``cfg.model.k_t_per_s``, ``cfg.rig.top_drive_inertia_kg_m2`` (absent keys hold
+    their schema default, possibly ``None``).
 
     Attributes
     ----------
@@ -360,25 +379,30 @@ class Config:
     source: Path | None = None
     assumed: tuple = field(default_factory=tuple)
 
-    def __getitem__(self, dotted: str) -> Any:
+    def __post_init__(self):
+        for table, kind in TABLE_TYPES.items():
+            object.__setattr__(self, table, kind(**self.values[table]))
+
+    def get(self, dotted: str) -> Any:
+        """The value of ``"table.key"`` (for keys chosen at run time, e.g. by the CLI)."""
         table, key = dotted.split(".")
-        return self.values[table][key]
+        return getattr(getattr(self, table), key)
 
     @property
     def omega_c_rad_s(self) -> float:
         """Static/kinetic switching speed ω_c [rad/s] (from either model key; default 1)."""
         from drillfric.units import RPM_TO_RAD_S
 
-        if self["model.omega_c_rad_s"] is not None:
-            return self["model.omega_c_rad_s"]
-        if self["model.omega_c_rpm"] is not None:
-            return self["model.omega_c_rpm"] * RPM_TO_RAD_S
+        if self.model.omega_c_rad_s is not None:
+            return self.model.omega_c_rad_s
+        if self.model.omega_c_rpm is not None:
+            return self.model.omega_c_rpm * RPM_TO_RAD_S
         return 1.0
 
     @property
     def tortuosity_rad_m(self) -> float:
         """Nominal tortuosity of the path assumed without a survey [rad/m] (0: vertical)."""
-        return math.radians(self["survey.tortuosity_deg_30m"]) / 30.0
+        return math.radians(self.survey.tortuosity_deg_30m) / 30.0
 
     def assumed_with(self, survey) -> list[str]:
         """What a command assumed: :attr:`assumed` and, when ``survey`` is None, the hole
@@ -388,7 +412,7 @@ class Config:
     @property
     def no_survey_note(self) -> str:
         """What is assumed about the hole when there is no survey (for the assumed list)."""
-        tortuosity = self["survey.tortuosity_deg_30m"]
+        tortuosity = self.survey.tortuosity_deg_30m
         if tortuosity == 0:
             return "vertical well: no survey found"
         text = f"{tortuosity:.1f}" if round(tortuosity, 1) == tortuosity else f"{tortuosity:g}"
@@ -398,8 +422,8 @@ class Config:
     @property
     def inner_mud_density_kg_m3(self) -> float:
         """Mud density inside the string [kg/m³] (defaults to the annulus density)."""
-        inner = self["fluid.inner_mud_density_kg_m3"]
-        return self["fluid.mud_density_kg_m3"] if inner is None else inner
+        inner = self.fluid.inner_mud_density_kg_m3
+        return self.fluid.mud_density_kg_m3 if inner is None else inner
 
     def to_dict(self) -> dict:
         """Plain-data effective configuration, as written into summary.json."""

@@ -270,9 +270,9 @@ def _bit_depth_default(well: Well, assumed: list) -> float:
     simulated well's ``[simulate] bit_depth_m``, else (announced in ``assumed``) the
     survey's last station or :data:`DEFAULT_BIT_DEPTH_M`."""
     cfg, survey = well.config, well.survey
-    for key in ("well.bit_depth_m", "simulate.bit_depth_m"):
-        if cfg[key] is not None:
-            return cfg[key]
+    for given in (cfg.well.bit_depth_m, cfg.simulate.bit_depth_m):
+        if given is not None:
+            return given
     if survey is not None:
         assumed.append(f"bit depth {survey.md_max_m:.0f} m (the survey's last station): the "
                        "log has no bit depth")

@@ -171,7 +171,7 @@ def _pumps(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
                         ("standpipe_pressure_Pa", "pumps_on_Pa")):
         if column in frame:
             values = frame[column].to_numpy(dtype=float)
-            on = np.where(values > cfg[f"segmentation.{key}"], 1, 0).astype(np.int8)
+            on = np.where(values > getattr(cfg.segmentation, key), 1, 0).astype(np.int8)
             on[np.isnan(values)] = -1
             return on
     return np.full(len(frame), -1, np.int8)
@@ -186,7 +186,7 @@ def _depth_mode(frame: pd.DataFrame) -> int:
 
 
 def _new_carry(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
-    start = cfg["segmentation.start_bit_depth_m"]
+    start = cfg.segmentation.start_bit_depth_m
     bit0 = 0.0 if _depth_mode(frame) == _DEPTH_BLOCK else np.nan
     if start is not None and _depth_mode(frame) == _DEPTH_BLOCK:
         bit0 = start
@@ -199,28 +199,28 @@ def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
     if missing:
         raise InputError(f"no {' or '.join(missing)} channel to segment",
                          fix="map the time and surface speed columns in [channels]")
-    slips = cfg["segmentation.slips_hookload_N"]
+    slips = cfg.segmentation.slips_hookload_N
     states, bit = _classify_kernel(
         _column(frame, "time_s"), _column(frame, "surface_rpm"),
         _column(frame, "hookload_N"), _column(frame, "bit_depth_m"),
         _column(frame, "hole_depth_m"), _column(frame, "block_position_m"),
         _column(frame, "wob_N"), _pumps(frame, cfg), _depth_mode(frame),
-        float(cfg["segmentation.rotating_rpm"]),
-        min(float(cfg["segmentation.rotating_stop_rpm"]),
-            float(cfg["segmentation.rotating_rpm"])),
+        float(cfg.segmentation.rotating_rpm),
+        min(float(cfg.segmentation.rotating_stop_rpm),
+            float(cfg.segmentation.rotating_rpm)),
         np.nan if slips is None else float(slips),
-        float(cfg["segmentation.on_bottom_m"]), float(cfg["segmentation.wob_on_bottom_N"]),
-        float(cfg["segmentation.trip_speed_m_s"]),
-        float(cfg["segmentation.max_rop_m_h"]) / 3600.0, carry)
+        float(cfg.segmentation.on_bottom_m), float(cfg.segmentation.wob_on_bottom_N),
+        float(cfg.segmentation.trip_speed_m_s),
+        float(cfg.segmentation.max_rop_m_h) / 3600.0, carry)
     absolute = (_depth_mode(frame) == _DEPTH_CHANNEL
-                or cfg["segmentation.start_bit_depth_m"] is not None)
+                or cfg.segmentation.start_bit_depth_m is not None)
     return states, bit if absolute else np.full(len(frame), np.nan)
 
 
 def classify(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
     """Rig state of every sample (codes into :data:`RIG_STATES`).
 
-    Rules, in order of precedence (thresholds from ``cfg["segmentation.*"]``, see
+    Rules, in order of precedence (thresholds from ``cfg.segmentation``, see
     docs/segmentation.md):
 
     1. ``unknown`` when the surface speed is null;
@@ -341,20 +341,20 @@ def _status(duration_s: float, n_null: dict[str, int], n_rows: int,
 
 def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) -> list[Segment]:
     """Segments of a block of samples (row indices shifted by ``offset``)."""
-    dwell = float(cfg["segmentation.kind_dwell_s"])
-    min_s = float(cfg["segmentation.min_segment_s"])
+    dwell = float(cfg.segmentation.kind_dwell_s)
+    min_s = float(cfg.segmentation.min_segment_s)
     on = pd.Series(np.where(states == ROTATING_ON_BOTTOM, 1.0,
                             np.where(states == ROTATING_OFF_BOTTOM, 0.0, np.nan)))
     on = on.ffill().to_numpy() > 0.5  # unknown samples keep the previous kind
     out: list[Segment] = []
-    for a, b in _pieces(t, states, float(cfg["segmentation.max_gap_s"])):
+    for a, b in _pieces(t, states, float(cfg.segmentation.max_gap_s)):
         for ra, rb, on_bottom in _kind_runs(t[a:b], on[a:b], dwell):
             i0, i1 = a + ra, a + rb
             depth = bit[i0:i1]
             finite = depth[np.isfinite(depth)]
             t0, t1 = float(t[i0]), float(t[i1 - 1])
             n_null = {name: int(np.count_nonzero(mask[i0:i1])) for name, mask in nulls.items()}
-            if t1 - t0 < float(cfg["segmentation.min_rotation_s"]):
+            if t1 - t0 < float(cfg.segmentation.min_rotation_s):
                 continue  # a blip of speed noise, not rotation
             status, message = _status(t1 - t0, n_null, i1 - i0, min_s)
             out.append(Segment(
@@ -469,7 +469,7 @@ class Segmenter:
         rotating = (states == ROTATING_OFF_BOTTOM) | (states == ROTATING_ON_BOTTOM)
         other = np.flatnonzero(~rotating & (states != UNKNOWN))
         with np.errstate(invalid="ignore"):
-            gaps = np.flatnonzero(np.diff(t) > self._cfg["segmentation.max_gap_s"]) + 1
+            gaps = np.flatnonzero(np.diff(t) > self._cfg.segmentation.max_gap_s) + 1
         candidates = np.concatenate((other, gaps))
         return int(candidates.max()) if candidates.size else 0
 

@@ -241,9 +241,9 @@ def load_scenario(path: str | Path, base: Stand) -> Scenario:
 
 def base_stand(cfg: Config) -> Stand:
     """Stand defaults from the ``[simulate]`` table (bit depth filled in by the caller)."""
-    return Stand(bit_depth_m=cfg["simulate.bit_depth_m"] or float("nan"),
-                 duration_s=cfg["simulate.duration_s"], rpm=cfg["simulate.rpm"],
-                 ramp_s=cfg["simulate.ramp_s"], wob_N=cfg["simulate.wob_N"])
+    return Stand(bit_depth_m=cfg.simulate.bit_depth_m or float("nan"),
+                 duration_s=cfg.simulate.duration_s, rpm=cfg.simulate.rpm,
+                 ramp_s=cfg.simulate.ramp_s, wob_N=cfg.simulate.wob_N)
 
 
 def single_stand(cfg: Config, bit_depth_m: float) -> Scenario:
@@ -277,9 +277,9 @@ class Noise:
     @classmethod
     def from_config(cls, cfg: Config) -> Noise:
         """Noise settings of the ``[simulate]`` table."""
-        return cls(cfg["simulate.rpm_noise"], cfg["simulate.torque_noise_Nm"],
-                   cfg["simulate.hookload_noise_N"], cfg["simulate.rpm_resolution"],
-                   cfg["simulate.torque_resolution_Nm"], cfg["simulate.seed"])
+        return cls(cfg.simulate.rpm_noise, cfg.simulate.torque_noise_Nm,
+                   cfg.simulate.hookload_noise_N, cfg.simulate.rpm_resolution,
+                   cfg.simulate.torque_resolution_Nm, cfg.simulate.seed)
 
     def apply(self, columns: dict[str, np.ndarray]) -> None:
         """Add noise then quantise ``surface_rpm``, ``surface_torque_Nm``, ``hookload_N``."""
@@ -330,13 +330,13 @@ class PlantSettings:
     @classmethod
     def from_config(cls, cfg: Config) -> PlantSettings:
         """Settings of a configuration; raises ModelError for meaningless ones."""
-        out = cls(mu_s=cfg["simulate.mu_s"], mu_k=cfg["simulate.mu_k"],
-                  omega_c_rad_s=cfg.omega_c_rad_s, k_t_per_s=cfg["model.k_t_per_s"],
-                  top_drive_inertia_kg_m2=cfg["rig.top_drive_inertia_kg_m2"],
-                  kp_Nms_rad=cfg["simulate.kp_Nms_rad"], ki_Nm_rad=cfg["simulate.ki_Nm_rad"],
-                  cells=cfg["simulate.cells"], bit_mu=cfg["simulate.bit_mu"],
-                  bit_diameter_m=cfg["simulate.bit_diameter_m"],
-                  torque_kind=cfg["rig.torque_kind"])
+        out = cls(mu_s=cfg.simulate.mu_s, mu_k=cfg.simulate.mu_k,
+                  omega_c_rad_s=cfg.omega_c_rad_s, k_t_per_s=cfg.model.k_t_per_s,
+                  top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+                  kp_Nms_rad=cfg.simulate.kp_Nms_rad, ki_Nm_rad=cfg.simulate.ki_Nm_rad,
+                  cells=cfg.simulate.cells, bit_mu=cfg.simulate.bit_mu,
+                  bit_diameter_m=cfg.simulate.bit_diameter_m,
+                  torque_kind=cfg.rig.torque_kind)
         if out.mu_k > out.mu_s:
             raise ModelError(f"μ_k = {out.mu_k} is larger than μ_s = {out.mu_s}",
                              file=cfg.source, fix="the kinetic friction factor cannot exceed "
@@ -483,7 +483,7 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     -------
     Simulation
     """
-    rate = cfg["simulate.rate_hz"] if rate_hz is None else rate_hz
+    rate = cfg.simulate.rate_hz if rate_hz is None else rate_hz
     if not rate > 0:
         raise ModelError(f"recording rate must be positive, got {rate} Hz")
     settings = PlantSettings.from_config(cfg)
@@ -520,7 +520,7 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
     surface_torque = rec.motor_torque_Nm if settings.torque_kind == "motor" \
         else rec.string_torque_Nm
     n = rec.time_s.size
-    off = 0.0 if stand.on_bottom else cfg["simulate.off_bottom_m"]
+    off = 0.0 if stand.on_bottom else cfg.simulate.off_bottom_m
     rotating = rec.time_s >= stand.idle_s + stand.start_up_s
     stuck = float(np.mean(np.abs(rec.bit_rad_s[rotating]) < 0.1 * settings.omega_c_rad_s)) \
         if rotating.any() else 0.0
@@ -548,7 +548,7 @@ def _connection(t0: float, span: float, rate: float, before: Stand, after: Stand
     t = t[t < t0 + span - 0.5 / rate]
     frac = (t - t0) / span
     depth = before.bit_depth_m + frac * (after.bit_depth_m - before.bit_depth_m)
-    off = cfg["simulate.off_bottom_m"]
+    off = cfg.simulate.off_bottom_m
     zero = np.zeros(t.size)
     return {"time_s": t, "surface_rpm": zero, "surface_torque_Nm": zero.copy(),
             "hookload_N": zero.copy(), "bit_depth_m": depth, "hole_depth_m": depth + off,

@@ -370,9 +370,9 @@ def config_friction(cfg, friction: float | None = None) -> Friction:
     """
     if friction is not None:
         return float(friction)
-    base = cfg["model.friction"]
-    shoe = cfg["model.casing_shoe_md_m"]
-    cased, open_ = cfg["model.friction_cased"], cfg["model.friction_open"]
+    base = cfg.model.friction
+    shoe = cfg.model.casing_shoe_md_m
+    cased, open_ = cfg.model.friction_cased, cfg.model.friction_open
     if shoe is None or (cased is None and open_ is None):
         return float(base)
     mu_c = base if cased is None else cased
@@ -411,10 +411,10 @@ def solve_config(cfg, path: WellPath | None, bit_depth_m: float, **kw) -> TDResu
     string = build_string(cfg.sections, bit_depth_m)
     kw = dict(kw)
     kw["friction"] = config_friction(cfg, kw.get("friction"))
-    kw.setdefault("mud_out_kg_m3", cfg["fluid.mud_density_kg_m3"])
+    kw.setdefault("mud_out_kg_m3", cfg.fluid.mud_density_kg_m3)
     kw.setdefault("mud_in_kg_m3", cfg.inner_mud_density_kg_m3)
-    kw.setdefault("element_length_m", cfg["model.element_length_m"])
-    shoe = cfg["model.casing_shoe_md_m"]
+    kw.setdefault("element_length_m", cfg.model.element_length_m)
+    shoe = cfg.model.casing_shoe_md_m
     if shoe is not None:
         kw.setdefault("extra_nodes_m", (shoe,))
     return solve(path, string, **kw)

@@ -72,10 +72,10 @@ def simulate(path: WellPath, bit_depth_m: float, mu_s: float, mu_k: float, rpm: 
     cfg = cfg or config()
     string = build_string(cfg.sections, bit_depth_m)
     td = torque_drag.solve(path, string, load_case="rotating_off_bottom",
-                           mud_out_kg_m3=cfg["fluid.mud_density_kg_m3"])
+                           mud_out_kg_m3=cfg.fluid.mud_density_kg_m3)
     grid = torsional.make_grid(string, cells)
     plant = torsional.Plant(grid, td.fc_at(grid.x_m), mu_s, mu_k, cfg.omega_c_rad_s,
-                            cfg["model.k_t_per_s"], cfg["rig.top_drive_inertia_kg_m2"])
+                            cfg.model.k_t_per_s, cfg.rig.top_drive_inertia_kg_m2)
     t = np.arange(0.0, duration_s + 1.0, 0.1)
     drive = torsional.Drive("pi", np.minimum(t / ramp_s, 1.0) * rpm * RPM, 0.1)
     record, _ = torsional.run(plant, drive, duration_s, rate_hz)

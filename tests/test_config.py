@@ -23,7 +23,7 @@ def test_every_key_documented():
 
 def test_defaults_and_assumptions_reported():
     cfg = load_config()
-    assert cfg["model.cells"] == 500
+    assert cfg.model.cells == 500
     assert cfg.omega_c_rad_s == 1.0
     assert any("drill string" in a for a in cfg.assumed)
 
@@ -61,7 +61,7 @@ bit_depth = { column = "BITDEP", unit = "m" }
     path = tmp_path / "a12.toml"
     path.write_text(text)
     cfg = load_config(path)
-    assert cfg["well.name"] == "A-12"
+    assert cfg.well.name == "A-12"
     assert len(cfg.sections) == 2 and cfg.sections[1]["length_m"] == 56.7
     assert cfg.channels["surface_torque"] == {"column": "STOR", "unit": "kN.m"}
     assert not any("drill string" in a for a in cfg.assumed)
@@ -98,14 +98,14 @@ def test_precedence_command_line_over_file_over_default(tmp_path):
     path = tmp_path / "w.toml"
     path.write_text("[model]\ncells = 800\nk_t_per_s = 0.2\n")
     cfg = load_config(path, overrides={"model.cells": 1000, "model.k_t_per_s": None})
-    assert cfg["model.cells"] == 1000  # command line wins
-    assert cfg["model.k_t_per_s"] == 0.2  # file over default
-    assert cfg["rig.top_drive_inertia_kg_m2"] == 2900.0  # default
+    assert cfg.model.cells == 1000  # command line wins
+    assert cfg.model.k_t_per_s == 0.2  # file over default
+    assert cfg.rig.top_drive_inertia_kg_m2 == 2900.0  # default
 
 
 def test_integer_accepted_for_float(tmp_path):
     cfg = config_from_dict({"fluid": {"mud_density_kg_m3": 1100}})
-    assert isinstance(cfg["fluid.mud_density_kg_m3"], float)
+    assert isinstance(cfg.fluid.mud_density_kg_m3, float)
 
 
 def test_no_survey_tortuosity_default_and_note():
@@ -113,7 +113,7 @@ def test_no_survey_tortuosity_default_and_note():
     rad/m inside, docs/torque_drag.md), and the note says so; 0 restores the plain vertical
     note."""
     cfg = load_config()
-    assert cfg["survey.tortuosity_deg_30m"] == 1.0
+    assert cfg.survey.tortuosity_deg_30m == 1.0
     assert cfg.tortuosity_rad_m == pytest.approx(3.141592653589793 / 180.0 / 30.0, rel=1e-15)
     assert "nominal tortuosity of 1.0°/30 m" in cfg.no_survey_note
     assert "0.25°/30 m" in config_from_dict(

@@ -21,7 +21,7 @@ PATH = build_and_hold(600.0, 50.0, 1600.0)
 def make_observer(case, cfg, cells=400, **kw) -> Observer:
     grid = torsional.make_grid(case.string, cells)
     plant = torsional.Plant(grid, case.td.fc_at(grid.x_m), 0.0, 0.0, cfg.omega_c_rad_s,
-                            cfg["model.k_t_per_s"], cfg["rig.top_drive_inertia_kg_m2"])
+                            cfg.model.k_t_per_s, cfg.rig.top_drive_inertia_kg_m2)
     n_pipe = grid.section_start[1]
     gains = gains_from_config(cfg, case.string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s)
     return Observer(plant, gains, **kw)

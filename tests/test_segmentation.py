@@ -362,7 +362,7 @@ def test_segments_are_ordered_disjoint_and_rotating(seed):
     # every rotating sample is in a segment, except one-sample runs (zero duration: noise)
     left_out = rotating & ~covered
     pairs = np.flatnonzero(left_out[:-1] & left_out[1:])
-    assert np.all(np.diff(data["time_s"].to_numpy())[pairs] > config["segmentation.max_gap_s"])
+    assert np.all(np.diff(data["time_s"].to_numpy())[pairs] > config.segmentation.max_gap_s)
 
 
 # ----------------------------------------------------------------------------------------

@@ -201,7 +201,7 @@ def test_cli_writes_data_and_sidecars_that_read_back(well, tmp_path, ext):
     assert list(frame.columns)[:3] == ["time_s", "surface_rpm", "surface_torque_Nm"]
     assert len(frame) == 20 * 20 + 1
     cfg = load_config(out.with_suffix(".toml"))
-    assert cfg["simulate.mu_s"] == 0.5 and cfg["survey.file"] == "sim.survey.csv"
+    assert cfg.simulate.mu_s == 0.5 and cfg.survey.file == "sim.survey.csv"
     assert [s["name"] for s in cfg.sections] == ["dp", "collars"]
     survey = pd.read_csv(out.parent / "sim.survey.csv")
     assert list(survey.columns) == ["md_m", "inc_deg", "azi_deg"]

@@ -296,7 +296,7 @@ def test_solve_config_defaults_to_vertical_and_config_string():
     res = solve_config(cfg, None, 2000.0)
     assert res.T_N_Nm == 0.0
     string = build_string(cfg.sections, 2000.0)
-    rho = cfg["fluid.mud_density_kg_m3"]
+    rho = cfg.fluid.mud_density_kg_m3
     assert res.hookload_N == pytest.approx(
         sum(s.buoyed_weight_N_m(rho, rho) * s.length_m for s in string.sections), rel=1e-12)
 
@@ -552,13 +552,13 @@ def test_side_force_on_the_assumed_tortuous_path():
     here), F_N = F·κ to r·sin 6° + r²/2 ≤ 4.1e-3 with r = b/a: checked at 5e-3.
     """
     cfg = load_config()
-    assert cfg["survey.tortuosity_deg_30m"] == 1.0
+    assert cfg.survey.tortuosity_deg_30m == 1.0
     kappa, bit = np.radians(1.0) / 30.0, 2500.0
     res = solve_config(cfg, None, bit)
     path = no_survey_path(bit, kappa)
     inc = path.inc_rad[0]
     string = build_string(cfg.sections, bit)
-    rho = cfg["fluid.mud_density_kg_m3"]
+    rho = cfg.fluid.mud_density_kg_m3
     tension = _tension_from_weight_below(string, res.md_m, rho, np.cos(inc))
     np.testing.assert_allclose(res.tension_N, tension, rtol=1e-5)
     mid = 0.5 * (res.md_m[1:] + res.md_m[:-1])

@@ -162,17 +162,17 @@ def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
     ``sample_dt_s`` is the logging interval of the measurements [s]."""
     grid = torsional.make_grid(string, cells)
     plant = torsional.Plant(grid, td.fc_at(grid.x_m), 0.0, 0.0, cfg.omega_c_rad_s,
-                            cfg["model.k_t_per_s"], cfg["rig.top_drive_inertia_kg_m2"])
+                            cfg.model.k_t_per_s, cfg.rig.top_drive_inertia_kg_m2)
     n_pipe = int(grid.section_start[1])
     gains = gains_from_config(cfg, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s,
                               sample_dt_s)
-    return Observer(plant, gains, law=cfg["observer.law"], mu_max=cfg["observer.mu_max"],
-                    deadlock_s=cfg["observer.deadlock_s"],
-                    hold=cfg["observer.interpolation"] == "hold")
+    return Observer(plant, gains, law=cfg.observer.law, mu_max=cfg.observer.mu_max,
+                    deadlock_s=cfg.observer.deadlock_s,
+                    hold=cfg.observer.interpolation == "hold")
 
 
 def _starts(cfg, warm, mu_max) -> np.ndarray:
-    starts = [list(s) for s in cfg["observer.starts"]]
+    starts = [list(s) for s in cfg.observer.starts]
     if warm is not None and all(v is not None for v in warm):
         starts.append([max(warm[0], warm[1]), warm[1]])
     out = np.clip(np.asarray(starts, dtype=float), 0.0, mu_max)
@@ -183,7 +183,7 @@ def _starts(cfg, warm, mu_max) -> np.ndarray:
 def _batch_cells(cfg, bit_depth_m: float) -> int:
     """Cells of the speed-driven fit: ``model.cells``, refined to Δx ≤ 5 m (THEORY §6.4:
     at 10 m the fit was biased by 10–14 %)."""
-    return max(int(cfg["model.cells"]), int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
+    return max(int(cfg.model.cells), int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
 
 
 def ensemble_starts(mu_s: float, mu_k: float, members: int, spread: float,
@@ -215,8 +215,8 @@ def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: 
     (``observer.ensemble_members``, ``observer.ensemble_spread``); μ̂ held unless ``adapt``."""
     if not adapt:
         observer = replace(observer, gains=replace(observer.gains, l_k=0.0, l_s=0.0))
-    members = ensemble_starts(mu_s, mu_k, cfg["observer.ensemble_members"],
-                              cfg["observer.ensemble_spread"], observer.mu_max)
+    members = ensemble_starts(mu_s, mu_k, cfg.observer.ensemble_members,
+                              cfg.observer.ensemble_spread, observer.mu_max)
     state = ObserverState.from_starts(observer, members, omega0_rad_s=meas.surface_rad_s[0],
                                       t_s=meas.t0_s)
     final, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz)
@@ -231,13 +231,13 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
         return None
     torque = batch.measured_string_torque(meas.time_s, meas.surface_rad_s,
                                           meas.motor_torque_Nm, "motor",
-                                          cfg["rig.top_drive_inertia_kg_m2"])
+                                          cfg.rig.top_drive_inertia_kg_m2)
     try:
         return float(torque_drag.back_calculate_friction(
             models.path, models.string, surface_torque_Nm=float(np.mean(torque[rotating])),
-            load_case="rotating_off_bottom", mud_out_kg_m3=cfg["fluid.mud_density_kg_m3"],
+            load_case="rotating_off_bottom", mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
             mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
-            element_length_m=cfg["model.element_length_m"]))
+            element_length_m=cfg.model.element_length_m))
     except DrillfricError:
         return None
 
@@ -294,10 +294,10 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
     check_torque_scale(data, td.T_N_Nm, cfg.omega_c_rad_s, torque_channel=torque_channel)
     meas = Measurements.from_samples(
         data.time_s, data.surface_rpm * RPM_TO_RAD_S, data.surface_torque_Nm,
-        torque_kind=cfg["rig.torque_kind"],
-        top_drive_inertia_kg_m2=cfg["rig.top_drive_inertia_kg_m2"], rate_hz=rate_hz)
+        torque_kind=cfg.rig.torque_kind,
+        top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2, rate_hz=rate_hz)
     string = build_string(cfg.sections, data.bit_depth_m)
-    observer = build_observer(cfg, string, td, cfg["model.cells"], sample_dt_s=meas.dt_s)
+    observer = build_observer(cfg, string, td, cfg.model.cells, sample_dt_s=meas.dt_s)
     return SegmentModels(path, string, td, meas, observer, on_bottom)
 
 
@@ -309,7 +309,7 @@ def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
     starts = _starts(cfg, warm, observer.mu_max)
     state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
                                       t_s=meas.t0_s)
-    window_end = min(meas.t_end_s, meas.t0_s + cfg["observer.starts_window_s"])
+    window_end = min(meas.t_end_s, meas.t0_s + cfg.observer.starts_window_s)
     first, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz,
                        t_end_s=window_end)
     return starts, first, diagnose(first, cfg.omega_c_rad_s)
@@ -318,12 +318,12 @@ def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
 def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:
     """Step 3: the speed-driven fit over the first ``batch.window_s`` (docs/theory.md §6.4)."""
     meas = models.meas
-    n_fit = min(meas.surface_rad_s.size, int(cfg["batch.window_s"] / meas.dt_s) + 1)
+    n_fit = min(meas.surface_rad_s.size, int(cfg.batch.window_s / meas.dt_s) + 1)
     return batch.refine(meas.time_s[:n_fit], meas.surface_rad_s[:n_fit],
                         meas.motor_torque_Nm[:n_fit], string=models.string,
                         fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
-                        k_t_per_s=cfg["model.k_t_per_s"],
-                        top_drive_inertia_kg_m2=cfg["rig.top_drive_inertia_kg_m2"],
+                        k_t_per_s=cfg.model.k_t_per_s,
+                        top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
                         torque_kind="motor", cells=_batch_cells(cfg, models.string.bit_depth_m))
 
 
@@ -346,10 +346,10 @@ def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,
     """Step 5: the ensemble seeded with the verdict's factors over the whole segment, and
     the bit speed it gives (weighted mean and band)."""
     final = _final_pass(cfg, models.observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
-                        adapt=verdict.adapt_final or cfg["observer.adapt_final"],
+                        adapt=verdict.adapt_final or cfg.observer.adapt_final,
                         output_rate_hz=output_rate_hz)
     bit = ensemble_bit_speed(final, _memory_s(models.observer, models.meas),
-                             cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S)
+                             cfg.observer.speed_noise_rpm * RPM_TO_RAD_S)
     return final, bit
 
 
@@ -385,7 +385,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         The segment cannot be estimated (survey above the bit, implausible torque scale).
     """
     tick = progress or (lambda amount: None)
-    out_rate = output_rate_hz or cfg["observer.output_rate_hz"]
+    out_rate = output_rate_hz or cfg.observer.output_rate_hz
     models = build_models(cfg, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
     starts, first, diag = starts_pass(cfg, models, warm, out_rate)
     tick(0.3)
@@ -449,7 +449,7 @@ def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | 
     """
     if refined.mu_s is not None and refined.details.creep_grid_move is not None:
         return float(refined.details.creep_grid_move * refined.mu_s)
-    return diag.mu_s_spread if cfg["observer.law"] == "paper" else None
+    return diag.mu_s_spread if cfg.observer.law == "paper" else None
 
 
 def _memory_s(observer: Observer, meas: Measurements) -> float:

@@ -373,13 +373,13 @@ def kalman_gains(params: LumpedParams, x_m, T_N_Nm: float, dt_s: float, *,
 
 def tuning_from_config(cfg) -> Tuning:
     """Backstepping tuning from the ``[observer]`` table (kappa1, lambda0_per_s, poles_per_s)."""
-    poles = cfg["observer.poles_per_s"]
+    poles = cfg.observer.poles_per_s
     if (len(poles) != 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                    for v in poles)):
         raise ConfigError(f"observer.poles_per_s must be two numbers [z, p], got {poles!r}",
                           file=None if cfg.source is None else str(cfg.source),
                           fix="write poles_per_s = [1.0, 1.5]")
-    return Tuning(kappa1=cfg["observer.kappa1"], lambda0_per_s=cfg["observer.lambda0_per_s"],
+    return Tuning(kappa1=cfg.observer.kappa1, lambda0_per_s=cfg.observer.lambda0_per_s,
                   z_per_s=float(poles[0]), p_per_s=float(poles[1]))
 
 
@@ -406,12 +406,12 @@ def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float,
         standard deviation per sample), so slower logs get a gentler injection. Default:
         the 100 Hz value of :class:`KalmanNoise`.
     """
-    params = LumpedParams.from_string(string, cfg["rig.top_drive_inertia_kg_m2"],
-                                      k_t_per_s=cfg["model.k_t_per_s"])
-    if cfg["observer.gains"] == "kalman":
+    params = LumpedParams.from_string(string, cfg.rig.top_drive_inertia_kg_m2,
+                                      k_t_per_s=cfg.model.k_t_per_s)
+    if cfg.observer.gains == "kalman":
         noise = KalmanNoise()
         if sample_dt_s is not None:
-            sigma = cfg["observer.speed_noise_rpm"] * RPM_TO_RAD_S
+            sigma = cfg.observer.speed_noise_rpm * RPM_TO_RAD_S
             noise = KalmanNoise(speed_psd=sigma**2 * sample_dt_s)
         return kalman_gains(params, x_m, T_N_Nm, dt_s, noise=noise)
     return backstepping_gains(params, tuning_from_config(cfg), x_m, T_N_Nm)

@@ -45,7 +45,7 @@ class LogCheck:
         rpm = chunk["surface_rpm"].to_numpy(float)
         rpm = rpm[np.isfinite(rpm)]
         if rpm.size:
-            fast = np.abs(rpm) > self.well.config["segmentation.rotating_rpm"]
+            fast = np.abs(rpm) > self.well.config.segmentation.rotating_rpm
             self.turning += int(fast.sum())
             self.backwards += int((rpm[fast] < 0).sum())
             self.rpm_min = min(self.rpm_min, float(rpm.min()))
@@ -55,7 +55,7 @@ class LogCheck:
         """Every sample a gap: almost surely time in ms read as s (or a max_gap_s too small)."""
         dt = np.diff(time_s)
         dt = dt[dt > 0]
-        limit = self.well.config["segmentation.max_gap_s"]
+        limit = self.well.config.segmentation.max_gap_s
         if dt.size and float(np.median(dt)) > limit:
             time = self.well.mappings["time"]
             raise InputError(f"time column '{time.column}' has samples {np.median(dt):.4g} "
@@ -95,7 +95,7 @@ class LogCheck:
         """Why a run found no rotating segment at all (a warning), or None."""
         if segments:
             return None
-        threshold = self.well.config["segmentation.rotating_rpm"]
+        threshold = self.well.config.segmentation.rotating_rpm
         top = f"{self.rpm_max:.4g} RPM" if np.isfinite(self.rpm_max) else "no value"
         return (f"no rotating segment found: the surface speed never exceeds "
                 f"segmentation.rotating_rpm = {threshold:.4g} RPM for "

@@ -206,7 +206,7 @@ class Well:
                              fix="give a file with data rows (and a readable time column)")
         check_plausible_rate(surface["time_s"].to_numpy(), file=self.files.data)
         timebase = summarize(surface["time_s"].to_numpy(),
-                             max_gap_s=self.config["segmentation.max_gap_s"],
+                             max_gap_s=self.config.segmentation.max_gap_s,
                              duplicates_dropped=tracker.duplicates,
                              untimed_dropped=tracker.untimed, origin=tracker.origin,
                              source_start_s=tracker.source_start_s)
@@ -244,7 +244,7 @@ def open_well(path, *, config=None, survey=None, overrides=None, name: str | Non
     """
     files, raw = _resolve(path, None if isinstance(config, Config) else config, survey)
     cfg = _config(files.config, raw, config, overrides)
-    shown = printable(name or cfg["well.name"] or default_name(path, files.data), 4096)
+    shown = printable(name or cfg.well.name or default_name(path, files.data), 4096)
     source, mappings = _open(files.data, cfg) if header else (None, {})
     return Well(name=shown, dir_name=safe_name(shown, files.config or files.data),
                 files=files, config=cfg, survey=_load_survey(files.survey), source=source,

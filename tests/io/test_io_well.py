@@ -42,7 +42,7 @@ def test_sidecars_found_by_name(csv_well):
     assert (cfg.name, survey.name) == ("A-12.toml", "A-12.survey.csv")
     pytest.importorskip("drillfric.io.survey")
     w = load_well(csv_well)
-    assert w.name == "Alpha" and w.config["segmentation.max_gap_s"] == 2.0
+    assert w.name == "Alpha" and w.config.segmentation.max_gap_s == 2.0
     assert w.survey.md_max_m == 1500.0 and set(w.files) == {"data", "config", "survey"}
 
 
@@ -61,7 +61,7 @@ def test_config_survey_key_and_overrides(csv_well, tmp_path):
     csv_well.with_suffix(".toml").write_text('[survey]\nfile = "dev.csv"\n')
     assert resolve_well(csv_well).survey == tmp_path / "dev.csv"
     w = load_well(csv_well, overrides={"segmentation.max_gap_s": 0.1})
-    assert w.config["segmentation.max_gap_s"] == 0.1
+    assert w.config.segmentation.max_gap_s == 0.1
 
 
 def test_config_object_is_accepted(csv_well):
@@ -103,7 +103,7 @@ def test_hdf5_bundle(tmp_path, frame):
         h5["config"] = '[well]\nname = "Charlie"\n[fluid]\nmud_density_kg_m3 = 1500.0\n'
     pytest.importorskip("drillfric.io.survey")
     w = load_well(path)
-    assert w.name == "Charlie" and w.config["fluid.mud_density_kg_m3"] == 1500.0
+    assert w.name == "Charlie" and w.config.fluid.mud_density_kg_m3 == 1500.0
     assert w.survey.md_max_m == 2000.0 and w.files["survey"] == path
 
 
@@ -115,7 +115,7 @@ def test_hdf5_config_as_attributes(tmp_path, frame):
         g.attrs["well.name"] = "Delta"
         g.attrs["rig.top_drive_inertia_kg_m2"] = 2500.0
     w = load_well(path)
-    assert w.name == "Delta" and w.config["rig.top_drive_inertia_kg_m2"] == 2500.0
+    assert w.name == "Delta" and w.config.rig.top_drive_inertia_kg_m2 == 2500.0
 
 
 def test_bad_config_key_in_sidecar(csv_well):
@@ -172,7 +172,7 @@ def test_open_without_header_reads_config_and_survey_only(csv_well, tmp_path):
     csv_well.with_suffix(".toml").write_text('[fluid]\nmud_density_kg_m3 = 1400.0\n')
     (tmp_path / "A-12.survey.csv").write_text(SURVEY_CSV)
     well = open_well(csv_well, header=False)
-    assert well.config["fluid.mud_density_kg_m3"] == 1400.0 and well.survey.md_max_m == 1500.0
+    assert well.config.fluid.mud_density_kg_m3 == 1400.0 and well.survey.md_max_m == 1500.0
     assert well.source is None and well.mappings == {}
 
 
