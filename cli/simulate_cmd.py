@@ -1,7 +1,7 @@
 """`drillfric simulate` (INTERFACE.md): synthetic surface data with ground truth.
 
 Thin layer: options become configuration overrides (command line > file > defaults), the
-survey and scenario are resolved, :func:`drillfric.simulate.simulate` runs the plant stand
+survey and scenario are resolved, :func:`drillfric.simulator.simulate` runs the plant stand
 by stand, :func:`drillfric.io.writers.write_well` writes the data file and its sidecars.
 """
 
@@ -50,7 +50,7 @@ def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool)
 
     ``single`` (--bit-depth given without --scenario) ignores the config's scenario.
     """
-    from drillfric import simulate as sim
+    from drillfric import simulator as sim
     from drillfric.errors import ConfigError
 
     name = None if single else cfg.simulate.scenario
@@ -103,7 +103,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     """
     import pandas as pd
 
-    from drillfric import simulate as sim
+    from drillfric import simulator as sim
     from drillfric.io.writers import data_format, write_well
     from drillfric.wellpath import no_survey_path
 

@@ -13,7 +13,7 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric import simulate as sim
+from drillfric import simulator as sim
 from drillfric import torsional as T
 from drillfric.config import config_from_dict, load_config
 from drillfric.errors import ConfigError

@@ -437,7 +437,7 @@ def test_stick_slip_torque_swing_well_b(well_b):
 @pytest.fixture(scope="module")
 def well_b():
     """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
-    from drillfric.simulate import well_b_plant
+    from drillfric.simulator import well_b_plant
 
     plant = well_b_plant()
     rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0), 300.0, 100.0)
