@@ -30,6 +30,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from drillfric import torsional
 from drillfric.config import Config, read_toml
@@ -604,3 +605,59 @@ def well_b_plant(cells: int = 500, k_t_per_s: float = 0.1, mu_s: float = 0.885,
     grid = torsional.make_grid(string, cells)
     fc = torsional.gravity_fc(string, well_b_inclination, grid.x_m)
     return torsional.Plant(grid, fc, mu_s, mu_k, omega_c_rad_s, k_t_per_s, 2900.0)
+
+
+def plan(cfg: Config, config_path: Path | None, well_path: WellPath | None,
+         scenario: Path | None = None, single: bool = False) -> tuple[Path | None, Scenario]:
+    """The stands to simulate: ``scenario`` (else the configuration's ``[simulate]
+    scenario``), or one stand at ``simulate.bit_depth_m`` (else the survey's last station).
+
+    ``single`` ignores the configuration's scenario (a bit depth given on its own).
+
+    Raises
+    ------
+    ConfigError
+        No bit depth from anywhere.
+    """
+    name = None if single else cfg.simulate.scenario
+    base = config_path.parent if config_path is not None else Path(".")
+    path = scenario if scenario is not None else (None if name is None else base / name)
+    if path is not None:
+        return path, load_scenario(path, base_stand(cfg))
+    depth = cfg.simulate.bit_depth_m
+    if depth is None:
+        if well_path is None:
+            raise ConfigError("no bit depth: give --bit-depth, simulate.bit_depth_m, a survey "
+                              "or a scenario", file=config_path)
+        depth = well_path.md_max_m
+    return None, single_stand(cfg, depth)
+
+
+def simulate_config(config, *, out=None, overrides: dict | None = None, survey=None,
+                    scenario=None, progress=None) -> Simulation:
+    """Simulate the well a configuration describes, and write it when ``out`` is given.
+
+    The survey is ``survey``, else the configuration's ``[survey] file``, else
+    ``NAME.survey.csv`` beside the configuration; without one the path ``run`` assumes
+    (vertical with the nominal tortuosity). ``out`` gets the data file and its sidecars
+    (:func:`drillfric.io.writers.write_well`), the well named after ``out``.
+    """
+    from drillfric.io.well import open_config
+    from drillfric.io.writers import data_format, write_well
+
+    if out is not None:
+        data_format(out)
+    cfg, survey_path, well_path = open_config(config, survey=survey, overrides=overrides)
+    _, stands = plan(cfg, Path(config), well_path, scenario,
+                     single=bool(overrides and "simulate.bit_depth_m" in overrides)
+                     and scenario is None)
+    check_depths(stands, well_path, survey_path)
+    result = simulate(cfg, well_path, stands, progress=progress)
+    if out is not None:
+        if well_path is None:
+            well_path = no_survey_path(max(s.bit_depth_m for s in stands.stands),
+                                       cfg.tortuosity_rad_m)
+        keep = tuple(p for p in (Path(config), survey_path) if p is not None)
+        write_well(out, pd.DataFrame(result.columns), config=cfg.to_dict(), survey=well_path,
+                   truth=result.truth(), keep=keep)
+    return result

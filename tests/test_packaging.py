@@ -42,3 +42,8 @@ def test_wheel_installs_and_runs_outside_repo(tmp_path: Path):
     assert "simulate" in out and "fleet" in out
     bare = subprocess.run([str(py), "-c", "import cli"], cwd=outside, capture_output=True)
     assert bare.returncode != 0, "a bare top-level package 'cli' must not be installed"
+    # from the repository root the source tree's drillfric/ shadows the installed one: its
+    # cli/ and templates/ must still be found (a regression: No module named
+    # 'drillfric.templates'), and the report code with them
+    _run([str(py), "-c", "import drillfric.cli.main, drillfric.templates, drillfric.report; "
+          "from drillfric.report import write_well_report"], cwd=REPO)

@@ -251,6 +251,27 @@ def open_well(path, *, config=None, survey=None, overrides=None, name: str | Non
                 mappings=mappings)
 
 
+def open_config(config, *, survey=None, overrides=None
+                ) -> tuple[Config, Path | None, WellPath | None]:
+    """A well configuration on its own (``simulate NAME.toml``, ``td NAME.toml``): the
+    configuration read once and its survey — ``survey``, else the configuration's
+    ``[survey] file``, else ``NAME.survey.{csv,parquet}`` beside it, as for a data file.
+
+    Returns
+    -------
+    (Config, survey path or None, WellPath or None)
+    """
+    path = Path(config)
+    if not path.is_file():
+        raise InputError("config file not found", file=path, fix="check the path")
+    raw = read_toml(path)
+    survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw)
+    if survey_path is not None and not survey_path.is_file():
+        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    return (config_from_dict(raw, file=path, overrides=overrides), survey_path,
+            _load_survey(survey_path))
+
+
 def default_name(path, data_path: Path) -> str:
     """A well's name when nothing names it: the directory's name (resolved, so ``.`` is the
     folder it stands for) or the data file's stem."""
