@@ -78,6 +78,6 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
         click.secho(f"note: {note}", err=True)
     echo(_closing_line(result))
     if result.count("failed") == len(result.wells):
-        raise UserError("no well could be processed (see the errors above)")
+        raise UserError("no well could be processed — fix: see each well's error above")
     if result.count("failed") or result.failed_segments:
         sys.exit(1)

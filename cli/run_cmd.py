@@ -42,7 +42,7 @@ def _describe(result) -> str:
 
 @click.command("run")
 @click.argument("wells", nargs=-1, required=True, type=click.Path(path_type=Path))
-@click.option("--out", "out", type=click.Path(path_type=Path, file_okay=False),
+@click.option("--out", "out", type=click.Path(path_type=Path),
               default=Path("drillfric-out"),
               show_default=True, help="Output directory; each well goes to OUT/NAME.")
 @click.option("--config", type=click.Path(path_type=Path), help="Well configuration (TOML), "

@@ -533,7 +533,8 @@ def read_toml(path: str | Path) -> dict:
                           fix="check the line it names (quotes around text, = between key "
                               "and value)") from exc
     except UnicodeDecodeError as exc:
-        raise ConfigError("not a text file", file=path) from exc
+        raise ConfigError("not a text file", file=path,
+                          fix="save the configuration as UTF-8 TOML text") from exc
 
 
 def config_from_dict(raw: dict, *, file: str | Path | None = None,

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import pint
 
 from drillfric.errors import InputError
+from drillfric.io.text import listing, printable
 from drillfric.units import UREG, parse_unit
 
 
@@ -291,8 +292,9 @@ def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | N
         by_base = [c for c in columns if split_unit(c)[0] == wanted]
         if len(by_base) == 1:
             return by_base[0], split_unit(by_base[0])[1]
-        raise InputError(f"[channels] {channel.key} column '{wanted}' not found; columns "
-                         f"are: {', '.join(map(str, columns))}", file=file,
+        raise InputError(f"[channels] {channel.key} column '{printable(wanted)}' not found; "
+                         f"columns are: {listing(columns, recognised=_recognisable(columns))}",
+                         file=file,
                          fix="use one of the listed column names (or a 0-based index)")
     extra = tuple(spec.get("mnemonics", ()))
     ranked = [(rank, col, unit) for col in columns
@@ -305,10 +307,10 @@ def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | N
     best = max(r[0] for r in ranked)
     top = [r for r in ranked if r[0] == best]
     if len(top) > 1:
-        names = " and ".join(f"'{r[1]}'" for r in top)
+        names = " and ".join(f"'{printable(r[1])}'" for r in top)
         raise InputError(f"columns {names} both look like {channel.name}", file=file,
                          fix=f'choose one in [channels], e.g. {channel.key} = '
-                             f'{{ column = "{top[0][1]}" }}')
+                             f'{{ column = "{printable(top[0][1])}" }}')
     return top[0][1], top[0][2]
 
 
@@ -317,6 +319,11 @@ def _unit_agrees(column: str, name_unit: str | None, channel: Channel, file_unit
     """False when the unit a file states for ``column`` measures another quantity."""
     unit = spec.get("unit") or name_unit or file_units.get(column)
     return channel.key == "time" or not unit or unit_fits(unit, channel) is not False
+
+
+def _recognisable(columns: list[str]) -> bool:
+    """Whether any column is a known channel (the file is a log, not something else)."""
+    return any(_rank(c, ch, ())[0] for ch in CHANNELS for c in columns)
 
 
 def find_column(columns: list[str], key: str, config_channels: dict, *,
@@ -344,7 +351,8 @@ def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: 
     configured = spec.get("unit")
     if configured is not None:
         if stated is not None and not _same_unit(stated, configured, channel, file):
-            raise InputError(f"inconsistent unit for {channel.name}: column '{column}' says "
+            raise InputError(f"inconsistent unit for {channel.name}: column "
+                             f"'{printable(column)}' says "
                              f"'{stated}' but [channels] says '{configured}'", file=file,
                              fix=f"remove unit from [channels] {channel.key} or correct it")
         return configured, "config"
@@ -423,7 +431,7 @@ def _missing(channel: Channel, columns: list[str], file_units: dict, config_chan
         example = '"NAME"' if pick is None else f'"{pick}"'
         if pick is not None and (split_unit(pick)[1] or file_units.get(pick)):
             unit = ""  # the file states it
-    shown = ", ".join(map(str, columns)) if columns else "(none)"
+    shown = listing(columns, recognised=bool(out) or example != '"NAME"')
     return InputError(f"required channel {channel.name} not found; columns found: {shown}",
                       file=file, fix=f"map the column holding the {channel.kind} in the well "
                                      f"config, e.g. [channels] {channel.key} = "

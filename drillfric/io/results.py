@@ -211,8 +211,12 @@ class ResultDirectory:
         self._created: list[Path] = []
 
     def __enter__(self) -> Path:
-        self.check_replaceable()
         try:
+            if self.out_root.is_dir():
+                with _Locked(self.out_root):  # not while another writer swaps
+                    self.check_replaceable()
+            else:
+                self.check_replaceable()
             self._created = missing_dirs(self.out_root)
             self.out_root.mkdir(parents=True, exist_ok=True)
             remove_stale(self.out_root, self.dir_name)

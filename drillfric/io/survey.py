@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.text import listing, printable
 from drillfric.units import conversion_factor
 from drillfric.wellpath import WellPath, minimum_curvature
 
@@ -268,7 +269,7 @@ def _canonical(names, units, data, file) -> pd.DataFrame:
             found[key] = (j, units[j] or unit)
     missing = [k for k in _REQUIRED if k not in found]
     if missing:
-        shown = ", ".join(repr(n) for n in names) or "none"
+        shown = listing(names, recognised=bool(found))
         raise InputError(f"survey has no {'/'.join(_OUT[k] for k in missing)} column "
                          f"(columns found: {shown})", file=file, fix=_FIX_NAMES)
     out = {}
@@ -289,8 +290,9 @@ def _numbers(column, name: str, file) -> np.ndarray:
     bad = np.isnan(values) & ~blank.to_numpy()
     if bad.any():
         k = int(np.argmax(bad))
-        raise InputError(f"column '{name}' has a non-numeric value '{text[k]}' at station "
-                         f"{k + 1}", file=file, fix="remove the text from the survey stations")
+        raise InputError(f"column '{printable(name)}' has a non-numeric value "
+                         f"'{printable(text[k], 20)}' at station {k + 1}", file=file,
+                         fix="remove the text from the survey stations")
     values[np.isin(values, _NULLS)] = np.nan
     return values
 
@@ -305,11 +307,11 @@ def _factor(unit: str | None, kind: str, name: str, file) -> float:
             return float(np.degrees(conversion_factor(unit, "angle")))
         m = re.fullmatch(r"\s*([^/]+?)\s*/\s*([0-9.]*)\s*([A-Za-z]+)\s*", unit.replace("°", "deg"))
         if m is None:
-            raise InputError(f"unknown unit '{unit}'")
+            raise InputError(f"unknown unit '{printable(unit, 20)}'")
         per = float(m.group(2) or 1.0) * conversion_factor(m.group(3), "length")
         return float(np.degrees(conversion_factor(m.group(1), "angle"))) * 30.0 / per
     except InputError as exc:
-        raise InputError(f"column '{name}': {exc.problem}", file=file,
+        raise InputError(f"column '{printable(name)}': {exc.problem}", file=file,
                          fix="use m or ft for depths, deg or rad for angles, deg/30m or "
                              "deg/100ft for DLS") from exc
 

@@ -27,3 +27,28 @@ def printable(text, limit: int = QUOTE_LIMIT) -> str:
     clean = "".join("?" if unicodedata.category(c) in ("Cc", "Cf", "Cs", "Co", "Cn")
                     else c for c in text)
     return clean if len(clean) <= limit else clean[:limit - 1] + "…"
+
+
+def listing(names, *, recognised: bool, limit: int = 12) -> str:
+    """Column names for a message, or a word saying why they are not shown.
+
+    A file's column names are quoted only when the file is recognisably the expected kind
+    (``recognised``: at least one of its columns was understood): an unrelated file named by
+    mistake — a secrets file as a survey — must not have its first line printed, logged by a
+    nightly job or copied into a fleet manifest. Names are sanitised (:func:`printable`) and
+    at most ``limit`` are shown.
+
+    Examples
+    --------
+    >>> listing(["MD", "INC", "X\\x1b"], recognised=True)
+    'MD, INC, X?'
+    >>> listing(["API_KEY=secret"], recognised=False)
+    'none recognisable (not shown)'
+    """
+    names = [str(n) for n in names]
+    if not names:
+        return "none"
+    if not recognised:
+        return "none recognisable (not shown)"
+    shown = ", ".join(printable(n) for n in names[:limit])
+    return shown + (f", … ({len(names)} in all)" if len(names) > limit else "")

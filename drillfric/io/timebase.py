@@ -19,6 +19,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.readers import NULL_VALUES
+from drillfric.io.text import printable
 
 
 @dataclass(frozen=True)
@@ -220,8 +221,9 @@ class TimeTracker:
         stamps = pd.to_datetime(text, format="ISO8601", errors="coerce", utc=True)
         bad = np.flatnonzero(stamps.isna().to_numpy() & _present(text))
         row = self._rows_seen + (bad[0] if bad.size else 0) + 1
-        shown = text.iloc[bad[0]] if bad.size else ""
-        raise InputError(f"time column '{self.column}': cannot read '{shown}' at data row "
+        shown = printable(text.iloc[bad[0]], 30) if bad.size else ""
+        raise InputError(f"time column '{printable(self.column)}': cannot read '{shown}' at "
+                         f"data row "
                          f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
                          fix="write times as seconds or like 2024-05-01T12:00:00")
 
