@@ -123,13 +123,22 @@ class Browser:
         raw, self._buffer = self._buffer.split(b"\0", 1)
         return json.loads(raw)
 
-    def visit(self, url: str, expressions: dict[str, str] | None = None) -> PageVisit:
-        """Open ``url`` in a new tab, wait for its load event, record what happened."""
+    def visit(self, url: str, expressions: dict[str, str] | None = None,
+              width: int | None = None, full_page: bool = False) -> PageVisit:
+        """Open ``url`` in a new tab, wait for its load event, record what happened.
+
+        ``width``: viewport width [px] (default: the window's); ``full_page``: the
+        screenshot covers the whole page, not only the viewport.
+        """
         target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = self.send("Target.attachToTarget",
                             {"targetId": target, "flatten": True})["sessionId"]
         for domain in ("Page", "Runtime", "Log", "Network"):
             self.send(f"{domain}.enable", session=session)
+        if width is not None:
+            self.send("Emulation.setDeviceMetricsOverride", {
+                "width": width, "height": 1600, "deviceScaleFactor": 1, "mobile": False},
+                session=session)
         self._events.clear()
         self.send("Page.navigate", {"url": url}, session=session)
         loaded = self.wait_event("Page.loadEventFired")
@@ -143,7 +152,9 @@ class Browser:
             reply = self.send("Runtime.evaluate", {"expression": expression,
                                                    "returnByValue": True}, session=session)
             visit.values[name] = reply.get("result", {}).get("value")
-        shot = self.send("Page.captureScreenshot", {"format": "png"}, session=session)
+        shot = self.send("Page.captureScreenshot", {"format": "png",
+                                                    "captureBeyondViewport": full_page},
+                         session=session)
         visit.screenshot = base64.b64decode(shot["data"])
         self.send("Target.closeTarget", {"targetId": target})
         return visit

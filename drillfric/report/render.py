@@ -22,13 +22,15 @@ from matplotlib.figure import Figure
 #: Resolution of the figures embedded in HTML [dots per inch].
 HTML_DPI = 90
 #: Columns of the diagnostics table (HTML and PDF), in order.
-DIAGNOSTIC_COLUMNS = ("segment", "kind", "bit depth [m]", "time", "μ_s", "μ_k", "μ_TD",
-                      "spread μ_s / μ_k", "settling [s]", "residual RMS [rpm]",
-                      "torque misfit / swing [kN·m]", "severity", "stuck",
-                      "hook load meas. / model [kN]", "bit speed", "observability", "status",
+DIAGNOSTIC_COLUMNS = ("seg.", "kind", "bit depth [m]", "time", "μ_s", "μ_k", "μ_TD",
+                      "spread μ_s / μ_k", "settling [s]", "residual [rpm]",
+                      "misfit / swing [kN·m]", "severity", "stuck",
+                      "hook load [kN] meas. / model", "bit speed", "observability", "status",
                       "message")
 #: Positions of the numeric columns of :data:`DIAGNOSTIC_COLUMNS` (right-aligned).
 NUMERIC_COLUMNS = frozenset((2, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13))
+#: Positions of the columns whose text may wrap in the HTML table (the others are short).
+WRAPPING_COLUMNS = frozenset((1, 15, 16, 17))
 #: Relative widths of the diagnostics columns in the PDF (the message gets the most room).
 PDF_COLUMN_WIDTHS = (3.2, 4.5, 3.8, 6.0, 4.2, 3.5, 3.5, 5.0, 3.5, 3.8, 5.5, 3.5, 3.0, 5.5,
                      4.5, 5.5, 5.5, 17.0)
@@ -120,8 +122,7 @@ def clock_span(row: dict, origin) -> str:
         end = (origin + pd.Timedelta(seconds=float(row["t_end_s"]))).isoformat()
     if isinstance(start, str) and isinstance(end, str):
         a, b = pd.Timestamp(start), pd.Timestamp(end)
-        day = a.strftime("%Y-%m-%d ")
-        return f"{day}{a:%H:%M:%S}–{b:%H:%M:%S}"
+        return f"{a:%H:%M:%S}–{b:%H:%M:%S}"
     return f"{fmt(row.get('t_start_s'), '.0f')}–{fmt(row.get('t_end_s'), '.0f')} s"
 
 
@@ -139,16 +140,16 @@ def _scaled(value, scale: float):
         return None
 
 
-def bit_speed_text(row: dict) -> str:
-    """Whether the segment's bit speed is resolved (and why not)."""
+def bit_speed_text(row: dict, reason: bool = True) -> str:
+    """Whether the segment's bit speed is resolved (and, with ``reason``, why not)."""
     resolved = row.get("bit_speed_resolved")
     if row.get("status") != "ok" or resolved is None or (isinstance(resolved, float)
                                                          and math.isnan(resolved)):
         return "—"
     if bool(resolved):
         return "resolved"
-    reason = str(row.get("bit_speed_reason") or "").strip()
-    return "not resolved" + (f": {reason}" if reason else "")
+    why = str(row.get("bit_speed_reason") or "").strip()
+    return "not resolved" + (f": {why}" if why and reason else "")
 
 
 def status_text(row: dict) -> str:
@@ -170,7 +171,10 @@ def diagnostic_rows(segments: pd.DataFrame, origin=None) -> list[dict]:
         ok = row["status"] == "ok"
         mu_s = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
         flags = ", ".join(row.get("flags") or [])
-        message = "; ".join(x for x in (str(row.get("message") or ""), flags) if x)
+        unresolved = bit_speed_text(row) if bit_speed_text(row, False) == "not resolved" \
+            else ""
+        message = "; ".join(x for x in (str(row.get("message") or ""), unresolved, flags)
+                            if x)
         kind = str(row.get("kind") or "—").replace("_rotating", "").replace("_", " ")
         cells = [str(row["id"]), kind, fmt(row["bit_depth_m"], ".1f"), clock_span(row, origin),
                  mu_s if ok else "—", fmt(row["mu_k"]), fmt(row["mu_td"]),
@@ -179,7 +183,8 @@ def diagnostic_rows(segments: pd.DataFrame, origin=None) -> list[dict]:
                  pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"), ".1f", 1e-3),
                  fmt(row["stick_slip_severity"], ".2f"), fmt(row["stuck_fraction"], ".0%"),
                  pair(row.get("hookload_N"), row.get("hookload_model_N"), ".0f", 1e-3),
-                 bit_speed_text(row), observability(row), status_text(row), message]
+                 bit_speed_text(row, reason=False), observability(row), status_text(row),
+                 message]
         out.append({"id": row["id"], "cls": row_class(row), "cells": cells})
     return out
 

@@ -36,6 +36,7 @@ from .render import (
     MESSAGE_FOLD_CHARS,
     NUMERIC_COLUMNS,
     PDF_COLUMN_WIDTHS,
+    WRAPPING_COLUMNS,
     bit_speed_text,
     clock,
     clock_span,
@@ -303,6 +304,7 @@ def _html(report: Report) -> str:
         broomstick_warning=bool(report.broomstick.check["warning"]),
         n_estimated=int((data.segments["status"] == "ok").sum()),
         columns=DIAGNOSTIC_COLUMNS, numeric=NUMERIC_COLUMNS, fold=MESSAGE_FOLD_CHARS,
+        wrapping=WRAPPING_COLUMNS,
         diagnostics=report.diagnostics)
 
 
