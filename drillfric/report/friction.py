@@ -44,6 +44,13 @@ def _source_frame(seg: pd.DataFrame) -> pd.DataFrame:
     return rows[keep].astype({"id": int})
 
 
+def _cds(frame: pd.DataFrame):
+    """A ColumnDataSource of a table's columns (no index column)."""
+    from bokeh.models import ColumnDataSource
+
+    return ColumnDataSource({c: frame[c].to_numpy() for c in frame.columns})
+
+
 def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: str,
             hollow_unconverged: bool = True, **kw):
     """Filled markers where converged, hollow where not; returns the renderers."""
@@ -56,7 +63,7 @@ def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: st
         part = part[part[x].notna()]
         if not len(part):
             continue
-        out.append(fig.scatter(x, "depth", source=ColumnDataSource(part), marker=marker,
+        out.append(fig.scatter(x, "depth", source=_cds(part), marker=marker,
                                size=9, line_color=color,
                                fill_color=color if conv else "white",
                                legend_label=label + suffix, **kw))
@@ -90,14 +97,14 @@ def friction_plot(segments: pd.DataFrame):
         mu.segment(bound["mu_s_lower_bound"], bound["depth"], bound["mu_s_lower_bound"] + 0.08,
                    bound["depth"], color=MU_S_COLOR, line_dash="dotted")
         renderers.append(mu.scatter("mu_s_lower_bound", "depth",
-                                    source=ColumnDataSource(bound), marker="triangle",
+                                    source=_cds(bound), marker="triangle",
                                     angle=-np.pi / 2, size=10, line_color=MU_S_COLOR,
                                     fill_color="white", legend_label="μ_s ≥ lower bound"))
     renderers += _points(mu, ok, "mu_td", "x", TD_COLOR, "μ from torque and drag",
                          hollow_unconverged=False)
     none = frame[frame["status"] != "ok"].assign(zero=0.0)
     if len(none):
-        renderers.append(mu.scatter("zero", "depth", source=ColumnDataSource(none),
+        renderers.append(mu.scatter("zero", "depth", source=_cds(none),
                                     marker="diamond", size=10, color="#888888",
                                     fill_color="white", legend_label="no estimate"))
     mu.add_tools(HoverTool(renderers=renderers, tooltips=_TIPS))
@@ -108,7 +115,7 @@ def friction_plot(segments: pd.DataFrame):
                  x_axis_label="stick-slip severity [-]")
     sev_rows = ok[ok["stick_slip_severity"].notna()]
     if len(sev_rows):
-        line = sev.scatter("stick_slip_severity", "depth", source=ColumnDataSource(sev_rows),
+        line = sev.scatter("stick_slip_severity", "depth", source=_cds(sev_rows),
                            marker="circle", size=8, color="#8e44ad")
         sev.add_tools(HoverTool(renderers=[line], tooltips=_TIPS))
     sev.add_layout(Span(location=1.0, dimension="height", line_dash="dashed",
@@ -136,7 +143,7 @@ def fleet_plot(logs: list[tuple[str, pd.DataFrame]]):
         color = palette[index % len(palette)]
         frame = _source_frame(ok.sort_values("bit_depth_m")).assign(well=name)
         frame["fill"] = np.where(frame["converged"], color, "white")
-        source = ColumnDataSource(frame)
+        source = _cds(frame)
         line = fig.line("mu_k", "depth", source=source, color=color, line_width=1)
         filled = fig.scatter("mu_k", "depth", source=source, size=8, color=color,
                              fill_color="fill")

@@ -22,7 +22,7 @@ PAGE_IN = (11.69, 8.27)
 #: Font size of table text [pt] (readable in print; the old tables shrank to ~4 pt).
 TABLE_FONT_PT = 7.5
 #: Longest cell shown [lines]; longer cells end in "…" (report.html has them whole).
-MAX_CELL_LINES = 6
+MAX_CELL_LINES = 14
 _MARGIN_IN = 0.45
 _TOP_IN = 0.85      # room for the page title
 _BOTTOM_IN = 0.55   # room for the footer
