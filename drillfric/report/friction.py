@@ -54,7 +54,6 @@ def _cds(frame: pd.DataFrame):
 def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: str,
             hollow_unconverged: bool = True, **kw):
     """Filled markers where converged, hollow where not; returns the renderers."""
-    from bokeh.models import ColumnDataSource
 
     out = []
     for conv, suffix in ((True, ""), (False, " (not converged)")):
@@ -73,7 +72,7 @@ def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: st
 def friction_plot(segments: pd.DataFrame):
     """μ versus bit depth and stick-slip severity versus bit depth (a Bokeh row)."""
     from bokeh.layouts import gridplot
-    from bokeh.models import ColumnDataSource, HoverTool, Span
+    from bokeh.models import HoverTool, Span
     from bokeh.plotting import figure
 
     seg = segments[segments["bit_depth_m"].notna()]
@@ -126,7 +125,7 @@ def friction_plot(segments: pd.DataFrame):
 
 def fleet_plot(logs: list[tuple[str, pd.DataFrame]]):
     """μ_k versus bit depth of every well, a colour per well; legend click hides a well."""
-    from bokeh.models import ColumnDataSource, HoverTool, Legend, LegendItem
+    from bokeh.models import HoverTool, Legend, LegendItem
     from bokeh.palettes import Category10, Category20
     from bokeh.plotting import figure
 
