@@ -144,6 +144,8 @@ def _optional_parquet(path: Path) -> pd.DataFrame | None:
 
 #: The final (seeded) observer pass in estimates.parquet (pipeline.SEEDED_START_ID).
 FINAL_START_ID = -1
+#: Points per observer start (their μ move slowly: a few hundred points draw them).
+START_POINTS = 300
 #: Signals whose extremes survive the decimation of the final pass (stick-slip peaks,
 #: break-over torque).
 _EXTREME_KEYS = ("surface_torque_Nm", "surface_rpm", "bit_rpm_est")
@@ -180,12 +182,12 @@ def extreme_rows(frame: pd.DataFrame, max_points: int,
 
 
 def segment_estimates(result_dir: Path, ids: list[int],
-                      max_points: int = 1500) -> dict[int, pd.DataFrame]:
+                      max_points: int = 1200) -> dict[int, pd.DataFrame]:
     """Estimates of the given segments, every start, decimated to ≤ ``max_points`` per start.
 
     The final pass (``start_id`` −1, the reported speeds and torques) keeps the extremes
     of its signals (:func:`extreme_rows`); the starts, whose μ move slowly, keep every k-th
-    sample. The figures are for reading; the Parquet file keeps every sample.
+    sample (≤ :data:`START_POINTS`). The figures are for reading; the Parquet file keeps every sample.
     """
     path = Path(result_dir) / "estimates.parquet"
     if not ids or not path.is_file():
@@ -210,6 +212,7 @@ def segment_estimates(result_dir: Path, ids: list[int],
             if start_id == FINAL_START_ID:
                 parts.append(one.iloc[extreme_rows(one, max_points)])
             else:
-                parts.append(one.iloc[::max(1, int(np.ceil(len(one) / max_points)))])
+                keep = min(max_points, START_POINTS)
+                parts.append(one.iloc[::max(1, int(np.ceil(len(one) / keep)))])
         out[int(seg_id)] = pd.concat(parts, ignore_index=True)
     return out
