@@ -187,7 +187,8 @@ def segment_estimates(result_dir: Path, ids: list[int],
 
     The final pass (``start_id`` −1, the reported speeds and torques) keeps the extremes
     of its signals (:func:`extreme_rows`); the starts, whose μ move slowly, keep every k-th
-    sample (≤ :data:`START_POINTS`). The figures are for reading; the Parquet file keeps every sample.
+    sample (≤ :data:`START_POINTS`). The figures are for reading; the Parquet file keeps
+    every sample.
     """
     path = Path(result_dir) / "estimates.parquet"
     if not ids or not path.is_file():

@@ -51,6 +51,24 @@ def wrap_cell(text: str, chars: int) -> list[str]:
     return lines
 
 
+def column_chars(columns: list[str], rows: list[list[str]], budget: int) -> list[float]:
+    """Column widths [characters] that fit ``budget`` characters a line.
+
+    Each column first gets its longest word (so no word is broken, when the budget allows),
+    then the remaining room goes to the columns whose text is longer than that, in
+    proportion to what they lack (capped at 60 characters a column).
+    """
+    cells = [[str(h), *(str(r[i]) for r in rows)] for i, h in enumerate(columns)]
+    need = [max(len(w) for c in col for w in (c.split() or [""])) + 1 for col in cells]
+    want = [min(max(len(c) for c in col), 60) + 1 for col in cells]
+    room = budget - sum(need)
+    if room <= 0:
+        return [float(n) for n in need]
+    lack = [max(w - n, 0) for w, n in zip(want, need, strict=True)]
+    share = room / max(sum(lack), 1)
+    return [n + min(share, 1.0) * gap for n, gap in zip(need, lack, strict=True)]
+
+
 def table_pages(title: str, columns: list[str], rows: list[list[str]],
                 widths: list[float] | None = None, *, font_pt: float = TABLE_FONT_PT
                 ) -> list[Figure]:
@@ -65,14 +83,13 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
     rows : list of list of str
         Cell texts.
     widths : list of float, optional
-        Relative column widths (default: from the longest text of each column, capped).
+        Relative column widths (default: :func:`column_chars` — no word is broken).
     font_pt : float
         Font size [pt].
     """
     width_in = PAGE_IN[0] - 2 * _MARGIN_IN
     if widths is None:
-        widths = [min(max(len(str(c)) for c in [h, *(r[i] for r in rows)]), 40) + 2
-                  for i, h in enumerate(columns)]
+        widths = column_chars(columns, rows, int(width_in * 72.0 / (_CHAR_EM * font_pt)))
     total = float(sum(widths))
     col_in = [width_in * w / total for w in widths]
     chars = [int(w * 72.0 / (_CHAR_EM * font_pt)) - 1 for w in col_in]
@@ -88,7 +105,8 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
             fig = blank_page(title + (" (continued)" if pages else ""))
             pages.append(fig)
             y = PAGE_IN[1] - _TOP_IN
-            y = _draw_row(fig, head, col_in, y, line_in, font_pt, header=True)
+            if any(columns):  # a table of label–value lines has no heading row
+                y = _draw_row(fig, head, col_in, y, line_in, font_pt, header=True)
         if cells is None:
             fig.text(_MARGIN_IN / PAGE_IN[0], y / PAGE_IN[1] - 0.02, "(none)",
                      fontsize=font_pt, parse_math=False)

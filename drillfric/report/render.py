@@ -31,9 +31,6 @@ DIAGNOSTIC_COLUMNS = ("seg.", "kind", "bit depth [m]", "time", "μ_s", "μ_k", "
 NUMERIC_COLUMNS = frozenset((2, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13))
 #: Positions of the columns whose text may wrap in the HTML table (the others are short).
 WRAPPING_COLUMNS = frozenset((1, 15, 16, 17))
-#: Relative widths of the diagnostics columns in the PDF (the message gets the most room).
-PDF_COLUMN_WIDTHS = (3.2, 4.5, 3.8, 6.0, 4.2, 3.5, 3.5, 5.0, 3.5, 3.8, 5.5, 3.5, 3.0, 5.5,
-                     4.5, 5.5, 5.5, 17.0)
 #: Messages longer than this [characters] are folded in the HTML table (click to read).
 MESSAGE_FOLD_CHARS = 90
 

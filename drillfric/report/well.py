@@ -35,7 +35,6 @@ from .render import (
     DIAGNOSTIC_COLUMNS,
     MESSAGE_FOLD_CHARS,
     NUMERIC_COLUMNS,
-    PDF_COLUMN_WIDTHS,
     WRAPPING_COLUMNS,
     bit_speed_text,
     clock,
@@ -362,8 +361,7 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
 
     head, data = report.head, report.data
     pages = [("", p) for p in table_pages(f"Friction report — {head['well']}",
-                                          ["", ""], _header_lines(report), [1.0, 4.0],
-                                          font_pt=9.0)]
+                                          ["", ""], _header_lines(report), font_pt=9.0)]
     if report.has_tracks:
         pages.append(("Time tracks", tracks_figure(data.tracks, data.segments,
                                                    data.time_origin, size)))
@@ -379,12 +377,10 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
         pages.append((f"Segment {row['id']} — bit at {fmt(row['bit_depth_m'], '.0f')} m, "
                       f"{row['span']}", evidence_figure(est, row, data.time_origin, size)))
     pages += [("", p) for p in table_pages("Diagnostics", list(DIAGNOSTIC_COLUMNS),
-                                           [r["cells"] for r in report.diagnostics],
-                                           list(PDF_COLUMN_WIDTHS))]
+                                           [r["cells"] for r in report.diagnostics])]
     config = [[table, key, value] for table, items in head["config"] for key, value in items]
     pages += [("", p) for p in table_pages("Configuration: drill string", *head["string"])]
-    pages += [("", p) for p in table_pages("Configuration", ["table", "key", "value"], config,
-                                           [1.2, 2.2, 6.0])]
+    pages += [("", p) for p in table_pages("Configuration", ["table", "key", "value"], config)]
     return pages
 
 
