@@ -53,7 +53,7 @@ def _shoot(html: Path, out: Path, tmp: Path) -> list[Path]:
     ids = json.dumps(list(SECTIONS))
     rects = (f"JSON.stringify(Object.fromEntries({ids}.map(id => {{ const r = "
              "document.getElementById(id).getBoundingClientRect(); return [id, "
-             "[r.left, r.top + window.scrollY, r.width, r.height]]; }})))")
+             "[r.left, r.top + window.scrollY, r.width, r.height]]; })))")
     try:
         visit = browser.visit(html.as_uri(), {"rects": rects}, width=1400)
         written = []
