@@ -1,7 +1,10 @@
 """`drillfric td` (INTERFACE.md): soft-string torque and drag at one bit depth, or a broomstick.
 
 Thin layer: resolve the well (config, survey), build the options into library calls of
-:mod:`drillfric.torque_drag`, print a summary or JSON, write the table / plot.
+:mod:`drillfric.torque_drag`, print a summary or JSON, write the table / plot. With
+``--broomstick`` and a well that has a log (a data file, HDF5 bundle or well directory),
+the log is segmented and each rotating segment's measured hook load and torque are drawn
+on the broomstick, with the string-weight check (:mod:`drillfric.report.broomstick`).
 """
 
 from __future__ import annotations
@@ -44,6 +47,16 @@ def _load(target: Path, config: str | None, survey: str | None, overrides: dict)
 
     well = open_well(target, config=config, survey=survey, overrides=overrides, header=False)
     return well.config, well.survey
+
+
+def _load_with_log(target: Path, config, survey, overrides):
+    """(Config, WellPath or None, measured points) of a well with a log: the log is read
+    (:func:`drillfric.io.well.load_well`) and segmented for the measured points."""
+    from drillfric.io.well import load_well
+    from drillfric.report.broomstick import measured_points_from_log
+
+    well = load_well(target, config=config, survey=survey, overrides=overrides)
+    return well.config, well.survey, measured_points_from_log(well.surface, well.config)
 
 
 def _floats(text: str | None, what: str) -> list[float] | None:
@@ -115,7 +128,13 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
     survey.tortuosity_deg_30m, and --bit-depth is required.
     """
     overrides = {"model.friction": friction, "model.element_length_m": element_length}
-    cfg, path = _load(well_or_config, config, survey, overrides)
+    measured = None
+    if broomstick and well_or_config.suffix.lower() != ".toml":
+        cfg, path, measured = _load_with_log(well_or_config, config, survey, overrides)
+        if bit_depth is None and path is None and len(measured):
+            bit_depth = float(measured["bit_depth_m"].max())
+    else:
+        cfg, path = _load(well_or_config, config, survey, overrides)
     if bit_depth is None:
         if path is None:
             raise UserError("no survey: give --bit-depth (the hole is taken as vertical, with "
@@ -126,7 +145,7 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
             warn(f"assumed {note}")
     kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
     if broomstick:
-        _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
+        _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw, measured)
     else:
         _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw)
 
@@ -165,7 +184,8 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
         echo(f"profile written to {out}")
 
 
-def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw) -> None:
+def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
+                measured=None) -> None:
     from drillfric.drillstring import build_string
     from drillfric.torque_drag import broomstick, broomstick_figure, config_friction
     from drillfric.wellpath import no_survey_path
@@ -194,12 +214,24 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw)
                        element_length_m=cfg.model.element_length_m, **kw)
     if out is not None:
         _write_table(table, out)
+    check = None
+    if measured is not None and len(measured):
+        from drillfric.report.broomstick import weight_check
+
+        check = weight_check(measured, table)
+        if check["warning"]:
+            warn(check["warning"])
     if plot is not None:
         plot.parent.mkdir(parents=True, exist_ok=True)
-        broomstick_figure(table).savefig(plot, dpi=120)
+        broomstick_figure(table, measured).savefig(plot, dpi=120)
     if as_json:
         click.echo(table.to_json(orient="records", indent=2))
         return
+    if measured is not None:
+        echo(f"measured: {len(measured)} rotating segment(s) of the log drawn on the plot"
+             + (f"; implied block weight {check['block_weight_N'] / 1e3:.0f} kN "
+                "(median measured − modelled rotating hook load)"
+                if check and check["checked"] else ""))
     echo(f"broomstick: {len(grid)} depths × {len(mus)} friction factors × {len(cases)} "
          f"load cases ({grid[0]:.0f}–{grid[-1]:.0f} m)")
     last = table[table["bit_depth_m"] == table["bit_depth_m"].max()]

@@ -162,6 +162,10 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("torque_kind", str, "motor", "", "What the logged surface torque is: 'motor' "
             "(drive torque τ_m) or 'string' (already inertia-corrected, τ(0) = τ_m − I_TD "
             "dω₀/dt).", choices=("motor", "string")),
+        _positive("sample_averaging_s", None, "s", "Each logged sample is the mean over this "
+                  "interval (EDR-style 1-s or 5-s averages); default: spot values. With the "
+                  "sample interval it decides whether the stick-slip cycle — and so the bit "
+                  "speed — is resolved (docs/bit_speed.md)."),
     ),
     "model": (
         Key("omega_c_rad_s", float, None, "rad/s", "Static/kinetic switching speed ω_c "

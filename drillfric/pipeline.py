@@ -46,6 +46,7 @@ from drillfric.io.results import (
     write_segments,
 )
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
+from drillfric.io.tracks import TrackAccumulator, write_tracks
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import (
     ESTIMATE_NAMES,
@@ -108,6 +109,8 @@ class WellResult:
         Segments whose estimation failed.
     warnings : list of str
         What the user should know (also ``summary["warnings"]``).
+    tracks : pandas.DataFrame or None
+        The whole log decimated for plotting (tracks.parquet).
     """
 
     well: str
@@ -116,6 +119,7 @@ class WellResult:
     out_dir: Path | None = None
     failed: int = 0
     warnings: list = field(default_factory=list)
+    tracks: pd.DataFrame | None = field(default=None, repr=False)
     _estimates: pd.DataFrame | None = field(default=None, repr=False)
 
     @property
@@ -179,6 +183,7 @@ def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
     tracker = well.time_tracker()
     total = _count_rows(well.files.data)
     stream = SegmentStream(well.config)
+    tracks = TrackAccumulator()
     records: list[SegmentRecord] = []
     warnings: list[str] = []
 
@@ -196,6 +201,7 @@ def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
             estimator.has_truth = "bit_rpm" in chunk
         check.feed(chunk)
         take(stream.feed(chunk))
+        tracks.feed(chunk, stream.last_states)
         if progress:
             progress(RunProgress(check.rows, total, len(records)))
     take(stream.close())
@@ -206,10 +212,21 @@ def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
     warnings += [w for w in (check.nothing_found(len(records)),) if w]
     summary = summarise(well, records, estimator, check.rows, rate_hz, warnings,
                         time.perf_counter() - t_wall)
-    sink.finish(well, summary, records)
+    summary["time_origin_utc"] = _iso(tracker.origin)
+    track_frame = tracks.result()
+    sink.finish(well, summary, records, track_frame)
     return WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
                       failed=estimator.failed, warnings=summary["warnings"],
-                      _estimates=sink.estimates())
+                      tracks=track_frame, _estimates=sink.estimates())
+
+
+def _iso(stamp) -> str | None:
+    """ISO 8601 UTC text of a timestamp (None when the log has no clock time)."""
+    if stamp is None or pd.isna(stamp):
+        return None
+    stamp = pd.Timestamp(stamp)
+    stamp = stamp.tz_localize("UTC") if stamp.tzinfo is None else stamp.tz_convert("UTC")
+    return stamp.isoformat()
 
 
 def _first_chunk(well: Well, chunk: pd.DataFrame, rate_hz, warnings: list) -> float | None:
@@ -238,7 +255,7 @@ class _SegmentEstimator:
         """The record and output rows (estimates, profile) of one segment."""
         depth = self._depth(seg)
         if seg.status != "ok":
-            return _record(seg, depth, Status.SKIPPED, seg.message), None
+            return _record(seg, depth, Status.SKIPPED, seg.message, rows), None
         data = _segment_data(rows, seg, depth)
         cfg = self.well.config
         try:
@@ -247,15 +264,15 @@ class _SegmentEstimator:
                                    rate_hz=self.rate_hz,
                                    torque_channel=self.well.channels["surface_torque_Nm"])
         except SkipSegment as exc:
-            return _record(seg, depth, Status.SKIPPED, exc.problem), None
+            return _record(seg, depth, Status.SKIPPED, exc.problem, rows), None
         except DrillfricError as exc:
             self.failed += 1
-            return _record(seg, depth, Status.FAILED, exc.message), None
+            return _record(seg, depth, Status.FAILED, exc.message, rows), None
         if est.converged and seg.kind == Kind.OFF_BOTTOM:
             self.warm = (est.mu_s_seed, est.mu_k)
         frames = {"estimates": _estimate_frame(seg.id, est, data, cfg.omega_c_rad_s),
                   "profile": _profile_frame(seg.id, est)}
-        return _record(seg, depth, Status.OK, seg.message, est), frames
+        return _record(seg, depth, Status.OK, seg.message, rows, est), frames
 
     def _depth(self, seg: Segment) -> float:
         if np.isfinite(seg.bit_depth_m):
@@ -324,11 +341,12 @@ def _segment_data(rows: pd.DataFrame, seg: Segment, depth: float) -> SegmentData
 
 
 # --------------------------------------------------------------------------- step 3
-def _record(seg: Segment, depth: float, status: Status, message: str,
+def _record(seg: Segment, depth: float, status: Status, message: str, rows: pd.DataFrame,
             est: SegmentEstimate | None = None) -> SegmentRecord:
     """A segment's :class:`SegmentRecord` (the estimate's numbers when there is one)."""
     base = dict(id=seg.id, kind=Kind(seg.kind), t_start_s=seg.t_start_s, t_end_s=seg.t_end_s,
-                bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message)
+                bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message,
+                hookload_N=_median(rows, "hookload_N"), **_clock(rows, seg))
     if est is None:
         return SegmentRecord(**base)
     return SegmentRecord(**base | dict(
@@ -337,10 +355,42 @@ def _record(seg: Segment, depth: float, status: Status, message: str,
         mu_s_lower_bound=est.mu_s_lower_bound, mu_s_spread=est.mu_s_spread,
         mu_k_spread=est.mu_k_spread, converged=est.converged, method=est.method,
         settling_time_s=est.settling_time_s, residual_rms_rpm=est.residual_rms_rpm,
-        stick_slip_severity=est.stick_slip_severity, stuck_fraction=est.stuck_fraction,
         mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
-        T_N_Nm=est.T_N_Nm, bit_rms_error_rpm=est.bit_rms_error_rpm, flags=est.flags,
-        starts=tuple(map(tuple, est.starts.tolist()))))
+        T_N_Nm=est.T_N_Nm, flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
+        friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
+        **_evidence_fields(est), **_bit_fields(est)))
+
+
+def _evidence_fields(est: SegmentEstimate) -> dict:
+    ev = est.evidence
+    return dict(torque_rms_misfit_Nm=ev.misfit_rms_Nm, torque_swing_Nm=ev.swing_Nm,
+                fit_quality=ev.quality, surface_torque_mean_Nm=ev.mean_Nm)
+
+
+def _bit_fields(est: SegmentEstimate) -> dict:
+    """The bit-speed statistics, or null with the reason where the rate cannot resolve the
+    stick-slip cycle (never a number drawn from an unresolved trace)."""
+    if not est.bit_speed.resolved:
+        return dict(bit_speed_resolved=False, bit_speed_reason=est.bit_speed.reason)
+    return dict(bit_speed_resolved=True, stick_slip_severity=est.stick_slip_severity,
+                stuck_fraction=est.stuck_fraction, bit_rms_error_rpm=est.bit_rms_error_rpm)
+
+
+def _median(rows: pd.DataFrame, column: str) -> float | None:
+    if column not in rows or not rows[column].notna().any():
+        return None
+    return float(np.nanmedian(rows[column].to_numpy(float)))
+
+
+def _clock(rows: pd.DataFrame, seg: Segment) -> dict:
+    """Clock times of the segment's ends when the log has absolute time."""
+    if "timestamp" not in rows or rows.empty:
+        return {}
+    t = rows["time_s"].to_numpy(float)
+    stamps = pd.to_datetime(rows["timestamp"])
+    origin = stamps.iloc[0] - pd.to_timedelta(t[0], unit="s")
+    return {"clock_start_utc": _iso(origin + pd.to_timedelta(seg.t_start_s, unit="s")),
+            "clock_end_utc": _iso(origin + pd.to_timedelta(seg.t_end_s, unit="s"))}
 
 
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
@@ -349,37 +399,46 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): its
     ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
     carry most of the weight) with the members' min–max bit speed as
-    ``bit_rpm_est_min/max`` (NaN on the starts' rows).
+    ``bit_rpm_est_min/max`` (NaN on the starts' rows). Where the logging does not resolve
+    the stick-slip cycle the bit columns are null: no trace is drawn from such data.
     """
     first = _record_frame(seg_id, est.first, 0, data,
-                          np.abs(est.first.bha_rad_s_est) <= omega_c)
+                          np.abs(est.first.bha_rad_s_est) <= omega_c, est)
     seeded = _record_frame(seg_id, est.bit.record(est.final), SEEDED_START_ID, data,
-                           est.bit.stuck(est.final, omega_c))
+                           est.bit.stuck(est.final, omega_c), est)
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
-    return pd.concat([first, seeded], ignore_index=True)
+    frame = pd.concat([first, seeded], ignore_index=True)
+    if not est.bit_speed.resolved:
+        frame[["bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max"]] = np.nan
+        frame["bit_stuck"] = pd.array([None] * len(frame), dtype="boolean")
+    return frame
 
 
 def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentData,
-                  stuck: np.ndarray) -> pd.DataFrame:
+                  stuck: np.ndarray, est: SegmentEstimate) -> pd.DataFrame:
     """Rows of one observer record, one per time and start (``start_id`` from ``offset``);
     ``stuck`` is the bit-stuck flag per time and start (R, S) or per time (R,)."""
     n_t, n_s = rec.mu_k.shape
-    measured = np.interp(rec.time_s, data.time_s, data.surface_rpm)
+    ev = est.evidence
+    at = lambda t, y: np.repeat(np.interp(rec.time_s, t, y), n_s)  # noqa: E731
     cols = {
         "time_s": np.repeat(rec.time_s, n_s),
         "segment_id": np.full(n_t * n_s, seg_id, dtype=np.int32),
         "start_id": np.tile(np.arange(n_s, dtype=np.int16) + offset, n_t),
         "mu_s": rec.mu_s.ravel(), "mu_k": rec.mu_k.ravel(),
-        "surface_rpm": np.repeat(measured, n_s),
+        "surface_rpm": at(data.time_s, data.surface_rpm),
         "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
         "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,
         "bit_stuck": np.asarray(stuck, dtype=bool).ravel(),
         "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S,
+        "surface_torque_Nm": at(ev.time_s, ev.measured_Nm),
+        "surface_torque_est_Nm": np.full(n_t * n_s, np.nan),
+        "surface_torque_fit_Nm": at(ev.time_s, ev.model_Nm),
         "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
         "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}
     if data.bit_rpm is not None:
-        cols["bit_rpm"] = np.repeat(np.interp(rec.time_s, data.time_s, data.bit_rpm), n_s)
+        cols["bit_rpm"] = at(data.time_s, data.bit_rpm)
     return pd.DataFrame(cols)
 
 
@@ -405,7 +464,7 @@ class _MemorySink:
         for key, frame in (frames or {}).items():
             self.frames[key].append(frame)
 
-    def finish(self, well: Well, summary: dict, records) -> None:
+    def finish(self, well: Well, summary: dict, records, tracks: pd.DataFrame) -> None:
         """Nothing to write."""
 
     def estimates(self) -> pd.DataFrame | None:
@@ -429,13 +488,14 @@ class _DirectorySink:
         self.writer.write(frames["estimates"])
         self.profiles.append(frames["profile"])
 
-    def finish(self, well: Well, summary: dict, records) -> None:
+    def finish(self, well: Well, summary: dict, records, tracks: pd.DataFrame) -> None:
         """Write every result file but the report."""
         if self.writer is None:
             self.writer = EstimatesWriter(self.folder / "estimates.parquet", False)
         self.writer.close()
         write_json(self.folder / "summary.json", summary)
         write_segments(self.folder / "segments.parquet", records)
+        write_tracks(self.folder / "tracks.parquet", tracks)
         if self.profiles:
             pd.concat(self.profiles, ignore_index=True).to_parquet(
                 self.folder / "profiles.parquet", index=False)

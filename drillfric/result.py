@@ -127,6 +127,25 @@ class SegmentRecord:
     flags: tuple[Flag, ...] = _f("", "conditions to know (Flag)", ())
     starts: tuple[tuple[float, float], ...] = _f("-", "observer starts (μ_s, μ_k) by start_id",
                                                  ())
+    friction_zone: str | None = _f("", "which factor μ is: open_hole (cased part known from "
+                                       "the configuration) or effective (torque-weighted over "
+                                       "the whole string)")
+    torque_rms_misfit_Nm: float | None = _f("N·m", "RMS of measured − fitted-model string "
+                                                   "torque (1-s smoothed) over the rotation")
+    torque_swing_Nm: float | None = _f("N·m", "swing of the measured string torque (5th–95th "
+                                              "percentile) over the rotation")
+    fit_quality: float | None = _f("-", "torque_rms_misfit_Nm / torque_swing_Nm (stick-slip "
+                                        "drifts in phase: ~0.3–0.6 is normal there)")
+    surface_torque_mean_Nm: float | None = _f("N·m", "mean measured rotating string torque")
+    hookload_N: float | None = _f("N", "median measured hook load over the segment")
+    hookload_model_N: float | None = _f("N", "modelled rotating off-bottom hook load at this "
+                                             "depth (torque and drag, no block weight)")
+    bit_speed_resolved: bool | None = _f("", "whether the logging rate resolves the stick-slip "
+                                             "cycle (else no bit-speed trace is reported)")
+    bit_speed_reason: str | None = _f("", "why the bit speed is not reported")
+    clock_start_utc: str | None = _f("", "clock time of t_start_s (ISO 8601, UTC) when the log "
+                                         "has absolute time")
+    clock_end_utc: str | None = _f("", "clock time of t_end_s (ISO 8601, UTC)")
 
     def to_json(self) -> dict:
         """Plain JSON values (enums as text, NaN as None), in field order."""
@@ -166,6 +185,12 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("bit_rpm_est", "float64", "RPM", "estimated bit speed"),
     Column("bit_stuck", "bool", "", "estimated bit in the static band (|ω| ≤ ω_c)"),
     Column("residual_rpm", "float64", "RPM", "innovation ω̂₀ − ω₀"),
+    Column("surface_torque_Nm", "float64", "N·m", "measured string torque at surface "
+                                                  "(inertia-corrected motor torque)"),
+    Column("surface_torque_est_Nm", "float64", "N·m", "the start's modelled string torque at "
+                                                      "surface τ̂(0)"),
+    Column("surface_torque_fit_Nm", "float64", "N·m", "the batch fit's model driven by the "
+                                                      "measured speed, at the fitted factors"),
     Column("bit_rpm", "float64", "RPM", "measured bit speed (synthetic truth only)"),
     Column("bit_rpm_est_min", "float32", "RPM", "ensemble band: lowest member (seeded rows)"),
     Column("bit_rpm_est_max", "float32", "RPM", "ensemble band: highest member (seeded rows)"),

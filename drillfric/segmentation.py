@@ -441,12 +441,14 @@ class Segmenter:
         self._buffer: dict[str, np.ndarray] = {}
         self._offset = 0  # row index of the first buffered row
         self._next_id = 1
+        self.last_states: np.ndarray | None = None  # rig states of the last chunk fed
 
     def feed(self, chunk: pd.DataFrame) -> list[Segment]:
         """Consume the next rows; return the segments completed by them (maybe none)."""
         if self._carry is None:
             self._carry = _new_carry(chunk, self._cfg)
         states, bit = _classify(chunk, self._cfg, self._carry)
+        self.last_states = states
         new = {"t": _column(chunk, "time_s"), "states": states, "bit": bit}
         new.update({f"null:{k}": v for k, v in _nulls(chunk).items()})
         self._buffer = {k: np.concatenate((self._buffer[k], v)) if self._buffer else v
@@ -539,6 +541,11 @@ class SegmentStream:
     def close(self) -> list[tuple[Segment, pd.DataFrame]]:
         """The segments still open at the end of the data, with their rows."""
         return self._rows(self._segmenter.close())
+
+    @property
+    def last_states(self) -> np.ndarray | None:
+        """Rig state codes of the last chunk fed (:data:`RIG_STATES`)."""
+        return self._segmenter.last_states
 
     def _rows(self, segments: list[Segment]) -> list[tuple[Segment, pd.DataFrame]]:
         out = []

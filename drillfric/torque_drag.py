@@ -545,17 +545,31 @@ def _as_sections(string_or_sections) -> list[dict]:
     return out
 
 
-def broomstick_figure(table):
+def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | None = None):
     """Broomstick plot of a :func:`broomstick` table: hook load and torque versus depth.
 
     Left: hook load [kN] of every load case and friction factor; right: surface torque
     [kN·m] of the rotating cases. Depth increases downwards. Returns a matplotlib Figure.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :func:`broomstick` output.
+    measured : pandas.DataFrame, optional
+        Measured points drawn on top, one per segment: ``bit_depth_m``, ``hookload_N``
+        [N], ``surface_torque_Nm`` [N·m] and ``kind`` (``off_bottom_rotating`` filled
+        black circles, ``on_bottom_rotating`` hollow triangles: their torque includes the
+        bit's). The measured hook load includes the travelling block; the model's does not.
+    size : (float, float)
+        Figure size [in].
+    note : str, optional
+        A line printed under the title (e.g. the string-weight check).
     """
     import matplotlib
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
-    fig = Figure(figsize=(10, 7), layout="constrained")
+    fig = Figure(figsize=size, layout="constrained")
     ax_h, ax_t = fig.subplots(1, 2, sharey=True)
     styles = {"pick_up": "-", "slack_off": "--", "rotating_off_bottom": ":",
               "rotating_on_bottom": "-.", "rotating_pick_up": (0, (5, 1)),
@@ -569,14 +583,39 @@ def broomstick_figure(table):
         ax_h.plot(grp["hookload_N"] / 1e3, grp["bit_depth_m"], **kw)
         if case.startswith("rotating"):
             ax_t.plot(grp["surface_torque_Nm"] / 1e3, grp["bit_depth_m"], **kw)
-    ax_h.invert_yaxis()
-    ax_h.set(xlabel="hook load (effective, no block) [kN]", ylabel="bit depth MD [m]")
-    ax_t.set(xlabel="surface torque [kN·m]")
     handles = [Line2D([], [], color="k", linestyle=styles.get(c, "-"), label=c.replace("_", " "))
                for c in table["load_case"].unique()]
     handles += [Line2D([], [], color=colours[f], label=f"μ = {f:g}") for f in frictions]
+    handles += _measured_points(ax_h, ax_t, measured)
+    ax_h.invert_yaxis()
+    ax_h.set(xlabel="hook load [kN] (model: effective, no block)", ylabel="bit depth MD [m]")
+    ax_t.set(xlabel="surface torque [kN·m]")
     ax_h.legend(handles=handles, fontsize="small")
     for ax in (ax_h, ax_t):
         ax.grid(alpha=0.3)
-    fig.suptitle("Broomstick: soft-string torque and drag (THEORY.md §2)")
+        ax.margins(x=0.06, y=0.04)
+    title = "Broomstick: soft-string torque and drag (THEORY.md §2)"
+    fig.suptitle(title if note is None else f"{title}\n{note}", fontsize=11 if note else 12)
     return fig
+
+
+def _measured_points(ax_h, ax_t, measured) -> list:
+    """Draw measured points (see :func:`broomstick_figure`); returns legend handles."""
+    from matplotlib.lines import Line2D
+
+    if measured is None or not len(measured):
+        return []
+    styles = {"off_bottom_rotating": ("o", "black", "measured, rotating off bottom"),
+              "on_bottom_rotating": ("^", "none", "measured, rotating on bottom")}
+    handles = []
+    for kind, (marker, face, label) in styles.items():
+        rows = measured[measured["kind"] == kind]
+        if not len(rows):
+            continue
+        kw = {"marker": marker, "linestyle": "none", "color": "black",
+              "markerfacecolor": face, "markersize": 6, "clip_on": False, "zorder": 5}
+        ax_h.plot(rows["hookload_N"] / 1e3, rows["bit_depth_m"], **kw)
+        ax_t.plot(rows["surface_torque_Nm"] / 1e3, rows["bit_depth_m"], **kw)
+        handles.append(Line2D([], [], label=label, **{k: v for k, v in kw.items()
+                                                        if k not in ("clip_on", "zorder")}))
+    return handles

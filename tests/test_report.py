@@ -1,8 +1,11 @@
-"""Reports (issue 7): the per-well report.html / report.pdf, the fleet report, the CLI.
+"""Reports (issues 7 and 16): report.html / report.pdf, the fleet report, the CLI.
 
 The bundled example (examples/demo) is run once per test session into a temporary directory
-(:func:`demo_result_dir`, shared with tests/test_report_browser.py); other cases are copies
-of it with an edited summary.json. The browser checks are in test_report_browser.py.
+(:func:`demo_result_dir`, shared with tests/test_report_browser.py). :func:`evidence_dir`
+completes a copy of it with the issue-16 files and columns (tracks.parquet, torque columns,
+new segment keys: tests/synthetic_results.py); the plain demo stands for older results.
+Other cases are copies with an edited summary.json. The browser checks are in
+test_report_browser.py.
 """
 
 from __future__ import annotations
@@ -26,10 +29,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.figure import Figure
 
-from drillfric.errors import InputError
+from drillfric.errors import ConfigError, InputError
 from drillfric.report import MAX_SEGMENT_FIGURES, figures, write_fleet_report, write_well_report
-from drillfric.report.data import load_result, segment_estimates, segments_frame
+from drillfric.report.data import extreme_rows, segment_estimates, segments_frame
+from drillfric.report.interactive import script_hash
 from drillfric.report.well import select_segments
+from tests.synthetic_results import UNRESOLVED_REASON, add_evidence_files, older_result
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO = REPO / "examples" / "demo" / "demo.csv"
@@ -46,6 +51,20 @@ def demo_result_dir(tmp_path_factory) -> Path:
         from drillfric.pipeline import run_well
 
         run_well(open_well(DEMO), out)
+    return result
+
+
+#: Clock time given to the evidence copy of the demo log.
+CLOCK = "2024-03-01T06:00:00+00:00"
+
+
+def evidence_dir(tmp_path_factory) -> Path:
+    """A copy of the demo results with the issue-16 files and columns, once per session."""
+    result = tmp_path_factory.getbasetemp() / "report-evidence" / "demo"
+    if not (result / "tracks.parquet").is_file():
+        shutil.rmtree(result, ignore_errors=True)
+        shutil.copytree(demo_result_dir(tmp_path_factory), result)
+        add_evidence_files(result, DEMO, clock=CLOCK)
     return result
 
 
@@ -86,8 +105,49 @@ def demo(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="module")
-def demo_html(demo) -> str:
-    return write_well_report(demo).read_text(encoding="utf-8")
+def evidence(tmp_path_factory) -> Path:
+    return evidence_dir(tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def demo_html(evidence) -> str:
+    return write_well_report(evidence).read_text(encoding="utf-8")
+
+
+def bokeh_items(html: str) -> dict[str, dict]:
+    """The Bokeh items of a report, by target element id."""
+    text = html.split('<script type="application/json" id="bokeh-items">')[1]
+    return {item["target_id"]: item for item in json.loads(text.split("</script>")[0])}
+
+
+def sources(item: dict) -> dict[str, dict[str, np.ndarray]]:
+    """Named ColumnDataSources of a Bokeh item, decoded to arrays (Bokeh's wire format:
+    base64 bytes, gzip-compressed when large)."""
+    import gzip
+
+    out = {}
+
+    def walk(node):
+        if isinstance(node, list):
+            for v in node:
+                walk(v)
+        elif isinstance(node, dict):
+            attrs = node.get("attributes", {})
+            if node.get("name") == "ColumnDataSource" and attrs.get("name"):
+                out[attrs["name"]] = {k: _array(v) for k, v in attrs["data"]["entries"]}
+            for v in node.values():
+                walk(v)
+
+    def _array(v):
+        if isinstance(v, dict) and v.get("type") == "ndarray":
+            raw = base64.b64decode(v["array"]["data"])
+            if raw[:2] == b"\x1f\x8b":
+                raw = gzip.decompress(raw)
+            return np.frombuffer(raw, dtype=v["dtype"])
+        return np.asarray(v)
+
+    walk(item)
+    return out
 
 
 def _png_images(html: str) -> list[bytes]:
@@ -97,13 +157,23 @@ def _png_images(html: str) -> list[bytes]:
 
 # --- the per-well HTML report ----------------------------------------------------------------
 
-def test_well_report_has_every_section(demo, demo_html):
-    """Header, inputs with hashes, configuration, well path, profiles, friction log,
-    one open section per estimated segment, the diagnostics table (issue 7, item 1)."""
+def test_well_report_has_every_section(evidence, demo_html):
+    """Header, time tracks, friction log, broomstick, one open section per estimated
+    segment, diagnostics, well path, profiles, inputs with hashes, the string as a table,
+    the configuration (issues 7 and 16)."""
+    demo = evidence
     summary = json.loads((demo / "summary.json").read_text())
-    for heading in ("Inputs and configuration", "Well path", "Normal force and F_c profiles",
-                    "Friction log", "Segments", "Diagnostics", "Effective configuration"):
+    for heading in ("Time tracks", "Friction log", "Broomstick: hook load and torque versus "
+                    "depth", "Segments", "Diagnostics", "Well path",
+                    "Normal force and F_c profiles", "Inputs and configuration",
+                    "Drill string", "Effective configuration"):
         assert f">{heading}<" in demo_html, heading
+    items = bokeh_items(demo_html)
+    assert {"bk-tracks", "bk-friction"} <= set(items)
+    assert {f"bk-segment-{s['id']}" for s in summary["segments"]} <= set(items)
+    for target in items:
+        assert f'id="{target}"' in demo_html
+    assert "5 7/8in DP" in demo_html.split('id="string-table"')[1].split("</table>")[0]
     for entry in ("data", "config", "survey"):
         assert summary["inputs"][entry]["sha256"] in demo_html
     assert f"drillfric {summary['drillfric_version']}" in demo_html
@@ -115,13 +185,28 @@ def test_well_report_has_every_section(demo, demo_html):
 
 
 def test_well_report_is_self_contained(demo_html):
-    """No external reference: every src/href is a data: URI or an in-page anchor, and every
-    embedded image is a PNG (issue 7, item 3)."""
-    refs = re.findall(r'(?:src|href)="([^"]*)"', demo_html)
+    """No external reference outside the scripts: every src/href is a data: URI or an
+    in-page anchor, every image a PNG (issue 7, item 3); exactly three scripts — Bokeh's
+    core bundle, the figures' JSON (not executed) and the loader — and the
+    Content-Security-Policy allows exactly the two executed ones by hash, no
+    'unsafe-inline', no 'unsafe-eval', no network source (issue 16, item 5)."""
+    scripts = re.findall(r"<script([^>]*)>(.*?)</script>", demo_html, flags=re.S)
+    assert [attrs for attrs, _ in scripts] == ["", ' type="application/json" id="bokeh-items"',
+                                                ""]
+    outside = re.sub(r"<script[^>]*>.*?</script>", "", demo_html, flags=re.S)
+    refs = re.findall(r'(?:src|href)="([^"]*)"', outside)
     assert refs and all(r.startswith(("data:image/png;base64,", "#")) for r in refs)
-    assert "<link" not in demo_html and "@import" not in demo_html and "url(" not in demo_html
-    images = _png_images(demo_html)
-    assert len(images) >= 4 and all(i.startswith(_PNG_MAGIC) for i in images)
+    assert "<link" not in outside and "@import" not in outside and "url(" not in outside
+    images = _png_images(outside)
+    assert len(images) >= 3 and all(i.startswith(_PNG_MAGIC) for i in images)
+    from html import unescape
+
+    csp = unescape(re.search(r'Content-Security-Policy" content="([^"]*)"', demo_html).group(1))
+    policy = dict(part.strip().split(" ", 1) for part in csp.split(";"))
+    assert policy["default-src"] == "'none'"
+    assert policy["script-src"].split() == [script_hash(scripts[0][1]),
+                                            script_hash(scripts[2][1])]
+    assert "unsafe" not in policy["script-src"] and "http" not in csp
 
 
 def test_assumed_defaults_are_highlighted(demo, tmp_path):
@@ -191,13 +276,14 @@ def test_not_a_result_directory_is_an_input_error(tmp_path):
         write_well_report(tmp_path)
 
 
-def test_report_is_fast(demo):
+def test_report_is_fast(evidence):
     """Issue 7: the report runs at the end of every nightly run. CPU time (not wall time:
-    the machine is shared) of the demo's HTML report; measured ≈ 1.8 s, bound 3× that."""
-    write_well_report(demo)
+    the machine is shared) of the demo's HTML report with every issue-16 section;
+    benchmarks/bench_report.py records the times; bound ≈ 3× the loaded-machine time."""
+    write_well_report(evidence)
     start = time.process_time()
-    write_well_report(demo)
-    assert time.process_time() - start < 6.0
+    write_well_report(evidence)
+    assert time.process_time() - start < 9.0
 
 
 # --- escaping of what comes from users' files ------------------------------------------------
@@ -211,7 +297,11 @@ def test_script_in_well_name_renders_as_text(demo, tmp_path):
         "summary": None}]).read_text(encoding="utf-8")
     for page in (html, fleet):
         assert "&lt;script&gt;alert(1)&lt;/script&gt;" in page
-        assert "<script>" not in page
+        assert "<script>alert" not in page
+        # in the figures' JSON the name is data: its "<" cannot close the script element
+        data = page.split('id="bokeh-items">')[1].split("</script>")[0] \
+            if "bokeh-items" in page else ""
+        assert "<" not in data
 
 
 def test_user_text_with_dollar_signs_does_not_break_figures(demo, tmp_path):
@@ -244,31 +334,71 @@ def test_any_well_name_is_escaped_in_fleet_report(name):
         with open(path, encoding="utf-8", newline="") as fh:  # keep "\r" as written
             html = fh.read()
     assert str(escape(name)) in html
-    assert "<script" not in html.lower()
+    outside = re.sub(r"<script[^>]*>.*?</script>", "", html, flags=re.S)
+    assert "<script" not in outside.lower()
+    data = html.split('id="bokeh-items">')[1].split("</script>")[0]
+    assert "<" not in data
+    labels = [i["attributes"]["label"]["value"] for i in _legend_items(json.loads(data))]
+    assert labels == [name]
 
 
 # --- the PDF ---------------------------------------------------------------------------------
 
-def test_pdf_has_a_page_per_section_none_blank(demo):
-    """report.pdf: header, well path, profiles, friction log, one page per drawn segment,
-    diagnostics, configuration — in that order, each page titled; none blank."""
+def test_pdf_pages_are_a4_landscape_numbered_and_in_order(evidence):
+    """report.pdf: header, time tracks, friction log, broomstick, well path, profiles, one
+    page per drawn segment, diagnostics, the string as a table, the configuration — every
+    page A4 landscape (one size), titled, numbered "page n of N", none blank (issue 16,
+    item 6)."""
     from pypdf import PdfReader
 
-    write_well_report(demo, pdf=True)
-    pdf = demo / "report.pdf"
-    summary = json.loads((demo / "summary.json").read_text())
+    write_well_report(evidence, pdf=True)
+    pdf = evidence / "report.pdf"
+    summary = json.loads((evidence / "summary.json").read_text())
     n_segments = sum(s["status"] == "ok" for s in summary["segments"])
-    expected = (["Friction report — demo", "Well path", "Normal force and F_c profiles",
-                 "Friction log"] + [f"Segment {i}" for i in range(1, n_segments + 1)]
-                + ["Diagnostics", "Configuration"])
-    texts = [page.extract_text() for page in PdfReader(pdf).pages]
+    expected = (["Friction report — demo", "Time tracks", "Friction log", "Broomstick",
+                 "Well path", "Normal force and F_c profiles"]
+                + [f"Segment {i}" for i in range(1, n_segments + 1)]
+                + ["Diagnostics", "Configuration: drill string", "Configuration"])
+    reader = PdfReader(pdf)
+    texts = [page.extract_text() for page in reader.pages]
     assert len(texts) >= len(expected)
     assert all(title in text for title, text in zip(expected, texts, strict=False))
-    assert all("Configuration (continued)" in t for t in texts[len(expected):])
+    sizes = {(round(float(p.mediabox.width)), round(float(p.mediabox.height)))
+             for p in reader.pages}
+    assert sizes == {(842, 595)}  # A4 landscape in points: 297 × 210 mm
+    for number, text in enumerate(texts, start=1):
+        assert f"page {number} of {len(texts)}" in text
+    string_page = next(t for t in texts if "Configuration: drill string" in t)
+    assert "5 7/8in DP" in string_page and "OD [mm]" in string_page
+    assert not any('[{"' in t or '{"name"' in t for t in texts)  # no raw JSON
+    _assert_pages_not_blank(pdf, len(texts))
+
+
+def test_pdf_diagnostics_wrap_instead_of_shrinking(evidence, tmp_path):
+    """A long message wraps over lines at the table's font size (7.5 pt) instead of being
+    cut or shrinking the font (the old table shrank to fit its widest row); every word of
+    it is on the page."""
+    from pypdf import PdfReader
+
+    words = " ".join(f"word{i:02d}" for i in range(40))
+    result = copy_result(evidence, tmp_path / "w", lambda s: s["segments"][0].update(
+        message=words))
+    write_well_report(result, pdf=True)
+    pages = PdfReader(result / "report.pdf").pages
+    diag = " ".join(p.extract_text() for p in pages if "Diagnostics" in p.extract_text())
+    assert all(f"word{i:02d}" in diag for i in range(40))
+    sizes = set()
+    for page in pages:
+        if "Diagnostics" in page.extract_text():
+            page.extract_text(visitor_operand_before=lambda op, args, cm, tm: sizes.add(
+                round(float(args[1]), 1)) if op == b"Tf" else None)
+    assert 7.5 in sizes and min(sizes) >= 7.0  # table text 7.5 pt; footer 7 pt
+
+
+def _assert_pages_not_blank(pdf: Path, count: int) -> None:
     if shutil.which("pdftoppm") is None:
-        assert all(len(t.strip()) > 20 for t in texts)
         return
-    for page in range(1, len(texts) + 1):
+    for page in range(1, count + 1):
         png = subprocess.run(["pdftoppm", "-r", "20", "-gray", "-f", str(page), "-l",
                               str(page), str(pdf)], capture_output=True, check=True).stdout
         pixels = np.frombuffer(png.split(b"\n", 3)[3], dtype=np.uint8)  # PGM body
@@ -290,8 +420,12 @@ def test_fleet_report_rows_links_and_failures_first(demo, tmp_path):
         assert f'href="./{well["well"]}/report.html"' in table
         assert (tmp_path / well["well"] / "report.html").is_file()
         assert f'{well["summary"]["mu_k"]:.3f}' in table
-    refs = re.findall(r'(?:src|href)="([^"]*)"', html)
+    outside = re.sub(r"<script[^>]*>.*?</script>", "", html, flags=re.S)
+    refs = re.findall(r'(?:src|href)="([^"]*)"', outside)
     assert all(r.startswith(("data:image/png;base64,", "./")) for r in refs)
+    wells_plotted = {s["attributes"]["label"]["value"] for s in _legend_items(
+        bokeh_items(html)["bk-fleet"])}
+    assert wells_plotted == {"alpha", "bravo", "charlie"}
 
 
 def test_fleet_link_is_relative_and_encoded(tmp_path, monkeypatch):
@@ -311,7 +445,7 @@ def test_fleet_link_is_relative_and_encoded(tmp_path, monkeypatch):
 
 # --- figures ---------------------------------------------------------------------------------
 
-def test_figures_build_headless_without_pyplot(demo):
+def test_figures_build_headless_without_pyplot(evidence):
     """Figures build in a fresh interpreter with no display and no backend chosen: no pyplot
     (no window, no global state), PNG and PDF output (issue 7: Agg)."""
     code = f"""
@@ -319,12 +453,18 @@ import io, sys
 from pathlib import Path
 from drillfric.report import figures
 from drillfric.report.data import load_result, segment_estimates
-d = load_result(Path({str(demo)!r}))
-est = segment_estimates(d.result_dir, [1])
-row = d.segments.set_index("id", drop=False).loc[1]
+from drillfric.report.evidence import evidence_figure
+from drillfric.report.tracks import tracks_figure
+from drillfric.report.well import build_report
+d = load_result(Path({str(evidence)!r}))
+est = segment_estimates(d.result_dir, [2])
+row = d.segments.set_index("id", drop=False).loc[2]
+from drillfric.torque_drag import broomstick_figure
+bs = build_report(d.result_dir).broomstick
 figs = [figures.wellpath_figure(d.wellpath), figures.profiles_figure(d.profiles, d.segments),
-        figures.friction_log_figure(d.segments), figures.segment_figure(est[1], row),
-        figures.fleet_friction_figure([("a", d.segments)])]
+        figures.friction_log_figure(d.segments), evidence_figure(est[2], row, d.time_origin),
+        tracks_figure(d.tracks, d.segments, d.time_origin),
+        broomstick_figure(bs.table, bs.points)]
 for f in figs:
     for fmt in ("png", "pdf"):
         f.savefig(io.BytesIO(), format=fmt)
@@ -336,7 +476,7 @@ print("ok", len(figs))
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           env=env, cwd=REPO, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
-    assert done.stdout.strip() == "ok 5"
+    assert done.stdout.strip() == "ok 6"
 
 
 def _segments(rows: list[dict]) -> pd.DataFrame:
@@ -377,30 +517,140 @@ def test_friction_log_marks_bounds_unconverged_and_missing_differently():
     assert sorted(len(ln.get_xdata()) for ln in hollow) == [1, 1]  # segment 3: μ_k and μ_s
 
 
-def test_segment_figure_draws_every_start_and_shades_stuck_time(demo):
-    """Fig. 10 view: one μ_k and one μ_s line per start (+ the seeded pass); stuck shaded."""
-    data = load_result(demo)
-    row = data.segments.set_index("id", drop=False).loc[2]
-    est = segment_estimates(demo, [2])[2]
-    fig = figures.segment_figure(est, row)
-    n_lines = est["start_id"].nunique()
-    assert len(fig.axes[0].get_lines()) == 2 * n_lines
-    assert n_lines == len(row["starts"]) + 1
-    shaded = fig.axes[2].collections
-    assert shaded and est["bit_stuck"].any()
+def _final_rows(result: Path, seg_id: int) -> pd.DataFrame:
+    est = pd.read_parquet(result / "estimates.parquet")
+    return est[(est["segment_id"] == seg_id) & (est["start_id"] == -1)].sort_values("time_s")
 
 
-def test_segment_figure_draws_the_ensemble_band(demo, tmp_path):
-    """The seeded pass's min–max bit speed (docs/bit_speed.md) is shaded when the results
-    have it, and results written before the band existed still render, without it."""
-    data = load_result(demo)
-    row = data.segments.set_index("id", drop=False).loc[2]
-    est = segment_estimates(demo, [2])[2]
-    labels = figures.segment_figure(est, row).axes[2].get_legend_handles_labels()[1]
-    assert "ensemble band (min–max)" in labels
-    old = est.drop(columns=["bit_rpm_est_min", "bit_rpm_est_max"])
-    labels = figures.segment_figure(old, row).axes[2].get_legend_handles_labels()[1]
-    assert "ensemble band (min–max)" not in labels and "estimated" in labels
+@pytest.mark.parametrize("seg_id", [1, 2, 3])
+def test_evidence_plot_data_equal_estimates(evidence, demo_html, seg_id):
+    """Issue 16, item 1: what the evidence figure of a segment draws is estimates.parquet's
+    columns — measured, observer and fit torque, their residuals, measured and estimated
+    speed, the speed residual, the bit speed and its band — at the rows it keeps (float32
+    in the page: 7 significant digits). Segment 1's fit did not simulate (NaN): no fit
+    series. Segments 3 and 4 reuse segment 2's serialised layout with their own data."""
+    data = sources(bokeh_items(demo_html)[f"bk-segment-{seg_id}"])
+    final = _final_rows(evidence, seg_id)
+    origin_ms = pd.Timestamp(CLOCK).value / 1e6
+    torque = data["panel:torque"]
+    time_s = (torque["x"] - origin_ms) / 1e3
+    rows = final.set_index(final["time_s"].round(3)).loc[np.round(time_s, 3)]
+    for name, col in (("measured", "surface_torque_Nm"), ("observer", "surface_torque_est_Nm"),
+                      ("fit", "surface_torque_fit_Nm")):
+        if seg_id == 1 and name == "fit":
+            assert name not in torque
+            continue
+        np.testing.assert_allclose(torque[name] * 1e3, rows[col], rtol=2e-7, atol=1e-3)
+        if name == "measured":
+            continue
+        np.testing.assert_allclose(data["panel:torque_residual"][name] * 1e3,
+                                   rows["surface_torque_Nm"] - rows[col], rtol=1e-6, atol=2e-3)
+    speed = data["panel:speed"]
+    np.testing.assert_allclose(speed["measured"], rows["surface_rpm"], rtol=2e-7, atol=1e-5)
+    np.testing.assert_allclose(speed["estimated"], rows["surface_rpm_est"], rtol=2e-7,
+                               atol=1e-5)
+    np.testing.assert_allclose(data["panel:speed_residual"]["residual"], rows["residual_rpm"],
+                               rtol=2e-7, atol=1e-5)
+    bit = data["panel:bit"]
+    np.testing.assert_allclose(bit["estimated"], rows["bit_rpm_est"], rtol=2e-7, atol=1e-5)
+    np.testing.assert_allclose(bit["low"], rows["bit_rpm_est_min"], rtol=2e-7, atol=1e-5)
+    np.testing.assert_allclose(bit["measured"], rows["bit_rpm"], rtol=2e-7, atol=1e-5)
+    starts = {k for k in data if k.startswith("start:")}
+    assert len(starts) == final_start_count(evidence, seg_id)
+
+
+def final_start_count(result: Path, seg_id: int) -> int:
+    est = pd.read_parquet(result / "estimates.parquet", columns=["segment_id", "start_id"])
+    return est.loc[est["segment_id"] == seg_id, "start_id"].nunique()
+
+
+def test_evidence_keeps_the_extremes_of_a_long_segment():
+    """Decimating 36 000 rows (1 h at 10 Hz) of 5-s stick-slip to ≤ 1500: every cycle is
+    shorter than the kept spacing, yet the global and per-bucket extremes stay, so the
+    drawn swing equals the data's (a stride would alias it)."""
+    t = np.arange(0.0, 3600.0, 0.1)
+    rng = np.random.default_rng(3)
+    frame = pd.DataFrame({"time_s": t,
+                          "surface_torque_Nm": 1e4 + 5e3 * np.sin(2 * np.pi * t / 5.0)
+                          + 100 * rng.standard_normal(t.size),
+                          "surface_rpm": 60 + 40 * np.sin(2 * np.pi * t / 5.0),
+                          "bit_rpm_est": np.maximum(0, 60 + 120 * np.sin(2 * np.pi * t / 5.0))})
+    rows = extreme_rows(frame, 1500)
+    assert len(rows) <= 1500 and np.all(np.diff(rows) > 0)
+    kept = frame.iloc[rows]
+    for col in ("surface_torque_Nm", "surface_rpm", "bit_rpm_est"):
+        assert kept[col].max() == frame[col].max() and kept[col].min() == frame[col].min()
+    # per ~2.4-min bucket the drawn swing is the data's (a stride of 24 samples loses it)
+    strided = frame.iloc[::24]
+    assert strided["surface_torque_Nm"].max() < frame["surface_torque_Nm"].max()
+
+
+def test_old_results_degrade_to_notes(demo, tmp_path):
+    """Results written before issue 16 (no tracks.parquet, no torque columns, no hook load
+    per segment) still render: each missing section is a one-line note."""
+    old = older_result(demo, tmp_path / "old")
+    html = write_well_report(old).read_text(encoding="utf-8")
+    assert "No time tracks: this result directory has no tracks.parquet" in html
+    assert "No measured hook load or torque per segment" in html
+    assert html.count("No torque evidence") == 4
+    assert "bk-friction" in bokeh_items(html)
+
+
+def test_tracks_plot_draws_tracks_parquet(evidence, demo_html):
+    """Issue 16, item 2: each track draws tracks.parquet's min/max envelope and mean (in
+    display units), and the strip names every rig state present."""
+    tracks = pd.read_parquet(evidence / "tracks.parquet")
+    item = bokeh_items(demo_html)["bk-tracks"]
+    text = json.dumps(item)
+    drawn = [d for d in _unnamed_sources(item) if "lo" in d]
+    assert len(drawn) == 5  # hook load, torque, speed, hole depth, bit depth
+    hook = next(d for d in drawn if np.nanmax(d["hi"]) > 700)  # kN
+    finite = np.isfinite(hook["hi"])
+    np.testing.assert_allclose(hook["hi"][finite] * 1e3, tracks["hookload_N_max"], rtol=1e-6)
+    for state in ("rotating off bottom", "tripping", "idle"):
+        assert state in text
+
+
+def _unnamed_sources(item: dict) -> list[dict]:
+    import gzip
+
+    out = []
+
+    def walk(node):
+        if isinstance(node, list):
+            for v in node:
+                walk(v)
+        elif isinstance(node, dict):
+            if node.get("name") == "ColumnDataSource":
+                data = {}
+                for key, v in node["attributes"]["data"]["entries"]:
+                    if isinstance(v, dict) and v.get("type") == "ndarray":
+                        raw = base64.b64decode(v["array"]["data"])
+                        raw = gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw
+                        data[key] = np.frombuffer(raw, dtype=v["dtype"])
+                out.append(data)
+            for v in node.values():
+                walk(v)
+
+    walk(item)
+    return out
+
+
+def _legend_items(item: dict) -> list[dict]:
+    found = []
+
+    def walk(node):
+        if isinstance(node, list):
+            for v in node:
+                walk(v)
+        elif isinstance(node, dict):
+            if node.get("name") == "LegendItem":
+                found.append(node)
+            for v in node.values():
+                walk(v)
+
+    walk(item)
+    return found
 
 
 def test_estimates_are_decimated_per_start(demo):
@@ -469,3 +719,115 @@ def test_mu_s_advice_only_when_not_identified(demo, tmp_path):
                           lambda s, v=identified: s.update(mu_s=0.6 if v else None))
         html = write_well_report(out).read_text(encoding="utf-8")
         assert ("creep break-over" in html) is (not identified)
+
+
+# --- issue 16: segments option, string-weight check, diagnostics ---------------------------
+
+def test_segments_option_draws_all_or_n(evidence, tmp_path):
+    """`segments="all"` draws every estimated segment, an int that many (worst and latest),
+    the default keeps MAX_SEGMENT_FIGURES; anything else is a ConfigError."""
+    result = copy_result(evidence, tmp_path / "w")
+    for segments, count in (("all", 4), (2, 2), (0, 0), ("3", 3)):
+        html = write_well_report(result, segments=segments).read_text(encoding="utf-8")
+        assert html.count('<section class="segment"') == count, segments
+    for bad in ("some", -1, 1.5):
+        with pytest.raises(ConfigError, match="segments"):
+            write_well_report(result, segments=bad)
+
+
+def test_report_command_segments_option(evidence, tmp_path):
+    from drillfric.cli.main import cli
+
+    result = copy_result(evidence, tmp_path / "w")
+    done = CliRunner().invoke(cli, ["report", str(result), "--segments", "1"])
+    assert done.exit_code == 0, done.output
+    assert (result / "report.html").read_text().count('<section class="segment"') == 1
+    done = CliRunner().invoke(cli, ["report", str(result), "--segments", "many"])
+    assert done.exit_code == 2 and len(done.output.strip().splitlines()) == 1
+
+
+def _points(measured_kN, model_kN, kinds=None) -> pd.DataFrame:
+    n = len(measured_kN)
+    return pd.DataFrame({"segment_id": np.arange(1, n + 1),
+                         "kind": kinds or ["off_bottom_rotating"] * n,
+                         "bit_depth_m": 1000.0 + 30 * np.arange(n),
+                         "hookload_N": np.asarray(measured_kN) * 1e3,
+                         "surface_torque_Nm": np.full(n, 1e4),
+                         "hookload_model_N": np.asarray(model_kN) * 1e3})
+
+
+def test_weight_check_rule_and_tolerance():
+    """The hook carries string + block, so model ≤ measured. Flag a segment when the model
+    exceeds the measurement by more than 5 % (HOOKLOAD_TOLERANCE); the implied block weight
+    is the median of measured − model. On-bottom segments (WOB unloads the hook) are not
+    checked."""
+    from drillfric.report.broomstick import HOOKLOAD_TOLERANCE, weight_check
+
+    assert HOOKLOAD_TOLERANCE == 0.05
+    ok = weight_check(_points([800, 820, 840], [700, 720, 745]))
+    assert ok["warning"] is None and ok["checked"] == 3
+    assert ok["block_weight_N"] == pytest.approx(100e3)
+    edge = weight_check(_points([800, 800], [800 * 1.049, 800 * 1.051]))
+    assert edge["violations"] == [2] and "segment 2" in edge["warning"]
+    on_bottom = weight_check(_points([500], [800], ["on_bottom_rotating"]))
+    assert on_bottom["checked"] == 0 and on_bottom["warning"] is None
+
+
+def test_report_warns_when_the_string_is_heavier_than_the_hook_load(evidence, tmp_path):
+    """A modelled rotating hook load 20 % above the measured one is shown as a warning at
+    the top and beside the broomstick; the consistent demo gets the implied block weight."""
+    html = write_well_report(evidence).read_text(encoding="utf-8")
+    assert 'id="weight-warning"' not in html and "implied travelling-block weight" in html
+
+    def heavier(summary):
+        for seg in summary["segments"]:
+            seg["hookload_model_N"] = 1.2 * seg["hookload_N"]
+
+    result = copy_result(evidence, tmp_path / "w", heavier)
+    html = write_well_report(result).read_text(encoding="utf-8")
+    warning = html.split('id="weight-warning">')[1].split("</li>")[0]
+    assert "string weight inconsistent with the hook load" in warning
+    assert "4 of 4" in warning
+
+
+def test_broomstick_measured_points_from_a_log():
+    """`td --broomstick WELL` points: one per rotating segment of the log, its median hook
+    load and mean torque over the segment's rows at its median bit depth."""
+    from drillfric.config import load_config
+    from drillfric.io.well import load_well
+    from drillfric.report.broomstick import measured_points_from_log
+    from drillfric.segmentation import segment
+
+    well = load_well(DEMO)
+    points = measured_points_from_log(well.surface, well.config)
+    segs = segment(well.surface, well.config)
+    assert len(points) == len(segs) == 4
+    for seg, row in zip(segs, points.itertuples(), strict=True):
+        rows = well.surface.iloc[seg.i_start:seg.i_end]
+        assert row.hookload_N == rows["hookload_N"].median()
+        assert row.surface_torque_Nm == pytest.approx(rows["surface_torque_Nm"].mean())
+        assert row.bit_depth_m == seg.bit_depth_m
+    assert load_config  # the demo's own configuration was used (sidecar demo.toml)
+
+
+def test_diagnostics_fold_long_messages_and_name_unresolved_bit_speed(evidence, demo_html):
+    """Messages longer than MESSAGE_FOLD_CHARS fold into a <details>; a segment whose bit
+    speed is not resolved says so in its row, with the reason in its message."""
+    from drillfric.report.render import MESSAGE_FOLD_CHARS
+
+    table = demo_html.split('id="diagnostics-table"')[1].split("</table>")[0]
+    rows = table.split("<tr")[2:]
+    from markupsafe import escape
+
+    assert "not resolved" in rows[1] and str(escape(UNRESOLVED_REASON)) in rows[1]
+    long = [r for r in rows if 'class="msg"' in r]
+    for row in long:
+        summary = row.split("<summary>")[1].split("</summary>")[0]
+        assert len(summary) <= MESSAGE_FOLD_CHARS
+
+
+def test_report_command_default_segments_is_the_library_default():
+    from drillfric.cli.main import cli
+
+    option = next(p for p in cli.commands["report"].params if p.name == "segments")
+    assert option.default == str(MAX_SEGMENT_FIGURES)

@@ -24,7 +24,14 @@ import numpy as np
 import pytest
 
 from drillfric.report import write_fleet_report, write_well_report
-from tests.test_report import XSS_NAME, demo_result_dir, fleet_wells, renamed_result
+from tests.synthetic_results import older_result
+from tests.test_report import (
+    XSS_NAME,
+    demo_result_dir,
+    evidence_dir,
+    fleet_wells,
+    renamed_result,
+)
 
 _FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
           "--disable-component-update", "--disable-sync", "--no-first-run",
@@ -123,13 +130,22 @@ class Browser:
         raw, self._buffer = self._buffer.split(b"\0", 1)
         return json.loads(raw)
 
-    def visit(self, url: str, expressions: dict[str, str] | None = None) -> PageVisit:
-        """Open ``url`` in a new tab, wait for its load event, record what happened."""
+    def visit(self, url: str, expressions: dict[str, str] | None = None,
+              width: int | None = None, full_page: bool = False) -> PageVisit:
+        """Open ``url`` in a new tab, wait for its load event, record what happened.
+
+        ``width``: viewport width [px] (default: the window's); ``full_page``: the
+        screenshot covers the whole page, not only the viewport.
+        """
         target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = self.send("Target.attachToTarget",
                             {"targetId": target, "flatten": True})["sessionId"]
         for domain in ("Page", "Runtime", "Log", "Network"):
             self.send(f"{domain}.enable", session=session)
+        if width is not None:
+            self.send("Emulation.setDeviceMetricsOverride", {
+                "width": width, "height": 1600, "deviceScaleFactor": 1, "mobile": False},
+                session=session)
         self._events.clear()
         self.send("Page.navigate", {"url": url}, session=session)
         loaded = self.wait_event("Page.loadEventFired")
@@ -143,7 +159,9 @@ class Browser:
             reply = self.send("Runtime.evaluate", {"expression": expression,
                                                    "returnByValue": True}, session=session)
             visit.values[name] = reply.get("result", {}).get("value")
-        shot = self.send("Page.captureScreenshot", {"format": "png"}, session=session)
+        shot = self.send("Page.captureScreenshot", {"format": "png",
+                                                    "captureBeyondViewport": full_page},
+                         session=session)
         visit.screenshot = base64.b64decode(shot["data"])
         self.send("Target.closeTarget", {"targetId": target})
         return visit
@@ -214,21 +232,67 @@ def test_browser_check_catches_remote_requests_and_errors(browser, tmp_path):
     assert any("boom" in e for e in visit.console_errors)
 
 
+#: JavaScript: every figure container holds a drawn Bokeh figure (non-zero height).
+_DRAWN = ("Array.from(document.querySelectorAll('.bk-root-box'))"
+          ".map(e => Math.round(e.getBoundingClientRect().height))")
+#: JavaScript: the toolbars' tools of every embedded Bokeh document (zoom, hover, ...).
+_TOOLS = ("Bokeh.documents.map(d => { const r = d.roots()[0];"
+          " const tb = r.toolbar || (r.children && r.children[0] && r.children[0].toolbar);"
+          " return tb ? tb.tools.map(t => t.type === 'ToolProxy' ? t.tools[0].type : t.type)"
+          " : []; })")
+
+
 def test_well_report_loads_offline_without_errors(browser, tmp_path_factory):
-    """Issue 7: report.html loads with no console error, no network request, non-blank."""
-    html = write_well_report(demo_result_dir(tmp_path_factory))
+    """Issues 7 and 16: report.html loads with no console error (none from the CSP
+    either), no network request; every interactive figure is drawn and has its zoom and
+    hover tools; the static images decode; the screenshot is not blank."""
+    result = evidence_dir(tmp_path_factory)
+    html = write_well_report(result)
     visit = browser.visit(html.as_uri(), {
         "images": "Array.from(document.images).filter(i => i.complete && i.naturalWidth > 0)"
                   ".length",
         "all_images": "document.images.length",
-        "title": "document.title"})
+        "title": "document.title",
+        "documents": "Bokeh.documents.length",
+        "drawn": _DRAWN,
+        "tools": _TOOLS}, full_page=True)
     assert visit.remote_requests == []
     assert visit.console_errors == []
     assert visit.dialogs == []
-    assert visit.values["all_images"] >= 4  # well path, profiles, friction log, segments
+    n_segments = len(json.loads((result / "summary.json").read_text())["segments"])
+    assert visit.values["documents"] == 2 + n_segments  # tracks, friction log, segments
+    assert len(visit.values["drawn"]) == visit.values["documents"]
+    assert min(visit.values["drawn"]) > 200
+    for tools in visit.values["tools"]:
+        assert {"WheelZoomTool", "BoxZoomTool", "HoverTool", "ResetTool"} <= set(
+            t.split(".")[-1] for t in tools), tools
+    assert visit.values["all_images"] >= 3  # broomstick, well path, profiles
     assert visit.values["images"] == visit.values["all_images"]  # every image decoded
     assert visit.values["title"] == "drillfric — demo"
     assert _non_blank(visit.screenshot)
+
+
+def test_older_results_load_without_errors(browser, tmp_path_factory, tmp_path):
+    """Results without the issue-16 files still give a working page (notes, no errors)."""
+    html = write_well_report(older_result(demo_result_dir(tmp_path_factory), tmp_path / "o"))
+    visit = browser.visit(html.as_uri(), {"documents": "Bokeh.documents.length"})
+    assert visit.remote_requests == [] and visit.console_errors == []
+    assert visit.values["documents"] == 1 + 4  # friction log and the 4 segments
+
+
+def test_diagnostics_rows_fit_at_1400_px(browser, tmp_path_factory):
+    """Issue 16, item 7: at 1400 px the diagnostics table fits its width (no horizontal
+    overflow) and no row is taller than 60 px (the old table had 100 px rows and a cut
+    message column)."""
+    html = write_well_report(evidence_dir(tmp_path_factory))
+    visit = browser.visit(html.as_uri(), {
+        "heights": "Array.from(document.querySelectorAll('#diagnostics-table tr'))"
+                   ".map(r => r.getBoundingClientRect().height)",
+        "table": "document.getElementById('diagnostics-table').getBoundingClientRect().right",
+        "page": "document.documentElement.clientWidth"}, width=1400)
+    assert visit.console_errors == []
+    assert max(visit.values["heights"]) <= 60.0, visit.values["heights"]
+    assert visit.values["table"] <= visit.values["page"]
 
 
 def test_fleet_report_loads_offline_without_errors(browser, tmp_path_factory, tmp_path):
@@ -236,12 +300,14 @@ def test_fleet_report_loads_offline_without_errors(browser, tmp_path_factory, tm
     wells = fleet_wells(tmp_path, demo_result_dir(tmp_path_factory))
     html = write_fleet_report(tmp_path, wells)
     visit = browser.visit(html.as_uri(), {
+        "documents": "Bokeh.documents.length", "drawn": _DRAWN,
         "rows": "document.querySelectorAll('#wells-table tr').length - 1",
         "links": "Array.from(document.querySelectorAll('#wells-table a')).map(a => a.href)",
         "failed": "document.getElementById('failed-wells').textContent"})
     assert visit.remote_requests == []
     assert visit.console_errors == []
     assert visit.values["rows"] == len(wells)
+    assert visit.values["documents"] == 1 and min(visit.values["drawn"]) > 200
     assert "disk full" in visit.values["failed"]
     assert len(visit.values["links"]) == 3
     for href in visit.values["links"]:
@@ -253,7 +319,8 @@ def test_fleet_report_loads_offline_without_errors(browser, tmp_path_factory, tm
 
 
 def test_script_in_well_name_is_text_in_browser(browser, tmp_path_factory, tmp_path):
-    """A well named <script>alert(1)</script> shows as text and runs nothing."""
+    """A well named <script>alert(1)</script> shows as text and runs nothing: the page's
+    only scripts are its own three (Bokeh, the figures' JSON, the loader)."""
     result = renamed_result(tmp_path, XSS_NAME, demo_result_dir(tmp_path_factory))
     html = write_well_report(result)
     fleet = write_fleet_report(tmp_path, [{"well": XSS_NAME, "status": "ok", "message": "",
@@ -265,6 +332,6 @@ def test_script_in_well_name_is_text_in_browser(browser, tmp_path_factory, tmp_p
             "text": f"document.querySelector('{selector}').textContent",
             "scripts": "document.scripts.length"})
         assert visit.values["text"] == XSS_NAME
-        assert visit.values["scripts"] == 0
+        assert visit.values["scripts"] == 3
         assert visit.dialogs == []
         assert visit.console_errors == []

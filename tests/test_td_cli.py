@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -192,3 +193,33 @@ def test_no_survey_is_vertical_with_the_nominal_tortuosity(tmp_path):
     cfg.write_text("[survey]\ntortuosity_deg_30m = 0.0\n")
     flat = json.loads(invoke(cfg, "--bit-depth", 2000, "--json").stdout)
     assert flat["T_N_Nm"] == 0.0 and "vertical well: no survey found" in flat["assumed"]
+
+
+DEMO = Path(__file__).resolve().parents[1] / "examples" / "demo"
+
+
+def test_broomstick_of_a_well_with_a_log_draws_measured_points(tmp_path):
+    """`td --broomstick demo.csv`: the log is segmented, its 4 rotating stands are drawn
+    on the plot, and the consistent demo string passes the weight check (the simulated
+    hook load has no block: implied block weight ≈ 0)."""
+    plot = tmp_path / "b.png"
+    result = invoke(DEMO / "demo.csv", "--broomstick", "--depths", "1500:2300:100",
+                    "--frictions", "0.2,0.3", "--plot", plot)
+    assert result.exit_code == 0, result.output
+    assert "measured: 4 rotating segment(s)" in result.output
+    assert "inconsistent" not in result.output
+    assert plot.stat().st_size > 1000
+
+
+def test_broomstick_warns_when_the_string_is_heavier_than_the_hook_load(tmp_path):
+    """Drill pipe 1.6× too heavy: its modelled rotating hook load exceeds the measured one
+    by far more than 5 %, and td says so (a warning, exit 0)."""
+    text = (DEMO / "demo.toml").read_text().replace("linear_mass_kg_m = 41.41",
+                                                    "linear_mass_kg_m = 66.0")
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(text.replace('data = "demo.csv"', ""))
+    result = invoke(DEMO / "demo.csv", "--broomstick", "--depths", "2000,2300",
+                    "--frictions", "0.3", "--config", heavy, "--survey",
+                    DEMO / "demo.survey.csv")
+    assert result.exit_code == 0, result.output
+    assert "string weight inconsistent with the hook load" in result.stderr

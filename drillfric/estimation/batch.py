@@ -518,6 +518,30 @@ def _as_fc_fn(fc_Nm_m) -> Callable[[np.ndarray], np.ndarray]:
     return lambda x: np.full(np.shape(x), value)
 
 
+def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
+                        omega_c_rad_s: float, k_t_per_s: float,
+                        top_drive_inertia_kg_m2: float, mu_s: float, mu_k: float,
+                        torque_kind: str = "motor", cells: int = 500
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fitted model against the data over a whole record (the evidence of a fit).
+
+    The speed-driven plant of THEORY §6.4 at (μ_s, μ_k), driven by the measured top-drive
+    speed from rest over the whole record, as :func:`refine`'s fits are.
+
+    Returns
+    -------
+    time_s, measured_Nm, model_Nm : ndarray
+        Sample times on the record's uniform grid [s], the measured string torque and the
+        model's string torque at the top [N·m].
+    """
+    data, _ = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind, top_drive_inertia_kg_m2)
+    model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
+                   top_drive_inertia_kg_m2, data, None)
+    whole = _Window(0, data.t.size - 1, np.arange(data.t.size))
+    tau, _ = model.simulate(whole, max(mu_s, mu_k), mu_k, cells)
+    return data.t, data.tau, tau
+
+
 def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
            omega_c_rad_s: float, k_t_per_s: float, top_drive_inertia_kg_m2: float,
            torque_kind: str = "motor", cells: int = 500, mu_s_seed: float | None = None,

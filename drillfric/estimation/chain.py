@@ -28,6 +28,7 @@ from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
 from drillfric.estimation import batch
+from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
 from drillfric.estimation.gains import gains_from_config
 from drillfric.estimation.observer import (
@@ -117,6 +118,13 @@ class SegmentEstimate:
         Bit speed of the seeded ensemble (weighted mean and band).
     bit_rms_error_rpm : float or None
         RMS error of the estimated bit speed when the truth is known [RPM].
+    evidence : FitEvidence
+        The fitted model's string torque against the measured one.
+    bit_speed : Resolution
+        Whether the logging resolves the stick-slip cycle (else no bit-speed trace).
+    friction_zone : str
+        Which factor μ is: "open_hole" (the cased part's factor given) or "effective"
+        (torque-weighted over the whole string).
     """
 
     mu_s: float | None
@@ -144,6 +152,9 @@ class SegmentEstimate:
     bit_rms_error_rpm: float | None = None
     td: torque_drag.TDResult | None = field(default=None, repr=False)
     mu_s_seed: float | None = None
+    evidence: FitEvidence | None = field(default=None, repr=False)
+    bit_speed: Resolution | None = None
+    friction_zone: str = "effective"
 
 
 def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
@@ -240,6 +251,64 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
             element_length_m=cfg.model.element_length_m))
     except DrillfricError:
         return None
+
+
+#: Rotation left out after the top drive first exceeds ω_c when the fit is scored [s]
+#: (the start-up transient; the batch fit's μ_k skips the same).
+EVIDENCE_SKIP_S = batch.MU_K_SKIP_S
+#: Samples per stick-slip cycle below which the cycle is not resolved: the bit speed and
+#: the stuck fraction are then not reported (docs/bit_speed.md "Logging rate").
+MIN_SAMPLES_PER_CYCLE = 6.0
+
+
+@dataclass(frozen=True)
+class FitEvidence:
+    """The fitted model against the data, the evidence beside a segment's numbers.
+
+    Attributes
+    ----------
+    time_s, measured_Nm, model_Nm : ndarray
+        The record's uniform time grid [s], measured and modelled string torque [N·m].
+    misfit_rms_Nm : float or None
+        RMS of the 1-s smoothed difference over the rotation after the start-up [N·m].
+    swing_Nm : float or None
+        5th–95th percentile swing of the measured torque there [N·m].
+    mean_Nm : float or None
+        Mean measured string torque there [N·m].
+    """
+
+    time_s: np.ndarray
+    measured_Nm: np.ndarray
+    model_Nm: np.ndarray
+    misfit_rms_Nm: float | None
+    swing_Nm: float | None
+    mean_Nm: float | None
+
+    @property
+    def quality(self) -> float | None:
+        """Misfit relative to the swing [-] (None without rotation)."""
+        if self.misfit_rms_Nm is None or not self.swing_Nm:
+            return None
+        return self.misfit_rms_Nm / self.swing_Nm
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Whether the logging resolves the stick-slip cycle, so that a bit-speed trace means
+    something (docs/bit_speed.md "Logging rate").
+
+    Attributes
+    ----------
+    resolved : bool
+    samples_per_cycle : float
+        Shortest stick-slip cycle over the effective sample interval [-].
+    reason : str
+        Why not ("" when resolved).
+    """
+
+    resolved: bool
+    samples_per_cycle: float
+    reason: str = ""
 
 
 @dataclass(frozen=True)
@@ -353,6 +422,49 @@ def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,
     return final, bit
 
 
+def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | None
+                 ) -> FitEvidence:
+    """Step 6: the fitted speed-driven model over the whole segment against the measured
+    string torque, with its misfit relative to the torque swing."""
+    meas = models.meas
+    t, measured, model = batch.model_string_torque(
+        meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
+        fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
+        k_t_per_s=cfg.model.k_t_per_s, top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+        mu_s=mu_s if mu_s is not None else verdict.mu_s_seed, mu_k=verdict.mu_k,
+        cells=_batch_cells(cfg, models.string.bit_depth_m))
+    fast = np.flatnonzero(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s)
+    scored = t >= (t[fast[0]] + EVIDENCE_SKIP_S if fast.size else np.inf)
+    if scored.sum() < 10:
+        return FitEvidence(t, measured, model, None, None, None)
+    dt = float(t[1] - t[0]) if t.size > 1 else 1.0
+    misfit = smooth(measured - model, dt, batch.TORQUE_SMOOTH_S)[scored]
+    low, high = np.percentile(measured[scored], [5.0, 95.0])
+    return FitEvidence(t, measured, model, float(np.sqrt(np.mean(misfit ** 2))),
+                       float(high - low), float(np.mean(measured[scored])))
+
+
+def bit_speed_resolution(cfg, models: SegmentModels) -> Resolution:
+    """Step 7: does the logging resolve the stick-slip cycle?
+
+    The shortest stick-slip cycle is the string's first torsional period, a quarter wave
+    from the top drive to the free bit: 4 × the wave travel time (docs/theory.md §3). Each
+    sample is a spot value or, with ``rig.sample_averaging_s``, the mean over that
+    interval; the effective interval is the larger. Below :data:`MIN_SAMPLES_PER_CYCLE`
+    samples per cycle the bit speed and the stuck fraction are not reported.
+    """
+    interval = max(models.meas.dt_s, cfg.rig.sample_averaging_s or 0.0)
+    period = 4.0 * models.observer.plant.grid.travel_time_s
+    per_cycle = period / interval
+    if per_cycle >= MIN_SAMPLES_PER_CYCLE:
+        return Resolution(True, per_cycle)
+    kind = "means" if (cfg.rig.sample_averaging_s or 0.0) >= models.meas.dt_s else "samples"
+    return Resolution(False, per_cycle, f"bit speed not resolved: {interval:.3g}-s {kind} "
+                      f"give {per_cycle:.2g} per stick-slip cycle (the shortest, "
+                      f"{period:.2g} s, needs ≥ {MIN_SAMPLES_PER_CYCLE:g}); log at "
+                      f"≥ {MIN_SAMPLES_PER_CYCLE / period:.2g} Hz to see the bit")
+
+
 def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                      warm: tuple | None = None, rate_hz: float | None = None,
                      output_rate_hz: float | None = None, progress=None,
@@ -394,7 +506,9 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     verdict = decide(evidence(cfg, models, diag, refined))
     final, bit = seeded_pass(cfg, models, verdict, out_rate)
     tick(0.2)
-    return _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
+    estimate = _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
+    return replace(estimate, evidence=fit_evidence(cfg, models, verdict, refined.mu_s),
+                   bit_speed=bit_speed_resolution(cfg, models))
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,

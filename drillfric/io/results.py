@@ -330,7 +330,8 @@ def check_distinct(outputs: list[tuple[str, str]]) -> None:
 
 # --------------------------------------------------------------------------- files
 def arrow_schema(with_truth: bool) -> pa.Schema:
-    """estimates.parquet's schema from :data:`drillfric.result.ESTIMATE_COLUMNS`."""
+    """estimates.parquet's schema from :data:`drillfric.result.ESTIMATE_COLUMNS` (every
+    column nullable: a bit speed the logging cannot resolve is null)."""
     return pa.schema([(c.name, pa.type_for_alias(c.type)) for c in ESTIMATE_COLUMNS
                       if with_truth or c.name != "bit_rpm"])
 

@@ -18,6 +18,9 @@ from drillfric.errors import InputError
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_FIELDS, SEGMENT_NUMBER_FIELDS
 
 _NUMERIC = SEGMENT_NUMBER_FIELDS  # None in summary.json becomes NaN
+#: Torque columns of estimates.parquet: measured string torque, the observer's and the
+#: batch fit's modelled surface torque [N·m].
+TORQUE_COLUMNS = ("surface_torque_Nm", "surface_torque_est_Nm", "surface_torque_fit_Nm")
 
 
 @dataclass(frozen=True)
@@ -35,6 +38,8 @@ class ResultData:
         profiles.parquet (torque-and-drag profile per estimated segment).
     wellpath : DataFrame or None
         wellpath.parquet (only when the run had a survey).
+    tracks : DataFrame or None
+        tracks.parquet: the whole log decimated for plotting (absent in older results).
     """
 
     result_dir: Path
@@ -42,6 +47,26 @@ class ResultData:
     segments: pd.DataFrame
     profiles: pd.DataFrame | None
     wellpath: pd.DataFrame | None
+    tracks: pd.DataFrame | None = None
+
+    @property
+    def time_origin(self) -> pd.Timestamp | None:
+        """Clock time (UTC) of ``time_s = 0``, or None when the log has no clock time.
+
+        From summary.json ``time_origin_utc``, else from tracks.parquet's ``timestamp``.
+        """
+        stamp = self.summary.get("time_origin_utc")
+        if isinstance(stamp, str):
+            try:
+                return pd.Timestamp(stamp).tz_convert("UTC") if pd.Timestamp(stamp).tzinfo \
+                    else pd.Timestamp(stamp).tz_localize("UTC")
+            except ValueError:
+                return None
+        tracks = self.tracks
+        if tracks is not None and "timestamp" in tracks and len(tracks):
+            first = pd.to_datetime(tracks["timestamp"].iloc[:1], utc=True).iloc[0]
+            return first - pd.Timedelta(seconds=float(tracks["time_s"].iloc[0]))
+        return None
 
 
 def segments_frame(rows: list[dict]) -> pd.DataFrame:
@@ -57,6 +82,7 @@ def segments_frame(rows: list[dict]) -> pd.DataFrame:
     frame["message"] = frame["message"].fillna("").astype(str)
     frame["flags"] = [list(f) if isinstance(f, list | tuple) else [] for f in frame["flags"]]
     frame["starts"] = [list(s) if isinstance(s, list | tuple) else [] for s in frame["starts"]]
+    frame["bit_speed_reason"] = frame["bit_speed_reason"].fillna("").astype(str)
     return frame
 
 
@@ -86,7 +112,8 @@ def load_result(result_dir: Path) -> ResultData:
                          fix="rerun 'drillfric run' to rewrite the results")
     return ResultData(result_dir, summary, segments_frame(summary.get("segments", [])),
                       _optional_parquet(result_dir / "profiles.parquet"),
-                      _optional_parquet(result_dir / "wellpath.parquet"))
+                      _optional_parquet(result_dir / "wellpath.parquet"),
+                      _optional_parquet(result_dir / "tracks.parquet"))
 
 
 def _optional_parquet(path: Path) -> pd.DataFrame | None:
@@ -99,13 +126,53 @@ def _optional_parquet(path: Path) -> pd.DataFrame | None:
                          fix="rerun 'drillfric run' to rewrite the results") from None
 
 
+#: The final (seeded) observer pass in estimates.parquet (pipeline.SEEDED_START_ID).
+FINAL_START_ID = -1
+#: Points per observer start (their μ move slowly: a few hundred points draw them).
+START_POINTS = 300
+#: Signals whose extremes survive the decimation of the final pass (stick-slip peaks,
+#: break-over torque).
+_EXTREME_KEYS = ("surface_torque_Nm", "surface_rpm", "bit_rpm_est")
+
+
+def extreme_rows(frame: pd.DataFrame, max_points: int,
+                 keys: tuple[str, ...] = _EXTREME_KEYS) -> np.ndarray:
+    """Row positions of ``frame`` (time-ordered) kept for plotting: ≤ ``max_points``.
+
+    The rows are cut into equal buckets; in each, the rows holding the minimum and the
+    maximum of every key signal are kept, with the first and the last row. Unlike keeping
+    every k-th sample, a stick-slip cycle shorter than the stride keeps its peaks and
+    troughs, and a one-sample break-over peak stays. Kept rows are rows of the file, so the
+    figure's values are the file's values.
+    """
+    n = len(frame)
+    if n <= max_points:
+        return np.arange(n)
+    keys = tuple(k for k in keys if k in frame and frame[k].notna().any())
+    buckets = max(1, (max_points - 2) // max(2 * len(keys), 1))
+    size = int(np.ceil(n / buckets))
+    keep = [np.array([0, n - 1])]
+    for key in keys:
+        values = np.full(buckets * size, np.nan)
+        values[:n] = frame[key].to_numpy(float)
+        grid = values.reshape(buckets, size)
+        base = np.arange(buckets) * size
+        keep.append(base + np.where(np.isnan(grid), np.inf, grid).argmin(axis=1))
+        keep.append(base + np.where(np.isnan(grid), -np.inf, grid).argmax(axis=1))
+    if not keys:
+        keep.append(np.linspace(0, n - 1, max_points - 2).round().astype(int))
+    rows = np.unique(np.concatenate(keep))
+    return rows[rows < n]
+
+
 def segment_estimates(result_dir: Path, ids: list[int],
                       max_points: int = 1200) -> dict[int, pd.DataFrame]:
     """Estimates of the given segments, every start, decimated to ≤ ``max_points`` per start.
 
-    Decimation keeps every k-th sample (no averaging), so stick-slip stays visible as long
-    as a cycle spans several kept samples; the figures are for reading, the Parquet file
-    keeps every sample.
+    The final pass (``start_id`` −1, the reported speeds and torques) keeps the extremes
+    of its signals (:func:`extreme_rows`); the starts, whose μ move slowly, keep every k-th
+    sample (≤ :data:`START_POINTS`). The figures are for reading; the Parquet file keeps
+    every sample.
     """
     path = Path(result_dir) / "estimates.parquet"
     if not ids or not path.is_file():
@@ -124,8 +191,12 @@ def segment_estimates(result_dir: Path, ids: list[int],
     out = {}
     for seg_id, rows in frame.groupby("segment_id", sort=True):
         parts = []
-        for _, one in rows.groupby("start_id", sort=True):
-            step = max(1, int(np.ceil(len(one) / max_points)))
-            parts.append(one.sort_values("time_s").iloc[::step])
+        for start_id, one in rows.groupby("start_id", sort=True):
+            one = one.sort_values("time_s", kind="stable")
+            if start_id == FINAL_START_ID:
+                parts.append(one.iloc[extreme_rows(one, max_points)])
+            else:
+                keep = min(max_points, START_POINTS)
+                parts.append(one.iloc[::max(1, int(np.ceil(len(one) / keep)))])
         out[int(seg_id)] = pd.concat(parts, ignore_index=True)
     return out

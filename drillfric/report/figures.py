@@ -4,9 +4,11 @@ Figures are built without pyplot (no global state, no window, Agg when saved), s
 be drawn in a nightly job or a test without a display. Text that comes from users' files
 (well names, messages) is drawn with ``parse_math=False`` so a ``$`` cannot break a figure.
 
-The views follow Aarsnes et al. (JPSE 2019) [1]: μ estimates of every observer start versus
-time (Fig. 10 of [1]), measured versus estimated surface speed and the estimated bit speed
-with stick-slip shaded (Figs. 9 and 11 of [1]).
+Static figures of the report (the PDF pages, and the HTML where no interaction is needed):
+well path, torque-and-drag profiles, the friction log with the stick-slip severity, and the
+fleet's friction logs. The per-segment evidence (after Figs. 9–11 of Aarsnes et al., JPSE
+2019) is in :mod:`drillfric.report.evidence`, the time tracks in
+:mod:`drillfric.report.tracks`.
 """
 
 from __future__ import annotations
@@ -19,10 +21,8 @@ from matplotlib.figure import Figure
 MU_K_COLOR = "#1f5fa8"
 MU_S_COLOR = "#c0392b"
 TD_COLOR = "#222222"
-STUCK_COLOR = "#f4b6b6"
+SEVERITY_COLOR = "#8e44ad"
 _WIDTH_IN = 9.0
-#: Points per observer start in the μ-versus-time panel (the estimates are decimated).
-_MU_POINTS = 400
 
 
 def _new(height_in: float, width_in: float = _WIDTH_IN, *, left_in: float = 0.8,
@@ -53,7 +53,8 @@ def _depth_axis(ax) -> None:
 
 
 def wellpath_figure(wellpath: pd.DataFrame | None,
-                    no_survey: str = "No survey: the well was taken as vertical.") -> Figure:
+                    no_survey: str = "No survey: the well was taken as vertical.",
+                    size: tuple[float, float] = (_WIDTH_IN, 4.2)) -> Figure:
     """Vertical section (along the azimuth to the last station) and plan view of the well.
 
     Parameters
@@ -62,8 +63,10 @@ def wellpath_figure(wellpath: pd.DataFrame | None,
         wellpath.parquet: ``md_m, tvd_m, north_m, east_m`` [m]. None: no survey.
     no_survey : str
         The note drawn instead when there is no survey (what the path was taken to be).
+    size : (float, float)
+        Figure size [in].
     """
-    fig = _new(4.2)
+    fig = _new(size[1], size[0])
     ax_vs, ax_plan = fig.subplots(1, 2)
     if wellpath is None or wellpath.empty:
         _note(ax_vs, no_survey)
@@ -100,7 +103,7 @@ def profile_depths(segments: pd.DataFrame, profiles: pd.DataFrame | None,
 
 
 def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
-                    count: int = 3) -> Figure:
+                    count: int = 3, size: tuple[float, float] = (_WIDTH_IN, 4.2)) -> Figure:
     """Normal force per length and F_c = r·F_n (THEORY.md §5.1) versus MD at a few bit depths.
 
     Parameters
@@ -111,8 +114,10 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
         The segments table (for the bit depths).
     count : int
         Number of bit depths drawn.
+    size : (float, float)
+        Figure size [in].
     """
-    fig = _new(4.2)
+    fig = _new(size[1], size[0])
     ax_fn, ax_fc = fig.subplots(1, 2, sharey=True)
     ids = profile_depths(segments, profiles, count)
     if not ids:
@@ -133,17 +138,21 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
     return fig
 
 
-def friction_log_figure(segments: pd.DataFrame) -> Figure:
-    """μ_s and μ_k versus bit depth, one point per segment (stand), with spread bars.
+def friction_log_figure(segments: pd.DataFrame,
+                        size: tuple[float, float] = (_WIDTH_IN, 5.5)) -> Figure:
+    """μ_s and μ_k versus bit depth, one point per segment (stand), with spread bars, and
+    the stick-slip severity versus bit depth beside it.
 
     Filled markers: converged; hollow: not converged. μ_s is drawn as a point only where it
     is identifiable (THEORY.md §6); where only a lower bound is known it is drawn as a
     right-pointing bound (▷ with a dotted tail: "at least this"). Crosses: the
     torque-and-drag back-calculated μ (``mu_td``). Bars span the spread across starts.
-    Segments without an estimate are grey diamonds on the left edge.
+    Segments without an estimate are grey diamonds on the left edge. Markers are not
+    clipped at the axes' edges. Right: severity (ω_max − ω_min)/(2 ω_mean) of the
+    estimated bit speed; beyond the dashed line at 1 the bit stops.
     """
-    fig = _new(5.5, 6.5, left_in=0.9)
-    ax = fig.subplots()
+    fig = _new(size[1], size[0], left_in=0.9, wspace=0.08)
+    ax, ax_sev = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [2.2, 1]})
     seg = segments
     ok = seg[seg["status"] == "ok"]
     conv = ok["converged"].to_numpy(bool)
@@ -154,24 +163,34 @@ def friction_log_figure(segments: pd.DataFrame) -> Figure:
     bound = ok[~ok["mu_s_identifiable"] & ok["mu_s_lower_bound"].notna()]
     if len(bound):
         ax.plot(bound["mu_s_lower_bound"], bound["bit_depth_m"], ">", color=MU_S_COLOR,
-                markerfacecolor="none", label="μ_s ≥ lower bound")
+                markerfacecolor="none", label="μ_s ≥ lower bound", clip_on=False)
         for x, y in zip(bound["mu_s_lower_bound"], bound["bit_depth_m"], strict=True):
             ax.plot([x, x + 0.08], [y, y], ":", color=MU_S_COLOR, linewidth=1.2)
     td = ok[ok["mu_td"].notna()]
     if len(td):
         ax.plot(td["mu_td"], td["bit_depth_m"], "x", color=TD_COLOR,
-                label="μ from torque and drag")
+                label="μ from torque and drag", clip_on=False)
     none = seg[(seg["status"] != "ok") & seg["bit_depth_m"].notna()]
     if len(none):
         ax.plot(np.zeros(len(none)), none["bit_depth_m"], "d", color="#888888",
                 markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")
     if not len(ok) and not len(none):
         _note(ax, "No segment: nothing to draw.")
+        ax_sev.set_axis_off()
         return fig
     ax.set(xlabel="friction factor μ [-]", ylabel="bit depth [m]")
+    ax.margins(x=0.08, y=0.08)
     ax.set_xlim(left=0.0)
     _depth_axis(ax)
     ax.legend(fontsize="small", loc="best")
+    sev = ok[ok["stick_slip_severity"].notna()]
+    ax_sev.plot(sev["stick_slip_severity"], sev["bit_depth_m"], "o", color=SEVERITY_COLOR,
+                clip_on=False)
+    ax_sev.axvline(1.0, color=MU_S_COLOR, linestyle="--", linewidth=0.8)
+    ax_sev.set(xlabel="stick-slip severity [-]")
+    ax_sev.set_xlim(left=0.0, right=max(1.2, 1.1 * float(sev["stick_slip_severity"].max()))
+                    if len(sev) else 1.2)
+    ax_sev.grid(True, color="#dddddd", linewidth=0.6)
     return fig
 
 
@@ -183,170 +202,8 @@ def _mu_points(ax, rows: pd.DataFrame, col: str, spread: str, converged: np.ndar
     for mask, suffix, face in ((converged, "", color), (~converged, " (not converged)", "none")):
         if not mask.any():
             continue
-        ax.errorbar(rows[col].to_numpy(float)[mask], rows["bit_depth_m"].to_numpy(float)[mask],
-                    xerr=half[mask], fmt=marker, color=color, markerfacecolor=face,
-                    ecolor=color, elinewidth=1.0, capsize=2, label=name + suffix)
-
-
-def segment_figure(est: pd.DataFrame, segment: dict) -> Figure:
-    """One segment: μ per start vs time, surface RPM measured vs estimated, bit RPM.
-
-    The final observer pass (``start_id == -1``, seeded with the batch-refined
-    factors) is drawn in black and gives the estimated speeds (its ensemble's weighted mean,
-    with the members' min–max bit speed as a band); the starts are thin lines.
-    Time where the estimated bit is stuck (|ω_BHA| ≤ ω_c) is shaded. Measured downhole
-    bit speed is drawn dashed when the input had it.
-
-    Parameters
-    ----------
-    est : DataFrame
-        estimates.parquet rows of this segment (every start, decimated).
-    segment : dict
-        The segment's row of the segments table (``starts``, ``id``, ``bit_depth_m``).
-    """
-    fig = _new(7.2, hspace=0.45)
-    ax_mu, ax_rpm, ax_bit = fig.subplots(3, 1, sharex=True)
-    final_id = -1  # the pass seeded with the batch-refined factors (pipeline.SEEDED_START_ID)
-    for start_id, rows in est.groupby("start_id", sort=True):
-        final = start_id == final_id
-        if not final:  # μ moves slowly: a few hundred points per start are plenty
-            rows = rows.iloc[::max(1, len(rows) // _MU_POINTS)]
-        kw = {"color": "black", "linewidth": 1.6} if final else {"linewidth": 0.9,
-                                                                  "alpha": 0.85}
-        label = "final (seeded) pass" if final else _start_label(segment, int(start_id))
-        line, = ax_mu.plot(rows["time_s"], rows["mu_k"], label=label, **kw)
-        ax_mu.plot(rows["time_s"], rows["mu_s"], linestyle="--", **{**kw,
-                                                                     "color": line.get_color()})
-    ax_mu.set(ylabel="μ [-]", title="Friction factors per start (solid μ_k, dashed μ_s)")
-    ax_mu.legend(fontsize="x-small", ncol=3, loc="upper right")
-    best = est[est["start_id"] == final_id]
-    time = best["time_s"].to_numpy(float)
-    ax_rpm.plot(time, best["surface_rpm"], color="#888888", label="measured")
-    ax_rpm.plot(time, best["surface_rpm_est"], color=MU_K_COLOR, linewidth=1.0,
-                label="estimated")
-    ax_rpm.set(ylabel="surface [rpm]", title="Surface speed")
-    ax_rpm.legend(fontsize="x-small", loc="upper right")
-    stuck = best["bit_stuck"].to_numpy(bool)
-    ax_bit.fill_between(time, 0, 1, where=stuck, transform=ax_bit.get_xaxis_transform(),
-                        color=STUCK_COLOR, step="mid", label="estimated stuck")
-    if "bit_rpm_est_min" in best and best["bit_rpm_est_min"].notna().any():
-        ax_bit.fill_between(time, best["bit_rpm_est_min"], best["bit_rpm_est_max"],
-                            color=MU_K_COLOR, alpha=0.18, linewidth=0,
-                            label="ensemble band (min–max)")
-    ax_bit.plot(time, best["bit_rpm_est"], color=MU_K_COLOR, linewidth=1.0,
-                label="estimated")
-    if "bit_rpm" in best and best["bit_rpm"].notna().any():
-        ax_bit.plot(time, best["bit_rpm"], "--", color=TD_COLOR, linewidth=0.9,
-                    label="measured downhole")
-    ax_bit.set(xlabel="time [s]", ylabel="bit [rpm]", title="Bit speed (stick-slip shaded)")
-    ax_bit.legend(fontsize="x-small", loc="upper right")
-    for ax in (ax_mu, ax_rpm, ax_bit):
-        ax.grid(True, color="#dddddd", linewidth=0.6)
-    return fig
-
-
-def _start_label(segment: dict, start_id: int) -> str:
-    starts = segment.get("starts") or []
-    if start_id < len(starts):
-        mu_s, mu_k = starts[start_id]
-        return f"start {start_id}: ({mu_s:.2f}, {mu_k:.2f})"
-    return f"start {start_id}"
-
-
-def fleet_friction_figure(logs: list[tuple[str, pd.DataFrame]]) -> Figure:
-    """Friction logs of several wells overlaid: μ_k and μ_s versus bit depth, a colour each.
-
-    Parameters
-    ----------
-    logs : list of (well name, segments table)
-        Only estimated (status ok) segments are drawn; hollow markers are not converged.
-    """
-    fig = _new(5.5)
-    ax_k, ax_s = fig.subplots(1, 2, sharey=True)
-    drawn = False
-    for index, (name, seg) in enumerate(logs):
-        color = f"C{index % 10}"
-        ok = seg[(seg["status"] == "ok") & seg["mu_k"].notna()].sort_values("bit_depth_m")
-        if not len(ok):
-            continue
-        drawn = True
-        ax_k.plot(ok["mu_k"], ok["bit_depth_m"], "-", color=color, linewidth=0.8, label=name)
-        _hollow_or_filled(ax_k, ok, "mu_k", color)
-        ident = ok[ok["mu_s_identifiable"] & ok["mu_s"].notna()]
-        _hollow_or_filled(ax_s, ident, "mu_s", color)
-        bound = ok[~ok["mu_s_identifiable"] & ok["mu_s_lower_bound"].notna()]
-        ax_s.plot(bound["mu_s_lower_bound"], bound["bit_depth_m"], ">", color=color,
-                  markerfacecolor="none")
-    if not drawn:
-        _note(ax_k, "No well has an estimated segment.")
-        ax_s.set_axis_off()
-        return fig
-    ax_k.set(xlabel="μ_k [-]", ylabel="bit depth [m]", title="Kinetic friction μ_k")
-    ax_s.set(xlabel="μ_s [-] (▷ lower bound)", title="Static friction μ_s")
-    for ax in (ax_k, ax_s):
-        ax.set_xlim(left=0.0)
-        _depth_axis(ax)
-    for text in ax_k.legend(fontsize="small" if len(logs) <= 12 else "xx-small", loc="best",
-                            ncol=1 + len(logs) // 20).get_texts():
-        text.set_parse_math(False)  # well names come from users' files
-    return fig
-
-
-def _hollow_or_filled(ax, rows: pd.DataFrame, col: str, color: str) -> None:
-    conv = rows["converged"].to_numpy(bool)
-    for mask, face in ((conv, color), (~conv, "none")):
-        if mask.any():
-            ax.plot(rows[col].to_numpy(float)[mask], rows["bit_depth_m"].to_numpy(float)[mask],
-                    "o", color=color, markerfacecolor=face)
-
-
-def text_pages(title: str, lines: list[tuple[str, str]], fontsize: float = 8.5,
-               wrap: int = 60) -> list[Figure]:
-    """A4 pages of ``(label, value)`` lines (the PDF's header and configuration pages).
-
-    Values come from users' files: drawn verbatim (no mathtext), long ones wrapped; lines
-    that do not fit go on the next page, titled "(continued)".
-    """
-    pages: list[Figure] = []
-    step = 0.0165 * fontsize / 8.5
-    y = 0.0
-    for label, value in lines or [("", "")]:
-        wrapped = _wrap(str(value), wrap)
-        if not pages or y - step * len(wrapped) < 0.04:
-            fig = Figure(figsize=(8.27, 11.69))
-            fig.text(0.07, 0.95, title + (" (continued)" if pages else ""), fontsize=16,
-                     weight="bold", parse_math=False)
-            pages.append(fig)
-            y = 0.91
-        fig.text(0.07, y, label, fontsize=fontsize, weight="bold", va="top", parse_math=False)
-        fig.text(0.34, y, "\n".join(wrapped), fontsize=fontsize, va="top", parse_math=False,
-                 family="monospace")
-        y -= step * len(wrapped) + 0.35 * step
-    return pages
-
-
-def _wrap(text: str, width: int) -> list[str]:
-    return [text[i:i + width] for i in range(0, max(len(text), 1), width)] or [""]
-
-
-def table_page(title: str, columns: list[str], rows: list[list[str]]) -> Figure:
-    """A landscape A4 page with a table of strings (the PDF's diagnostics pages)."""
-    fig = Figure(figsize=(11.69, 8.27))
-    fig.text(0.04, 0.95, title, fontsize=14, weight="bold", parse_math=False)
-    ax = fig.add_axes((0.02, 0.03, 0.96, 0.88))
-    ax.set_axis_off()
-    if rows:
-        chars = np.array([max(len(str(r[i])) for r in [columns, *rows]) + 2
-                          for i in range(len(columns))], dtype=float)
-        width_pt = 0.96 * 11.69 * 72.0
-        # a character is about 0.58 font sizes wide: shrink the font until the table fits
-        fontsize = min(6.5, width_pt / (0.58 * chars.sum()))
-        table = ax.table(cellText=rows, colLabels=columns, loc="upper center",
-                         cellLoc="left", colLoc="left", colWidths=list(chars / chars.sum()))
-        table.auto_set_font_size(False)
-        table.set_fontsize(fontsize)
-        for cell in table.get_celld().values():
-            cell.get_text().set_parse_math(False)
-    else:
-        ax.text(0.5, 0.9, "No segment.", ha="center", parse_math=False)
-    return fig
+        bars = ax.errorbar(rows[col].to_numpy(float)[mask],
+                           rows["bit_depth_m"].to_numpy(float)[mask], xerr=half[mask],
+                           fmt=marker, color=color, markerfacecolor=face, ecolor=color,
+                           elinewidth=1.0, capsize=2, label=name + suffix)
+        bars.lines[0].set_clip_on(False)

@@ -1,4 +1,5 @@
-"""The fleet report (``fleet.html``): one row per well, friction logs overlaid, failures first."""
+"""The fleet report (``fleet.html``): failures first, one row per well with a link to its
+report, and μ_k versus depth of every well in one interactive figure (Bokeh, inlined)."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ from urllib.parse import quote
 from drillfric import __version__
 
 from .data import segments_frame
-from .figures import fleet_friction_figure
-from .render import environment, figure_uri, fmt, mu_s_text, now_utc
+from .friction import fleet_plot
+from .interactive import Embedder
+from .render import environment, fmt, mu_s_text, now_utc
 from .well import _write_text
 
 
@@ -88,11 +90,13 @@ def write_fleet_report(out_dir: Path, wells: list[dict]) -> Path:
     rows = [_row(out_dir, w) for w in wells]
     logs = [(str(w.get("well", "?")), segments_frame(w["summary"].get("segments") or []))
             for w in wells if w.get("summary") and w["summary"].get("segments")]
-    figure = figure_uri(fleet_friction_figure(logs))
+    embed = Embedder()
+    plot_id = embed.add(fleet_plot(logs), "fleet") if any(
+        ((seg["status"] == "ok") & seg["mu_k"].notna()).any() for _, seg in logs) else None
     counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
     html = environment().get_template("fleet_report.html.j2").render(
         rows=rows, failed=[r for r in rows if r["status"] == "failed"], counts=counts,
-        figure=figure, version=__version__, built=now_utc())
+        plot_id=plot_id, bokeh=embed.head, version=__version__, built=now_utc())
     out = out_dir / "fleet.html"
     _write_text(out, html)
     return out

@@ -1,43 +1,173 @@
-"""The PDF report: matplotlib's PdfPages alone (no system library), one page per section."""
+"""The PDF report: matplotlib's PdfPages alone (no system library), every page A4 landscape.
+
+Tables are drawn here rather than with ``Axes.table``: their cells wrap to the column width
+(instead of the font shrinking until a wide table fits), rows grow to the lines they need,
+and a table continues on the next page with its header repeated. Every page carries the
+well's name and "page n of N" in its footer.
+"""
 
 from __future__ import annotations
 
 import os
+import textwrap
 from pathlib import Path
 
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
-from .figures import table_page
 from .render import quiet_glyphs
 
-#: Rows of the diagnostics table per landscape page.
-TABLE_ROWS_PER_PAGE = 28
-#: Longest message shown in a PDF table cell [characters] (report.html has them whole).
-_MESSAGE_CHARS = 70
+#: Every page: A4 landscape [in].
+PAGE_IN = (11.69, 8.27)
+#: Font size of table text [pt] (readable in print; the old tables shrank to ~4 pt).
+TABLE_FONT_PT = 7.5
+#: Longest cell shown [lines]; longer cells end in "…" (report.html has them whole).
+MAX_CELL_LINES = 14
+_MARGIN_IN = 0.45
+_TOP_IN = 0.85      # room for the page title
+_BOTTOM_IN = 0.55   # room for the footer
+#: Average width of a character of the sans-serif font, in font sizes.
+_CHAR_EM = 0.56
 
 
-def table_pages(title: str, columns: list[str], rows: list[list[str]]) -> list[Figure]:
-    """The diagnostics table split over landscape pages of :data:`TABLE_ROWS_PER_PAGE` rows."""
-    cut = [[c if len(c) <= _MESSAGE_CHARS else c[:_MESSAGE_CHARS - 1] + "…" for c in row]
-           for row in rows]
-    chunks = [cut[i:i + TABLE_ROWS_PER_PAGE] for i in range(0, len(cut), TABLE_ROWS_PER_PAGE)]
-    return [table_page(title + (f" ({n + 1}/{len(chunks)})" if len(chunks) > 1 else ""),
-                       columns, chunk) for n, chunk in enumerate(chunks or [[]])]
+def blank_page(title: str) -> Figure:
+    """An empty A4 landscape page with a title."""
+    fig = Figure(figsize=PAGE_IN)
+    fig.text(_MARGIN_IN / PAGE_IN[0], 1 - 0.45 / PAGE_IN[1], title, fontsize=14,
+             weight="bold", va="center", parse_math=False)
+    return fig
 
 
-def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str) -> Path:
+def wrap_cell(text: str, chars: int) -> list[str]:
+    """``text`` wrapped to ``chars`` characters a line (long words broken), at most
+    :data:`MAX_CELL_LINES` lines."""
+    lines = []
+    for part in str(text).splitlines() or [""]:
+        lines += textwrap.wrap(part, max(chars, 1), break_long_words=True,
+                               break_on_hyphens=False) or [""]
+    if len(lines) > MAX_CELL_LINES:
+        lines = lines[:MAX_CELL_LINES]
+        lines[-1] = lines[-1][:max(chars - 1, 1)] + "…"
+    return lines
+
+
+def column_chars(columns: list[str], rows: list[list[str]], budget: int) -> list[float]:
+    """Column widths [characters] that fit ``budget`` characters a line.
+
+    Each column first gets its longest word (so no word is broken, when the budget allows),
+    then the remaining room goes to the columns whose text is longer than that, in
+    proportion to what they lack (capped at 60 characters a column).
+    """
+    cells = [[str(h), *(str(r[i]) for r in rows)] for i, h in enumerate(columns)]
+    need = [max(len(w) for c in col for w in (c.split() or [""])) + 1 for col in cells]
+    want = [min(max(len(c) for c in col), 60) + 1 for col in cells]
+    room = budget - sum(need)
+    if room <= 0:
+        return [float(n) for n in need]
+    lack = [max(w - n, 0) for w, n in zip(want, need, strict=True)]
+    share = room / max(sum(lack), 1)
+    return [n + min(share, 1.0) * gap for n, gap in zip(need, lack, strict=True)]
+
+
+def table_pages(title: str, columns: list[str], rows: list[list[str]],
+                widths: list[float] | None = None, *, font_pt: float = TABLE_FONT_PT
+                ) -> list[Figure]:
+    """A table over as many A4 landscape pages as it needs, cells wrapped to their column.
+
+    Parameters
+    ----------
+    title : str
+        Page title ("(continued)" is added on the following pages).
+    columns : list of str
+        Headings (wrapped too).
+    rows : list of list of str
+        Cell texts.
+    widths : list of float, optional
+        Relative column widths (default: :func:`column_chars` — no word is broken).
+    font_pt : float
+        Font size [pt].
+    """
+    width_in = PAGE_IN[0] - 2 * _MARGIN_IN
+    if widths is None:
+        widths = column_chars(columns, rows, int(width_in * 72.0 / (_CHAR_EM * font_pt)))
+    total = float(sum(widths))
+    col_in = [width_in * w / total for w in widths]
+    chars = [int(w * 72.0 / (_CHAR_EM * font_pt)) - 1 for w in col_in]
+    line_in = 1.22 * font_pt / 72.0
+    head = [wrap_cell(h, c) for h, c in zip(columns, chars, strict=True)]
+    body = [[wrap_cell(v, c) for v, c in zip(r, chars, strict=True)] for r in rows]
+    pages: list[Figure] = []
+    y = 0.0
+    usable_bottom = _BOTTOM_IN
+    for cells in body or [None]:
+        height = (max(len(c) for c in cells) if cells else 1) * line_in + 0.06
+        if not pages or y - height < usable_bottom:
+            fig = blank_page(title + (" (continued)" if pages else ""))
+            pages.append(fig)
+            y = PAGE_IN[1] - _TOP_IN
+            if any(columns):  # a table of label–value lines has no heading row
+                y = _draw_row(fig, head, col_in, y, line_in, font_pt, header=True)
+        if cells is None:
+            fig.text(_MARGIN_IN / PAGE_IN[0], y / PAGE_IN[1] - 0.02, "(none)",
+                     fontsize=font_pt, parse_math=False)
+            break
+        y = _draw_row(fig, cells, col_in, y, line_in, font_pt)
+    return pages
+
+
+def _draw_row(fig: Figure, cells: list[list[str]], col_in: list[float], y_in: float,
+              line_in: float, font_pt: float, header: bool = False) -> float:
+    """Draw one row with its top at ``y_in`` [in from the bottom]; returns its bottom."""
+    height = max(len(c) for c in cells) * line_in + 0.06
+    w, h = PAGE_IN
+    if header:
+        fig.patches.append(_rect(fig, _MARGIN_IN / w, (y_in - height) / h,
+                                 sum(col_in) / w, height / h))
+    x = _MARGIN_IN
+    for lines, width in zip(cells, col_in, strict=True):
+        fig.text((x + 0.04) / w, (y_in - 0.03) / h, "\n".join(lines), fontsize=font_pt,
+                 va="top", ha="left", linespacing=1.05, parse_math=False,
+                 weight="bold" if header else "normal")
+        x += width
+    fig.add_artist(_hline(fig, _MARGIN_IN / w, (_MARGIN_IN + sum(col_in)) / w,
+                          (y_in - height) / h))
+    return y_in - height
+
+
+def _rect(fig: Figure, x: float, y: float, width: float, height: float):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((x, y), width, height, transform=fig.transFigure, facecolor="#eef2f7",
+                     edgecolor="none", figure=fig)
+
+
+def _hline(fig: Figure, x0: float, x1: float, y: float):
+    from matplotlib.lines import Line2D
+
+    return Line2D([x0, x1], [y, y], transform=fig.transFigure, color="#c8c8c8",
+                  linewidth=0.5)
+
+
+def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str,
+              footer: str = "") -> Path:
     """Write ``pages`` (``(title, figure)``, in order) to ``path``, atomically.
 
-    Figures without a title of their own get ``title`` as their suptitle, so that every page
-    says what it is (and its text can be found in the PDF).
+    Every page is made A4 landscape; figures with a title get it as their suptitle, so
+    that every page says what it is (and its text can be found in the PDF). The footer
+    holds ``footer`` (left) and "page n of N" (right).
     """
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
+    count = len(pages)
     with PdfPages(tmp, metadata={"Title": title, "Creator": "drillfric"}) as pdf:
-        for page_title, fig in pages:
+        for number, (page_title, fig) in enumerate(pages, start=1):
+            fig.set_size_inches(*PAGE_IN)
             if page_title:
                 fig.suptitle(page_title, fontsize=13, weight="bold").set_parse_math(False)
+            fig.text(_MARGIN_IN / PAGE_IN[0], 0.25 / PAGE_IN[1], footer, fontsize=7,
+                     color="#555555", parse_math=False)
+            fig.text(1 - _MARGIN_IN / PAGE_IN[0], 0.25 / PAGE_IN[1],
+                     f"page {number} of {count}", fontsize=7, color="#555555", ha="right")
             with quiet_glyphs():
                 pdf.savefig(fig)
     os.replace(tmp, path)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import base64
 import io
-import json
 import math
 import warnings
 from contextlib import contextmanager
@@ -23,10 +22,17 @@ from matplotlib.figure import Figure
 #: Resolution of the figures embedded in HTML [dots per inch].
 HTML_DPI = 90
 #: Columns of the diagnostics table (HTML and PDF), in order.
-DIAGNOSTIC_COLUMNS = ("segment", "kind", "bit depth [m]", "time [s]", "μ_s", "μ_k", "μ_TD",
-                      "settling [s]", "spread μ_s", "spread μ_k", "residual RMS [rpm]",
-                      "severity", "stuck", "observability", "converged", "method", "status",
+DIAGNOSTIC_COLUMNS = ("seg.", "kind", "bit depth [m]", "time", "μ_s", "μ_k", "μ_TD",
+                      "spread μ_s / μ_k", "settling [s]", "residual [rpm]",
+                      "misfit / swing [kN·m]", "severity", "stuck",
+                      "hook load [kN] meas. / model", "bit speed", "observability", "status",
                       "message")
+#: Positions of the numeric columns of :data:`DIAGNOSTIC_COLUMNS` (right-aligned).
+NUMERIC_COLUMNS = frozenset((2, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13))
+#: Positions of the columns whose text may wrap in the HTML table (the others are short).
+WRAPPING_COLUMNS = frozenset((1, 15, 16, 17))
+#: Messages longer than this [characters] are folded in the HTML table (click to read).
+MESSAGE_FOLD_CHARS = 90
 
 
 def environment() -> Environment:
@@ -105,43 +111,139 @@ def row_class(row: dict) -> str:
     return "ok" if row.get("converged") else "unconverged"
 
 
-def diagnostic_rows(segments: pd.DataFrame) -> list[dict]:
+def clock_span(row: dict, origin) -> str:
+    """A segment's time span: UTC clock times when known, else log seconds."""
+    start, end = row.get("clock_start_utc"), row.get("clock_end_utc")
+    if origin is not None and math.isfinite(row.get("t_start_s", math.nan)):
+        start = (origin + pd.Timedelta(seconds=float(row["t_start_s"]))).isoformat()
+        end = (origin + pd.Timedelta(seconds=float(row["t_end_s"]))).isoformat()
+    if isinstance(start, str) and isinstance(end, str):
+        a, b = pd.Timestamp(start), pd.Timestamp(end)
+        return f"{a:%H:%M:%S}–{b:%H:%M:%S}"
+    return f"{fmt(row.get('t_start_s'), '.0f')}–{fmt(row.get('t_end_s'), '.0f')} s"
+
+
+def pair(a, b, spec: str = ".3f", scale: float = 1.0) -> str:
+    """``"a / b"`` formatted (scaled), "—" for a missing one; "—" when both are missing."""
+    left = fmt(None if a is None else _scaled(a, scale), spec)
+    right = fmt(None if b is None else _scaled(b, scale), spec)
+    return "—" if left == right == "—" else f"{left} / {right}"
+
+
+def _scaled(value, scale: float):
+    try:
+        return float(value) * scale
+    except (TypeError, ValueError):
+        return None
+
+
+def bit_speed_text(row: dict, reason: bool = True) -> str:
+    """Whether the segment's bit speed is resolved (and, with ``reason``, why not)."""
+    resolved = row.get("bit_speed_resolved")
+    if row.get("status") != "ok" or resolved is None or (isinstance(resolved, float)
+                                                         and math.isnan(resolved)):
+        return "—"
+    if bool(resolved):
+        return "resolved"
+    why = str(row.get("bit_speed_reason") or "").strip()
+    return "not resolved" + (f": {why}" if why and reason else "")
+
+
+def status_text(row: dict) -> str:
+    """Status, convergence and method in one cell."""
+    if row.get("status") != "ok":
+        return str(row.get("status"))
+    converged = "converged" if row.get("converged") else "not converged"
+    return f"ok, {converged}, {row.get('method') or '—'}"
+
+
+def diagnostic_rows(segments: pd.DataFrame, origin=None) -> list[dict]:
     """One dict per segment: ``cells`` (strings in :data:`DIAGNOSTIC_COLUMNS` order), ``id``,
-    ``cls`` and ``anchor`` (whether the segment has a figure section is set by the caller)."""
+    ``cls`` and ``anchor`` (whether the segment has a figure section is set by the caller).
+
+    ``origin``: clock time of log time 0 (UTC), when known.
+    """
     out = []
     for row in segments.to_dict("records"):
+        ok = row["status"] == "ok"
         mu_s = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
         flags = ", ".join(row.get("flags") or [])
-        message = "; ".join(x for x in (str(row.get("message") or ""), flags) if x)
-        cells = [str(row["id"]), str(row.get("kind") or "—"), fmt(row["bit_depth_m"], ".1f"),
-                 f"{fmt(row['t_start_s'], '.0f')}–{fmt(row['t_end_s'], '.0f')}",
-                 mu_s if row["status"] == "ok" else "—", fmt(row["mu_k"]), fmt(row["mu_td"]),
-                 fmt(row["settling_time_s"], ".1f"), fmt(row["mu_s_spread"]),
-                 fmt(row["mu_k_spread"]), fmt(row["residual_rms_rpm"], ".2f"),
+        unresolved = bit_speed_text(row) if bit_speed_text(row, False) == "not resolved" \
+            else ""
+        message = "; ".join(x for x in (str(row.get("message") or ""), unresolved, flags)
+                            if x)
+        kind = str(row.get("kind") or "—").replace("_rotating", "").replace("_", " ")
+        cells = [str(row["id"]), kind, fmt(row["bit_depth_m"], ".1f"), clock_span(row, origin),
+                 mu_s if ok else "—", fmt(row["mu_k"]), fmt(row["mu_td"]),
+                 pair(row["mu_s_spread"], row["mu_k_spread"]),
+                 fmt(row["settling_time_s"], ".1f"), fmt(row["residual_rms_rpm"], ".2f"),
+                 pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"), ".1f", 1e-3),
                  fmt(row["stick_slip_severity"], ".2f"), fmt(row["stuck_fraction"], ".0%"),
-                 observability(row), fmt(bool(row["converged"])) if row["status"] == "ok"
-                 else "—", str(row.get("method") or "—"), str(row["status"]), message]
+                 pair(row.get("hookload_N"), row.get("hookload_model_N"), ".0f", 1e-3),
+                 bit_speed_text(row, reason=False), observability(row), status_text(row),
+                 message]
         out.append({"id": row["id"], "cls": row_class(row), "cells": cells})
     return out
 
 
 def config_rows(config: dict) -> list[tuple[str, list[tuple[str, str]]]]:
-    """The effective configuration as ``[(table, [(key, value text), ...]), ...]``."""
+    """The effective configuration as ``[(table, [(key, value text), ...]), ...]``, without
+    the drill string (:func:`string_table`)."""
     out = []
     for table, values in config.items():
+        if table == "string":
+            continue
         if isinstance(values, dict):
-            items = [(str(k), _value_text(v)) for k, v in values.items()]
+            items = [(str(k), value_text(v)) for k, v in values.items()]
         else:
-            items = [("", _value_text(values))]
+            items = [("", value_text(values))]
         out.append((str(table), items))
     return out
 
 
-def _value_text(value) -> str:
+#: Columns of the drill-string table: (config key, heading, scale to the shown unit, format).
+STRING_COLUMNS = (("name", "section", 1.0, ""), ("od_m", "OD [mm]", 1e3, ".1f"),
+                  ("id_m", "ID [mm]", 1e3, ".1f"), ("length_m", "length [m]", 1.0, ".1f"),
+                  ("tool_joint_od_m", "tool joint OD [mm]", 1e3, ".1f"),
+                  ("linear_mass_kg_m", "linear mass [kg/m]", 1.0, ".2f"),
+                  ("shear_modulus_Pa", "shear modulus [GPa]", 1e-9, ".1f"),
+                  ("steel_density_kg_m3", "steel density [kg/m³]", 1.0, ".0f"))
+
+
+def string_table(config: dict) -> tuple[list[str], list[list[str]]]:
+    """The drill string of a configuration as ``(headings, rows)``, top section first.
+
+    A missing length is the top section's "to the bit"; other missing values are the
+    defaults the run computed (steel area, OD/2 contact), shown as "default".
+    """
+    sections = ((config.get("string") or {}).get("sections")) or []
+    rows = []
+    for index, section in enumerate(sections):
+        row = []
+        for key, _, scale, spec in STRING_COLUMNS:
+            value = section.get(key) if isinstance(section, dict) else None
+            if value is None:
+                row.append("to the bit" if key == "length_m" and index == 0 else "default")
+            elif spec:
+                row.append(fmt(_scaled(value, scale), spec))
+            else:
+                row.append(str(value))
+        rows.append(row)
+    return [heading for _, heading, _, _ in STRING_COLUMNS], rows
+
+
+def value_text(value) -> str:
+    """A configuration value as text: lists of numbers as "(a, b), (c, d)", not JSON."""
     if value is None:
         return "—"
-    if isinstance(value, list | dict):
-        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, list | tuple):
+        if all(isinstance(v, list | tuple) for v in value):
+            return ", ".join("(" + ", ".join(value_text(x) for x in v) + ")" for v in value)
+        return ", ".join(value_text(v) for v in value)
+    if isinstance(value, dict):
+        return "; ".join(f"{k} = {value_text(v)}" for k, v in value.items())
+    if isinstance(value, float):
+        return format(value, "g")
     return str(value)
 
 

@@ -1,0 +1,156 @@
+"""The friction log versus depth, interactive (Bokeh): one well, and all wells of a fleet.
+
+Marks follow the static friction log (:func:`drillfric.report.figures.friction_log_figure`,
+docs/reports.md): μ_k ●, μ_s ■ where identified, ▷ μ_s lower bound, × the torque-and-drag
+back-calculation μ_TD, grey ◆ segments without an estimate; hollow = not converged;
+whiskers = spread across observer starts. Beside it the stick-slip severity versus depth.
+Hover names the segment and its numbers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .figures import MU_K_COLOR, MU_S_COLOR, TD_COLOR
+from .interactive import MIN_WIDTH_PX
+from .render import fmt, mu_s_text
+
+_TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+_TIPS = [("segment", "@id (@kind)"), ("bit depth", "@depth{0.0} m"), ("μ_k", "@mu_k_text"),
+         ("μ_s", "@mu_s_text"), ("μ_TD", "@mu_td_text"), ("severity", "@severity_text"),
+         ("friction zone", "@zone"), ("status", "@status")]
+
+
+def _source_frame(seg: pd.DataFrame) -> pd.DataFrame:
+    """One row per segment with the hover texts."""
+    rows = seg.copy()
+    rows["depth"] = rows["bit_depth_m"]
+    rows["kind"] = rows["kind"].fillna("—").astype(str).str.replace("_", " ")
+    rows["mu_k_text"] = [fmt(v) for v in rows["mu_k"]]
+    rows["mu_s_text"] = [mu_s_text(m, i, b) for m, i, b in
+                         zip(rows["mu_s"], rows["mu_s_identifiable"], rows["mu_s_lower_bound"],
+                             strict=True)]
+    rows["mu_td_text"] = [fmt(v) for v in rows["mu_td"]]
+    rows["severity_text"] = [fmt(v, ".2f") for v in rows["stick_slip_severity"]]
+    rows["zone"] = rows["friction_zone"].fillna("—").astype(str).str.replace("_", " ")
+    rows["status"] = rows["status"].astype(str)
+    rows["identified"] = rows["mu_s_identifiable"].astype(bool) & rows["mu_s"].notna()
+    rows["half_k"] = rows["mu_k_spread"].fillna(0.0) / 2
+    rows["half_s"] = rows["mu_s_spread"].fillna(0.0) / 2
+    keep = ["id", "depth", "kind", "mu_k", "mu_s", "mu_s_lower_bound", "mu_td",
+            "stick_slip_severity", "mu_k_text", "mu_s_text", "mu_td_text", "severity_text",
+            "zone", "status", "half_k", "half_s", "converged", "identified"]
+    return rows[keep].astype({"id": int})
+
+
+def _cds(frame: pd.DataFrame):
+    """A ColumnDataSource of a table's columns (no index column)."""
+    from bokeh.models import ColumnDataSource
+
+    return ColumnDataSource({c: frame[c].to_numpy() for c in frame.columns})
+
+
+def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: str,
+            hollow_unconverged: bool = True, **kw):
+    """Filled markers where converged, hollow where not; returns the renderers."""
+
+    out = []
+    for conv, suffix in ((True, ""), (False, " (not converged)")):
+        part = frame[frame["converged"] == conv] if hollow_unconverged else \
+            (frame if conv else frame.iloc[:0])
+        part = part[part[x].notna()]
+        if not len(part):
+            continue
+        out.append(fig.scatter(x, "depth", source=_cds(part), marker=marker,
+                               size=9, line_color=color,
+                               fill_color=color if conv else "white",
+                               legend_label=label + suffix, **kw))
+    return out
+
+
+def friction_plot(segments: pd.DataFrame):
+    """μ versus bit depth and stick-slip severity versus bit depth (a Bokeh row)."""
+    from bokeh.layouts import gridplot
+    from bokeh.models import HoverTool, Span
+    from bokeh.plotting import figure
+
+    seg = segments[segments["bit_depth_m"].notna()]
+    frame = _source_frame(seg)
+    ok = frame[frame["status"] == "ok"]
+    mu = figure(height=520, width=560, tools=_TOOLS,
+                x_axis_label="friction factor μ [-]", y_axis_label="bit depth [m]")
+    mu.y_range.flipped = True
+    renderers = []
+    for col, half, color in (("mu_k", "half_k", MU_K_COLOR), ("mu_s", "half_s", MU_S_COLOR)):
+        whisk = ok[ok[col].notna() & (ok[half] > 0)]
+        if col == "mu_s":
+            whisk = whisk[whisk["identified"]]
+        if len(whisk):
+            mu.segment(whisk[col] - whisk[half], whisk["depth"], whisk[col] + whisk[half],
+                       whisk["depth"], color=color, line_width=1)
+    renderers += _points(mu, ok, "mu_k", "circle", MU_K_COLOR, "μ_k")
+    renderers += _points(mu, ok[ok["identified"]], "mu_s", "square", MU_S_COLOR, "μ_s")
+    bound = ok[~ok["identified"] & ok["mu_s_lower_bound"].notna()]
+    if len(bound):
+        mu.segment(bound["mu_s_lower_bound"], bound["depth"], bound["mu_s_lower_bound"] + 0.08,
+                   bound["depth"], color=MU_S_COLOR, line_dash="dotted")
+        renderers.append(mu.scatter("mu_s_lower_bound", "depth",
+                                    source=_cds(bound), marker="triangle",
+                                    angle=-np.pi / 2, size=10, line_color=MU_S_COLOR,
+                                    fill_color="white", legend_label="μ_s ≥ lower bound"))
+    renderers += _points(mu, ok, "mu_td", "x", TD_COLOR, "μ from torque and drag",
+                         hollow_unconverged=False)
+    none = frame[frame["status"] != "ok"].assign(zero=0.0)
+    if len(none):
+        renderers.append(mu.scatter("zero", "depth", source=_cds(none),
+                                    marker="diamond", size=10, color="#888888",
+                                    fill_color="white", legend_label="no estimate"))
+    mu.add_tools(HoverTool(renderers=renderers, tooltips=_TIPS))
+    mu.legend.location = "bottom_right"
+    mu.legend.label_text_font_size = "10px"
+    mu.legend.click_policy = "hide"
+    sev = figure(height=520, width=300, tools=_TOOLS, y_range=mu.y_range,
+                 x_axis_label="stick-slip severity [-]")
+    sev_rows = ok[ok["stick_slip_severity"].notna()]
+    if len(sev_rows):
+        line = sev.scatter("stick_slip_severity", "depth", source=_cds(sev_rows),
+                           marker="circle", size=8, color="#8e44ad")
+        sev.add_tools(HoverTool(renderers=[line], tooltips=_TIPS))
+    sev.add_layout(Span(location=1.0, dimension="height", line_dash="dashed",
+                        line_color="#c0392b"))
+    sev.x_range.start = 0.0
+    return gridplot([[mu, sev]], merge_tools=True, toolbar_location="right")
+
+
+def fleet_plot(logs: list[tuple[str, pd.DataFrame]]):
+    """μ_k versus bit depth of every well, a colour per well; legend click hides a well."""
+    from bokeh.models import HoverTool, Legend, LegendItem
+    from bokeh.palettes import Category10, Category20
+    from bokeh.plotting import figure
+
+    fig = figure(height=560, sizing_mode="stretch_width", min_width=MIN_WIDTH_PX,
+                 tools=_TOOLS, active_scroll="wheel_zoom", x_axis_label="μ_k [-]",
+                 y_axis_label="bit depth [m]")
+    fig.y_range.flipped = True
+    palette = Category10[10] if len(logs) <= 10 else Category20[20]
+    items, renderers = [], []
+    for index, (name, seg) in enumerate(logs):
+        ok = seg[(seg["status"] == "ok") & seg["mu_k"].notna() & seg["bit_depth_m"].notna()]
+        if not len(ok):
+            continue
+        color = palette[index % len(palette)]
+        frame = _source_frame(ok.sort_values("bit_depth_m")).assign(well=name)
+        frame["fill"] = np.where(frame["converged"], color, "white")
+        source = _cds(frame)
+        line = fig.line("mu_k", "depth", source=source, color=color, line_width=1)
+        filled = fig.scatter("mu_k", "depth", source=source, size=8, color=color,
+                             fill_color="fill")
+        renderers.append(filled)
+        items.append(LegendItem(label=name, renderers=[line, filled]))
+    if items:
+        fig.add_layout(Legend(items=items, click_policy="hide", label_text_font_size="10px"),
+                       "right")
+        fig.add_tools(HoverTool(renderers=renderers,
+                                tooltips=[("well", "@well"), *_TIPS[:3]]))
+    return fig

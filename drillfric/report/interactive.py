@@ -1,0 +1,187 @@
+"""Interactive figures in a self-contained HTML file: Bokeh, its JavaScript inlined.
+
+The page loads ``bokeh.min.js`` (the core bundle alone, ~1.3 MB: no widgets, tables, WebGL
+or MathJax bundles) from an inline ``<script>``, keeps every figure's JSON in a
+``<script type="application/json">`` data block (not executed) and embeds them with one
+small inline loader. The Content-Security-Policy allows exactly these two scripts by their
+SHA-256 hashes (no ``'unsafe-inline'``, no ``'unsafe-eval'``) and no network source at all:
+the file makes no request and can be archived or mailed.
+
+Text from users' files (well names, messages) is never put in titles or axis labels —
+Bokeh would read ``$$…$$`` there as TeX and needs the MathJax bundle for it — only in
+legends and hover fields, which Bokeh shows as plain text.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+from dataclasses import dataclass, field
+from functools import cache
+
+import numpy as np
+import pandas as pd
+from markupsafe import Markup
+
+#: Width of the interactive figures when the page is wider than this [px] (they stretch).
+MIN_WIDTH_PX = 600
+#: Tools of every time-axis figure: zoom and pan along time, box zoom, reset, hover, save.
+TIME_TOOLS = "xpan,xwheel_zoom,box_zoom,reset,save"
+_LOADER = ("for (const item of JSON.parse(document.getElementById('bokeh-items').textContent))"
+           " { Bokeh.embed.embed_item(item); }")
+
+
+@cache
+def bokeh_js() -> str:
+    """The inline text of Bokeh's core bundle, made safe to sit inside ``<script>``."""
+    from bokeh.resources import Resources
+
+    text = Resources(mode="inline", components=["bokeh"]).js_raw[0]
+    return text.replace("</script", "<\\/script")
+
+
+def script_hash(text: str) -> str:
+    """CSP source expression allowing an inline script with exactly this text."""
+    digest = hashlib.sha256(text.encode("utf-8")).digest()
+    return "'sha256-" + base64.b64encode(digest).decode("ascii") + "'"
+
+
+def json_in_script(payload) -> Markup:
+    """JSON that can sit inside a ``<script type="application/json">`` element.
+
+    ``<``, ``>`` and ``&`` are written as ``\\u003c`` etc. (still the same JSON), so no
+    text from a user's file can close the element.
+    """
+    text = json.dumps(payload, separators=(",", ":"), allow_nan=False)
+    text = text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
+    return Markup(text)
+
+
+@dataclass
+class Embedder:
+    """Collects Bokeh layouts of one page and gives the template what it needs.
+
+    ``add(layout, key)`` returns the id of the ``<div>`` to place; :attr:`head` is what
+    goes into the template (scripts, data block, CSP script sources).
+
+    Building and serialising Bokeh models costs ~0.2 s per multi-panel layout, whatever
+    the data; a report with 30 segments would spend seconds on it. Layouts that differ only
+    in their data (:meth:`add_like`) are therefore built and serialised once per
+    ``signature``; the others are copies of that JSON with the data of their named
+    ColumnDataSources replaced, encoded by Bokeh's own serializer.
+    """
+
+    items: list = field(default_factory=list)
+    _templates: dict = field(default_factory=dict)
+
+    def add(self, layout, key: str) -> str:
+        """Register a Bokeh layout; returns the element id where it is drawn."""
+        from bokeh.embed import json_item
+
+        target = f"bk-{key}"
+        self.items.append(json_item(layout, target))
+        return target
+
+    def add_like(self, signature, build, data: dict[str, dict], key: str) -> str:
+        """Register a layout made by ``build()`` whose ColumnDataSources are named by the
+        keys of ``data``; a layout with the same ``signature`` is not built again."""
+        target = f"bk-{key}"
+        template = self._templates.get(signature)
+        if template is None:
+            self.add(build(), key)
+            self._templates[signature] = self.items[-1]
+            return target
+        self.items.append(with_data(template, target, data))
+        return target
+
+    @property
+    def head(self) -> dict:
+        """``{"js", "loader", "data", "script_src"}`` for the page (empty without items)."""
+        if not self.items:
+            return {"js": None, "loader": None, "data": None, "script_src": "'none'"}
+        js = bokeh_js()
+        return {"js": Markup(js), "loader": Markup(_LOADER),
+                "data": json_in_script(self.items),
+                "script_src": f"{script_hash(js)} {script_hash(_LOADER)}"}
+
+
+def with_data(item: dict, target: str, data: dict[str, dict]) -> dict:
+    """A copy of a ``json_item`` drawn at ``target`` whose ColumnDataSources named like the
+    keys of ``data`` hold that data instead (structure, styles and ids unchanged: each
+    item is its own Bokeh document, so ids may repeat across items)."""
+    from bokeh.core.serialization import Serializer
+
+    encode = Serializer(deferred=False).encode
+    replaced = set()
+
+    def copy(node):
+        if isinstance(node, list):
+            return [copy(v) for v in node]
+        if not isinstance(node, dict):
+            return node
+        out = {k: copy(v) for k, v in node.items()}
+        name = node.get("attributes", {}).get("name") if node.get("name") == \
+            "ColumnDataSource" else None
+        if name in data:
+            out["attributes"]["data"] = encode({k: v for k, v in data[name].items()})
+            replaced.add(name)
+        return out
+
+    out = copy(item)
+    out["target_id"] = target
+    missing = set(data) - replaced
+    if missing:
+        raise ValueError(f"no ColumnDataSource named {sorted(missing)} in the template")
+    return out
+
+
+def time_figure(height: int, y_label: str, *, x_range=None, clock: bool = False,
+                x_label: str | None = None):
+    """A Bokeh figure for a time track: stretches to the page width, shared time axis.
+
+    Parameters
+    ----------
+    height : int
+        Height [px].
+    y_label : str
+        Axis label (drillfric's text only; see the module docstring).
+    x_range : bokeh Range, optional
+        Shared with the figures above (zooming one zooms all).
+    clock : bool
+        Clock time (UTC) on the axis instead of seconds of log time.
+    """
+    from bokeh.plotting import figure
+
+    kw = {"x_range": x_range} if x_range is not None else {}
+    fig = figure(height=height, sizing_mode="stretch_width", min_width=MIN_WIDTH_PX,
+                 tools=TIME_TOOLS, active_scroll="xwheel_zoom", active_drag="xpan",
+                 x_axis_type="datetime" if clock else "linear", toolbar_location="right",
+                 **kw)
+    fig.yaxis.axis_label = y_label
+    if x_label is not None:
+        fig.xaxis.axis_label = x_label
+    fig.min_border_left = 70  # aligned y axes in a stack of tracks
+    fig.yaxis.axis_label_text_font_size = "11px"
+    fig.xaxis.visible = x_label is not None
+    fig.grid.grid_line_color = "#e5e5e5"
+    return fig
+
+
+def float32(values) -> np.ndarray:
+    """Values as float32 (half the bytes of float64 in the page; 7 digits are plenty)."""
+    return np.asarray(values, dtype=np.float32)
+
+
+def time_values(time_s, origin: pd.Timestamp | None) -> np.ndarray:
+    """Log time [s] as plotted: seconds, or naive-UTC datetimes when the clock is known."""
+    seconds = np.asarray(time_s, dtype=float)
+    if origin is None:
+        return seconds
+    return (origin.tz_convert("UTC").tz_localize(None)
+            + pd.to_timedelta(seconds, unit="s")).to_numpy()
+
+
+def time_label(origin: pd.Timestamp | None) -> str:
+    """Axis label of log time."""
+    return "time [UTC]" if origin is not None else "log time [s]"
