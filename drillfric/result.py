@@ -183,7 +183,8 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("surface_rpm", "float64", "RPM", "measured top-drive speed"),
     Column("surface_rpm_est", "float64", "RPM", "observer's top-drive speed"),
     Column("bit_rpm_est", "float64", "RPM", "estimated bit speed"),
-    Column("bit_stuck", "bool", "", "estimated bit in the static band (|ω| ≤ ω_c)"),
+    Column("bit_stuck", "bool", "", "estimated bit in the static band (ω within ±ω_c); null "
+                                    "where the bit speed is not resolved"),
     Column("residual_rpm", "float64", "RPM", "innovation ω̂₀ − ω₀"),
     Column("surface_torque_Nm", "float64", "N·m", "measured string torque at surface "
                                                   "(inertia-corrected motor torque)"),
@@ -222,6 +223,14 @@ def segment_columns(records) -> dict[str, list]:
     rows = [r.to_json() for r in records]
     return {name: [json.dumps(row[name]) if name in SEGMENT_LIST_FIELDS else row[name]
                    for row in rows] for name in SEGMENT_FIELDS}
+
+
+def segment_arrow_types() -> dict[str, str]:
+    """Arrow type of every segments.parquet column (a column null in every row keeps its
+    type): numbers float64, flags and counts as declared, text and JSON lists string."""
+    kinds = {"float": "float64", "float | None": "float64", "int": "int32", "bool": "bool",
+             "bool | None": "bool"}
+    return {f.name: kinds.get(f.type, "string") for f in fields(SegmentRecord)}
 
 
 def outputs_markdown() -> str:
