@@ -238,6 +238,15 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "(hysteresis: noise at standstill does not chatter; a creep stays whole)."),
         _positive("min_rotation_s", 2.0, "s", "Rotation shorter than this is speed noise and "
                   "not listed as a segment at all."),
+        Key("dip_max_s", float, 10.0, "s", "Longest dip of the surface speed below "
+            "rotating_stop_rpm that stays inside a rotation while the string stays loaded "
+            "(a soft-torque or slow top-drive controller lets the top drive almost stop "
+            "between slips while the string is wound up). 0: every stop ends the rotation.",
+            min=0.0, max=600.0),
+        Key("dip_torque_fraction", float, 0.5, "", "A speed dip is loaded while the torque "
+            "holds at least this fraction of the rotating torque level (a running mean over "
+            "10 s of rotation); a released string ends the rotation at once.", min=0.0,
+            max=1.0, min_exclusive=True),
         _positive("min_segment_s", 30.0, "s", "Shortest rotating segment that is estimated; "
                   "shorter ones are kept as 'skipped'."),
         _positive("on_bottom_m", 0.5, "m", "Bit within this distance of hole depth counts "
@@ -337,6 +346,19 @@ CHANNEL_KEYS = ("time", "surface_rpm", "surface_torque", "hookload", "bit_depth"
                 "flow_in", "flow_out", "pump_rate", "surface_torque_min", "surface_torque_max",
                 "surface_rpm_min", "surface_rpm_max", "hookload_min", "hookload_max")
 _CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
+
+
+def default(dotted: str) -> Any:
+    """The schema's default of ``"table.key"`` (for library functions whose parameters
+    mirror a configuration key: one source for every default).
+
+    Examples
+    --------
+    >>> default("rig.top_drive_inertia_kg_m2")
+    2900.0
+    """
+    table, key = dotted.split(".")
+    return next(k.default for k in SCHEMA[table] if k.name == key)
 
 
 def _table_type(table: str, keys: tuple[Key, ...]) -> type:

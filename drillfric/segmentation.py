@@ -88,17 +88,49 @@ class Segment:
 # Classification
 
 
+#: Time constant of the running level of the rotating torque, against which a speed dip is
+#: judged loaded or released [s].
+_LOAD_TAU_S = 10.0
+
+
 @njit(cache=True)
-def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_N, pumps,
-                     depth_mode, rotating_rpm, stop_rpm, slips_N, on_bottom_m, wob_on_N,
-                     trip_m_s, max_rop_m_s, carry):  # pragma: no cover - compiled; see classify()
+def _still_turning(rpm, torque, t, turning, level, dip_start, rotating_rpm, stop_rpm,
+                   dip_s, dip_fraction):  # pragma: no cover - compiled
+    """Rotation latch with hysteresis and loaded dips; returns (turning, dip start).
+
+    Rotation starts above ``rotating_rpm`` and ends below ``stop_rpm`` — unless the string
+    stays loaded: a dip below ``stop_rpm`` whose torque holds at least ``dip_fraction`` of
+    the rotating torque level, for at most ``dip_s``, is part of the rotation (a soft-torque
+    or slow top-drive controller lets the surface speed fall to ~0 between slips while the
+    string stays wound up).
+    """
+    if np.isnan(rpm):
+        return turning, dip_start
+    if not turning:
+        return rpm > rotating_rpm, np.nan
+    if rpm > stop_rpm:
+        return True, np.nan
+    start = t if np.isnan(dip_start) else dip_start
+    loaded = level > 0.0 and not np.isnan(torque) and abs(torque) >= dip_fraction * level
+    if loaded and t - start <= dip_s:
+        return True, start
+    return False, np.nan
+
+
+@njit(cache=True)
+def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, block_m, wob_N,
+                     pumps, depth_mode, rotating_rpm, stop_rpm, dip_s, dip_fraction, slips_N,
+                     on_bottom_m, wob_on_N, trip_m_s, max_rop_m_s,
+                     carry):  # pragma: no cover - compiled; see classify()
     """Causal per-sample rig state; updates ``carry`` in place (see :func:`classify`).
 
     ``carry`` = [previous time, previous block position, previous bit depth, hole depth,
-    started flag, smoothed downward bit speed, rotating latch]; ``pumps`` is 1 on, 0 off,
-    -1 unknown. Rotation has hysteresis: it starts above ``rotating_rpm`` and lasts until
-    the speed drops below ``stop_rpm`` (speed noise at standstill does not chatter, and a
-    slow creep start-up stays inside its segment).
+    started flag, smoothed downward bit speed, rotating latch, rotating torque level,
+    start of the current speed dip]; ``pumps`` is 1 on, 0 off, -1 unknown. Rotation has
+    hysteresis (:func:`_still_turning`): it starts above ``rotating_rpm`` and lasts until
+    the speed drops below ``stop_rpm`` and the string is unloaded (speed noise at standstill
+    does not chatter, a slow creep start-up stays inside its segment, and so do the brief
+    stops of a soft-torque drive while the string stays wound up).
     """
     n = time_s.size
     states = np.empty(n, np.int8)
@@ -106,6 +138,7 @@ def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_
     t_prev, block_prev, bit_prev = carry[0], carry[1], carry[2]
     hole, have_prev, v_down = carry[3], carry[4], carry[5]
     turning = carry[6] > 0
+    level, dip_start = carry[7], carry[8]
     for i in range(n):
         in_slips = hookload_N[i] < slips_N  # False for NaN hook load or no threshold (NaN)
         bit = bit_prev
@@ -132,8 +165,15 @@ def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_
             on_bottom = hole - bit <= on_bottom_m and v_down <= max_rop_m_s
         else:
             on_bottom = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
-        if not np.isnan(rpm[i]):
-            turning = rpm[i] > (stop_rpm if turning else rotating_rpm)
+        was = turning
+        turning, dip_start = _still_turning(rpm[i], torque_Nm[i], time_s[i], turning, level,
+                                            dip_start, rotating_rpm, stop_rpm, dip_s,
+                                            dip_fraction)
+        if turning and rpm[i] > rotating_rpm and not np.isnan(torque_Nm[i]):
+            dt_level = time_s[i] - t_prev if was and have_prev > 0 else _LOAD_TAU_S
+            level += (abs(torque_Nm[i]) - level) * min(1.0, dt_level / _LOAD_TAU_S)
+        elif not turning:
+            level = 0.0
         if np.isnan(rpm[i]) or np.isnan(time_s[i]):
             state = UNKNOWN
         elif in_slips:
@@ -155,6 +195,7 @@ def _classify_kernel(time_s, rpm, hookload_N, bit_in_m, hole_in_m, block_m, wob_
     carry[0], carry[1], carry[2] = t_prev, block_prev, bit_prev
     carry[3], carry[4], carry[5] = hole, have_prev, v_down
     carry[6] = 1.0 if turning else 0.0
+    carry[7], carry[8] = level, dip_start
     return states, bit_out
 
 
@@ -190,7 +231,7 @@ def _new_carry(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
     bit0 = 0.0 if _depth_mode(frame) == _DEPTH_BLOCK else np.nan
     if start is not None and _depth_mode(frame) == _DEPTH_BLOCK:
         bit0 = start
-    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0, 0.0])
+    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan])
 
 
 def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
@@ -200,14 +241,15 @@ def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
         raise InputError(f"no {' or '.join(missing)} channel to segment",
                          fix="map the time and surface speed columns in [channels]")
     slips = cfg.segmentation.slips_hookload_N
+    seg = cfg.segmentation
     states, bit = _classify_kernel(
         _column(frame, "time_s"), _column(frame, "surface_rpm"),
+        _column(frame, "surface_torque_Nm"),
         _column(frame, "hookload_N"), _column(frame, "bit_depth_m"),
         _column(frame, "hole_depth_m"), _column(frame, "block_position_m"),
         _column(frame, "wob_N"), _pumps(frame, cfg), _depth_mode(frame),
-        float(cfg.segmentation.rotating_rpm),
-        min(float(cfg.segmentation.rotating_stop_rpm),
-            float(cfg.segmentation.rotating_rpm)),
+        float(seg.rotating_rpm), min(float(seg.rotating_stop_rpm), float(seg.rotating_rpm)),
+        float(seg.dip_max_s), float(seg.dip_torque_fraction),
         np.nan if slips is None else float(slips),
         float(cfg.segmentation.on_bottom_m), float(cfg.segmentation.wob_on_bottom_N),
         float(cfg.segmentation.trip_speed_m_s),

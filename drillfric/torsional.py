@@ -321,6 +321,41 @@ class State:
         """String at rest with no twist."""
         return cls(np.zeros(grid.n_cells), np.zeros(grid.n_cells), np.zeros(2), t_s)
 
+    @classmethod
+    def wound(cls, grid: Grid, fc_Nm_m, torque_top_Nm: float, mu: float,
+              omega_rad_s: float = 0.0, t_s: float = 0.0) -> State:
+        """A string held twisted by friction, as it stands after it stuck while sliding.
+
+        τ(x) = sign(τ₀)·max(|τ₀| − μ∫₀ˣF_c dx, 0) — the sliding torque gradient μ·F_c frozen
+        from the surface torque τ₀ down to where the torque runs out (docs/theory.md §3,
+        static friction holds each cell) — and every cell at ``omega_rad_s``.
+
+        Parameters
+        ----------
+        grid : Grid
+        fc_Nm_m : array_like
+            F_c at the cells [N·m/m].
+        torque_top_Nm : float
+            Measured string torque at the surface τ₀ [N·m].
+        mu : float
+            Friction factor of the frozen gradient (the kinetic one) [-].
+
+        Examples
+        --------
+        >>> from drillfric.drillstring import Section, DrillString
+        >>> g = make_grid(DrillString((Section("dp", 0.15, 0.12, 1000.0, 0.075, 40.0, 79.3e9),
+        ...                            )), cells=10)
+        >>> tau = State.wound(g, np.full(10, 10.0), 3000.0, 0.5).torque_Nm(g)
+        >>> np.round(tau[:3]).tolist(), float(tau[-1])
+        ([2750.0, 2250.0, 1750.0], 0.0)
+        """
+        fc = np.broadcast_to(np.asarray(fc_Nm_m, dtype=float), grid.x_m.shape)
+        capacity = np.cumsum(fc * grid.dx_true_m) - 0.5 * fc * grid.dx_true_m  # to centres
+        torque = np.sign(torque_top_Nm) * np.maximum(abs(torque_top_Nm) - mu * capacity, 0.0)
+        omega = np.full(grid.n_cells, float(omega_rad_s))
+        return cls(omega + torque / grid.zeta_Nms, omega - torque / grid.zeta_Nms,
+                   np.array([float(omega_rad_s), 0.0]), t_s)
+
     @property
     def omega_rad_s(self) -> np.ndarray:
         """Angular velocity ω = (α + β)/2 of every cell [rad/s]."""

@@ -332,10 +332,12 @@ def test_compiled_kernel_matches_its_python_source():
     comparisons, integer codes); the Python source is the readable oracle."""
     data = _random_well(3, depth="block_position_m")
     data["wob_N"] = np.linspace(0.0, 20e3, len(data))
-    args = [_column(data, c) for c in ("time_s", "surface_rpm", "hookload_N", "bit_depth_m",
-                                        "hole_depth_m", "block_position_m", "wob_N")]
-    args += [_pumps(data, cfg()), 1, 5.0, 2.5, 300e3, 0.5, 10e3, 0.1, 300.0 / 3600.0]
-    carry = [np.nan, np.nan, 0.0, np.nan, 0.0, 0.0, 0.0]
+    data["surface_torque_Nm"] = np.where(data["surface_rpm"] > 1.0, 5e3, 100.0)
+    args = [_column(data, c) for c in ("time_s", "surface_rpm", "surface_torque_Nm",
+                                        "hookload_N", "bit_depth_m", "hole_depth_m",
+                                        "block_position_m", "wob_N")]
+    args += [_pumps(data, cfg()), 1, 5.0, 2.5, 10.0, 0.5, 300e3, 0.5, 10e3, 0.1, 300.0 / 3600.0]
+    carry = [np.nan, np.nan, 0.0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan]
     fast = _classify_kernel(*args, np.array(carry))
     slow = _classify_kernel.py_func(*args, np.array(carry))
     np.testing.assert_array_equal(fast[0], slow[0])
@@ -405,3 +407,33 @@ def test_dsats_drilling_agreement(dsats_result):
                    "record: 88.8 %; see docs/validation.md")
 def test_dsats_drilling_agreement_meets_acceptance(dsats_result):
     assert dsats_result["all"]["accuracy"] >= 0.90
+
+
+def _soft_torque_log(dip_torque: float, dip_s: float = 1.5) -> pd.DataFrame:
+    """A soft-torque drive: the top drive turns at 80 RPM for 4 s, then almost stops for
+    ``dip_s`` while the string stays wound (``dip_torque``), 30 times; 10 Hz."""
+    t = np.arange(0.0, 30 * (4.0 + dip_s) + 20.0, 0.1)
+    phase = np.mod(t - 10.0, 4.0 + dip_s)
+    turning = (t >= 10.0) & (t < t[-1] - 10.0)
+    dip = turning & (phase >= 4.0)
+    rpm = np.where(turning, np.where(dip, 0.3, 80.0), 0.0)
+    torque = np.where(turning, np.where(dip, dip_torque, 12e3), 0.0)
+    return pd.DataFrame({"time_s": t, "surface_rpm": rpm, "surface_torque_Nm": torque})
+
+
+def test_soft_torque_dips_while_wound_stay_one_segment():
+    """A regression: a soft-torque drive's dips to ~0 RPM while the string stays wound cut
+    one operation into ~30 pieces, none long enough to converge."""
+    segs = segment(_soft_torque_log(dip_torque=11e3), cfg())
+    assert len(segs) == 1 and segs[0].duration_s > 150.0
+
+
+def test_a_stop_with_the_torque_released_ends_the_rotation():
+    """Released torque (below half the rotating level) is a real stop: one piece per turn."""
+    segs = segment(_soft_torque_log(dip_torque=1e3), cfg(min_segment_s=1.0))
+    assert len(segs) == 30
+
+
+def test_a_loaded_stop_longer_than_the_dip_limit_ends_the_rotation():
+    segs = segment(_soft_torque_log(dip_torque=11e3, dip_s=15.0), cfg(min_segment_s=1.0))
+    assert len(segs) == 30

@@ -34,11 +34,19 @@ from scipy.optimize import minimize_scalar
 from scipy.signal import savgol_filter
 
 from drillfric import torsional
+from drillfric.config import default
 from drillfric.drillstring import DrillString
 from drillfric.errors import InputError
-from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
+from drillfric.estimation import creep
+from drillfric.estimation.creep import bridge_loaded_dips, find_creeps, rotating_runs, smooth
 
 MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
+WOUND_SPAN_S = 0.5  #: rest at a window's start over which a trapped torque is measured [s]
+#: A stop of the top drive at most this long, with the string still loaded (torque at least
+#: DIP_TORQUE_FRACTION of the run's mean), does not end a rotating run (soft-torque drives):
+#: the configuration's segmentation.dip_max_s and dip_torque_fraction [s], [-].
+DIP_MAX_S, DIP_TORQUE_FRACTION = (default("segmentation.dip_max_s"),
+                                  default("segmentation.dip_torque_fraction"))
 PRE_ROLL_S = 2.0  #: model starts this long before a run or creep leaves rest [s]
 DRIVE_SMOOTH_S = 0.2  #: light smoothing of the speed that drives the model [s]
 TORQUE_SMOOTH_S = 1.0  #: smoothing of torques compared in the creep misfit [s]
@@ -252,7 +260,10 @@ class _Window:
 
 
 class _Model:
-    """The speed-driven plant on grids of any resolution; counts its runs (THEORY §6.4)."""
+    """The speed-driven plant on grids of any resolution; counts its runs (THEORY §6.4).
+
+    Each window starts from rest, holding the twist the measured torque says the string has
+    there (:meth:`drillfric.torsional.State.wound`; none after a released stop)."""
 
     def __init__(self, string, fc_fn, omega_c, k_t, itd, data: _Data, progress):
         self.string, self.fc_fn, self.data = string, fc_fn, data
@@ -272,6 +283,17 @@ class _Model:
         g, fc = self.grid(cells)
         return float(np.sum(fc * g.dx_true_m))
 
+    def _initial(self, win: _Window, g, fc, mu_k: float) -> torsional.State:
+        """The state a window starts from: at rest, holding the twist of the torque measured
+        over its first :data:`WOUND_SPAN_S` when the top drive is at rest all that time (a
+        creep window starts untwisted: creeps with trapped torque are not used)."""
+        d = self.data
+        t0 = float(d.t[win.sim0])
+        span = slice(win.sim0, max(win.sim0 + 1, d.index(t0 + WOUND_SPAN_S)))
+        if win.creep or np.any(np.abs(d.w_bar[span]) > creep.REST_FRACTION * self.omega_c):
+            return torsional.State.rest(g, t0)
+        return torsional.State.wound(g, fc, float(np.median(d.tau[span])), mu_k, t_s=t0)
+
     def simulate(self, win: _Window, mu_s: float, mu_k: float,
                  cells: int) -> tuple[np.ndarray, np.ndarray]:
         """String torque [N·m] and bit speed [rad/s] at samples sim0..end."""
@@ -283,7 +305,7 @@ class _Model:
         drive = torsional.Drive("speed", speed[win.sim0:win.end + 1], d.dt, d.t[win.sim0])
         t = d.t[win.sim0:win.end + 1]
         rec, _ = torsional.run(plant, drive, t[-1] - t[0], 1.0 / d.dt,
-                               torsional.State.rest(g, float(t[0])))
+                               self._initial(win, g, fc, mu_k))
         self.runs += 1
         if self.progress is not None:
             self.progress(1.0)
@@ -306,7 +328,8 @@ def _mu_k_windows(data: _Data, omega_c: float) -> tuple[list[_Window], list[str]
     """One window per rotating run with samples ≥ MU_K_SKIP_S after first exceeding ω_c."""
     pre = int(round(PRE_ROLL_S / data.dt))
     wins, notes = [], []
-    for i0, i1 in rotating_runs(data.w_bar, omega_c):
+    for i0, i1 in bridge_loaded_dips(rotating_runs(data.w_bar, omega_c), data.t, data.tau_bar,
+                                     max_dip_s=DIP_MAX_S, fraction=DIP_TORQUE_FRACTION):
         fast = np.flatnonzero(data.w_bar[i0:i1 + 1] > omega_c)
         if fast.size == 0:
             continue

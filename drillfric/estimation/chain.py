@@ -229,9 +229,16 @@ def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: 
     members = ensemble_starts(mu_s, mu_k, cfg.observer.ensemble_members,
                               cfg.observer.ensemble_spread, observer.mu_max)
     state = ObserverState.from_starts(observer, members, omega0_rad_s=meas.surface_rad_s[0],
-                                      t_s=meas.t0_s)
+                                      t_s=meas.t0_s, torque_top_Nm=_initial_torque(meas))
     final, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz)
     return final
+
+
+def _initial_torque(meas: Measurements, span_s: float = 0.5) -> float:
+    """Measured torque at the start of a segment [N·m] (median over ``span_s``: the twist the
+    string holds when the segment starts from rest)."""
+    n = max(1, int(round(span_s / meas.dt_s)))
+    return float(np.median(meas.motor_torque_Nm[:n]))
 
 
 def _td_cross_check(models: SegmentModels, cfg) -> float | None:
@@ -377,7 +384,7 @@ def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
     meas, observer = models.meas, models.observer
     starts = _starts(cfg, warm, observer.mu_max)
     state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
-                                      t_s=meas.t0_s)
+                                      t_s=meas.t0_s, torque_top_Nm=_initial_torque(meas))
     window_end = min(meas.t_end_s, meas.t0_s + cfg.observer.starts_window_s)
     first, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz,
                        t_end_s=window_end)

@@ -77,6 +77,40 @@ def rotating_runs(omega_bar_rad_s, omega_c_rad_s: float,
     return _runs(np.asarray(omega_bar_rad_s, dtype=float) > rest)
 
 
+def bridge_loaded_dips(runs: list[tuple[int, int]], time_s, torque_Nm, *,
+                       max_dip_s: float = 10.0,
+                       fraction: float = 0.5) -> list[tuple[int, int]]:
+    """Join rotating runs separated by a brief stop while the string stays loaded.
+
+    A soft-torque or slow top-drive controller lets the surface speed fall to ~0 between
+    slips while the string stays wound up: that is one rotation, not many short ones
+    (the segmentation's rule, :func:`drillfric.segmentation._still_turning`). Two runs are
+    joined when the stop between them lasts at most ``max_dip_s`` and the smoothed torque
+    holds at least ``fraction`` of the previous run's mean torque throughout it.
+
+    Examples
+    --------
+    >>> t = np.arange(10.0)
+    >>> tau = np.array([5, 5, 5, 4, 5, 5, 0, 0, 5, 5.0])
+    >>> bridge_loaded_dips([(0, 2), (4, 5), (8, 9)], t, tau, max_dip_s=3.0)
+    [(0, 5), (8, 9)]
+    """
+    t = np.asarray(time_s, dtype=float)
+    tau = np.abs(np.asarray(torque_Nm, dtype=float))
+    out: list[list[int]] = []
+    for i0, i1 in runs:
+        if out:
+            a0, a1 = out[-1]
+            gap = tau[a1 + 1:i0]
+            level = float(np.mean(tau[a0:a1 + 1]))
+            if t[i0] - t[a1] <= max_dip_s and gap.size and level > 0 and \
+                    float(gap.min()) >= fraction * level:
+                out[-1][1] = i1
+                continue
+        out.append([i0, i1])
+    return [(a, b) for a, b in out]
+
+
 def find_creeps(time_s, surface_rad_s, omega_c_rad_s: float, *, torque_Nm=None,
                 min_hold_s: float = 10.0, rest_s: float = 2.0, smooth_s: float = 1.0,
                 rest_rad_s: float | None = None,

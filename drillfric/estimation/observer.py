@@ -25,7 +25,7 @@ from scipy.signal import lfilter
 from drillfric.errors import InputError, ModelError
 from drillfric.estimation.gains import Gains
 from drillfric.kernels.observer import LAW_CORRECTED, LAW_PAPER, OBS_COLUMNS
-from drillfric.torsional import Plant
+from drillfric.torsional import Plant, State
 
 _LAWS = {"corrected": LAW_CORRECTED, "paper": LAW_PAPER}
 
@@ -187,12 +187,15 @@ class ObserverState:
 
     @classmethod
     def from_starts(cls, observer: Observer, starts, *, omega0_rad_s: float = 0.0,
-                    t_s: float = 0.0) -> ObserverState:
+                    t_s: float = 0.0, torque_top_Nm: float = 0.0) -> ObserverState:
         """Initial states for ``starts`` = [(μ_s, μ_k), ...].
 
-        At rest (|ω₀| ≤ ω_c): no twist. Rotating: every cell at ω₀ with the steady sliding
-        torque τ(x) = sign(ω₀)·μ_k∫ₓᴸF_c dx (THEORY §3.1, steady rotation), so a window
-        that starts mid-rotation does not begin with a huge transient.
+        Rotating (|ω₀| > ω_c): every cell at ω₀ with the steady sliding torque
+        τ(x) = sign(ω₀)·μ_k∫ₓᴸF_c dx (THEORY §3.1, steady rotation), so a window that starts
+        mid-rotation does not begin with a huge transient. At rest: the string held by
+        friction at the measured surface torque ``torque_top_Nm`` [N·m]
+        (:meth:`drillfric.torsional.State.wound` with each start's μ_k) — never untwisted
+        when the measured torque says it is wound (a stop inside a soft-torque rotation).
         """
         starts = np.atleast_2d(np.asarray(starts, dtype=float))
         if starts.shape[1] != 2 or np.any(starts < 0) or np.any(starts[:, 1] > starts[:, 0]):
@@ -206,6 +209,9 @@ class ObserverState:
         if abs(omega0_rad_s) > plant.omega_c_rad_s:
             below = np.cumsum((plant.fc_Nm_m * g.dx_true_m)[::-1])[::-1]
             torque = np.sign(omega0_rad_s) * starts[:, 1:2] * below[None, :]
+        elif torque_top_Nm:
+            torque = np.stack([State.wound(g, plant.fc_Nm_m, torque_top_Nm, mu_k).torque_Nm(g)
+                               for mu_k in starts[:, 1]])
         alpha = omega + torque / g.zeta_Nms
         beta = omega - torque / g.zeta_Nms
         return cls(alpha, beta, np.full(n_start, float(omega0_rad_s)),
