@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -51,6 +51,7 @@ from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import (
     ESTIMATE_NAMES,
     SEEDED_START_ID,
+    Flag,
     Kind,
     SegmentRecord,
     Status,
@@ -64,6 +65,9 @@ DEFAULT_BIT_DEPTH_M = 2500.0
 #: Relative margin by which a requested rate may exceed the data's nominal rate (timing
 #: jitter) before it counts as upsampling.
 RATE_MARGIN = 0.01
+#: Flags a short segment may carry and still be pooled (it is only too short).
+_POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
+                       "estimators_disagree"})
 
 
 @dataclass(frozen=True)
@@ -210,7 +214,8 @@ def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
                          fix="check that the file holds samples below its header")
     check.finish(tracker.duplicates)
     warnings += [w for w in (check.nothing_found(len(records)),) if w]
-    summary = summarise(well, records, estimator, check.rows, rate_hz, warnings,
+    records, pools = pool_short_segments(records)
+    summary = summarise(well, records, pools, estimator, check.rows, rate_hz, warnings,
                         time.perf_counter() - t_wall)
     summary["time_origin_utc"] = _iso(tracker.origin)
     track_frame = tracks.result()
@@ -508,16 +513,68 @@ class _DirectorySink:
 
 
 # --------------------------------------------------------------------------- step 4
-def consensus(records: list[SegmentRecord]) -> dict:
+#: Short segments pool when their bit depths are within this [m] (one stand's depth)...
+POOL_DEPTH_M = 5.0
+#: ...their μ_k agree within this (max/min − 1) [-]...
+POOL_AGREEMENT = 0.05
+#: ...and together they hold at least this much rotation [s] (the converged minimum).
+POOL_MIN_ROTATION_S = 90.0
+
+
+def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]:
+    """Pool short off-bottom segments at one bit depth whose μ_k agree into one estimate.
+
+    Segments too short to converge alone (only ``too_short_to_converge`` keeps them from
+    it) at one depth (within :data:`POOL_DEPTH_M`), whose batch μ_k agree within
+    :data:`POOL_AGREEMENT` and which together rotate for :data:`POOL_MIN_ROTATION_S`, give a
+    converged estimate: the rotation-weighted mean μ_k. Returns the records (members flagged
+    ``pooled``) and the pools (summary.json ``pooled``).
+    """
+
+    short = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
+             and not r.converged and r.method.value == "batch" and r.mu_k is not None
+             and set(r.flags) <= _POOLABLE]
+    groups: list[list[SegmentRecord]] = []
+    for r in sorted(short, key=lambda r: r.bit_depth_m):
+        if groups and r.bit_depth_m - groups[-1][0].bit_depth_m <= POOL_DEPTH_M:
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    pools, members = [], {}
+    for group in groups:
+        mu = np.array([r.mu_k for r in group])
+        weight = np.array([r.duration_s for r in group])
+        if len(group) < 2 or weight.sum() < POOL_MIN_ROTATION_S or \
+                mu.max() / mu.min() - 1.0 > POOL_AGREEMENT:
+            continue
+        pool = {"segment_ids": [r.id for r in group],
+                "bit_depth_m": float(np.median([r.bit_depth_m for r in group])),
+                "mu_k": float(np.sum(mu * weight) / weight.sum()),
+                "mu_k_spread": float(mu.max() - mu.min()), "rotation_s": float(weight.sum())}
+        pools.append(pool)
+        members |= {r.id: pool for r in group}
+    return [_pooled(r, members[r.id]) if r.id in members else r for r in records], pools
+
+
+def _pooled(record: SegmentRecord, pool: dict) -> SegmentRecord:
+    note = (f"pooled with segments {', '.join(map(str, pool['segment_ids']))} at "
+            f"{pool['bit_depth_m']:.0f} m: μ_k = {pool['mu_k']:.3f} over "
+            f"{pool['rotation_s']:.0f} s of rotation")
+    return replace(record, flags=record.flags + (Flag.POOLED,),
+                   message="; ".join(filter(None, [record.message, note])))
+
+
+def consensus(records: list[SegmentRecord], pools: list[dict] = ()) -> dict:
     """Well-level friction factors from the segments (never a made-up value).
 
-    Only converged, off-bottom segments with status ok count. μ_k: their median; μ_s: the
-    median over those that identify it; otherwise the median of their lower bounds (each is
-    claimed valid, so the median is too, and one unreliable segment cannot set it).
+    Only converged, off-bottom segments with status ok count, and pools of short segments
+    (:func:`pool_short_segments`) as one each. μ_k: their median; μ_s: the median over those
+    that identify it; otherwise the median of their lower bounds (each is claimed valid, so
+    the median is too, and one unreliable segment cannot set it).
     """
     ok = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
           and r.converged]
-    mu_k = [r.mu_k for r in ok if r.mu_k is not None]
+    mu_k = [r.mu_k for r in ok if r.mu_k is not None] + [p["mu_k"] for p in pools]
     mu_s = [r.mu_s for r in ok if r.mu_s_identifiable and r.mu_s is not None]
     bounds = [r.mu_s_lower_bound for r in ok if r.mu_s_lower_bound is not None]
     return {"mu_k": float(np.median(mu_k)) if mu_k else None,
@@ -525,8 +582,9 @@ def consensus(records: list[SegmentRecord]) -> dict:
             "mu_s_lower_bound": None if mu_s or not bounds else float(np.median(bounds))}
 
 
-def summarise(well: Well, records: list[SegmentRecord], estimator: _SegmentEstimator,
-              n_rows: int, rate_hz, warnings: list, wall_s: float) -> dict:
+def summarise(well: Well, records: list[SegmentRecord], pools: list[dict],
+              estimator: _SegmentEstimator, n_rows: int, rate_hz, warnings: list,
+              wall_s: float) -> dict:
     """summary.json (docs/outputs.md)."""
     files = {"data": well.files.data, "config": well.files.config,
              "survey": well.files.survey}
@@ -535,8 +593,8 @@ def summarise(well: Well, records: list[SegmentRecord], estimator: _SegmentEstim
     inputs.update(rows=n_rows, resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
     assumed = well.assumed + estimator.assumed
     count = {s: sum(r.status is s for r in records) for s in Status}
-    return {"well": well.name, "drillfric_version": __version__, **consensus(records),
-            "segments": [r.to_json() for r in records], "inputs": inputs,
+    return {"well": well.name, "drillfric_version": __version__, **consensus(records, pools),
+            "pooled": pools, "segments": [r.to_json() for r in records], "inputs": inputs,
             "config": well.config.to_dict(), "assumed": assumed, "indicative": bool(assumed),
             "counts": {"segments": len(records), "estimated": count[Status.OK],
                        "converged": sum(r.status is Status.OK and r.converged

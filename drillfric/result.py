@@ -57,6 +57,7 @@ class Flag(StrEnum):
     TOO_SHORT_TO_CONVERGE = "too_short_to_converge"
     OUTSIDE_TYPICAL_RANGE = "outside_typical_range"
     BIT_TORQUE_IN_FRICTION = "bit_torque_in_friction"
+    POOLED = "pooled"
 
 
 #: What each flag means (docs/outputs.md).
@@ -80,6 +81,8 @@ FLAG_MEANINGS = {
     Flag.TOO_SHORT_TO_CONVERGE: "less than 90 s of rotation: not converged",
     Flag.OUTSIDE_TYPICAL_RANGE: "μ_k outside 0.05–0.8: check string, survey, torque units",
     Flag.BIT_TORQUE_IN_FRICTION: "on bottom: the bit torque is in the apparent friction",
+    Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
+                 "μ_k agree (summary.json pooled)",
 }
 
 
