@@ -21,10 +21,8 @@ import difflib
 import re
 from dataclasses import dataclass
 
-import pint
-
 from drillfric.errors import InputError
-from drillfric.units import UREG, parse_unit
+from drillfric.units import parse_unit, registry
 
 
 @dataclass(frozen=True)
@@ -182,16 +180,18 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     >>> round(factor("klbf", BY_KEY["hookload"]), 3)
     4448.222
     """
+    import pint
+
     source = _source_unit(unit, channel, file)
     try:
-        return float(UREG.Quantity(1.0, source).to(channel.unit).magnitude)
+        return float(registry().Quantity(1.0, source).to(channel.unit).magnitude)
     except pint.errors.DimensionalityError as exc:
         raise InputError(f"unit '{unit}' of {channel.name} is not a {channel.kind} unit",
                          file=file, fix=f'give a {channel.kind} unit, e.g. {channel.key} = '
                                         f'{{ unit = "{channel.default_unit}" }}') from exc
 
 
-def _source_unit(unit: str, channel: Channel, file: str | None) -> pint.Unit:
+def _source_unit(unit: str, channel: Channel, file: str | None):
     """The pint unit of a spelling, read as the channel reads it (1/min is RPM on a speed)."""
     key = unit.strip().lower().replace(" ", "")
     spelled = _EXTRA_UNITS.get(key, unit)
@@ -219,8 +219,9 @@ def unit_fits(unit: str, channel: Channel) -> bool | None:
         source = _source_unit(unit, channel, None)
     except InputError:
         return None
-    return (UREG.Quantity(1.0, source).dimensionality
-            == UREG.Quantity(1.0, channel.unit).dimensionality)
+    reg = registry()
+    return (reg.Quantity(1.0, source).dimensionality
+            == reg.Quantity(1.0, channel.unit).dimensionality)
 
 
 @dataclass(frozen=True)
