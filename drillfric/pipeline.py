@@ -161,6 +161,11 @@ def run_well(well: Well, out_root=None, *, rate_hz: float | None = None, pdf: bo
         Unreadable or meaningless input, or results that cannot be written (nothing is
         written then).
     """
+    if well.depth_indexed:  # no time series: a static friction log by depth
+        from drillfric.friction_log import run_depth_log
+
+        return run_depth_log(well, out_root, rate_hz=rate_hz, pdf=pdf, report=report,
+                             progress=progress, chunk_rows=chunk_rows)
     t_wall = time.perf_counter()
     if out_root is None:
         return _run(well, _MemorySink(), rate_hz, progress, chunk_rows, t_wall)
