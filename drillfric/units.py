@@ -350,7 +350,7 @@ def _magnitude(match: re.Match) -> Decimal:
     return Decimal(match["number"])
 
 
-def quantity_value(text: str, unit: str, *, what: str = "value", file=None,
+def quantity_value(text: str, unit: str, *, what: str = "", file=None,
                    bare: bool = False) -> float:
     """A quantity written by a person, in ``unit``: ``"10.5 ppg"`` → 1258.177… (kg/m³).
 
@@ -368,7 +368,8 @@ def quantity_value(text: str, unit: str, *, what: str = "value", file=None,
         Target unit: a label of :data:`LABEL_UNITS` (``"kg/m³"``, ``"m"``, ``"RPM"``) or
         a pint expression.
     what : str
-        What the value is, for messages (``"key 'fluid.mud_density_kg_m3'"``, ``"--wob"``).
+        What the value is, for messages (``"key 'fluid.mud_density_kg_m3'"``); empty when
+        the caller names it (a command-line option).
     file : str or Path, optional
         Where the value was written, for messages.
     bare : bool
@@ -394,18 +395,19 @@ def quantity_value(text: str, unit: str, *, what: str = "value", file=None,
         text = text.replace(char, spelled)
     match = _QUANTITY.match(text)
     example = f'"{_EXAMPLE_VALUE.get(name, "1.0 " + unit)}"'
+    given = f"{what} = '{_shown(text.strip())}'" if what else f"'{_shown(text.strip())}'"
     if match is None:
-        raise ConfigError(f"{what} = '{_shown(text)}' is not a number with a unit", file=file,
-                          fix=f"write e.g. {example}")
+        problem = (f"{what} must be a number or a number with a unit, got "
+                   f"'{_shown(text.strip())}'" if what else f"{given} is not a number")
+        raise ConfigError(problem, file=file, fix=f"write e.g. {example}")
     if not match["unit"]:
         if bare:
             return float(_magnitude(match))
-        raise ConfigError(f"{what} = '{_shown(text)}' has no unit", file=file,
+        raise ConfigError(f"{given} has no unit", file=file,
                           fix=f"write the number without quotes (in {unit}) or with its unit, "
                               f"e.g. {example}")
     expected = f"{name} ({unit})" if name else unit
-    return _convert(_magnitude(match), match["unit"], expr, expected,
-                    f"{what} = '{_shown(text.strip())}'", file, example)
+    return _convert(_magnitude(match), match["unit"], expr, expected, given, file, example)
 
 
 def _convert(magnitude: Decimal, spelled: str, expr: str, expected: str, what: str, file,
@@ -441,10 +443,15 @@ _EXAMPLE_VALUE = {"length": "8200 ft", "density": "10.5 ppg", "linear mass": "19
                   "2900 kg.m**2", "dogleg severity": "3 deg/(100 ft)"}
 
 
+#: Further quantities named in messages (a value given in kg where a length is expected).
+_OTHER_QUANTITIES = (("kilogram", "mass"), ("meter**2", "area"), ("meter**3", "volume"),
+                     ("dimensionless", "pure number"))
+
+
 def _dimension_name(quantity) -> str:
     """'a length', 'a density' … for a pint quantity (its dimensionality when unnamed)."""
     reg = quantity._REGISTRY
-    for expr, name in LABEL_UNITS.values():
+    for expr, name in (*LABEL_UNITS.values(), *_OTHER_QUANTITIES):
         if reg.parse_expression(expr).dimensionality == quantity.dimensionality:
             return f"a {name}"
     return f"of dimension {quantity.dimensionality}"

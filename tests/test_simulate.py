@@ -328,8 +328,9 @@ def test_cli_without_survey_simulates_the_path_run_assumes(tmp_path):
     assert truth["stands"][0]["T_N_Nm"] > 1e3
     survey = pd.read_csv(tmp_path / "v.survey.csv")
     assert survey["inc_deg"].max() == pytest.approx(1.59, abs=0.01)  # a 1°/30 m helix
-    cfg.write_text("[survey]\ntortuosity_deg_30m = 0.0\n" + CONFIG)
-    result = CliRunner().invoke(cli, ["simulate", str(cfg), "--out", str(tmp_path / "w.csv"),
+    flat = tmp_path / "flat.toml"  # v.toml now has v.survey.csv beside it, which it would use
+    flat.write_text("[survey]\ntortuosity_deg_30m = 0.0\n" + CONFIG)
+    result = CliRunner().invoke(cli, ["simulate", str(flat), "--out", str(tmp_path / "w.csv"),
                                       "--duration", "15", "--bit-depth", "1500"])
     assert result.exit_code == 0, result.output
     assert "tortuosity of 0°/30 m" in result.output

@@ -356,6 +356,27 @@ def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
     return WellFiles(data_path, config_path, survey_path), raw
 
 
+def config_survey(config_path, *, survey=None) -> tuple[Path | None, dict]:
+    """The survey file of a configuration used on its own (``simulate NAME.toml``,
+    ``td NAME.toml``) and its raw mapping, found as :func:`open_well` finds a data file's:
+    ``survey`` (``--survey``) > the configuration's ``[survey] file`` (relative to it) >
+    ``NAME.survey.{csv,parquet}`` beside ``NAME.toml``.
+
+    Raises
+    ------
+    InputError, ConfigError
+        The configuration or the survey it names is missing; the TOML is invalid.
+    """
+    config_path = Path(config_path)
+    if not config_path.is_file():
+        raise InputError("config file not found", file=config_path, fix="check the path")
+    raw = read_toml(config_path)
+    path = Path(survey) if survey is not None else _find_survey(config_path, config_path, raw)
+    if path is not None and not path.is_file():
+        raise InputError("survey file not found", file=path, fix="check the path")
+    return path, raw
+
+
 def _directory_data(folder: Path) -> tuple[Path, Path, dict]:
     well_toml = folder / "well.toml"
     if not well_toml.is_file():
