@@ -198,6 +198,10 @@ class Quantity(click.ParamType):
     def __init__(self, unit: str):
         self.unit = unit
 
+    def get_metavar(self, param, ctx=None) -> str:
+        """The unit as the metavar (``--bit-depth M``, ``--rate HZ``), as INTERFACE.md writes."""
+        return {"N·m": "NM", "m/s": "M/S"}.get(self.unit, self.unit.upper())
+
     def convert(self, value, param, ctx):
         if isinstance(value, int | float) and not isinstance(value, bool):
             return float(value)

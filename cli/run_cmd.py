@@ -8,7 +8,16 @@ import click
 
 from drillfric.errors import DrillfricError
 
-from .common import UserError, context, echo, unit_system, units_option, warn, well_progress
+from .common import (
+    Quantity,
+    UserError,
+    context,
+    echo,
+    unit_system,
+    units_option,
+    warn,
+    well_progress,
+)
 
 
 def parse_starts(text: str | None) -> list[tuple[float, float]] | None:
@@ -75,8 +84,9 @@ def _describe_depth_log(result, units: str) -> str:
               "overrides the NAME.toml sidecar.")
 @click.option("--survey", type=click.Path(path_type=Path), help="Survey file, overrides the "
               "NAME.survey.* sidecar.")
-@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation "
-              "(not above the data's own rate: a higher HZ is ignored with a warning).")
+@click.option("--rate", "rate", type=Quantity("Hz"), help="Resample the input to HZ before "
+              "estimation (not above the data's own rate: a higher HZ is ignored with a "
+              "warning).")
 @click.option("--starts", help="Observer starts MU_S:MU_K,... (overrides observer.starts).")
 @click.option("--pdf/--no-pdf", default=False, help="Also write report.pdf.")
 @click.option("--report/--no-report", default=True, show_default=True,

@@ -352,7 +352,6 @@ def run_depth_log(well: Well, out_root=None, *, rate_hz: float | None = None,
 
             _write_report(tmp, pdf, result)
     result.out_dir = Path(out_root) / well.dir_name
-    result._estimates = None
     return result
 
 
