@@ -23,29 +23,22 @@ def _overrides(**options) -> dict:
     return {keys[k]: v for k, v in options.items() if v is not None}
 
 
-def _load(config: Path, raw: dict, overrides: dict, omega_c_rpm: float | None):
-    from drillfric.config import config_from_dict
+def _load(config: Path, survey: Path | None, overrides: dict, omega_c_rpm: float | None):
+    """The configuration and its survey (``--survey`` > ``[survey] file`` >
+    ``NAME.survey.{csv,parquet}`` beside ``NAME.toml``, as ``run`` finds a well's:
+    :func:`drillfric.io.well.open_config`), with ``--omega-c-rpm`` in the configuration's
+    own ω_c key."""
+    from drillfric.io.well import open_config
 
-    cfg = config_from_dict(raw, file=config, overrides=overrides)
+    cfg, survey_path, well_path = open_config(config, survey=survey, overrides=overrides)
     if omega_c_rpm is not None:
         key = "model.omega_c_rpm" if cfg.model.omega_c_rpm is not None or \
             cfg.model.omega_c_rad_s is None else "model.omega_c_rad_s"
         from drillfric.units import RPM_TO_RAD_S
 
         value = omega_c_rpm if key.endswith("rpm") else omega_c_rpm * RPM_TO_RAD_S
-        cfg = config_from_dict(raw, file=config, overrides=overrides | {key: value})
-    return cfg
-
-
-def _survey(config: Path, survey: Path | None):
-    """The survey file and well path of a configuration (``--survey`` > ``[survey] file`` >
-    ``NAME.survey.{csv,parquet}`` beside ``NAME.toml``, as ``run`` finds them), and the raw
-    configuration."""
-    from drillfric.io.survey import read_survey
-    from drillfric.io.well import config_survey
-
-    path, raw = config_survey(config, survey=survey)
-    return path, None if path is None else read_survey(path), raw
+        cfg = open_config(config, survey=survey, overrides=overrides | {key: value})[0]
+    return cfg, survey_path, well_path
 
 
 def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool):
@@ -120,8 +113,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     overrides = _overrides(duration=duration, rate=rate, mu_s=mu_s, mu_k=mu_k,
                            bit_depth=bit_depth, rpm=rpm, seed=seed, rpm_noise=rpm_noise,
                            torque_noise=torque_noise, wob=wob, cells=cells)
-    survey_path, well_path, raw = _survey(config, survey)
-    cfg = _load(config, raw, overrides, omega_c_rpm)
+    cfg, survey_path, well_path = _load(config, survey, overrides, omega_c_rpm)
     _, plan = _scenario(cfg, config, scenario, well_path,
                         single=bit_depth is not None and scenario is None)
     sim.check_depths(plan, well_path, survey_path)

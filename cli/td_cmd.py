@@ -25,22 +25,18 @@ def _load(target: Path, config: str | None, survey: str | None, overrides: dict)
     """(Config, WellPath or None) for a .toml configuration, a data file or a well directory.
 
     A configuration's survey is ``--survey``, else its ``[survey] file`` (relative to it),
-    else ``NAME.survey.csv`` beside ``NAME.toml``
-    (:func:`drillfric.io.well.config_survey`); ``--config`` overrides the configuration.
-    Other targets are resolved like every command does (:func:`drillfric.io.well.
-    open_well`: sidecars, HDF5 bundles, directories).
+    else ``NAME.survey.csv`` beside ``NAME.toml`` (:func:`drillfric.io.well.open_config`);
+    ``--config`` overrides the configuration. Other targets are resolved like every command
+    does (:func:`drillfric.io.well.open_well`: sidecars, HDF5 bundles, directories).
     """
-    from drillfric.config import config_from_dict
-    from drillfric.io.survey import read_survey
-    from drillfric.io.well import config_survey
+    from drillfric.io.well import open_config
 
     if target.suffix.lower() == ".toml":
         if not target.is_file():
             raise InputError("config file not found", file=target, fix="check the path")
-        cfg_path = Path(config) if config else target
-        survey_path, raw = config_survey(cfg_path, survey=survey)
-        cfg = config_from_dict(raw, file=cfg_path, overrides=overrides)
-        return cfg, None if survey_path is None else read_survey(survey_path)
+        cfg, _, path = open_config(Path(config) if config else target, survey=survey,
+                                   overrides=overrides)
+        return cfg, path
     from drillfric.io.well import open_well
 
     well = open_well(target, config=config, survey=survey, overrides=overrides, header=False)

@@ -264,6 +264,27 @@ def open_well(path, *, config=None, survey=None, overrides=None, name: str | Non
                 mappings=mappings)
 
 
+def open_config(config, *, survey=None, overrides=None
+                ) -> tuple[Config, Path | None, WellPath | None]:
+    """A well configuration on its own (``simulate NAME.toml``, ``td NAME.toml``): the
+    configuration read once and its survey — ``survey``, else the configuration's
+    ``[survey] file``, else ``NAME.survey.{csv,parquet}`` beside it, as for a data file.
+
+    Returns
+    -------
+    (Config, survey path or None, WellPath or None)
+    """
+    path = Path(config)
+    if not path.is_file():
+        raise InputError("config file not found", file=path, fix="check the path")
+    raw = read_toml(path)
+    survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw)
+    if survey_path is not None and not survey_path.is_file():
+        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    return (config_from_dict(raw, file=path, overrides=overrides), survey_path,
+            _load_survey(survey_path))
+
+
 def default_name(path, data_path: Path) -> str:
     """A well's name when nothing names it: the directory's name (resolved, so ``.`` is the
     folder it stands for) or the data file's stem."""
@@ -354,27 +375,6 @@ def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
     if survey_path is not None and not survey_path.is_file():
         raise InputError("survey file not found", file=survey_path, fix="check the path")
     return WellFiles(data_path, config_path, survey_path), raw
-
-
-def config_survey(config_path, *, survey=None) -> tuple[Path | None, dict]:
-    """The survey file of a configuration used on its own (``simulate NAME.toml``,
-    ``td NAME.toml``) and its raw mapping, found as :func:`open_well` finds a data file's:
-    ``survey`` (``--survey``) > the configuration's ``[survey] file`` (relative to it) >
-    ``NAME.survey.{csv,parquet}`` beside ``NAME.toml``.
-
-    Raises
-    ------
-    InputError, ConfigError
-        The configuration or the survey it names is missing; the TOML is invalid.
-    """
-    config_path = Path(config_path)
-    if not config_path.is_file():
-        raise InputError("config file not found", file=config_path, fix="check the path")
-    raw = read_toml(config_path)
-    path = Path(survey) if survey is not None else _find_survey(config_path, config_path, raw)
-    if path is not None and not path.is_file():
-        raise InputError("survey file not found", file=path, fix="check the path")
-    return path, raw
 
 
 def _directory_data(folder: Path) -> tuple[Path, Path, dict]:
