@@ -180,3 +180,58 @@ def well_progress(name: str):
                        detail=f"{event.rows_done:,} rows, {event.segments_done} segments")
 
         yield update
+
+
+class Quantity(click.ParamType):
+    """A physical option value: a number in the option's unit, or a number with a unit
+    (``--bit-depth "8200 ft"``), converted exactly (:func:`drillfric.units.quantity_value`).
+
+    Parameters
+    ----------
+    unit : str
+        The option's unit, a label of :data:`drillfric.units.LABEL_UNITS` (``"m"``,
+        ``"N"``, ``"N·m"``, ``"RPM"``, ``"s"``, ``"Hz"``, ``"m/s"``).
+    """
+
+    name = "quantity"
+
+    def __init__(self, unit: str):
+        self.unit = unit
+
+    def get_metavar(self, param, ctx=None) -> str:
+        """The unit as the metavar (``--bit-depth M``, ``--rate HZ``), as INTERFACE.md writes."""
+        return {"N·m": "NM", "m/s": "M/S"}.get(self.unit, self.unit.upper())
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        try:
+            return float(value)  # a plain number: no pint needed
+        except (TypeError, ValueError):
+            pass
+        from drillfric.errors import ConfigError
+        from drillfric.units import quantity_value
+
+        try:
+            return quantity_value(value, self.unit, bare=True)
+        except ConfigError as exc:
+            self.fail(f"{exc.problem} (a number in {self.unit}, or with a unit such as "
+                      f"\"8200 ft\")", param, ctx)
+
+
+def units_option(command):
+    """``--units si|field`` for a command that prints physical values."""
+    return click.option("--units", "units", type=click.Choice(["si", "field"]),
+                        help="Units of the printed summary: si (m, kN, kN·m) or field (ft, "
+                             "klbf, kft·lbf, ppg). Default: the configuration's [well] "
+                             "units, else si. JSON and result files stay SI.")(command)
+
+
+def unit_system(option: str | None, config) -> str:
+    """The unit system to print in: ``--units``, else ``[well] units`` of ``config`` (a
+    Config or its ``to_dict()``), else ``"si"``."""
+    if option:
+        return option
+    if isinstance(config, dict):
+        return (config.get("well") or {}).get("units") or "si"
+    return getattr(getattr(config, "well", None), "units", None) or "si"

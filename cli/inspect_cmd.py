@@ -7,6 +7,12 @@ import json
 import click
 import numpy as np
 
+from .common import unit_system, units_option
+
+#: Channel quantities shown in the display units of ``--units`` (others as stored).
+_SHOWN = {"length": "length", "force": "force", "torque": "torque",
+          "rotary speed": "rotary speed", "pressure": "pressure", "flow rate": "flow rate"}
+
 
 @click.command("inspect")
 @click.argument("well", type=click.Path(path_type=str))
@@ -14,50 +20,45 @@ import numpy as np
               help="Well configuration TOML (overrides the NAME.toml sidecar).")
 @click.option("--survey", "survey_file", type=click.Path(path_type=str),
               help="Survey file (overrides the NAME.survey.* sidecar).")
-@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-def command(well: str, config_file: str | None, survey_file: str | None, as_json: bool) -> None:
+@click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON (SI).")
+@units_option
+def command(well: str, config_file: str | None, survey_file: str | None, as_json: bool,
+            units: str | None) -> None:
     """Show the channels, units, rate, gaps, time span and survey recognised in WELL.
 
-    WELL is a data file (.parquet, .csv, .h5, .las) with optional NAME.toml and
-    NAME.survey.csv sidecars, an HDF5 file with /surface, /survey and /config, or a
-    directory holding well.toml.
+    WELL is a data file (.parquet, .csv, .h5, .las, .xml, .dlis, .xlsx) with optional
+    NAME.toml and NAME.survey.csv sidecars, an HDF5 file with /surface, /survey and
+    /config, or a directory holding well.toml. For a depth-indexed log: the depth span and
+    the windows of its friction log instead of the time base and segments.
     """
-    from drillfric.io.well import load_well
+    from drillfric.io.well import open_well
 
-    data = load_well(well, config=config_file, survey=survey_file)
-    summary = summarize(data)
+    opened = open_well(well, config=config_file, survey=survey_file)
+    if opened.depth_indexed:
+        summary = summarize_depth_log(opened)
+    else:
+        summary = summarize(opened.load())
     if as_json:
         click.echo(json.dumps(summary, indent=2))
-    else:
-        click.echo(render(summary))  # the result: printed even with --quiet
+        return
+    system = unit_system(units, opened.config)
+    text = render_depth_log(summary, system) if opened.depth_indexed else render(summary, system)
+    click.echo(text)  # the result: printed even with --quiet
 
 
 def summarize(data) -> dict:
     """The ``inspect --json`` document (INTERFACE.md keys first, then extras)."""
-    from drillfric.io.channels import BY_NAME, SUFFIX_UNITS
     from drillfric.io.timebase import spacing_summary
     from drillfric.segmentation import segment
 
     tb = data.timebase
     channels = {}
     for name, info in data.channels.items():
-        values = data.surface[name].to_numpy(dtype=float)
-        finite = values[np.isfinite(values)]
-        channels[name] = {
-            "column": info.column, "unit": info.unit, "unit_source": info.source,
-            "si_unit": SUFFIX_UNITS[BY_NAME[name].key],
-            "null_fraction": info.null_fraction,
-            "null_count": int(round(info.null_fraction * (tb.rows if name != "time_s" else
-                                    tb.rows + tb.untimed_dropped + tb.duplicates_dropped))),
-            "min": float(finite.min()) if finite.size else None,
-            "median": float(np.median(finite)) if finite.size else None,
-            "max": float(finite.max()) if finite.size else None,
-        }
-    survey = None
-    if data.survey is not None:
-        survey = {"stations": int(len(data.survey.md_m)), "md_max_m": data.survey.md_max_m,
-                  "inc_max_deg": float(np.degrees(np.max(data.survey.inc_rad))),
-                  "tvd_max_m": float(np.max(data.survey.tvd_m))}
+        total = tb.rows if name != "time_s" else (tb.rows + tb.untimed_dropped
+                                                  + tb.duplicates_dropped)
+        channels[name] = _channel(name, info.column, info.unit, info.source,
+                                  info.null_fraction, total, data.surface)
+    survey = _survey(data.survey)
     return {
         "channels": channels, "rows": tb.rows, "t_start_s": tb.t_start_s,
         "t_end_s": tb.t_end_s, "rate_hz": tb.rate_hz, "gaps": [list(g) for g in tb.gaps],
@@ -70,6 +71,60 @@ def summarize(data) -> dict:
         "max_gap_s": data.config.segmentation.max_gap_s,
         "assumed": data.config.assumed_with(data.survey),
         "segments": [_segment(seg) for seg in segment(data.surface, data.config)],
+    }
+
+
+def _channel(name: str, column, unit: str, source: str, null_fraction: float, total: int,
+             frame) -> dict:
+    """One channel of the ``inspect --json`` document."""
+    from drillfric.io.channels import BY_NAME, SUFFIX_UNITS
+
+    values = frame[name].to_numpy(dtype=float)
+    finite = values[np.isfinite(values)]
+    return {"column": str(column), "unit": unit, "unit_source": source,
+            "si_unit": SUFFIX_UNITS[BY_NAME[name].key], "null_fraction": null_fraction,
+            "null_count": int(round(null_fraction * total)),
+            "min": float(finite.min()) if finite.size else None,
+            "median": float(np.median(finite)) if finite.size else None,
+            "max": float(finite.max()) if finite.size else None}
+
+
+def _survey(path) -> dict | None:
+    if path is None:
+        return None
+    return {"stations": int(len(path.md_m)), "md_max_m": path.md_max_m,
+            "inc_max_deg": float(np.degrees(np.max(path.inc_rad))),
+            "tvd_max_m": float(np.max(path.tvd_m))}
+
+
+def summarize_depth_log(well) -> dict:
+    """The ``inspect --json`` document of a depth-indexed log: the interface's keys (no time
+    base: ``t_start_s``, ``t_end_s``, ``rate_hz`` null), ``index = "depth"``, the depth span
+    and the windows of its friction log (:mod:`drillfric.friction_log`)."""
+    from drillfric.friction_log import read_depth_log, windows
+
+    log = read_depth_log(well)
+    channels = {m.channel.name: _channel(m.channel.name, m.column, m.unit, m.source,
+                                         float(log[m.channel.name].isna().mean()), len(log),
+                                         log)
+                for m in well.mappings.values()}
+    md = log["measured_depth_m"].to_numpy(float)
+    found, assumed = windows(log, well.config)
+    least = well.config.friction_log.min_rows
+    files = {k: str(v) for k, v in (("data", well.files.data), ("config", well.files.config),
+                                     ("survey", well.files.survey)) if v is not None}
+    return {
+        "channels": channels, "rows": len(log), "t_start_s": None, "t_end_s": None,
+        "rate_hz": None, "gaps": [], "survey": _survey(well.survey), "well": well.name,
+        "files": files, "index": "depth", "md_start_m": float(md.min()),
+        "md_end_m": float(md.max()),
+        "md_step_m": float(np.median(np.diff(np.sort(md)))) if md.size > 1 else None,
+        "window_m": well.config.friction_log.window_m,
+        "assumed": [n for n in well.assumed if not n.startswith("top-drive")] + assumed,
+        "segments": [{"id": w.id, "kind": w.kind.value, "md_top_m": w.md_top_m,
+                      "md_bottom_m": w.md_bottom_m, "rows": w.rows,
+                      "bit_depth_m": w.bit_depth_m,
+                      "status": "ok" if w.rows >= least else "skipped"} for w in found],
     }
 
 
@@ -87,21 +142,43 @@ def _num(value: float | None) -> str:
     return "—" if value is None else f"{value:.4g}"
 
 
-def render(s: dict) -> str:
-    """Human-readable table of an inspect summary."""
+def _channel_table(s: dict, units: str) -> list[str]:
+    """The channel table: source column and unit, nulls, min/median/max in the SI unit of the
+    canonical column (``units = "si"``) or the display unit of ``--units field``."""
+    from drillfric.io.channels import BY_NAME
+    from drillfric.units import display_factor, display_unit
+
+    head = ("channel", "column", "unit", "from", "SI unit" if units == "si" else "shown in",
+            "nulls", "min", "median", "max")
+    rows = [head]
+    for name, c in s["channels"].items():
+        quantity = _SHOWN.get(BY_NAME[name].kind) if units != "si" else None
+        shown, scale = ((display_unit(quantity, units), display_factor(quantity, units))
+                        if quantity else (c["si_unit"], 1.0))
+        rows.append((name, c["column"], c["unit"], c["unit_source"], shown,
+                     f"{c['null_count']} ({100 * c['null_fraction']:.1f}%)",
+                     *(_num(None if c[k] is None else c[k] * scale)
+                       for k in ("min", "median", "max"))))
+    widths = [max(len(str(r[i])) for r in rows) for i in range(len(head))]
+    return ["  ".join(str(v).ljust(w) for v, w in zip(r, widths, strict=True)).rstrip()
+            for r in rows]
+
+
+def _survey_line(sv: dict | None, units: str) -> str:
+    from drillfric.units import format_value
+
+    if sv is None:
+        return "survey     none — a vertical well is assumed (see below)"
+    return (f"survey     {sv['stations']} stations to "
+            f"{format_value(sv['md_max_m'], 'length', units)} MD, max inclination "
+            f"{sv['inc_max_deg']:.1f}°, TVD {format_value(sv['tvd_max_m'], 'length', units)}")
+
+
+def render(s: dict, units: str = "si") -> str:
+    """Human-readable table of an inspect summary (physical values in ``units``)."""
     lines = [f"well       {s['well']}"]
     lines += [f"{k:<10} {v}" for k, v in s["files"].items()]
-    head = ("channel", "column", "unit", "from", "SI unit", "nulls", "min", "median", "max")
-    rows = [head] + [
-        (name, c["column"], c["unit"], c["unit_source"], c["si_unit"],
-         f"{c['null_count']} ({100 * c['null_fraction']:.1f}%)",
-         _num(c["min"]), _num(c["median"]), _num(c["max"]))
-        for name, c in s["channels"].items()]
-    widths = [max(len(str(r[i])) for r in rows) for i in range(len(head))]
-    lines.append("")
-    lines += ["  ".join(str(v).ljust(w) for v, w in zip(r, widths, strict=True)).rstrip()
-              for r in rows]
-    lines.append("")
+    lines += [""] + _channel_table(s, units) + [""]
     dropped = []
     if s["duplicates_dropped"]:
         dropped.append(f"{s['duplicates_dropped']} repeated timestamps dropped")
@@ -122,10 +199,7 @@ def render(s: dict) -> str:
     shown = ", ".join(f"{a:.6g}–{b:.6g} s" for a, b in gaps[:5]) + (" …" if len(gaps) > 5 else "")
     lines.append(f"gaps       {len(gaps)} longer than {limit:.3g} s" + (f": {shown}" if gaps
                                                                         else ""))
-    sv = s["survey"]
-    lines.append("survey     none — a vertical well is assumed (see below)" if sv is None else
-                 f"survey     {sv['stations']} stations to {sv['md_max_m']:.1f} m MD, "
-                 f"max inclination {sv['inc_max_deg']:.1f}°, TVD {sv['tvd_max_m']:.1f} m")
+    lines.append(_survey_line(s["survey"], units))
     lines.append(_segments_line(s["segments"]))
     lines += [f"assumed    {note}" for note in s["assumed"]]
     return "\n".join(lines)
@@ -139,3 +213,29 @@ def _segments_line(segments: list[dict]) -> str:
     return (f"segments   {len(segments)} rotating: {len(ok)} usable"
             + (f" ({detail}; {seconds / 3600:.2f} h)" if ok else "")
             + f", {len(segments) - len(ok)} skipped")
+
+
+def render_depth_log(s: dict, units: str = "si") -> str:
+    """Human-readable summary of a depth-indexed log (:func:`summarize_depth_log`)."""
+    from drillfric.units import format_value
+
+    lines = [f"well       {s['well']}"]
+    lines += [f"{k:<10} {v}" for k, v in s["files"].items()]
+    lines.append("index      depth-indexed log (no time base): `run` gives a static friction "
+                 "log by torque-and-drag back-calculation per depth window — no observer, "
+                 "no μ_s, no bit speed")
+    lines += [""] + _channel_table(s, units) + [""]
+    lines.append(f"rows       {s['rows']}")
+    step = "" if s["md_step_m"] is None else (
+        f" (step median {format_value(s['md_step_m'], 'length', units, '.3g')})")
+    lines.append(f"depth      {format_value(s['md_start_m'], 'length', units)} … "
+                 f"{format_value(s['md_end_m'], 'length', units)} MD{step}")
+    lines.append(_survey_line(s["survey"], units))
+    ok = [w for w in s["segments"] if w["status"] == "ok"]
+    kinds = {k: sum(w["kind"] == k for w in ok) for k in sorted({w["kind"] for w in ok})}
+    detail = ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in kinds.items())
+    lines.append(f"windows    {len(s['segments'])} of "
+                 f"{format_value(s['window_m'], 'length', units, '.0f')}: {len(ok)} usable"
+                 + (f" ({detail})" if ok else "") + f", {len(s['segments']) - len(ok)} skipped")
+    lines += [f"assumed    {note}" for note in s["assumed"]]
+    return "\n".join(lines)

@@ -8,7 +8,16 @@ import click
 
 from drillfric.errors import DrillfricError
 
-from .common import UserError, context, echo, warn, well_progress
+from .common import (
+    Quantity,
+    UserError,
+    context,
+    echo,
+    unit_system,
+    units_option,
+    warn,
+    well_progress,
+)
 
 
 def parse_starts(text: str | None) -> list[tuple[float, float]] | None:
@@ -29,15 +38,41 @@ def _fmt(value, spec=".3f") -> str:
     return "—" if value is None else format(value, spec)
 
 
-def _describe(result) -> str:
+def _depths(segments: list[dict], units: str) -> str:
+    """``", bit 2000–2500 m"`` over the segments (in the display units), or ""."""
+    from drillfric.units import display_unit, to_display
+
+    depths = [g["bit_depth_m"] for g in segments if g.get("bit_depth_m") is not None]
+    if not depths:
+        return ""
+    low, high = to_display(min(depths), "length", units), to_display(max(depths), "length",
+                                                                       units)
+    return f", bit {low:.0f}–{high:.0f} {display_unit('length', units)}"
+
+
+def _describe(result, units: str = "si") -> str:
     s = result.summary
     c = s["counts"]
+    if s.get("index") == "depth":
+        return _describe_depth_log(result, units)
     mu_s = _fmt(s["mu_s"]) if s["mu_s"] is not None else (
         f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
         else "not identifiable")
     return (f"{result.well}: {c['segments']} segments ({c['estimated']} estimated, "
-            f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed); "
-            f"μ_k = {_fmt(s['mu_k'])}, μ_s = {mu_s}")
+            f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed"
+            f"{_depths(s['segments'], units)}); μ_k = {_fmt(s['mu_k'])}, μ_s = {mu_s}")
+
+
+def _describe_depth_log(result, units: str) -> str:
+    """The result line of a depth-indexed log's friction log."""
+    from drillfric.units import format_value
+
+    s, c, log = result.summary, result.summary["counts"], result.summary["friction_log"]
+    return (f"{result.well}: friction log of a depth-indexed log, {c['segments']} windows of "
+            f"{format_value(log['window_m'], 'length', units, '.0f')} ({c['estimated']} "
+            f"estimated, {c['skipped']} skipped, {c['failed']} failed"
+            f"{_depths(s['segments'], units)}); μ off bottom = {_fmt(s['mu_k'])}, apparent "
+            f"μ on bottom = {_fmt(log['mu_apparent'])}; μ_s: no observer in depth data")
 
 
 @click.command("run")
@@ -49,19 +84,23 @@ def _describe(result) -> str:
               "overrides the NAME.toml sidecar.")
 @click.option("--survey", type=click.Path(path_type=Path), help="Survey file, overrides the "
               "NAME.survey.* sidecar.")
-@click.option("--rate", "rate", type=float, help="Resample the input to HZ before estimation "
-              "(not above the data's own rate: a higher HZ is ignored with a warning).")
+@click.option("--rate", "rate", type=Quantity("Hz"), help="Resample the input to HZ before "
+              "estimation (not above the data's own rate: a higher HZ is ignored with a "
+              "warning).")
 @click.option("--starts", help="Observer starts MU_S:MU_K,... (overrides observer.starts).")
 @click.option("--pdf/--no-pdf", default=False, help="Also write report.pdf.")
 @click.option("--report/--no-report", default=True, show_default=True,
               help="Write report.html (--no-report: the result files only).")
 @click.option("--workers", type=int, default=1, show_default=True,
               help="Wells processed in parallel (local processes).")
-def command(wells, out, config, survey, rate, starts, pdf, report, workers) -> None:
+@units_option
+def command(wells, out, config, survey, rate, starts, pdf, report, workers, units) -> None:
     """Estimate friction factors (μ_s, μ_k) and bit speed, stand by stand, for each WELL.
 
-    WELL is a data file (.parquet, .csv, .h5, .las) with optional NAME.toml and
-    NAME.survey.csv sidecars, an HDF5 bundle, or a directory with well.toml.
+    WELL is a data file (.parquet, .csv, .h5, .las, .xml, .dlis, .xlsx) with optional
+    NAME.toml and NAME.survey.csv sidecars, an HDF5 bundle, or a directory with well.toml.
+    A depth-indexed log gives a static friction log by depth window instead (torque-and-drag
+    back-calculation; no observer, no μ_s).
     """
     if rate is not None and not rate > 0:
         raise UserError(f"--rate must be positive, got {rate:.4g}")
@@ -84,7 +123,7 @@ def command(wells, out, config, survey, rate, starts, pdf, report, workers) -> N
             click.secho(f"error: {exc.message}", err=True, fg="red")
             unreadable += 1
             continue
-        _print(result)
+        _print(result, units)
         failures += result.failed
     if unreadable == len(wells):
         raise UserError("no well could be read")
@@ -117,13 +156,15 @@ def _run_one(well, out, rate, pdf, report, tick):
     return run_well(well, out, rate_hz=rate, pdf=pdf, report=report, progress=tick)
 
 
-def _print(result) -> None:
-    """Warnings, the result line and the report's path (only when it was written)."""
+def _print(result, units: str | None = None) -> None:
+    """Warnings, the result line (in ``--units``, else the well's ``[well] units``) and the
+    report's path (only when it was written)."""
     for note in result.summary["assumed"]:
         warn(f"{result.well}: assumed {note} — the numbers are indicative")
     for note in result.warnings:
         warn(f"{result.well}: {note}")
-    click.echo(_describe(result))  # the result: printed even with --quiet
+    system = unit_system(units, result.summary.get("config", {}))
+    click.echo(_describe(result, system))  # the result: printed even with --quiet
     if result.report is not None:
         echo(f"report: {result.report}")
     else:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import click
 
-from .common import echo, progress, warn
+from .common import Quantity, echo, progress, warn
 
 
 def _overrides(**options) -> dict:
@@ -23,26 +23,22 @@ def _overrides(**options) -> dict:
     return {keys[k]: v for k, v in options.items() if v is not None}
 
 
-def _load(config: Path, overrides: dict, omega_c_rpm: float | None):
-    from drillfric.config import load_config, read_toml
+def _load(config: Path, survey: Path | None, overrides: dict, omega_c_rpm: float | None):
+    """The configuration and its survey (``--survey`` > ``[survey] file`` >
+    ``NAME.survey.{csv,parquet}`` beside ``NAME.toml``, as ``run`` finds a well's:
+    :func:`drillfric.io.well.open_config`), with ``--omega-c-rpm`` in the configuration's
+    own ω_c key."""
+    from drillfric.io.well import open_config
 
-    cfg = load_config(config, overrides=overrides)
+    cfg, survey_path, well_path = open_config(config, survey=survey, overrides=overrides)
     if omega_c_rpm is not None:
         key = "model.omega_c_rpm" if cfg.model.omega_c_rpm is not None or \
             cfg.model.omega_c_rad_s is None else "model.omega_c_rad_s"
         from drillfric.units import RPM_TO_RAD_S
 
         value = omega_c_rpm if key.endswith("rpm") else omega_c_rpm * RPM_TO_RAD_S
-        cfg = load_config(config, overrides=overrides | {key: value})
-    return cfg, read_toml(config)
-
-
-def _survey(config: Path, raw: dict, survey: Path | None):
-    from drillfric.io.survey import read_survey
-
-    name = raw.get("survey", {}).get("file")
-    path = survey if survey is not None else (None if name is None else config.parent / name)
-    return path, None if path is None else read_survey(path)
+        cfg = open_config(config, survey=survey, overrides=overrides | {key: value})[0]
+    return cfg, survey_path, well_path
 
 
 def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool):
@@ -72,26 +68,30 @@ def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool)
 @click.argument("config", type=click.Path(path_type=Path))
 @click.option("--out", "out", required=True, type=click.Path(path_type=Path),
               help="Output data file: .parquet, .csv, .h5 or .hdf5 (sidecars written beside).")
-@click.option("--duration", type=float, help="Simulated seconds of a single stand "
-              "(with --scenario: default rotating time of each stand).")
-@click.option("--rate", type=float, help="Recording rate [Hz] (default 100).")
+@click.option("--duration", type=Quantity("s"), help="Simulated seconds of a single stand "
+              "(with --scenario: default rotating time of each stand); e.g. 120 or \"2 min\".")
+@click.option("--rate", type=Quantity("Hz"), help="Recording rate [Hz] (default 100).")
 @click.option("--mu-s", type=float, help="True static friction factor.")
 @click.option("--mu-k", type=float, help="True kinetic friction factor.")
-@click.option("--omega-c-rpm", type=float, help="Static/kinetic switching speed ω_c [RPM].")
-@click.option("--bit-depth", type=float, help="Bit depth of a single stand [m] "
-              "(default: simulate.bit_depth_m, else the end of the survey); without "
-              "--scenario it overrides the configuration's scenario.")
-@click.option("--rpm", type=float, help="Surface speed set-point after the ramp [RPM].")
-@click.option("--wob", type=float, help="Weight on bit of a single stand [N] (> 0: on bottom).")
+@click.option("--omega-c-rpm", type=Quantity("RPM"),
+              help="Static/kinetic switching speed ω_c [RPM].")
+@click.option("--bit-depth", type=Quantity("m"), help="Bit depth of a single stand [m], e.g. "
+              "2500 or \"8200 ft\" (default: simulate.bit_depth_m, else the end of the "
+              "survey); without --scenario it overrides the configuration's scenario.")
+@click.option("--rpm", type=Quantity("RPM"),
+              help="Surface speed set-point after the ramp [RPM].")
+@click.option("--wob", type=Quantity("N"), help="Weight on bit of a single stand [N] (> 0: on "
+              "bottom), e.g. \"30 klbf\".")
 @click.option("--seed", type=int, help="Seed of the measurement noise.")
-@click.option("--rpm-noise", type=float, help="Gaussian surface-speed noise [RPM].")
-@click.option("--torque-noise", type=float, help="Gaussian torque noise [N·m].")
+@click.option("--rpm-noise", type=Quantity("RPM"), help="Gaussian surface-speed noise [RPM].")
+@click.option("--torque-noise", type=Quantity("N·m"), help="Gaussian torque noise [N·m].")
 @click.option("--cells", type=int, help="Cells of the simulated (true) string model "
               "(default simulate.cells = 2500).")
 @click.option("--scenario", type=click.Path(path_type=Path),
               help="Scenario TOML of several stands (docs/simulator.md).")
 @click.option("--survey", type=click.Path(path_type=Path),
-              help="Survey file (overrides the configuration's [survey] file).")
+              help="Survey file (overrides the configuration's [survey] file and a "
+                   "CONFIG-stem.survey.csv beside it).")
 def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bit_depth, rpm,
             wob, seed, rpm_noise, torque_noise, cells, scenario, survey) -> None:
     """Simulate surface data with ground truth from the torsional plant (THEORY §3).
@@ -99,7 +99,9 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     Writes OUT with time_s, surface_rpm, surface_torque_Nm, hookload_N, bit_depth_m,
     hole_depth_m, bit_rpm and string_torque_Nm (noise-free truth), plus OUT's sidecars
     NAME.toml, NAME.survey.csv and NAME.truth.json, so that `drillfric run OUT` reads it
-    directly.
+    directly (NAME: OUT's stem, also the well's name in NAME.toml). The survey is --survey,
+    else CONFIG's [survey] file, else CONFIG-stem.survey.csv beside CONFIG (as `run` finds
+    a well's).
     """
     import pandas as pd
 
@@ -111,8 +113,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     overrides = _overrides(duration=duration, rate=rate, mu_s=mu_s, mu_k=mu_k,
                            bit_depth=bit_depth, rpm=rpm, seed=seed, rpm_noise=rpm_noise,
                            torque_noise=torque_noise, wob=wob, cells=cells)
-    cfg, raw = _load(config, overrides, omega_c_rpm)
-    survey_path, well_path = _survey(config, raw, survey)
+    cfg, survey_path, well_path = _load(config, survey, overrides, omega_c_rpm)
     _, plan = _scenario(cfg, config, scenario, well_path,
                         single=bit_depth is not None and scenario is None)
     sim.check_depths(plan, well_path, survey_path)

@@ -17,7 +17,7 @@ import numpy as np
 
 from drillfric.errors import InputError
 
-from .common import UserError, echo, warn
+from .common import Quantity, UserError, echo, unit_system, units_option, warn
 
 _TABLE_SUFFIXES = (".csv", ".parquet")
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
@@ -27,22 +27,19 @@ _DEFAULT_FRICTIONS = (0.1, 0.2, 0.3, 0.4, 0.5)
 def _load(target: Path, config: str | None, survey: str | None, overrides: dict):
     """(Config, WellPath or None) for a .toml configuration, a data file or a well directory.
 
-    A configuration's ``[survey] file`` is relative to the configuration; ``--config`` and
-    ``--survey`` override. Other targets are resolved like every command does
-    (:func:`drillfric.io.well.resolve_well`: sidecars, HDF5 bundles, directories).
+    A configuration's survey is ``--survey``, else its ``[survey] file`` (relative to it),
+    else ``NAME.survey.csv`` beside ``NAME.toml`` (:func:`drillfric.io.well.open_config`);
+    ``--config`` overrides the configuration. Other targets are resolved like every command
+    does (:func:`drillfric.io.well.open_well`: sidecars, HDF5 bundles, directories).
     """
-    from drillfric.config import load_config, read_toml
-    from drillfric.io.survey import read_survey
+    from drillfric.io.well import open_config
 
     if target.suffix.lower() == ".toml":
         if not target.is_file():
             raise InputError("config file not found", file=target, fix="check the path")
-        cfg_path = Path(config) if config else target
-        name = read_toml(cfg_path).get("survey", {}).get("file")
-        survey_path = Path(survey) if survey else (
-            None if name is None else cfg_path.parent / name)
-        cfg = load_config(cfg_path, overrides=overrides)
-        return cfg, None if survey_path is None else read_survey(survey_path)
+        cfg, _, path = open_config(Path(config) if config else target, survey=survey,
+                                   overrides=overrides)
+        return cfg, path
     from drillfric.io.well import open_well
 
     well = open_well(target, config=config, survey=survey, overrides=overrides, header=False)
@@ -90,21 +87,24 @@ def _write_table(frame, out: Path) -> None:
 
 @click.command("td")
 @click.argument("well_or_config", type=click.Path(path_type=Path))
-@click.option("--bit-depth", type=float, help="Bit measured depth [m] (default: end of survey).")
+@click.option("--bit-depth", type=Quantity("m"), help="Bit measured depth [m] (default: end "
+              "of survey); a number with a unit is converted, e.g. \"8200 ft\".")
 @click.option("--friction", type=float, help="Friction factor μ (default: from the config, "
               "per hole section when casing_shoe_md_m is set).")
 @click.option("--load-case", default="rotating_off_bottom", show_default=True,
               type=click.Choice(["rotating_off_bottom", "rotating_on_bottom", "pick_up",
                                  "slack_off", "rotating_pick_up", "rotating_slack_off",
                                  "sliding"]))
-@click.option("--wob", type=float, default=0.0, show_default=True,
-              help="Weight on bit [N] (on-bottom cases).")
-@click.option("--bit-torque", type=float, default=0.0, show_default=True,
-              help="Torque on bit [N·m] (on-bottom cases).")
-@click.option("--rpm", type=float, default=0.0, help="Rotary speed [RPM] (combined motion).")
-@click.option("--axial-speed", type=float, default=0.0,
-              help="Trip speed [m/s] (combined motion).")
-@click.option("--element-length", type=float, help="Element length [m] (default: config).")
+@click.option("--wob", type=Quantity("N"), default=0.0, show_default=True,
+              help="Weight on bit [N] (on-bottom cases), e.g. 150000 or \"35 klbf\".")
+@click.option("--bit-torque", type=Quantity("N·m"), default=0.0, show_default=True,
+              help="Torque on bit [N·m] (on-bottom cases), e.g. \"3 kft.lbf\".")
+@click.option("--rpm", type=Quantity("RPM"), default=0.0,
+              help="Rotary speed [RPM] (combined motion).")
+@click.option("--axial-speed", type=Quantity("m/s"), default=0.0,
+              help="Trip speed [m/s] (combined motion), e.g. \"60 ft/min\".")
+@click.option("--element-length", type=Quantity("m"),
+              help="Element length [m] (default: config).")
 @click.option("--out", type=click.Path(path_type=Path),
               help="Profile (or broomstick table) file, .csv or .parquet.")
 @click.option("--broomstick", is_flag=True, help="Hook load and torque versus bit depth for "
@@ -118,14 +118,16 @@ def _write_table(frame, out: Path) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--config", type=click.Path(), help="Well configuration (overrides sidecars).")
 @click.option("--survey", type=click.Path(), help="Survey file (overrides the config's).")
+@units_option
 def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm, axial_speed,
             element_length, out, broomstick, frictions, depths, plot, as_json, config,
-            survey) -> None:
+            survey, units) -> None:
     """Soft-string torque and drag (THEORY.md §2) for WELL_OR_CONFIG.
 
-    WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file) or a well on
-    disk (INTERFACE.md). Without a survey the hole is vertical with the nominal tortuosity
-    survey.tortuosity_deg_30m, and --bit-depth is required.
+    WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file or a
+    NAME.survey.csv beside it) or a well on disk (INTERFACE.md). Without a survey the hole is
+    vertical with the nominal tortuosity survey.tortuosity_deg_30m, and --bit-depth is
+    required.
     """
     overrides = {"model.friction": friction, "model.element_length_m": element_length}
     measured = None
@@ -144,14 +146,17 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
         if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
             warn(f"assumed {note}")
     kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
+    system = unit_system(units, cfg)
     if broomstick:
-        _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw, measured)
+        _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw, system,
+                    measured)
     else:
-        _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw)
+        _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, system)
 
 
-def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> None:
+def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, units) -> None:
     from drillfric.torque_drag import config_friction, solve_config
+    from drillfric.units import format_value as show
 
     _check_out(out, _TABLE_SUFFIXES)
     result = solve_config(cfg, path, bit_depth, friction=friction, load_case=load_case, **kw)
@@ -175,17 +180,21 @@ def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw) -> Non
         return
     mu_text = (f"{summary['friction_factor']:g}" if summary["friction_factor"] is not None
                else f"{mu.cased:g} cased above {mu.shoe_md_m:g} m, {mu.open_hole:g} open hole")
-    click.echo(f"bit depth        {result.bit_depth_m:10.1f} m   ({load_case}, μ = {mu_text})")
-    click.echo(f"hook load        {result.hookload_N / 1e3:10.1f} kN  (effective, no block weight)")
-    click.echo(f"surface torque   {result.surface_torque_Nm / 1e3:10.2f} kN·m")
-    click.echo(f"T_N = ∫F_c dx    {result.T_N_Nm / 1e3:10.2f} kN·m per unit friction factor")
-    click.echo(f"max side force   {summary['max_normal_force_N_m']:10.1f} N/m")
+    click.echo(f"bit depth        {show(result.bit_depth_m, 'length', units, '10.1f')}   "
+               f"({load_case}, μ = {mu_text})")
+    click.echo(f"hook load        {show(result.hookload_N, 'force', units, '10.1f')}  "
+               "(effective, no block weight)")
+    click.echo(f"surface torque   {show(result.surface_torque_Nm, 'torque', units, '10.2f')}")
+    click.echo(f"T_N = ∫F_c dx    {show(result.T_N_Nm, 'torque', units, '10.2f')} per unit "
+               "friction factor")
+    click.echo(f"max side force   "
+               f"{show(summary['max_normal_force_N_m'], 'side force', units, '10.1f')}")
     if out is not None:
         echo(f"profile written to {out}")
 
 
 def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
-                measured=None) -> None:
+                units, measured=None) -> None:
     from drillfric.drillstring import build_string
     from drillfric.torque_drag import broomstick, broomstick_figure, config_friction
     from drillfric.wellpath import no_survey_path
@@ -227,18 +236,22 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
     if as_json:
         click.echo(table.to_json(orient="records", indent=2))
         return
+    from drillfric.units import format_value as show
+
     if measured is not None:
         echo(f"measured: {len(measured)} rotating segment(s) of the log drawn on the plot"
              + (f"; implied block weight {check['block_weight_N'] / 1e3:.0f} kN "
                 "(median measured − modelled rotating hook load)"
                 if check and check["checked"] else ""))
     echo(f"broomstick: {len(grid)} depths × {len(mus)} friction factors × {len(cases)} "
-         f"load cases ({grid[0]:.0f}–{grid[-1]:.0f} m)")
+         f"load cases ({show(grid[0], 'length', units, '.0f')}–"
+         f"{show(grid[-1], 'length', units, '.0f')})")
     last = table[table["bit_depth_m"] == table["bit_depth_m"].max()]
     for row in last.itertuples():
-        echo(f"  at {row.bit_depth_m:7.1f} m  μ = {row.friction_factor:4.2f}  "
-             f"{row.load_case:20s} hook load {row.hookload_N / 1e3:8.1f} kN  "
-             f"torque {row.surface_torque_Nm / 1e3:6.2f} kN·m")
+        echo(f"  at {show(row.bit_depth_m, 'length', units, '7.1f')}  μ = "
+             f"{row.friction_factor:4.2f}  {row.load_case:20s} hook load "
+             f"{show(row.hookload_N, 'force', units, '8.1f')}  "
+             f"torque {show(row.surface_torque_Nm, 'torque', units, '6.2f')}")
     for target in (out, plot):
         if target is not None:
             echo(f"written {target}")

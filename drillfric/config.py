@@ -72,8 +72,21 @@ class Key:
                     None)
 
     def validate(self, value: Any, where: str, file: str | None) -> Any:
-        """Return ``value`` checked (and ints widened to float) or raise ConfigError."""
+        """Return ``value`` checked (and ints widened to float) or raise ConfigError.
+
+        A number with a unit, written as text (``"10.5 ppg"``, ``"5 1/2 in"``), is accepted
+        for a key with a unit and converted exactly to it
+        (:func:`drillfric.units.quantity_value`); a unit of another dimension is an error
+        naming the key, the file and the quantity expected.
+        """
         types = self.type if isinstance(self.type, tuple) else (self.type,)
+        written = ""
+        if isinstance(value, str) and float in types and str not in types and self.unit:
+            from drillfric.units import quantity_value
+
+            text = "".join(c if c.isprintable() else "?" for c in value.strip()[:40])
+            written = f" ('{text}')"
+            value = quantity_value(value, self.unit, what=f"key '{where}'", file=file)
         if float in types and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if isinstance(value, bool) and bool not in types or not isinstance(value, types):
@@ -91,7 +104,7 @@ class Key:
             low_bad = self.min is not None and (
                 value <= self.min if self.min_exclusive else value < self.min)
             if low_bad or (self.upper is not None and value > self.upper):
-                raise ConfigError(f"key '{where}' = {value:.4g} is outside "
+                raise ConfigError(f"key '{where}' = {value:.4g}{written} is outside "
                                   f"{self.range_text()}", file=file,
                                   fix=f"give a value {self.range_text()}"
                                       + (f" [{self.unit}]" if self.unit else ""))
@@ -138,6 +151,10 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "bit-depth channel (and no block reckoning): a single stand or a test at one "
             "depth. Default: the survey's last station, announced as assumed.", min=0.0,
             min_exclusive=True),
+        Key("units", str, "si", "", "Units people read: terminal summaries (run, td, inspect) "
+            "and report axes and tables — 'si' (m, kN, kN·m, kg/m³) or 'field' (ft, klbf, "
+            "kft·lbf, ppg, in); --units overrides. Result files (Parquet, JSON) stay SI.",
+            choices=("si", "field")),
     ),
     "survey": (
         Key("file", str, None, "", "Survey file (MD, inclination, azimuth), relative to the "
@@ -274,6 +291,20 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "depth is reckoned from block position (without it segment depths are unknown).",
             min=0.0),
     ),
+    "friction_log": (
+        _positive("window_m", 30.0, "m", "Depth window of the static friction log of a "
+                  "depth-indexed log (docs/ingestion.md): the rows of each window give one "
+                  "back-calculated friction factor per load case (default: one stand).",
+                  max=1000.0),
+        Key("min_rows", int, 3, "", "Fewest rotating rows a window needs for a friction "
+            "factor (fewer: the window is listed as skipped).", min=1),
+        Key("bit_mu", float, 0.0, "", "Bit friction coefficient μ_bit of the bit torque "
+            "assumed on bottom, T_bit = μ_bit·WOB·D_bit/3. 0 (default): no bit torque is "
+            "separated, so the on-bottom factor is apparent friction including the bit torque.",
+            min=0.0, max=2.0),
+        _positive("bit_diameter_m", 0.2159, "m", "Bit diameter D_bit of the assumed bit "
+                  "torque (used when bit_mu > 0).", max=1.5),
+    ),
     "simulate": (
         Key("bit_depth_m", float, None, "m", "Bit depth of a single-stand simulation "
             "(default: the survey's last station).", min=0.0, min_exclusive=True),
@@ -341,8 +372,8 @@ DEFAULT_SECTIONS: tuple[dict, ...] = (
 )
 
 #: Channel keys accepted in ``[channels]`` (canonical names without the unit suffix).
-CHANNEL_KEYS = ("time", "surface_rpm", "surface_torque", "hookload", "bit_depth",
-                "hole_depth", "wob", "block_position", "bit_rpm", "standpipe_pressure",
+CHANNEL_KEYS = ("time", "measured_depth", "surface_rpm", "surface_torque", "hookload",
+                "bit_depth", "hole_depth", "wob", "block_position", "bit_rpm", "standpipe_pressure",
                 "flow_in", "flow_out", "pump_rate", "surface_torque_min", "surface_torque_max",
                 "surface_rpm_min", "surface_rpm_max", "hookload_min", "hookload_max")
 _CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
@@ -629,7 +660,16 @@ def schema_markdown() -> str:
              "docs/configuration.md`); a test fails when this file and the schema differ.",
              "", "A well configuration is a TOML file (`NAME.toml` beside the data, "
              "`well.toml` in a well directory, or `--config FILE`). Precedence: command line "
-             "> config file > defaults. Unknown keys are an error naming the key and file.", ""]
+             "> config file > defaults. Unknown keys are an error naming the key and file.", "",
+             "**Units.** A key's unit is in its name and in the *unit* column. Any key with a "
+             "unit also takes a number with another unit, written as text: "
+             '`mud_density_kg_m3 = "10.5 ppg"`, `od_m = "5 1/2 in"`, '
+             '`linear_mass_kg_m = "19.5 lb/ft"`, `wob_N = "40 klbf"`, `bit_depth_m = '
+             '"8200 ft"`. It is converted exactly to the key\'s unit (the float nearest the '
+             "exact value: a field-unit configuration gives bit-for-bit the results of its SI "
+             "twin); a unit of another quantity is an error naming the key, the file and the "
+             "quantity expected. Spellings: docs/ingestion.md (*Units in configurations and "
+             "options*).", ""]
 
     def rows(keys):
         out = ["| key | type | unit | default | range | description |",

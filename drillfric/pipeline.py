@@ -169,13 +169,18 @@ def run_well(well: Well, out_root=None, *, rate_hz: float | None = None, pdf: bo
         Unreadable or meaningless input, or results that cannot be written (nothing is
         written then).
     """
+    if well.depth_indexed:  # no time series: a static friction log by depth
+        from drillfric.friction_log import run_depth_log
+
+        return run_depth_log(well, out_root, rate_hz=rate_hz, pdf=pdf, report=report,
+                             progress=progress, chunk_rows=chunk_rows)
     t_wall = time.perf_counter()
     if out_root is None:
         return _run(well, _MemorySink(), rate_hz, progress, chunk_rows, t_wall)
     with ResultDirectory(out_root, well.dir_name, well.name) as tmp:
         result = _run(well, _DirectorySink(tmp), rate_hz, progress, chunk_rows, t_wall)
         if report:
-            _write_report(tmp, pdf, result)
+            write_report(tmp, pdf, result)
     result.out_dir = Path(out_root) / well.dir_name
     return result
 
@@ -603,7 +608,7 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict],
             "run_time_s": wall_s, "warnings": list(warnings)}
 
 
-def _write_report(result_dir: Path, pdf: bool, result: WellResult) -> None:
+def write_report(result_dir: Path, pdf: bool, result: WellResult) -> None:
     """Write the report; a failure to render is a warning, not a lost run (the results
     stand), and leaves no partial report file; a failure to write (disk) fails the run."""
     from drillfric.report import write_well_report

@@ -36,6 +36,7 @@ class Method(StrEnum):
 
     BATCH = "batch"  #: the speed-driven fit (docs/theory.md §6.4)
     OBSERVER = "observer"  #: the adaptive observer's consensus (§5), the fit gave no μ_k
+    TD_BACKCALC = "td_backcalc"  #: static torque-and-drag back-calculation of a depth log
     NONE = "none"  #: no estimate (skipped or failed)
 
 
@@ -113,7 +114,8 @@ class SegmentRecord:
                                         "refinement)")
     mu_k_spread: float | None = _f("-", "spread of the observer starts' μ_k")
     converged: bool = _f("", "whether μ_k is converged (agreeing estimators, ≥ 90 s)", False)
-    method: Method = _f("", "estimator of the numbers: batch, observer or none", Method.NONE)
+    method: Method = _f("", "estimator of the numbers: batch, observer, td_backcalc (a "
+                             "depth-indexed log's friction log) or none", Method.NONE)
     settling_time_s: float | None = _f("s", "time the observer starts took to settle")
     residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
     stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated bit "

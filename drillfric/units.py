@@ -1,27 +1,46 @@
 """Unit conversion at the edges, with pint, including drilling spellings.
 
-Everything inside drillfric is SI (m, s, rad, N, N·m, kg); rig logs arrive in kN·m,
-ft·lbf, klbf, kkgf, ppg, RPM and friends. :func:`to_si` converts an array given a unit
-string as written in a file header; :func:`parse_unit` normalises drilling spellings
-(``kN.m``, ``kNm``, ``ft.lbf``, ``klbf``, ``kkgf``, ``g/cm3``, ``sg``, ``ppg``, ``rpm``,
-``c/s``, ``deg``) before pint parses them.
+Everything inside drillfric is SI (m, s, rad, N, N·m, kg); rig logs and users speak kN·m,
+ft·lbf, klbf, kkgf, ppg, inches, RPM and friends. Three edges:
+
+- **file headers** — :func:`to_si` converts an array given a unit as written in a header;
+  :func:`parse_unit` normalises drilling spellings (``kN.m``, ``kNm``, ``ft.lbf``,
+  ``klbf``, ``kkgf``, ``g/cm3``, ``sg``, ``ppg``, ``rpm``, ``c/s``, ``deg``) before pint
+  parses them;
+- **configuration values and command-line options** — :func:`quantity_value` reads
+  ``"10.5 ppg"``, ``"5 1/2 in"``, ``"19.5 lb/ft"``, ``"40 klbf"`` or ``"8200 ft"`` in the
+  unit a key or option is declared in, checks the dimension, and converts exactly (decimal
+  arithmetic; the result is the float nearest the exact value, so a field-unit
+  configuration and its SI twin give bit-for-bit the same numbers);
+- **what people read** — :func:`display_unit`, :func:`to_display` and
+  :func:`format_value` show SI values in the ``"si"`` or ``"field"`` system of
+  :data:`DISPLAY_UNITS` (terminal summaries, report axes and tables; result files stay SI).
+
+pint is imported and its registry built on first use (:func:`registry`), not at import:
+``import drillfric.config`` must stay fast for commands that never meet a unit.
 """
 
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from decimal import Decimal, InvalidOperation, localcontext
+from functools import cache, lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pint
 
-from drillfric.errors import InputError
+from drillfric.errors import ConfigError, InputError
 
-UREG = pint.UnitRegistry()
-UREG.define("kilopound_force = 1000 * force_pound = klbf")
-UREG.define("kilokilogram_force = 1000 * kilogram_force = kkgf")
-UREG.define("specific_gravity = 1000 * kilogram / meter ** 3 = sg")
-UREG.define("pound_per_gallon = pound / gallon = ppg")
+if TYPE_CHECKING:
+    import pint
+
+#: Units pint does not define, added to every registry.
+_DEFINITIONS = (
+    "kilopound_force = 1000 * force_pound = klbf",
+    "kilokilogram_force = 1000 * kilogram_force = kkgf",
+    "specific_gravity = 1000 * kilogram / meter ** 3 = sg",
+    "pound_per_gallon = pound / gallon = ppg",
+)
 
 #: Drilling spellings pint does not know, lower-cased, mapped to pint expressions.
 _ALIASES = {
@@ -34,17 +53,21 @@ _ALIASES = {
     "knm": "kilonewton*meter",
     "kn.m": "kilonewton*meter",
     "kn-m": "kilonewton*meter",
+    "kn·m": "kilonewton*meter",
     "n.m": "newton*meter",
     "nm": "newton*meter",
     "n-m": "newton*meter",
+    "n·m": "newton*meter",
     "ft.lbf": "foot*force_pound",
     "ft-lbf": "foot*force_pound",
+    "ft·lbf": "foot*force_pound",
     "ftlbf": "foot*force_pound",
     "ft.lb": "foot*force_pound",
     "ft-lb": "foot*force_pound",
     "lbf.ft": "foot*force_pound",
     "kft.lbf": "kilofoot*force_pound",
     "kft-lbf": "kilofoot*force_pound",
+    "kft·lbf": "kilofoot*force_pound",
     "klbf": "kilopound_force",
     "kips": "kilopound_force",
     "kip": "kilopound_force",
@@ -57,12 +80,18 @@ _ALIASES = {
     "g/cm3": "gram/centimeter**3",
     "g/cc": "gram/centimeter**3",
     "kg/m3": "kilogram/meter**3",
+    "kg/m³": "kilogram/meter**3",
     "sg": "specific_gravity",
     "ppg": "pound_per_gallon",
     "lbm/gal": "pound_per_gallon",
+    "lb/gal": "pound_per_gallon",
     "ft": "foot",
     "f": "foot",  # LAS depth unit
     "feet": "foot",
+    "in": "inch",
+    "inch": "inch",
+    "inches": "inch",
+    '"': "inch",
     "klb": "kilopound_force",
     "klbs": "kilopound_force",
     "kftlb": "kilofoot*force_pound",
@@ -77,10 +106,13 @@ _ALIASES = {
     "deg": "degree",
     "dega": "degree",
     "degrees": "degree",
+    "°": "degree",
     "%": "percent",
     # WITSML 1.x unit spellings (uom attributes, unitList)
     "lbm": "pound",
     "lbm/ft": "pound/foot",
+    "lb/ft": "pound/foot",
+    "ppf": "pound/foot",
     "ftus": "survey_foot",
     "hz": "hertz",
 }
@@ -97,6 +129,115 @@ SI_UNITS = {
     "density": "kilogram/meter**3",
     "dimensionless": "dimensionless",
 }
+
+#: The unit labels of configuration keys and options (``Key.unit`` of
+#: :data:`drillfric.config.SCHEMA`) as pint expressions, with the quantity's name for
+#: messages. A quantity given for a key is converted to its label's unit.
+LABEL_UNITS = {
+    "m": ("meter", "length"),
+    "kg/m³": ("kilogram/meter**3", "density"),
+    "kg/m": ("kilogram/meter", "linear mass"),
+    "kg·m²": ("kilogram*meter**2", "moment of inertia"),
+    "N": ("newton", "force"),
+    "N·m": ("newton*meter", "torque"),
+    "N·m/rad": ("newton*meter/radian", "rotational stiffness"),
+    "N·m·s/rad": ("newton*meter*second/radian", "rotational damping"),
+    "Pa": ("pascal", "pressure"),
+    "s": ("second", "time"),
+    "Hz": ("hertz", "frequency"),
+    "1/s": ("1/second", "rate"),
+    "1/min": ("1/minute", "rate"),
+    "RPM": ("revolution/minute", "rotary speed"),
+    "rad/s": ("radian/second", "rotary speed"),
+    "m/s": ("meter/second", "speed"),
+    "m/h": ("meter/hour", "speed"),
+    "m³/s": ("meter**3/second", "flow rate"),
+    "°/30 m": ("degree/(30*meter)", "dogleg severity"),
+}
+
+#: Units shown to people in each system (terminal summaries, report axes and tables), by
+#: quantity: ``(label, pint expression)``. Result files (Parquet, JSON) stay SI.
+DISPLAY_UNITS = {
+    "si": {"length": ("m", "meter"), "diameter": ("mm", "millimeter"),
+           "force": ("kN", "kilonewton"), "torque": ("kN·m", "kilonewton*meter"),
+           "side force": ("N/m", "newton/meter"), "density": ("kg/m³", "kilogram/meter**3"),
+           "linear mass": ("kg/m", "kilogram/meter"), "pressure": ("bar", "bar"),
+           "rotary speed": ("RPM", "revolution/minute"), "flow rate": ("L/min", "liter/minute"),
+           "speed": ("m/h", "meter/hour"), "time": ("s", "second")},
+    "field": {"length": ("ft", "foot"), "diameter": ("in", "inch"),
+              "force": ("klbf", "kilopound_force"),
+              "torque": ("kft·lbf", "kilofoot*force_pound"),
+              "side force": ("lbf/ft", "force_pound/foot"),
+              "density": ("ppg", "pound_per_gallon"), "linear mass": ("lb/ft", "pound/foot"),
+              "pressure": ("psi", "psi"), "rotary speed": ("RPM", "revolution/minute"),
+              "flow rate": ("gpm", "gallon/minute"), "speed": ("ft/h", "foot/hour"),
+              "time": ("s", "second")},
+}
+#: The SI unit each displayed quantity is stored in (the value handed to :func:`to_display`).
+_STORED = {"length": "meter", "diameter": "meter", "force": "newton", "torque": "newton*meter",
+           "side force": "newton/meter", "density": "kilogram/meter**3",
+           "linear mass": "kilogram/meter", "pressure": "pascal",
+           "rotary speed": "revolution/minute", "flow rate": "meter**3/second",
+           "speed": "meter/second", "time": "second"}
+#: Unit systems of :data:`DISPLAY_UNITS` (``--units``, ``[well] units``).
+UNIT_SYSTEMS = tuple(DISPLAY_UNITS)
+
+RPM_TO_RAD_S = 2.0 * np.pi / 60.0
+"""Revolutions per minute to radians per second [rad/s per RPM]."""
+
+
+@cache
+def registry() -> pint.UnitRegistry:
+    """The pint registry (float magnitudes) with drilling units, built on first use."""
+    import pint
+
+    reg = pint.UnitRegistry()
+    for definition in _DEFINITIONS:
+        reg.define(definition)
+    return reg
+
+
+@cache
+def _exact_registry() -> pint.UnitRegistry:
+    """A pint registry with :class:`~decimal.Decimal` magnitudes (exact decimal factors:
+    1 in = 0.0254 m, 1 lb = 0.45359237 kg) for :func:`quantity_value`."""
+    import pint
+
+    reg = pint.UnitRegistry(non_int_type=Decimal)
+    for definition in _DEFINITIONS:
+        reg.define(definition)
+    return reg
+
+
+def __getattr__(name: str):
+    """``UREG``: the registry of :func:`registry` (built when first asked for)."""
+    if name == "UREG":
+        return registry()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _candidates(text: str) -> list[str]:
+    """pint expressions a unit spelling may stand for, most likely first."""
+    key = text.strip().lower().replace(" ", "")
+    expr = _ALIASES.get(key)
+    if expr is not None:
+        return [expr]
+    return [re.sub(r"(?<=[A-Za-z])[.·](?=[A-Za-z])", "*", spelled)
+            for spelled in (text.strip(), text.strip().lower())]  # LAS headers are upper case
+
+
+def _parse(reg, text: str, *, scaled: bool = False):
+    """The units of ``text`` in registry ``reg`` (None when no candidate parses); with
+    ``scaled``, also a scaled unit such as ``deg/(100 ft)``, as a quantity."""
+    import pint
+
+    for candidate in _candidates(text):
+        try:
+            return reg.parse_expression(candidate) if scaled else reg.parse_units(candidate)
+        except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError,
+                AttributeError, TypeError, ValueError, AssertionError):  # pint on "#1"
+            continue
+    return None
 
 
 @lru_cache(maxsize=256)
@@ -122,19 +263,11 @@ def parse_unit(text: str) -> pint.Unit:
     >>> str(parse_unit("kN.m"))
     'kilonewton * meter'
     """
-    key = text.strip().lower().replace(" ", "")
-    expr = _ALIASES.get(key)
-    candidates = [expr] if expr is not None else [
-        re.sub(r"(?<=[A-Za-z])\.(?=[A-Za-z])", "*", spelled)
-        for spelled in (text.strip(), text.strip().lower())]  # LAS headers are upper case
-    for candidate in candidates:
-        try:
-            return UREG.parse_units(candidate)
-        except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError,
-                AttributeError, TypeError, ValueError, AssertionError):  # pint on "#1"
-            continue
-    raise InputError(f"unknown unit '{text}'",
-                     fix="use a unit such as rpm, kN.m, ft.lbf, klbf, m, ft")
+    unit = _parse(registry(), text)
+    if unit is None:
+        raise InputError(f"unknown unit '{text}'",
+                         fix="use a unit such as rpm, kN.m, ft.lbf, klbf, m, ft")
+    return unit
 
 
 def conversion_factor(unit: str, kind: str) -> float:
@@ -157,10 +290,13 @@ def conversion_factor(unit: str, kind: str) -> float:
     >>> round(conversion_factor("ft.lbf", "torque"), 6)
     1.355818
     """
+    import pint
+
+    reg = registry()
     source = parse_unit(unit)
-    target = UREG.parse_units(SI_UNITS[kind])
+    target = reg.parse_units(SI_UNITS[kind])
     try:
-        return float(UREG.Quantity(1.0, source).to(target).magnitude)
+        return float(reg.Quantity(1.0, source).to(target).magnitude)
     except pint.errors.DimensionalityError as exc:
         raise InputError(f"unit '{unit}' is not a {kind.replace('_', ' ')} unit",
                          fix=f"give a {kind.replace('_', ' ')} unit such as "
@@ -190,5 +326,207 @@ def from_si(values, unit: str, kind: str) -> np.ndarray:
     return np.asarray(values, dtype=float) / conversion_factor(unit, kind)
 
 
-RPM_TO_RAD_S = 2.0 * np.pi / 60.0
-"""Revolutions per minute to radians per second [rad/s per RPM]."""
+# --------------------------------------------------------------------------- quantities
+#: A number, optionally a whole number and a fraction (``5 1/2``, ``5-1/2``) or a fraction
+#: alone (``3/8``), then the unit.
+_QUANTITY = re.compile(
+    r"^\s*(?:(?P<whole>[+-]?\d+)[\s-]+(?P<num>\d+)\s*/\s*(?P<den>\d+)"
+    r"|(?P<fnum>[+-]?\d+)\s*/\s*(?P<fden>\d+)"
+    r"|(?P<number>[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?))\s*(?P<unit>.*?)\s*$")
+#: Unicode vulgar fractions written by hand (``5½ in``).
+_VULGAR = {"½": " 1/2", "¼": " 1/4", "¾": " 3/4", "⅛": " 1/8", "⅜": " 3/8", "⅝": " 5/8",
+           "⅞": " 7/8"}
+#: Decimal digits of the exact conversion (far beyond float64's 17: correctly rounded).
+_DIGITS = 50
+
+
+def _magnitude(match: re.Match) -> Decimal:
+    """The number of a :data:`_QUANTITY` match, exactly (``5 1/2`` → 5.5)."""
+    if match["whole"] is not None:
+        whole, frac = Decimal(match["whole"]), Decimal(match["num"]) / Decimal(match["den"])
+        return whole - frac if match["whole"].startswith("-") else whole + frac
+    if match["fnum"] is not None:
+        return Decimal(match["fnum"]) / Decimal(match["fden"])
+    return Decimal(match["number"])
+
+
+def quantity_value(text: str, unit: str, *, what: str = "", file=None,
+                   bare: bool = False) -> float:
+    """A quantity written by a person, in ``unit``: ``"10.5 ppg"`` → 1258.177… (kg/m³).
+
+    The number may be a decimal, ``5 1/2``, ``5-1/2``, ``5½`` or ``3/8``; the unit any
+    spelling of :func:`parse_unit` (``in``, ``ft``, ``ppg``, ``sg``, ``lb/ft``, ``klbf``,
+    ``kN.m``, ``ft.lbf``, ``rpm`` …). The conversion is exact (decimal arithmetic with 50
+    digits) and the result the float nearest to it, so ``"5 in"`` gives exactly the float
+    ``0.127``.
+
+    Parameters
+    ----------
+    text : str
+        The quantity as written.
+    unit : str
+        Target unit: a label of :data:`LABEL_UNITS` (``"kg/m³"``, ``"m"``, ``"RPM"``) or
+        a pint expression.
+    what : str
+        What the value is, for messages (``"key 'fluid.mud_density_kg_m3'"``); empty when
+        the caller names it (a command-line option).
+    file : str or Path, optional
+        Where the value was written, for messages.
+    bare : bool
+        Accept a number without a unit as already in ``unit`` (command-line options);
+        otherwise a unit is required.
+
+    Raises
+    ------
+    ConfigError
+        Not a number with a unit, an unknown unit, or a unit of another dimension (naming
+        what was given and what is expected).
+
+    Examples
+    --------
+    >>> quantity_value("5 in", "m"), quantity_value("5 1/2 in", "m")
+    (0.127, 0.1397)
+    >>> round(quantity_value("10.5 ppg", "kg/m³"), 3)
+    1258.177
+    """
+    expr, name = LABEL_UNITS.get(unit, (unit, None))
+    text = str(text)
+    for char, spelled in _VULGAR.items():
+        text = text.replace(char, spelled)
+    match = _QUANTITY.match(text)
+    example = f'"{_EXAMPLE_VALUE.get(name, "1.0 " + unit)}"'
+    given = f"{what} = '{_shown(text.strip())}'" if what else f"'{_shown(text.strip())}'"
+    if match is None:
+        problem = (f"{what} must be a number or a number with a unit, got "
+                   f"'{_shown(text.strip())}'" if what else f"{given} is not a number")
+        raise ConfigError(problem, file=file, fix=f"write e.g. {example}")
+    if not match["unit"]:
+        if bare:
+            return float(_magnitude(match))
+        raise ConfigError(f"{given} has no unit", file=file,
+                          fix=f"write the number without quotes (in {unit}) or with its unit, "
+                              f"e.g. {example}")
+    expected = f"{name} ({unit})" if name else unit
+    return _convert(_magnitude(match), match["unit"], expr, expected, given, file, example)
+
+
+def _convert(magnitude: Decimal, spelled: str, expr: str, expected: str, what: str, file,
+             example: str) -> float:
+    """``magnitude`` ``spelled`` in the unit ``expr``, exactly, then rounded to a float."""
+    import pint
+
+    reg = _exact_registry()
+    source = _parse(reg, spelled, scaled=True)
+    if not isinstance(source, reg.Quantity):
+        raise ConfigError(f"{what} has an unknown unit '{_shown(spelled)}'", file=file,
+                          fix=f"use a unit such as in, ft, m, ppg, sg, lb/ft, klbf, kN.m, "
+                              f"ft.lbf, rpm; e.g. {example}")
+    with localcontext() as ctx:
+        ctx.prec = _DIGITS
+        target = reg.parse_expression(expr)
+        try:
+            ratio = (magnitude * source / target).to("dimensionless").magnitude
+        except pint.errors.DimensionalityError:
+            given = _dimension_name(source)
+            raise ConfigError(f"{what} is {given}, not a {expected}", file=file,
+                              fix=f"give a {expected.split(' (')[0]}, e.g. {example}") from None
+        try:
+            return float(Decimal(ratio))
+        except (InvalidOperation, TypeError, ValueError):
+            return float(ratio)
+
+
+#: Example values for messages, by quantity.
+_EXAMPLE_VALUE = {"length": "8200 ft", "density": "10.5 ppg", "linear mass": "19.5 lb/ft",
+                  "force": "40 klbf", "torque": "25 kft.lbf", "pressure": "3000 psi",
+                  "rotary speed": "120 rpm", "time": "2 min", "moment of inertia":
+                  "2900 kg.m**2", "dogleg severity": "3 deg/(100 ft)"}
+
+
+#: Further quantities named in messages (a value given in kg where a length is expected).
+_OTHER_QUANTITIES = (("kilogram", "mass"), ("meter**2", "area"), ("meter**3", "volume"),
+                     ("dimensionless", "pure number"))
+
+
+def _dimension_name(quantity) -> str:
+    """'a length', 'a density' … for a pint quantity (its dimensionality when unnamed)."""
+    reg = quantity._REGISTRY
+    for expr, name in (*LABEL_UNITS.values(), *_OTHER_QUANTITIES):
+        if reg.parse_expression(expr).dimensionality == quantity.dimensionality:
+            return f"a {name}"
+    return f"of dimension {quantity.dimensionality}"
+
+
+def _shown(text: str) -> str:
+    """Text of a value for a message: printable and short."""
+    text = "".join(c if c.isprintable() else "?" for c in str(text))
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+# --------------------------------------------------------------------------- display
+def _system(system: str | None) -> dict:
+    table = DISPLAY_UNITS.get(system or "si")
+    if table is None:
+        raise ConfigError(f"unknown unit system '{system}'",
+                          fix=f"use one of: {', '.join(UNIT_SYSTEMS)}")
+    return table
+
+
+def display_unit(quantity: str, system: str | None = "si") -> str:
+    """Label of the unit ``quantity`` is shown in, e.g. ``display_unit("force", "field")``
+    → ``"klbf"``.
+
+    Parameters
+    ----------
+    quantity : str
+        A key of :data:`DISPLAY_UNITS` tables: ``length``, ``diameter``, ``force``,
+        ``torque``, ``side force``, ``density``, ``linear mass``, ``pressure``,
+        ``rotary speed``, ``flow rate``, ``speed``, ``time``.
+    system : str
+        ``"si"`` (default) or ``"field"``.
+
+    Examples
+    --------
+    >>> display_unit("torque", "field"), display_unit("torque")
+    ('kft·lbf', 'kN·m')
+    """
+    return _system(system)[quantity][0]
+
+
+@lru_cache(maxsize=64)
+def display_factor(quantity: str, system: str | None = "si") -> float:
+    """Factor from the stored SI unit of ``quantity`` to its display unit.
+
+    Examples
+    --------
+    >>> round(display_factor("length", "field"), 6)
+    3.28084
+    """
+    reg = registry()
+    return float(reg.Quantity(1.0, _STORED[quantity]).to(_system(system)[quantity][1])
+                 .magnitude)
+
+
+def to_display(values, quantity: str, system: str | None = "si"):
+    """SI values of ``quantity`` in the display unit of ``system`` (scalar or array).
+
+    Examples
+    --------
+    >>> round(to_display(1000.0, "length", "field"), 1)
+    3280.8
+    """
+    scaled = np.asarray(values, dtype=float) * display_factor(quantity, system)
+    return float(scaled) if scaled.ndim == 0 else scaled
+
+
+def format_value(value, quantity: str, system: str | None = "si", spec: str = ".1f") -> str:
+    """An SI value as text in the display unit, e.g. ``"8202.1 ft"`` (``"—"`` for None/NaN).
+
+    Examples
+    --------
+    >>> format_value(2500.0, "length", "field", ".0f"), format_value(None, "force")
+    ('8202 ft', '—')
+    """
+    if value is None or not np.isfinite(value):
+        return "—"
+    return f"{format(to_display(value, quantity, system), spec)} {display_unit(quantity, system)}"

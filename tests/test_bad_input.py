@@ -82,14 +82,16 @@ def _las(path, *, time_curve: bool):
     return path
 
 
-@pytest.mark.parametrize("command", ["inspect", "run"])
-def test_depth_indexed_las_is_refused_in_one_line(tmp_path, command):
+def test_depth_indexed_las_gives_a_friction_log(tmp_path):
+    """A depth-indexed LAS log without a time curve was refused; it is now read as a
+    friction log by depth (tests/test_friction_log.py checks the numbers)."""
     path = _las(tmp_path / "depth.las", time_curve=False)
-    args = [command, path] + (["--out", tmp_path / "out"] if command == "run" else [])
-    line = _one_line_error(_invoke(*args), "depth.las")
-    assert "depth-indexed" in line and "DEPT" in line and "time-indexed" in line
-    assert "[channels] time" in line  # the fix when the file has a time curve by another name
-    assert not (tmp_path / "out").exists()
+    shown = _invoke("inspect", path)
+    assert shown.exit_code == 0 and "depth-indexed log" in shown.output, shown.output
+    result = _invoke("run", path, "--out", tmp_path / "out")
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "out" / "depth" / "summary.json").read_text())
+    assert summary["index"] == "depth" and summary["segments"][0]["method"] == "td_backcalc"
 
 
 def test_depth_indexed_las_with_a_time_curve_uses_it(tmp_path):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import pytest
 
 from drillfric.config import SCHEMA, SECTION_KEYS, config_from_dict, load_config, schema_markdown
@@ -120,3 +122,50 @@ def test_no_survey_tortuosity_default_and_note():
         {"survey": {"tortuosity_deg_30m": 0.25}}).no_survey_note
     zero = config_from_dict({"survey": {"tortuosity_deg_30m": 0}})
     assert zero.tortuosity_rad_m == 0.0 and zero.no_survey_note == "vertical well: no survey found"
+
+
+def _keys_with_units():
+    return [(table, key) for table, keys in [*SCHEMA.items(), ("string.sections", SECTION_KEYS)]
+            for key in keys if key.unit and key.type in (float, int)]
+
+
+@pytest.mark.parametrize("table, key", _keys_with_units(), ids=lambda v: getattr(v, "name", v))
+def test_every_key_with_a_unit_takes_a_quantity(table, key):
+    """A key's unit label converts (docs/configuration.md: any key with a unit takes a number
+    with a unit): one of its own unit is 1 exactly."""
+    from drillfric.units import LABEL_UNITS, quantity_value
+
+    assert key.unit in LABEL_UNITS, f"add {key.unit!r} to drillfric.units.LABEL_UNITS"
+    assert quantity_value(f"1 {LABEL_UNITS[key.unit][0]}", key.unit) == 1.0
+
+
+def test_field_units_in_a_config_file(tmp_path):
+    path = tmp_path / "w.toml"
+    path.write_text('[fluid]\nmud_density_kg_m3 = "1.2 sg"\n[well]\nbit_depth_m = "7500 ft"\n'
+                    '[[string.sections]]\nod_m = "5 in"\nid_m = "4.276 in"\n'
+                    'linear_mass_kg_m = "19.5 lb/ft"\n')
+    cfg = load_config(path)
+    assert cfg.fluid.mud_density_kg_m3 == 1200.0 and cfg.well.bit_depth_m == 2286.0
+    assert cfg.sections[0]["od_m"] == 0.127
+    assert cfg.sections[0]["id_m"] == float(Fraction("4.276") * Fraction("0.0254"))
+
+
+@pytest.mark.parametrize("value, words", [
+    ('"5 in"', "key 'fluid.mud_density_kg_m3' = '5 in' is a length, not a density (kg/m³)"),
+    ('"100 ppg"', "key 'fluid.mud_density_kg_m3' = 1.198e+04 ('100 ppg') is outside [0, 7849]"),
+    ('"1200"', "key 'fluid.mud_density_kg_m3' = '1200' has no unit"),
+])
+def test_bad_quantity_in_a_config_is_one_line_naming_key_and_file(tmp_path, value, words):
+    path = tmp_path / "w.toml"
+    path.write_text(f"[fluid]\nmud_density_kg_m3 = {value}\n")
+    with pytest.raises(ConfigError) as err:
+        load_config(path)
+    assert words in err.value.message and str(path) in err.value.message
+    assert "\n" not in err.value.message
+
+
+def test_unit_system_key():
+    assert config_from_dict({}).well.units == "si"
+    assert config_from_dict({"well": {"units": "field"}}).well.units == "field"
+    with pytest.raises(ConfigError, match="must be one of 'si', 'field'"):
+        config_from_dict({"well": {"units": "imperial"}})

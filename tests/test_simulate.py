@@ -328,9 +328,49 @@ def test_cli_without_survey_simulates_the_path_run_assumes(tmp_path):
     assert truth["stands"][0]["T_N_Nm"] > 1e3
     survey = pd.read_csv(tmp_path / "v.survey.csv")
     assert survey["inc_deg"].max() == pytest.approx(1.59, abs=0.01)  # a 1°/30 m helix
-    cfg.write_text("[survey]\ntortuosity_deg_30m = 0.0\n" + CONFIG)
-    result = CliRunner().invoke(cli, ["simulate", str(cfg), "--out", str(tmp_path / "w.csv"),
+    flat = tmp_path / "flat.toml"  # v.toml now has v.survey.csv beside it, which it would use
+    flat.write_text("[survey]\ntortuosity_deg_30m = 0.0\n" + CONFIG)
+    result = CliRunner().invoke(cli, ["simulate", str(flat), "--out", str(tmp_path / "w.csv"),
                                       "--duration", "15", "--bit-depth", "1500"])
     assert result.exit_code == 0, result.output
     assert "tortuosity of 0°/30 m" in result.output
     assert json.loads((tmp_path / "w.truth.json").read_text())["stands"][0]["T_N_Nm"] < 1.0
+
+
+def test_simulate_config_uses_the_survey_beside_it(tmp_path):
+    """Regression (issue 15): `simulate NAME.toml` ignored NAME.survey.csv beside it and
+    simulated a vertical hole; it now finds the survey as `run` finds a well's."""
+    (tmp_path / "w.survey.csv").write_text(SURVEY)
+    (tmp_path / "w.toml").write_text(CONFIG)  # no [survey] file: the sidecar by name
+    result = invoke(tmp_path / "w.toml", "--out", tmp_path / "out" / "sim.csv",
+                    "--duration", 15, "--bit-depth", 1500)
+    assert result.exit_code == 0, result.output
+    survey = pd.read_csv(tmp_path / "out" / "sim.survey.csv")
+    assert survey["inc_deg"].max() == 30.0 and survey["md_m"].iloc[-1] == 2000.0
+    truth = json.loads((tmp_path / "out" / "sim.truth.json").read_text())
+    path = minimum_curvature(np.array([0.0, 500.0, 1000.0, 2000.0]),
+                             np.radians([0.0, 0.0, 30.0, 30.0]), np.radians([0.0, 0, 20, 20]))
+    expected = sim.fc_profile(load_config(tmp_path / "w.toml"), path, 1500.0).T_N_Nm
+    # the plant meshes the string on its own grid (simulate.cells): T_N agrees with the
+    # configuration's torque and drag on this path to that discretisation (0.03 % here)
+    assert truth["stands"][0]["T_N_Nm"] == pytest.approx(expected, rel=1e-3)
+
+
+def test_simulate_sidecar_names_the_well_after_the_output(well, tmp_path):
+    """Regression (issue 15): the sidecar config kept the input config's well name, so two
+    outputs of one config claimed one well (and one result directory)."""
+    well.write_text('[well]\nname = "A-12"\n' + well.read_text())
+    out = tmp_path / "runs" / "A-12_high_mu.parquet"
+    assert invoke(well, "--out", out, "--duration", 15, "--bit-depth", 1500).exit_code == 0
+    assert load_config(out.with_suffix(".toml")).well.name == "A-12_high_mu"
+
+
+def test_simulate_options_take_quantities(well, tmp_path):
+    """--bit-depth "4921.26 ft" is 1499.999… m, "5000 ft" exactly 1524 m; "0.25 min" 15 s."""
+    out = tmp_path / "q.csv"
+    result = invoke(well, "--out", out, "--duration", "0.25 min", "--bit-depth", "5000 ft",
+                    "--wob", "0 klbf")
+    assert result.exit_code == 0, result.output
+    truth = json.loads((tmp_path / "q.truth.json").read_text())
+    assert truth["stands"][0]["bit_depth_m"] == 1524.0
+    assert load_config(out.with_suffix(".toml")).simulate.duration_s == 15.0

@@ -21,11 +21,9 @@ import difflib
 import re
 from dataclasses import dataclass
 
-import pint
-
 from drillfric.errors import InputError
 from drillfric.io.text import listing, printable
-from drillfric.units import UREG, parse_unit
+from drillfric.units import parse_unit, registry
 
 
 @dataclass(frozen=True)
@@ -48,6 +46,9 @@ class Channel:
         Names recognised in files (compared case-, space- and punctuation-insensitively).
     required : bool
         Whether a well without this channel is rejected.
+    index : str or None
+        ``"time"`` or ``"depth"`` for the index of a time- or depth-indexed log: mapped
+        (and required) only in logs of that index; None for the other channels.
     """
 
     key: str
@@ -57,6 +58,7 @@ class Channel:
     default_unit: str
     mnemonics: tuple[str, ...]
     required: bool = False
+    index: str | None = None
 
 
 #: The mnemonic table (the only one): canonical channels in output column order. Interval
@@ -65,7 +67,10 @@ class Channel:
 CHANNELS: tuple[Channel, ...] = (
     Channel("time", "time_s", "time", "second", "s",
             ("TIME", "DATETIME", "DATE_TIME", "TIMESTAMP", "TIME_S", "ETIM", "ELAPSED TIME",
-             "TIM", "DATE TIME", "RIG TIME"), required=True),
+             "TIM", "DATE TIME", "RIG TIME"), required=True, index="time"),
+    Channel("measured_depth", "measured_depth_m", "length", "meter", "m",
+            ("DEPT", "DEPTH", "MD", "MEASURED DEPTH", "DEPTH MD", "MD DEPTH",
+             "MEASURED DEPTH MD"), required=True, index="depth"),
     Channel("surface_rpm", "surface_rpm", "rotary speed", "revolution/minute", "rpm",
             ("RPM", "SRPM", "TDRPM", "RPMA", "RPMS", "TDS", "ROTARY SPEED", "TOP DRIVE SPEED",
              "AVERAGE ROTARY SPEED", "SURFACE RPM", "SURFACE ROTARY SPEED", "TOP DRIVE RPM",
@@ -131,8 +136,9 @@ _EXTRA_UNITS = {
 _PER_MINUTE = frozenset({"1/min", "u/min", "min-1", "min^-1", "1/minute", "rev/min"})
 
 #: Unit as spelled in the canonical suffix of each channel (``surface_torque_Nm`` → N.m).
-SUFFIX_UNITS = {"time": "s", "surface_rpm": "rpm", "surface_torque": "N.m", "hookload": "N",
-                "bit_depth": "m", "hole_depth": "m", "wob": "N", "block_position": "m",
+SUFFIX_UNITS = {"time": "s", "measured_depth": "m", "surface_rpm": "rpm",
+                "surface_torque": "N.m", "hookload": "N", "bit_depth": "m", "hole_depth": "m",
+                "wob": "N", "block_position": "m",
                 "bit_rpm": "rpm", "standpipe_pressure": "Pa", "flow_in": "m3/s",
                 "flow_out": "%", "pump_rate": "spm", "surface_torque_min": "N.m",
                 "surface_torque_max": "N.m", "surface_rpm_min": "rpm", "surface_rpm_max": "rpm",
@@ -183,16 +189,18 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     >>> round(factor("klbf", BY_KEY["hookload"]), 3)
     4448.222
     """
+    import pint
+
     source = _source_unit(unit, channel, file)
     try:
-        return float(UREG.Quantity(1.0, source).to(channel.unit).magnitude)
+        return float(registry().Quantity(1.0, source).to(channel.unit).magnitude)
     except pint.errors.DimensionalityError as exc:
         raise InputError(f"unit '{unit}' of {channel.name} is not a {channel.kind} unit",
                          file=file, fix=f'give a {channel.kind} unit, e.g. {channel.key} = '
                                         f'{{ unit = "{channel.default_unit}" }}') from exc
 
 
-def _source_unit(unit: str, channel: Channel, file: str | None) -> pint.Unit:
+def _source_unit(unit: str, channel: Channel, file: str | None):
     """The pint unit of a spelling, read as the channel reads it (1/min is RPM on a speed)."""
     key = unit.strip().lower().replace(" ", "")
     spelled = _EXTRA_UNITS.get(key, unit)
@@ -220,8 +228,9 @@ def unit_fits(unit: str, channel: Channel) -> bool | None:
         source = _source_unit(unit, channel, None)
     except InputError:
         return None
-    return (UREG.Quantity(1.0, source).dimensionality
-            == UREG.Quantity(1.0, channel.unit).dimensionality)
+    reg = registry()
+    return (reg.Quantity(1.0, source).dimensionality
+            == reg.Quantity(1.0, channel.unit).dimensionality)
 
 
 @dataclass(frozen=True)
@@ -366,8 +375,42 @@ def _same_unit(a: str, b: str, channel: Channel, file: str | None) -> bool:
     return abs(fa - fb) <= 1e-9 * max(abs(fa), abs(fb))
 
 
+def log_index(columns: list[str], config_channels: dict, *, depth_index: str | None = None,
+              file: str | None = None) -> str:
+    """Whether a log is indexed by ``"time"`` or by ``"depth"`` (docs/ingestion.md).
+
+    A log with a time column (by mnemonic or ``[channels] time``) is a time log. Without
+    one, a log whose reader found a depth index (LAS, WITSML, DLIS: ``depth_index``) or
+    that has a measured-depth column (``MD``, ``DEPTH``, ``Measured Depth``, or
+    ``[channels] measured_depth``) is a depth log. Otherwise it is taken as a time log (whose
+    missing time column is then the error).
+
+    Raises
+    ------
+    InputError
+        The time column is the log's depth index or its measured-depth column: a depth is
+        never read as a time.
+
+    Examples
+    --------
+    >>> log_index(["TIME", "DEPTH", "RPM", "TORQUE"], {}), log_index(["MD", "RPM"], {})
+    ('time', 'depth')
+    """
+    time = find_column(columns, "time", config_channels, file=file)
+    depth = (split_unit(depth_index)[0] if depth_index else
+             find_column(columns, "measured_depth", config_channels, file=file))
+    if time is None:
+        return "depth" if depth is not None else "time"
+    if time == depth or (depth is None and _rank(time, BY_KEY["measured_depth"], ())[0]):
+        raise InputError(f"column '{time}' is a measured depth, not a time: this log is "
+                         "depth-indexed", file=file,
+                         fix="remove [channels] time; drillfric reads a depth-indexed log as "
+                             "a friction log by depth (docs/ingestion.md)")
+    return "time"
+
+
 def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
-                 file: str | None = None) -> dict[str, Mapping]:
+                 file: str | None = None, index: str = "time") -> dict[str, Mapping]:
     """Match source columns to canonical channels.
 
     Parameters
@@ -381,6 +424,9 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
         The ``[channels]`` table of the configuration (``Config.channels``).
     file : str, optional
         File name for messages.
+    index : str
+        ``"time"`` or ``"depth"`` (:func:`log_index`): which index channel is mapped and
+        required (``time`` or ``measured_depth``).
 
     Returns
     -------
@@ -396,6 +442,8 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
     """
     out: dict[str, Mapping] = {}
     for channel in CHANNELS:
+        if channel.index not in (None, index):
+            continue
         spec = config_channels.get(channel.key, {})
         column, name_unit = _find_column(columns, channel, spec, file, file_units)
         if column is None:
@@ -432,10 +480,13 @@ def _missing(channel: Channel, columns: list[str], file_units: dict, config_chan
         if pick is not None and (split_unit(pick)[1] or file_units.get(pick)):
             unit = ""  # the file states it
     shown = listing(columns, recognised=bool(out) or example != '"NAME"')
+    depth_log = ('; a depth-indexed log needs its measured-depth column instead, e.g. '
+                 '[channels] measured_depth = { column = "NAME", unit = "m" }'
+                 if channel.key == "time" else "")
     return InputError(f"required channel {channel.name} not found; columns found: {shown}",
                       file=file, fix=f"map the column holding the {channel.kind} in the well "
                                      f"config, e.g. [channels] {channel.key} = "
-                                     f"{{ column = {example}{unit} }}")
+                                     f"{{ column = {example}{unit} }}{depth_log}")
 
 
 def suggest_column(channel: Channel, columns: list[str], file_units: dict,
@@ -478,6 +529,7 @@ def mnemonics_markdown() -> str:
              "mnemonics |", "|---|---|---|---|---|---|"]
     for c in CHANNELS:
         names = ", ".join(f"`{m}`" for m in c.mnemonics)
+        required = f"{c.index} logs" if c.index else "yes" if c.required else ""
         lines.append(f"| `{c.key}` | `{c.name}` | {SUFFIX_UNITS[c.key]} | {c.default_unit} | "
-                     f"{'yes' if c.required else ''} | {names} |")
+                     f"{required} | {names} |")
     return "\n".join(lines)

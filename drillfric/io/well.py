@@ -38,7 +38,7 @@ import pandas as pd
 
 from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
-from drillfric.io.channels import Mapping, find_column, map_channels
+from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
 from drillfric.io.text import printable
 from drillfric.io.timebase import TimeBase, TimeTracker, check_plausible_rate, summarize
@@ -169,6 +169,12 @@ class Well:
         return {m.channel.name: m for m in self.mappings.values()}
 
     @property
+    def depth_indexed(self) -> bool:
+        """Whether the data file is a depth-indexed log (per-depth averages, no time base):
+        ``run`` turns it into a static friction log (:mod:`drillfric.friction_log`)."""
+        return bool(self.mappings) and "time" not in self.mappings
+
+    @property
     def assumed(self) -> list[str]:
         """What was assumed for this well: configuration defaults, the hole without a
         survey, and channel units nothing stated (docs/ingestion.md)."""
@@ -177,8 +183,11 @@ class Well:
                  for m in self.mappings.values() if m.source == "default"]
         return self.config.assumed_with(self.survey) + units
 
-    def time_tracker(self) -> TimeTracker:
-        """A fresh time-base tracker for one pass over the data (origin, duplicates)."""
+    def time_tracker(self) -> TimeTracker | None:
+        """A fresh time-base tracker for one pass over the data (origin, duplicates); None
+        for a depth-indexed log."""
+        if self.depth_indexed:
+            return None
         time = self.mappings["time"]
         return TimeTracker(time.factor, file=str(self.files.data), column=time.column)
 
@@ -188,7 +197,8 @@ class Well:
 
         Yields DataFrames with the columns of :attr:`WellData.surface`; concatenated they
         equal :meth:`load`'s. Each call reads the file again from the start (pass a
-        :meth:`time_tracker` to read the time base's counts afterwards).
+        :meth:`time_tracker` to read the time base's counts afterwards). A depth-indexed
+        log yields ``measured_depth_m`` and its other channels, row for row, instead.
         """
         if self.source is None:
             raise ValueError("well opened without its data file's header (header=False)")
@@ -197,7 +207,10 @@ class Well:
             yield _convert(chunk, self.mappings, tracker)
 
     def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
-        """Read the whole surface log into a :class:`WellData` (SI units)."""
+        """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
+        if self.depth_indexed:
+            raise InputError("a depth-indexed log has no time base", file=self.files.data,
+                             fix="read it with drillfric.friction_log.read_depth_log")
         tracker = self.time_tracker()
         chunks = list(self.chunks(chunk_rows, tracker))
         surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
@@ -480,15 +493,16 @@ def _load_survey(survey_path: Path | None) -> WellPath | None:
 
 # --------------------------------------------------------------------------- surface data
 def _open(data_path: Path, cfg: Config) -> tuple[RawSource, dict[str, Mapping]]:
+    """The opened data file and its channel mappings, for a time or a depth log
+    (:func:`~drillfric.io.channels.log_index`); a depth index found by the reader (LAS,
+    WITSML, DLIS) is the measured depth unless ``[channels] measured_depth`` says otherwise."""
     raw = open_source(data_path)
-    if raw.depth_index is not None and find_column(raw.columns, "time", cfg.channels,
-                                                   file=str(data_path)) is None:
-        raise InputError(f"depth-indexed LAS log (index curve {raw.depth_index}) without a "
-                         "time curve; drillfric needs time-indexed logs", file=data_path,
-                         fix="export the time-based log (1 s or faster) from the rig's "
-                             "recorder, or map a time curve of this file with [channels] "
-                             'time = { column = "NAME", unit = "s" }')
-    return raw, map_channels(raw.columns, raw.units, cfg.channels, file=str(data_path))
+    file = str(data_path)
+    index = log_index(raw.columns, cfg.channels, depth_index=raw.depth_index, file=file)
+    channels = cfg.channels
+    if index == "depth" and raw.depth_index is not None and "measured_depth" not in channels:
+        channels = channels | {"measured_depth": {"column": split_unit(raw.depth_index)[0]}}
+    return raw, map_channels(raw.columns, raw.units, channels, file=file, index=index)
 
 
 def _numeric(values: pd.Series) -> np.ndarray:
@@ -523,12 +537,16 @@ def _text_numbers(text: pd.Series) -> np.ndarray:
 
 
 def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
-             tracker: TimeTracker) -> pd.DataFrame:
-    """Canonical SI columns of one raw chunk (time checked by ``tracker``)."""
-    time_s, keep = tracker.step(chunk[mappings["time"].column])
-    out = {"time_s": time_s}
-    if tracker.origin is not None:
-        out["timestamp"] = tracker.origin + pd.to_timedelta(time_s, unit="s")
+             tracker: TimeTracker | None) -> pd.DataFrame:
+    """Canonical SI columns of one raw chunk (time checked by ``tracker``; None: a depth
+    log, every row kept)."""
+    out: dict = {}
+    keep = slice(None)
+    if tracker is not None:
+        time_s, keep = tracker.step(chunk[mappings["time"].column])
+        out["time_s"] = time_s
+        if tracker.origin is not None:
+            out["timestamp"] = tracker.origin + pd.to_timedelta(time_s, unit="s")
     for key, m in mappings.items():
         if key != "time":
             out[m.channel.name] = _numeric(chunk[m.column])[keep] * m.factor

@@ -40,7 +40,7 @@ from defusedxml.ElementTree import iterparse
 from drillfric.errors import InputError
 from drillfric.io.channels import CHANNELS, find_column
 from drillfric.io.readers import RawSource
-from drillfric.units import UREG, conversion_factor, parse_unit
+from drillfric.units import conversion_factor, parse_unit, registry
 
 #: Namespace of WITSML 1.x data objects (1.3.1 and 1.4.1 share it).
 NAMESPACE = "http://www.witsml.org/schemas/1series"
@@ -680,7 +680,8 @@ def _component(comp, path: Path) -> dict:
 
 def _linear_mass(measure: tuple[float, str], path: Path) -> float:
     try:
-        return float(UREG.Quantity(measure[0], parse_unit(measure[1])).to("kg/m").magnitude)
+        return float(registry().Quantity(measure[0], parse_unit(measure[1])).to("kg/m")
+                     .magnitude)
     except (InputError, pint.errors.DimensionalityError) as exc:
         raise InputError(f"tubularComponent wtPerLen unit '{measure[1]}' is not a mass per "
                          "length", file=path, fix=_FIX_EXPORT) from exc

@@ -112,7 +112,8 @@ def write_well(path: str | Path, frame: pd.DataFrame, *, config: dict, survey: W
         Canonical surface columns.
     config : dict
         Effective configuration as plain data (``Config.to_dict()``); ``[survey] file`` is
-        set to the survey sidecar and ``[well] name`` to NAME.
+        set to the survey sidecar and ``[well] name`` to NAME (the well is named after the
+        file written, whatever the input configuration called it).
     survey : WellPath
     truth : dict, optional
         Ground truth (NAME.truth.json and file metadata).
@@ -142,7 +143,7 @@ def write_well(path: str | Path, frame: pd.DataFrame, *, config: dict, survey: W
 def _sidecar_config(config: dict, data: Path, survey: Path) -> dict:
     out = {k: (dict(v) if isinstance(v, dict) else v) for k, v in config.items()}
     out.setdefault("well", {})
-    out["well"]["name"] = out["well"].get("name") or data.stem
+    out["well"]["name"] = data.stem
     out["well"]["data"] = data.name
     out["survey"] = {"file": survey.name}
     if "simulate" in out:

@@ -1,0 +1,426 @@
+"""Static friction log of a depth-indexed drilling log: torque and drag back-calculated per
+depth window.
+
+A depth-indexed log (per-depth averages of surface torque, RPM, WOB, hook load — the most
+common post-well data) has no time series, so the observer of docs/theory.md §5 cannot
+run and μ_s cannot be identified. What the data do hold is the mean torque at each depth,
+and for a rotating string the soft-string model (docs/theory.md §2, docs/torque_drag.md)
+gives that torque as the bit torque plus μ·T_N, T_N = ∫F_c dx. So, per window of
+``[friction_log] window_m`` of measured depth (one stand, 30 m, by default):
+
+1. the **rotating rows** (surface RPM above ``segmentation.rotating_rpm``, torque logged) are
+   split by **load case**: on bottom where WOB exceeds ``segmentation.wob_on_bottom_N``;
+   without WOB, where the bit (``bit_depth_m``, else the row's measured depth) is within
+   ``segmentation.on_bottom_m`` of ``hole_depth_m``; with neither, on bottom (a depth log
+   is a drilling log: announced as assumed);
+2. the **medians** of the window's rows of one load case (depth, torque, RPM, WOB, hook
+   load) stand for it (medians: a few spikes of a reamed connection do not move them);
+3. the **friction factor** is the μ for which the modelled surface torque at the window's
+   bit depth equals the median torque (:func:`drillfric.torque_drag.back_calculate_friction`),
+   with the well's string, survey and mud. Off bottom it is the kinetic friction factor of
+   the string (``off_bottom_rotating``). On bottom the WOB is put at the bit and a bit
+   torque T_bit = μ_bit·WOB·D_bit/3 is assumed (``[friction_log] bit_mu``, ``bit_diameter_m``;
+   μ_bit = 0 by default: none) — surface data cannot separate the bit torque from the
+   string's friction, so the on-bottom factor is **apparent** friction, flagged
+   ``bit_torque_in_friction``.
+
+One friction factor holds along the whole string at each depth (cased and open hole are
+not separated). The results are written as a time log's are (:func:`run_depth_log`), with
+``method = "td_backcalc"``, μ_s null and no estimates over time.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from drillfric.drillstring import build_string
+from drillfric.errors import InputError, ModelError
+from drillfric.estimation.verdict import TYPICAL_MU
+from drillfric.io.results import EstimatesWriter, ResultDirectory, write_json, write_segments
+from drillfric.io.well import CHUNK_ROWS, Well
+from drillfric.result import Flag, Kind, Method, SegmentRecord, Status, segment_columns
+from drillfric.torque_drag import TDResult, back_calculate_friction, solve
+from drillfric.wellpath import no_survey_path
+
+#: What a depth log cannot give, said in every summary and segment message.
+NO_OBSERVER = ("depth-indexed log: no time series, so no observer — μ_s is not identifiable "
+               "and there is no bit speed")
+#: Spacing of the torque-and-drag profile rows written per window [m].
+PROFILE_STEP_M = 10.0
+
+
+@dataclass(frozen=True)
+class Window:
+    """The rows of one depth window and one load case, as the medians μ is fitted to.
+
+    Attributes
+    ----------
+    id : int
+        Segment id, 1-based in depth order.
+    kind : Kind
+        Load case of the rows.
+    md_top_m, md_bottom_m : float
+        The window's measured-depth interval [m].
+    rows : int
+        Rotating rows of this load case in the window.
+    bit_depth_m : float
+        Median bit depth [m] (the measured depth where the log has no bit depth).
+    surface_torque_Nm, surface_rpm, wob_N, hookload_N : float
+        Median surface torque [N·m], surface speed [RPM], weight on bit [N] and hook load
+        [N] of the rows (NaN when not logged).
+    """
+
+    id: int
+    kind: Kind
+    md_top_m: float
+    md_bottom_m: float
+    rows: int
+    bit_depth_m: float
+    surface_torque_Nm: float
+    surface_rpm: float
+    wob_N: float
+    hookload_N: float
+
+
+@dataclass(frozen=True)
+class WindowResult:
+    """One window's record, its torque-and-drag solution (None when not estimated) and the
+    bit torque assumed [N·m]."""
+
+    window: Window
+    record: SegmentRecord
+    td: TDResult | None = field(default=None, repr=False)
+    bit_torque_Nm: float = 0.0
+
+
+# --------------------------------------------------------------------------- reading
+def read_depth_log(well: Well, chunk_rows: int = CHUNK_ROWS) -> pd.DataFrame:
+    """The canonical SI columns of a depth-indexed log, rows with a measured depth only.
+
+    Raises
+    ------
+    InputError
+        The well is not a depth-indexed log, or no row has a measured depth.
+    """
+    if not well.depth_indexed:
+        raise InputError("not a depth-indexed log", file=well.files.data,
+                         fix="run a time log with drillfric.pipeline.run_well")
+    chunks = [c for c in well.chunks(chunk_rows) if len(c)]
+    log = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
+    if not log.empty:
+        log = log[np.isfinite(log["measured_depth_m"].to_numpy(float))]
+    if log.empty:
+        raise InputError("no data rows with a measured depth", file=well.files.data,
+                         fix="give a file with data rows below its header")
+    return log.reset_index(drop=True)
+
+
+def _column(log: pd.DataFrame, name: str) -> np.ndarray:
+    """A channel as floats (all NaN when the log does not have it)."""
+    return log[name].to_numpy(float) if name in log else np.full(len(log), np.nan)
+
+
+def bit_depth(log: pd.DataFrame) -> np.ndarray:
+    """Bit depth of each row [m]: the logged bit depth, else the row's measured depth."""
+    bit = _column(log, "bit_depth_m")
+    return np.where(np.isfinite(bit), bit, log["measured_depth_m"].to_numpy(float))
+
+
+def on_bottom(log: pd.DataFrame, cfg) -> tuple[np.ndarray, str | None]:
+    """Whether each row is on bottom, and what was assumed to decide it (None: nothing).
+
+    WOB above ``segmentation.wob_on_bottom_N`` where logged; else the bit within
+    ``segmentation.on_bottom_m`` of the hole depth where that is logged; else on bottom.
+    """
+    wob = _column(log, "wob_N")
+    gap = _column(log, "hole_depth_m") - bit_depth(log)
+    by_depth = np.isfinite(gap)
+    decided = np.where(np.isfinite(wob), wob > cfg.segmentation.wob_on_bottom_N,
+                       np.where(by_depth, gap <= cfg.segmentation.on_bottom_m, True))
+    blind = ~np.isfinite(wob) & ~by_depth
+    note = None
+    if blind.any():
+        note = (f"bit on bottom in {int(blind.sum())} of {blind.size} rows that log neither "
+                "WOB nor hole depth (a depth log is a drilling log)")
+    return decided, note
+
+
+# --------------------------------------------------------------------------- windows
+def windows(log: pd.DataFrame, cfg) -> tuple[list[Window], list[str]]:
+    """The depth windows of a log, one :class:`Window` per window and load case with rows.
+
+    Windows are ``[friction_log] window_m`` long and aligned on its multiples (2820–2850 m),
+    in depth order; a window whose rows do not rotate gives one window of zero rows (listed
+    as skipped). Returns the windows and what was assumed.
+    """
+    width = cfg.friction_log.window_m
+    md = log["measured_depth_m"].to_numpy(float)
+    rpm, torque = _column(log, "surface_rpm"), _column(log, "surface_torque_Nm")
+    rotating = (rpm > cfg.segmentation.rotating_rpm) & np.isfinite(torque)
+    bottom, note = on_bottom(log, cfg)
+    slot = np.floor(md / width).astype(np.int64)
+    out: list[Window] = []
+    for k in np.unique(slot):
+        here = slot == k
+        kinds = [(Kind.OFF_BOTTOM, here & rotating & ~bottom),
+                 (Kind.ON_BOTTOM, here & rotating & bottom)]
+        kinds = [(kind, rows) for kind, rows in kinds if rows.any()] or [
+            (Kind.ON_BOTTOM if bottom[here].mean() >= 0.5 else Kind.OFF_BOTTOM, here)]
+        for kind, rows in kinds:
+            out.append(_window(len(out) + 1, kind, k * width, width, log, rows & rotating,
+                               rows))
+    return out, [note] if note else []
+
+
+def _window(wid: int, kind: Kind, top: float, width: float, log: pd.DataFrame,
+            rows: np.ndarray, where: np.ndarray) -> Window:
+    """The medians of ``rows`` (the depth of ``where`` when none rotate)."""
+    def median(values: np.ndarray) -> float:
+        finite = values[rows & np.isfinite(values)]
+        return float(np.median(finite)) if finite.size else float("nan")
+
+    depth = median(bit_depth(log)) if rows.any() else float(np.median(bit_depth(log)[where]))
+    return Window(id=wid, kind=kind, md_top_m=float(top), md_bottom_m=float(top + width),
+                  rows=int(rows.sum()), bit_depth_m=depth,
+                  surface_torque_Nm=median(_column(log, "surface_torque_Nm")),
+                  surface_rpm=median(_column(log, "surface_rpm")),
+                  wob_N=median(_column(log, "wob_N")),
+                  hookload_N=median(_column(log, "hookload_N")))
+
+
+# --------------------------------------------------------------------------- back-calculation
+def bit_torque_Nm(wob_N: float, cfg) -> float:
+    """Bit torque assumed on bottom [N·m]: T_bit = μ_bit·WOB·D_bit/3 (a Coulomb bit face,
+    as the simulator's, docs/simulator.md), 0 without WOB or with μ_bit = 0.
+
+    Examples
+    --------
+    >>> from drillfric.config import config_from_dict
+    >>> cfg = config_from_dict({"friction_log": {"bit_mu": 0.3, "bit_diameter_m": 0.2}})
+    >>> round(bit_torque_Nm(100e3, cfg), 6)
+    2000.0
+    """
+    if not np.isfinite(wob_N) or wob_N <= 0:
+        return 0.0
+    return cfg.friction_log.bit_mu * wob_N * cfg.friction_log.bit_diameter_m / 3.0
+
+
+def back_calculate(window: Window, well: Well) -> WindowResult:
+    """The friction factor of one window (docs/ingestion.md *Depth-indexed logs*).
+
+    A window with too few rotating rows, or a bit beyond the survey, is skipped; one whose
+    torque no friction factor in [0, 2] reproduces has failed (with the model's message).
+    """
+    cfg = well.config
+    base = _base_record(window)
+    problem = _skip_reason(window, well)
+    if problem:
+        return WindowResult(window, SegmentRecord(**base, status=Status.SKIPPED,
+                                                  message=f"{problem}; {NO_OBSERVER}"))
+    on = window.kind is Kind.ON_BOTTOM
+    wob = window.wob_N if on and np.isfinite(window.wob_N) else 0.0
+    torque_bit = bit_torque_Nm(wob, cfg) if on else 0.0
+    kw = {"load_case": "rotating_on_bottom" if on else "rotating_off_bottom", "wob_N": wob,
+          "bit_torque_Nm": torque_bit, "mud_out_kg_m3": cfg.fluid.mud_density_kg_m3,
+          "mud_in_kg_m3": cfg.inner_mud_density_kg_m3,
+          "element_length_m": cfg.model.element_length_m}
+    path = well.survey if well.survey is not None else no_survey_path(
+        window.bit_depth_m, cfg.tortuosity_rad_m)
+    string = build_string(cfg.sections, window.bit_depth_m)
+    try:
+        mu = back_calculate_friction(path, string, surface_torque_Nm=window.surface_torque_Nm,
+                                     **kw)
+    except ModelError as exc:
+        return WindowResult(window, SegmentRecord(**base, status=Status.FAILED,
+                                                  message=exc.message), None, torque_bit)
+    td = solve(path, string, friction=mu, **kw)
+    return WindowResult(window, _record(base, window, mu, td, torque_bit), td, torque_bit)
+
+
+def _base_record(window: Window) -> dict:
+    return dict(id=window.id, kind=window.kind, t_start_s=float("nan"),
+                t_end_s=float("nan"), duration_s=float("nan"), bit_depth_m=window.bit_depth_m)
+
+
+def _skip_reason(window: Window, well: Well) -> str:
+    where = f"{window.md_top_m:.0f}–{window.md_bottom_m:.0f} m"
+    least = well.config.friction_log.min_rows
+    if window.rows == 0:
+        return f"no rotation in {where}"
+    if window.rows < least:
+        return (f"{window.rows} rotating rows in {where}, fewer than friction_log.min_rows "
+                f"= {least}")
+    if well.survey is not None and window.bit_depth_m > well.survey.md_max_m:
+        return (f"bit depth {window.bit_depth_m:.1f} m is beyond the survey (last station "
+                f"{well.survey.md_max_m:.1f} m)")
+    return ""
+
+
+def _record(base: dict, window: Window, mu: float, td: TDResult,
+            torque_bit: float) -> SegmentRecord:
+    """The record of a back-calculated window."""
+    notes = [f"{window.md_top_m:.0f}–{window.md_bottom_m:.0f} m window, {window.rows} "
+             "rotating rows, friction factor by torque-and-drag back-calculation"]
+    flags = []
+    if window.kind is Kind.ON_BOTTOM:
+        flags.append(Flag.BIT_TORQUE_IN_FRICTION)
+        notes.append(f"apparent friction: bit torque assumed {torque_bit / 1e3:.2f} kN·m "
+                     "(friction_log.bit_mu), not separated by the data")
+    if not TYPICAL_MU[0] <= mu <= TYPICAL_MU[1]:
+        flags.append(Flag.OUTSIDE_TYPICAL_RANGE)
+        notes.append(f"μ = {mu:.3f} is outside the range usually seen ({TYPICAL_MU[0]}–"
+                     f"{TYPICAL_MU[1]}): check string, survey, torque units")
+    notes.append(NO_OBSERVER)
+    return SegmentRecord(**base, mu_k=mu, mu_td=mu, T_N_Nm=td.T_N_Nm, converged=True,
+                         method=Method.TD_BACKCALC, status=Status.OK, message="; ".join(notes),
+                         flags=tuple(flags))
+
+
+def estimate(well: Well, log: pd.DataFrame | None = None,
+             progress: Callable[[int], None] | None = None) -> tuple[list[WindowResult], list]:
+    """Every window of a depth-indexed well back-calculated, and what was assumed.
+
+    ``progress`` is called with the number of windows done.
+    """
+    log = read_depth_log(well) if log is None else log
+    found, assumed = windows(log, well.config)
+    results = []
+    for window in found:
+        results.append(back_calculate(window, well))
+        if progress:
+            progress(len(results))
+    return results, assumed
+
+
+def friction_log(well: Well) -> list[SegmentRecord]:
+    """The static friction log of a depth-indexed well: one record per window and load
+    case (the module's description), in depth order."""
+    return [r.record for r in estimate(well)[0]]
+
+
+# --------------------------------------------------------------------------- run
+@dataclass
+class _Assumed:
+    """What :func:`drillfric.pipeline.summarise` reads of an estimator: here, no rate."""
+
+    assumed: list
+    rate_hz: float | None = None
+
+
+def run_depth_log(well: Well, out_root=None, *, rate_hz: float | None = None,
+                  pdf: bool = False, report: bool = True, progress=None,
+                  chunk_rows: int = CHUNK_ROWS):
+    """:func:`drillfric.pipeline.run_well` for a depth-indexed log: the friction log, its
+    summary and, with ``out_root``, the result files of ``OUT/NAME`` and the report.
+
+    Writes summary.json (the keys a time log's has, plus ``index = "depth"`` and
+    ``friction_log``), segments.parquet, profiles.parquet, wellpath.parquet (with a
+    survey), friction_log.parquet (the medians of each window, the bit torque assumed and
+    the modelled hook load) and an estimates.parquet without rows (no time series).
+    Parameters as :func:`drillfric.pipeline.run_well`; ``rate_hz`` does not apply (a
+    warning says so).
+    """
+    from drillfric.pipeline import RunProgress, WellResult, summarise
+
+    t_wall = time.perf_counter()
+    log = read_depth_log(well, chunk_rows)
+    tick = (lambda done: progress(RunProgress(len(log), len(log), done))) if progress else None
+    results, assumed = estimate(well, log, tick)
+    records = [r.record for r in results]
+    warnings = [NO_OBSERVER] + (["--rate does not apply to a depth-indexed log: ignored"]
+                                if rate_hz is not None else [])
+    summary = summarise(well, records, [], _Assumed(_assumptions(well, results, assumed)),
+                        len(log), None, warnings, time.perf_counter() - t_wall)
+    kept = [n for n in summary["assumed"] if not n.startswith("top-drive")]  # not used here
+    summary.update(assumed=kept, indicative=bool(kept), index="depth",
+                   friction_log=_log_summary(well, log, results))
+    result = WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
+                        failed=sum(r.status is Status.FAILED for r in records),
+                        warnings=summary["warnings"], _estimates=_no_estimates())
+    if out_root is None:
+        return result
+    with ResultDirectory(out_root, well.dir_name, well.name) as tmp:
+        _write(tmp, well, summary, results)
+        if report:
+            from drillfric.pipeline import write_report
+
+            write_report(tmp, pdf, result)
+    result.out_dir = Path(out_root) / well.dir_name
+    return result
+
+
+def _assumptions(well: Well, results: list[WindowResult], notes: list[str]) -> list[str]:
+    """What the friction log assumed beyond the well's own: the load-case rule, the bit
+    torque."""
+    out = list(notes)
+    if any(r.window.kind is Kind.ON_BOTTOM and r.td is not None for r in results):
+        cfg = well.config.friction_log
+        out.append("on bottom, apparent friction: the bit torque is not separated" if
+                   cfg.bit_mu == 0 else f"on bottom: bit torque μ_bit·WOB·D_bit/3 with μ_bit "
+                   f"= {cfg.bit_mu:g}, D_bit = {cfg.bit_diameter_m:g} m (friction_log)")
+    return out
+
+
+def _log_summary(well: Well, log: pd.DataFrame, results: list[WindowResult]) -> dict:
+    """summary.json ``friction_log``: the windows and the apparent on-bottom consensus."""
+    md = log["measured_depth_m"].to_numpy(float)
+    apparent = [r.record.mu_k for r in results if r.record.status is Status.OK
+                and r.window.kind is Kind.ON_BOTTOM]
+    return {"window_m": well.config.friction_log.window_m, "rows": len(log),
+            "md_start_m": float(md.min()), "md_end_m": float(md.max()),
+            "bit_mu": well.config.friction_log.bit_mu,
+            "mu_apparent": float(np.median(apparent)) if apparent else None}
+
+
+def _no_estimates() -> pd.DataFrame:
+    from drillfric.result import ESTIMATE_NAMES
+
+    return pd.DataFrame(columns=list(ESTIMATE_NAMES))
+
+
+def _write(folder: Path, well: Well, summary: dict, results: list[WindowResult]) -> None:
+    """Every result file but the report."""
+    EstimatesWriter(folder / "estimates.parquet", False).close()
+    write_json(folder / "summary.json", summary)
+    write_segments(folder / "segments.parquet", [r.record for r in results])
+    profiles = [_profile(r.window.id, r.td) for r in results if r.td is not None]
+    if profiles:
+        pd.concat(profiles, ignore_index=True).to_parquet(folder / "profiles.parquet",
+                                                          index=False)
+    if well.survey is not None:
+        pd.DataFrame(well.survey.at(well.survey.md_m)).to_parquet(
+            folder / "wellpath.parquet", index=False)
+    log_table(results).to_parquet(folder / "friction_log.parquet", index=False)
+
+
+def _profile(seg_id: int, td: TDResult) -> pd.DataFrame:
+    """profiles.parquet rows of one window: the solution every ~:data:`PROFILE_STEP_M`."""
+    frame = td.to_frame().drop(columns="azi_deg")
+    step = max(1, int(PROFILE_STEP_M // max(float(np.diff(td.md_m).mean()), 1e-9)))
+    keep = np.unique(np.r_[np.arange(0, len(frame) - 1, step), len(frame) - 2])
+    frame = frame.iloc[keep].reset_index(drop=True)
+    frame.insert(0, "segment_id", np.int32(seg_id))
+    return frame
+
+
+def log_table(results: list[WindowResult]) -> pd.DataFrame:
+    """friction_log.parquet: one row per window and load case, SI (docs/ingestion.md)."""
+    rows = []
+    for r in results:
+        w, rec = r.window, r.record
+        rows.append({"segment_id": w.id, "kind": w.kind.value, "md_top_m": w.md_top_m,
+                     "md_bottom_m": w.md_bottom_m, "bit_depth_m": w.bit_depth_m,
+                     "rows": w.rows, "surface_torque_Nm": w.surface_torque_Nm,
+                     "surface_rpm": w.surface_rpm, "wob_N": w.wob_N,
+                     "hookload_N": w.hookload_N, "bit_torque_Nm": r.bit_torque_Nm,
+                     "mu": np.nan if rec.mu_k is None else rec.mu_k,
+                     "T_N_Nm": np.nan if r.td is None else r.td.T_N_Nm,
+                     "hookload_model_N": np.nan if r.td is None else r.td.hookload_N,
+                     "status": rec.status.value})
+    return pd.DataFrame(rows)

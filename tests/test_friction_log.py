@@ -1,0 +1,259 @@
+"""Depth-indexed drilling logs: a static friction log by torque-and-drag back-calculation
+(drillfric.friction_log, docs/ingestion.md "Depth-indexed logs").
+
+The synthetic depth log is built from the soft-string model itself at a known friction
+factor: each 30 m window holds five rows at depths k·30 + 3, 9, 15, 21, 27 m, so the median
+depth is the middle row's and (the surface torque grows with depth) the median torque is
+the torque at that depth — the back-calculation must return the friction factor to the
+root finder's tolerance. The USROP F-5 log (../shared/data/real, read in place, skipped
+when absent) checks a real log against the plausibility range its README gives.
+"""
+
+from __future__ import annotations
+
+import json
+
+import lasio
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric.config import config_from_dict, read_toml
+from drillfric.drillstring import build_string
+from drillfric.errors import InputError
+from drillfric.friction_log import bit_torque_Nm, friction_log, run_depth_log
+from drillfric.io.survey import read_survey
+from drillfric.io.well import open_well
+from drillfric.result import Flag, Kind, Method, Status
+from drillfric.torque_drag import solve
+from tests.conftest import REPO
+
+MU = 0.27  # the synthetic log's friction factor
+WOB_N = 80e3  # on-bottom windows' weight on bit
+#: brentq's tolerances (xtol 1e-8, rtol 1e-10) bound the back-calculated μ's error; the model
+#: is the one that made the data, so nothing else differs.
+ROOT_TOL = 1e-6
+FIRST, WINDOWS, WIDTH = 1800.0, 8, 30.0
+
+SURVEY = ("md_m,inc_deg,azi_deg\n0,0,0\n500,0,0\n900,40,30\n2500,40,30\n")
+CONFIG = """
+[fluid]
+mud_density_kg_m3 = 1250.0
+[[string.sections]]
+name = "5in DP"
+od_m = 0.127
+id_m = 0.1086
+tool_joint_od_m = 0.1651
+linear_mass_kg_m = 31.0
+[[string.sections]]
+name = "6.5in collars"
+od_m = 0.1651
+id_m = 0.0714
+length_m = 150.0
+[friction_log]
+bit_mu = 0.3
+bit_diameter_m = 0.2159
+"""
+
+
+def _rows(cfg, path) -> pd.DataFrame:
+    """The synthetic log: windows alternate off bottom (WOB 0) and on bottom (WOB 80 kN)."""
+    out = []
+    for k in range(WINDOWS):
+        on = k % 2 == 1
+        for offset in (3.0, 9.0, 15.0, 21.0, 27.0):
+            depth = FIRST + k * WIDTH + offset
+            wob = WOB_N if on else 0.0
+            td = solve(path, build_string(cfg.sections, depth), friction=MU,
+                       load_case="rotating_on_bottom" if on else "rotating_off_bottom",
+                       wob_N=wob, bit_torque_Nm=bit_torque_Nm(wob, cfg) if on else 0.0,
+                       mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
+                       element_length_m=cfg.model.element_length_m)
+            out.append({"MD": depth, "RPM": 120.0, "TORQUE": td.surface_torque_Nm / 1e3,
+                        "WOB": wob / 1e3, "HKLD": td.hookload_N / 1e3})
+    return pd.DataFrame(out)
+
+
+@pytest.fixture(scope="module")
+def depth_log(tmp_path_factory):
+    """A CSV depth log with its config and survey sidecars, and the rows it holds."""
+    folder = tmp_path_factory.mktemp("depthlog")
+    (folder / "d.survey.csv").write_text(SURVEY)
+    (folder / "d.toml").write_text(CONFIG)
+    cfg = config_from_dict(read_toml(folder / "d.toml"))
+    rows = _rows(cfg, read_survey(folder / "d.survey.csv"))
+    data = rows.rename(columns={"MD": "MD [m]", "RPM": "RPM [rpm]", "TORQUE": "TORQUE [kN.m]",
+                                "WOB": "WOB [kN]", "HKLD": "HKLD [kN]"})
+    data.to_csv(folder / "d.csv", index=False)
+    return folder / "d.csv", rows
+
+
+def _check_recovered(records, *, apparent: bool = False):
+    assert [r.status for r in records] == [Status.OK] * WINDOWS
+    assert [r.kind for r in records] == [Kind.OFF_BOTTOM, Kind.ON_BOTTOM] * (WINDOWS // 2)
+    np.testing.assert_allclose([r.bit_depth_m for r in records],
+                               FIRST + WIDTH * np.arange(WINDOWS) + 15.0)
+    for r in records:
+        assert r.method is Method.TD_BACKCALC and r.mu_td == r.mu_k
+        assert r.mu_s is None and not r.mu_s_identifiable and "no observer" in r.message
+        assert (Flag.BIT_TORQUE_IN_FRICTION in r.flags) == (r.kind is Kind.ON_BOTTOM)
+        if not (apparent and r.kind is Kind.ON_BOTTOM):
+            assert r.mu_k == pytest.approx(MU, abs=ROOT_TOL)
+
+
+def test_friction_log_recovers_the_friction_factor_of_a_synthetic_depth_log(depth_log):
+    well = open_well(depth_log[0])
+    assert well.depth_indexed and well.channels["measured_depth_m"].column == "MD [m]"
+    _check_recovered(friction_log(well))
+
+
+def test_apparent_friction_holds_the_bit_torque_over_T_N(depth_log):
+    """With no bit torque separated (bit_mu = 0), a rotating string's surface torque is
+    linear in μ (soft string, σ = 0: docs/theory.md §2), T = T_bit + μ·T_N, so the apparent
+    factor is μ + T_bit/T_N."""
+    well = open_well(depth_log[0], overrides={"friction_log.bit_mu": 0.0})
+    records = friction_log(well)
+    _check_recovered(records, apparent=True)
+    t_bit = 0.3 * WOB_N * 0.2159 / 3.0
+    for r in records:
+        if r.kind is Kind.ON_BOTTOM:
+            assert r.mu_k == pytest.approx(MU + t_bit / r.T_N_Nm, abs=ROOT_TOL)
+
+
+def test_depth_log_windows_follow_the_measured_depth_column(depth_log):
+    """Regression (issue 15): a depth log run through the hint of the old refusal gave every
+    segment one fake depth (the survey's last station); each window is at its own depth."""
+    records = friction_log(open_well(depth_log[0]))
+    depths = [r.bit_depth_m for r in records]
+    assert len(set(depths)) == WINDOWS and min(depths) > FIRST and max(depths) < 2100.0
+
+
+def test_a_depth_column_is_never_read_as_time(depth_log, tmp_path):
+    """Regression (issue 15): mapping time to the measured depth, as the old hint invited,
+    ran with exit 0 and nonsense; it is now one line saying the log is depth-indexed."""
+    (tmp_path / "c.toml").write_text(CONFIG + '[channels]\ntime = { column = "MD [m]" }\n')
+    with pytest.raises(InputError, match="is a measured depth, not a time"):
+        open_well(depth_log[0], config=tmp_path / "c.toml")
+
+
+def test_missing_index_names_both_kinds_of_log(tmp_path):
+    path = tmp_path / "x.csv"
+    path.write_text("RPM,TORQUE\n60,10\n60,11\n")
+    with pytest.raises(InputError, match=r"\[channels\] measured_depth"):
+        open_well(path)
+
+
+def _las(path, rows: pd.DataFrame):
+    las = lasio.LASFile()
+    las.append_curve("DEPT", rows["MD"].to_numpy(), unit="M")
+    for name, unit in (("RPM", "RPM"), ("TORQUE", "KN.M"), ("WOB", "KN"), ("HKLD", "KN")):
+        las.append_curve(name, rows[name].to_numpy(), unit=unit)
+    las.write(str(path), version=2.0)
+
+
+def _witsml(path, rows: pd.DataFrame):
+    """A WITSML 1.4.1 depth log (index type measured depth)."""
+    names, units = "DEPTH,SURF_RPM,TORQUE,WOB", "m,c/s,kN.m,kN"
+    curves = "".join(f'<logCurveInfo uid="{m}"><mnemonic>{m}</mnemonic><unit>{u}</unit>'
+                     "<typeLogData>double</typeLogData></logCurveInfo>"
+                     for m, u in zip(names.split(","), units.split(","), strict=True))
+    data = "".join(f"<data>{r.MD!r},{r.RPM / 60!r},{r.TORQUE!r},{r.WOB!r}</data>"
+                   for r in rows.itertuples())
+    path.write_text('<?xml version="1.0" encoding="UTF-8"?><logs xmlns="http://www.witsml.org/'
+                    'schemas/1series" version="1.4.1.1"><log uidWell="W" uidWellbore="B" '
+                    'uid="D"><nameWell>W</nameWell><name>Depth</name><indexType>measured '
+                    "depth</indexType><indexCurve>DEPTH</indexCurve><nullValue>-999.25"
+                    f"</nullValue>{curves}<logData><mnemonicList>{names}</mnemonicList>"
+                    f"<unitList>{units}</unitList>{data}</logData></log></logs>")
+
+
+@pytest.mark.parametrize("fmt", ["las", "xml", "parquet"])
+def test_depth_logs_of_every_format_give_the_friction_log(depth_log, tmp_path, fmt):
+    """LAS (index curve DEPT) and WITSML (index type measured depth) are depth-indexed by
+    their reader; a Parquet table by its measured-depth column."""
+    rows = depth_log[1]
+    path = tmp_path / f"d.{fmt}"
+    if fmt == "las":
+        _las(path, rows)
+    elif fmt == "xml":
+        _witsml(path, rows)
+    else:
+        rows.rename(columns={"MD": "measured_depth_m", "TORQUE": "TORQUE [kN.m]",
+                             "WOB": "WOB [kN]", "HKLD": "HKLD [kN]"}).to_parquet(path)
+    folder = depth_log[0].parent
+    well = open_well(path, config=folder / "d.toml", survey=folder / "d.survey.csv")
+    assert well.depth_indexed
+    _check_recovered(friction_log(well))
+
+
+def test_run_writes_the_result_files_of_a_time_log(depth_log, tmp_path):
+    path = depth_log[0]
+    result = CliRunner().invoke(cli, ["run", str(path), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    assert "friction log of a depth-indexed log, 8 windows of 30 m" in result.output
+    assert "no observer" in result.output
+    folder = tmp_path / "out" / "d"
+    summary = json.loads((folder / "summary.json").read_text())
+    binding = {"well", "drillfric_version", "mu_s", "mu_k", "mu_s_lower_bound", "segments",
+               "inputs", "config", "assumed", "counts", "warnings", "run_time_s"}
+    assert binding <= set(summary) and summary["index"] == "depth"
+    assert summary["mu_k"] == pytest.approx(MU, abs=ROOT_TOL)  # off-bottom consensus
+    assert summary["friction_log"]["mu_apparent"] == pytest.approx(MU, abs=ROOT_TOL)
+    assert any("no observer" in w for w in summary["warnings"])
+    segments = pd.read_parquet(folder / "segments.parquet")
+    assert list(segments["method"]) == ["td_backcalc"] * WINDOWS
+    assert segments["mu_s"].isna().all()
+    assert len(pd.read_parquet(folder / "estimates.parquet")) == 0
+    table = pd.read_parquet(folder / "friction_log.parquet")
+    np.testing.assert_allclose(table["mu"], MU, atol=ROOT_TOL)
+    profiles = pd.read_parquet(folder / "profiles.parquet")
+    assert set(profiles["segment_id"]) == set(range(1, WINDOWS + 1))
+    assert (folder / "wellpath.parquet").is_file() and (folder / "report.html").is_file()
+
+
+def test_run_depth_log_in_memory_writes_nothing(depth_log, tmp_path):
+    result = run_depth_log(open_well(depth_log[0]))
+    assert result.out_dir is None and result.failed == 0 and len(result.segments) == WINDOWS
+    assert result.estimates.empty
+
+
+def test_inspect_says_the_log_is_depth_indexed(depth_log):
+    text = CliRunner().invoke(cli, ["inspect", str(depth_log[0])])
+    assert text.exit_code == 0, text.output
+    assert "depth-indexed log" in text.output
+    assert "windows    8 of 30 m: 8 usable (4 off bottom rotating, 4 on bottom rotating)" \
+        in text.output
+    doc = json.loads(CliRunner().invoke(cli, ["inspect", str(depth_log[0]), "--json"]).output)
+    assert doc["index"] == "depth" and doc["rate_hz"] is None and doc["rows"] == 5 * WINDOWS
+    assert doc["channels"]["measured_depth_m"]["column"] == "MD [m]"
+    assert doc["md_start_m"] == FIRST + 3.0
+
+
+def test_fleet_runs_depth_logs(depth_log, tmp_path):
+    result = CliRunner().invoke(cli, ["fleet", str(depth_log[0].parent), "--out",
+                                      str(tmp_path / "fleet"), "--workers", "1",
+                                      "--no-report"])
+    assert result.exit_code == 0, result.output
+    table = pd.read_parquet(tmp_path / "fleet" / "fleet_summary.parquet")
+    assert set(table["method"]) == {"td_backcalc"}
+
+
+# --------------------------------------------------------------------------- real data
+def test_usrop_f5_gives_a_plausible_friction_log(real_data):
+    """USROP F-5, 8½in section, with the string of examples/usrop_f5.toml (an assumption)
+    and the operator's survey. The data's README: a 5½in DP / ~150 m BHA soft-string
+    inversion gives apparent factors around 0.13–0.19 (plausibility, not truth); ours also
+    carry the whole bit torque (bit_mu = 0), so the band is widened to 0.25 upwards."""
+    path = real_data / "volve_usrop_f5" / "USROP_F-5_depth.csv"
+    well = open_well(path, config=REPO / "examples" / "usrop_f5.toml",
+                     survey=real_data / "volve_surveys" / "F-5_ACTUAL.txt")
+    assert well.depth_indexed
+    records = friction_log(well)
+    assert all(r.status is Status.OK for r in records)
+    depths = [r.bit_depth_m for r in records]
+    assert min(depths) < 2850 and max(depths) > 3770 and len(set(depths)) > 30
+    apparent = [r.mu_k for r in records if r.kind is Kind.ON_BOTTOM]
+    assert 0.13 <= float(np.median(apparent)) <= 0.25
+    assert all(0.1 <= mu <= 0.3 for mu in apparent)
