@@ -22,10 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from numba import njit
 
 from drillfric.config import Config
 from drillfric.errors import InputError
+from drillfric.kernels.lazy import lazy_jit
 
 #: Rig states, coded by their position (``np.int8``). ``sliding_on_bottom`` (on bottom with
 #: the pumps on but no surface rotation: motor drilling) is drillfric's addition.
@@ -93,9 +93,8 @@ class Segment:
 _LOAD_TAU_S = 10.0
 
 
-@njit(cache=True)
 def _still_turning(rpm, torque, t, turning, level, dip_start, rotating_rpm, stop_rpm,
-                   dip_s, dip_fraction):  # pragma: no cover - compiled
+                   dip_s, dip_fraction):
     """Rotation latch with hysteresis and loaded dips; returns (turning, dip start).
 
     Rotation starts above ``rotating_rpm`` and ends below ``stop_rpm`` — unless the string
@@ -117,12 +116,13 @@ def _still_turning(rpm, torque, t, turning, level, dip_start, rotating_rpm, stop
     return False, np.nan
 
 
-@njit(cache=True)
 def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, block_m, wob_N,
                      pumps, depth_mode, rotating_rpm, stop_rpm, dip_s, dip_fraction, slips_N,
                      on_bottom_m, wob_on_N, trip_m_s, max_rop_m_s,
-                     carry):  # pragma: no cover - compiled; see classify()
+                     carry):
     """Causal per-sample rig state; updates ``carry`` in place (see :func:`classify`).
+
+    Plain Python, compiled by numba for large inputs (:data:`_compiled_kernel`).
 
     ``carry`` = [previous time, previous block position, previous bit depth, hole depth,
     started flag, smoothed downward bit speed, rotating latch, rotating torque level,
@@ -199,6 +199,12 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
     return states, bit_out
 
 
+#: :func:`_classify_kernel` compiled (on first use); inputs up to :data:`_PLAIN_ROWS` rows
+#: run the plain function (no numba import or kernel load for a small file).
+_compiled_kernel = lazy_jit(_classify_kernel, _still_turning)
+_PLAIN_ROWS = 20_000
+
+
 def _column(frame: pd.DataFrame, name: str) -> np.ndarray:
     """Column as float64, or all-NaN when the channel is not recorded."""
     if name in frame:
@@ -242,7 +248,8 @@ def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
                          fix="map the time and surface speed columns in [channels]")
     slips = cfg.segmentation.slips_hookload_N
     seg = cfg.segmentation
-    states, bit = _classify_kernel(
+    kernel = _classify_kernel if len(frame) <= _PLAIN_ROWS else _compiled_kernel()
+    states, bit = kernel(
         _column(frame, "time_s"), _column(frame, "surface_rpm"),
         _column(frame, "surface_torque_Nm"),
         _column(frame, "hookload_N"), _column(frame, "bit_depth_m"),

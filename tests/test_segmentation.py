@@ -30,6 +30,7 @@ from drillfric.segmentation import (
     Segmenter,
     _classify_kernel,
     _column,
+    _compiled_kernel,
     _pumps,
     classify,
     segment,
@@ -328,8 +329,8 @@ def test_block_reckoning_follows_the_bit_in_a_random_well():
 
 
 def test_compiled_kernel_matches_its_python_source():
-    """The numba kernel and its plain-Python source (``py_func``) agree exactly (NaN
-    comparisons, integer codes); the Python source is the readable oracle."""
+    """The numba kernel and its plain-Python source agree exactly (NaN comparisons, integer
+    codes); the Python source is the readable oracle and runs small inputs."""
     data = _random_well(3, depth="block_position_m")
     data["wob_N"] = np.linspace(0.0, 20e3, len(data))
     data["surface_torque_Nm"] = np.where(data["surface_rpm"] > 1.0, 5e3, 100.0)
@@ -338,8 +339,8 @@ def test_compiled_kernel_matches_its_python_source():
                                         "block_position_m", "wob_N")]
     args += [_pumps(data, cfg()), 1, 5.0, 2.5, 10.0, 0.5, 300e3, 0.5, 10e3, 0.1, 300.0 / 3600.0]
     carry = [np.nan, np.nan, 0.0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan]
-    fast = _classify_kernel(*args, np.array(carry))
-    slow = _classify_kernel.py_func(*args, np.array(carry))
+    fast = _compiled_kernel()(*args, np.array(carry))
+    slow = _classify_kernel(*args, np.array(carry))
     np.testing.assert_array_equal(fast[0], slow[0])
     np.testing.assert_array_equal(fast[1], slow[1])
 

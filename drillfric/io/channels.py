@@ -174,6 +174,29 @@ def split_unit(header: str) -> tuple[str, str | None]:
     return str(header), None
 
 
+_FT, _LBF, _GAL, _KGF = 0.3048, 4.4482216152605, 3.785411784e-3, 9.80665
+#: Exact factors of the common spellings to each canonical unit, so that reading a usual
+#: log does not build pint's registry (≈ 0.6 s); anything else goes through pint.
+_COMMON = {
+    "second": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0, "hr": 3600.0},
+    "revolution/minute": {"rpm": 1.0, "rev/min": 1.0, "r/min": 1.0, "c/s": 60.0,
+                          "rev/s": 60.0, "rps": 60.0},
+    "newton*meter": {"n.m": 1.0, "nm": 1.0, "n·m": 1.0, "n-m": 1.0, "n*m": 1.0,
+                     "kn.m": 1e3, "knm": 1e3, "kn·m": 1e3, "kn-m": 1e3, "kn*m": 1e3,
+                     "ft.lbf": _FT * _LBF, "ft-lbf": _FT * _LBF, "ft·lbf": _FT * _LBF,
+                     "lbf.ft": _FT * _LBF, "kft.lbf": 1e3 * _FT * _LBF,
+                     "kft-lbf": 1e3 * _FT * _LBF},
+    "newton": {"n": 1.0, "kn": 1e3, "dan": 10.0, "lbf": _LBF, "klbf": 1e3 * _LBF,
+               "kgf": _KGF, "kkgf": 1e3 * _KGF},
+    "meter": {"m": 1.0, "ft": _FT, "cm": 1e-2, "mm": 1e-3, "in": 0.0254},
+    "pascal": {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "bar": 1e5, "psi": _LBF / 0.0254 ** 2},
+    "meter**3/second": {"m3/s": 1.0, "l/min": 1e-3 / 60.0, "lpm": 1e-3 / 60.0,
+                        "m3/min": 1.0 / 60.0, "gpm": _GAL / 60.0},
+    "percent": {"%": 1.0, "pct": 1.0, "percent": 1.0},
+    "1/minute": {"spm": 1.0, "stk/min": 1.0, "1/min": 1.0},
+}
+
+
 def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     """Factor turning values in ``unit`` into the canonical unit of ``channel``.
 
@@ -189,6 +212,9 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     >>> round(factor("klbf", BY_KEY["hookload"]), 3)
     4448.222
     """
+    common = _COMMON.get(channel.unit, {}).get(unit.strip().lower().replace(" ", ""))
+    if common is not None:
+        return common
     import pint
 
     source = _source_unit(unit, channel, file)
