@@ -17,7 +17,8 @@ the same injection points (see docs/observer_gains.md).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg
@@ -331,6 +332,35 @@ def kalman_filter_gain(params: LumpedParams, n_cells: int,
     return gain[:, 0] / scale
 
 
+#: Pipe lengths within one band of this width share a Kalman design [m]: stands a few
+#: metres apart reuse the design of the band's centre (its gains differ by far less than
+#: their own tuning uncertainty: docs/observer_gains.md "Design cache").
+DESIGN_BAND_M = 30.0
+
+
+def _banded(params: LumpedParams) -> LumpedParams:
+    """The design parameters with the pipe length moved to its band's centre."""
+    centre = (np.floor(params.Lp_m / DESIGN_BAND_M) + 0.5) * DESIGN_BAND_M
+    return replace(params, Lp_m=float(centre))
+
+
+@functools.lru_cache(maxsize=64)
+def _kalman_design(params: LumpedParams, n: int,
+                   noise: KalmanNoise) -> tuple[np.ndarray, np.ndarray]:
+    """Kalman gain per unit time on the design nodes, and the nodes [m] (cached: one dense
+    Riccati solve per string, depth band and step; BLAS on one thread — the machine's cores
+    go to the kernels and the fleet's workers, and a solve this size gains nothing from more).
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        gain = kalman_filter_gain(params, n, noise) / lumped.time_step_s(params, n)
+    nodes = lumped.nodes_m(params, n)
+    gain.setflags(write=False)
+    nodes.setflags(write=False)
+    return gain, nodes
+
+
 def kalman_gains(params: LumpedParams, x_m, T_N_Nm: float, dt_s: float, *,
                  noise: KalmanNoise = KalmanNoise(), max_design_cells: int = 60) -> Gains:
     """Steady-state Kalman gains mapped onto the observer's injection points (THEORY.md §5.1).
@@ -360,9 +390,7 @@ def kalman_gains(params: LumpedParams, x_m, T_N_Nm: float, dt_s: float, *,
     if not np.isfinite(dt_s) or dt_s <= 0:
         raise ModelError(f"observer time step must be positive, got {dt_s} s")
     n = int(np.clip(round(params.t_D_s / dt_s), 20, max_design_cells))
-    h = lumped.time_step_s(params, n)
-    gain = kalman_filter_gain(params, n, noise) / h
-    nodes = lumped.nodes_m(params, n)
+    gain, nodes = _kalman_design(_banded(params), n, noise)
     p_d = float(gain[2 * n + 2])
     l_k = -p_d / T_N_Nm
     return Gains(x_m=x, p0=float(gain[0]), P0=0.0,
