@@ -23,9 +23,12 @@ from drillfric.kernels.plant import (
     LAW_STEP,
     drive_value,
     inflows,
+    padded,
+    padded_size,
     pass_cells,
-    section_ends,
+    state_buffers,
     top_drive_step,
+    unpadded,
     variant,
 )
 
@@ -64,39 +67,49 @@ def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
     return mu_s, mu_k
 
 
-@njit(cache=True)
-def bha_speed(A, B, row, n_pipe):
-    """Mean speed of the BHA cells n_pipe … n−1 in row ``row`` of the state buffers [rad/s]
-    (decides stuck/sliding in the adaptation, eqs. 42–43)."""
-    n = A.shape[1]
+@njit(cache=True, fastmath={"reassoc"})
+def bha_speed(W, row, section_start):
+    """Mean speed of the BHA cells (sections after the first) in row ``row`` of the speed
+    buffer (ghost layout) [rad/s]; decides stuck/sliding in the adaptation (eqs. 42–43).
+
+    Summed in any order (``reassoc``: vectorised; as a sequential sum this scalar loop was
+    a fifth of an observer step): the mean differs from a sequential one by round-off,
+    ~1e-16 relative.
+    """
     acc = 0.0
-    for j in range(n_pipe, n):
-        acc += A[row, j] + B[row, j]
-    return 0.5 * acc / max(n - n_pipe, 1)
+    for s in range(1, section_start.size - 1):
+        for j in range(section_start[s] + 1 + 2 * s, section_start[s + 1] + 1 + 2 * s):
+            acc += W[row, j]
+    return acc / max(section_start[-1] - section_start[1], 1)
+
+
+@njit(cache=True)
+def measurements_at_steps(u, m_t0, m_dt, t0, dt, n_steps, hold):
+    """The measurement series at the model steps t0 + k·Δt, k = 0 … n_steps
+    (:func:`measured_value`), computed once for all members."""
+    out = np.empty(n_steps + 1)
+    for k in range(n_steps + 1):
+        out[k] = measured_value(u, m_t0, m_dt, t0 + k * dt, hold)
+    return out
 
 
 @njit(cache=True)
 def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
                    junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed,
-                   law_exp, bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0,
-                   inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn,
-                   times, out, law, fixed):
+                   law_exp, bit_cap_rel, inv_itd, w_meas, tau_meas, p0, P0, inj_a, inj_b, P1,
+                   l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out, law,
+                   fixed):
     """Advance member ``s`` (row s of the state arrays) ``n_steps`` steps; see
-    :func:`observer_kernels` for the arguments. ``law``, ``fixed``: the friction variant
+    :func:`run_observer` for the arguments, except that ``w_meas``, ``tau_meas`` are the
+    measurements at the model steps (:func:`measurements_at_steps`) and the per-cell
+    arrays ``fcap``, ``fix_k``, ``fix_s``, ``inj_a``, ``inj_b`` are in the ghost layout of
+    :func:`drillfric.kernels.plant.padded`. ``law``, ``fixed``: the friction variant
     (:func:`drillfric.kernels.plant.variant`), compile-time constants."""
     literally(law)
     literally(fixed)
-    n = alpha.shape[1]
-    n_pipe = section_start[1]
-    n_sec = section_start.size - 1
-    A = np.empty((2, n))
-    B = np.empty((2, n))
-    A[0] = alpha[s]
-    B[0] = beta[s]
+    last = alpha.shape[1] + 2 * section_start.size - 4  # the bit cell in the ghost layout
+    A, B, W = state_buffers(alpha[s], beta[s], section_start)
     cur = 0
-    a_in = np.empty(n_sec)
-    b_in = np.empty(n_sec)
-    w_in = np.empty(n_sec + 1)
     inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
     q_td = 0.5 * zeta[0] * dt * inv_itd
     n_rec = times.size
@@ -104,36 +117,34 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
     eps = 1e-9 * dt
     om, ms, mk = omega0[s], mu_s[s], mu_k[s]
     stuck_s, events = guard[s, 0], guard[s, 1]
-    e_last = om - measured_value(w_meas, m_t0, m_dt, t0, hold)
-    w_bha_last = bha_speed(A, B, 0, n_pipe)
+    e_last = om - w_meas[0]
+    w_bha_last = bha_speed(W, 0, section_start)
     for k in range(n_steps + 1):
         t = t0 + k * dt
         while r < n_rec and times[r] <= t + eps:
             out[r, s, 0] = ms
             out[r, s, 1] = mk
             out[r, s, 2] = om
-            out[r, s, 3] = 0.5 * (A[cur, n - 1] + B[cur, n - 1])
+            out[r, s, 3] = W[cur, last]
             out[r, s, 4] = w_bha_last
             out[r, s, 5] = e_last
             r += 1
         if k == n_steps:
             break
-        wm = measured_value(w_meas, m_t0, m_dt, t, hold)
-        taum = measured_value(tau_meas, m_t0, m_dt, t, hold)
+        wm = w_meas[k]
+        taum = tau_meas[k]
         e = om - wm
-        beta0 = B[cur, 0]
+        beta0 = B[cur, 1]
         omega_next = top_drive_step(om, beta0, q_td, dt * inv_itd * taum - dt * p0 * e)
         omega_bar = 0.5 * (om + omega_next)
-        inflows(A, B, cur, section_start, junction_z, 2.0 * omega_bar - beta0 - P0 * e,
-                omega_bar, bit_cap_rel, a_in, b_in, w_in)
-        if n_sec > 1:
-            b_in[0] -= P1 * e
-        pass_cells(A, B, cur, kt_dt, fcap, fix_s, fix_k, ms, mk, omega_c, inv_vs, law_exp, law,
-                   fixed, inj_a, inj_b, e, True)
-        section_ends(A, B, cur, section_start, a_in, b_in, w_in, kt_dt, fcap, fix_s, fix_k,
-                     ms, mk, omega_c, inv_vs, law_exp, law, fixed, inj_a, inj_b, e, True)
+        inflows(A, B, W, cur, section_start, junction_z, 2.0 * omega_bar - beta0 - P0 * e,
+                omega_bar, bit_cap_rel)
+        if section_start.size > 2:  # β reflected into the pipe at the pipe/BHA junction
+            B[cur, section_start[1] + 1] -= P1 * e
+        pass_cells(A, B, W, cur, kt_dt, fcap, fix_s, fix_k, ms, mk, omega_c, inv_vs, law_exp,
+                   law, fixed, inj_a, inj_b, e, True)
         cur = 1 - cur
-        w_bha = bha_speed(A, B, cur, n_pipe)
+        w_bha = bha_speed(W, cur, section_start)
         om = omega_next
         stuck = abs(w_bha) <= omega_c
         ms, mk = adapt(ms, mk, e, stuck, l_s, l_k, dt, adapt_law, mu_max)
@@ -149,10 +160,23 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
             stuck_s = 0.0
         e_last = e
         w_bha_last = w_bha
-    alpha[s] = A[cur]
-    beta[s] = B[cur]
+    unpadded(A[cur], section_start, alpha[s])
+    unpadded(B[cur], section_start, beta[s])
     omega0[s], mu_s[s], mu_k[s] = om, ms, mk
     guard[s, 0], guard[s, 1] = stuck_s, events
+
+
+@njit(cache=True)
+def padded_cells(section_start, fcap, fix_k, fix_s, inj_a, inj_b):
+    """The per-cell arrays in the ghost layout (:func:`drillfric.kernels.plant.padded`), as
+    rows (fcap, fix_k, fix_s, inj_a, inj_b)."""
+    out = np.empty((5, padded_size(section_start)))
+    out[0] = padded(fcap, section_start)
+    out[1] = padded(fix_k, section_start)
+    out[2] = padded(fix_s, section_start)
+    out[3] = padded(inj_a, section_start)
+    out[4] = padded(inj_b, section_start)
+    return out
 
 
 def observer_kernels(law: int, fixed: bool):
@@ -169,24 +193,30 @@ def observer_kernels(law: int, fixed: bool):
                junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
                bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b,
                P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out):
+        cells = padded_cells(section_start, fcap, fix_k, fix_s, inj_a, inj_b)
+        wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
+        taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         for s in range(alpha.shape[0]):
             observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
-                           section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
-                           omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, w_meas,
-                           tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s,
-                           adapt_law, mu_max, deadlock_s, omega_turn, times, out, law, fixed)
+                           section_start, junction_z, zeta, cells[0], cells[1], cells[2], dt,
+                           kt_dt, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum,
+                           p0, P0, cells[3], cells[4], P1, l_k, l_s, adapt_law, mu_max,
+                           deadlock_s, omega_turn, times, out, law, fixed)
 
     @njit(cache=True, parallel=True)
     def parallel(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
                  junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
                  bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a,
                  inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out):
+        cells = padded_cells(section_start, fcap, fix_k, fix_s, inj_a, inj_b)
+        wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
+        taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         for s in prange(alpha.shape[0]):
             observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
-                           section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
-                           omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, w_meas,
-                           tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s,
-                           adapt_law, mu_max, deadlock_s, omega_turn, times, out, law, fixed)
+                           section_start, junction_z, zeta, cells[0], cells[1], cells[2], dt,
+                           kt_dt, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum,
+                           p0, P0, cells[3], cells[4], P1, l_k, l_s, adapt_law, mu_max,
+                           deadlock_s, omega_turn, times, out, law, fixed)
 
     return serial, parallel
 

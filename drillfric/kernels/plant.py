@@ -149,37 +149,70 @@ def friction_cap(w_old, fcap_j, fix_s_j, fix_k_j, mu_s, mu_k, omega_c, inv_vs, d
 
 
 @njit(cache=True)
-def inflows(A, B, cur, section_start, junction_z, alpha_top, omega_top, bit_cap_rel, a_in,
-            b_in, w_in):
-    """Boundary values of step 1 of THEORY §3.1, from the invariants α = A[cur], β = B[cur]
-    at step k.
+def padded_size(section_start):
+    """Length of a row in the ghost layout (:func:`padded`): n + 2·n_sec cells, rounded up
+    so that the cells between the first and the last of the row fill whole 8-wide vectors
+    (the cell loop then has no scalar remainder)."""
+    return 2 + (section_start[-1] + 2 * (section_start.size - 1) - 2 + 7) // 8 * 8
 
-    Fills ``a_in[s]`` (α entering section s at its top), ``b_in[s]`` (β entering it at its
-    bottom) and ``w_in[s]``, ``w_in[s + 1]`` (ω at the section's top and bottom interfaces,
-    used by the viscous term of the end cells). The top boundary α(0) = 2ω̄₀ − β(0) (eq. 15)
-    is passed in as ``alpha_top`` with ``omega_top`` = ω̄₀, the top-drive speed averaged
-    over the step (:func:`top_drive_step`; for a prescribed speed, ω₀ at step k); a
-    junction between an upper section (last cell α_a) and a lower one (first cell β_b)
-    with Z = ζ_b/ζ_a gives
+
+@njit(cache=True)
+def padded(x, section_start):
+    """Per-cell values in the ghost layout of the kernels: a zero ghost cell at the top, two
+    between consecutive sections and one at the bottom, then zeros to
+    :func:`padded_size`."""
+    n_sec = section_start.size - 1
+    out = np.zeros(padded_size(section_start))
+    for s in range(n_sec):
+        for j in range(section_start[s], section_start[s + 1]):
+            out[j + 1 + 2 * s] = x[j]
+    return out
+
+
+@njit(cache=True)
+def unpadded(xp, section_start, out):
+    """The real cells of ``xp`` (ghost layout of :func:`padded`) into ``out`` (length n)."""
+    for s in range(section_start.size - 1):
+        for j in range(section_start[s], section_start[s + 1]):
+            out[j] = xp[j + 1 + 2 * s]
+
+
+@njit(cache=True)
+def inflows(A, B, W, cur, section_start, junction_z, alpha_top, omega_top, bit_cap_rel):
+    """Boundary values of step 1 of THEORY §3.1 into the ghost cells of row ``cur`` of the
+    state buffers ``A`` (α), ``B`` (β), ``W`` (ω = (α + β)/2), from the real cells at step k.
+
+    Each section is framed by ghost cells (layout of :func:`padded`): the one above its
+    first cell holds the α entering it and the interface speed ω, the one below its last
+    cell the β entering it and ω; :func:`pass_cells` then updates every cell the same way.
+    The top boundary α(0) = 2ω̄₀ − β(0) (eq. 15) is passed in as ``alpha_top`` with
+    ``omega_top`` = ω̄₀, the top-drive speed averaged over the step (:func:`top_drive_step`;
+    for a prescribed speed, ω₀ at step k); a junction between an upper section (last cell
+    α_a) and a lower one (first cell β_b) with Z = ζ_b/ζ_a gives
     α_b = [2α_a − (1 − Z)β_b]/(1 + Z) and β_a = [(1 − Z)α_a + 2Zβ_b]/(1 + Z) (eqs. 12–14,
-    38–39); the bit gives β = α − 2τ_bit/ζ with τ_bit = ζ·clamp(α, ±T_bit/ζ) (Coulomb bit,
-    solved exactly; ``bit_cap_rel`` = T_bit/ζ [rad/s]; 0 is the free end β = α, erratum of
-    eq. 40).
+    38–39) and the interface speed (α_a + β_a)/2; the bit gives β = α − 2τ_bit/ζ with
+    τ_bit = ζ·clamp(α, ±T_bit/ζ) (Coulomb bit, solved exactly; ``bit_cap_rel`` = T_bit/ζ
+    [rad/s]; 0 is the free end β = α, erratum of eq. 40).
     """
     n_sec = section_start.size - 1
-    a_in[0] = alpha_top
-    w_in[0] = omega_top
+    A[cur, 0] = alpha_top
+    W[cur, 0] = omega_top
     for s in range(1, n_sec):
-        first = section_start[s]
+        last = section_start[s] + 2 * s - 2  # last cell of section s − 1
         z = junction_z[s - 1]
-        a_up = A[cur, first - 1]
-        b_dn = B[cur, first]
-        a_in[s] = (2.0 * a_up - (1.0 - z) * b_dn) / (1.0 + z)
-        b_in[s - 1] = ((1.0 - z) * a_up + 2.0 * z * b_dn) / (1.0 + z)
-        w_in[s] = 0.5 * (a_up + b_in[s - 1])
-    al = A[cur, A.shape[1] - 1]
-    b_in[n_sec - 1] = al - 2.0 * min(max(al, -bit_cap_rel), bit_cap_rel)
-    w_in[n_sec] = 0.5 * (al + b_in[n_sec - 1])
+        a_up = A[cur, last]
+        b_dn = B[cur, last + 3]
+        b_up = ((1.0 - z) * a_up + 2.0 * z * b_dn) / (1.0 + z)
+        w_if = 0.5 * (a_up + b_up)
+        A[cur, last + 2] = (2.0 * a_up - (1.0 - z) * b_dn) / (1.0 + z)
+        W[cur, last + 2] = w_if
+        B[cur, last + 1] = b_up
+        W[cur, last + 1] = w_if
+    end = section_start[-1] + 2 * n_sec - 1  # the ghost cell below the bit
+    al = A[cur, end - 1]
+    b_bit = al - 2.0 * min(max(al, -bit_cap_rel), bit_cap_rel)
+    B[cur, end] = b_bit
+    W[cur, end] = 0.5 * (al + b_bit)
 
 
 @njit(cache=True, inline="always")
@@ -206,66 +239,48 @@ def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_s_j, f
 
 
 @njit(cache=True)
-def pass_cells(A, B, cur, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs, delta, law,
+def pass_cells(A, B, W, cur, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs, delta, law,
                fixed, inj_a, inj_b, e, inject):
-    """Steps 1–3 of THEORY §3.1 on the interior cells 1 … n−2 as if the string were uniform:
-    α*_j = α_{j−1}, β*_j = β_{j+1} (exact Courant-1 shift) from row ``cur`` of the state
-    buffers ``A`` (α) and ``B`` (β), then :func:`cell_update`, written to row 1 − ``cur``.
+    """Steps 1–3 of THEORY §3.1 on every cell: α*_j = α_{j−1}, β*_j = β_{j+1} (exact
+    Courant-1 shift) from row ``cur`` of the state buffers ``A`` (α), ``B`` (β), ``W`` (ω),
+    then :func:`cell_update`, written to row 1 − ``cur``.
 
-    With ``inject`` (the observer, docs/theory.md §5) each cell then loses ``inj_a[j]·e``,
-    ``inj_b[j]·e`` in the same pass; without ``fixed`` the fixed arrays are not read.
-    ``law``, ``fixed`` and ``inject`` must be compile-time constants at the call site: each
-    combination compiles to its own branch-free loop, which the compiler vectorises.
-    :func:`section_ends` then redoes the first and last cell of every section.
+    Buffers and per-cell arrays are in the ghost layout of :func:`padded`, the ghost cells
+    of row ``cur`` filled by :func:`inflows`, so section ends, junctions, the top drive and
+    the bit need no separate pass (the ghost cells are updated too, meaninglessly, and
+    refilled before they are read). With ``inject`` (the observer, docs/theory.md §5) each
+    cell then loses ``inj_a[j]·e``, ``inj_b[j]·e`` in the same pass; without ``fixed`` the
+    fixed arrays are not read. ``law``, ``fixed`` and ``inject`` must be compile-time
+    constants at the call site: each combination compiles to its own branch-free loop,
+    which the compiler vectorises.
     """
     literally(law)
     literally(fixed)
     literally(inject)
     nxt = 1 - cur
     for j in range(1, A.shape[1] - 1):
-        an, bn = cell_update(A[cur, j - 1], B[cur, j + 1],
-                             0.5 * (A[cur, j - 1] + B[cur, j - 1]),
-                             0.5 * (A[cur, j + 1] + B[cur, j + 1]),
-                             0.5 * (A[cur, j] + B[cur, j]), kt_dt, fcap[j],
-                             fix_s[j] if fixed else 0.0, fix_k[j] if fixed else 0.0, mu_s,
-                             mu_k, omega_c, inv_vs, delta, law, fixed)
+        an, bn = cell_update(A[cur, j - 1], B[cur, j + 1], W[cur, j - 1], W[cur, j + 1],
+                             W[cur, j], kt_dt, fcap[j], fix_s[j] if fixed else 0.0,
+                             fix_k[j] if fixed else 0.0, mu_s, mu_k, omega_c, inv_vs, delta,
+                             law, fixed)
         if inject:
             an -= inj_a[j] * e
             bn -= inj_b[j] * e
         A[nxt, j] = an
         B[nxt, j] = bn
+        W[nxt, j] = 0.5 * (an + bn)
 
 
 @njit(cache=True)
-def section_ends(A, B, cur, section_start, a_in, b_in, w_in, kt_dt, fcap, fix_s, fix_k, mu_s,
-                 mu_k, omega_c, inv_vs, delta, law, fixed, inj_a, inj_b, e, inject):
-    """Redo the first and last cell of every section with the section inflows.
-
-    Completes :func:`pass_cells` (same arguments; here the flags may vary at run time):
-    ``a_in``, ``b_in``, ``w_in`` come from :func:`inflows`; each cell reads only step-k
-    values, so the overwrite is exact.
-    """
-    nxt = 1 - cur
-    for s in range(section_start.size - 1):
-        lo = section_start[s]
-        hi = section_start[s + 1]
-        for j in (lo, hi - 1):
-            if j == lo:
-                a_src, w_a = a_in[s], w_in[s]
-            else:
-                a_src, w_a = A[cur, j - 1], 0.5 * (A[cur, j - 1] + B[cur, j - 1])
-            if j == hi - 1:
-                b_src, w_b = b_in[s], w_in[s + 1]
-            else:
-                b_src, w_b = B[cur, j + 1], 0.5 * (A[cur, j + 1] + B[cur, j + 1])
-            an, bn = cell_update(a_src, b_src, w_a, w_b, 0.5 * (A[cur, j] + B[cur, j]), kt_dt,
-                                 fcap[j], fix_s[j], fix_k[j], mu_s, mu_k, omega_c, inv_vs,
-                                 delta, law, fixed)
-            if inject:
-                an -= inj_a[j] * e
-                bn -= inj_b[j] * e
-            A[nxt, j] = an
-            B[nxt, j] = bn
+def state_buffers(alpha, beta, section_start):
+    """Double-buffered state (A, B, W) in the ghost layout, row 0 = ``alpha``, ``beta``."""
+    A = np.zeros((2, padded_size(section_start)))
+    B = np.zeros_like(A)
+    W = np.zeros_like(A)
+    A[0] = padded(alpha, section_start)
+    B[0] = padded(beta, section_start)
+    W[0] = 0.5 * (A[0] + B[0])
+    return A, B, W
 
 
 @njit(cache=True)
@@ -320,15 +335,12 @@ def plant_kernel(law: int, fixed: bool):
     def kernel(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
                fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
                inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
-        n = alpha.size
-        A = np.empty((2, n))
-        B = np.empty((2, n))
-        A[0] = alpha
-        B[0] = beta
+        last = alpha.size + 2 * section_start.size - 4  # the bit cell in the ghost layout
+        A, B, W = state_buffers(alpha, beta, section_start)
+        fcap_p = padded(fcap, section_start)
+        fix_s_p = padded(fix_s, section_start)
+        fix_k_p = padded(fix_k, section_start)
         cur = 0
-        a_in = np.empty(section_start.size - 1)
-        b_in = np.empty(section_start.size - 1)
-        w_in = np.empty(section_start.size)
         inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
         omega0 = top[0]
         integral = top[1]
@@ -345,11 +357,11 @@ def plant_kernel(law: int, fixed: bool):
             if mode == _MODE_SPEED:
                 omega0 = u_now
                 u_next = drive_value(u, u_t0, u_dt, t + dt)
-            beta0 = B[cur, 0]
+            beta0 = B[cur, 1]
             tau0 = zeta0 * (omega0 - beta0)
             tau_m = motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt,
                                  inv_itd)
-            w_bit = 0.5 * (A[cur, n - 1] + B[cur, n - 1])
+            w_bit = W[cur, last]
             while r < n_rec and times[r] <= t + eps:
                 f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
                 out[r, 0] = p0 + f * (omega0 - p0)
@@ -364,19 +376,16 @@ def plant_kernel(law: int, fixed: bool):
             if mode != _MODE_SPEED:
                 omega_next = top_drive_step(omega0, beta0, q_td, dt * inv_itd * tau_m)
             omega_bar = 0.5 * (omega0 + omega_next)
-            inflows(A, B, cur, section_start, junction_z, 2.0 * omega_bar - beta0, omega_bar,
-                    bit_cap_rel, a_in, b_in, w_in)
-            pass_cells(A, B, cur, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs,
-                       law_exp, law, fixed, fcap, fcap, 0.0, False)
-            section_ends(A, B, cur, section_start, a_in, b_in, w_in, kt_dt, fcap, fix_s,
-                         fix_k, mu_s, mu_k, omega_c, inv_vs, law_exp, law, fixed, fcap, fcap,
-                         0.0, False)
+            inflows(A, B, W, cur, section_start, junction_z, 2.0 * omega_bar - beta0,
+                    omega_bar, bit_cap_rel)
+            pass_cells(A, B, W, cur, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k, omega_c,
+                       inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
             if mode == _MODE_PI:
                 integral += dt * (u_now - omega0)
             omega0 = omega_next
             cur = 1 - cur
-        alpha[:] = A[cur]
-        beta[:] = B[cur]
+        unpadded(A[cur], section_start, alpha)
+        unpadded(B[cur], section_start, beta)
         top[0] = omega0
         top[1] = integral
 

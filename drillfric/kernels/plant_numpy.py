@@ -7,6 +7,8 @@ the baseline of ``benchmarks/bench_plant.py``. Not for production use (slow).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from drillfric.kernels.plant import LAW_STEP, LAW_STRIBECK, LAW_STRIBECK_1, LAW_STRIBECK_2
@@ -81,7 +83,12 @@ def friction_cap(w_old, cap_s, cap_k, omega_c, inv_vs, delta, law):
     if law == LAW_STEP:
         return np.where(np.abs(w_old) <= omega_c, cap_s, cap_k)
     u = np.abs(w_old) * inv_vs
-    x = u if law == LAW_STRIBECK_1 else u * u if law == LAW_STRIBECK_2 else u ** delta
+    if law == LAW_STRIBECK_1:
+        x = u
+    elif law == LAW_STRIBECK_2:
+        x = u * u
+    else:  # the C library's pow, as the kernel (NumPy's own vectorised pow differs by an ulp)
+        x = np.array([math.pow(v, delta) for v in u])
     return cap_k + (cap_s - cap_k) * exp_neg(x)
 
 
