@@ -4,15 +4,16 @@ One step k → k+1 of the Courant-1 scheme is split into small functions that th
 observer (docs/theory.md §5, a copy of this plant plus injections) reuses:
 
 - :func:`inflows` — the values entering each section at step 1: top boundary (eq. 15),
-  section junctions (eqs. 12–14 / 38–39) and the bit (β = α − 2τ_bit/ζ, erratum of eq. 40);
+  section junctions (eqs. 12–14 / 38–39) and the bit (β = α − 2τ_bit/ζ, erratum of eq. 40),
+  written into the ghost cells that frame every section;
 - :func:`cell_update` — steps 2–3 for one cell: viscous term −(k_t/2)(α + β) (erratum of
   eq. 11), taken at the foot of each characteristic (see docs/simulator.md: evaluated at
   the cell itself, as THEORY §3.1 step 2 reads, it amplifies grid-scale waves at rate k_t),
   and the friction inclusion (eqs. 5–6, A.1–A.5 with consistent units) with the cap of
   :func:`friction_cap` (docs/theory.md §3.2: friction profile, step or Stribeck law);
-- :func:`pass_cells` — steps 1–3 fused in one vectorised pass over the interior cells
-  (exact shift), with the observer's per-cell injections when asked; :func:`section_ends`
-  redoes the first and last cell of every section with the inflows;
+- :func:`pass_cells` — steps 1–3 fused in one vectorised pass over every cell (exact
+  shift; the ghost cells make section ends like any other cell), with the observer's
+  per-cell injections when asked;
 - :func:`drive_value`, :func:`motor_torque`, :func:`top_drive_step` — the top-drive input
   (PI on a set-point series, prescribed torque, or prescribed speed) and step 4, taken
   trapezoidally and solved *before* step 1 because the top inflow α(0) = 2ω̄₀ − β(0) uses
@@ -22,22 +23,25 @@ observer (docs/theory.md §5, a copy of this plant plus injections) reuses:
   interpolation between steps (no Python loop over time steps); it runs the compiled
   :func:`plant_kernel` of the call's friction variant.
 
-State layout: two buffers ``A`` (α) and ``B`` (β) of shape (2, n) over the whole string;
-row ``cur`` holds step k and the step writes row 1 − ``cur`` (no views, no array swaps: both
-cost atomic reference counting at every step). ``section_start`` (first cell of each
-section + total), per-cell ``zeta``, ``fcap`` (speed change friction can impose in one step
-per unit μ, F_c·Δt/(ρJ) [rad/s]) and the fixed part of the profile ``fix_k``, ``fix_s``
-(the same for a zone of known friction, already times its friction factor [rad/s]). The
-friction law is given by ``law_speed`` (Stribeck decay speed v_s [rad/s]; 0 is the step law
-at ω_c) and ``law_exp`` (Stribeck exponent δ). The plain-NumPy twin with the same argument
-list is :mod:`drillfric.kernels.plant_numpy`.
+Arguments: cell arrays ``alpha``, ``beta`` over the whole string, ``section_start`` (first
+cell of each section + total), per-cell ``zeta``, ``fcap`` (speed change friction can impose
+in one step per unit μ, F_c·Δt/(ρJ) [rad/s]) and the fixed part of the profile ``fix_k``,
+``fix_s`` (the same for a zone of known friction, already times its friction factor
+[rad/s]); the friction law is given by ``law_speed`` (Stribeck decay speed v_s [rad/s]; 0
+is the step law at ω_c) and ``law_exp`` (Stribeck exponent δ). The plain-NumPy twin with
+the same argument list is :mod:`drillfric.kernels.plant_numpy`.
 
-Performance rules these kernels follow (docs/performance.md): the friction variant (law,
-fixed part, injection) is a compile-time constant of every cell loop (:func:`plant_kernel`
-closes over it; :func:`pass_cells` is specialised with ``literally``), so each loop is
-branch-free and vectorised; functions that take arrays are called, not inlined, and inline
-helpers take scalars only — an inlined helper with array arguments inside the time loop
-left ~30 atomic reference-count updates per step (half the time of a 65-cell step).
+Inside, the state is three double buffers ``A`` (α), ``B`` (β) and ``W`` (ω = (α + β)/2,
+stored so that no cell recomputes its neighbours' speeds) of shape (2, m) in the ghost
+layout of :func:`padded`: a ghost cell above the string, two between consecutive sections,
+one below the bit, rows padded to whole 8-wide vectors. Row ``cur`` holds step k and the
+step writes row 1 − ``cur``. Performance rules (docs/performance.md): no array views or
+swaps in the time loop and no inlined helper with array arguments (each cost atomic
+reference counting at every step — it was half the time of a 65-cell step); the friction
+variant (law, fixed part, injection) is a compile-time constant of every cell loop
+(:func:`plant_kernel` closes over it; :func:`pass_cells` is specialised with
+``literally``), so each loop is branch-free and vectorised. The arithmetic is that of the
+twin, operation for operation (no fastmath): the kernels agree with it bit for bit.
 """
 
 from __future__ import annotations
