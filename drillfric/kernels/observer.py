@@ -23,13 +23,12 @@ from drillfric.kernels.plant import (
     LAW_STEP,
     drive_value,
     inflows,
-    padded,
     padded_size,
     pass_cells,
-    state_buffers,
     top_drive_step,
     unpadded,
     variant,
+    work_buffer,
 )
 
 #: Columns of the observer record, per start.
@@ -101,14 +100,16 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
                    fixed):
     """Advance member ``s`` (row s of the state arrays) ``n_steps`` steps; see
     :func:`run_observer` for the arguments, except that ``w_meas``, ``tau_meas`` are the
-    measurements at the model steps (:func:`measurements_at_steps`) and the per-cell
-    arrays ``fcap``, ``fix_k``, ``fix_s``, ``inj_a``, ``inj_b`` are in the ghost layout of
-    :func:`drillfric.kernels.plant.padded`. ``law``, ``fixed``: the friction variant
-    (:func:`drillfric.kernels.plant.variant`), compile-time constants."""
+    measurements at the model steps (:func:`measurements_at_steps`). The member works in its
+    own :func:`drillfric.kernels.plant.work_buffer`. ``law``, ``fixed``: the friction
+    variant (:func:`drillfric.kernels.plant.variant`), compile-time constants."""
     literally(law)
     literally(fixed)
     last = alpha.shape[1] + 2 * section_start.size - 4  # the bit cell in the ghost layout
-    A, B, W = state_buffers(alpha[s], beta[s], section_start)
+    X = work_buffer(alpha[s], beta[s], section_start, (fcap, fix_k, fix_s, inj_a, inj_b))
+    A, B, W = X[0:2], X[2:4], X[4:6]
+    fcap, fix_k, fix_s, inj_a, inj_b = X[6], X[7], X[8], X[9], X[10]
+    end = padded_size(section_start) - 1
     cur = 0
     inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
     q_td = 0.5 * zeta[0] * dt * inv_itd
@@ -141,8 +142,8 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
                 omega_bar, bit_cap_rel)
         if section_start.size > 2:  # β reflected into the pipe at the pipe/BHA junction
             B[cur, section_start[1] + 1] -= P1 * e
-        pass_cells(A, B, W, cur, kt_dt, fcap, fix_s, fix_k, ms, mk, omega_c, inv_vs, law_exp,
-                   law, fixed, inj_a, inj_b, e, True)
+        pass_cells(A, B, W, cur, end, kt_dt, fcap, fix_s, fix_k, ms, mk, omega_c, inv_vs,
+                   law_exp, law, fixed, inj_a, inj_b, e, True)
         cur = 1 - cur
         w_bha = bha_speed(W, cur, section_start)
         om = omega_next
@@ -166,19 +167,6 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
     guard[s, 0], guard[s, 1] = stuck_s, events
 
 
-@njit(cache=True)
-def padded_cells(section_start, fcap, fix_k, fix_s, inj_a, inj_b):
-    """The per-cell arrays in the ghost layout (:func:`drillfric.kernels.plant.padded`), as
-    rows (fcap, fix_k, fix_s, inj_a, inj_b)."""
-    out = np.empty((5, padded_size(section_start)))
-    out[0] = padded(fcap, section_start)
-    out[1] = padded(fix_k, section_start)
-    out[2] = padded(fix_s, section_start)
-    out[3] = padded(inj_a, section_start)
-    out[4] = padded(inj_b, section_start)
-    return out
-
-
 def observer_kernels(law: int, fixed: bool):
     """(serial, parallel) compiled observer kernels of one friction variant.
 
@@ -193,30 +181,28 @@ def observer_kernels(law: int, fixed: bool):
                junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
                bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b,
                P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out):
-        cells = padded_cells(section_start, fcap, fix_k, fix_s, inj_a, inj_b)
         wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         for s in range(alpha.shape[0]):
             observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
-                           section_start, junction_z, zeta, cells[0], cells[1], cells[2], dt,
-                           kt_dt, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum,
-                           p0, P0, cells[3], cells[4], P1, l_k, l_s, adapt_law, mu_max,
-                           deadlock_s, omega_turn, times, out, law, fixed)
+                           section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
+                           omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum, p0, P0,
+                           inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s,
+                           omega_turn, times, out, law, fixed)
 
     @njit(cache=True, parallel=True)
     def parallel(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
                  junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
                  bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a,
                  inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out):
-        cells = padded_cells(section_start, fcap, fix_k, fix_s, inj_a, inj_b)
         wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         for s in prange(alpha.shape[0]):
             observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
-                           section_start, junction_z, zeta, cells[0], cells[1], cells[2], dt,
-                           kt_dt, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum,
-                           p0, P0, cells[3], cells[4], P1, l_k, l_s, adapt_law, mu_max,
-                           deadlock_s, omega_turn, times, out, law, fixed)
+                           section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
+                           omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum, p0, P0,
+                           inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s,
+                           omega_turn, times, out, law, fixed)
 
     return serial, parallel
 

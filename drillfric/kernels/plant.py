@@ -34,7 +34,9 @@ the same argument list is :mod:`drillfric.kernels.plant_numpy`.
 Inside, the state is three double buffers ``A`` (α), ``B`` (β) and ``W`` (ω = (α + β)/2,
 stored so that no cell recomputes its neighbours' speeds) of shape (2, m) in the ghost
 layout of :func:`padded`: a ghost cell above the string, two between consecutive sections,
-one below the bit, rows padded to whole 8-wide vectors. Row ``cur`` holds step k and the
+one below the bit, the cell loop padded to whole 8-wide vectors; they and the per-cell
+arrays are rows of one :func:`work_buffer` whose row stride avoids 4K aliasing
+(:func:`row_length`). Row ``cur`` holds step k and the
 step writes row 1 − ``cur``. Performance rules (docs/performance.md): no array views or
 swaps in the time loop and no inlined helper with array arguments (each cost atomic
 reference counting at every step — it was half the time of a 65-cell step); the friction
@@ -154,19 +156,32 @@ def friction_cap(w_old, fcap_j, fix_s_j, fix_k_j, mu_s, mu_k, omega_c, inv_vs, d
 
 @njit(cache=True)
 def padded_size(section_start):
-    """Length of a row in the ghost layout (:func:`padded`): n + 2·n_sec cells, rounded up
-    so that the cells between the first and the last of the row fill whole 8-wide vectors
-    (the cell loop then has no scalar remainder)."""
+    """Cells of the ghost layout (:func:`padded`): n + 2·n_sec, rounded up so that the cells
+    between the first and the last fill whole 8-wide vectors (no scalar loop remainder)."""
     return 2 + (section_start[-1] + 2 * (section_start.size - 1) - 2 + 7) // 8 * 8
+
+
+@njit(cache=True)
+def row_length(section_start):
+    """Length of a row of the work buffer (:func:`work_buffer`): the smallest 88 + 512·q
+    cells ≥ :func:`padded_size`, i.e. a row stride of 704 bytes modulo 4096.
+
+    The loop stores three rows while it loads from the others; a load whose address equals
+    a store still in flight modulo 4096 waits for it ("4K aliasing"). With separately
+    allocated arrays that depended on where the heap put them: the same 475-cell step took
+    266–641 ns over 24 placements. Rows 704 bytes apart (mod 4096) keep every load at least
+    576 bytes (72 cells) from the stores of the last iterations, for up to 11 rows.
+    """
+    return 88 + 512 * max(0, (padded_size(section_start) - 88 + 511) // 512)
 
 
 @njit(cache=True)
 def padded(x, section_start):
     """Per-cell values in the ghost layout of the kernels: a zero ghost cell at the top, two
-    between consecutive sections and one at the bottom, then zeros to
-    :func:`padded_size`."""
+    between consecutive sections and one at the bottom, zeros after the last
+    (length :func:`row_length`)."""
     n_sec = section_start.size - 1
-    out = np.zeros(padded_size(section_start))
+    out = np.zeros(row_length(section_start))
     for s in range(n_sec):
         for j in range(section_start[s], section_start[s + 1]):
             out[j + 1 + 2 * s] = x[j]
@@ -243,11 +258,12 @@ def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_s_j, f
 
 
 @njit(cache=True)
-def pass_cells(A, B, W, cur, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs, delta, law,
-               fixed, inj_a, inj_b, e, inject):
+def pass_cells(A, B, W, cur, end, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs, delta,
+               law, fixed, inj_a, inj_b, e, inject):
     """Steps 1–3 of THEORY §3.1 on every cell: α*_j = α_{j−1}, β*_j = β_{j+1} (exact
     Courant-1 shift) from row ``cur`` of the state buffers ``A`` (α), ``B`` (β), ``W`` (ω),
-    then :func:`cell_update`, written to row 1 − ``cur``.
+    then :func:`cell_update`, written to row 1 − ``cur``, for the cells 1 … ``end`` − 1
+    (``end`` = :func:`padded_size` − 1).
 
     Buffers and per-cell arrays are in the ghost layout of :func:`padded`, the ghost cells
     of row ``cur`` filled by :func:`inflows`, so section ends, junctions, the top drive and
@@ -262,7 +278,7 @@ def pass_cells(A, B, W, cur, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv
     literally(fixed)
     literally(inject)
     nxt = 1 - cur
-    for j in range(1, A.shape[1] - 1):
+    for j in range(1, end):
         an, bn = cell_update(A[cur, j - 1], B[cur, j + 1], W[cur, j - 1], W[cur, j + 1],
                              W[cur, j], kt_dt, fcap[j], fix_s[j] if fixed else 0.0,
                              fix_k[j] if fixed else 0.0, mu_s, mu_k, omega_c, inv_vs, delta,
@@ -276,15 +292,18 @@ def pass_cells(A, B, W, cur, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv
 
 
 @njit(cache=True)
-def state_buffers(alpha, beta, section_start):
-    """Double-buffered state (A, B, W) in the ghost layout, row 0 = ``alpha``, ``beta``."""
-    A = np.zeros((2, padded_size(section_start)))
-    B = np.zeros_like(A)
-    W = np.zeros_like(A)
-    A[0] = padded(alpha, section_start)
-    B[0] = padded(beta, section_start)
-    W[0] = 0.5 * (A[0] + B[0])
-    return A, B, W
+def work_buffer(alpha, beta, section_start, cells):
+    """All the rows the cell loop touches, in one array of :func:`row_length` columns: the
+    double-buffered state α (rows 0, 1), β (2, 3), ω = (α + β)/2 (4, 5), row 0, 2, 4 from
+    ``alpha``, ``beta``, then the per-cell arrays of the tuple ``cells`` (rows 6, …), all
+    in the ghost layout of :func:`padded`."""
+    X = np.zeros((6 + len(cells), row_length(section_start)))
+    X[0] = padded(alpha, section_start)
+    X[2] = padded(beta, section_start)
+    X[4] = 0.5 * (X[0] + X[2])
+    for i in range(len(cells)):
+        X[6 + i] = padded(cells[i], section_start)
+    return X
 
 
 @njit(cache=True)
@@ -340,10 +359,9 @@ def plant_kernel(law: int, fixed: bool):
                fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
                inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
         last = alpha.size + 2 * section_start.size - 4  # the bit cell in the ghost layout
-        A, B, W = state_buffers(alpha, beta, section_start)
-        fcap_p = padded(fcap, section_start)
-        fix_s_p = padded(fix_s, section_start)
-        fix_k_p = padded(fix_k, section_start)
+        X = work_buffer(alpha, beta, section_start, (fcap, fix_s, fix_k))
+        A, B, W, fcap_p, fix_s_p, fix_k_p = X[0:2], X[2:4], X[4:6], X[6], X[7], X[8]
+        end = padded_size(section_start) - 1
         cur = 0
         inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
         omega0 = top[0]
@@ -382,8 +400,8 @@ def plant_kernel(law: int, fixed: bool):
             omega_bar = 0.5 * (omega0 + omega_next)
             inflows(A, B, W, cur, section_start, junction_z, 2.0 * omega_bar - beta0,
                     omega_bar, bit_cap_rel)
-            pass_cells(A, B, W, cur, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k, omega_c,
-                       inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
+            pass_cells(A, B, W, cur, end, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k,
+                       omega_c, inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
             if mode == _MODE_PI:
                 integral += dt * (u_now - omega0)
             omega0 = omega_next
