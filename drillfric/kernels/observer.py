@@ -66,6 +66,25 @@ def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
     return mu_s, mu_k
 
 
+@njit(cache=True, inline="always")
+def deadlock_guard(mu_s, mu_k, stuck_s, events, turning_stuck, dt, deadlock_s):
+    """Deadlock guard (THEORY §6.1); returns (μ̂_s, μ̂_k, stuck time [s], interventions).
+
+    While the estimated BHA is stuck and the measured top drive turns (``turning_stuck``)
+    the stuck time grows by Δt, else it resets; past ``deadlock_s`` μ̂_s drops to μ̂_k (and
+    μ̂_k by 20 % if μ̂_s already was there), the stuck time resets and one intervention is
+    counted.
+    """
+    if not turning_stuck:
+        return mu_s, mu_k, 0.0, events
+    stuck_s += dt
+    if stuck_s > deadlock_s:
+        if mu_s <= mu_k * (1.0 + 1e-9):
+            mu_k *= 0.8
+        return mu_k, mu_k, 0.0, events + 1.0
+    return mu_s, mu_k, stuck_s, events
+
+
 @njit(cache=True, fastmath={"reassoc"})
 def bha_speed(W, row, section_start):
     """Mean speed of the BHA cells (sections after the first) in row ``row`` of the speed
@@ -149,16 +168,9 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
         om = omega_next
         stuck = abs(w_bha) <= omega_c
         ms, mk = adapt(ms, mk, e, stuck, l_s, l_k, dt, adapt_law, mu_max)
-        if stuck and abs(wm) > omega_turn:
-            stuck_s += dt
-            if stuck_s > deadlock_s:
-                if ms <= mk * (1.0 + 1e-9):
-                    mk *= 0.8
-                ms = mk
-                stuck_s = 0.0
-                events += 1.0
-        else:
-            stuck_s = 0.0
+        ms, mk, stuck_s, events = deadlock_guard(ms, mk, stuck_s, events,
+                                                 stuck and abs(wm) > omega_turn, dt,
+                                                 deadlock_s)
         e_last = e
         w_bha_last = w_bha
     unpadded(A[cur], section_start, alpha[s])
