@@ -1,10 +1,13 @@
-"""Throughput of the torsional plant kernel (THEORY.md §3.1), numba vs its NumPy twin.
+"""Throughput of the torsional plant kernel (docs/theory.md §3.1, §3.2), numba vs its NumPy twin.
 
 Case: A&S 2018 Well B at 2500 m in off-bottom stick-slip (40 RPM, μ_s 0.885, μ_k 0.425),
-500 cells, one core, recording at 100 Hz. Both backends run the same plant side by side in
-this process; the machine may be shared, so compare the ratio (best of several repeats)
-rather than absolute times across runs. Targets (issue 4): ≤ 1.5 ns per cell-step and
-≥ 30× faster than the NumPy twin.
+500 requested cells, one thread, recording at 100 Hz, started from a stick-slip state. Rows:
+the step law (the default), the Stribeck law with δ = 1, 2 and 1.5 (v_s = 0.8 rad/s), and the
+step law with a fixed (cased) part of the friction profile above 1600 m. All numba rows are
+timed interleaved (A B C … A B C …, best of ``--repeats``) so they share the machine's state;
+the NumPy twin runs the step law on a shorter window. Times are the thread's CPU time. The
+machine may be shared: compare the ratios, and quote the load. Targets (issue 17):
+≤ 0.65 ns per cell-step for the step law, ≥ 30× the NumPy twin.
 
 Usage: python benchmarks/bench_plant.py [--cells N] [--seconds S] [--repeats R]
 """
@@ -12,6 +15,7 @@ Usage: python benchmarks/bench_plant.py [--cells N] [--seconds S] [--repeats R]
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import time
 
@@ -26,37 +30,58 @@ from drillfric.simulator import well_b_plant  # noqa: E402
 from drillfric.units import RPM_TO_RAD_S as RPM  # noqa: E402
 
 
-def best_time(plant, drive, seconds, backend, repeats, state):
-    """Best wall time of ``repeats`` runs of ``seconds`` simulated from ``state``."""
-    best = np.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        T.run(plant, drive, seconds, 100.0, state, backend=backend)
-        best = min(best, time.perf_counter() - t0)
-    return best
+def variants(plant: T.Plant) -> dict[str, T.Plant]:
+    """The benchmarked friction variants of ``plant`` (docs/theory.md §3.2)."""
+    cased = plant.grid.x_m < 1600.0
+    fc = plant.fc_Nm_m
+    profile = dataclasses.replace(plant, fc_Nm_m=np.where(cased, 0.0, fc),
+                                  fc_fixed_k_Nm_m=np.where(cased, 0.25 * fc, 0.0),
+                                  fc_fixed_s_Nm_m=np.where(cased, 0.35 * fc, 0.0))
+    out = {"step law": plant, "step law + fixed part": profile}
+    for delta in (1.0, 2.0, 1.5):
+        out[f"Stribeck δ = {delta:g}"] = dataclasses.replace(
+            plant, stribeck_speed_rad_s=0.8, stribeck_exponent=delta)
+    return out
+
+
+def timed(plant, drive, seconds, state, backend="numba") -> float:
+    """CPU time of this thread for one run of ``seconds`` simulated from ``state`` [s] (the
+    run is single-threaded: CPU time is its wall time without the preemption a shared
+    machine adds)."""
+    t0 = time.thread_time()
+    T.run(plant, drive, seconds, 100.0, state, backend=backend)
+    return time.thread_time() - t0
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=int, default=500)
-    parser.add_argument("--seconds", type=float, default=60.0)
-    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--seconds", type=float, default=120.0)
+    parser.add_argument("--repeats", type=int, default=15)
     args = parser.parse_args()
-    plant = well_b_plant(cells=args.cells)
+    base = well_b_plant(cells=args.cells)
     drive = T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0)
-    _, state = T.run(plant, drive, 30.0, 10.0)  # compile, and start in stick-slip
-    n = plant.grid.n_cells
-    fast = best_time(plant, drive, args.seconds, "numba", args.repeats, state)
-    slow_s = max(1.0, args.seconds / 30.0)
-    slow = best_time(plant, drive, slow_s, "numpy", max(1, args.repeats // 2), state)
-    ns_fast = fast / (args.seconds / plant.grid.dt_s) / n * 1e9
-    ns_slow = slow / (slow_s / plant.grid.dt_s) / n * 1e9
-    print(f"cells {n}, dt {plant.grid.dt_s * 1e3:.3f} ms, "
-          f"{args.seconds / plant.grid.dt_s:.0f} steps per {args.seconds:g} s simulated")
-    print(f"numba : {ns_fast:8.3f} ns per cell-step  ({fast:.3f} s for {args.seconds:g} s, "
-          f"{args.seconds / fast:.0f}x real time)")
-    print(f"numpy : {ns_slow:8.3f} ns per cell-step  ({slow:.3f} s for {slow_s:g} s)")
-    print(f"ratio : {ns_slow / ns_fast:8.1f}x  (targets: <= 1.5 ns, >= 30x)")
+    _, state = T.run(base, drive, 30.0, 10.0)  # start in stick-slip
+    plants = variants(base)
+    for plant in plants.values():
+        T.run(plant, drive, 1.0, 10.0, state)  # compile / load the cached variant
+    best = dict.fromkeys(plants, np.inf)
+    for _ in range(args.repeats):
+        for name, plant in plants.items():
+            best[name] = min(best[name], timed(plant, drive, args.seconds, state))
+    slow_s = 2.0
+    slow = min(timed(base, drive, slow_s, state, "numpy") for _ in range(3))
+    n, dt = base.grid.n_cells, base.grid.dt_s
+    ns = lambda wall, seconds: wall / (seconds / dt) / n * 1e9  # noqa: E731
+    print(f"cells {n}, dt {dt * 1e3:.3f} ms, {args.seconds / dt:.0f} steps per "
+          f"{args.seconds:g} s simulated, best of {args.repeats} interleaved, load "
+          f"{os.getloadavg()[0]:.1f}")
+    print("| variant | ns per cell-step | real-time factor |\n|---|---|---|")
+    for name, wall in best.items():
+        print(f"| {name} | {ns(wall, args.seconds):.3f} | {args.seconds / wall:.0f}× |")
+    print(f"| NumPy twin, step law ({slow_s:g} s) | {ns(slow, slow_s):.1f} | |")
+    print(f"twin / numba (step law): {ns(slow, slow_s) / ns(best['step law'], args.seconds):.0f}×"
+          "  (targets: ≤ 0.65 ns per cell-step, ≥ 30×)")
 
 
 if __name__ == "__main__":

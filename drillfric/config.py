@@ -343,6 +343,18 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "hole size).", max=1.5),
         Key("off_bottom_m", float, 5.0, "m", "Distance of the bit above hole bottom in "
             "off-bottom stands (recorded hole depth = bit depth + this).", min=0.0),
+        Key("friction_law", str, "step", "", "Friction law of the truth (docs/theory.md §3.2): "
+            "'step' (μ_s below ω_c, μ_k above, the paper's) or 'stribeck' (μ falls "
+            "continuously from μ_s at rest to μ_k at speed).", choices=("step", "stribeck")),
+        _positive("stribeck_speed_rad_s", 1.0, "rad/s", "Stribeck decay speed v_s: "
+                  "μ = μ_k + (μ_s − μ_k)·exp(−(|ω|/v_s)^δ) (friction_law = 'stribeck')."),
+        Key("stribeck_exponent", float, 1.0, "", "Stribeck exponent δ (1: exponential, 2: "
+            "Gaussian decay).", min=1.0, max=2.0),
+        Key("mu_s_cased", float, None, "", "True static friction factor above "
+            "model.casing_shoe_md_m (with mu_k_cased; mu_s, mu_k are then the open-hole "
+            "truth).", min=0.0, max=2.0),
+        Key("mu_k_cased", float, None, "", "True kinetic friction factor above "
+            "model.casing_shoe_md_m (with mu_s_cased).", min=0.0, max=2.0),
     ),
 }
 

@@ -181,6 +181,7 @@ def process_well(task: WellTask) -> dict:
     from drillfric.io.well import open_well
     from drillfric.pipeline import run_well
 
+    _one_kernel_thread()
     started = _now()
     t0 = time.perf_counter()
     record = {"status": "failed", "message": "", "summary": None, "out_dir": None,
@@ -200,6 +201,20 @@ def process_well(task: WellTask) -> dict:
                   task_s=time.perf_counter() - t0, worker=f"{socket.gethostname()}:"
                   f"{os.getpid()}", worker_version=__version__)
     return record
+
+
+def _one_kernel_thread() -> None:
+    """On a Dask worker (one task per core) the compiled kernels run on this thread only:
+    numba's parallel observer members (docs/performance.md) would oversubscribe the cores."""
+    try:
+        from distributed import get_worker
+
+        get_worker()
+    except (ImportError, ValueError):
+        return
+    import numba
+
+    numba.set_num_threads(1)
 
 
 def _now() -> str:

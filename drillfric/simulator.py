@@ -303,7 +303,7 @@ class PlantSettings:
     Attributes
     ----------
     mu_s, mu_k : float
-        True friction factors [-].
+        True friction factors [-] (of the open hole when the cased ones are given).
     omega_c_rad_s, k_t_per_s, top_drive_inertia_kg_m2 : float
         ω_c [rad/s], k_t [1/s], I_TD [kg·m²].
     kp_Nms_rad, ki_Nm_rad : float
@@ -314,6 +314,14 @@ class PlantSettings:
         Bit-torque model T_bit = μ_bit·WOB·D/3.
     torque_kind : str
         "motor" records τ_m as surface torque, "string" records τ(0).
+    friction_law : str
+        "step" or "stribeck" (docs/theory.md §3.2).
+    stribeck_speed_rad_s, stribeck_exponent : float
+        Stribeck decay speed v_s [rad/s] and exponent δ (used by "stribeck").
+    casing_shoe_md_m : float, optional
+        Casing shoe [m]; with ``mu_s_cased``, ``mu_k_cased`` the truth above it.
+    mu_s_cased, mu_k_cased : float, optional
+        True friction factors above the shoe (the fixed part of the profile) [-].
     """
 
     mu_s: float
@@ -327,6 +335,28 @@ class PlantSettings:
     bit_mu: float = 0.3
     bit_diameter_m: float = 0.2159
     torque_kind: str = "motor"
+    friction_law: str = "step"
+    stribeck_speed_rad_s: float = 1.0
+    stribeck_exponent: float = 1.0
+    casing_shoe_md_m: float | None = None
+    mu_s_cased: float | None = None
+    mu_k_cased: float | None = None
+
+    @property
+    def cased(self) -> bool:
+        """The truth has its own friction factors above the casing shoe."""
+        return self.mu_k_cased is not None
+
+    def zones(self) -> list[dict]:
+        """Truth of each friction zone: name, measured-depth span [m], μ_s, μ_k."""
+        shoe = self.casing_shoe_md_m if self.cased else None
+        zones = [{"zone": "open" if shoe is not None else "whole string",
+                  "md_from_m": shoe or 0.0, "md_to_m": None, "mu_s": self.mu_s,
+                  "mu_k": self.mu_k}]
+        if shoe is not None:
+            zones.insert(0, {"zone": "cased", "md_from_m": 0.0, "md_to_m": shoe,
+                             "mu_s": self.mu_s_cased, "mu_k": self.mu_k_cased})
+        return zones
 
     @classmethod
     def from_config(cls, cfg: Config) -> PlantSettings:
@@ -337,17 +367,65 @@ class PlantSettings:
                   kp_Nms_rad=cfg.simulate.kp_Nms_rad, ki_Nm_rad=cfg.simulate.ki_Nm_rad,
                   cells=cfg.simulate.cells, bit_mu=cfg.simulate.bit_mu,
                   bit_diameter_m=cfg.simulate.bit_diameter_m,
-                  torque_kind=cfg.rig.torque_kind)
-        if out.mu_k > out.mu_s:
-            raise ModelError(f"μ_k = {out.mu_k} is larger than μ_s = {out.mu_s}",
-                             file=cfg.source, fix="the kinetic friction factor cannot exceed "
-                             "the static one (simulate.mu_k ≤ simulate.mu_s)")
+                  torque_kind=cfg.rig.torque_kind,
+                  friction_law=cfg.simulate.friction_law,
+                  stribeck_speed_rad_s=cfg.simulate.stribeck_speed_rad_s,
+                  stribeck_exponent=cfg.simulate.stribeck_exponent,
+                  casing_shoe_md_m=cfg.model.casing_shoe_md_m,
+                  mu_s_cased=cfg.simulate.mu_s_cased, mu_k_cased=cfg.simulate.mu_k_cased)
+        for zone, mu_s, mu_k in (("", out.mu_s, out.mu_k),
+                                 ("_cased", out.mu_s_cased, out.mu_k_cased)):
+            if mu_k is not None and mu_s is not None and mu_k > mu_s:
+                raise ModelError(f"μ_k = {mu_k} is larger than μ_s = {mu_s}",
+                                 file=cfg.source, fix="the kinetic friction factor cannot "
+                                 f"exceed the static one (simulate.mu_k{zone} ≤ "
+                                 f"simulate.mu_s{zone})")
+        if (out.mu_s_cased is None) != (out.mu_k_cased is None):
+            raise ConfigError("simulate.mu_s_cased and simulate.mu_k_cased go together",
+                              file=cfg.source, fix="give both (or neither)")
+        if out.cased and out.casing_shoe_md_m is None:
+            raise ConfigError("simulate.mu_s_cased/mu_k_cased need a casing shoe",
+                              file=cfg.source, fix="set model.casing_shoe_md_m")
         return out
+
+    def cased_share(self, grid: torsional.Grid) -> np.ndarray:
+        """Share of each cell's true length above the casing shoe [-] (zeros without a cased
+        truth)."""
+        if not self.cased:
+            return np.zeros(grid.n_cells)
+        top = grid.x_m - 0.5 * grid.dx_true_m
+        return np.clip((self.casing_shoe_md_m - top) / grid.dx_true_m, 0.0, 1.0)
+
+    def plant(self, grid: torsional.Grid, fc_Nm_m: np.ndarray,
+              bit_torque_cap_Nm: float) -> torsional.Plant:
+        """The true plant on ``grid`` with the capacity profile F_c at the cell centres.
+
+        With a cased truth, each cell's F_c is split by the share of its true length above
+        the shoe: that share times μ_k_cased, μ_s_cased is the fixed part of the profile,
+        the rest is the open hole that μ_s, μ_k multiply (docs/theory.md §3.2).
+        """
+        fixed_k = fixed_s = None
+        if self.cased:
+            cased = self.cased_share(grid)
+            fixed_k = self.mu_k_cased * cased * fc_Nm_m
+            fixed_s = self.mu_s_cased * cased * fc_Nm_m
+            fc_Nm_m = (1.0 - cased) * fc_Nm_m
+        stribeck = self.friction_law == "stribeck"
+        return torsional.Plant(grid, fc_Nm_m, self.mu_s, self.mu_k, self.omega_c_rad_s,
+                               self.k_t_per_s, self.top_drive_inertia_kg_m2, bit_torque_cap_Nm,
+                               fixed_k, fixed_s,
+                               self.stribeck_speed_rad_s if stribeck else None,
+                               self.stribeck_exponent)
 
 
 @dataclass(frozen=True)
 class StandResult:
-    """Truth of one simulated stand (times on the global clock)."""
+    """Truth of one simulated stand (times on the global clock).
+
+    ``T_N_Nm`` is ∫F_c dx over the part of the string whose truth is ``mu_s``, ``mu_k``
+    (the open hole with a cased truth, else the whole string), ``T_N_cased_Nm`` over the
+    cased part (0 without a cased truth) [N·m per unit friction factor].
+    """
 
     index: int
     bit_depth_m: float
@@ -364,6 +442,7 @@ class StandResult:
     max_rounding_m: float
     bit_stuck_fraction: float
     creep_end_s: float | None = None
+    T_N_cased_Nm: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -392,8 +471,13 @@ class Simulation:
         """Ground truth as plain data (NAME.truth.json, file metadata)."""
         from drillfric import __version__
 
+        law = {"friction_law": self.settings.friction_law}
+        if self.settings.friction_law == "stribeck":
+            law |= {"stribeck_speed_rad_s": self.settings.stribeck_speed_rad_s,
+                    "stribeck_exponent": self.settings.stribeck_exponent}
         return {"drillfric_version": __version__, "mu_s": self.settings.mu_s,
-                "mu_k": self.settings.mu_k, "settings": asdict(self.settings),
+                "mu_k": self.settings.mu_k, **law, "zones": self.settings.zones(),
+                "settings": asdict(self.settings),
                 "noise": asdict(self.noise), "rate_hz": self.rate_hz,
                 "stands": [asdict(s) for s in self.stands], "notes": list(self.notes)}
 
@@ -454,10 +538,7 @@ def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None,
     grid = torsional.make_grid(string, settings.cells)
     td = fc_profile(cfg, path, stand.bit_depth_m, stand.wob_N)
     cap = torsional.bit_torque_cap(settings.bit_mu, stand.wob_N, settings.bit_diameter_m)
-    plant = torsional.Plant(grid, td.fc_at(grid.x_m), settings.mu_s, settings.mu_k,
-                            settings.omega_c_rad_s, settings.k_t_per_s,
-                            settings.top_drive_inertia_kg_m2, cap)
-    return plant, td
+    return settings.plant(grid, td.fc_at(grid.x_m), cap), td
 
 
 def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
@@ -531,12 +612,15 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
             "hole_depth_m": np.full(n, stand.bit_depth_m + off),
             "wob_N": np.full(n, stand.wob_N), "bit_rpm": rec.bit_rad_s / RPM_TO_RAD_S,
             "string_torque_Nm": rec.string_torque_Nm}
+    grid = plant.grid
+    cased_T_N = float(np.sum(settings.cased_share(grid) * td.fc_at(grid.x_m) * grid.dx_true_m))
     creep_end = (t0 + stand.idle_s + stand.creep_ramp_s + stand.creep_hold_s
                  if stand.start == "creep" and stand.setpoint_rpm is None else None)
     result = StandResult(index=index, bit_depth_m=stand.bit_depth_m, t_start_s=t0,
                          t_rotation_start_s=t0 + stand.idle_s, t_end_s=t0 + stand.total_s,
                          start=stand.start, rpm=stand.rpm, wob_N=stand.wob_N,
-                         T_N_Nm=plant.T_N_Nm, hookload_N=float(td.hookload_N),
+                         T_N_Nm=plant.T_N_Nm, T_N_cased_Nm=cased_T_N,
+                         hookload_N=float(td.hookload_N),
                          cells=plant.grid.n_cells, dt_s=plant.grid.dt_s,
                          max_rounding_m=float(np.max(np.abs(plant.grid.rounding_m))),
                          bit_stuck_fraction=stuck, creep_end_s=creep_end)

@@ -202,6 +202,16 @@ class Plant:
     bit_torque_cap_Nm : float
         Coulomb bit torque magnitude T_bit = μ_bit·WOB·r_bit [N·m]; 0 is a free bit (off
         bottom). See :func:`bit_torque_cap`.
+    fc_fixed_k_Nm_m, fc_fixed_s_Nm_m : ndarray, optional
+        Fixed part of the friction profile (docs/theory.md §3.2): kinetic and static friction
+        torque per metre of a zone whose friction factor is known (e.g. cased hole above the
+        shoe), already times that factor [N·m/m], one value per cell, kinetic ≤ static.
+        None (default) is zero: all friction is μ·F_c.
+    stribeck_speed_rad_s : float, optional
+        Stribeck decay speed v_s [rad/s] (docs/theory.md §3.2); 0 or None (default) is the
+        step law at ω_c.
+    stribeck_exponent : float
+        Stribeck exponent δ, 1 ≤ δ ≤ 2 [-] (1 and 2 are the fast variants of the kernel).
     """
 
     grid: Grid
@@ -212,6 +222,10 @@ class Plant:
     k_t_per_s: float = 0.0
     top_drive_inertia_kg_m2: float = 2900.0
     bit_torque_cap_Nm: float = 0.0
+    fc_fixed_k_Nm_m: np.ndarray | None = None
+    fc_fixed_s_Nm_m: np.ndarray | None = None
+    stribeck_speed_rad_s: float | None = None
+    stribeck_exponent: float = 1.0
 
     def __post_init__(self):
         if self.top_drive_inertia_kg_m2 <= 0:
@@ -226,9 +240,39 @@ class Plant:
                              fix="the kinetic friction factor cannot exceed the static one")
         if self.k_t_per_s < 0 or self.bit_torque_cap_Nm < 0:
             raise ModelError("viscous damping and bit torque must be ≥ 0")
-        if np.shape(self.fc_Nm_m) != (self.grid.n_cells,) or np.any(
-                ~np.isfinite(self.fc_Nm_m)) or np.any(np.asarray(self.fc_Nm_m) < 0):
-            raise ModelError("F_c must be one finite, non-negative value per cell")
+        for name in ("fc_Nm_m", "fc_fixed_k_Nm_m", "fc_fixed_s_Nm_m"):
+            value = getattr(self, name)
+            if value is not None and (np.shape(value) != (self.grid.n_cells,) or np.any(
+                    ~np.isfinite(value)) or np.any(np.asarray(value) < 0)):
+                raise ModelError(f"{name} must be one finite, non-negative value per cell")
+        if np.any(self.fixed_k_Nm_m > self.fixed_s_Nm_m):
+            raise ModelError("the fixed kinetic friction exceeds the fixed static friction",
+                             fix="give fc_fixed_k_Nm_m ≤ fc_fixed_s_Nm_m in every cell")
+        if self.stribeck_speed_rad_s is not None and not self.stribeck_speed_rad_s >= 0:
+            raise ModelError(f"the Stribeck speed must be ≥ 0 (0: step law), got "
+                             f"{self.stribeck_speed_rad_s} rad/s",
+                             fix="set simulate.stribeck_speed_rad_s > 0")
+        if not 1.0 <= self.stribeck_exponent <= 2.0:
+            raise ModelError(f"the Stribeck exponent must be in [1, 2], got "
+                             f"{self.stribeck_exponent}", fix="set simulate.stribeck_exponent")
+
+    def _fixed(self, value) -> np.ndarray:
+        return np.zeros(self.grid.n_cells) if value is None else np.asarray(value, float)
+
+    @property
+    def fixed_k_Nm_m(self) -> np.ndarray:
+        """Fixed kinetic friction torque per metre of each cell, zeros if none [N·m/m]."""
+        return self._fixed(self.fc_fixed_k_Nm_m)
+
+    @property
+    def fixed_s_Nm_m(self) -> np.ndarray:
+        """Fixed static friction torque capacity per metre of each cell, zeros if none
+        [N·m/m]."""
+        return self._fixed(self.fc_fixed_s_Nm_m)
+
+    def _rad_s(self, per_m: np.ndarray) -> np.ndarray:
+        g = self.grid
+        return per_m * (g.dx_true_m / g.dx_model_m) * g.dt_s / g.rho_j_kg_m
 
     @property
     def fcap_rad_s(self) -> np.ndarray:
@@ -238,14 +282,67 @@ class Plant:
         The factor L_i/L_i^model keeps the total capacity Σ = ∫F_c dx of the true string
         despite the length rounding.
         """
-        g = self.grid
-        return self.fc_Nm_m * (g.dx_true_m / g.dx_model_m) * g.dt_s / g.rho_j_kg_m
+        return self._rad_s(self.fc_Nm_m)
+
+    @property
+    def fix_k_rad_s(self) -> np.ndarray:
+        """Fixed kinetic part of the cap per cell and step, like :attr:`fcap_rad_s` but
+        already times its friction factor [rad/s] (docs/theory.md §3.2)."""
+        return self._rad_s(self.fixed_k_Nm_m)
+
+    @property
+    def fix_s_rad_s(self) -> np.ndarray:
+        """Fixed static part of the cap per cell and step [rad/s] (docs/theory.md §3.2)."""
+        return self._rad_s(self.fixed_s_Nm_m)
+
+    @property
+    def law_speed_rad_s(self) -> float:
+        """Kernel argument ``law_speed``: v_s of the Stribeck law, 0 for the step law."""
+        return float(self.stribeck_speed_rad_s or 0.0)
 
     @property
     def T_N_Nm(self) -> float:
         """T_N = ∫F_c dx over the true string (cell lengths L_i/n_i) [N·m] (A&S 2018 eq. 27
-        per unit μ)."""
+        per unit μ): the part the estimated μ multiplies."""
         return float(np.sum(self.fc_Nm_m * self.grid.dx_true_m))
+
+    @property
+    def T_fixed_k_Nm(self) -> float:
+        """Kinetic Coulomb torque of the fixed part, ∫F_fixed,k dx [N·m]."""
+        return float(np.sum(self.fixed_k_Nm_m * self.grid.dx_true_m))
+
+    @property
+    def T_fixed_s_Nm(self) -> float:
+        """Static Coulomb torque capacity of the fixed part, ∫F_fixed,s dx [N·m]."""
+        return float(np.sum(self.fixed_s_Nm_m * self.grid.dx_true_m))
+
+    def friction_Nm_m(self, omega_rad_s: float, mu_s: float | None = None,
+                      mu_k: float | None = None) -> np.ndarray:
+        """Friction torque per metre of each cell turning at ω [N·m/m] (docs/theory.md §3.2).
+
+        F_k + (F_s − F_k)·w(ω) with F_k = μ_k F_c + F_fixed,k, F_s = μ_s F_c + F_fixed,s and
+        w = exp(−(|ω|/v_s)^δ) (Stribeck) or w = [|ω| ≤ ω_c] (step law: the static capacity
+        inside the band). ``mu_s``, ``mu_k`` default to the plant's. Times the true cell
+        lengths and summed, the Coulomb torque of the whole string turning at ω.
+        """
+        mu_s = self.mu_s if mu_s is None else mu_s
+        mu_k = self.mu_k if mu_k is None else mu_k
+        f_k = mu_k * self.fc_Nm_m + self.fixed_k_Nm_m
+        f_s = mu_s * self.fc_Nm_m + self.fixed_s_Nm_m
+        return f_k + (f_s - f_k) * self.static_weight(omega_rad_s)
+
+    def static_weight(self, omega_rad_s: float) -> float:
+        """Weight of the static cap at speed ω, (cap − cap_k)/(cap_s − cap_k) [-]
+        (docs/theory.md §3.2): exp(−(|ω|/v_s)^δ) (Stribeck) or [|ω| ≤ ω_c] (step law)."""
+        if self.law_speed_rad_s > 0:
+            return float(np.exp(-(abs(omega_rad_s) / self.law_speed_rad_s)
+                                ** self.stribeck_exponent))
+        return float(abs(omega_rad_s) <= self.omega_c_rad_s)
+
+    def friction_torque_Nm(self, omega_rad_s: float) -> float:
+        """Coulomb torque of the whole string turning uniformly at ω, Σ friction·Δx [N·m]
+        (docs/theory.md §3.2; the steady rotating surface torque without viscous part)."""
+        return float(np.sum(self.friction_Nm_m(omega_rad_s) * self.grid.dx_true_m))
 
 
 def bit_torque_cap(bit_mu: float, wob_N: float, bit_diameter_m: float) -> float:
@@ -409,8 +506,9 @@ def record_times(t_start_s: float, duration_s: float, rate_hz: float) -> np.ndar
 def kernel_args(plant: Plant, drive: Drive) -> tuple:
     """Plain-array arguments shared by the numba kernel and its NumPy twin (in order)."""
     g = plant.grid
-    return (g.section_start, g.junction_z, g.zeta_Nms, plant.fcap_rad_s, g.dt_s,
-            plant.k_t_per_s * g.dt_s, plant.mu_s, plant.mu_k, plant.omega_c_rad_s,
+    return (g.section_start, g.junction_z, g.zeta_Nms, plant.fcap_rad_s, plant.fix_k_rad_s,
+            plant.fix_s_rad_s, g.dt_s, plant.k_t_per_s * g.dt_s, plant.mu_s, plant.mu_k,
+            plant.omega_c_rad_s, plant.law_speed_rad_s, float(plant.stribeck_exponent),
             plant.bit_torque_cap_Nm / g.zeta_Nms[-1], 1.0 / plant.top_drive_inertia_kg_m2,
             DRIVE_MODES[drive.kind], np.ascontiguousarray(drive.values, dtype=float),
             drive.t0_s, drive.dt_s, drive.kp_Nms_rad, drive.ki_Nm_rad)

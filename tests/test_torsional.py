@@ -434,6 +434,130 @@ def test_stick_slip_torque_swing_well_b(well_b):
     assert np.mean(rec.motor_torque_Nm[m]) == pytest.approx(plant.mu_k * plant.T_N_Nm, rel=0.05)
 
 
+# ------------------------------------------------ friction profile and law (theory §3.2)
+
+def _cased_open_plant(k_t, shoe_m=1000.0, omega_c=0.5, **law):
+    """Two-section string, F_c = 20 N·m/m: open hole below ``shoe_m`` (μ_s 0.3, μ_k 0.2
+    multiply F_c), cased above with the known factors 0.25 / 0.15 as the fixed part."""
+    g, fc = _string_and_fc()
+    cased = g.x_m < shoe_m
+    plant = T.Plant(g, np.where(cased, 0.0, fc), 0.3, 0.2, omega_c, k_t, 2900.0, 0.0,
+                    np.where(cased, 0.15 * fc, 0.0), np.where(cased, 0.25 * fc, 0.0), **law)
+    open_m = float(np.sum(np.where(cased, 0.0, fc) * g.dx_true_m))
+    cased_m = float(np.sum(np.where(cased, fc, 0.0) * g.dx_true_m))
+    t_k, t_s = 0.2 * open_m + 0.15 * cased_m, 0.3 * open_m + 0.25 * cased_m
+    return plant, t_k, t_s
+
+
+@pytest.mark.parametrize("law", [{}, {"stribeck_speed_rad_s": 4.0},
+                                 {"stribeck_speed_rad_s": 4.0, "stribeck_exponent": 2.0}],
+                         ids=["step", "stribeck-1", "stribeck-2"])
+def test_steady_rotation_with_cased_open_profile_and_friction_law(law):
+    """docs/theory.md §3.2: steady sliding at Ω needs τ(0) = T_k + (T_s − T_k)·w(Ω) +
+    k_tΩ∫ρJ dx with T_k = μ_k∫F_c,open + μ_k,cased∫F_c,cased (T_s likewise) and
+    w = exp(−(Ω/v_s)^δ), 0 for the step law above ω_c. At 60 RPM and v_s = 4 rad/s the
+    Stribeck term is 21 % (δ = 1) and 8.5 % (δ = 2) of T_s − T_k, i.e. 7.6 % and 3.1 % of
+    the friction torque, far outside the tolerance. k_t = 1 1/s keeps steady sliding stable
+    against the velocity weakening (slope ≤ 333 N·m·s/rad < k_t∫ρJ dx = 743). Tolerance
+    0.5 % as for the uniform profile (the O(k_tΔt) speed gradient; measured ≤ 0.09 %).
+    """
+    k_t, omega = 1.0, 60 * RPM
+    plant, t_k, t_s = _cased_open_plant(k_t, **law)
+    g = plant.grid
+    assert plant.T_fixed_k_Nm == pytest.approx(t_k - 0.2 * plant.T_N_Nm, rel=1e-12)
+    assert plant.T_fixed_s_Nm == pytest.approx(t_s - 0.3 * plant.T_N_Nm, rel=1e-12)
+    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, omega]), 10.0), 100.0, 10.0)
+    speed = law.get("stribeck_speed_rad_s")
+    w = np.exp(-(omega / speed) ** law.get("stribeck_exponent", 1.0)) if speed else 0.0
+    friction = t_k + (t_s - t_k) * w
+    assert plant.friction_torque_Nm(omega) == pytest.approx(friction, rel=1e-12)
+    expected = friction + k_t * omega * float(np.sum(g.rho_j_kg_m * g.dx_model_m))
+    assert rec.motor_torque_Nm[-1] == pytest.approx(expected, rel=5e-3)
+    assert rec.string_torque_Nm[-1] == pytest.approx(expected, rel=5e-3)
+    assert rec.bit_rad_s[-1] == pytest.approx(omega, rel=5e-3)
+
+
+@pytest.mark.parametrize("delta, v_s", [(1.0, 0.5), (2.0, 1.0)])
+def test_creep_plateau_follows_the_stribeck_curve(delta, v_s):
+    """docs/theory.md §3.2, THEORY §6.3: a string turned from rest at the creep speed
+    Ω = 0.5 rad/s; once all of it turns, every element carries
+    F_k + (F_s − F_k)·exp(−(Ω/v_s)^δ), so the torque plateau is
+    μ_k T_N + (μ_s − μ_k)T_N·w + k_tΩ∫ρJ dx with w = e^−1 = 0.37 (δ = 1) and e^−0.25 = 0.78
+    (δ = 2) — far from the step law's μ_s T_N (the creep test above). F_c = 2 N·m/m and
+    k_t = 2 1/s keep the creep stable (Stribeck slope ≤ 780 N·m·s/rad < k_t∫ρJ dx =
+    1487: a steeper one turns it into stick-slip, as it should). Mean over the last 50 s,
+    1 %: the static part is 23 % (δ = 1) and 39 % (δ = 2) of the plateau and w differs
+    from the step law's 1 by 63 % and 22 % (measured within 0.065 %).
+    """
+    g, fc = _string_and_fc(fc=2.0)
+    k_t, omega = 2.0, 0.5
+    plant = T.Plant(g, fc, 0.3, 0.1, 1.0, k_t, stribeck_speed_rad_s=v_s,
+                    stribeck_exponent=delta)
+    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, omega]), 5.0), 150.0, 10.0)
+    late = rec.time_s > 100.0
+    t_n = plant.T_N_Nm
+    expected = (0.1 * t_n + 0.2 * t_n * np.exp(-(omega / v_s) ** delta)
+                + k_t * omega * float(np.sum(g.rho_j_kg_m * g.dx_model_m)))
+    assert rec.string_torque_Nm[late].mean() == pytest.approx(expected, rel=0.01)
+    assert rec.bit_rad_s[late].mean() == pytest.approx(omega, rel=0.01)
+
+
+def test_stribeck_with_vanishing_speed_tends_to_the_step_law_in_sliding():
+    """docs/theory.md §3.2: as v_s → 0 the Stribeck cap at any speed ≠ 0 tends to the
+    kinetic cap, so steady rotation needs the step law's kinetic torque. The excess
+    over the step-law torque falls with v_s (4.3 % of T_s − T_k left at v_s = 2 rad/s,
+    3.5e-6 at 0.5) and at v_s = 1e-3 rad/s (weight e^−40 by the clamp of the kernel's exp)
+    the steady torque is the step law's to round-off (1e-12)."""
+    omega = 60 * RPM
+    step, t_k, t_s = _cased_open_plant(1.0)
+    drive = T.Drive("pi", np.array([0.0, omega]), 10.0)
+    ref = T.run(step, drive, 100.0, 10.0)[0].motor_torque_Nm[-1]
+    excess = []
+    for v_s in (2.0, 0.5, 1e-3):
+        plant = _cased_open_plant(1.0, stribeck_speed_rad_s=v_s)[0]
+        excess.append(T.run(plant, drive, 100.0, 10.0)[0].motor_torque_Nm[-1] - ref)
+    assert excess[0] == pytest.approx((t_s - t_k) * np.exp(-omega / 2.0), rel=0.05)
+    assert 0 < excess[1] < 1e-3 * excess[0]
+    assert abs(excess[2]) < 1e-12 * ref
+
+
+def test_friction_split_into_fixed_part_is_the_same_plant():
+    """docs/theory.md §3.2: the caps are μ_s·F_c + F_fixed,s and μ_k·F_c + F_fixed,k, so
+    moving all friction into the fixed part (F_c = 0, F_fixed = μ·F_c) is the same plant.
+    Stick-slip on Well B for 30 s: μ·fcap and the fixed cap differ by round-off (8e-17
+    relative), which the chaotic stick-slip may amplify; records within 1e-9 of their scale
+    (measured 1.6e-15 here, 2.4e-15 over 120 s)."""
+    from drillfric.simulator import well_b_plant
+
+    p = well_b_plant(cells=200)
+    moved = T.Plant(p.grid, np.zeros(p.grid.n_cells), p.mu_s, p.mu_k, p.omega_c_rad_s,
+                    p.k_t_per_s, p.top_drive_inertia_kg_m2, 0.0, p.mu_k * p.fc_Nm_m,
+                    p.mu_s * p.fc_Nm_m)
+    drive = T.Drive("pi", np.array([0.0, 40 * RPM]), 5.0)
+    a, _ = T.run(p, drive, 30.0, 20.0)
+    b, _ = T.run(moved, drive, 30.0, 20.0)
+    assert moved.T_fixed_k_Nm == pytest.approx(p.mu_k * p.T_N_Nm, rel=1e-12)
+    assert np.mean(np.abs(a.bit_rad_s) < 0.05) > 0.2  # stick-slip
+    scale = np.abs(a.motor_torque_Nm).max()
+    np.testing.assert_allclose(b.motor_torque_Nm, a.motor_torque_Nm, atol=1e-9 * scale)
+    np.testing.assert_allclose(b.bit_rad_s, a.bit_rad_s, atol=1e-9 * np.abs(a.bit_rad_s).max())
+
+
+@settings(max_examples=5, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), delta=st.sampled_from([1.0, 1.5, 2.0]))
+def test_energy_conserved_without_friction_under_the_stribeck_law(seed, delta):
+    """The Stribeck variant of the kernel with zero caps (no friction, k_t = 0, clamped top)
+    conserves energy exactly like the step law (THEORY §3.1): rel 1e-11 after 10 000
+    steps, as the step-law test."""
+    rng = np.random.default_rng(seed)
+    g = T.make_grid(two_section_string(), 150)
+    plant = T.Plant(g, np.zeros(g.n_cells), 0.0, 0.0, 1.0, 0.0, stribeck_speed_rad_s=0.3,
+                    stribeck_exponent=delta)
+    state = T.State(rng.normal(size=g.n_cells), rng.normal(size=g.n_cells))
+    out = steps(plant, clamp_top(), 10_000, state)
+    assert T.energy(g, out) == pytest.approx(T.energy(g, state), rel=1e-11)
+
+
 @pytest.fixture(scope="module")
 def well_b():
     """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
@@ -454,6 +578,18 @@ def test_bad_plant_settings_raise(kw, word):
     args = {"grid": g, "fc_Nm_m": fc, "mu_s": 0.6, "mu_k": 0.3, "omega_c_rad_s": 1.0} | kw
     with pytest.raises(ModelError, match=word):
         T.Plant(**args)
+
+
+@pytest.mark.parametrize("kw, word", [
+    ({"fc_fixed_k_Nm_m": 2.0, "fc_fixed_s_Nm_m": 1.0}, "exceeds"),
+    ({"fc_fixed_k_Nm_m": -1.0}, "non-negative"),
+    ({"stribeck_speed_rad_s": -1.0}, "Stribeck speed"),
+    ({"stribeck_exponent": 2.5}, "exponent")])
+def test_bad_friction_profile_and_law_raise(kw, word):
+    g, fc = _string_and_fc(cells=50)
+    kw = {k: np.full(g.n_cells, v) if k.startswith("fc_") else v for k, v in kw.items()}
+    with pytest.raises(ModelError, match=word):
+        T.Plant(g, fc, 0.6, 0.3, 1.0, **kw)
 
 
 def test_bad_duration_and_rate_raise():

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from scipy.signal import lfilter
 
@@ -191,11 +192,12 @@ class ObserverState:
         """Initial states for ``starts`` = [(μ_s, μ_k), ...].
 
         Rotating (|ω₀| > ω_c): every cell at ω₀ with the steady sliding torque
-        τ(x) = sign(ω₀)·μ_k∫ₓᴸF_c dx (THEORY §3.1, steady rotation), so a window that starts
-        mid-rotation does not begin with a huge transient. At rest: the string held by
-        friction at the measured surface torque ``torque_top_Nm`` [N·m]
-        (:meth:`drillfric.torsional.State.wound` with each start's μ_k) — never untwisted
-        when the measured torque says it is wound (a stop inside a soft-torque rotation).
+        τ(x) = sign(ω₀)·∫ₓᴸ f(ω₀) dx (THEORY §3.1, steady rotation; f the friction per metre at
+        ω₀ of docs/theory.md §3.2, μ_k F_c plus the fixed kinetic part under the step law), so
+        a window that starts mid-rotation does not begin with a huge transient. At rest: the
+        string held by friction at the measured surface torque ``torque_top_Nm`` [N·m]
+        (:meth:`drillfric.torsional.State.wound` with each start's kinetic friction per metre)
+        — never untwisted when the measured torque says it is wound.
         """
         starts = np.atleast_2d(np.asarray(starts, dtype=float))
         if starts.shape[1] != 2 or np.any(starts < 0) or np.any(starts[:, 1] > starts[:, 0]):
@@ -207,10 +209,18 @@ class ObserverState:
         omega = np.full((n_start, g.n_cells), float(omega0_rad_s))
         torque = np.zeros((n_start, g.n_cells))
         if abs(omega0_rad_s) > plant.omega_c_rad_s:
-            below = np.cumsum((plant.fc_Nm_m * g.dx_true_m)[::-1])[::-1]
-            torque = np.sign(omega0_rad_s) * starts[:, 1:2] * below[None, :]
+            def below(per_m):
+                return np.cumsum((per_m * g.dx_true_m)[::-1])[::-1][None, :]
+
+            est, fix_k, fix_s = (below(plant.fc_Nm_m), below(plant.fixed_k_Nm_m),
+                                  below(plant.fixed_s_Nm_m))
+            weight = plant.static_weight(omega0_rad_s)
+            torque = np.sign(omega0_rad_s) * (
+                starts[:, 1:2] * est + fix_k
+                + weight * ((starts[:, :1] - starts[:, 1:2]) * est + fix_s - fix_k))
         elif torque_top_Nm:
-            torque = np.stack([State.wound(g, plant.fc_Nm_m, torque_top_Nm, mu_k).torque_Nm(g)
+            torque = np.stack([State.wound(g, mu_k * plant.fc_Nm_m + plant.fixed_k_Nm_m,
+                                           torque_top_Nm, 1.0).torque_Nm(g)
                                for mu_k in starts[:, 1]])
         alpha = omega + torque / g.zeta_Nms
         beta = omega - torque / g.zeta_Nms
@@ -256,7 +266,8 @@ class ObserverRecord:
 
 def observe(observer: Observer, meas: Measurements, state: ObserverState, *,
             output_rate_hz: float = 10.0, t_end_s: float | None = None,
-            backend: str = "numba") -> tuple[ObserverRecord, ObserverState]:
+            backend: str = "numba", parallel: bool | None = None
+            ) -> tuple[ObserverRecord, ObserverState]:
     """Run the observer from ``state.t_s`` to ``t_end_s`` (default: the last measurement).
 
     Parameters
@@ -269,6 +280,12 @@ def observe(observer: Observer, meas: Measurements, state: ObserverState, *,
         Rate of the returned record [Hz].
     backend : str
         "numba" (compiled) or "numpy" (the twin: tests and benchmarks only).
+    parallel : bool, optional
+        Run the starts (members) on numba's threads, one member per thread at a time (the
+        same numbers as serially: they do not interact). Default: when numba may use more
+        than one thread (``numba.get_num_threads()``; ``numba.set_num_threads(1)`` or
+        ``NUMBA_NUM_THREADS=1`` forces one, as fleet workers do) and there is more than
+        one start.
 
     Returns
     -------
@@ -292,14 +309,17 @@ def observe(observer: Observer, meas: Measurements, state: ObserverState, *,
         from drillfric.kernels.observer_numpy import run_observer
     else:
         raise ModelError(f"unknown backend '{backend}'", fix="use 'numba' or 'numpy'")
+    if parallel is None:
+        parallel = numba.get_num_threads() > 1 and state.alpha.shape[0] > 1
     run_observer(new.alpha, new.beta, new.omega0, new.mu_s, new.mu_k, new.guard, state.t_s,
-                 n_steps, g.section_start, g.junction_z, g.zeta_Nms, plant.fcap_rad_s, g.dt_s,
-                 plant.k_t_per_s * g.dt_s, plant.omega_c_rad_s,
+                 n_steps, g.section_start, g.junction_z, g.zeta_Nms, plant.fcap_rad_s,
+                 plant.fix_k_rad_s, plant.fix_s_rad_s, g.dt_s, plant.k_t_per_s * g.dt_s,
+                 plant.omega_c_rad_s, plant.law_speed_rad_s, float(plant.stribeck_exponent),
                  plant.bit_torque_cap_Nm / g.zeta_Nms[-1], 1.0 / plant.top_drive_inertia_kg_m2,
                  meas.surface_rad_s, meas.motor_torque_Nm, meas.t0_s, meas.dt_s, observer.hold,
                  gains.p0, gains.P0, *observer.injections, gains.P1, gains.l_k, gains.l_s,
                  _LAWS[observer.law], observer.mu_max, observer.deadlock_s,
-                 observer.omega_turn_rad_s, times, out)
+                 observer.omega_turn_rad_s, times, out, parallel)
     new.t_s = state.t_s + n_steps * g.dt_s
     record = ObserverRecord(times, *(out[:, :, c] for c in range(len(OBS_COLUMNS))),
                             deadlock_events=new.guard[:, 1].copy())

@@ -1,8 +1,9 @@
-"""Plain-NumPy twin of :func:`drillfric.kernels.observer.run_observer` (THEORY.md §5).
+"""Plain-NumPy twin of :func:`drillfric.kernels.observer.run_observer` (docs/theory.md §5).
 
 Same arguments and effects, built from the plant twin's whole-array steps
-(:mod:`drillfric.kernels.plant_numpy`) with a Python loop over time steps and starts: the oracle
-of the observer kernel tests and the baseline of ``benchmarks/bench_observer.py``.
+(:mod:`drillfric.kernels.plant_numpy`, with the friction profile and law of docs/theory.md
+§3.2) with a Python loop over time steps and members: the oracle of the observer kernel
+tests and the baseline of ``benchmarks/bench_observer.py``.
 """
 
 from __future__ import annotations
@@ -10,7 +11,14 @@ from __future__ import annotations
 import numpy as np
 
 from drillfric.kernels.observer import LAW_PAPER
-from drillfric.kernels.plant_numpy import damp_and_friction, drive_value, top_drive_step, transport
+from drillfric.kernels.plant_numpy import (
+    LAW_STEP,
+    damp_and_friction,
+    drive_value,
+    law_code,
+    top_drive_step,
+    transport,
+)
 
 
 def measured_value(u, t0, dt, t, hold):
@@ -33,10 +41,14 @@ def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
 
 
 def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
-                 junction_z, zeta, fcap, dt, kt_dt, omega_c, bit_cap_rel, inv_itd,
-                 w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s,
-                 law, mu_max, deadlock_s, omega_turn, times, out):
-    """NumPy twin of :func:`drillfric.kernels.observer.run_observer`."""
+                 junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
+                 bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b,
+                 P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out,
+                 parallel=False):
+    """NumPy twin of :func:`drillfric.kernels.observer.run_observer` (``parallel`` is
+    accepted and ignored: the twin is serial)."""
+    law = law_code(law_speed, law_exp)
+    inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
     n_start, n = alpha.shape
     n_pipe = int(section_start[1])
     a, b = alpha.copy(), beta.copy()
@@ -65,8 +77,8 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
                       2.0 * omega_bar[s] - b[s, 0] - P0 * e[s], omega_bar[s], bit_cap_rel)
             if section_start.size > 2:
                 b2[s, n_pipe - 1] -= P1 * e[s]
-            damp_and_friction(a[s], b[s], a2[s], b2[s], w_a, w_b, kt_dt, fcap, mu_s[s],
-                              mu_k[s], omega_c)
+            damp_and_friction(a[s], b[s], a2[s], b2[s], w_a, w_b, kt_dt, fcap, fix_s, fix_k,
+                              mu_s[s], mu_k[s], omega_c, inv_vs, law_exp, law)
         a2 -= inj_a[None, :] * e[:, None]
         b2 -= inj_b[None, :] * e[:, None]
         w_bha = 0.5 * (a2[:, n_pipe:] + b2[:, n_pipe:]).mean(axis=1) if n > n_pipe \
@@ -74,7 +86,8 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
         omega0[:] = omega_next
         for s in range(n_start):
             stuck = abs(w_bha[s]) <= omega_c
-            mu_s[s], mu_k[s] = adapt(mu_s[s], mu_k[s], e[s], stuck, l_s, l_k, dt, law, mu_max)
+            mu_s[s], mu_k[s] = adapt(mu_s[s], mu_k[s], e[s], stuck, l_s, l_k, dt, adapt_law,
+                                     mu_max)
             if stuck and abs(wm) > omega_turn:
                 guard[s, 0] += dt
                 if guard[s, 0] > deadlock_s:

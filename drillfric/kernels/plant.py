@@ -1,41 +1,64 @@
-"""Compiled (numba) kernels of the torsional plant, THEORY.md §3.1.
+"""Compiled (numba) kernels of the torsional plant, docs/theory.md §3.1 and §3.2.
 
 One step k → k+1 of the Courant-1 scheme is split into small functions that the adaptive
-observer (THEORY §5, a copy of this plant plus injections) reuses:
+observer (docs/theory.md §5, a copy of this plant plus injections) reuses:
 
 - :func:`inflows` — the values entering each section at step 1: top boundary (eq. 15),
-  section junctions (eqs. 12–14 / 38–39) and the bit (β = α − 2τ_bit/ζ, erratum of eq. 40);
+  section junctions (eqs. 12–14 / 38–39) and the bit (β = α − 2τ_bit/ζ, erratum of eq. 40),
+  written into the ghost cells that frame every section;
 - :func:`cell_update` — steps 2–3 for one cell: viscous term −(k_t/2)(α + β) (erratum of
   eq. 11), taken at the foot of each characteristic (see docs/simulator.md: evaluated at
   the cell itself, as THEORY §3.1 step 2 reads, it amplifies grid-scale waves at rate k_t),
-  and the friction inclusion (eqs. 5–6, A.1–A.5 with consistent units);
-- :func:`advance_cells` — steps 1–3 fused in one vectorised pass over the
-  cells (exact shift);
+  and the friction inclusion (eqs. 5–6, A.1–A.5 with consistent units) with the cap of
+  :func:`friction_cap` (docs/theory.md §3.2: friction profile, step or Stribeck law);
+- :func:`pass_cells` — steps 1–3 fused in one vectorised pass over every cell (exact
+  shift; the ghost cells make section ends like any other cell), with the observer's
+  per-cell injections when asked;
 - :func:`drive_value`, :func:`motor_torque`, :func:`top_drive_step` — the top-drive input
   (PI on a set-point series, prescribed torque, or prescribed speed) and step 4, taken
   trapezoidally and solved *before* step 1 because the top inflow α(0) = 2ω̄₀ − β(0) uses
   the step-mean speed ω̄₀ = (ω₀^k + ω₀^(k+1))/2 (docs/theory.md erratum E11: the explicit
   step 4 of THEORY §3.1 adds energy at every step);
 - :func:`run_plant` — many steps in one call, recording at the requested times by linear
-  interpolation between steps (no Python loop over time steps).
+  interpolation between steps (no Python loop over time steps); it runs the compiled
+  :func:`plant_kernel` of the call's friction variant.
 
-Array layout: one contiguous cell array for α and one for β over the whole string,
-``section_start`` (first cell of each section + total), per-cell ``zeta`` and ``fcap``
-(speed change friction can impose in one step per unit μ, F_c·Δt/(ρJ) [rad/s]).
-The plain-NumPy twin with the same argument list is :mod:`drillfric.kernels.plant_numpy`.
-For an observer: ``alpha_top`` of :func:`inflows` is an argument (pass
-ω̂₀^k + ω̂₀^(k+1) − β̂(0) − P₀e with ω̂₀^(k+1) from :func:`top_drive_step`);
-``b_in[0]`` after :func:`inflows` is the β reflected into the pipe at the pipe/BHA junction
-(add −P₁e there before :func:`advance_cells`); per-cell injections go on ``a_new``,
-``b_new`` afterwards.
+Arguments: cell arrays ``alpha``, ``beta`` over the whole string, ``section_start`` (first
+cell of each section + total), per-cell ``zeta``, ``fcap`` (speed change friction can impose
+in one step per unit μ, F_c·Δt/(ρJ) [rad/s]) and the fixed part of the profile ``fix_k``,
+``fix_s`` (the same for a zone of known friction, already times its friction factor
+[rad/s]); the friction law is given by ``law_speed`` (Stribeck decay speed v_s [rad/s]; 0
+is the step law at ω_c) and ``law_exp`` (Stribeck exponent δ). The plain-NumPy twin with
+the same argument list is :mod:`drillfric.kernels.plant_numpy`.
+
+Inside, the state is three double buffers ``A`` (α), ``B`` (β) and ``W`` (ω = (α + β)/2,
+stored so that no cell recomputes its neighbours' speeds) of shape (2, m) in the ghost
+layout of :func:`padded`: a ghost cell above the string, two between consecutive sections,
+one below the bit, the cell loop padded to whole 8-wide vectors; they and the per-cell
+arrays are rows of one :func:`work_buffer` whose row stride avoids 4K aliasing
+(:func:`row_length`). Row ``cur`` holds step k and the
+step writes row 1 − ``cur``. Performance rules (docs/performance.md): no array views or
+swaps in the time loop and no inlined helper with array arguments (each cost atomic
+reference counting at every step — it was half the time of a 65-cell step); the friction
+variant (law, fixed part, injection) is a compile-time constant of every cell loop
+(:func:`plant_kernel` closes over it; :func:`pass_cells` is specialised with
+``literally``), so each loop is branch-free and vectorised. The arithmetic is that of the
+twin, operation for operation (no fastmath): the kernels agree with it bit for bit.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 
 _MODE_PI, _MODE_TORQUE, _MODE_SPEED = 0, 1, 2
+#: Friction-law variants of the cell loop (:func:`law_code`): the step law at ω_c, and the
+#: Stribeck law with δ = 1, δ = 2 (vectorised) or any other δ (a scalar power per cell).
+LAW_STEP, LAW_STRIBECK_1, LAW_STRIBECK_2, LAW_STRIBECK = 0, 1, 2, 3
+_EXP_CLAMP = 40.0  # e^−40 = 4.2e-18: below round-off of any cap it multiplies
+_LN2_HI = 6.93147180369123816490e-01  # ln 2 split so that n·_LN2_HI is exact (n ≤ 58)
+_LN2_LO = 1.90821492927058770002e-10
+_INV_LN2 = 1.44269504088896338700e+00
 
 
 @njit(cache=True)
@@ -52,40 +75,168 @@ def drive_value(u, u_t0, u_dt, t):
 
 
 @njit(cache=True)
-def inflows(a, b, section_start, junction_z, alpha_top, omega_top, bit_cap_rel, a_in, b_in,
-            w_in):
-    """Boundary values of step 1 of THEORY §3.1, from the invariants at step k.
-
-    Fills ``a_in[s]`` (α entering section s at its top), ``b_in[s]`` (β entering it at its
-    bottom) and ``w_in[s]``, ``w_in[s + 1]`` (ω at the section's top and bottom interfaces,
-    used by the viscous term of the end cells). The top boundary α(0) = 2ω̄₀ − β(0) (eq. 15)
-    is passed in as ``alpha_top`` with ``omega_top`` = ω̄₀, the top-drive speed averaged
-    over the step (:func:`top_drive_step`; for a prescribed speed, ω₀ at step k); a
-    junction between an upper section (last cell α_a) and a lower one (first cell β_b)
-    with Z = ζ_b/ζ_a gives
-    α_b = [2α_a − (1 − Z)β_b]/(1 + Z) and β_a = [(1 − Z)α_a + 2Zβ_b]/(1 + Z) (eqs. 12–14,
-    38–39); the bit gives β = α − 2τ_bit/ζ with τ_bit = ζ·clamp(α, ±T_bit/ζ) (Coulomb bit,
-    solved exactly; ``bit_cap_rel`` = T_bit/ζ [rad/s]; 0 is the free end β = α, erratum of
-    eq. 40).
-    """
-    n_sec = section_start.size - 1
-    a_in[0] = alpha_top
-    w_in[0] = omega_top
-    for s in range(1, n_sec):
-        first = section_start[s]
-        z = junction_z[s - 1]
-        a_up = a[first - 1]
-        b_dn = b[first]
-        a_in[s] = (2.0 * a_up - (1.0 - z) * b_dn) / (1.0 + z)
-        b_in[s - 1] = ((1.0 - z) * a_up + 2.0 * z * b_dn) / (1.0 + z)
-        w_in[s] = 0.5 * (a_up + b_in[s - 1])
-    al = a[a.size - 1]
-    b_in[n_sec - 1] = al - 2.0 * min(max(al, -bit_cap_rel), bit_cap_rel)
-    w_in[n_sec] = 0.5 * (al + b_in[n_sec - 1])
+def law_code(law_speed, law_exp):
+    """Variant of the friction law: :data:`LAW_STEP` when ``law_speed`` ≤ 0, else Stribeck
+    with δ = ``law_exp`` (1 and 2 have their own vectorised variants)."""
+    if law_speed <= 0.0:
+        return LAW_STEP
+    if law_exp == 1.0:
+        return LAW_STRIBECK_1
+    if law_exp == 2.0:
+        return LAW_STRIBECK_2
+    return LAW_STRIBECK
 
 
 @njit(cache=True, inline="always")
-def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, mu_s, mu_k, omega_c):
+def exp_neg(x):
+    """e^(−x) for x ≥ 0 [-], within 3e-16 relative, in operations the compiler vectorises.
+
+    x is clamped to 40 (e^−40 = 4.2e-18); x = n·ln 2 + r with |r| ≤ ln 2/2 (Cody–Waite),
+    e^(−r) by its Taylor polynomial of degree 13 (truncation < 1e-17), times 2^(−n) built
+    from the six bits of n (≤ 58). Used by the Stribeck law (docs/theory.md §3.2); numba has
+    no vectorised exp without Intel's SVML, and a libm call per cell is ~10× the cell update.
+    """
+    x = min(x, _EXP_CLAMP)
+    n = np.floor(x * _INV_LN2 + 0.5)
+    y = (n * _LN2_HI - x) + n * _LN2_LO  # −r
+    p = 1.6059043836821613e-10
+    p = p * y + 2.08767569878681e-09
+    p = p * y + 2.505210838544172e-08
+    p = p * y + 2.755731922398589e-07
+    p = p * y + 2.7557319223985893e-06
+    p = p * y + 2.48015873015873e-05
+    p = p * y + 0.0001984126984126984
+    p = p * y + 0.001388888888888889
+    p = p * y + 0.008333333333333333
+    p = p * y + 0.041666666666666664
+    p = p * y + 0.16666666666666666
+    p = p * y + 0.5
+    p = p * y + 1.0
+    p = p * y + 1.0
+    k = int(n)
+    s = 0.5 if k & 1 else 1.0
+    s *= 0.25 if k & 2 else 1.0
+    s *= 0.0625 if k & 4 else 1.0
+    s *= 0.00390625 if k & 8 else 1.0
+    s *= 1.52587890625e-05 if k & 16 else 1.0
+    s *= 2.3283064365386963e-10 if k & 32 else 1.0
+    return p * s
+
+
+@njit(cache=True, inline="always")
+def friction_cap(w_old, fcap_j, fix_s_j, fix_k_j, mu_s, mu_k, omega_c, inv_vs, delta, law,
+                 fixed):
+    """Friction cap of a cell at speed ω^k = ``w_old`` [rad/s per step] (docs/theory.md §3.2).
+
+    Static and kinetic caps μ_s·fcap_j + fix_s_j and μ_k·fcap_j + fix_k_j (the fixed part
+    only when ``fixed``). Step law (eqs. 5–6): the static cap if |ω^k| ≤ ω_c, else the
+    kinetic one. Stribeck law: cap_k + (cap_s − cap_k)·exp(−(|ω^k|/v_s)^δ), ``inv_vs`` =
+    1/v_s [s/rad].
+    """
+    if law == LAW_STEP:
+        stuck = abs(w_old) <= omega_c
+        cap = (mu_s if stuck else mu_k) * fcap_j
+        if fixed:
+            cap += fix_s_j if stuck else fix_k_j
+        return cap
+    cap_s = mu_s * fcap_j
+    cap_k = mu_k * fcap_j
+    if fixed:
+        cap_s += fix_s_j
+        cap_k += fix_k_j
+    u = abs(w_old) * inv_vs
+    if law == LAW_STRIBECK_1:
+        x = u
+    elif law == LAW_STRIBECK_2:
+        x = u * u
+    else:
+        x = u ** delta
+    return cap_k + (cap_s - cap_k) * exp_neg(x)
+
+
+@njit(cache=True)
+def padded_size(section_start):
+    """Cells of the ghost layout (:func:`padded`): n + 2·n_sec, rounded up so that the cells
+    between the first and the last fill whole 8-wide vectors (no scalar loop remainder)."""
+    return 2 + (section_start[-1] + 2 * (section_start.size - 1) - 2 + 7) // 8 * 8
+
+
+@njit(cache=True)
+def row_length(section_start):
+    """Length of a row of the work buffer (:func:`work_buffer`): the smallest 88 + 512·q
+    cells ≥ :func:`padded_size`, i.e. a row stride of 704 bytes modulo 4096.
+
+    The loop stores three rows while it loads from the others; a load whose address equals
+    a store still in flight modulo 4096 waits for it ("4K aliasing"). With separately
+    allocated arrays that depended on where the heap put them: the same 475-cell step took
+    266–641 ns over 24 placements. Rows 704 bytes apart (mod 4096) keep every load at least
+    576 bytes (72 cells) from the stores of the last iterations, for up to 11 rows.
+    """
+    return 88 + 512 * max(0, (padded_size(section_start) - 88 + 511) // 512)
+
+
+@njit(cache=True)
+def padded(x, section_start):
+    """Per-cell values in the ghost layout of the kernels: a zero ghost cell at the top, two
+    between consecutive sections and one at the bottom, zeros after the last
+    (length :func:`row_length`)."""
+    n_sec = section_start.size - 1
+    out = np.zeros(row_length(section_start))
+    for s in range(n_sec):
+        for j in range(section_start[s], section_start[s + 1]):
+            out[j + 1 + 2 * s] = x[j]
+    return out
+
+
+@njit(cache=True)
+def unpadded(xp, section_start, out):
+    """The real cells of ``xp`` (ghost layout of :func:`padded`) into ``out`` (length n)."""
+    for s in range(section_start.size - 1):
+        for j in range(section_start[s], section_start[s + 1]):
+            out[j] = xp[j + 1 + 2 * s]
+
+
+@njit(cache=True)
+def inflows(A, B, W, cur, section_start, junction_z, alpha_top, omega_top, bit_cap_rel):
+    """Boundary values of step 1 of THEORY §3.1 into the ghost cells of row ``cur`` of the
+    state buffers ``A`` (α), ``B`` (β), ``W`` (ω = (α + β)/2), from the real cells at step k.
+
+    Each section is framed by ghost cells (layout of :func:`padded`): the one above its
+    first cell holds the α entering it and the interface speed ω, the one below its last
+    cell the β entering it and ω; :func:`pass_cells` then updates every cell the same way.
+    The top boundary α(0) = 2ω̄₀ − β(0) (eq. 15) is passed in as ``alpha_top`` with
+    ``omega_top`` = ω̄₀, the top-drive speed averaged over the step (:func:`top_drive_step`;
+    for a prescribed speed, ω₀ at step k); a junction between an upper section (last cell
+    α_a) and a lower one (first cell β_b) with Z = ζ_b/ζ_a gives
+    α_b = [2α_a − (1 − Z)β_b]/(1 + Z) and β_a = [(1 − Z)α_a + 2Zβ_b]/(1 + Z) (eqs. 12–14,
+    38–39) and the interface speed (α_a + β_a)/2; the bit gives β = α − 2τ_bit/ζ with
+    τ_bit = ζ·clamp(α, ±T_bit/ζ) (Coulomb bit, solved exactly; ``bit_cap_rel`` = T_bit/ζ
+    [rad/s]; 0 is the free end β = α, erratum of eq. 40).
+    """
+    n_sec = section_start.size - 1
+    A[cur, 0] = alpha_top
+    W[cur, 0] = omega_top
+    for s in range(1, n_sec):
+        last = section_start[s] + 2 * s - 2  # last cell of section s − 1
+        z = junction_z[s - 1]
+        a_up = A[cur, last]
+        b_dn = B[cur, last + 3]
+        b_up = ((1.0 - z) * a_up + 2.0 * z * b_dn) / (1.0 + z)
+        w_if = 0.5 * (a_up + b_up)
+        A[cur, last + 2] = (2.0 * a_up - (1.0 - z) * b_dn) / (1.0 + z)
+        W[cur, last + 2] = w_if
+        B[cur, last + 1] = b_up
+        W[cur, last + 1] = w_if
+    end = section_start[-1] + 2 * n_sec - 1  # the ghost cell below the bit
+    al = A[cur, end - 1]
+    b_bit = al - 2.0 * min(max(al, -bit_cap_rel), bit_cap_rel)
+    B[cur, end] = b_bit
+    W[cur, end] = 0.5 * (al + b_bit)
+
+
+@njit(cache=True, inline="always")
+def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_s_j, fix_k_j, mu_s,
+                mu_k, omega_c, inv_vs, delta, law, fixed):
     """Steps 2–3 of THEORY §3.1 for one cell; returns (α, β) at step k+1 [rad/s].
 
     ``a_src``, ``b_src`` are the transported values α*, β* (step 1) and ``w_src_a``,
@@ -94,54 +245,65 @@ def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, mu_s, mu_k
     the characteristic so that it dissipates energy): α** = α* − Δt·k_t·ω^k_(j−1),
     β** = β* − Δt·k_t·ω^k_(j+1). Friction inclusion (eqs. 5–6, A.1–A.5 with consistent
     units): the speed change that would stop the cell, ω** = (α** + β**)/2, is clamped to
-    ±μ·fcap_j with μ = μ_s if |ω^k_j| ≤ ω_c else μ_k and removed from both invariants (τ is
-    untouched).
+    ±cap with the cap of :func:`friction_cap` at ω^k (docs/theory.md §3.2) and removed from
+    both invariants (τ is untouched).
     """
     an = a_src - kt_dt * w_src_a
     bn = b_src - kt_dt * w_src_b
     w = 0.5 * (an + bn)
-    mu = mu_s if abs(w_old) <= omega_c else mu_k
-    cap = mu * fcap_j
+    cap = friction_cap(w_old, fcap_j, fix_s_j, fix_k_j, mu_s, mu_k, omega_c, inv_vs, delta,
+                       law, fixed)
     d = min(max(w, -cap), cap)
     return an - d, bn - d
 
 
-@njit(cache=True, inline="always")
-def _end_cell(a, b, a_new, b_new, j, a_src, b_src, w_src_a, w_src_b, kt_dt, fcap, mu_s, mu_k,
-              omega_c):
-    a_new[j], b_new[j] = cell_update(a_src, b_src, w_src_a, w_src_b, 0.5 * (a[j] + b[j]),
-                                     kt_dt, fcap[j], mu_s, mu_k, omega_c)
+@njit(cache=True)
+def pass_cells(A, B, W, cur, end, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs, delta,
+               law, fixed, inj_a, inj_b, e, inject):
+    """Steps 1–3 of THEORY §3.1 on every cell: α*_j = α_{j−1}, β*_j = β_{j+1} (exact
+    Courant-1 shift) from row ``cur`` of the state buffers ``A`` (α), ``B`` (β), ``W`` (ω),
+    then :func:`cell_update`, written to row 1 − ``cur``, for the cells 1 … ``end`` − 1
+    (``end`` = :func:`padded_size` − 1).
+
+    Buffers and per-cell arrays are in the ghost layout of :func:`padded`, the ghost cells
+    of row ``cur`` filled by :func:`inflows`, so section ends, junctions, the top drive and
+    the bit need no separate pass (the ghost cells are updated too, meaninglessly, and
+    refilled before they are read). With ``inject`` (the observer, docs/theory.md §5) each
+    cell then loses ``inj_a[j]·e``, ``inj_b[j]·e`` in the same pass; without ``fixed`` the
+    fixed arrays are not read. ``law``, ``fixed`` and ``inject`` must be compile-time
+    constants at the call site: each combination compiles to its own branch-free loop,
+    which the compiler vectorises.
+    """
+    literally(law)
+    literally(fixed)
+    literally(inject)
+    nxt = 1 - cur
+    for j in range(1, end):
+        an, bn = cell_update(A[cur, j - 1], B[cur, j + 1], W[cur, j - 1], W[cur, j + 1],
+                             W[cur, j], kt_dt, fcap[j], fix_s[j] if fixed else 0.0,
+                             fix_k[j] if fixed else 0.0, mu_s, mu_k, omega_c, inv_vs, delta,
+                             law, fixed)
+        if inject:
+            an -= inj_a[j] * e
+            bn -= inj_b[j] * e
+        A[nxt, j] = an
+        B[nxt, j] = bn
+        W[nxt, j] = 0.5 * (an + bn)
 
 
 @njit(cache=True)
-def advance_cells(a, b, a_new, b_new, section_start, a_in, b_in, w_in, kt_dt, fcap, mu_s,
-                  mu_k, omega_c):
-    """Steps 1–3 of THEORY §3.1 over the whole string: α*_j = α_{j−1}, β*_j = β_{j+1}
-    (exact Courant-1 shift), then :func:`cell_update`.
-
-    Reads ``a``, ``b`` (step k), writes ``a_new``, ``b_new`` (step k+1 before the top-drive
-    update); ``a_in``, ``b_in``, ``w_in`` come from :func:`inflows`. One branch-free pass
-    over all interior cells as if the string were uniform (the compiler vectorises it),
-    then the first and last cell of every section are redone with the section inflows
-    (each cell reads only step-k values, so the overwrite is exact).
-    """
-    n = a.size
-    for j in range(1, n - 1):
-        a_new[j], b_new[j] = cell_update(a[j - 1], b[j + 1], 0.5 * (a[j - 1] + b[j - 1]),
-                                         0.5 * (a[j + 1] + b[j + 1]), 0.5 * (a[j] + b[j]),
-                                         kt_dt, fcap[j], mu_s, mu_k, omega_c)
-    for s in range(section_start.size - 1):
-        lo = section_start[s]
-        hi = section_start[s + 1]
-        if hi - lo == 1:
-            _end_cell(a, b, a_new, b_new, lo, a_in[s], b_in[s], w_in[s], w_in[s + 1], kt_dt,
-                      fcap, mu_s, mu_k, omega_c)
-            continue
-        _end_cell(a, b, a_new, b_new, lo, a_in[s], b[lo + 1], w_in[s],
-                  0.5 * (a[lo + 1] + b[lo + 1]), kt_dt, fcap, mu_s, mu_k, omega_c)
-        _end_cell(a, b, a_new, b_new, hi - 1, a[hi - 2], b_in[s],
-                  0.5 * (a[hi - 2] + b[hi - 2]), w_in[s + 1], kt_dt, fcap, mu_s, mu_k,
-                  omega_c)
+def work_buffer(alpha, beta, section_start, cells):
+    """All the rows the cell loop touches, in one array of :func:`row_length` columns: the
+    double-buffered state α (rows 0, 1), β (2, 3), ω = (α + β)/2 (4, 5), row 0, 2, 4 from
+    ``alpha``, ``beta``, then the per-cell arrays of the tuple ``cells`` (rows 6, …), all
+    in the ghost layout of :func:`padded`."""
+    X = np.zeros((6 + len(cells), row_length(section_start)))
+    X[0] = padded(alpha, section_start)
+    X[2] = padded(beta, section_start)
+    X[4] = 0.5 * (X[0] + X[2])
+    for i in range(len(cells)):
+        X[6 + i] = padded(cells[i], section_start)
+    return X
 
 
 @njit(cache=True)
@@ -182,72 +344,104 @@ def top_drive_step(omega0, beta0, q, accel_dt):
     return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
 
 
-@njit(cache=True)
-def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, dt,
-              kt_dt, mu_s, mu_k, omega_c, bit_cap_rel, inv_itd, mode, u, u_t0, u_dt, kp, ki,
-              times, out):
+def plant_kernel(law: int, fixed: bool):
+    """The compiled plant kernel for one friction-law variant (``law``, :func:`law_code`) with
+    or without a fixed friction part: :func:`run_plant` without the variant dispatch.
+
+    The variant flags are constants of the compiled code (closure variables), so the cell
+    loop of :func:`pass_cells` is branch-free and vectorised, and no reference counting
+    happens inside the time loop (a run-time dispatch there cost ~30 atomic reference-count
+    updates per step: half the time of a 65-cell step). Compiled on first use, cached on
+    disk per variant.
+    """
+    @njit(cache=True)
+    def kernel(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
+               fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
+               inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
+        last = alpha.size + 2 * section_start.size - 4  # the bit cell in the ghost layout
+        X = work_buffer(alpha, beta, section_start, (fcap, fix_s, fix_k))
+        A, B, W, fcap_p, fix_s_p, fix_k_p = X[0:2], X[2:4], X[4:6], X[6], X[7], X[8]
+        end = padded_size(section_start) - 1
+        cur = 0
+        inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
+        omega0 = top[0]
+        integral = top[1]
+        zeta0 = zeta[0]
+        q_td = 0.5 * zeta0 * dt * inv_itd
+        n_rec = times.size
+        r = 0
+        eps = 1e-9 * dt
+        p0 = p1 = p2 = p3 = 0.0
+        for k in range(n_steps + 1):
+            t = t0 + k * dt
+            u_now = drive_value(u, u_t0, u_dt, t)
+            u_next = u_now
+            if mode == _MODE_SPEED:
+                omega0 = u_now
+                u_next = drive_value(u, u_t0, u_dt, t + dt)
+            beta0 = B[cur, 1]
+            tau0 = zeta0 * (omega0 - beta0)
+            tau_m = motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt,
+                                 inv_itd)
+            w_bit = W[cur, last]
+            while r < n_rec and times[r] <= t + eps:
+                f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
+                out[r, 0] = p0 + f * (omega0 - p0)
+                out[r, 1] = p1 + f * (tau_m - p1)
+                out[r, 2] = p2 + f * (tau0 - p2)
+                out[r, 3] = p3 + f * (w_bit - p3)
+                r += 1
+            p0, p1, p2, p3 = omega0, tau_m, tau0, w_bit
+            if k == n_steps:
+                break
+            omega_next = omega0
+            if mode != _MODE_SPEED:
+                omega_next = top_drive_step(omega0, beta0, q_td, dt * inv_itd * tau_m)
+            omega_bar = 0.5 * (omega0 + omega_next)
+            inflows(A, B, W, cur, section_start, junction_z, 2.0 * omega_bar - beta0,
+                    omega_bar, bit_cap_rel)
+            pass_cells(A, B, W, cur, end, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k,
+                       omega_c, inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
+            if mode == _MODE_PI:
+                integral += dt * (u_now - omega0)
+            omega0 = omega_next
+            cur = 1 - cur
+        unpadded(A[cur], section_start, alpha)
+        unpadded(B[cur], section_start, beta)
+        top[0] = omega0
+        top[1] = integral
+
+    return kernel
+
+
+_KERNELS: dict = {}
+
+
+def variant(law_speed: float, law_exp: float, fix_k, fix_s) -> tuple[int, bool]:
+    """(law code, has a fixed part) of a kernel call: the variant that runs it."""
+    return law_code(law_speed, law_exp), bool(np.any(fix_k) or np.any(fix_s))
+
+
+def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
+              fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd,
+              mode, u, u_t0, u_dt, kp, ki, times, out):
     """Advance ``n_steps`` steps from time ``t0`` and record at ``times`` (THEORY §3.1).
 
     ``alpha``, ``beta`` (cells) and ``top`` = [ω₀, PI integral] are updated in place.
-    Per step: τ_m from the state at step k (held over the step), ω₀^(k+1) by the trapezoidal
-    :func:`top_drive_step` (except for a prescribed speed), then steps 1–3 with the top
-    inflow α(0) = 2ω̄₀ − β(0) (erratum E11).
+    Friction (docs/theory.md §3.2): caps μ_s·fcap + fix_s, μ_k·fcap + fix_k, step law at
+    ``omega_c`` when ``law_speed`` = 0, else Stribeck with v_s = ``law_speed`` and
+    δ = ``law_exp``. Per step: τ_m from the state at step k (held over the step), ω₀^(k+1)
+    by the trapezoidal :func:`top_drive_step` (except for a prescribed speed), then steps
+    1–3 with the top inflow α(0) = 2ω̄₀ − β(0) (erratum E11).
     ``out[r]`` receives (ω₀, τ_m, τ(0) = ζ(ω₀ − β(0)), ω_bit) at ``times[r]`` (step values,
     τ(0) from ω₀ and β(0) at the step), linearly interpolated
     between the bracketing steps; ``times`` must lie in [t0, t0 + n_steps·dt].
-    Argument order: see :func:`drillfric.torsional.kernel_args`.
+    Argument order: see :func:`drillfric.torsional.kernel_args`. Runs the compiled
+    :func:`plant_kernel` of the call's variant (:func:`variant`).
     """
-    n = alpha.size
-    a = alpha
-    b = beta
-    a2 = alpha.copy()
-    b2 = beta.copy()
-    a_in = np.empty(section_start.size - 1)
-    b_in = np.empty(section_start.size - 1)
-    w_in = np.empty(section_start.size)
-    omega0 = top[0]
-    integral = top[1]
-    zeta0 = zeta[0]
-    q_td = 0.5 * zeta0 * dt * inv_itd
-    n_rec = times.size
-    r = 0
-    eps = 1e-9 * dt
-    p0 = p1 = p2 = p3 = 0.0
-    for k in range(n_steps + 1):
-        t = t0 + k * dt
-        u_now = drive_value(u, u_t0, u_dt, t)
-        u_next = u_now
-        if mode == _MODE_SPEED:
-            omega0 = u_now
-            u_next = drive_value(u, u_t0, u_dt, t + dt)
-        tau0 = zeta0 * (omega0 - b[0])
-        tau_m = motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_itd)
-        w_bit = 0.5 * (a[n - 1] + b[n - 1])
-        while r < n_rec and times[r] <= t + eps:
-            f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
-            out[r, 0] = p0 + f * (omega0 - p0)
-            out[r, 1] = p1 + f * (tau_m - p1)
-            out[r, 2] = p2 + f * (tau0 - p2)
-            out[r, 3] = p3 + f * (w_bit - p3)
-            r += 1
-        p0, p1, p2, p3 = omega0, tau_m, tau0, w_bit
-        if k == n_steps:
-            break
-        omega_next = omega0
-        if mode != _MODE_SPEED:
-            omega_next = top_drive_step(omega0, b[0], q_td, dt * inv_itd * tau_m)
-        omega_bar = 0.5 * (omega0 + omega_next)
-        inflows(a, b, section_start, junction_z, 2.0 * omega_bar - b[0], omega_bar,
-                bit_cap_rel, a_in, b_in, w_in)
-        advance_cells(a, b, a2, b2, section_start, a_in, b_in, w_in, kt_dt, fcap, mu_s, mu_k,
-                      omega_c)
-        if mode == _MODE_PI:
-            integral += dt * (u_now - omega0)
-        omega0 = omega_next
-        a, a2 = a2, a
-        b, b2 = b2, b
-    if n_steps % 2 == 1:
-        alpha[:] = a
-        beta[:] = b
-    top[0] = omega0
-    top[1] = integral
+    key = variant(law_speed, law_exp, fix_k, fix_s)
+    if key not in _KERNELS:
+        _KERNELS[key] = plant_kernel(*key)
+    _KERNELS[key](alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
+                  fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
+                  inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out)

@@ -1,4 +1,4 @@
-"""Plain-NumPy twins of :mod:`drillfric.kernels.plant` (THEORY.md §3.1).
+"""Plain-NumPy twins of :mod:`drillfric.kernels.plant` (docs/theory.md §3.1, §3.2).
 
 Same argument lists and the same arithmetic, written with whole-array NumPy operations and
 a Python loop over time steps: the oracle of the kernel tests (agreement to round-off) and
@@ -7,9 +7,17 @@ the baseline of ``benchmarks/bench_plant.py``. Not for production use (slow).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from drillfric.kernels.plant import LAW_STEP, LAW_STRIBECK, LAW_STRIBECK_1, LAW_STRIBECK_2
+
 _MODE_PI, _MODE_TORQUE, _MODE_SPEED = 0, 1, 2
+_EXP_COEF = (1.6059043836821613e-10, 2.08767569878681e-09, 2.505210838544172e-08,
+             2.755731922398589e-07, 2.7557319223985893e-06, 2.48015873015873e-05,
+             0.0001984126984126984, 0.001388888888888889, 0.008333333333333333,
+             0.041666666666666664, 0.16666666666666666, 0.5, 1.0, 1.0)
 
 
 def drive_value(u, u_t0, u_dt, t):
@@ -48,13 +56,51 @@ def transport(a, b, a_new, b_new, w_a, w_b, section_start, junction_z, alpha_top
     w_b[-1] = 0.5 * (al + b_new[-1])
 
 
-def damp_and_friction(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, mu_s, mu_k, omega_c):
+def law_code(law_speed, law_exp):
+    """Friction-law variant; see :func:`drillfric.kernels.plant.law_code`."""
+    if law_speed <= 0.0:
+        return LAW_STEP
+    return {1.0: LAW_STRIBECK_1, 2.0: LAW_STRIBECK_2}.get(law_exp, LAW_STRIBECK)
+
+
+def exp_neg(x):
+    """e^(−x) for x ≥ 0, the arithmetic of :func:`drillfric.kernels.plant.exp_neg`."""
+    x = np.minimum(x, 40.0)
+    n = np.floor(x * 1.44269504088896338700e+00 + 0.5)
+    y = (n * 6.93147180369123816490e-01 - x) + n * 1.90821492927058770002e-10
+    p = np.full_like(x, _EXP_COEF[0])
+    for c in _EXP_COEF[1:]:
+        p = p * y + c
+    k = n.astype(np.int64)
+    s = np.ones_like(x)
+    for bit in range(6):
+        s *= np.where(k & (1 << bit), 2.0 ** -(1 << bit), 1.0)
+    return p * s
+
+
+def friction_cap(w_old, cap_s, cap_k, omega_c, inv_vs, delta, law):
+    """Cap of each cell (docs/theory.md §3.2); see :func:`drillfric.kernels.plant.friction_cap`."""
+    if law == LAW_STEP:
+        return np.where(np.abs(w_old) <= omega_c, cap_s, cap_k)
+    u = np.abs(w_old) * inv_vs
+    if law == LAW_STRIBECK_1:
+        x = u
+    elif law == LAW_STRIBECK_2:
+        x = u * u
+    else:  # the C library's pow, as the kernel (NumPy's own vectorised pow differs by an ulp)
+        x = np.array([math.pow(v, delta) for v in u])
+    return cap_k + (cap_s - cap_k) * exp_neg(x)
+
+
+def damp_and_friction(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k,
+                      omega_c, inv_vs, delta, law):
     """Steps 2–3: viscous term along the characteristics and friction inclusion, in place."""
     w_old = 0.5 * (a + b)
     an = a_new - kt_dt * w_a
     bn = b_new - kt_dt * w_b
     w = 0.5 * (an + bn)
-    cap = np.where(np.abs(w_old) <= omega_c, mu_s, mu_k) * fcap
+    cap = friction_cap(w_old, mu_s * fcap + fix_s, mu_k * fcap + fix_k, omega_c, inv_vs,
+                       delta, law)
     d = np.minimum(np.maximum(w, -cap), cap)
     a_new[:] = an - d
     b_new[:] = bn - d
@@ -75,10 +121,12 @@ def top_drive_step(omega0, beta0, q, accel_dt):
     return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
 
 
-def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, dt,
-              kt_dt, mu_s, mu_k, omega_c, bit_cap_rel, inv_itd, mode, u, u_t0, u_dt, kp, ki,
-              times, out):
+def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
+              fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd,
+              mode, u, u_t0, u_dt, kp, ki, times, out):
     """NumPy twin of :func:`drillfric.kernels.plant.run_plant` (same arguments and effects)."""
+    law = law_code(law_speed, law_exp)
+    inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
     a, b = alpha.copy(), beta.copy()
     a2, b2 = alpha.copy(), beta.copy()
     w_a, w_b = np.empty_like(a), np.empty_like(a)
@@ -109,7 +157,8 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
         omega_bar = 0.5 * (omega0 + omega_next)
         transport(a, b, a2, b2, w_a, w_b, section_start, junction_z, 2.0 * omega_bar - b[0],
                   omega_bar, bit_cap_rel)
-        damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, mu_s, mu_k, omega_c)
+        damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k,
+                          omega_c, inv_vs, law_exp, law)
         if mode == _MODE_PI:
             integral += dt * (u_now - omega0)
         omega0 = float(omega_next)
