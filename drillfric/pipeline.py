@@ -443,7 +443,7 @@ def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentDa
         "bit_stuck": np.asarray(stuck, dtype=bool).ravel(),
         "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S,
         "surface_torque_Nm": at(ev.time_s, ev.measured_Nm),
-        "surface_torque_est_Nm": np.full(n_t * n_s, np.nan),
+        "surface_torque_est_Nm": rec.surface_torque_est_Nm.ravel(),
         "surface_torque_fit_Nm": at(ev.time_s, ev.model_Nm),
         "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
         "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}

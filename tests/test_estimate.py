@@ -52,7 +52,8 @@ def test_ensemble_members_stay_distinct_where_the_bounds_cut(mu_s, mu_k, mu_max)
 def _record(bit, residual):
     time = np.arange(bit.shape[0]) * 0.1
     zero = np.zeros_like(bit)
-    return ObserverRecord(time, zero, zero, zero, bit, bit, residual, np.zeros(bit.shape[1]))
+    return ObserverRecord(time, zero, zero, zero, bit, bit, residual, zero,
+                          np.zeros(bit.shape[1]))
 
 
 def test_ensemble_weights_favour_the_member_matching_the_surface():

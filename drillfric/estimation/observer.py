@@ -250,6 +250,8 @@ class ObserverRecord:
         Estimated mean BHA speed [rad/s] (decides stuck/sliding in the adaptation).
     residual_rad_s : ndarray
         Innovation e = ω̂₀ − ω₀ [rad/s].
+    surface_torque_est_Nm : ndarray
+        Modelled string torque at the top τ̂(0) = ζ(ω̂₀ − β̂(0)) [N·m] (eq. 15).
     deadlock_events : ndarray, shape (S,)
         Deadlock-guard interventions per start.
     """
@@ -261,6 +263,7 @@ class ObserverRecord:
     bit_rad_s_est: np.ndarray
     bha_rad_s_est: np.ndarray
     residual_rad_s: np.ndarray
+    surface_torque_est_Nm: np.ndarray
     deadlock_events: np.ndarray
 
 
@@ -353,6 +356,7 @@ class BitSpeedEstimate:
         return ObserverRecord(members.time_s, members.mu_s[:, :1], members.mu_k[:, :1],
                               mean(members.surface_rad_s_est), self.rad_s[:, None],
                               mean(members.bha_rad_s_est), mean(members.residual_rad_s),
+                              mean(members.surface_torque_est_Nm),
                               members.deadlock_events[:1])
 
     def stuck(self, members: ObserverRecord, omega_c_rad_s: float) -> np.ndarray:

@@ -33,7 +33,7 @@ from drillfric.kernels.plant import (
 
 #: Columns of the observer record, per start.
 OBS_COLUMNS = ("mu_s", "mu_k", "surface_rad_s_est", "bit_rad_s_est", "bha_rad_s_est",
-               "residual_rad_s")
+               "residual_rad_s", "surface_torque_est_Nm")
 LAW_CORRECTED, LAW_PAPER = 0, 1
 
 
@@ -148,6 +148,7 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
             out[r, s, 3] = W[cur, last]
             out[r, s, 4] = w_bha_last
             out[r, s, 5] = e_last
+            out[r, s, 6] = zeta[0] * (om - B[cur, 1])  # string torque at the top, eq. (15)
             r += 1
         if k == n_steps:
             break

@@ -60,8 +60,8 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
     for k in range(n_steps + 1):
         t = t0 + k * dt
         while r < times.size and times[r] <= t + eps:
-            out[r] = np.stack([mu_s, mu_k, omega0, 0.5 * (a[:, -1] + b[:, -1]), w_bha, e_last],
-                              axis=1)
+            out[r] = np.stack([mu_s, mu_k, omega0, 0.5 * (a[:, -1] + b[:, -1]), w_bha, e_last,
+                               zeta[0] * (omega0 - b[:, 0])], axis=1)
             r += 1
         if k == n_steps:
             break
