@@ -198,11 +198,31 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("friction", float, 0.25, "", "Friction factor used by torque-and-drag when no "
             "other is given (td without --friction).", min=0.0, max=2.0),
         Key("casing_shoe_md_m", float, None, "m", "Measured depth of the last casing shoe; "
-            "with friction_cased/friction_open the T&D friction differs above/below.", min=0.0),
-        Key("friction_cased", float, None, "", "T&D friction factor inside casing.",
+            "with friction_cased (or friction_ratio_cased) the friction differs above and "
+            "below it, and the estimated factors are the open hole's (docs/theory.md §3.2).",
+            min=0.0),
+        Key("friction_cased", float, None, "", "Kinetic friction factor inside casing, known "
+            "from the previous section: torque and drag use it above the shoe, and the "
+            "estimator holds it fixed there and estimates the open-hole factors.",
             min=0.0, max=2.0),
-        Key("friction_open", float, None, "", "T&D friction factor in open hole.",
+        Key("friction_cased_static", float, None, "", "Static friction factor inside casing, "
+            "when known (≥ friction_cased). Unknown, a μ_s is reported for the open hole only "
+            "when it holds both with the open hole's static/kinetic ratio and with none.",
             min=0.0, max=2.0),
+        Key("friction_ratio_cased", float, None, "", "Cased friction as a ratio of the open "
+            "hole's, μ_cased/μ_open (instead of friction_cased): the estimated factors are "
+            "the open hole's, the cased part scaled by the ratio.", min=0.0, max=10.0,
+            min_exclusive=True),
+        Key("friction_open", float, None, "", "T&D friction factor in open hole (td and the "
+            "broomstick; the estimator estimates it).", min=0.0, max=2.0),
+        Key("friction_law", str, "step", "", "Friction law of the estimator's models: 'step' "
+            "(μ_s below ω_c, μ_k above: the paper) or 'stribeck' (μ falls from μ_s at rest to "
+            "μ_k with stribeck_speed_rad_s, docs/theory.md §3.2).",
+            choices=("step", "stribeck")),
+        _positive("stribeck_speed_rad_s", None, "rad/s", "Decay speed v_s of the Stribeck "
+                  "law (with friction_law = 'stribeck')."),
+        Key("stribeck_exponent", float, 1.0, "", "Exponent δ of the Stribeck law "
+            "exp(−(|ω|/v_s)^δ): 1 exponential, 2 Gaussian.", min=1.0, max=2.0),
     ),
     "observer": (
         Key("gains", str, "kalman", "", "Gain design: steady-state 'kalman' (default; far less "
@@ -589,6 +609,22 @@ def _check_observer_lists(observer: dict, file: str | None) -> None:
                           "[z, p] in 1/s", file=file, fix="e.g. poles_per_s = [1.0, 1.5]")
 
 
+def _check_friction(model: dict, file: str | None) -> None:
+    """The friction keys of [model] that go together (docs/theory.md §3.2)."""
+    if model["friction_cased"] is not None and model["friction_ratio_cased"] is not None:
+        raise ConfigError("give model.friction_cased or model.friction_ratio_cased, not both",
+                          file=file, fix="the cased friction is known either absolutely or "
+                                         "as a ratio of the open hole's")
+    static, kinetic = model["friction_cased_static"], model["friction_cased"]
+    if static is not None and (kinetic is None or static < kinetic):
+        raise ConfigError("model.friction_cased_static needs friction_cased and must not be "
+                          "below it", file=file, fix="e.g. friction_cased = 0.2, "
+                                                     "friction_cased_static = 0.3")
+    if model["friction_law"] == "stribeck" and model["stribeck_speed_rad_s"] is None:
+        raise ConfigError("model.friction_law = 'stribeck' needs model.stribeck_speed_rad_s",
+                          file=file, fix="e.g. stribeck_speed_rad_s = 0.5")
+
+
 def read_toml(path: str | Path) -> dict:
     """Read a TOML file, turning syntax errors into one-line ConfigErrors."""
     path = Path(path)
@@ -647,6 +683,7 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
         raise ConfigError("segmentation.rotating_stop_rpm must not exceed rotating_rpm "
                           "(rotation starts above rotating_rpm and ends below the stop speed)",
                           file=fname, fix="e.g. rotating_rpm = 2.0, rotating_stop_rpm = 1.0")
+    _check_friction(values["model"], fname)
     if values["model"]["omega_c_rad_s"] is not None and values["model"]["omega_c_rpm"] is not None:
         raise ConfigError("give either model.omega_c_rad_s or model.omega_c_rpm, not both",
                           file=fname)

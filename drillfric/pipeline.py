@@ -37,6 +37,7 @@ from drillfric.estimation.chain import (
     estimate_segment,
 )
 from drillfric.estimation.observer import ObserverRecord
+from drillfric.friction import FrictionProfile
 from drillfric.io.logcheck import LogCheck
 from drillfric.io.results import (
     EstimatesWriter,
@@ -598,7 +599,9 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict],
     inputs.update(rows=n_rows, resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
     assumed = well.assumed + estimator.assumed
     count = {s: sum(r.status is s for r in records) for s in Status}
+    profile = FrictionProfile.from_config(well.config)
     return {"well": well.name, "drillfric_version": __version__, **consensus(records, pools),
+            "friction_zone": profile.zone, "friction_profile": profile.describe(),
             "pooled": pools, "segments": [r.to_json() for r in records], "inputs": inputs,
             "config": well.config.to_dict(), "assumed": assumed, "indicative": bool(assumed),
             "counts": {"segments": len(records), "estimated": count[Status.OK],

@@ -377,11 +377,11 @@ def config_friction(cfg, friction: float | None = None) -> Friction:
         return float(base)
     mu_c = base if cased is None else cased
     mu_o = base if open_ is None else open_
-    return _SectionFriction(float(shoe), float(mu_c), float(mu_o))
+    return SectionFriction(float(shoe), float(mu_c), float(mu_o))
 
 
 @dataclass(frozen=True)
-class _SectionFriction:
+class SectionFriction:
     """μ(md) = cased above the shoe, open hole below (picklable, unlike a lambda)."""
 
     shoe_md_m: float
@@ -423,7 +423,8 @@ def solve_config(cfg, path: WellPath | None, bit_depth_m: float, **kw) -> TDResu
 def back_calculate_friction(path: WellPath, string: DrillString, *,
                             surface_torque_Nm: float | None = None,
                             hookload_N: float | None = None,
-                            load_case: str = "rotating_off_bottom", **kw) -> float:
+                            load_case: str = "rotating_off_bottom", friction_of=None,
+                            **kw) -> float:
     """Friction factor that makes the model match a measured surface torque or hook load.
 
     A scalar root find (scipy ``brentq``) of model − measurement over μ ∈ [0, 2].
@@ -436,6 +437,9 @@ def back_calculate_friction(path: WellPath, string: DrillString, *,
         Measured effective hook load [N] (pick-up / slack-off), block weight removed.
     load_case : str
         Load case of the measurement.
+    friction_of : callable, optional
+        μ → the friction to solve with (e.g. a known cased factor above the shoe and μ
+        below: μ is then the open hole's); default μ everywhere.
     **kw
         Passed to :func:`solve` (WOB, bit torque, muds, element length, ...).
 
@@ -452,7 +456,9 @@ def back_calculate_friction(path: WellPath, string: DrillString, *,
     attr = "surface_torque_Nm" if hookload_N is None else "hookload_N"
 
     def residual(mu: float) -> float:
-        return getattr(solve(path, string, friction=mu, load_case=load_case, **kw), attr) - target
+        friction = mu if friction_of is None else friction_of(mu)
+        return getattr(solve(path, string, friction=friction, load_case=load_case, **kw),
+                       attr) - target
 
     lo, hi = _FRICTION_BRACKET
     r_lo, r_hi = residual(lo), residual(hi)

@@ -39,6 +39,7 @@ from drillfric.drillstring import DrillString
 from drillfric.errors import InputError
 from drillfric.estimation import creep
 from drillfric.estimation.creep import bridge_loaded_dips, find_creeps, rotating_runs, smooth
+from drillfric.friction import CASED_STATIC, FrictionProfile
 
 MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
 WOUND_SPAN_S = 0.5  #: rest at a window's start over which a trapped torque is measured [s]
@@ -265,10 +266,13 @@ class _Model:
     Each window starts from rest, holding the twist the measured torque says the string has
     there (:meth:`drillfric.torsional.State.wound`; none after a released stop)."""
 
-    def __init__(self, string, fc_fn, omega_c, k_t, itd, data: _Data, progress):
+    def __init__(self, string, fc_fn, omega_c, k_t, itd, data: _Data, progress,
+                 profile: FrictionProfile | None = None):
         self.string, self.fc_fn, self.data = string, fc_fn, data
         self.omega_c, self.k_t, self.itd = omega_c, k_t, itd
         self.progress = progress
+        self.profile = profile or FrictionProfile()
+        self.cased_static = CASED_STATIC[0]  # the hypothesis for an unknown cased μ_s
         self.runs = 0
         self._grids: dict[int, tuple[torsional.Grid, np.ndarray]] = {}
 
@@ -280,8 +284,14 @@ class _Model:
         return self._grids[cells]
 
     def t_n(self, cells: int) -> float:
+        """T_N of the estimated part: ∫F_c dx where μ is estimated [N·m]."""
+        return self.t_parts(cells)[0]
+
+    def t_parts(self, cells: int) -> tuple[float, float]:
+        """(T_N of the estimated part, kinetic torque of the fixed part) [N·m]."""
         g, fc = self.grid(cells)
-        return float(np.sum(fc * g.dx_true_m))
+        est, fix_k, _ = self.profile.parts(g.x_m, g.dx_true_m, fc, 1.0, 1.0)
+        return float(np.sum(est * g.dx_true_m)), float(np.sum(fix_k * g.dx_true_m))
 
     def _initial(self, win: _Window, g, fc, mu_k: float) -> torsional.State:
         """The state a window starts from: at rest, holding the twist of the torque measured
@@ -292,15 +302,18 @@ class _Model:
         span = slice(win.sim0, max(win.sim0 + 1, d.index(t0 + WOUND_SPAN_S)))
         if win.creep or np.any(np.abs(d.w_bar[span]) > creep.REST_FRACTION * self.omega_c):
             return torsional.State.rest(g, t0)
-        return torsional.State.wound(g, fc, float(np.median(d.tau[span])), mu_k, t_s=t0)
+        est, fix_k, _ = self.profile.parts(g.x_m, g.dx_true_m, fc, mu_k, mu_k)
+        return torsional.State.wound(g, mu_k * est + fix_k, float(np.median(d.tau[span])), 1.0,
+                                     t_s=t0)
 
     def simulate(self, win: _Window, mu_s: float, mu_k: float,
                  cells: int) -> tuple[np.ndarray, np.ndarray]:
         """String torque [N·m] and bit speed [rad/s] at samples sim0..end."""
         d = self.data
         g, fc = self.grid(cells)
-        plant = torsional.Plant(g, fc, mu_s=mu_s, mu_k=mu_k, omega_c_rad_s=self.omega_c,
-                                k_t_per_s=self.k_t, top_drive_inertia_kg_m2=self.itd)
+        plant = self.profile.plant(g, fc, mu_s, mu_k, omega_c_rad_s=self.omega_c,
+                                   k_t_per_s=self.k_t, top_drive_inertia_kg_m2=self.itd,
+                                   cased_static=self.cased_static)
         speed = d.creep_drive if win.creep else d.drive
         drive = torsional.Drive("speed", speed[win.sim0:win.end + 1], d.dt, d.t[win.sim0])
         t = d.t[win.sim0:win.end + 1]
@@ -544,7 +557,8 @@ def _as_fc_fn(fc_Nm_m) -> Callable[[np.ndarray], np.ndarray]:
 def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                         omega_c_rad_s: float, k_t_per_s: float,
                         top_drive_inertia_kg_m2: float, mu_s: float, mu_k: float,
-                        torque_kind: str = "motor", cells: int = 500
+                        torque_kind: str = "motor", cells: int = 500,
+                        profile: FrictionProfile | None = None
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fitted model against the data over a whole record (the evidence of a fit).
 
@@ -559,7 +573,7 @@ def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString
     """
     data, _ = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind, top_drive_inertia_kg_m2)
     model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
-                   top_drive_inertia_kg_m2, data, None)
+                   top_drive_inertia_kg_m2, data, None, profile)
     whole = _Window(0, data.t.size - 1, np.arange(data.t.size))
     tau, _ = model.simulate(whole, max(mu_s, mu_k), mu_k, cells)
     return data.t, data.tau, tau
@@ -568,7 +582,8 @@ def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString
 def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
            omega_c_rad_s: float, k_t_per_s: float, top_drive_inertia_kg_m2: float,
            torque_kind: str = "motor", cells: int = 500, mu_s_seed: float | None = None,
-           progress: Callable[[float], None] | None = None) -> BatchResult:
+           progress: Callable[[float], None] | None = None,
+           profile: FrictionProfile | None = None) -> BatchResult:
     """Refine μ_k and μ_s of one record with the speed-driven model (THEORY §6.4).
 
     Parameters
@@ -598,6 +613,9 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         μ_s used by the model while fitting μ_k on stick-slip data (default 2.5·μ_k).
     progress : callable, optional
         Called with 1.0 after each model run.
+    profile : FrictionProfile, optional
+        Friction zones and law of the model (docs/theory.md §3.2); default: one zone, the
+        step law. With a known cased zone μ_k, μ_s are the open hole's.
 
     Returns
     -------
@@ -606,7 +624,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     data, messages = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
                               top_drive_inertia_kg_m2)
     model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
-                   top_drive_inertia_kg_m2, data, progress)
+                   top_drive_inertia_kg_m2, data, progress, profile)
     flags: list[str] = []
     details = BatchDetails(cells=cells, T_N_Nm=model.t_n(cells))
     creeps = find_creeps(data.t, data.drive, omega_c_rad_s, torque_Nm=data.tau,
@@ -663,7 +681,8 @@ def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flag
     string_inertia = float(np.sum(model.grid(cells)[0].rho_j_kg_m
                                   * model.grid(cells)[0].dx_true_m))
     viscous = model.k_t * string_inertia * float(np.mean(d.w_bar[used]))
-    x0 = float(np.clip((target - viscous) / model.t_n(cells), 0.01, 1.0))
+    t_est, t_fixed = model.t_parts(cells)
+    x0 = float(np.clip((target - viscous - t_fixed) / t_est, 0.01, 1.0))
     ratios = (PROVISIONAL_RATIO, 4.0) if stick_slip else (1.0,)
     for ratio in ratios:
         def mu_s_of(mu_k, ratio=ratio):

@@ -42,6 +42,7 @@ from drillfric.estimation.observer import (
 )
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import Evidence, Verdict, decide
+from drillfric.friction import FrictionProfile
 from drillfric.result import Flag, Method
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
@@ -168,12 +169,17 @@ def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
 
 
 def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
-                   sample_dt_s: float | None = None) -> Observer:
+                   sample_dt_s: float | None = None, mu_s: float = 0.0,
+                   mu_k: float = 0.0) -> Observer:
     """Observer for this string and F_c profile from the configuration (THEORY §5);
-    ``sample_dt_s`` is the logging interval of the measurements [s]."""
+    ``sample_dt_s`` is the logging interval of the measurements [s]. With a cased zone of
+    unknown static friction, (``mu_s``, ``mu_k``) tie it to the open hole's ratio (the
+    observer's own μ̂ multiply the open hole's F_c only: docs/theory.md §3.2)."""
     grid = torsional.make_grid(string, cells)
-    plant = torsional.Plant(grid, td.fc_at(grid.x_m), 0.0, 0.0, cfg.omega_c_rad_s,
-                            cfg.model.k_t_per_s, cfg.rig.top_drive_inertia_kg_m2)
+    plant = FrictionProfile.from_config(cfg).plant(
+        grid, td.fc_at(grid.x_m), mu_s, mu_k, omega_c_rad_s=cfg.omega_c_rad_s,
+        k_t_per_s=cfg.model.k_t_per_s, top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+        cased_static="tied" if mu_k > 0 else "kinetic")
     n_pipe = int(grid.section_start[1])
     gains = gains_from_config(cfg, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s,
                               sample_dt_s)
@@ -241,6 +247,17 @@ def _initial_torque(meas: Measurements, span_s: float = 0.5) -> float:
     return float(np.median(meas.motor_torque_Nm[:n]))
 
 
+def _open_hole_friction(cfg):
+    """μ → the torque-and-drag friction of the profile with μ in the open hole (None: one
+    zone)."""
+    profile = FrictionProfile.from_config(cfg)
+    if profile.zone != "open_hole":
+        return None
+    cased = (lambda mu: profile.ratio * mu) if profile.ratio is not None else (
+        lambda mu: profile.cased_kinetic)
+    return lambda mu: torque_drag.SectionFriction(profile.shoe_md_m, cased(mu), mu)
+
+
 def _td_cross_check(models: SegmentModels, cfg) -> float | None:
     """Static friction factor from the mean rotating string torque (T&D back-calculation)."""
     meas = models.meas
@@ -253,7 +270,8 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
     try:
         return float(torque_drag.back_calculate_friction(
             models.path, models.string, surface_torque_Nm=float(np.mean(torque[rotating])),
-            load_case="rotating_off_bottom", mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
+            load_case="rotating_off_bottom", friction_of=_open_hole_friction(cfg),
+            mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
             mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
             element_length_m=cfg.model.element_length_m))
     except DrillfricError:
@@ -400,7 +418,8 @@ def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:
                         fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
                         k_t_per_s=cfg.model.k_t_per_s,
                         top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
-                        torque_kind="motor", cells=_batch_cells(cfg, models.string.bit_depth_m))
+                        torque_kind="motor", cells=_batch_cells(cfg, models.string.bit_depth_m),
+                        profile=FrictionProfile.from_config(cfg))
 
 
 def evidence(cfg, models: SegmentModels, diag: Diagnostics,
@@ -421,10 +440,15 @@ def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,
                 output_rate_hz: float) -> tuple[ObserverRecord, BitSpeedEstimate]:
     """Step 5: the ensemble seeded with the verdict's factors over the whole segment, and
     the bit speed it gives (weighted mean and band)."""
-    final = _final_pass(cfg, models.observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
+    observer = models.observer
+    if not FrictionProfile.from_config(cfg).static_known:  # tie the cased μ_s to the seed
+        observer = replace(observer, plant=build_observer(
+            cfg, models.string, models.td, cfg.model.cells, models.meas.dt_s,
+            verdict.mu_s_seed, verdict.mu_k).plant)
+    final = _final_pass(cfg, observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
                         adapt=verdict.adapt_final or cfg.observer.adapt_final,
                         output_rate_hz=output_rate_hz)
-    bit = ensemble_bit_speed(final, _memory_s(models.observer, models.meas),
+    bit = ensemble_bit_speed(final, _memory_s(observer, models.meas),
                              cfg.observer.speed_noise_rpm * RPM_TO_RAD_S)
     return final, bit
 
@@ -439,7 +463,8 @@ def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | Non
         fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
         k_t_per_s=cfg.model.k_t_per_s, top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
         mu_s=mu_s if mu_s is not None else verdict.mu_s_seed, mu_k=verdict.mu_k,
-        cells=_batch_cells(cfg, models.string.bit_depth_m))
+        cells=_batch_cells(cfg, models.string.bit_depth_m),
+        profile=FrictionProfile.from_config(cfg))
     fast = np.flatnonzero(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s)
     scored = t >= (t[fast[0]] + EVIDENCE_SKIP_S if fast.size else np.inf)
     if scored.sum() < 10:
@@ -537,7 +562,8 @@ def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag
         mu_td=_td_cross_check(models, cfg), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags, messages=tuple(messages), starts=starts, first=first,
         final=final, bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data),
-        td=models.td, mu_s_seed=verdict.mu_s_seed)
+        td=models.td, mu_s_seed=verdict.mu_s_seed,
+        friction_zone=FrictionProfile.from_config(cfg).zone)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,
