@@ -52,6 +52,7 @@ class Flag(StrEnum):
     CREEP_RATE_TOO_LOW = "creep_rate_too_low"
     CREEP_FIT_AT_BOUND = "creep_fit_at_bound"
     CREEP_NOT_GRID_CONVERGED = "creep_not_grid_converged"
+    MU_S_NOT_EXPLAINED = "mu_s_not_explained"
     BISTABLE_REGIME = "bistable_regime"
     STICK_SLIP_NOT_REPRODUCED = "stick_slip_not_reproduced"
     ESTIMATORS_DISAGREE = "estimators_disagree"
@@ -75,6 +76,9 @@ FLAG_MEANINGS = {
     Flag.CREEP_FIT_AT_BOUND: "the creep fit ran to its search bound: μ_s not reported",
     Flag.CREEP_NOT_GRID_CONVERGED: "the creep μ_s moved by more than 3 % on grid refinement: "
                                    "not reported",
+    Flag.MU_S_NOT_EXPLAINED: "the creep fit's μ_s failed a check (misfit, sensitivity, the "
+                             "slips after it, its two halves, the cased static hypotheses): "
+                             "not reported, the message says which",
     Flag.BISTABLE_REGIME: "whether the model sticks is not monotone in μ_s: no lower bound",
     Flag.STICK_SLIP_NOT_REPRODUCED: "the model does not stick-slip for any μ_s: no lower bound",
     Flag.ESTIMATORS_DISAGREE: "batch and observer μ_k differ by more than a factor 1.5: not "
