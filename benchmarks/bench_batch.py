@@ -1,6 +1,7 @@
 """Benchmark: batch refinement of a 10-minute 100-Hz record on one core (issue 5: ≤ 5 s).
 
-Records: the paper's case (CASES.md, μ_k = 0.187, μ_s = 0.6, build-and-hold to 2500 m,
+Records: the paper's case (docs/reference_cases.md, μ_k = 0.187, μ_s = 0.6, build-and-hold to 2500
+m,
 six-section BHA) simulated by the 1500-cell plant in PI mode, noise 0.5 RPM / 200 N·m:
 (a) stick-slip at 40 RPM after a normal start (μ_k fit + onset scan),
 (b) steady rotation at 100 RPM (μ_k fit only),

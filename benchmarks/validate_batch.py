@@ -1,6 +1,7 @@
-"""Validation table of the batch refinement (THEORY §6.4) against synthetic truths (issue 5).
+"""Validation table of the batch refinement (docs/theory.md §6.4) against synthetic truths (issue
+5).
 
-Each truth is the plant of THEORY §3 in PI mode on a finer grid than the estimator (1500 or
+Each truth is the plant of docs/theory.md §3 in PI mode on a finer grid than the estimator (1500 or
 2000 cells against 500 for μ_k and ≥ MD/1000 for creeps), A&S Well A six-section BHA,
 gravity F_c on a build-and-hold well, noise 0.5 RPM / 200 N·m, logged motor torque, at
 100, 5 and 1 Hz. Records are 120 s: a normal start (ramp to the set-point in 10 s) or a

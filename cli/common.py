@@ -199,7 +199,7 @@ class Quantity(click.ParamType):
         self.unit = unit
 
     def get_metavar(self, param, ctx=None) -> str:
-        """The unit as the metavar (``--bit-depth M``, ``--rate HZ``), as INTERFACE.md writes."""
+        """The unit as the metavar (``--bit-depth M``, ``--rate HZ``), as docs/cli.md writes."""
         return {"N·m": "NM", "m/s": "M/S"}.get(self.unit, self.unit.upper())
 
     def convert(self, value, param, ctx):

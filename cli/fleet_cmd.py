@@ -1,4 +1,4 @@
-"""`drillfric fleet` (INTERFACE.md, docs/fleet.md): every well of a directory or manifest.
+"""`drillfric fleet` (docs/cli.md, docs/fleet.md): every well of a directory or manifest.
 
 Thin layer over :func:`drillfric.fleet.run_many`: a progress bar over wells, one line per
 failed well, a closing summary line. SIGTERM (and Ctrl-C) stop the run cleanly: finished

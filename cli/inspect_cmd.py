@@ -1,4 +1,4 @@
-"""`drillfric inspect WELL` (INTERFACE.md): what was recognised in a well's files."""
+"""`drillfric inspect WELL` (docs/cli.md): what was recognised in a well's files."""
 
 from __future__ import annotations
 
@@ -47,7 +47,7 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
 
 
 def summarize(data) -> dict:
-    """The ``inspect --json`` document (INTERFACE.md keys first, then extras)."""
+    """The ``inspect --json`` document (docs/cli.md keys first, then extras)."""
     from drillfric.io.timebase import spacing_summary
     from drillfric.segmentation import segment
 

@@ -1,4 +1,4 @@
-"""The ``drillfric`` command group (INTERFACE.md): run, simulate, td, inspect, fleet, report."""
+"""The ``drillfric`` command group (docs/cli.md): run, simulate, td, inspect, fleet, report."""
 
 from __future__ import annotations
 

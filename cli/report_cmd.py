@@ -1,4 +1,4 @@
-"""`drillfric report RESULT_DIR [--pdf] [--segments all|N]` (INTERFACE.md): rebuild reports.
+"""`drillfric report RESULT_DIR [--pdf] [--segments all|N]` (docs/cli.md): rebuild reports.
 
 Thin layer over :func:`drillfric.report.write_well_report`, which reads only the files of
 the result directory (so reports can be rebuilt after an upgrade, or with a PDF later).

@@ -1,4 +1,4 @@
-"""`drillfric simulate` (INTERFACE.md): synthetic surface data with ground truth.
+"""`drillfric simulate` (docs/cli.md): synthetic surface data with ground truth.
 
 Thin layer: options become configuration overrides (command line > file > defaults), the
 survey and scenario are resolved, :func:`drillfric.simulator.simulate` runs the plant stand
@@ -94,7 +94,7 @@ def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool)
                    "CONFIG-stem.survey.csv beside it).")
 def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bit_depth, rpm,
             wob, seed, rpm_noise, torque_noise, cells, scenario, survey) -> None:
-    """Simulate surface data with ground truth from the torsional plant (THEORY §3).
+    """Simulate surface data with ground truth from the torsional plant (docs/theory.md §3).
 
     Writes OUT with time_s, surface_rpm, surface_torque_Nm, hookload_N, bit_depth_m,
     hole_depth_m, bit_rpm and string_torque_Nm (noise-free truth), plus OUT's sidecars

@@ -1,4 +1,4 @@
-"""`drillfric td` (INTERFACE.md): soft-string torque and drag at one bit depth, or a broomstick.
+"""`drillfric td` (docs/cli.md): soft-string torque and drag at one bit depth, or a broomstick.
 
 Thin layer: resolve the well (config, survey), build the options into library calls of
 :mod:`drillfric.torque_drag`, print a summary or JSON, write the table / plot. With
@@ -122,10 +122,10 @@ def _write_table(frame, out: Path) -> None:
 def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm, axial_speed,
             element_length, out, broomstick, frictions, depths, plot, as_json, config,
             survey, units) -> None:
-    """Soft-string torque and drag (THEORY.md §2) for WELL_OR_CONFIG.
+    """Soft-string torque and drag (docs/theory.md §2) for WELL_OR_CONFIG.
 
     WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file or a
-    NAME.survey.csv beside it) or a well on disk (INTERFACE.md). Without a survey the hole is
+    NAME.survey.csv beside it) or a well on disk (docs/ingestion.md). Without a survey the hole is
     vertical with the nominal tortuosity survey.tortuosity_deg_30m, and --bit-depth is
     required.
     """

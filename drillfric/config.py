@@ -1,7 +1,7 @@
 """Well configuration: one declarative schema, a validating TOML loader, precedence.
 
 Every key of the well configuration file (``NAME.toml`` / ``well.toml``, see
-INTERFACE.md) is declared once in :data:`SCHEMA` with its type, unit, default, allowed
+docs/configuration.md) is declared once in :data:`SCHEMA` with its type, unit, default, allowed
 range and help text. The loader validates types and ranges and rejects unknown keys by
 name and file; ``docs/configuration.md`` is generated from the same declaration
 (:func:`schema_markdown`, checked by ``tests/test_config.py``).
@@ -190,11 +190,11 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("omega_c_rpm", float, None, "RPM", "Static/kinetic switching speed ω_c in RPM "
             "(alternative to omega_c_rad_s).", min=0.0, min_exclusive=True),
         Key("k_t_per_s", float, 0.1, "1/s", "Viscous damping rate k_t of the torsional "
-            "model (THEORY §3, eq. 2–3).", min=0.0),
+            "model (docs/theory.md §3, eq. 2–3).", min=0.0),
         Key("cells", int, 500, "", "Number of cells of the torsional model (the paper: 500).",
             min=20, max=200000),
         _positive("element_length_m", 2.0, "m", "Element length of the soft-string "
-                  "torque-and-drag march (THEORY §2).", max=30.0),
+                  "torque-and-drag march (docs/theory.md §2).", max=30.0),
         Key("friction", float, 0.25, "", "Friction factor used by torque-and-drag when no "
             "other is given (td without --friction).", min=0.0, max=2.0),
         Key("casing_shoe_md_m", float, None, "m", "Measured depth of the last casing shoe; "
@@ -227,7 +227,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
     "observer": (
         Key("gains", str, "kalman", "", "Gain design: steady-state 'kalman' (default; far less "
             "driven by measurement noise, docs/validation.md) or the closed-form "
-            "'backstepping' of THEORY §5.1.", choices=("backstepping", "kalman")),
+            "'backstepping' of docs/theory.md §5.1.", choices=("backstepping", "kalman")),
         Key("law", str, "corrected", "", "Adaptation law: 'corrected' (drillfric) or 'paper' "
             "(eqs. 42–43 exactly as printed, for comparison).", choices=("corrected", "paper")),
         Key("kappa1", float, 1.0, "", "Fraction κ₁ of the top-side reflection cancelled.",
@@ -248,7 +248,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         _positive("starts_window_s", 300.0, "s", "The starts run together over this first part "
                   "of each segment (they converge within it); the seeded pass covers all."),
         _positive("deadlock_s", 15.0, "s", "Deadlock guard: an estimated BHA stuck this long "
-                  "while the top drive turns releases μ̂_s to μ̂_k (THEORY §6.1)."),
+                  "while the top drive turns releases μ̂_s to μ̂_k (docs/theory.md §6.1)."),
         Key("ensemble_members", int, 5, "", "Members of the final pass seeded with the "
             "batch-refined factors; the estimated bit speed is their mean and min–max its "
             "band (the stick-slip cycle is chaotic: members drift apart in phase; weighted by "
@@ -260,13 +260,14 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "ensemble members: μ_s·(1 ± spread), the uncertainty of the refined μ_s.",
             min=0.0, max=0.5),
         Key("adapt_final", bool, False, "", "Keep adapting μ̂ in the final pass. Off by "
-            "default: the batch factors are the better estimates (±2 % vs ±10 %, THEORY §6) "
-            "and adaptation through a creep break-over can drive μ̂_k to μ_s."),
+            "default: the batch factors are the better estimates (±2 % vs ±10 %, "
+            "docs/theory.md §6) and adaptation through a creep break-over can drive μ̂_k to "
+            "μ_s."),
     ),
     "batch": (
-        _positive("window_s", 600.0, "s", "The batch refinement (THEORY §6.4) fits the first "
-                  "this-many seconds of each segment (the mean-torque match needs minutes; "
-                  "creep start-ups are at the start)."),
+        _positive("window_s", 600.0, "s", "The batch refinement (docs/theory.md §6.4) fits "
+                  "the first this-many seconds of each segment (the mean-torque match needs "
+                  "minutes; creep start-ups are at the start)."),
     ),
     "segmentation": (
         _positive("rotating_rpm", 2.0, "RPM", "Surface speed above which the string starts "
@@ -341,7 +342,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             min=0.0),
         Key("cells", int, 2500, "", "Cells of the simulated (true) string: finer than the "
             "estimator's model.cells, since creep torque is not grid-converged on coarse "
-            "grids (THEORY §6.4: dx ≤ MD/1000).", min=20, max=200000),
+            "grids (docs/theory.md §6.4: dx ≤ MD/1000).", min=20, max=200000),
         _positive("duration_s", 120.0, "s", "Simulated time of a single-stand run; with a "
                   "scenario, the rotating time of stands that do not give their own."),
         _positive("rate_hz", 100.0, "Hz", "Recording rate of the simulated surface data."),
@@ -394,7 +395,7 @@ SECTION_KEYS: tuple[Key, ...] = (
 )
 
 #: Documented default drill string, used (and reported as assumed) when a config has none:
-#: the A&S 2018 drill pipe, 5in heavy-weight and 8in collars (CASES.md).
+#: the A&S 2018 drill pipe, 5in heavy-weight and 8in collars (docs/reference_cases.md).
 DEFAULT_SECTIONS: tuple[dict, ...] = (
     {"name": "5 7/8in DP (assumed)", "od_m": 0.146529, "id_m": 0.123024,
      "tool_joint_od_m": 0.1778, "linear_mass_kg_m": 41.41},

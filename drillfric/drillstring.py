@@ -1,6 +1,6 @@
 """Drill-string description: sections top-down and their per-position properties.
 
-Quantities for THEORY.md §2 (soft-string weights, contact radius) and §3 (polar moment
+Quantities for docs/theory.md §2 (soft-string weights, contact radius) and §3 (polar moment
 J = π(OD⁴ − ID⁴)/32, wave speed c = √(G/ρ), line impedance ζ = J·√(Gρ)). The top section
 (drill pipe) fills from surface to whatever the lower sections leave, so a string is
 rebuilt for every bit depth. Sections below the first form the "BHA" of the semi-lumped
@@ -66,7 +66,7 @@ class Section:
 
     @property
     def polar_moment_m4(self) -> float:
-        """Polar moment of area J = π(OD⁴ − ID⁴)/32 [m⁴] (THEORY §3).
+        """Polar moment of area J = π(OD⁴ − ID⁴)/32 [m⁴] (docs/theory.md §3).
 
         Examples
         --------
@@ -78,12 +78,12 @@ class Section:
 
     @property
     def wave_speed_m_s(self) -> float:
-        """Torsional wave speed c = √(G/ρ) [m/s] (THEORY §3)."""
+        """Torsional wave speed c = √(G/ρ) [m/s] (docs/theory.md §3)."""
         return float(np.sqrt(self.shear_modulus_Pa / self.steel_density_kg_m3))
 
     @property
     def impedance_Nms(self) -> float:
-        """Line impedance ζ = J·√(Gρ) [N·m·s/rad] (THEORY §3)."""
+        """Line impedance ζ = J·√(Gρ) [N·m·s/rad] (docs/theory.md §3)."""
         return self.polar_moment_m4 * float(np.sqrt(self.shear_modulus_Pa
                                                     * self.steel_density_kg_m3))
 
@@ -93,7 +93,7 @@ class Section:
         return G_ACCEL * self.linear_mass_kg_m
 
     def buoyed_weight_N_m(self, mud_out_kg_m3: float, mud_in_kg_m3: float) -> float:
-        """Buoyed weight per metre g·[m_lin − ρ_o·A_o + ρ_i·A_i] [N/m] (THEORY §2 step 1).
+        """Buoyed weight per metre g·[m_lin − ρ_o·A_o + ρ_i·A_i] [N/m] (docs/theory.md §2 step 1).
 
         Examples
         --------
@@ -142,7 +142,7 @@ class DrillString:
 
     @property
     def bha_top_m(self) -> float:
-        """Top of the BHA L_p = length of the first (drill-pipe) section [m] (THEORY §4)."""
+        """Top of the BHA L_p = length of the first (drill-pipe) section [m] (docs/theory.md §4)."""
         return float(self.sections[0].length_m)
 
     @property
@@ -171,7 +171,7 @@ class DrillString:
         return values[self.section_index(md_m)]
 
     def buoyed_weight_N_m(self, md_m, mud_out_kg_m3: float, mud_in_kg_m3: float) -> np.ndarray:
-        """Buoyed weight per metre [N/m] at measured depths (THEORY.md §2 step 1).
+        """Buoyed weight per metre [N/m] at measured depths (docs/theory.md §2 step 1).
 
         Examples
         --------

@@ -66,7 +66,8 @@ _MANIFEST_COLUMNS = ("well", "data", "config", "survey")
 # --------------------------------------------------------------------------- discovery
 @dataclass(frozen=True)
 class WellSpec:
-    """A well to process: a data file, an HDF5 bundle or a well directory (INTERFACE.md).
+    """A well to process: a data file, an HDF5 bundle or a well directory (docs/ingestion.md,
+    docs/fleet.md).
 
     Attributes
     ----------

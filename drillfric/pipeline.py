@@ -345,10 +345,14 @@ def _segment_data(rows: pd.DataFrame, seg: Segment, depth: float) -> SegmentData
                 & np.isfinite(rows["surface_torque_Nm"].to_numpy(float))]
     wob = float(np.nanmedian(rows["wob_N"])) if "wob_N" in rows and \
         rows["wob_N"].notna().any() else 0.0
-    truth = rows["bit_rpm"].to_numpy(float) if "bit_rpm" in rows else None
+    def column(name):
+        return rows[name].to_numpy(float) if name in rows else None
+
     return SegmentData(rows["time_s"].to_numpy(float), rows["surface_rpm"].to_numpy(float),
                        rows["surface_torque_Nm"].to_numpy(float), float(depth), kind=seg.kind,
-                       wob_N=max(wob, 0.0), bit_rpm=truth)
+                       wob_N=max(wob, 0.0), bit_rpm=column("bit_rpm"),
+                       torque_min_Nm=column("surface_torque_min_Nm"),
+                       torque_max_Nm=column("surface_torque_max_Nm"))
 
 
 # --------------------------------------------------------------------------- step 3
@@ -381,10 +385,13 @@ def _evidence_fields(est: SegmentEstimate) -> dict:
 def _bit_fields(est: SegmentEstimate) -> dict:
     """The bit-speed statistics, or null with the reason where the rate cannot resolve the
     stick-slip cycle (never a number drawn from an unresolved trace)."""
+    logged = dict(sample_interval_s=est.logged.interval_s,
+                  interval_torque_swing=est.logged.torque_swing)
     if not est.bit_speed.resolved:
-        return dict(bit_speed_resolved=False, bit_speed_reason=est.bit_speed.reason)
-    return dict(bit_speed_resolved=True, stick_slip_severity=est.stick_slip_severity,
-                stuck_fraction=est.stuck_fraction, bit_rms_error_rpm=est.bit_rms_error_rpm)
+        return logged | dict(bit_speed_resolved=False, bit_speed_reason=est.bit_speed.reason)
+    return logged | dict(bit_speed_resolved=True, stick_slip_severity=est.stick_slip_severity,
+                         stuck_fraction=est.stuck_fraction,
+                         bit_rms_error_rpm=est.bit_rms_error_rpm)
 
 
 def _median(rows: pd.DataFrame, column: str) -> float | None:

@@ -152,6 +152,12 @@ class SegmentRecord:
     bit_speed_resolved: bool | None = _f("", "whether the logging rate resolves the stick-slip "
                                              "cycle (else no bit-speed trace is reported)")
     bit_speed_reason: str | None = _f("", "why the bit speed is not reported")
+    sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
+                                              "the spacing, the averaging interval and the "
+                                              "update interval of held values")
+    interval_torque_swing: float | None = _f("-", "median (max − min)/|mean| of the torque "
+                                                  "within each logged interval (min/max "
+                                                  "channels; > 0.3: stick-slip)")
     clock_start_utc: str | None = _f("", "clock time of t_start_s (ISO 8601, UTC) when the log "
                                          "has absolute time")
     clock_end_utc: str | None = _f("", "clock time of t_end_s (ISO 8601, UTC)")

@@ -4,7 +4,7 @@ Implements part 1 of the ``drillfric run`` job (issue 6): every sample gets a ri
 from whatever channels exist, and the rotating stretches are cut into segments (stands,
 sections) that carry their kind (on/off bottom), bit depth, duration and a status. The
 friction estimation of Aarsnes et al. (JPSE 2019) runs per segment: a segment is one
-load case (THEORY.md §2 item 5: bit boundary off bottom, or on bottom with WOB) at one
+load case (docs/theory.md §2 item 5: bit boundary off bottom, or on bottom with WOB) at one
 string length.
 
 Rules and thresholds (config table ``[segmentation]``) are documented in
@@ -35,7 +35,7 @@ RIG_STATES = ("rotating_off_bottom", "rotating_on_bottom", "in_slips", "tripping
  SLIDING_ON_BOTTOM) = range(len(RIG_STATES))
 #: States that make hole ("drilling"): on bottom, rotating or sliding.
 DRILLING_STATES = (ROTATING_ON_BOTTOM, SLIDING_ON_BOTTOM)
-#: Segment kind of each rotating state (INTERFACE.md ``kind`` values).
+#: Segment kind of each rotating state (docs/outputs.md ``kind`` values).
 KINDS = {ROTATING_OFF_BOTTOM: "off_bottom_rotating", ROTATING_ON_BOTTOM: "on_bottom_rotating"}
 
 #: How the bit depth is known: measured channel, reckoned from the block, or not at all.
@@ -545,7 +545,8 @@ class Segmenter:
 PREROLL_S = 5.0
 #: Columns a segment's rows keep (what estimation and the segment's measured values need).
 SEGMENT_COLUMNS = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N",
-                   "bit_rpm", "hookload_N", "timestamp")
+                   "bit_rpm", "hookload_N", "timestamp", "surface_torque_min_Nm",
+                   "surface_torque_max_Nm")
 
 
 class SegmentStream:

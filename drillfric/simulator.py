@@ -1,10 +1,10 @@
 """Synthetic rig data with ground truth: the torsional plant driven stand by stand.
 
-The pipeline behind ``drillfric simulate`` (INTERFACE.md). For each stand of a
+The pipeline behind ``drillfric simulate`` (docs/cli.md). For each stand of a
 :class:`Scenario` the drill string is rebuilt at the stand's bit depth
 (:func:`drillfric.drillstring.build_string`), its Coulomb capacity profile F_c(x) and hook
-load come from soft-string torque and drag (:mod:`drillfric.torque_drag`, THEORY.md §2), and
-the plant of THEORY.md §3 (:mod:`drillfric.torsional`) is run from rest under a PI
+load come from soft-string torque and drag (:mod:`drillfric.torque_drag`, docs/theory.md §2), and
+the plant of docs/theory.md §3 (:mod:`drillfric.torsional`) is run from rest under a PI
 top-drive speed controller following the stand's set-point schedule (or a prescribed motor
 torque). Between stands the rotation is stopped, the trapped torque released and the bit
 moved to the next depth (a connection: speed, torque and hook load recorded as zero).
@@ -57,7 +57,7 @@ class Stand:
         Set-point after the start-up [RPM].
     start : str
         "ramp" (0 → rpm in ``ramp_s``) or "creep" (0 → ``creep_rpm`` in ``creep_ramp_s``,
-        hold ``creep_hold_s``, then ramp to rpm in ``ramp_s``), THEORY §6.3.
+        hold ``creep_hold_s``, then ramp to rpm in ``ramp_s``), docs/theory.md §6.3.
     ramp_s, creep_rpm, creep_ramp_s, creep_hold_s : float
         Start-up shape [s], [RPM].
     idle_s : float
@@ -452,7 +452,7 @@ class Simulation:
     Attributes
     ----------
     columns : dict of ndarray
-        Canonical surface channels (INTERFACE.md) plus the noise-free truth ``bit_rpm``
+        Canonical surface channels (docs/ingestion.md) plus the noise-free truth ``bit_rpm``
         and ``string_torque_Nm`` (τ(0) = τ_m − I_TD dω₀/dt).
     stands : tuple of StandResult
     settings : PlantSettings
@@ -483,7 +483,7 @@ class Simulation:
 
 
 def fc_profile(cfg: Config, path: WellPath | None, bit_depth_m: float, wob_N: float = 0.0):
-    """Soft-string F_c profile and hook load at a bit depth (THEORY §2, rotating).
+    """Soft-string F_c profile and hook load at a bit depth (docs/theory.md §2, rotating).
 
     Returns the :class:`~drillfric.torque_drag.TDResult` of the rotating off-bottom case, or
     on bottom with ``wob_N`` when it is positive.
@@ -544,7 +544,7 @@ def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None,
 def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
              rate_hz: float | None = None, noise: Noise | None = None,
              progress: Callable[[float], None] | None = None) -> Simulation:
-    """Simulate a scenario stand by stand (THEORY §3) and build the surface channels.
+    """Simulate a scenario stand by stand (docs/theory.md §3) and build the surface channels.
 
     Parameters
     ----------
@@ -652,7 +652,8 @@ def _notes(stands) -> tuple:
 
 # ------------------------------------------------------------------ published reference case
 
-#: A&S 2018 Well B BHA sections (CASES.md): length, OD, ID [m]; order top-down is drillfric's
+#: A&S 2018 Well B BHA sections (docs/reference_cases.md): length, OD, ID [m]; order top-down is
+#: drillfric's
 #: choice (OD increasing towards the bit).
 WELL_B_BHA = ((48.700, 0.150473, 0.096207), (114.800, 0.187322, 0.098912),
               (56.700, 0.209550, 0.071438), (38.880, 0.247280, 0.123391))
@@ -675,15 +676,18 @@ def well_b_string(bit_depth_m: float = 2500.0) -> DrillString:
 
 
 def well_b_inclination(md_m) -> np.ndarray:
-    """Well B inclination [rad]: 0° to 500 m, linear to 60° at 1600 m, 60° below (CASES.md)."""
+    """Well B inclination [rad]: 0° to 500 m, linear to 60° at 1600 m, 60° below
+    (docs/reference_cases.md)."""
     return np.radians(np.interp(md_m, [0.0, 500.0, 1600.0], [0.0, 0.0, 60.0]))
 
 
 def well_b_plant(cells: int = 500, k_t_per_s: float = 0.1, mu_s: float = 0.885,
                  mu_k: float = 0.425, omega_c_rad_s: float = 0.9) -> torsional.Plant:
-    """The A&S 2018 Well B plant at 2500 m MD with its published friction fit (CASES.md).
+    """The A&S 2018 Well B plant at 2500 m MD with its published friction fit
+    (docs/reference_cases.md).
 
-    F_c is A&S's gravity-only r_c·g·ρ·A·sin I (THEORY §2, last paragraph); I_TD = 2900 kg·m².
+    F_c is A&S's gravity-only r_c·g·ρ·A·sin I (docs/theory.md §2, last paragraph); I_TD = 2900
+    kg·m².
     """
     string = well_b_string()
     grid = torsional.make_grid(string, cells)

@@ -1,10 +1,10 @@
 """Soft-string torque and drag: normal force, effective tension and torque along the string.
 
-Implements THEORY.md §2, the soft-string model of [1] in the vector form of the normal
+Implements docs/theory.md §2, the soft-string model of [1] in the vector form of the normal
 force, marched from the bit to the surface over elements that follow the minimum-curvature
-arc (THEORY.md §1). Its main product for the friction observer is the Coulomb torque
+arc (docs/theory.md §1). Its main product for the friction observer is the Coulomb torque
 capacity per unit length per unit friction factor F_c(x) = r_c(x)·F_N(x) [N·m/m] and its
-integral T_N = ∫F_c dx (THEORY.md §5.1).
+integral T_N = ∫F_c dx (docs/theory.md §5.1).
 
 [1] C.A. Johancsik, D.B. Friesen, R. Dawson, "Torque and drag in directional wells —
     prediction and measurement", JPT 36(6), 1984, SPE-11380-PA.
@@ -29,7 +29,7 @@ from drillfric.errors import ModelError
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
 
-#: Load cases (THEORY.md §2 step 3): σ is the axial share of the friction (+1 pulling out,
+#: Load cases (docs/theory.md §2 step 3): σ is the axial share of the friction (+1 pulling out,
 #: −1 running in, 0 rotating), the torque share is the tangential one.
 LOAD_CASES = ("rotating_off_bottom", "rotating_on_bottom", "pick_up", "slack_off",
               "rotating_pick_up", "rotating_slack_off", "sliding")
@@ -44,7 +44,7 @@ Friction = float | Callable[[np.ndarray], np.ndarray]
 
 @dataclass(frozen=True)
 class TDResult:
-    """Soft-string profile at one bit depth for one load case (THEORY.md §2).
+    """Soft-string profile at one bit depth for one load case (docs/theory.md §2).
 
     Attributes
     ----------
@@ -60,13 +60,13 @@ class TDResult:
         Side force per unit length F_N of each element, length n [N/m].
     fc_Nm_m : ndarray
         F_c = r_c·F_N of each element: Coulomb torque capacity per unit length per unit
-        friction factor [N·m/m] (THEORY.md §2).
+        friction factor [N·m/m] (docs/theory.md §2).
     hookload_N : float
         Effective tension at surface [N] (no block weight, no sheave friction).
     surface_torque_Nm : float
         Torque at surface [N·m].
     T_N_Nm : float
-        T_N = ∫F_c dx over the string [N·m] (THEORY.md §5.1).
+        T_N = ∫F_c dx over the string [N·m] (docs/theory.md §5.1).
     load_case : str
         One of :data:`LOAD_CASES`.
     friction : float or None
@@ -114,7 +114,7 @@ class TDResult:
 
 
 def element_normal_force(force_lower_N: float, t_upper, t_lower, weight_N: float) -> float:
-    """Side force N [N] on one element, vector form (THEORY.md §2 step 2, after [1]).
+    """Side force N [N] on one element, vector form (docs/theory.md §2 step 2, after [1]).
 
     q = F_d·(t_d − t_u) + W·(ĝ − (ĝ·t̄)·t̄), N = |q|, with t̄ = normalise(t_u + t_d) and
     ĝ = (0, 0, 1) pointing down.
@@ -145,7 +145,7 @@ def element_normal_force(force_lower_N: float, t_upper, t_lower, weight_N: float
 @njit(cache=True)
 def _march_many(t, weight, rc, mu, sigma, share, force_bit, torque_bit,
                 force, torque, normal):  # pragma: no cover - compiled; oracle-tested
-    """Bit-to-surface march (THEORY.md §2 steps 2–5) for k load variants on one mesh.
+    """Bit-to-surface march (docs/theory.md §2 steps 2–5) for k load variants on one mesh.
 
     t (n+1, 3) node tangents; weight, rc (n,) element buoyed weight [N] and contact radius
     [m]; mu, sigma, share (n, k) friction factor, axial and tangential friction shares;
@@ -251,7 +251,7 @@ def _friction_array(friction: Friction, mid_m: np.ndarray) -> np.ndarray:
 
 def _shares(load_case: str, rc_m: np.ndarray, axial_speed_m_s: float,
             rpm: float) -> tuple[np.ndarray, np.ndarray]:
-    """Axial σ and tangential share of the friction per element (THEORY.md §2 steps 3–4)."""
+    """Axial σ and tangential share of the friction per element (docs/theory.md §2 steps 3–4)."""
     if load_case not in LOAD_CASES:
         raise ModelError(f"unknown load case '{load_case}'",
                          fix=f"use one of: {', '.join(LOAD_CASES)}")
@@ -273,7 +273,7 @@ def _shares(load_case: str, rc_m: np.ndarray, axial_speed_m_s: float,
 
 
 def _bit_boundary(load_case: str, wob_N: float, bit_torque_Nm: float) -> tuple[float, float]:
-    """Bit boundary (THEORY.md §2 step 5): F = −WOB, M = torque on bit on bottom; else 0."""
+    """Bit boundary (docs/theory.md §2 step 5): F = −WOB, M = torque on bit on bottom; else 0."""
     if load_case not in ON_BOTTOM_CASES:
         return 0.0, 0.0
     if not np.isfinite(wob_N) or wob_N < 0:
@@ -304,7 +304,7 @@ def solve(path: WellPath, string: DrillString, *, friction: Friction = 0.25,
           mud_in_kg_m3: float | None = None, element_length_m: float = 2.0,
           axial_speed_m_s: float = 0.0, rpm: float = 0.0,
           extra_nodes_m=()) -> TDResult:
-    """Soft-string torque and drag at one bit depth (THEORY.md §2, after [1]).
+    """Soft-string torque and drag at one bit depth (docs/theory.md §2, after [1]).
 
     Parameters
     ----------
@@ -600,7 +600,7 @@ def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | Non
     for ax in (ax_h, ax_t):
         ax.grid(alpha=0.3)
         ax.margins(x=0.06, y=0.04)
-    title = "Broomstick: soft-string torque and drag (THEORY.md §2)"
+    title = "Broomstick: soft-string torque and drag (docs/theory.md §2)"
     fig.suptitle(title if note is None else f"{title}\n{note}", fontsize=11 if note else 12)
     return fig
 

@@ -1,12 +1,12 @@
-"""Distributed torsional drill-string model (the "plant"), THEORY.md §3 and §3.1.
+"""Distributed torsional drill-string model (the "plant"), docs/theory.md §3 and §3.1.
 
 Implements the wave model of Aarsnes & Shor (JPSE 163, 2018) as used in Aarsnes et al.
-(JPSE 179, 2019, Section 2 and Appendix A), with the errata of THEORY.md §3 (viscous term
+(JPSE 179, 2019, Section 2 and Appendix A), with the errata of docs/theory.md §3 (viscous term
 of eq. 11, free bit end of eq. 40). The string is cut into sections with their own polar
 moment, shear modulus and density; the Riemann invariants α = ω + τ/ζ and β = ω − τ/ζ
 (eq. 8) are carried on one cell array over the whole string. The time step Δt is common and
 every section gets cells of length Δx_i = c_i·Δt, so the Courant number is exactly 1 in
-every section: the upwind transport is an exact shift (THEORY §3.1).
+every section: the upwind transport is an exact shift (docs/theory.md §3.1).
 
 Layers: :func:`make_grid` (cells from a :class:`~drillfric.drillstring.DrillString`),
 :class:`Plant` (grid + friction, damping, top-drive and bit parameters, as plain arrays),
@@ -26,7 +26,7 @@ from drillfric.errors import ModelError
 
 #: Top-drive modes of the kernel: PI speed control on a set-point series, a prescribed
 #: motor-torque series, or a prescribed top-drive speed (the speed-driven model of §6.4).
-DRIVE_MODES = {"pi": 0, "torque": 1, "speed": 2}
+DRIVE_MODES = {"pi": 0, "torque": 1, "speed": 2, "fed": 3}
 #: Columns of the record array returned by the kernels.
 RECORD_COLUMNS = ("surface_rad_s", "motor_torque_Nm", "string_torque_Nm", "bit_rad_s")
 _CANDIDATE_SPREAD = 0.05  # the cell count may move ±5 % from the request to reduce rounding
@@ -34,7 +34,7 @@ _CANDIDATE_SPREAD = 0.05  # the cell count may move ±5 % from the request to re
 
 @dataclass(frozen=True)
 class Grid:
-    """Cells of the Courant-1 discretisation (THEORY §3.1).
+    """Cells of the Courant-1 discretisation (docs/theory.md §3.1).
 
     Attributes
     ----------
@@ -86,7 +86,7 @@ class Grid:
 
     @property
     def junction_z(self) -> np.ndarray:
-        """Impedance ratio Z = ζ_b/ζ_a at each junction, top-down (THEORY §3)."""
+        """Impedance ratio Z = ζ_b/ζ_a at each junction, top-down (docs/theory.md §3)."""
         first = self.section_start[1:-1]
         return self.zeta_Nms[first] / self.zeta_Nms[first - 1]
 
@@ -102,7 +102,7 @@ def _section_cells(travel_s: np.ndarray, dt: float) -> np.ndarray:
 
 
 def make_grid(string: DrillString, cells: int = 500) -> Grid:
-    """Cut a drill string into Courant-1 cells (THEORY §3.1).
+    """Cut a drill string into Courant-1 cells (docs/theory.md §3.1).
 
     Δt is chosen so that the string holds about ``cells`` cells; each section gets
     n_i = round(L_i/(c_i Δt)) ≥ 1 cells of length c_i·Δt. Among cell totals within ±5 %
@@ -163,7 +163,7 @@ def gravity_fc(string: DrillString, inc_rad, x_m) -> np.ndarray:
     """Gravity-only Coulomb torque capacity F_c = r_c·g·ρ·A·sin I [N·m/m] (A&S 2018).
 
     The normal force of A&S 2018 (steel weight only, no buoyancy, no tension–curvature
-    term; THEORY §2, last paragraph), times the contact radius.
+    term; docs/theory.md §2, last paragraph), times the contact radius.
 
     Parameters
     ----------
@@ -183,14 +183,14 @@ def gravity_fc(string: DrillString, inc_rad, x_m) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Plant:
-    """Everything the kernel needs, as plain arrays and numbers (THEORY §3).
+    """Everything the kernel needs, as plain arrays and numbers (docs/theory.md §3).
 
     Attributes
     ----------
     grid : Grid
     fc_Nm_m : ndarray
         Coulomb torque capacity per unit length per unit friction F_c at the cell centres
-        [N·m/m] (from torque and drag, THEORY §2).
+        [N·m/m] (from torque and drag, docs/theory.md §2).
     mu_s, mu_k : float
         Static and kinetic friction factors [-].
     omega_c_rad_s : float
@@ -278,7 +278,7 @@ class Plant:
     def fcap_rad_s(self) -> np.ndarray:
         """Speed change friction can impose on a cell in one step, per unit μ [rad/s].
 
-        F_c·(L_i/L_i^model)·Δt/(ρJ): the step-3 cap μ·F_c of THEORY §3.1 in speed units.
+        F_c·(L_i/L_i^model)·Δt/(ρJ): the step-3 cap μ·F_c of docs/theory.md §3.1 in speed units.
         The factor L_i/L_i^model keeps the total capacity Σ = ∫F_c dx of the true string
         despite the length rounding.
         """
@@ -368,15 +368,18 @@ class Drive:
     ----------
     kind : str
         "pi" (PI speed control on a set-point series [rad/s]), "torque" (prescribed motor
-        torque [N·m]) or "speed" (prescribed top-drive speed [rad/s]).
+        torque [N·m]), "speed" (prescribed top-drive speed [rad/s]) or "fed" (a logged
+        drive replayed in closed loop: the logged motor torque plus PI control of the
+        top-drive speed towards the logged speed, docs/theory.md §6.4).
     values : ndarray
-        The series; held constant beyond its ends.
+        The series; held constant beyond its ends. "fed": shape (2, n), the motor torque
+        [N·m] and the speed [rad/s].
     dt_s : float
         Sample interval of ``values`` [s].
     t0_s : float
         Time of ``values[0]`` [s].
     kp_Nms_rad, ki_Nm_rad : float
-        PI gains (A&S 2018: 38e3 N·m·s/rad and 100e3 N·m/rad).
+        PI gains (A&S 2018: 38e3 N·m·s/rad and 100e3 N·m/rad); of the correction in "fed".
     """
 
     kind: str
@@ -392,6 +395,10 @@ class Drive:
                              fix=f"use one of {', '.join(DRIVE_MODES)}")
         if self.dt_s <= 0 or np.size(self.values) < 1:
             raise ModelError("a drive series needs at least one value and dt_s > 0")
+        if (self.kind == "fed") != (np.ndim(self.values) == 2 and len(self.values) == 2):
+            raise ModelError(f"a '{self.kind}' drive takes "
+                             + ("two series (motor torque, speed)" if self.kind == "fed"
+                                else "one series"))
 
 
 @dataclass
@@ -488,7 +495,7 @@ class Record:
 
 
 def energy(grid: Grid, state: State, top_drive_inertia_kg_m2: float = 0.0) -> float:
-    """Mechanical energy of the string (+ top drive) [J] (THEORY §3).
+    """Mechanical energy of the string (+ top drive) [J] (docs/theory.md §3).
 
     Per cell ρJω²/2 + τ²/(2JG) over Δx = c Δt equals ζ·Δt·(α² + β²)/4; the top drive adds
     I_TD·ω₀²/2.
@@ -510,13 +517,13 @@ def kernel_args(plant: Plant, drive: Drive) -> tuple:
             plant.fix_s_rad_s, g.dt_s, plant.k_t_per_s * g.dt_s, plant.mu_s, plant.mu_k,
             plant.omega_c_rad_s, plant.law_speed_rad_s, float(plant.stribeck_exponent),
             plant.bit_torque_cap_Nm / g.zeta_Nms[-1], 1.0 / plant.top_drive_inertia_kg_m2,
-            DRIVE_MODES[drive.kind], np.ascontiguousarray(drive.values, dtype=float),
+            DRIVE_MODES[drive.kind], np.ascontiguousarray(drive.values, dtype=float).ravel(),
             drive.t0_s, drive.dt_s, drive.kp_Nms_rad, drive.ki_Nm_rad)
 
 
 def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
         state: State | None = None, *, backend: str = "numba") -> tuple[Record, State]:
-    """Advance the plant for ``duration_s`` and record at ``rate_hz`` (THEORY §3.1).
+    """Advance the plant for ``duration_s`` and record at ``rate_hz`` (docs/theory.md §3.1).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Well path by the minimum-curvature method (THEORY.md §1).
+"""Well path by the minimum-curvature method (docs/theory.md §1).
 
 Reference: S.J. Sawaryn, J.L. Thorogood, "A compendium of directional calculations based on
 the minimum curvature method", SPE Drilling & Completion 20(1), 2005, SPE-84246-PA.
@@ -172,7 +172,7 @@ class WellPath:
 
 
 def minimum_curvature(md_m, inc_rad, azi_rad, *, tie_in=None) -> WellPath:
-    """Compute station positions by minimum curvature (THEORY.md §1).
+    """Compute station positions by minimum curvature (docs/theory.md §1).
 
     Parameters
     ----------
@@ -250,11 +250,11 @@ def tortuous_vertical(depth_m: float, dls_rad_m: float, *, period_m: float = TOR
     """A nominally vertical hole with constant tortuosity: a helix about the vertical.
 
     Real "vertical" holes are tortuous; in an exactly vertical one the soft-string side
-    force is zero (THEORY.md §2) and friction cannot act on the torque. This is the path
+    force is zero (docs/theory.md §2) and friction cannot act on the torque. This is the path
     assumed when a well has no survey: constant inclination I, azimuth turning uniformly,
     A(s) = 2π s/P, so that the curvature is the same everywhere.
 
-    Curvature of the helix: with t(s) = (sin I cos A, sin I sin A, cos I) (THEORY.md §1),
+    Curvature of the helix: with t(s) = (sin I cos A, sin I sin A, cos I) (docs/theory.md §1),
     dt/ds = sin I·(2π/P)·(−sin A, cos A, 0), so κ = |dt/ds| = (2π/P)·sin I. The path is
     built from stations every h = ``station_m`` (ΔA = 2π h/P); between two stations the
     minimum-curvature dogleg (§1) is β = 2·atan2(|t₂ − t₁|, |t₂ + t₁|) with
@@ -319,7 +319,7 @@ def no_survey_path(depth_m: float, tortuosity_rad_m: float) -> WellPath:
     """The path assumed when a well has no survey, to ``depth_m`` [m].
 
     :func:`tortuous_vertical` with dogleg severity ``tortuosity_rad_m`` [rad/m]; exactly
-    :func:`vertical` when it is 0 (then the soft-string side force is zero, THEORY.md §2).
+    :func:`vertical` when it is 0 (then the soft-string side force is zero, docs/theory.md §2).
 
     Examples
     --------

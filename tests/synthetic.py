@@ -1,6 +1,7 @@
 """Synthetic wells with known truth for estimator tests (built from the project's own plant).
 
-A&S 2018 drill pipe (CASES.md) on a build-and-hold path; the BHA is two collar sections so
+A&S 2018 drill pipe (docs/reference_cases.md) on a build-and-hold path; the BHA is two collar
+sections so
 the plant has junctions. Plants used as "truth" run on a finer grid than the estimators.
 """
 
@@ -16,7 +17,7 @@ from drillfric.drillstring import DrillString, build_string
 from drillfric.units import RPM_TO_RAD_S as RPM
 from drillfric.wellpath import WellPath, minimum_curvature
 
-#: A&S 2018 drill pipe and the Well A collar sections (CASES.md), G = 61 / 67 GPa.
+#: A&S 2018 drill pipe and the Well A collar sections (docs/reference_cases.md), G = 61 / 67 GPa.
 AS_SECTIONS = [
     {"name": "DP", "od_m": 0.146529, "id_m": 0.123024, "shear_modulus_Pa": 61e9},
     {"name": "c1", "od_m": 0.150167, "id_m": 0.096799, "length_m": 76.32,

@@ -1,6 +1,6 @@
 """Result directories for the report tests and the report benchmark, built file by file.
 
-The report reads only the files of a result directory (INTERFACE.md "Outputs of run" and
+The report reads only the files of a result directory (docs/outputs.md and
 docs/reports.md "What the report reads"). These helpers write those files directly:
 
 - :func:`add_evidence_files` completes the demo's real result directory with the files

@@ -31,7 +31,7 @@ def test_defaults_and_assumptions_reported():
 
 
 def test_interface_example_loads(tmp_path):
-    """The example of INTERFACE.md must load unchanged (binding keys)."""
+    """A full example configuration (every table of docs/configuration.md) loads unchanged."""
     text = '''
 [well]
 name = "A-12"

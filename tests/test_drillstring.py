@@ -11,11 +11,12 @@ from drillfric.errors import ModelError
 
 
 def test_section_properties_closed_forms():
-    """THEORY §3: J = π(OD⁴ − ID⁴)/32, c = √(G/ρ), ζ = J√(Gρ); §2: A_o, A_i. Exact formulas."""
+    """docs/theory.md §3: J = π(OD⁴ − ID⁴)/32, c = √(G/ρ), ζ = J√(Gρ); §2: A_o, A_i. Exact
+    formulas."""
     s = Section("dp", 0.146529, 0.123024, 100.0, 0.0889, 41.41, shear_modulus_Pa=61e9)
     assert s.polar_moment_m4 == pytest.approx(np.pi * (0.146529**4 - 0.123024**4) / 32,
                                               rel=1e-15)
-    # CASES.md: A&S 2018 drill pipe, c ≈ 2788 m/s (G = 61 GPa, ρ = 7850 kg/m³)
+    # docs/reference_cases.md: A&S 2018 drill pipe, c ≈ 2788 m/s (G = 61 GPa, ρ = 7850 kg/m³)
     assert s.wave_speed_m_s == pytest.approx(2788.0, abs=0.5)
     assert s.impedance_Nms == pytest.approx(s.polar_moment_m4 * np.sqrt(61e9 * 7850.0),
                                             rel=1e-15)
@@ -24,7 +25,8 @@ def test_section_properties_closed_forms():
 
 
 def test_buoyed_weight_inside_outside_mud():
-    """THEORY §2 step 1: w = g[m − ρ_o A_o + ρ_i A_i]; one mud and steel mass: w(1 − ρ/ρ_s)."""
+    """docs/theory.md §2 step 1: w = g[m − ρ_o A_o + ρ_i A_i]; one mud and steel mass: w(1 −
+    ρ/ρ_s)."""
     od, id_ = 0.127, 0.1086
     steel = 7850.0 * np.pi * (od**2 - id_**2) / 4
     s = Section("dp", od, id_, 10.0, od / 2, steel)

@@ -14,7 +14,7 @@ from tests.synthetic import RPM, config
 
 def test_creep_advice_is_the_wind_up_time():
     """Twist to break free under uniform friction = μ_s·T_N·L/(2GJ) (torque falls linearly
-    from the top, THEORY §3, §6.3); at the creep speed that takes twist/ω seconds."""
+    from the top, docs/theory.md §3, §6.3); at the creep speed that takes twist/ω seconds."""
     string = build_string(config().sections, 3000.0)
     pipe = string.sections[0]
     t = np.arange(0.0, 60.0, 0.1)

@@ -22,7 +22,7 @@ from drillfric.errors import InputError
 from drillfric.fleet import WellSpec, discover, run_many
 
 REPO = Path(__file__).resolve().parents[1]
-#: Files of a complete well directory (INTERFACE.md "Outputs of run").
+#: Files of a complete well directory (docs/outputs.md).
 WELL_FILES = ("summary.json", "estimates.parquet", "segments.parquet", "report.html")
 #: Per-well friction truth of the synthetic wells (μ_s, μ_k).
 TRUTH = {"w1": (0.5, 0.21), "w2": (0.5, 0.23), "w3": (0.5, 0.25)}

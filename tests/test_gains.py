@@ -1,4 +1,5 @@
-"""Observer gains (drillfric.estimation.gains) by the linear analysis of THEORY §5.1–§5.2."""
+"""Observer gains (drillfric.estimation.gains) by the linear analysis of docs/theory.md
+§5.1–§5.2."""
 
 from __future__ import annotations
 
@@ -68,7 +69,7 @@ def zeros_inside(params, tuning, re_lo, re_hi, im_hi, points=40000):
 # --- closed-form design ------------------------------------------------------------------
 
 def test_backstepping_closed_form_values():
-    """THEORY.md §5.1 term by term, with hand-computed a₀, a_L for the A&S string."""
+    """docs/theory.md §5.1 term by term, with hand-computed a₀, a_L for the A&S string."""
     p, tun = as_params(), Tuning()
     x = np.array([0.0, 1000.0, p.Lp_m])
     g = backstepping_gains(p, tun, x, T_N)
@@ -90,7 +91,7 @@ def test_backstepping_closed_form_values():
 @given(k1=st.floats(0.05, 1.95), lam=st.floats(0.5, 50), z=st.floats(0.05, 5),
        pp=st.floats(0.05, 5), md=st.floats(800, 6000))
 def test_N_at_zero_is_lambda0_a2(k1, lam, z, pp, md):
-    """THEORY.md §5.1: N(0) = λ₀·a₂ ≠ 0 — the rigid-body mode and the disturbance integrator
+    """docs/theory.md §5.1: N(0) = λ₀·a₂ ≠ 0 — the rigid-body mode and the disturbance integrator
     are both removed. Exact in floating point up to round-off (1e-12 relative)."""
     tun = Tuning(k1, lam, z, pp)
     assert complex(characteristic_N(0.0, as_params(md), tun)) == pytest.approx(lam * z * pp,
@@ -101,7 +102,7 @@ def test_N_at_zero_is_lambda0_a2(k1, lam, z, pp, md):
 @given(k1=st.floats(1e-3, 2 - 1e-3), lam=st.floats(0.1, 100), sigma=st.floats(0, 50),
        omega=st.floats(-1e3, 1e3))
 def test_top_reflection_is_contractive(k1, lam, sigma, omega):
-    """THEORY.md §5.1: |R(s)| ≤ 1 on the closed right half-plane for 0 < κ₁ < 2 (a
+    """docs/theory.md §5.1: |R(s)| ≤ 1 on the closed right half-plane for 0 < κ₁ < 2 (a
     first-order all-pass scaled by |1 − κ₁| < 1 at s = 0 and → 1 as |s| → ∞)."""
     assert abs(complex(top_reflection(sigma + 1j * omega, Tuning(kappa1=k1, lambda0_per_s=lam)))
                ) <= 1 + 1e-12
@@ -127,7 +128,7 @@ def test_dN_is_the_derivative_of_N():
 
 @pytest.mark.parametrize("tuning", TUNINGS, ids=["default", "k0.5-l15", "k1.5-l8"])
 def test_error_system_eigenvalues_are_the_roots_of_N(tuning):
-    """THEORY.md §5.2, first bullet. The Courant-1 error system (observer − plant of §4,
+    """docs/theory.md §5.2, first bullet. The Courant-1 error system (observer − plant of §4,
     lumped friction, no saturation) at 250 cells, eigenvalues mapped by s = log(λ)/Δt.
     Matching: every discrete s with |Im s| < 25 rad/s and Re s > −60 is refined by Newton on
     N(s); the refined point is a root (|N| tiny), within 1e-3 rad/s of the discrete s
@@ -153,7 +154,7 @@ def test_error_system_eigenvalues_are_the_roots_of_N(tuning):
 
 
 def test_default_tuning_low_modes_decay():
-    """THEORY.md §5.2: for the default tuning the modes of the error system with
+    """docs/theory.md §5.2: for the default tuning the modes of the error system with
     |Im s| < 25 rad/s all have Re s < 0, at several depths, and the lowest ones
     (|Im s| < 10 rad/s, the first torsional modes) decay faster than 0.1 1/s. The damping
     falls with frequency (−0.027 1/s at 25 rad/s for a 1200 m string): high-frequency error
@@ -215,7 +216,7 @@ def simulate_pair(params, inj, n, mu_true, mu_start, seconds):
 
 @pytest.mark.parametrize("design", ["backstepping", "kalman"])
 def test_linear_convergence_of_friction_and_bit_speed(design):
-    """THEORY.md §5.2: with a constant true lumped friction torque d, d̂ → d and ω̂_L → ω_L.
+    """docs/theory.md §5.2: with a constant true lumped friction torque d, d̂ → d and ω̂_L → ω_L.
     Observer and plant from rest, μ̂ = 0.1 against 0.3. Backstepping on the undamped model of
     §4; Kalman on its design model (k_t = 0.1 1/s, plant alike). After 50 s the low modes
     (slowest ≈ −0.15 1/s or faster) have shrunk the initial error by > e⁻⁷: μ̂ within 0.1 %
@@ -236,7 +237,7 @@ def test_linear_convergence_of_friction_and_bit_speed(design):
 
 
 def test_started_at_the_truth_the_estimate_stays():
-    """THEORY.md §5.2 (signs): observer = plant initially, so e ≡ 0 and nothing moves, even
+    """docs/theory.md §5.2 (signs): observer = plant initially, so e ≡ 0 and nothing moves, even
     through a torque kick: μ̂ stays at the truth to round-off."""
     p, n = as_params(), 60
     inj = observer_injection(backstepping_gains(p, Tuning(), lumped.nodes_m(p, n), T_N), p, n,
@@ -266,7 +267,7 @@ def test_wrong_sign_of_l_k_does_not_converge():
 
 @pytest.mark.parametrize("k_t", [0.0, 0.1])
 def test_kalman_closed_loop_is_stable(k_t):
-    """THEORY.md §5.1: the steady-state Kalman error dynamics A − LC of the Courant-1 model
+    """docs/theory.md §5.1: the steady-state Kalman error dynamics A − LC of the Courant-1 model
     (undamped as in §4, or with the default k_t) have every eigenvalue inside the unit
     circle except one: the grid's zero-speed torque checkerboard at λ = −1, which ω₀ cannot
     see (C v = 0) and which is left untouched. 1e-9 margin: round-off of the dense

@@ -1,4 +1,4 @@
-"""`drillfric inspect`: the table, --json keys of INTERFACE.md, and one-line errors (exit 2)."""
+"""`drillfric inspect`: the table, --json keys of docs/cli.md, and one-line errors (exit 2)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Numba kernel vs its plain-NumPy twin (drillfric.kernels.plant vs drillfric.kernels.plant_numpy).
 
-Both implement THEORY.md §3.1 and the friction profile and laws of docs/theory.md §3.2 with
+Both implement docs/theory.md §3.1 and the friction profile and laws of docs/theory.md §3.2 with
 the same operations in the same order (no fastmath), so they must agree to round-off; 10 000
 steps of stick-slip (the most sensitive regime: a cell that sticks in one run and not in the
 other would show at once) with every boundary type. Measured: bit-identical.
@@ -65,6 +65,13 @@ def test_torque_drive_agrees_from_a_twisted_state(plant):
 def test_speed_drive_agrees(plant):
     t = np.arange(0, 30, 0.1)
     drive = T.Drive("speed", 4.0 * np.minimum(t / 5, 1.0) + 0.5 * np.sin(t), 0.1)
+    _assert_same(*_both(plant, drive, 10_000, 100.0))
+
+
+def test_fed_drive_agrees(plant):
+    t = np.arange(0, 30, 0.1)
+    drive = T.Drive("fed", np.vstack([20e3 + 5e3 * np.sin(t), 4.0 + 0.5 * np.sin(0.7 * t)]),
+                    0.1, kp_Nms_rad=900.0, ki_Nm_rad=2500.0)
     _assert_same(*_both(plant, drive, 10_000, 100.0))
 
 

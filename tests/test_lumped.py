@@ -1,4 +1,5 @@
-"""Semi-lumped model of THEORY §4 and its Courant-1 discretisation (drillfric.estimation.lumped)."""
+"""Semi-lumped model of docs/theory.md §4 and its Courant-1 discretisation
+(drillfric.estimation.lumped)."""
 
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ def as_params(md_m: float = 2500.0, **kw) -> LumpedParams:
 def free_plant_F(s, p: LumpedParams):
     """Characteristic function of the free lumped plant: loop gain R₀ R_L e^{−2 s t_D} = 1.
 
-    Derived from THEORY.md §4 with no injection: the top drive reflects β into α with
+    Derived from docs/theory.md §4 with no injection: the top drive reflects β into α with
     R₀ = (a₀ − s)/(s + a₀), the BHA α into β with R_L = (a_L − s)/(s + a_L).
     """
     return ((s + p.a0_per_s) * (s + p.aL_per_s)
@@ -29,7 +30,8 @@ def free_plant_F(s, p: LumpedParams):
 
 
 def test_from_string_coefficients():
-    """a₀, a_L, c, L_p, I_BHA by hand from THEORY.md §3–§4 (CASES.md: c ≈ 2788 m/s)."""
+    """a₀, a_L, c, L_p, I_BHA by hand from docs/theory.md §3–§4 (docs/reference_cases.md: c ≈ 2788
+    m/s)."""
     p = as_params()
     J = np.pi * (0.146529**4 - 0.123024**4) / 32
     zeta = J * np.sqrt(61e9 * 7850)
@@ -53,7 +55,7 @@ def test_from_string_needs_a_bha_and_inertia():
 
 
 def test_transport_is_an_exact_shift():
-    """Courant 1 (THEORY.md §3.1): interior invariants move one node per step, bit for bit."""
+    """Courant 1 (docs/theory.md §3.1): interior invariants move one node per step, bit for bit."""
     p, n = as_params(), 50
     z = np.random.default_rng(1).normal(size=lumped.state_size(n))
     z1 = lumped.step(p, Injection.none(n), z)
@@ -62,7 +64,7 @@ def test_transport_is_an_exact_shift():
 
 
 def test_steady_rotation_is_a_fixed_point():
-    """With τ_m = d the string turns steadily with uniform twist τ = d (THEORY.md §4)."""
+    """With τ_m = d the string turns steadily with uniform twist τ = d (docs/theory.md §4)."""
     p, n = as_params(), 40
     z = lumped.steady_state(p, n, 4.0, 9000.0)
     z1 = lumped.step(p, Injection.none(n), z, tau_m=(9000.0, 9000.0))
@@ -90,7 +92,7 @@ def test_free_plant_is_lossless():
 
 
 def test_damping_only_removes_energy():
-    """k_t > 0 (THEORY.md §3): no eigenvalue outside the unit circle; the rigid rotation now
+    """k_t > 0 (docs/theory.md §3): no eigenvalue outside the unit circle; the rigid rotation now
     decays, and the only ones left on it are the constant friction torque d (λ = 1) and the
     grid's zero-speed torque checkerboard (λ = −1, which nodal viscous damping cannot see)."""
     A = lumped.transition_matrix(as_params(k_t_per_s=0.1), Injection.none(60))
@@ -103,7 +105,7 @@ def test_damping_only_removes_energy():
 @pytest.mark.parametrize("n", [150, 250])
 def test_free_plant_modes_match_the_analytic_loop(n):
     """Discrete eigenvalues (s = log λ/Δt, |Im s| < 20 rad/s) are roots of the free plant's
-    characteristic function (derived from THEORY.md §4, see free_plant_F): refined by Newton
+    characteristic function (derived from docs/theory.md §4, see free_plant_F): refined by Newton
     on F, each moves by less than 5e-4·(150/n)² rad/s — the scheme is second order; the
     largest mode error measured is 1.9e-4 rad/s at 150 cells and 6.8e-5 at 250."""
     p = as_params()
@@ -121,7 +123,8 @@ def test_free_plant_modes_match_the_analytic_loop(n):
 
 
 def test_first_torsional_mode_near_the_published_one():
-    """CASES.md: the A&S 2018 synthetic well (2500 m, this pipe, a 230 m BHA) has its first
+    """docs/reference_cases.md: the A&S 2018 synthetic well (2500 m, this pipe, a 230 m BHA) has
+    its first
     torsional mode near 0.22 Hz. Lumping the BHA into a rigid inertia stiffens the string,
     so within 15 % only (we get 0.241 Hz)."""
     p, n = as_params(), 100
@@ -132,7 +135,7 @@ def test_first_torsional_mode_near_the_published_one():
 
 
 def test_kt_damps_the_speed_checkerboard():
-    """THEORY.md §5.1: physical damping is what kills grid-scale speed waves. With k_t = 0 a
+    """docs/theory.md §5.1: physical damping is what kills grid-scale speed waves. With k_t = 0 a
     node-alternating speed pattern (α = β = ±1) is an undamped λ = −1 mode; with k_t > 0
     it decays by (1 − k_t Δt) per step (explicit viscous term)."""
     n = 40

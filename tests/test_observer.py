@@ -1,4 +1,4 @@
-"""Adaptive observer (THEORY.md §5): kernel vs NumPy twin, signs, convergence, guards.
+"""Adaptive observer (docs/theory.md §5): kernel vs NumPy twin, signs, convergence, guards.
 
 Truth plants run on a finer grid than the observer (800 vs 400 cells) with measurement noise
 (0.5 RPM, 200 N·m, the issue's levels), so these are not self-consistency checks.
@@ -151,7 +151,7 @@ def test_rotating_start_carries_the_fixed_friction():
 
 
 def test_started_at_truth_stays_at_truth():
-    """Signs (THEORY §5.2): observer = plant (same grid, exact samples at every step, no
+    """Signs (docs/theory.md §5.2): observer = plant (same grid, exact samples at every step, no
     noise) started at the true state and friction keeps zero innovation and its estimates."""
     cfg = config()
     case = simulate(PATH, 1600.0, 0.3, 0.2, 80.0, 20.0, cells=300, rate_hz=200.0)
@@ -175,7 +175,7 @@ def test_started_at_truth_stays_at_truth():
     # docs/validation.md); the Kalman design does not show it.
     ("backstepping", [[0.3, 0.05], [0.2, 0.2]], 0.03)])
 def test_mu_k_converges_in_steady_rotation(steady, design, starts, tol):
-    """μ̂_k → μ_k from starts spanning 0.05–0.4 (THEORY §5.2 linear convergence). Tolerance:
+    """μ̂_k → μ_k from starts spanning 0.05–0.4 (docs/theory.md §5.2 linear convergence). Tolerance:
     2 % (Kalman) / 3 % (backstepping, noisier: P₀ ≈ −56 injects the speed noise) of the
     truth, the grid mismatch (400 vs 800 cells) being a fraction of that."""
     cfg = config(gains=design)
@@ -201,7 +201,7 @@ def test_bit_speed_in_steady_rotation(steady):
 
 
 def test_deadlock_guard_releases_a_stuck_observer(steady):
-    """THEORY §6.1: started with μ̂ far too high the estimated string never breaks free and
+    """docs/theory.md §6.1: started with μ̂ far too high the estimated string never breaks free and
     the μ_k law never runs; the guard must intervene and the estimate recover."""
     obs = make_observer(steady, config(), deadlock_s=5.0)
     w, q = noisy(steady.record)
@@ -213,7 +213,7 @@ def test_deadlock_guard_releases_a_stuck_observer(steady):
 
 def test_paper_law_moves_mu_s_corrected_holds_it():
     """The printed law (42) adapts μ̂_s while the BHA is stuck; the default holds it
-    (THEORY §6.1) — μ_s comes from the batch fit."""
+    (docs/theory.md §6.1) — μ_s comes from the batch fit."""
     case = simulate(PATH, 1600.0, 0.6, 0.2, 40.0, 40.0, cells=400)
     w, q = noisy(case.record)
     meas = Measurements.from_samples(case.record.time_s, w, q)
@@ -226,7 +226,7 @@ def test_paper_law_moves_mu_s_corrected_holds_it():
 
 
 def test_string_torque_converted_to_motor_torque():
-    """τ_m = τ(0) + I_TD dω₀/dt (THEORY §3 eq. 7): a pure spin-up at constant τ_m."""
+    """τ_m = τ(0) + I_TD dω₀/dt (docs/theory.md §3 eq. 7): a pure spin-up at constant τ_m."""
     t = np.arange(0.0, 20.0, 0.01)
     w = 0.5 * t  # rad/s, constant acceleration 0.5 rad/s²
     string_torque = np.full_like(t, 8000.0)

@@ -156,7 +156,7 @@ def test_several_wells_on_two_workers(tmp_path):
     for name in ("a", "b"):
         summary = json.loads((tmp_path / "o" / name / "summary.json").read_text())
         assert summary["well"] == name and summary["counts"]["estimated"] == 4
-    # OUT holds the wells' results only: no fleet files, lock or manifest (INTERFACE.md)
+    # OUT holds the wells' results only: no fleet files, lock or manifest (docs/outputs.md)
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["a", "b"]
 
 

@@ -713,7 +713,7 @@ def test_report_command_bad_directory_is_one_line_exit_2(tmp_path, make):
 
 def test_mu_s_advice_only_when_not_identified(demo, tmp_path):
     """Without an identified μ_s the report tells drillers how to make it measurable
-    (THEORY §6: a creep break-over); with one it does not."""
+    (docs/theory.md §6: a creep break-over); with one it does not."""
     for identified in (True, False):
         out = copy_result(demo, tmp_path / str(identified),
                           lambda s, v=identified: s.update(mu_s=0.6 if v else None))

@@ -78,7 +78,7 @@ def invoke(*args):
 # ------------------------------------------------------------------------------ scenario
 
 def test_creep_start_shape(tmp_path):
-    """THEORY §6.3 creep: 0 → 5 RPM in 5 s, hold 30 s, then ramp to the set-point."""
+    """docs/theory.md §6.3 creep: 0 → 5 RPM in 5 s, hold 30 s, then ramp to the set-point."""
     stand = sim.Stand(2000.0, duration_s=100.0, rpm=40.0, start="creep", idle_s=5.0)
     k = stand.knots()
     np.testing.assert_allclose(k[:6], [[0, 0], [5, 0], [10, 5], [40, 5], [50, 40], [105, 40]])
@@ -369,7 +369,7 @@ def test_cli_without_survey_simulates_the_path_run_assumes(tmp_path):
     """No survey: the plant runs on the path `run` assumes (vertical with the nominal
     tortuosity, docs/torque_drag.md) — friction acts — and that path is written as the
     output's survey, so `run` on the output uses the true path. With tortuosity 0 the hole
-    is exactly vertical (T_N = 0, THEORY §2) and the warning says so."""
+    is exactly vertical (T_N = 0, docs/theory.md §2) and the warning says so."""
     cfg = tmp_path / "v.toml"
     cfg.write_text(CONFIG)
     result = CliRunner().invoke(cli, ["simulate", str(cfg), "--out", str(tmp_path / "v.csv"),

@@ -1,4 +1,4 @@
-"""`drillfric td` (INTERFACE.md): JSON keys, profile/broomstick files, bad input → exit 2."""
+"""`drillfric td` (docs/cli.md): JSON keys, profile/broomstick files, bad input → exit 2."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from drillfric.config import load_config
 from drillfric.io.survey import read_survey
 from drillfric.torque_drag import solve_config
 
-INTERFACE_KEYS = {"bit_depth_m", "friction_factor", "load_case", "surface_torque_Nm",
+DOCUMENTED_KEYS = {"bit_depth_m", "friction_factor", "load_case", "surface_torque_Nm",
                   "hookload_N", "T_N_Nm"}
 PROFILE_COLUMNS = ["md_m", "inc_deg", "azi_deg", "tension_N", "torque_Nm",
                    "normal_force_N_m", "fc_Nm_m"]
@@ -41,7 +41,7 @@ def test_json_has_interface_keys_and_library_numbers(well):
     result = invoke(well, "--bit-depth", 2500, "--friction", 0.3, "--json")
     assert result.exit_code == 0, result.output
     out = json.loads(result.stdout)
-    assert INTERFACE_KEYS <= set(out)
+    assert DOCUMENTED_KEYS <= set(out)
     assert out["bit_depth_m"] == 2500.0 and out["friction_factor"] == 0.3
     assert out["load_case"] == "rotating_off_bottom"
     expected = solve_config(load_config(well), read_survey(well.parent / "w.survey.csv"),
@@ -73,7 +73,7 @@ def test_profile_file_columns(well, tmp_path, suffix):
 
 
 def test_data_file_with_sidecars(well, tmp_path):
-    """A well given as a data file finds NAME.toml and NAME.survey.csv (INTERFACE.md)."""
+    """A well given as a data file finds NAME.toml and NAME.survey.csv (docs/ingestion.md)."""
     pd.DataFrame({"time_s": [0.0, 1.0], "surface_rpm": [60.0, 60.0],
                   "surface_torque_Nm": [1e4, 1e4]}).to_csv(tmp_path / "w.csv", index=False)
     by_data = invoke(tmp_path / "w.csv", "--bit-depth", 2500, "--json")
@@ -114,7 +114,7 @@ def test_broomstick_json(well):
                     "--wob", 5e4, "--json")
     assert result.exit_code == 0, result.output
     rows = json.loads(result.stdout)
-    assert len(rows) == 2 * 4 and INTERFACE_KEYS <= set(rows[0])
+    assert len(rows) == 2 * 4 and DOCUMENTED_KEYS <= set(rows[0])
     assert {r["load_case"] for r in rows} >= {"rotating_on_bottom"}  # added when WOB given
 
 

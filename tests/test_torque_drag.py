@@ -1,4 +1,4 @@
-"""Soft-string torque and drag (drillfric.torque_drag, THEORY.md §2).
+"""Soft-string torque and drag (drillfric.torque_drag, docs/theory.md §2).
 
 Analytic checks first (each states its source and why its tolerance is what it is), then
 the compiled march against a plain-Python oracle, then API behaviour.
@@ -46,7 +46,7 @@ def build_hold(kop=500.0, eob=1500.0, inc_deg=60.0, td=4000.0, azi_deg=30.0):
 
 
 # ---------------------------------------------------------------------------------------
-# plain-Python oracle: THEORY.md §2 steps 2–5 written literally, one element at a time
+# plain-Python oracle: docs/theory.md §2 steps 2–5 written literally, one element at a time
 def naive_march(md, tangents, w_per_m, rc, mu, sigma, share, f_bit, m_bit):
     n = len(md) - 1
     force, torque, normal = [0.0] * (n + 1), [0.0] * (n + 1), [0.0] * n
@@ -79,7 +79,7 @@ def oracle_for(path, string, res, *, mu, sigma, share, f_bit=0.0, m_bit=0.0, mud
     ("sliding", -1.0, 0.0, -80e3, 0.0),
 ])
 def test_compiled_march_matches_plain_python_oracle(case, sigma, share, f_bit, m_bit):
-    """Oracle: THEORY.md §2 literally. Same arithmetic in another order: rtol 1e-10."""
+    """Oracle: docs/theory.md §2 literally. Same arithmetic in another order: rtol 1e-10."""
     path = minimum_curvature([0, 300, 900, 1400, 2500], np.radians([0, 5, 40, 62, 75]),
                              np.radians([0, 20, 70, 95, 100]))
     string = two_section(2400.0)
@@ -94,7 +94,8 @@ def test_compiled_march_matches_plain_python_oracle(case, sigma, share, f_bit, m
 
 
 def test_combined_motion_shares_follow_speed_ratio():
-    """THEORY §2 step 3: σ = v/√(v² + (ω r_c)²), torque share ω r_c/√(...). Oracle: rtol 1e-10."""
+    """docs/theory.md §2 step 3: σ = v/√(v² + (ω r_c)²), torque share ω r_c/√(...). Oracle: rtol
+    1e-10."""
     path = build_hold(td=2000.0)
     string = DrillString((pipe(2000.0),))
     v, rpm = 0.2, 30.0
@@ -110,11 +111,12 @@ def test_combined_motion_shares_follow_speed_ratio():
 
 
 # ---------------------------------------------------------------------------------------
-# analytic checks of THEORY.md §2
+# analytic checks of docs/theory.md §2
 @pytest.mark.parametrize("case", ["rotating_off_bottom", "rotating_on_bottom", "pick_up",
                                   "slack_off"])
 def test_vertical_hole_zero_side_force_and_buoyed_weight(case):
-    """THEORY §2: vertical → N = 0 and F(0) = buoyed weight − WOB. Sums of ~10³ terms: 1e-12."""
+    """docs/theory.md §2: vertical → N = 0 and F(0) = buoyed weight − WOB. Sums of ~10³ terms:
+    1e-12."""
     string = two_section(3000.0)
     wob = 120e3 if case == "rotating_on_bottom" else 0.0
     res = solve(vertical(3000.0), string, friction=0.4, load_case=case, wob_N=wob,
@@ -127,7 +129,7 @@ def test_vertical_hole_zero_side_force_and_buoyed_weight(case):
 
 @pytest.mark.parametrize("inc_deg", [10.0, 45.0, 80.0])
 def test_straight_slant_axial_force_increment_is_exact(inc_deg):
-    """THEORY §2: straight hole at I → ΔF = w·Δs·(cos I ± μ sin I), per element, exact.
+    """docs/theory.md §2: straight hole at I → ΔF = w·Δs·(cos I ± μ sin I), per element, exact.
 
     Both tangents equal, so N = W sin I with no discretisation error: rtol 1e-12.
     """
@@ -155,7 +157,7 @@ def weightless_arc(beta_rad, radius_m=500.0):
 
 
 def test_weightless_arc_tends_to_capstan_with_first_order_convergence():
-    """Capstan (Euler–Eytelwein): |F_out| = |F_in|·e^{μβ} on a weightless arc (THEORY §2).
+    """Capstan (Euler–Eytelwein): |F_out| = |F_in|·e^{μβ} on a weightless arc (docs/theory.md §2).
 
     Sliding with WOB pushes the string through a 90° bend. The march uses the lower-node
     force in N (explicit), so the error per element is O(δ²) and the total O(δ): the
@@ -175,7 +177,7 @@ def test_weightless_arc_tends_to_capstan_with_first_order_convergence():
 
 
 def test_build_under_tension_normal_force_crosses_zero():
-    """THEORY §2 scalar form: planar build, N = |F_d·2sin(ΔI/2) − W sin Ī| exactly.
+    """docs/theory.md §2 scalar form: planar build, N = |F_d·2sin(ΔI/2) − W sin Ī| exactly.
 
     Pins the sign that published open-source code gets wrong (+W sin Ī would never vanish):
     deep in the build gravity dominates, near the kick-off tension does, and F_N dips to
@@ -225,7 +227,7 @@ def test_azimuth_crossing_north_gives_no_spurious_side_force():
 
 
 def test_buoyancy_inside_and_outside_mud():
-    """THEORY §2 step 1: W = g·Δs·[m − ρ_o A_o + ρ_i A_i]; one mud: w_air·(1 − ρ/ρ_steel).
+    """docs/theory.md §2 step 1: W = g·Δs·[m − ρ_o A_o + ρ_i A_i]; one mud: w_air·(1 − ρ/ρ_steel).
 
     Vertical hole, so the hook load is the sum of buoyed weights: rtol 1e-12.
     """
@@ -243,7 +245,8 @@ def test_buoyancy_inside_and_outside_mud():
 
 
 def test_rotating_torque_is_mu_times_T_N_off_bottom():
-    """THEORY §2 step 4 and §5.1: off bottom, rotating, surface torque = μ·∫F_c dx exactly."""
+    """docs/theory.md §2 step 4 and §5.1: off bottom, rotating, surface torque = μ·∫F_c dx
+    exactly."""
     res = solve(build_hold(), two_section(3800.0), friction=0.27)
     assert res.surface_torque_Nm == pytest.approx(0.27 * res.T_N_Nm, rel=1e-12)
     assert res.T_N_Nm == pytest.approx(np.sum(res.fc_Nm_m * np.diff(res.md_m)), rel=1e-12)
@@ -272,7 +275,8 @@ def test_nodes_honour_section_boundaries_stations_and_shoe():
 
 
 def test_friction_per_hole_section_from_config(tmp_path):
-    """Cased above the shoe, open hole below: dM/ds = μ(s)·F_c per element (THEORY §2 step 4)."""
+    """Cased above the shoe, open hole below: dM/ds = μ(s)·F_c per element (docs/theory.md §2 step
+    4)."""
     cfg_file = tmp_path / "w.toml"
     cfg_file.write_text("[model]\ncasing_shoe_md_m = 1234.5\nfriction_cased = 0.15\n"
                         "friction_open = 0.35\nelement_length_m = 4.0\n")
@@ -302,9 +306,9 @@ def test_solve_config_defaults_to_vertical_and_config_string():
 
 
 # ---------------------------------------------------------------------------------------
-# Johancsik et al. 1984, Example 3 (CASES.md)
+# Johancsik et al. 1984, Example 3 (docs/reference_cases.md)
 def johancsik_example3(bit_m=3718.0):
-    """Vertical to 731.5 m, build to 44° at 1280 m, hold to 3718 m (CASES.md).
+    """Vertical to 731.5 m, build to 44° at 1280 m, hold to 3718 m (docs/reference_cases.md).
 
     String: 5" 19.5 lb/ft DP (adjusted 22.6 lb/ft, 6⅝" tool joints), 840 ft of 5" HWDP
     (49.3 lb/ft, 6½" joints), 372 ft of 6½" × 2¼" collars (91.8 lb/ft); 10 lb/gal mud
@@ -339,7 +343,7 @@ def build_ode_top_force(f_eob, w, kappa, beta, mu_sigma):
 
 
 def test_johancsik_example3_against_semi_analytic_solution():
-    """Johancsik et al. 1984 Example 3 (CASES.md) at μ = 0.39, against closed forms.
+    """Johancsik et al. 1984 Example 3 (docs/reference_cases.md) at μ = 0.39, against closed forms.
 
     The paper's printed loads are not available here (numbers we get are recorded in
     docs/validation.md). What is exact on this well: the hold is straight
@@ -528,7 +532,7 @@ def test_volve_f5_apparent_friction_in_plausible_band(real_data):
 
 def _tension_from_weight_below(string, md_m, rho, cos_inc):
     """F(s) = cos I·∫_s^L w ds: effective tension rotating off bottom on a constant-
-    inclination path (THEORY §2 step 3 with σ = 0), section by section [N]."""
+    inclination path (docs/theory.md §2 step 3 with σ = 0), section by section [N]."""
     edges = string.boundaries_m
     w = [sec.buoyed_weight_N_m(rho, rho) for sec in string.sections]
     return cos_inc * np.array([sum(wi * max(0.0, hi - max(lo, s))
@@ -537,8 +541,8 @@ def _tension_from_weight_below(string, md_m, rho, cos_inc):
 
 
 def test_side_force_on_the_assumed_tortuous_path():
-    """No survey: the assumed path (a helix of DLS κ = 1°/30 m, THEORY §1) gives the
-    soft-string side force of THEORY §2 step 2 in closed form.
+    """No survey: the assumed path (a helix of DLS κ = 1°/30 m, docs/theory.md §1) gives the
+    soft-string side force of docs/theory.md §2 step 2 in closed form.
 
     Tension from the buoyed weight below, F = cos I·∫w ds (rel 1e-5: the element-mean
     inclination inside each 10 m arc dips below the stations' by < 1 %, cos I moves ~1e-6).

@@ -1,4 +1,4 @@
-"""Torsional plant (THEORY.md §3, §3.1): exact wave invariants and friction closed forms."""
+"""Torsional plant (docs/theory.md §3, §3.1): exact wave invariants and friction closed forms."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def section(name, od, id_, length, g=61e9):
 
 
 def two_section_string(pipe_m=2270.0):
-    """A&S drill pipe over 230 m of 8in collars (CASES.md)."""
+    """A&S drill pipe over 230 m of 8in collars (docs/reference_cases.md)."""
     return DrillString((section("dp", 0.146529, 0.123024, pipe_m),
                         section("dc", 0.2096, 0.0714, 230.0, 67e9)))
 
@@ -43,7 +43,7 @@ def frictionless(grid, k_t=0.0):
 # ------------------------------------------------------------------------------ grid
 
 def test_grid_courant_one_in_every_section():
-    """THEORY §3.1: Δx_i = c_i·Δt, whole cells, rounding at most half a cell per section."""
+    """docs/theory.md §3.1: Δx_i = c_i·Δt, whole cells, rounding at most half a cell per section."""
     g = T.make_grid(two_section_string(), 500)
     counts = np.diff(g.section_start)
     np.testing.assert_allclose(g.model_length_m, counts * g.wave_speed_m_s * g.dt_s,
@@ -63,7 +63,7 @@ def test_grid_keeps_true_friction_integral():
 # --------------------------------------------------------------- waves (no friction)
 
 def test_pulse_reaches_bit_after_exactly_L_over_c_and_reflects():
-    """THEORY §3: with Courant 1 a pulse is shifted one cell per step, exactly.
+    """docs/theory.md §3: with Courant 1 a pulse is shifted one cell per step, exactly.
 
     A one-step speed pulse at the top (α(0) = 2ω₀) enters cell 0 at step 1 and the bit
     cell at step N: travel time N·Δt = L/c. The free bit reflects β = α (coefficient +1,
@@ -88,7 +88,8 @@ def test_pulse_reaches_bit_after_exactly_L_over_c_and_reflects():
 
 
 def test_junction_reflection_and_transmission_coefficients():
-    """THEORY §3 eqs. (12)–(14): α_b = 2α_a/(1+Z), β_a = (1−Z)α_a/(1+Z) for an incoming α_a."""
+    """docs/theory.md §3 eqs. (12)–(14): α_b = 2α_a/(1+Z), β_a = (1−Z)α_a/(1+Z) for an incoming
+    α_a."""
     s = two_section_string(1000.0)
     g = T.make_grid(s, 300)
     first = int(g.section_start[1])
@@ -109,7 +110,7 @@ def _junction_string(lower_od):
 
 @pytest.mark.parametrize("lower_od", [0.2096, 0.11])
 def test_junction_mirror_case_beta_from_below(lower_od):
-    """THEORY §3 eqs. (12)–(14), the other direction: a β wave arriving from the lower
+    """docs/theory.md §3 eqs. (12)–(14), the other direction: a β wave arriving from the lower
     section (α_a = 0) is transmitted as β_a = 2Zβ_b/(1+Z) and reflected as
     α_b = −(1 − Z)β_b/(1+Z), Z = ζ_b/ζ_a, for a stiffer (Z > 1, collars) and a softer (Z < 1)
     lower section. Energy flux is conserved across the junction:
@@ -133,7 +134,7 @@ def test_junction_mirror_case_beta_from_below(lower_od):
 
 @pytest.mark.parametrize("direction", ["alpha", "beta"])
 def test_unit_impedance_junction_passes_a_pulse_unchanged(direction):
-    """Z = 1 (THEORY §3.1): the junction formulas give α_b = α_a and β_a = β_b exactly, so a
+    """Z = 1 (docs/theory.md §3.1): the junction formulas give α_b = α_a and β_a = β_b exactly, so a
     pulse crosses in either direction bit-identically and nothing is reflected."""
     two = DrillString((section("a", 0.15, 0.12, 600.0), section("b", 0.15, 0.12, 900.0)))
     g = T.make_grid(two, 300)
@@ -155,7 +156,7 @@ def test_unit_impedance_junction_passes_a_pulse_unchanged(direction):
 
 @pytest.mark.parametrize("end", ["clamped", "free"])
 def test_bit_reflection_clamped_and_free(end):
-    """THEORY §3, bit boundary (and erratum E2 on eq. 40). A square speed pulse (α = 1 over
+    """docs/theory.md §3, bit boundary (and erratum E2 on eq. 40). A square speed pulse (α = 1 over
     m cells: ω = 1/2, τ = ζ/2) runs into the bit.
 
     Clamped bit — a stuck bit whose Coulomb cap T_bit exceeds the wave's torque, so
@@ -188,7 +189,7 @@ def test_bit_reflection_clamped_and_free(end):
 
 
 def test_coulomb_bit_holds_below_its_cap_and_slips_above():
-    """THEORY §3 bit: τ(L) = ζ·clamp(α, ±T_bit/ζ). An incident wave whose clamped-end
+    """docs/theory.md §3 bit: τ(L) = ζ·clamp(α, ±T_bit/ζ). An incident wave whose clamped-end
     torque ζα stays within T_bit reflects as from a clamped end (β = −α); a stronger one
     slips the bit with τ(L) = T_bit exactly, β = α − 2T_bit/ζ."""
     g = T.make_grid(DrillString((section("dp", 0.146529, 0.123024, 1000.0),)), 100)
@@ -207,7 +208,7 @@ def test_coulomb_bit_holds_below_its_cap_and_slips_above():
 def test_unit_impedance_junction_is_transparent():
     """Z = 1: the junction formulas reduce to α_b = α_a, β_a = β_b (bit-identical states).
 
-    THEORY §3.1 states it without damping; friction is cell-local, so it is included.
+    docs/theory.md §3.1 states it without damping; friction is cell-local, so it is included.
     """
     one = DrillString((section("a", 0.15, 0.12, 1500.0),))
     two = DrillString((section("a", 0.15, 0.12, 600.0), section("b", 0.15, 0.12, 900.0)))
@@ -233,7 +234,7 @@ def _random_string(lengths, ods, g_moduli):
 @settings(max_examples=15, deadline=None)
 @given(n_sec=st.integers(1, 4), seed=st.integers(0, 2**31 - 1))
 def test_energy_conserved_without_friction_and_damping(n_sec, seed):
-    """THEORY §3.1: transport is a shift and the junctions are lossless, so the energy
+    """docs/theory.md §3.1: transport is a shift and the junctions are lossless, so the energy
     Σ ζΔt(α² + β²)/4 is conserved exactly (up to round-off, ~1e-13 after 10 000 steps)."""
     rng = np.random.default_rng(seed)
     s = _random_string(rng.uniform(30.0, 800.0, n_sec), rng.uniform(0.1, 0.25, n_sec),
@@ -254,13 +255,13 @@ def free_top():
 @given(n_sec=st.integers(1, 4), seed=st.integers(0, 2**31 - 1),
        i_td=st.floats(50.0, 5000.0), backend=st.sampled_from(["numba", "numpy"]))
 def test_energy_conserved_with_free_top_drive(n_sec, seed, i_td, backend):
-    """THEORY §3 eq. (7) with τ_m = 0, no friction, k_t = 0, free bit: the total energy
+    """docs/theory.md §3 eq. (7) with τ_m = 0, no friction, k_t = 0, free bit: the total energy
     ½∫ρJω² dx + ½∫τ²/(GJ) dx + ½I_TDω₀² of the continuum is constant.
 
     The top-drive coupling of docs/theory.md erratum E11 (trapezoidal ω₀ update with the
     boundary value α(0) = 2ω̄₀ − β(0)) conserves the discrete energy exactly, so the check
     is to round-off: rel 1e-10 after 20 000 steps (round-off drifts up to ~2e-16 per step;
-    measured ≤ 4e-12 over 36 draws). The explicit Euler step 4 of THEORY §3.1 adds
+    measured ≤ 4e-12 over 36 draws). The explicit Euler step 4 of docs/theory.md §3.1 adds
     ½ζa₀Δt²(β(0) − ω₀)² every step: +3.2 % in 100 s for a random state on the A&S string,
     and it is unstable for a₀Δt > 2 (light top drive, stiff pipe: ×10³⁴ here at I_TD = 50).
     """
@@ -279,10 +280,10 @@ def test_energy_conserved_with_free_top_drive(n_sec, seed, i_td, backend):
 
 def test_energy_after_motor_torque_stops_is_constant():
     """Spin the A&S string up with 20 kN·m for 5 s, then τ_m = 0 (no friction, k_t = 0,
-    free bit): from then on the energy of string + top drive must stay constant (THEORY §3
+    free bit): from then on the energy of string + top drive must stay constant (docs/theory.md §3
     eq. 7; docs/theory.md E11). Tolerance rel 1e-10 over 200 s (1.1·10⁵ steps): round-off
     of the ω₀ update drifts ~1e-16 per step on this nearly rigid rotation (measured −1.4e-11
-    at the end). With the explicit step 4 of THEORY §3.1 it grew by +1.2e-4.
+    at the end). With the explicit step 4 of docs/theory.md §3.1 it grew by +1.2e-4.
     """
     g = T.make_grid(two_section_string(), 500)
     plant = T.Plant(g, np.zeros(g.n_cells), 0.0, 0.0, 1.0, 0.0, 2900.0)
@@ -301,7 +302,7 @@ def test_motor_work_equals_energy_change():
     E11): E^N − E^0 = Σ_k Δt·τ_m^k·(ω₀^k + ω₀^{k+1})/2 exactly, for any motor torque (no
     friction, k_t = 0, free bit). Recorded at every step; rel 1e-10 covers the round-off of
     the step-time interpolation of the records (measured 1e-13; the explicit coupling of
-    THEORY §3.1 step 4 misses by −7.5e-5)."""
+    docs/theory.md §3.1 step 4 misses by −7.5e-5)."""
     g = T.make_grid(two_section_string(), 200)
     plant = T.Plant(g, np.zeros(g.n_cells), 0.0, 0.0, 1.0, 0.0, 2900.0)
     t = np.arange(0.0, 12.0, 0.5)
@@ -350,7 +351,7 @@ def _string_and_fc(fc=20.0, cells=500):
 
 
 def test_steady_rotation_torque_is_kinetic_friction_plus_viscous():
-    """THEORY §3.1: steady sliding at Ω needs τ(0) = μ_k∫F_c dx + k_t Ω ∫ρJ dx.
+    """docs/theory.md §3.1: steady sliding at Ω needs τ(0) = μ_k∫F_c dx + k_t Ω ∫ρJ dx.
 
     Tolerance 0.5 %: the steady state of the first-order scheme carries an O(k_t·Δt) speed
     gradient along the string (0.07 % here); the PI integral removes the speed error.
@@ -367,7 +368,7 @@ def test_steady_rotation_torque_is_kinetic_friction_plus_viscous():
 
 
 def test_creep_torque_is_static_friction():
-    """THEORY §6.3: with the whole string turning below ω_c every element carries μ_s·F_c,
+    """docs/theory.md §6.3: with the whole string turning below ω_c every element carries μ_s·F_c,
     so the mean torque tends to μ_s∫F_c dx (no damping). Without damping the BHA keeps
     oscillating inside the static band, so means over the last 50 s are compared; 1 %
     covers the residual oscillation of the mean."""
@@ -405,7 +406,7 @@ def test_break_free_torque_converges_to_static_friction_integral():
 def test_stick_slip_torque_swing_well_b(well_b):
     """A&S 2018 eqs. 30, 34: swing ≈ 2(1 − μ_k/μ_s)·μ_s∫F_c dx if the whole string sticks.
 
-    That is an upper estimate: the string is released progressively from the top (THEORY
+    That is an upper estimate: the string is released progressively from the top (docs/theory.md
     §6.2) and the top drive keeps sliding, so the torque never climbs to μ_s∫F_c dx (max
     0.74–0.76 μ_sT_N here). Statistics over 60–300 s, as in docs/validation.md.
 
@@ -419,7 +420,7 @@ def test_stick_slip_torque_swing_well_b(well_b):
     bound, and stick-slip itself is required directly: bit stuck part of the time (0.62–0.66
     measured; > 0.2) and peaks above twice the set-point (5–7× measured).
 
-    The mean torque is the stable statistic (THEORY §6.4 fits μ_k on it): μ_k∫F_c dx, +1.0 %
+    The mean torque is the stable statistic (docs/theory.md §6.4 fits μ_k on it): μ_k∫F_c dx, +1.0 %
     viscous k_tΩ∫ρJ dx, plus the share of stuck cells holding more than μ_kF_c; 1.026–1.033
     μ_kT_N in the same 14 runs, so 5 % (formerly 10 %).
     """
@@ -432,6 +433,41 @@ def test_stick_slip_torque_swing_well_b(well_b):
     assert np.mean(np.abs(bit) < 0.05) > 0.2
     assert bit.max() > 2 * 40 * RPM
     assert np.mean(rec.motor_torque_Nm[m]) == pytest.approx(plant.mu_k * plant.T_N_Nm, rel=0.05)
+
+
+def test_fed_drive_replays_its_own_pi_run_exactly():
+    """A PI run of Well B in stick-slip, logged at every model step, replayed with the "fed"
+    drive (logged motor torque + the same PI on the logged speed, docs/theory.md §6.4): in
+    sync the correction is zero and the replay is the run itself. Stick-slip amplifies
+    round-off (the logged series carry 1e-16 relative error), so 20 s are compared — the
+    top-drive speed within 1e-6 rad/s and the string torque within 1e-3 N·m."""
+    from drillfric.simulator import well_b_plant
+
+    plant = well_b_plant(cells=200)
+    dt = plant.grid.dt_s
+    pi = T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0)
+    n = int(round(20.0 / dt))
+    rec, _ = T.run(plant, pi, n * dt, 1.0 / dt)
+    fed = T.Drive("fed", np.vstack([rec.motor_torque_Nm, rec.surface_rad_s]), dt,
+                  kp_Nms_rad=pi.kp_Nms_rad, ki_Nm_rad=pi.ki_Nm_rad)
+    replay, _ = T.run(plant, fed, n * dt, 1.0 / dt)
+    assert np.mean(np.abs(rec.bit_rad_s) < 0.05) > 0.1  # it does stick-slip
+    np.testing.assert_allclose(replay.surface_rad_s, rec.surface_rad_s, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(replay.string_torque_Nm, rec.string_torque_Nm, rtol=0,
+                               atol=1e-3)
+
+
+def test_fed_drive_corrects_towards_the_logged_speed():
+    """A logged speed the motor torque cannot explain (torque 0, speed 2 rad/s, frictionless
+    string): the PI correction brings the top drive to the logged speed."""
+    g, _ = _string_and_fc(cells=50)
+    p = frictionless(g, k_t=0.1)
+    fed = T.Drive("fed", np.array([[0.0, 0.0], [2.0, 2.0]]), 100.0, kp_Nms_rad=2e4,
+                  ki_Nm_rad=5e4)
+    rec, _ = T.run(p, fed, 60.0, 1.0)
+    assert rec.surface_rad_s[-1] == pytest.approx(2.0, rel=1e-3)
+    with pytest.raises(ModelError, match="two series"):
+        T.Drive("fed", np.array([1.0, 2.0]), 1.0)
 
 
 # ------------------------------------------------ friction profile and law (theory §3.2)
@@ -479,7 +515,7 @@ def test_steady_rotation_with_cased_open_profile_and_friction_law(law):
 
 @pytest.mark.parametrize("delta, v_s", [(1.0, 0.5), (2.0, 1.0)])
 def test_creep_plateau_follows_the_stribeck_curve(delta, v_s):
-    """docs/theory.md §3.2, THEORY §6.3: a string turned from rest at the creep speed
+    """docs/theory.md §3.2, docs/theory.md §6.3: a string turned from rest at the creep speed
     Ω = 0.5 rad/s; once all of it turns, every element carries
     F_k + (F_s − F_k)·exp(−(Ω/v_s)^δ), so the torque plateau is
     μ_k T_N + (μ_s − μ_k)T_N·w + k_tΩ∫ρJ dx with w = e^−1 = 0.37 (δ = 1) and e^−0.25 = 0.78
@@ -547,7 +583,7 @@ def test_friction_split_into_fixed_part_is_the_same_plant():
 @given(seed=st.integers(0, 2**31 - 1), delta=st.sampled_from([1.0, 1.5, 2.0]))
 def test_energy_conserved_without_friction_under_the_stribeck_law(seed, delta):
     """The Stribeck variant of the kernel with zero caps (no friction, k_t = 0, clamped top)
-    conserves energy exactly like the step law (THEORY §3.1): rel 1e-11 after 10 000
+    conserves energy exactly like the step law (docs/theory.md §3.1): rel 1e-11 after 10 000
     steps, as the step-law test."""
     rng = np.random.default_rng(seed)
     g = T.make_grid(two_section_string(), 150)
@@ -560,7 +596,7 @@ def test_energy_conserved_without_friction_under_the_stribeck_law(seed, delta):
 
 @pytest.fixture(scope="module")
 def well_b():
-    """A&S 2018 Well B (CASES.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
+    """A&S 2018 Well B (docs/reference_cases.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
     from drillfric.simulator import well_b_plant
 
     plant = well_b_plant()
@@ -601,7 +637,8 @@ def test_bad_duration_and_rate_raise():
             T.run(plant, drive, duration, rate)
 
 
-#: A&S 2018 Well A / synthetic BHA (CASES.md): length, OD, ID [m], top-down as listed.
+#: A&S 2018 Well A / synthetic BHA (docs/reference_cases.md): length, OD, ID [m], top-down as
+#: listed.
 WELL_A_BHA = ((19.080, 0.150167, 0.096799), (10.240, 0.206375, 0.076200),
               (57.240, 0.150167, 0.096799), (9.750, 0.206248, 0.069850),
               (95.400, 0.150167, 0.096799), (38.750, 0.222392, 0.095964))

@@ -1,4 +1,4 @@
-"""Minimum-curvature well path (THEORY.md §1; Sawaryn & Thorogood 2005, SPE-84246-PA).
+"""Minimum-curvature well path (docs/theory.md §1; Sawaryn & Thorogood 2005, SPE-84246-PA).
 
 Analytic geometry is the oracle: a straight line, a circular arc and the ratio-factor
 Taylor series. Tolerances are float64 round-off scaled by the lengths involved (1e-9 m on
@@ -203,7 +203,7 @@ def test_tortuous_vertical_is_a_helix():
 
 
 def test_no_survey_path_zero_tortuosity_is_exactly_vertical():
-    """Tortuosity 0 restores the exactly vertical path (no side force, THEORY §2)."""
+    """Tortuosity 0 restores the exactly vertical path (no side force, docs/theory.md §2)."""
     zero, plain = no_survey_path(2345.0, 0.0), vertical(2345.0)
     for name in ("md_m", "inc_rad", "azi_rad", "tvd_m", "north_m", "east_m", "dogleg_rad"):
         np.testing.assert_array_equal(getattr(zero, name), getattr(plain, name))

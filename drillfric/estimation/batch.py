@@ -1,6 +1,6 @@
-"""Batch refinement of the friction factors (the "speed-driven fit"), THEORY.md §6.4.
+"""Batch refinement of the friction factors (the "speed-driven fit"), docs/theory.md §6.4.
 
-The plant of THEORY §3 is driven at x = 0 by the measured top-drive speed (lightly
+The plant of docs/theory.md §3 is driven at x = 0 by the measured top-drive speed (lightly
 smoothed, interpolated to the model step), α(0) = 2ω₀(t) − β(0), starting at rest with no
 twist; its output is the string torque at the top τ(0) = ζ(ω₀ − β(0)), compared with the
 measured string torque τ_s = τ_m − I_TD dω̄₀/dt. From that model:
@@ -39,6 +39,8 @@ from drillfric.drillstring import DrillString
 from drillfric.errors import InputError
 from drillfric.estimation import creep
 from drillfric.estimation.creep import bridge_loaded_dips, find_creeps, rotating_runs, smooth
+from drillfric.estimation.drive import DriveModel
+from drillfric.estimation.drive import identify as identify_drive
 from drillfric.friction import CASED_STATIC, FrictionProfile
 
 MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
@@ -55,11 +57,11 @@ CREEP_DRIVE_SMOOTH_S = 4.0  #: smoothing of the speed driving a creep (keeps its
 STICK_SLIP_FLUCTUATION = 0.1  #: data stick-slip when std/mean of the smoothed torque exceeds
 STUCK_FRACTION = 0.01  #: the model's bit sticks when this share of samples is near rest
 REST_BIT = 0.1  #: the bit is near rest below this fraction of ω_c
-SCAN_STEP = 0.02  #: μ_s grid step of the onset scan (THEORY §6.4)
+SCAN_STEP = 0.02  #: μ_s grid step of the onset scan (docs/theory.md §6.4)
 SCAN_CONFIRM = 3  #: grid points above the first sticking one that must stick too
 SCAN_ROTATION_S = 90.0  #: rotation simulated per onset-scan point (30 s skipped + 60 s) [s]
 MU_MAX = 1.5  #: upper end of every friction search [-]
-CREEP_CELLS_PER_MD = 1000  #: creep fits at Δx ≤ MD/1000 (THEORY §6.4)
+CREEP_CELLS_PER_MD = 1000  #: creep fits at Δx ≤ MD/1000 (docs/theory.md §6.4)
 CREEP_CONVERGENCE = 0.03  #: relative move allowed when the creep fit doubles its cells
 CREEP_MAX_S = 60.0  #: longest creep window fitted [s]
 CREEP_LEVELS = 3  #: creep fits at MD/1000, then doubled cells at most twice
@@ -79,6 +81,10 @@ MIN_SWING_RATIO = 0.5  #: model/data stick-slip fluctuation after the creep
 #: the second (a top of lower friction, e.g. casing, the creep wound up first) and this much
 #: either way (the onset of a slowly logged creep fits high: +4…+13 % at 5 Hz on the plants).
 MAX_HALVES_BELOW, MAX_HALVES_SPLIT = 0.06, 0.15
+#: Both limits widen to this many standard deviations of the halves' difference due to
+#: noise alone: each half holds about half the creep's information, so the relative 1-σ of
+#: their difference is ≈ 2 × CREEP_SENSITIVITY_STEP / sensitivity (4.9 % at sensitivity 4).
+HALVES_SIGMAS = 2.0
 MAX_HYPOTHESIS_SPLIT = 0.05  #: the two hypotheses for an unknown cased static factor
 #: Slowest logging rate for a creep fit [Hz]: the twist is the integral of the logged speed,
 #: and its noise (σ√(Δt·T)) moved μ_s by +17…+33 % at 1 Hz with 0.5 RPM noise, ±6 % at 5 Hz
@@ -91,7 +97,7 @@ _GRID_SPREAD = 0.05  # make_grid may take up to 5 % fewer cells than requested (
 
 @dataclass(frozen=True)
 class BatchResult:
-    """Friction factors of one record from the speed-driven fit (THEORY §6.4).
+    """Friction factors of one record from the speed-driven fit (docs/theory.md §6.4).
 
     Attributes
     ----------
@@ -165,6 +171,9 @@ class BatchDetails:
         What the creep fit was checked against before μ_s is claimed.
     onset_scan : list of (float, bool)
         (μ_s, the model's bit sticks) of the stick-slip-onset scan.
+    drive : DriveModel or None
+        The top drive's PI controller identified from the rotation (replayed in closed loop
+        when usable, docs/theory.md §6.4).
     """
 
     cells: int = 0
@@ -180,6 +189,7 @@ class BatchDetails:
     creep_grid_move: float | None = None
     creep_checks: CreepChecks | None = None
     onset_scan: list = field(default_factory=list)
+    drive: DriveModel | None = None
 
 
 @dataclass(frozen=True)
@@ -199,23 +209,28 @@ class CreepChecks:
         smoothed noise of the measured torque [-].
     noise_Nm : float
         Standard deviation of the smoothed measured torque's noise [N·m].
+    halves : tuple of float
+        μ_s fitted on the first and on the second half of the creep alone [-].
     swing_ratio : float or None
         Model/data ratio of the torque fluctuation in the rotation after the creep at the
         fitted factors (None without stick-slip rotation to compare) [-].
+    other_hypothesis : float or None
+        μ_s refitted with the cased static factor equal to the kinetic one, where the cased
+        static factor is unknown (None: it is known, or there is no cased part) [-].
     """
 
     engaged: float
     misfit: float
     sensitivity: float
     noise_Nm: float
+    halves: tuple[float, float]
     swing_ratio: float | None = None
-    halves: tuple[float, float] | None = None
     other_hypothesis: float | None = None
 
 
 def measured_string_torque(time_s, surface_rad_s, torque_Nm, torque_kind: str,
                            top_drive_inertia_kg_m2: float, smooth_s: float = 1.0) -> np.ndarray:
-    """String torque at the top from the logged torque [N·m] (THEORY §3 top drive, §6.4).
+    """String torque at the top from the logged torque [N·m] (docs/theory.md §3 top drive, §6.4).
 
     τ_s = τ_m − I_TD·dω̄₀/dt for a motor torque (eq. 7 of the paper), with ω̄₀ the top-drive
     speed smoothed over ``smooth_s`` (a Savitzky–Golay derivative: least-squares quadratic
@@ -266,6 +281,7 @@ class _Data:
     t: np.ndarray  # [s]
     dt: float  # [s]
     drive: np.ndarray  # lightly smoothed ω₀ [rad/s]
+    motor: np.ndarray  # lightly smoothed motor torque τ_m [N·m]
     creep_drive: np.ndarray  # ω₀ smoothed over CREEP_DRIVE_SMOOTH_S [rad/s]
     w_bar: np.ndarray  # ω₀ smoothed over TORQUE_SMOOTH_S [rad/s]
     tau: np.ndarray  # measured string torque [N·m]
@@ -293,7 +309,10 @@ def _prepare(time_s, surface_rad_s, torque_Nm, torque_kind, itd) -> tuple[_Data,
         w, tau, t = np.interp(grid, t, w), np.interp(grid, t, tau), grid
         notes.append(f"irregular sampling resampled to {1 / dt:g} Hz")
     tau_s = measured_string_torque(t, w, tau, torque_kind, itd, TORQUE_SMOOTH_S)
+    tau_m = tau if torque_kind == "motor" else \
+        tau - measured_string_torque(t, w, np.zeros_like(tau), "motor", itd, TORQUE_SMOOTH_S)
     data = _Data(t=t, dt=dt, drive=smooth(w, dt, DRIVE_SMOOTH_S),
+                 motor=smooth(tau_m, dt, DRIVE_SMOOTH_S),
                  creep_drive=smooth(w, dt, CREEP_DRIVE_SMOOTH_S),
                  w_bar=smooth(w, dt, max(TORQUE_SMOOTH_S, 3 * dt)), tau=tau_s,
                  tau_bar=smooth(tau_s, dt, TORQUE_SMOOTH_S))
@@ -311,7 +330,9 @@ class _Window:
 
 
 class _Model:
-    """The speed-driven plant on grids of any resolution; counts its runs (THEORY §6.4).
+    """The plant driven by the log, on grids of any resolution; counts its runs (docs/theory.md
+    §6.4). Creeps follow the logged speed; rotation replays the identified drive in closed
+    loop (``drive``, :mod:`drillfric.estimation.drive`), else follows the logged speed too.
 
     Each window starts from rest, holding the twist the measured torque says the string has
     there (:meth:`drillfric.torsional.State.wound`; none after a released stop)."""
@@ -323,6 +344,7 @@ class _Model:
         self.progress = progress
         self.profile = profile or FrictionProfile()
         self.cased_static = CASED_STATIC[0]  # the hypothesis for an unknown cased μ_s
+        self.drive: DriveModel | None = None  # replayed in rotation when usable
         self.runs = 0
         self._grids: dict[int, tuple[torsional.Grid, np.ndarray]] = {}
 
@@ -364,11 +386,18 @@ class _Model:
         plant = self.profile.plant(g, fc, mu_s, mu_k, omega_c_rad_s=self.omega_c,
                                    k_t_per_s=self.k_t, top_drive_inertia_kg_m2=self.itd,
                                    cased_static=self.cased_static)
-        speed = d.creep_drive if win.creep else d.drive
-        drive = torsional.Drive("speed", speed[win.sim0:win.end + 1], d.dt, d.t[win.sim0])
-        t = d.t[win.sim0:win.end + 1]
-        rec, _ = torsional.run(plant, drive, t[-1] - t[0], 1.0 / d.dt,
-                               self._initial(win, g, fc, mu_k))
+        span = slice(win.sim0, win.end + 1)
+        state = self._initial(win, g, fc, mu_k)
+        if win.creep or self.drive is None or not self.drive.usable:
+            speed = d.creep_drive if win.creep else d.drive
+            drive = torsional.Drive("speed", speed[span], d.dt, d.t[win.sim0])
+        else:
+            drive = torsional.Drive("fed", np.vstack([d.motor[span], d.drive[span]]), d.dt,
+                                    d.t[win.sim0], kp_Nms_rad=self.drive.kp_Nms_rad,
+                                    ki_Nm_rad=self.drive.ki_Nm_rad)
+            state.top[0] = d.drive[win.sim0]
+        t = d.t[span]
+        rec, _ = torsional.run(plant, drive, t[-1] - t[0], 1.0 / d.dt, state)
         self.runs += 1
         if self.progress is not None:
             self.progress(1.0)
@@ -383,7 +412,7 @@ def _fluctuation(tau_bar: np.ndarray) -> float:
 
 
 def _sticks(bit_rad_s: np.ndarray, omega_c: float) -> bool:
-    """Whether the model's bit sticks: a share of samples near rest (THEORY §6.4)."""
+    """Whether the model's bit sticks: a share of samples near rest (docs/theory.md §6.4)."""
     return bool(np.mean(np.abs(bit_rad_s) <= REST_BIT * omega_c) >= STUCK_FRACTION)
 
 
@@ -482,7 +511,7 @@ def _fit_mu_k(model: _Model, wins, target_Nm: float, mu_s_of: Callable[[float], 
 
 def _onset_scan(model: _Model, win: _Window, mu_k: float,
                 cells: int) -> tuple[float | None, bool, list]:
-    """Lower bound on μ_s from the stick-slip onset (THEORY §6.2, §6.4).
+    """Lower bound on μ_s from the stick-slip onset (docs/theory.md §6.2, §6.4).
 
     Scans μ_s = μ_k + 0.02 j upward until the model's bit sticks, then checks that the next
     :data:`SCAN_CONFIRM` points stick too. Returns (bound, bistable, scan): the bound is the
@@ -547,7 +576,7 @@ def _creep_misfit(model: _Model, wins, mu_k: float, cells: int) -> Callable[[flo
 
 def _fit_creep(model: _Model, wins, mu_k: float, cells: int, lo: float,
                hi: float) -> tuple[float, int]:
-    """μ_s minimising the smoothed torque misfit over the creeps (THEORY §6.3–6.4):
+    """μ_s minimising the smoothed torque misfit over the creeps (docs/theory.md §6.3–6.4):
     bounded 1-D minimisation (Brent) on [lo, hi]; returns (μ_s, runs)."""
     start = model.runs
     res = minimize_scalar(_creep_misfit(model, wins, mu_k, cells), bounds=(lo, hi),
@@ -612,7 +641,7 @@ def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fitted model against the data over a whole record (the evidence of a fit).
 
-    The speed-driven plant of THEORY §6.4 at (μ_s, μ_k), driven by the measured top-drive
+    The speed-driven plant of docs/theory.md §6.4 at (μ_s, μ_k), driven by the measured top-drive
     speed from rest over the whole record, as :func:`refine`'s fits are.
 
     Returns
@@ -633,8 +662,9 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
            omega_c_rad_s: float, k_t_per_s: float, top_drive_inertia_kg_m2: float,
            torque_kind: str = "motor", cells: int = 500, mu_s_seed: float | None = None,
            progress: Callable[[float], None] | None = None,
-           profile: FrictionProfile | None = None) -> BatchResult:
-    """Refine μ_k and μ_s of one record with the speed-driven model (THEORY §6.4).
+           profile: FrictionProfile | None = None,
+           sample_interval_s: float | None = None) -> BatchResult:
+    """Refine μ_k and μ_s of one record with the speed-driven model (docs/theory.md §6.4).
 
     Parameters
     ----------
@@ -648,7 +678,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         The string at this record's bit depth.
     fc_Nm_m : callable or float
         F_c(x) [N·m/m], a function of measured depth [m] (e.g. ``TDResult.fc_at`` from
-        torque and drag, THEORY §2), or a constant.
+        torque and drag, docs/theory.md §2), or a constant.
     omega_c_rad_s : float
         Static/kinetic switching speed ω_c [rad/s].
     k_t_per_s : float
@@ -666,6 +696,10 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     profile : FrictionProfile, optional
         Friction zones and law of the model (docs/theory.md §3.2); default: one zone, the
         step law. With a known cased zone μ_k, μ_s are the open hole's.
+    sample_interval_s : float, optional
+        Effective interval of the log when coarser than its spacing (means, held values;
+        :mod:`drillfric.estimation.sampling`) [s]: a creep is fitted only when this, too,
+        is within :data:`MIN_CREEP_RATE_HZ`.
 
     Returns
     -------
@@ -682,6 +716,11 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     details.creeps_found = creeps
     wins, notes = _mu_k_windows(data, omega_c_rad_s)
     messages += notes
+    if wins:
+        model.drive = identify_drive(data.t, data.drive, data.motor, [w.used for w in wins])
+        details.drive = model.drive
+        if model.drive is not None:
+            messages.append(model.drive.describe())
     mu_k = None
     stick_slip = False
     if wins:
@@ -699,9 +738,10 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     else:
         flags.append("no_rotation")
     mu_s, bound, method, used_creeps = None, None, "none", ()
-    if creeps and 1.0 / data.dt < MIN_CREEP_RATE_HZ:
+    rate_hz = 1.0 / max(data.dt, sample_interval_s or 0.0)
+    if creeps and rate_hz < MIN_CREEP_RATE_HZ:
         flags.append("creep_rate_too_low")
-        messages.append(f"creep start-up found but logged at {1 / data.dt:g} Hz: the creep "
+        messages.append(f"creep start-up found but logged at {rate_hz:.3g} Hz: the creep "
                         f"fit needs ≥ {MIN_CREEP_RATE_HZ:g} Hz (speed noise integrated into "
                         "the twist); μ_s not fitted")
     elif mu_k is not None and creeps:
@@ -725,7 +765,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
 
 
 def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flags, messages):
-    """μ_k by mean-torque matching with the model in the data's regime (THEORY §6.4)."""
+    """μ_k by mean-torque matching with the model in the data's regime (docs/theory.md §6.4)."""
     d = model.data
     used = np.concatenate([w.used for w in wins])
     string_inertia = float(np.sum(model.grid(cells)[0].rho_j_kg_m
@@ -767,7 +807,7 @@ def _refit_mu_k(model, wins, target, mu_s, mu_k, cells, details, messages):
 
 def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages, rotating=()):
     """μ_s from the creeps at Δx ≤ MD/1000, refitted with doubled cells until it moves
-    less than :data:`CREEP_CONVERGENCE` (THEORY §6.4); None when it never settles."""
+    less than :data:`CREEP_CONVERGENCE` (docs/theory.md §6.4); None when it never settles."""
     wins = _creep_windows(data, creeps)
     n = _creep_cells(model.string, cells)
     lo = max(mu_k, 0.02)
@@ -872,7 +912,8 @@ def _creep_problems(mu_s: float, c: CreepChecks) -> list[str]:
                         "not explain the slips (friction falling with speed?)")
     first, second = c.halves
     change = first / max(second, 1e-9) - 1.0
-    if change < -MAX_HALVES_BELOW or abs(change) > MAX_HALVES_SPLIT:
+    noise = HALVES_SIGMAS * 2.0 * CREEP_SENSITIVITY_STEP / max(c.sensitivity, 1e-9)
+    if change < -max(MAX_HALVES_BELOW, noise) or abs(change) > max(MAX_HALVES_SPLIT, noise):
         problems.append(f"the first and second half of the creep give μ_s = "
                         f"{c.halves[0]:.3f} and {c.halves[1]:.3f}: friction is not the same "
                         "along the string the creep wound up (cased and open hole?)")

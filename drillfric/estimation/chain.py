@@ -40,6 +40,7 @@ from drillfric.estimation.observer import (
     ensemble_bit_speed,
     observe,
 )
+from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_interval, resolution
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import Evidence, Verdict, decide
 from drillfric.friction import FrictionProfile
@@ -70,6 +71,8 @@ class SegmentData:
         Median weight on bit [N] (0 off bottom).
     bit_rpm : ndarray or None
         Downhole truth when the input has it (validation).
+    torque_min_Nm, torque_max_Nm : ndarray or None
+        The torque's minimum and maximum within each logged interval, when the log has them.
     """
 
     time_s: np.ndarray
@@ -79,6 +82,8 @@ class SegmentData:
     kind: str = "off_bottom_rotating"
     wob_N: float = 0.0
     bit_rpm: np.ndarray | None = None
+    torque_min_Nm: np.ndarray | None = None
+    torque_max_Nm: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -123,6 +128,8 @@ class SegmentEstimate:
         The fitted model's string torque against the measured one.
     bit_speed : Resolution
         Whether the logging resolves the stick-slip cycle (else no bit-speed trace).
+    logged : LoggingInterval
+        The log's effective interval and, with min/max channels, the torque swing within it.
     friction_zone : str
         Which factor μ is: "open_hole" (the cased part's factor given) or "effective"
         (torque-weighted over the whole string).
@@ -155,6 +162,7 @@ class SegmentEstimate:
     mu_s_seed: float | None = None
     evidence: FitEvidence | None = field(default=None, repr=False)
     bit_speed: Resolution | None = None
+    logged: LoggingInterval | None = None
     friction_zone: str = "effective"
 
 
@@ -171,7 +179,7 @@ def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
 def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
                    sample_dt_s: float | None = None, mu_s: float = 0.0,
                    mu_k: float = 0.0) -> Observer:
-    """Observer for this string and F_c profile from the configuration (THEORY §5);
+    """Observer for this string and F_c profile from the configuration (docs/theory.md §5);
     ``sample_dt_s`` is the logging interval of the measurements [s]. With a cased zone of
     unknown static friction, (``mu_s``, ``mu_k``) tie it to the open hole's ratio (the
     observer's own μ̂ multiply the open hole's F_c only: docs/theory.md §3.2)."""
@@ -198,7 +206,7 @@ def _starts(cfg, warm, mu_max) -> np.ndarray:
 
 
 def _batch_cells(cfg, bit_depth_m: float) -> int:
-    """Cells of the speed-driven fit: ``model.cells``, refined to Δx ≤ 5 m (THEORY §6.4:
+    """Cells of the speed-driven fit: ``model.cells``, refined to Δx ≤ 5 m (docs/theory.md §6.4:
     at 10 m the fit was biased by 10–14 %)."""
     return max(int(cfg.model.cells), int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
 
@@ -281,9 +289,6 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
 #: Rotation left out after the top drive first exceeds ω_c when the fit is scored [s]
 #: (the start-up transient; the batch fit's μ_k skips the same).
 EVIDENCE_SKIP_S = batch.MU_K_SKIP_S
-#: Samples per stick-slip cycle below which the cycle is not resolved: the bit speed and
-#: the stuck fraction are then not reported (docs/bit_speed.md "Logging rate").
-MIN_SAMPLES_PER_CYCLE = 6.0
 
 
 @dataclass(frozen=True)
@@ -318,25 +323,6 @@ class FitEvidence:
 
 
 @dataclass(frozen=True)
-class Resolution:
-    """Whether the logging resolves the stick-slip cycle, so that a bit-speed trace means
-    something (docs/bit_speed.md "Logging rate").
-
-    Attributes
-    ----------
-    resolved : bool
-    samples_per_cycle : float
-        Shortest stick-slip cycle over the effective sample interval [-].
-    reason : str
-        Why not ("" when resolved).
-    """
-
-    resolved: bool
-    samples_per_cycle: float
-    reason: str = ""
-
-
-@dataclass(frozen=True)
 class SegmentModels:
     """What every estimator of one segment shares (step 1).
 
@@ -353,6 +339,8 @@ class SegmentModels:
     observer : Observer
         The observer (plant copy and gains) for this string and F_c.
     on_bottom : bool
+    logged : LoggingInterval
+        The log's effective sample interval (docs/bit_speed.md "Logging rate").
     """
 
     path: WellPath
@@ -361,6 +349,7 @@ class SegmentModels:
     meas: Measurements
     observer: Observer
     on_bottom: bool
+    logged: LoggingInterval
 
 
 def build_models(cfg, path: WellPath | None, data: SegmentData, *,
@@ -392,7 +381,11 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
         top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2, rate_hz=rate_hz)
     string = build_string(cfg.sections, data.bit_depth_m)
     observer = build_observer(cfg, string, td, cfg.model.cells, sample_dt_s=meas.dt_s)
-    return SegmentModels(path, string, td, meas, observer, on_bottom)
+    logged = logging_interval(data.time_s, data.surface_rpm, data.surface_torque_Nm,
+                              averaging_s=cfg.rig.sample_averaging_s, model_dt_s=meas.dt_s,
+                              torque_min_Nm=data.torque_min_Nm,
+                              torque_max_Nm=data.torque_max_Nm)
+    return SegmentModels(path, string, td, meas, observer, on_bottom, logged)
 
 
 def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
@@ -419,7 +412,8 @@ def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:
                         k_t_per_s=cfg.model.k_t_per_s,
                         top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
                         torque_kind="motor", cells=_batch_cells(cfg, models.string.bit_depth_m),
-                        profile=FrictionProfile.from_config(cfg))
+                        profile=FrictionProfile.from_config(cfg),
+                        sample_interval_s=models.logged.interval_s)
 
 
 def evidence(cfg, models: SegmentModels, diag: Diagnostics,
@@ -476,25 +470,11 @@ def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | Non
                        float(high - low), float(np.mean(measured[scored])))
 
 
-def bit_speed_resolution(cfg, models: SegmentModels) -> Resolution:
-    """Step 7: does the logging resolve the stick-slip cycle?
-
-    The shortest stick-slip cycle is the string's first torsional period, a quarter wave
-    from the top drive to the free bit: 4 × the wave travel time (docs/theory.md §3). Each
-    sample is a spot value or, with ``rig.sample_averaging_s``, the mean over that
-    interval; the effective interval is the larger. Below :data:`MIN_SAMPLES_PER_CYCLE`
-    samples per cycle the bit speed and the stuck fraction are not reported.
-    """
-    interval = max(models.meas.dt_s, cfg.rig.sample_averaging_s or 0.0)
-    period = 4.0 * models.observer.plant.grid.travel_time_s
-    per_cycle = period / interval
-    if per_cycle >= MIN_SAMPLES_PER_CYCLE:
-        return Resolution(True, per_cycle)
-    kind = "means" if (cfg.rig.sample_averaging_s or 0.0) >= models.meas.dt_s else "samples"
-    return Resolution(False, per_cycle, f"bit speed not resolved: {interval:.3g}-s {kind} "
-                      f"give {per_cycle:.2g} per stick-slip cycle (the shortest, "
-                      f"{period:.2g} s, needs ≥ {MIN_SAMPLES_PER_CYCLE:g}); log at "
-                      f"≥ {MIN_SAMPLES_PER_CYCLE / period:.2g} Hz to see the bit")
+def bit_speed_resolution(models: SegmentModels) -> Resolution:
+    """Step 7: does the logging resolve the stick-slip cycle? The shortest cycle is the
+    string's first torsional period, 4 × the wave travel time to the free bit (docs/theory.md
+    §3), against the log's effective interval (:mod:`drillfric.estimation.sampling`)."""
+    return resolution(models.logged, 4.0 * models.observer.plant.grid.travel_time_s)
 
 
 def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
@@ -540,7 +520,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     tick(0.2)
     estimate = _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
     return replace(estimate, evidence=fit_evidence(cfg, models, verdict, refined.mu_s),
-                   bit_speed=bit_speed_resolution(cfg, models))
+                   bit_speed=bit_speed_resolution(models), logged=models.logged)
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,
@@ -571,7 +551,8 @@ def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult
     """Why a creep did not identify μ_s: the wind-up time it would have needed.
 
     Under uniform friction the torque falls linearly from the top, so winding the string up
-    to break-free takes a twist μ_s·T_N·L/(2GJ) [rad] (pipe G, J; THEORY §3, §6.3), turned at
+    to break-free takes a twist μ_s·T_N·L/(2GJ) [rad] (pipe G, J; docs/theory.md §3, §6.3), turned
+    at
     the creep speed; μ_s ≈ 2μ_k is assumed for the estimate.
     """
     pipe = string.sections[0]

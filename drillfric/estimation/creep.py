@@ -1,10 +1,10 @@
-"""Where a surface record can tell μ_s: creep start-ups and rotating runs, THEORY.md §6.2–6.3.
+"""Where a surface record can tell μ_s: creep start-ups and rotating runs, docs/theory.md §6.2–6.3.
 
 A *creep* (or break-over) is a start from rest with no trapped twist in which the top drive
 turns slower than the static/kinetic switching speed ω_c for 10–30 s: every moving element
-is then in the static band and the surface-torque build-up is governed by μ_s (THEORY §6.3).
+is then in the static band and the surface-torque build-up is governed by μ_s (docs/theory.md §6.3).
 A *rotating run* is a stretch in which the top drive turns forward; its samples far enough
-from the start-up carry the kinetic friction μ_k through the mean torque (THEORY §6.4).
+from the start-up carry the kinetic friction μ_k through the mean torque (docs/theory.md §6.4).
 
 Everything works on the top-drive speed smoothed over about a second, so that logging noise
 (0.5 RPM is typical) does not split or invent segments. All times in s, speeds in rad/s.
@@ -122,7 +122,7 @@ def find_creeps(time_s, surface_rad_s, omega_c_rad_s: float, *, torque_Nm=None,
     :data:`CREEP_TOP_FRACTION`·ω_c or returns to rest. With ``torque_Nm``, a start whose mean
     torque over the preceding rest exceeds ``max_rest_torque_fraction`` of the largest
     smoothed torque in the creep is rejected: that torque is twist trapped during the stop,
-    which the model (starting with zero twist) cannot know (THEORY §6.4, restarts).
+    which the model (starting with zero twist) cannot know (docs/theory.md §6.4, restarts).
 
     Parameters
     ----------

@@ -1,11 +1,11 @@
 """Observer gains: the closed-form backstepping design and a steady-state Kalman design.
 
-THEORY.md §5.1. The adaptive observer of Aarsnes et al. (2019) [1], Section 4, eqs.
+docs/theory.md §5.1. The adaptive observer of Aarsnes et al. (2019) [1], Section 4, eqs.
 (32)–(43), corrects a copy of the torsional model with the top-drive speed innovation
 e = ω̂₀ − ω₀ at fixed injection points: the top-drive ODE (p₀), the top boundary (P₀),
 the pipe invariants (p_α(x), p_β(x)), the pipe/BHA junction (P₁), the BHA speed (p₁) and
 the friction adaptation (l_k, l_s). The paper does not print its gains; the closed form
-here was derived for drillfric on the semi-lumped model of THEORY.md §4
+here was derived for drillfric on the semi-lumped model of docs/theory.md §4
 (:mod:`drillfric.estimation.lumped`) and is checked against the exact characteristic function N(s)
 by ``tests/test_gains.py``. The Kalman alternative solves the discrete algebraic Riccati
 equation on the Courant-1 discretisation of the same model and maps the gain back onto
@@ -32,7 +32,7 @@ from drillfric.units import RPM_TO_RAD_S
 
 @dataclass(frozen=True)
 class Tuning:
-    """Tuning of the backstepping design (THEORY.md §5.1).
+    """Tuning of the backstepping design (docs/theory.md §5.1).
 
     Attributes
     ----------
@@ -62,7 +62,7 @@ class Tuning:
 
 @dataclass(frozen=True)
 class Gains:
-    """Output-injection and adaptation gains of the observer (THEORY.md §5, eqs. (32)–(43)).
+    """Output-injection and adaptation gains of the observer (docs/theory.md §5, eqs. (32)–(43)).
 
     Sign convention (e = ω̂₀ − ω₀ [rad/s], per observer step Δt): ω̂₀ += −Δt p₀ e;
     α̂_j += −Δt p_α(x_j) e and β̂_j += −Δt p_β(x_j) e on the pipe cells; both BHA invariants
@@ -107,7 +107,7 @@ class Gains:
 
 @dataclass(frozen=True)
 class KalmanNoise:
-    """Noise intensities of the Kalman design, continuous-time (THEORY.md §5.1).
+    """Noise intensities of the Kalman design, continuous-time (docs/theory.md §5.1).
 
     They are tuning knobs, not measured statistics: only their ratios matter for the gain.
     Discretised as Q = q·Δt, R = r/Δt, so the gains converge as the grid is refined. The
@@ -146,7 +146,7 @@ def _validate(x_m, T_N_Nm: float) -> np.ndarray:
 
 
 def _p_beta(params: LumpedParams, tuning: Tuning, x: np.ndarray) -> np.ndarray:
-    """p_β(x) of THEORY.md §5.1 [1/s] (closed-form backstepping kernel)."""
+    """p_β(x) of docs/theory.md §5.1 [1/s] (closed-form backstepping kernel)."""
     aL, a1, a2 = params.aL_per_s, tuning.z_per_s + tuning.p_per_s, tuning.z_per_s * tuning.p_per_s
     g = tuning.lambda0_per_s / params.a0_per_s
     decay = np.exp(-aL * x / params.c_m_s)
@@ -155,12 +155,12 @@ def _p_beta(params: LumpedParams, tuning: Tuning, x: np.ndarray) -> np.ndarray:
 
 
 def backstepping_gains(params: LumpedParams, tuning: Tuning, x_m, T_N_Nm: float) -> Gains:
-    """Closed-form backstepping gains of THEORY.md §5.1.
+    """Closed-form backstepping gains of docs/theory.md §5.1.
 
     Parameters
     ----------
     params : LumpedParams
-        Semi-lumped model of the string (THEORY.md §4).
+        Semi-lumped model of the string (docs/theory.md §4).
     tuning : Tuning
         κ₁, λ₀, z, p.
     x_m : array_like
@@ -186,7 +186,7 @@ def backstepping_gains(params: LumpedParams, tuning: Tuning, x_m, T_N_Nm: float)
 
 
 def characteristic_N(s, params: LumpedParams, tuning: Tuning):
-    """Characteristic function N(s) of the linear error system (THEORY.md §5.1).
+    """Characteristic function N(s) of the linear error system (docs/theory.md §5.1).
 
     N(s) = s²(s + a_L) + λ₀(s² + a₁s + a₂) + e^{−2 s t_D}·s·(a_L − s)(s + (1 − κ₁)λ₀),
     a₁ = z + p, a₂ = z·p. Its roots are the error system's eigenvalues [1/s].
@@ -235,7 +235,7 @@ def injection_on_nodes(gains: Gains, params: LumpedParams, n_cells: int) -> Inje
 
 def error_system(params: LumpedParams, design: Tuning | Gains,
                  n_cells: int) -> tuple[np.ndarray, float]:
-    """Discrete linear error system observer − plant of THEORY.md §4 (lumped friction).
+    """Discrete linear error system observer − plant of docs/theory.md §4 (lumped friction).
 
     Parameters
     ----------
@@ -310,7 +310,7 @@ def _observable_part(a: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def kalman_filter_gain(params: LumpedParams, n_cells: int,
                        noise: KalmanNoise = KalmanNoise()) -> np.ndarray:
-    """Steady-state predictor gain L of the Courant-1 lumped model (THEORY.md §5.1).
+    """Steady-state predictor gain L of the Courant-1 lumped model (docs/theory.md §5.1).
 
     ẑ_{k+1} = A ẑ_k + B u_k − L (C ẑ_k − y_k), L = A P Cᵀ (C P Cᵀ + R)⁻¹ with P the
     stabilising solution of the discrete algebraic Riccati equation
@@ -363,7 +363,7 @@ def _kalman_design(params: LumpedParams, n: int,
 
 def kalman_gains(params: LumpedParams, x_m, T_N_Nm: float, dt_s: float, *,
                  noise: KalmanNoise = KalmanNoise(), max_design_cells: int = 60) -> Gains:
-    """Steady-state Kalman gains mapped onto the observer's injection points (THEORY.md §5.1).
+    """Steady-state Kalman gains mapped onto the observer's injection points (docs/theory.md §5.1).
 
     The Riccati equation is solved on the Courant-1 model of :mod:`drillfric.estimation.lumped` with
     n = round(t_D/dt_s) pipe cells, capped at ``max_design_cells`` (the noise is scaled
@@ -413,7 +413,7 @@ def tuning_from_config(cfg) -> Tuning:
 
 def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float,
                       sample_dt_s: float | None = None) -> Gains:
-    """Observer gains of the design selected by ``observer.gains`` (THEORY.md §5.1).
+    """Observer gains of the design selected by ``observer.gains`` (docs/theory.md §5.1).
 
     Parameters
     ----------

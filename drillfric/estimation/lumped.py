@@ -1,6 +1,6 @@
 """Semi-lumped ODE–PDE–ODE torsional model and its Courant-1 linear discretisation.
 
-THEORY.md §4 (Section 3 of Aarsnes et al. 2019, eqs. (30)–(31)): the drill pipe [0, L_p] is
+docs/theory.md §4 (Section 3 of Aarsnes et al. 2019, eqs. (30)–(31)): the drill pipe [0, L_p] is
 a lossless transmission line in the Riemann invariants α, β; the top drive (x = 0) and the
 BHA, lumped into one rigid inertia at x = L_p carrying all the friction as a torque d, are
 ODEs at its ends::
@@ -14,7 +14,7 @@ with e = ω₀ − y the innovation against a measured top-drive speed y. Withou
 (all gains zero) this is the plant of §4; with them it is the observer of §5 (and, written
 for observer − plant with y = 0, its linear error system).
 
-With k_t > 0 the pipe also carries the viscous term −(k_t/2)(α + β) of THEORY.md §3 on
+With k_t > 0 the pipe also carries the viscous term −(k_t/2)(α + β) of docs/theory.md §3 on
 both invariants (the §4 model and N(s) have k_t = 0; the Kalman design uses the physical
 damping, which is what damps the grid-scale modes).
 
@@ -44,7 +44,7 @@ from drillfric.errors import ModelError
 
 @dataclass(frozen=True)
 class LumpedParams:
-    """Coefficients of the semi-lumped model (THEORY.md §4, eqs. (30)–(31) of [1]).
+    """Coefficients of the semi-lumped model (docs/theory.md §4, eqs. (30)–(31) of [1]).
 
     Attributes
     ----------
@@ -61,7 +61,7 @@ class LumpedParams:
     zeta_pipe_Nms : float
         Line impedance of the pipe ζ_pipe [N·m·s/rad].
     k_t_per_s : float
-        Viscous damping of the pipe k_t [1/s] (THEORY.md §3, eq. (2)–(3)); 0 in the §4 model
+        Viscous damping of the pipe k_t [1/s] (docs/theory.md §3, eq. (2)–(3)); 0 in the §4 model
         and its error analysis, positive for the Kalman design.
     """
 
@@ -82,7 +82,7 @@ class LumpedParams:
     @classmethod
     def from_string(cls, string: DrillString, top_drive_inertia_kg_m2: float, *,
                     k_t_per_s: float = 0.0) -> LumpedParams:
-        """Lump a drill string: first section = pipe, the rest = rigid BHA (THEORY.md §4).
+        """Lump a drill string: first section = pipe, the rest = rigid BHA (docs/theory.md §4).
 
         Parameters
         ----------
@@ -115,7 +115,7 @@ class LumpedParams:
 
 @dataclass(frozen=True)
 class Injection:
-    """Output injection gains of the observer, sampled on the model nodes (THEORY.md §5).
+    """Output injection gains of the observer, sampled on the model nodes (docs/theory.md §5).
 
     Attributes
     ----------
@@ -143,7 +143,7 @@ class Injection:
 
     @classmethod
     def none(cls, n_cells: int) -> Injection:
-        """No injection: the plant of THEORY.md §4."""
+        """No injection: the plant of docs/theory.md §4."""
         zeros = np.zeros(n_cells + 1)
         return cls(0.0, 0.0, zeros, zeros, 0.0, 0.0, 0.0)
 
@@ -216,7 +216,7 @@ def step(params: LumpedParams, inj: Injection, z: np.ndarray, y=(0.0, 0.0),
 def transition_matrix(params: LumpedParams, inj: Injection) -> np.ndarray:
     """Matrix A of z_{k+1} = A z_k for y ≡ 0, τ_m ≡ 0 (plant, or observer-error system).
 
-    With ``Injection.none(n)`` this is the free plant of THEORY.md §4; with the observer's
+    With ``Injection.none(n)`` this is the free plant of docs/theory.md §4; with the observer's
     gains it is the linear error system observer − plant (the measured speed is the
     plant's, so the error's "measurement" is zero).
     """
@@ -235,7 +235,7 @@ def steady_state(params: LumpedParams, n_cells: int, omega_rad_s: float,
                  d_Nm: float) -> np.ndarray:
     """Steady rotation at ω with friction torque d (needs τ_m = d): a uniform twist.
 
-    The pipe carries τ = d everywhere: α = ω + d/ζ, β = ω − d/ζ (THEORY.md §3, eq. (8)).
+    The pipe carries τ = d everywhere: α = ω + d/ζ, β = ω − d/ζ (docs/theory.md §3, eq. (8)).
     """
     z = np.empty(state_size(n_cells))
     z[0] = omega_rad_s

@@ -1,4 +1,4 @@
-"""The adaptive observer of Aarsnes et al. (2019), Section 4 — THEORY.md §5.
+"""The adaptive observer of Aarsnes et al. (2019), Section 4 — docs/theory.md §5.
 
 A copy of the distributed torsional model (:mod:`drillfric.torsional`, same grid, same
 F_c(x) profile, friction with the current estimates μ̂_s, μ̂_k) corrected by the measured
@@ -9,7 +9,7 @@ pass; the final state warm-starts the next window.
 Measurements arrive at the logging rate (1–100 Hz) while the observer steps at Δt. The
 default is linear interpolation between samples (one sample of lag, fine for a batch tool);
 ``observer.interpolation = "hold"`` reproduces the paper's zero-order hold, which in the
-prototype of THEORY §6 already shifted stick/slip timing at 100 Hz.
+prototype of docs/theory.md §6 already shifted stick/slip timing at 100 Hz.
 
 [1] U.J.F. Aarsnes, J. Auriol, F. Di Meglio, R.J. Shor, "Estimating friction factors while
     drilling", JPSE 179 (2019) 80–91.
@@ -43,7 +43,7 @@ class Observer:
     gains : Gains
         Injection and adaptation gains on the pipe cells of ``plant.grid``.
     law : str
-        "corrected" (μ̂_s held, THEORY §6.1) or "paper" (eqs. 42–43 as printed).
+        "corrected" (μ̂_s held, docs/theory.md §6.1) or "paper" (eqs. 42–43 as printed).
     mu_max : float
         Physical clamp on the estimates [-].
     deadlock_s : float
@@ -125,7 +125,7 @@ class Measurements:
             Logged samples (increasing time, finite values).
         torque_kind : str
             "motor": the log is τ_m. "string": the log is τ(0) = τ_m − I_TD dω₀/dt
-            (THEORY §3, eq. 7), so τ_m = τ(0) + I_TD dω̄₀/dt with ω̄₀ smoothed over
+            (docs/theory.md §3, eq. 7), so τ_m = τ(0) + I_TD dω̄₀/dt with ω̄₀ smoothed over
             ``smooth_s``.
         rate_hz : float, optional
             Uniform rate [Hz] (default: the median sampling rate).
@@ -192,7 +192,8 @@ class ObserverState:
         """Initial states for ``starts`` = [(μ_s, μ_k), ...].
 
         Rotating (|ω₀| > ω_c): every cell at ω₀ with the steady sliding torque
-        τ(x) = sign(ω₀)·∫ₓᴸ f(ω₀) dx (THEORY §3.1, steady rotation; f the friction per metre at
+        τ(x) = sign(ω₀)·∫ₓᴸ f(ω₀) dx (docs/theory.md §3.1, steady rotation; f the friction per
+        metre at
         ω₀ of docs/theory.md §3.2, μ_k F_c plus the fixed kinetic part under the step law), so
         a window that starts mid-rotation does not begin with a huge transient. At rest: the
         string held by friction at the measured surface torque ``torque_top_Nm`` [N·m]
@@ -370,7 +371,7 @@ def ensemble_bit_speed(record: ObserverRecord, memory_s: float,
                        noise_rad_s: float) -> BitSpeedEstimate:
     """Bit speed of an ensemble of observer members (the starts of ``record``).
 
-    In stick-slip the members' cycles drift apart in phase (the cycle is chaotic, THEORY
+    In stick-slip the members' cycles drift apart in phase (the cycle is chaotic, docs/theory.md
     §6.2) and a member that has drifted shows it in its innovation e = ω̂₀ − ω₀ about one
     wave round trip later. Each member is weighted by 1/(ē² + σ²), ē² the mean square of
     its innovation over the last ``memory_s`` (exponential memory) and σ the measurement

@@ -1,6 +1,6 @@
 """Is the logged torque in the unit it claims? A plausibility check per rotating segment.
 
-Off bottom the soft-string model gives a mean rotating surface torque μ·T_N (THEORY.md §2,
+Off bottom the soft-string model gives a mean rotating surface torque μ·T_N (docs/theory.md §2,
 §5.1, T_N = ∫F_c dx); no physical friction factor puts it 1000 times higher or lower. A
 segment whose mean torque lies far outside what friction factors in :data:`PLAUSIBLE_MU`
 can give fails with advice on the unit (kN·m read as N·m, ft·lbf, …), rather than being
@@ -16,7 +16,7 @@ from drillfric.io.channels import factor
 from drillfric.units import RPM_TO_RAD_S
 
 #: Friction factors bounding any physical rotating torque (generous): off bottom the soft
-#: string gives a surface torque μ·T_N (THEORY §2, §5.1), so μ ∈ this range bounds it.
+#: string gives a surface torque μ·T_N (docs/theory.md §2, §5.1), so μ ∈ this range bounds it.
 PLAUSIBLE_MU = (0.02, 1.5)
 #: How far outside the plausible torque range (either way) a segment's mean rotating torque
 #: may lie before the segment fails: beyond it the torque channel is almost surely in
@@ -33,7 +33,8 @@ _TORQUE_UNITS = ("N.m", "kN.m", "ft.lbf", "kft.lbf")
 
 def plausible_torque_range(T_N_Nm: float, kind: str, wob_N: float = 0.0) -> tuple[float, float]:
     """Mean rotating surface torque [N·m] that friction factors in :data:`PLAUSIBLE_MU`
-    can give: μ·T_N off bottom (THEORY §5.1), plus an allowance for the bit torque on bottom.
+    can give: μ·T_N off bottom (docs/theory.md §5.1), plus an allowance for the bit torque on
+    bottom.
 
     Parameters
     ----------

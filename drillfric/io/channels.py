@@ -1,6 +1,6 @@
 """Channel recognition: the one mnemonic table, and the mapping of source columns to channels.
 
-Every canonical surface channel of INTERFACE.md is declared once in :data:`CHANNELS` (its
+Every canonical surface channel of docs/ingestion.md is declared once in :data:`CHANNELS` (its
 ``[channels]`` key, canonical column with unit suffix, quantity, unit assumed when the file
 states none, and the mnemonics recognised). :func:`map_channels` matches a file's columns to
 these channels and decides each channel's source unit, in this order of precedence:

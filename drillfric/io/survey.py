@@ -2,10 +2,10 @@
 
 A survey is a table of stations: measured depth, inclination and azimuth, optionally with
 the operator's own TVD, north/east offsets and dogleg severity. :func:`read_survey_table`
-returns it in the canonical columns of INTERFACE.md (``md_m, inc_deg, azi_deg`` plus
+returns it in the canonical columns of docs/ingestion.md (``md_m, inc_deg, azi_deg`` plus
 ``tvd_m, north_m, east_m, dls_deg_30m`` when the file has them), validated, in file order;
 :func:`read_survey` turns it into a :class:`~drillfric.wellpath.WellPath` by minimum
-curvature (THEORY.md §1). The sidecar a pipeline writes and reads is ``NAME.survey.csv``
+curvature (docs/theory.md §1). The sidecar a pipeline writes and reads is ``NAME.survey.csv``
 with the columns ``md_m,inc_deg,azi_deg`` (:func:`write_survey`).
 
 Recognised layouts
@@ -35,7 +35,7 @@ from drillfric.io.text import listing, printable
 from drillfric.units import conversion_factor
 from drillfric.wellpath import WellPath, minimum_curvature
 
-#: Columns of the survey sidecar ``NAME.survey.csv`` (INTERFACE.md).
+#: Columns of the survey sidecar ``NAME.survey.csv`` (docs/ingestion.md).
 SIDECAR_COLUMNS = ("md_m", "inc_deg", "azi_deg")
 
 #: Canonical column -> accepted names, lower-cased with everything but letters and digits
@@ -108,7 +108,7 @@ def read_survey_table(path) -> pd.DataFrame:
 
 
 def read_survey(path, *, tie_in=None) -> WellPath:
-    """Read a survey file and compute its well path by minimum curvature (THEORY.md §1).
+    """Read a survey file and compute its well path by minimum curvature (docs/theory.md §1).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""A well on disk (INTERFACE.md) read into one in-memory representation in SI units.
+"""A well on disk (docs/ingestion.md) read into one in-memory representation in SI units.
 
 A well is one of
 

@@ -1,4 +1,5 @@
-"""Writing a well to disk (INTERFACE.md "A well on disk"): surface table, sidecars, truth.
+"""Writing a well to disk (docs/ingestion.md "Well layouts: a well on disk"): surface table,
+sidecars, truth.
 
 :func:`write_well` writes ``NAME.{parquet,csv,h5,hdf5}`` (format by extension) with the
 canonical columns, and beside it ``NAME.toml`` (a configuration that

@@ -52,7 +52,7 @@ def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
     """Friction adaptation, eqs. (42)–(44) of [1]; returns (μ̂_s, μ̂_k).
 
     Sliding BHA: dμ̂_k/dt = +l_k e. Stuck BHA: the paper's law dμ̂_s/dt = −l_s e
-    (``law`` = paper) or, by default, μ̂_s held (THEORY §6.1: every μ_s law tried ends at
+    (``law`` = paper) or, by default, μ̂_s held (docs/theory.md §6.1: every μ_s law tried ends at
     its clamp, on μ̂_k or wherever its start put it; μ_s comes from the batch fit). Then
     μ̂_s ← max(μ̂_s, μ̂_k) (eq. 44) and both are clamped to [0, μ_max].
     """
@@ -68,7 +68,7 @@ def adapt(mu_s, mu_k, e, stuck, l_s, l_k, dt, law, mu_max):
 
 @njit(cache=True, inline="always")
 def deadlock_guard(mu_s, mu_k, stuck_s, events, turning_stuck, dt, deadlock_s):
-    """Deadlock guard (THEORY §6.1); returns (μ̂_s, μ̂_k, stuck time [s], interventions).
+    """Deadlock guard (docs/theory.md §6.1); returns (μ̂_s, μ̂_k, stuck time [s], interventions).
 
     While the estimated BHA is stuck and the measured top drive turns (``turning_stuck``)
     the stuck time grows by Δt, else it resets; past ``deadlock_s`` μ̂_s drops to μ̂_k (and

@@ -8,7 +8,7 @@ observer (docs/theory.md §5, a copy of this plant plus injections) reuses:
   written into the ghost cells that frame every section;
 - :func:`cell_update` — steps 2–3 for one cell: viscous term −(k_t/2)(α + β) (erratum of
   eq. 11), taken at the foot of each characteristic (see docs/simulator.md: evaluated at
-  the cell itself, as THEORY §3.1 step 2 reads, it amplifies grid-scale waves at rate k_t),
+  the cell itself, as docs/theory.md §3.1 step 2 reads, it amplifies grid-scale waves at rate k_t),
   and the friction inclusion (eqs. 5–6, A.1–A.5 with consistent units) with the cap of
   :func:`friction_cap` (docs/theory.md §3.2: friction profile, step or Stribeck law);
 - :func:`pass_cells` — steps 1–3 fused in one vectorised pass over every cell (exact
@@ -18,7 +18,7 @@ observer (docs/theory.md §5, a copy of this plant plus injections) reuses:
   (PI on a set-point series, prescribed torque, or prescribed speed) and step 4, taken
   trapezoidally and solved *before* step 1 because the top inflow α(0) = 2ω̄₀ − β(0) uses
   the step-mean speed ω̄₀ = (ω₀^k + ω₀^(k+1))/2 (docs/theory.md erratum E11: the explicit
-  step 4 of THEORY §3.1 adds energy at every step);
+  step 4 of docs/theory.md §3.1 adds energy at every step);
 - :func:`run_plant` — many steps in one call, recording at the requested times by linear
   interpolation between steps (no Python loop over time steps); it runs the compiled
   :func:`plant_kernel` of the call's friction variant.
@@ -51,7 +51,7 @@ from __future__ import annotations
 import numpy as np
 from numba import literally, njit
 
-_MODE_PI, _MODE_TORQUE, _MODE_SPEED = 0, 1, 2
+_MODE_PI, _MODE_TORQUE, _MODE_SPEED, _MODE_FED = 0, 1, 2, 3
 #: Friction-law variants of the cell loop (:func:`law_code`): the step law at ω_c, and the
 #: Stribeck law with δ = 1, δ = 2 (vectorised) or any other δ (a scalar power per cell).
 LAW_STEP, LAW_STRIBECK_1, LAW_STRIBECK_2, LAW_STRIBECK = 0, 1, 2, 3
@@ -72,6 +72,21 @@ def drive_value(u, u_t0, u_dt, t):
         return u[n - 1]
     i = int(s)
     return u[i] + (s - i) * (u[i + 1] - u[i])
+
+
+@njit(cache=True)
+def drive_half(u, half, u_t0, u_dt, t):
+    """:func:`drive_value` of the first (``half`` = 0) or second half of ``u`` (two series
+    of equal length one after the other; no array view is made)."""
+    n = u.size // 2
+    base = half * n
+    s = (t - u_t0) / u_dt
+    if s <= 0.0:
+        return u[base]
+    if s >= n - 1:
+        return u[base + n - 1]
+    i = int(s)
+    return u[base + i] + (s - i) * (u[base + i + 1] - u[base + i])
 
 
 @njit(cache=True)
@@ -198,7 +213,7 @@ def unpadded(xp, section_start, out):
 
 @njit(cache=True)
 def inflows(A, B, W, cur, section_start, junction_z, alpha_top, omega_top, bit_cap_rel):
-    """Boundary values of step 1 of THEORY §3.1 into the ghost cells of row ``cur`` of the
+    """Boundary values of step 1 of docs/theory.md §3.1 into the ghost cells of row ``cur`` of the
     state buffers ``A`` (α), ``B`` (β), ``W`` (ω = (α + β)/2), from the real cells at step k.
 
     Each section is framed by ghost cells (layout of :func:`padded`): the one above its
@@ -237,7 +252,7 @@ def inflows(A, B, W, cur, section_start, junction_z, alpha_top, omega_top, bit_c
 @njit(cache=True, inline="always")
 def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_s_j, fix_k_j, mu_s,
                 mu_k, omega_c, inv_vs, delta, law, fixed):
-    """Steps 2–3 of THEORY §3.1 for one cell; returns (α, β) at step k+1 [rad/s].
+    """Steps 2–3 of docs/theory.md §3.1 for one cell; returns (α, β) at step k+1 [rad/s].
 
     ``a_src``, ``b_src`` are the transported values α*, β* (step 1) and ``w_src_a``,
     ``w_src_b`` the speeds ω^k at the feet of their characteristics (the cell above and the
@@ -260,7 +275,7 @@ def cell_update(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_s_j, f
 @njit(cache=True)
 def pass_cells(A, B, W, cur, end, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c, inv_vs, delta,
                law, fixed, inj_a, inj_b, e, inject):
-    """Steps 1–3 of THEORY §3.1 on every cell: α*_j = α_{j−1}, β*_j = β_{j+1} (exact
+    """Steps 1–3 of docs/theory.md §3.1 on every cell: α*_j = α_{j−1}, β*_j = β_{j+1} (exact
     Courant-1 shift) from row ``cur`` of the state buffers ``A`` (α), ``B`` (β), ``W`` (ω),
     then :func:`cell_update`, written to row 1 − ``cur``, for the cells 1 … ``end`` − 1
     (``end`` = :func:`padded_size` − 1).
@@ -307,22 +322,26 @@ def work_buffer(alpha, beta, section_start, cells):
 
 
 @njit(cache=True)
-def motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_itd):
-    """Motor torque τ_m at step k [N·m] (THEORY §3, top-drive controller).
+def motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt, inv_itd):
+    """Motor torque τ_m at step k [N·m] (docs/theory.md §3, top-drive controller).
 
     PI: k_p(ω_ref − ω₀) + k_i∫(ω_ref − ω₀)dt; prescribed torque: the series; prescribed
-    speed: the torque that makes the top drive follow it, τ(0) + I_TD·Δω₀/Δt.
+    speed: the torque that makes the top drive follow it, τ(0) + I_TD·Δω₀/Δt (``u_aux`` the
+    next speed); fed: the logged motor torque plus the PI on the logged speed ``u_aux``,
+    τ_m,log + k_p(ω_log − ω₀) + k_i∫(ω_log − ω₀)dt (docs/theory.md §6.4).
     """
     if mode == _MODE_PI:
         return kp * (u_now - omega0) + ki * integral
     if mode == _MODE_TORQUE:
         return u_now
-    return tau0 + (u_next - u_now) / (dt * inv_itd)
+    if mode == _MODE_FED:
+        return u_now + kp * (u_aux - omega0) + ki * integral
+    return tau0 + (u_aux - u_now) / (dt * inv_itd)
 
 
 @njit(cache=True, inline="always")
 def top_drive_step(omega0, beta0, q, accel_dt):
-    """Step 4 of THEORY §3.1, eq. (7), trapezoidal (docs/theory.md erratum E11) [rad/s].
+    """Step 4 of docs/theory.md §3.1, eq. (7), trapezoidal (docs/theory.md erratum E11) [rad/s].
 
     Eq. (7), I_TD dω₀/dt = τ_m − τ(0), with τ(0) = ζ_pipe(ω(0) − β(0)) (eq. 15), over one
     step: β(0) is the β of cell 0 at step k — under Courant-1 transport exactly the wave
@@ -374,14 +393,18 @@ def plant_kernel(law: int, fixed: bool):
         p0 = p1 = p2 = p3 = 0.0
         for k in range(n_steps + 1):
             t = t0 + k * dt
-            u_now = drive_value(u, u_t0, u_dt, t)
-            u_next = u_now
+            if mode == _MODE_FED:
+                u_now = drive_half(u, 0, u_t0, u_dt, t)
+                u_aux = drive_half(u, 1, u_t0, u_dt, t)
+            else:
+                u_now = drive_value(u, u_t0, u_dt, t)
+                u_aux = u_now
             if mode == _MODE_SPEED:
                 omega0 = u_now
-                u_next = drive_value(u, u_t0, u_dt, t + dt)
+                u_aux = drive_value(u, u_t0, u_dt, t + dt)
             beta0 = B[cur, 1]
             tau0 = zeta0 * (omega0 - beta0)
-            tau_m = motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt,
+            tau_m = motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt,
                                  inv_itd)
             w_bit = W[cur, last]
             while r < n_rec and times[r] <= t + eps:
@@ -404,6 +427,8 @@ def plant_kernel(law: int, fixed: bool):
                        omega_c, inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
             if mode == _MODE_PI:
                 integral += dt * (u_now - omega0)
+            elif mode == _MODE_FED:
+                integral += dt * (u_aux - omega0)
             omega0 = omega_next
             cur = 1 - cur
         unpadded(A[cur], section_start, alpha)
@@ -425,7 +450,7 @@ def variant(law_speed: float, law_exp: float, fix_k, fix_s) -> tuple[int, bool]:
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
               fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd,
               mode, u, u_t0, u_dt, kp, ki, times, out):
-    """Advance ``n_steps`` steps from time ``t0`` and record at ``times`` (THEORY §3.1).
+    """Advance ``n_steps`` steps from time ``t0`` and record at ``times`` (docs/theory.md §3.1).
 
     ``alpha``, ``beta`` (cells) and ``top`` = [ω₀, PI integral] are updated in place.
     Friction (docs/theory.md §3.2): caps μ_s·fcap + fix_s, μ_k·fcap + fix_k, step law at

@@ -13,7 +13,7 @@ import numpy as np
 
 from drillfric.kernels.plant import LAW_STEP, LAW_STRIBECK, LAW_STRIBECK_1, LAW_STRIBECK_2
 
-_MODE_PI, _MODE_TORQUE, _MODE_SPEED = 0, 1, 2
+_MODE_PI, _MODE_TORQUE, _MODE_SPEED, _MODE_FED = 0, 1, 2, 3
 _EXP_COEF = (1.6059043836821613e-10, 2.08767569878681e-09, 2.505210838544172e-08,
              2.755731922398589e-07, 2.7557319223985893e-06, 2.48015873015873e-05,
              0.0001984126984126984, 0.001388888888888889, 0.008333333333333333,
@@ -106,13 +106,15 @@ def damp_and_friction(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, fix_s, fix_k, m
     b_new[:] = bn - d
 
 
-def motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_itd):
-    """Motor torque τ_m at step k [N·m] (PI, prescribed torque or prescribed speed)."""
+def motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt, inv_itd):
+    """Motor torque τ_m at step k [N·m] (PI, prescribed torque, prescribed speed or fed)."""
     if mode == _MODE_PI:
         return kp * (u_now - omega0) + ki * integral
     if mode == _MODE_TORQUE:
         return u_now
-    return tau0 + (u_next - u_now) / (dt * inv_itd)
+    if mode == _MODE_FED:
+        return u_now + kp * (u_aux - omega0) + ki * integral
+    return tau0 + (u_aux - u_now) / (dt * inv_itd)
 
 
 def top_drive_step(omega0, beta0, q, accel_dt):
@@ -136,13 +138,18 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     prev = np.zeros(4)
     for k in range(n_steps + 1):
         t = t0 + k * dt
-        u_now = drive_value(u, u_t0, u_dt, t)
-        u_next = u_now
+        if mode == _MODE_FED:
+            half = u.size // 2
+            u_now = drive_value(u[:half], u_t0, u_dt, t)
+            u_aux = drive_value(u[half:], u_t0, u_dt, t)
+        else:
+            u_now = drive_value(u, u_t0, u_dt, t)
+            u_aux = u_now
         if mode == _MODE_SPEED:
             omega0 = u_now
-            u_next = drive_value(u, u_t0, u_dt, t + dt)
+            u_aux = drive_value(u, u_t0, u_dt, t + dt)
         tau0 = zeta[0] * (omega0 - b[0])
-        tau_m = motor_torque(mode, u_now, u_next, omega0, integral, tau0, kp, ki, dt, inv_itd)
+        tau_m = motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt, inv_itd)
         cur = np.array([omega0, tau_m, tau0, 0.5 * (a[-1] + b[-1])])
         while r < times.size and times[r] <= t + eps:
             f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
@@ -161,6 +168,8 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
                           omega_c, inv_vs, law_exp, law)
         if mode == _MODE_PI:
             integral += dt * (u_now - omega0)
+        elif mode == _MODE_FED:
+            integral += dt * (u_aux - omega0)
         omega0 = float(omega_next)
         a, a2 = a2, a
         b, b2 = b2, b

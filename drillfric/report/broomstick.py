@@ -2,7 +2,7 @@
 of friction factors, and what the rig measured on top (docs/reports.md "Broomstick").
 
 Model lines come from the soft-string model (:func:`drillfric.torque_drag.broomstick`,
-THEORY.md §2) for pick-up, slack-off and rotating off bottom; measured points are one per
+docs/theory.md §2) for pick-up, slack-off and rotating off bottom; measured points are one per
 segment: its median hook load and mean rotating surface torque at its bit depth — from a
 result directory's segments (``hookload_N``, ``surface_torque_mean_Nm``) or straight from a
 log (:func:`measured_points_from_log`, used by ``drillfric td --broomstick WELL``).
@@ -10,7 +10,7 @@ log (:func:`measured_points_from_log`, used by ``drillfric td --broomstick WELL`
 The string-weight check (:func:`weight_check`). The hook carries the string *and* the
 travelling block and top drive, so a measured off-bottom hook load is the string's
 effective tension at surface plus a positive block weight. Rotating off bottom, the
-soft-string model has no axial friction (σ = 0, THEORY.md §2 step 3): its hook load is the
+soft-string model has no axial friction (σ = 0, docs/theory.md §2 step 3): its hook load is the
 string's buoyed weight along the path, whatever μ is. A modelled rotating hook load above
 the measured one at the same depth is therefore impossible; it means the configured string
 is too heavy (linear masses, section lengths), the mud too light, or the hook-load channel

@@ -1,4 +1,4 @@
-"""What a report reads from a result directory (INTERFACE.md "Outputs of run").
+"""What a report reads from a result directory (docs/outputs.md).
 
 Only files of the directory are read (``summary.json`` and the Parquet tables next to it),
 so ``drillfric report RESULT_DIR`` can rebuild a report long after the run. Estimates are

@@ -104,7 +104,7 @@ def profile_depths(segments: pd.DataFrame, profiles: pd.DataFrame | None,
 
 def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
                     count: int = 3, size: tuple[float, float] = (_WIDTH_IN, 4.2)) -> Figure:
-    """Normal force per length and F_c = r·F_n (THEORY.md §5.1) versus MD at a few bit depths.
+    """Normal force per length and F_c = r·F_n (docs/theory.md §5.1) versus MD at a few bit depths.
 
     Parameters
     ----------
@@ -144,7 +144,7 @@ def friction_log_figure(segments: pd.DataFrame,
     the stick-slip severity versus bit depth beside it.
 
     Filled markers: converged; hollow: not converged. μ_s is drawn as a point only where it
-    is identifiable (THEORY.md §6); where only a lower bound is known it is drawn as a
+    is identifiable (docs/theory.md §6); where only a lower bound is known it is drawn as a
     right-pointing bound (▷ with a dotted tail: "at least this"). Crosses: the
     torque-and-drag back-calculated μ (``mu_td``). Bars span the spread across starts.
     Segments without an estimate are grey diamonds on the left edge. Markers are not

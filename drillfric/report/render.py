@@ -85,7 +85,7 @@ def clock(seconds: float) -> str:
 
 
 def mu_s_text(mu_s, identifiable: bool, lower_bound) -> str:
-    """μ_s as shown to users: the value, "≥ bound", or "not identifiable" (THEORY.md §6)."""
+    """μ_s as shown to users: the value, "≥ bound", or "not identifiable" (docs/theory.md §6)."""
     if identifiable and fmt(mu_s) != "—":
         return fmt(mu_s)
     if fmt(lower_bound) != "—":

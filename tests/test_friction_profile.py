@@ -1,0 +1,136 @@
+"""Friction zones along the string (drillfric.friction, docs/theory.md §3.2) and the checks a
+creep fit must pass before its μ_s is claimed (drillfric.estimation.batch, docs/theory.md
+§6.3, docs/batch_refinement.md "Checks of a creep fit").
+
+The profile's parts are exact bookkeeping, so they are checked to round-off against hand
+sums: the friction capacity of a string with a cased top is the cased factor times F_c over
+the cased length plus the open-hole factor times F_c below it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from drillfric.config import config_from_dict
+from drillfric.estimation import batch
+from drillfric.friction import EFFECTIVE, OPEN_HOLE, FrictionProfile
+
+#: Ten 100-m cells from 0 to 1000 m, F_c = 40 N·m/m, shoe at 350 m (half a cell).
+X_M = np.arange(50.0, 1000.0, 100.0)
+DX_M = np.full(10, 100.0)
+FC = 40.0
+
+
+def _capacity(parts, mu: float, which: int) -> float:
+    """∫ (μ·estimated + fixed) dx over the string [N·m] (which: 1 kinetic, 2 static)."""
+    est, fixed = parts[0], parts[which]
+    return float(np.sum((mu * est + fixed) * DX_M))
+
+
+def test_one_zone_is_all_estimated():
+    """Without casing keys the whole F_c is estimated and nothing is fixed: μ is an
+    effective factor."""
+    p = FrictionProfile()
+    est, fix_k, fix_s = p.parts(X_M, DX_M, FC, 0.6, 0.25)
+    assert np.all(est == FC) and not fix_k.any() and not fix_s.any()
+    assert p.zone == EFFECTIVE and p.static_known
+
+
+def test_known_cased_factor_fixes_the_cased_length():
+    """Shoe at 350 m, cased μ_k = 0.2: 350 m carry 0.2·F_c fixed, 650 m carry μ_open·F_c —
+    the kinetic capacity is 0.2·40·350 + 0.3·40·650 N·m."""
+    p = FrictionProfile(shoe_md_m=350.0, cased_kinetic=0.2, cased_static=0.3)
+    parts = p.parts(X_M, DX_M, FC, 0.6, 0.3)
+    assert p.cased_share(X_M, DX_M)[3] == pytest.approx(0.5)
+    assert _capacity(parts, 0.3, 1) == pytest.approx(0.2 * FC * 350 + 0.3 * FC * 650)
+    assert _capacity(parts, 0.6, 2) == pytest.approx(0.3 * FC * 350 + 0.6 * FC * 650)
+    assert p.zone == OPEN_HOLE and p.static_known
+
+
+@pytest.mark.parametrize("hypothesis, cased_static", [("tied", 0.2 * 0.6 / 0.3),
+                                                       ("kinetic", 0.2)])
+def test_unknown_cased_static_follows_the_hypothesis(hypothesis, cased_static):
+    """Unknown cased μ_s: "tied" keeps the open hole's μ_s/μ_k (0.2·2 = 0.4), "kinetic"
+    gives the casing no static excess (0.2)."""
+    p = FrictionProfile(shoe_md_m=350.0, cased_kinetic=0.2)
+    parts = p.parts(X_M, DX_M, FC, 0.6, 0.3, hypothesis)
+    assert not p.static_known
+    assert _capacity(parts, 0.6, 2) == pytest.approx(cased_static * FC * 350
+                                                     + 0.6 * FC * 650)
+
+
+def test_ratio_scales_the_cased_fc():
+    """μ_cased = 0.5·μ_open: the estimated F_c is halved above the shoe, nothing fixed."""
+    p = FrictionProfile(shoe_md_m=350.0, ratio=0.5)
+    est, fix_k, fix_s = p.parts(X_M, DX_M, FC, 0.6, 0.3)
+    assert float(np.sum(est * DX_M)) == pytest.approx(FC * (0.5 * 350 + 650))
+    assert not fix_k.any() and not fix_s.any() and p.static_known
+
+
+def test_profile_from_config_needs_the_shoe_and_a_cased_factor():
+    """A shoe alone changes nothing (no known factor): the estimate stays effective."""
+    assert FrictionProfile.from_config(config_from_dict({})).zone == EFFECTIVE
+    shoe = config_from_dict({"model": {"casing_shoe_md_m": 1500.0}})
+    assert FrictionProfile.from_config(shoe).zone == EFFECTIVE
+    cased = config_from_dict({"model": {"casing_shoe_md_m": 1500.0, "friction_cased": 0.2}})
+    assert FrictionProfile.from_config(cased) == FrictionProfile(shoe_md_m=1500.0,
+                                                                 cased_kinetic=0.2)
+
+
+# --- checks of a creep fit ----------------------------------------------------------------
+
+#: A creep fit of the model family (validation plant "step" at 100 Hz: misfit 0.6 %,
+#: halves within 3 %, swing ratio ≈ 1).
+PASSING = batch.CreepChecks(engaged=0.9, misfit=0.006, sensitivity=25.0, noise_Nm=20.0,
+                            halves=(0.59, 0.60), swing_ratio=0.95)
+
+
+def test_a_fit_of_the_model_family_passes():
+    assert batch._creep_problems(0.6, PASSING) == []
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"misfit": 0.08}, "misses the creep torque by 8 %"),
+    ({"sensitivity": 1.2}, "hardly depends on μ_s"),
+    ({"swing_ratio": 0.05}, "does not explain the slips"),
+    ({"halves": (0.50, 0.60)}, "not the same along the string"),  # first half 17 % low
+    ({"halves": (0.70, 0.60)}, "not the same along the string"),  # 17 % high
+    ({"other_hypothesis": 0.66}, "give model.friction_cased_static"),
+])
+def test_each_failed_check_withholds_mu_s_with_its_reason(change, words):
+    """Each check fails alone, and its reason names the physics (issue 14: a μ_s the model
+    does not explain is withheld, visibly)."""
+    problems = batch._creep_problems(0.6, replace(PASSING, **change))
+    assert len(problems) == 1 and words in problems[0]
+
+
+def test_halves_allow_a_slowly_logged_onset_but_not_a_low_top():
+    """The first half may fit up to 15 % high (onset of a slowly logged creep) but at most
+    6 % low (a top of lower friction wound up first)."""
+    assert batch._creep_problems(0.6, replace(PASSING, halves=(0.68, 0.60))) == []
+    assert batch._creep_problems(0.6, replace(PASSING, halves=(0.57, 0.60))) == []
+    assert batch._creep_problems(0.6, replace(PASSING, halves=(0.555, 0.60)))
+
+
+def test_halves_allow_for_their_own_noise():
+    """A quiet creep (sensitivity 4: each half's μ_s uncertain by ≈ 3.5 %) may split by
+    2σ of the difference, 2 × 2 × 10 %/4 = 10 %; a well-measured one (sensitivity 25) not."""
+    quiet = replace(PASSING, sensitivity=4.0, halves=(0.416, 0.443))  # −6.1 %
+    assert batch._creep_problems(0.43, quiet) == []
+    assert batch._creep_problems(0.43, replace(quiet, sensitivity=25.0))
+    assert batch._creep_problems(0.43, replace(quiet, halves=(0.38, 0.443)))  # −14 %
+
+
+def test_smoothed_noise_of_white_noise_on_a_smooth_torque():
+    """σ from second differences (var Δ²n = 6σ² for white noise) over √(T_smooth/Δt): white
+    noise of 200 N·m at 100 Hz on a slow torque build-up is 200/√100 = 20 N·m after 1-s
+    smoothing. 5 %: the median estimator's sampling error on 6000 samples is ≈ 2 %."""
+    rng = np.random.default_rng(1)
+    t = np.arange(0.0, 60.0, 0.01)
+    tau = 8000.0 * (1.0 - np.exp(-t / 20.0)) + rng.normal(0.0, 200.0, t.size)
+    data = batch._Data(t=t, dt=0.01, drive=0 * t, motor=tau, creep_drive=0 * t,
+                       w_bar=0 * t, tau=tau, tau_bar=tau)
+    assert batch._smoothed_noise_Nm(data, np.arange(t.size)) == pytest.approx(20.0, rel=0.05)
