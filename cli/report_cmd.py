@@ -1,4 +1,5 @@
-"""`drillfric report RESULT_DIR [--pdf] [--segments all|N]` (docs/cli.md): rebuild reports.
+"""`drillfric report RESULT_DIR [--pdf] [--segments all|N] [--units si|field]` (docs/cli.md):
+rebuild reports.
 
 Thin layer over :func:`drillfric.report.write_well_report`, which reads only the files of
 the result directory (so reports can be rebuilt after an upgrade, or with a PDF later).
@@ -20,11 +21,15 @@ from .common import echo
 @click.option("--segments", default="10", show_default=True, metavar="all|N",
               help="How many estimated segments get their evidence drawn: 'all', or N "
                    "(the worst and the latest). Every segment is in the diagnostics table.")
-def command(result_dir: Path, pdf: bool, segments: str) -> None:
+@click.option("--units", "units", type=click.Choice(["si", "field"]),
+              help="Units of the report's axes and tables: si (m, kN, kN·m, bar) or field "
+                   "(ft, klbf, kft·lbf, psi). Default: the run's [well] units, else si. The "
+                   "result files stay SI.")
+def command(result_dir: Path, pdf: bool, segments: str, units: str | None) -> None:
     """Rebuild report.html (and report.pdf) of RESULT_DIR, an OUT/NAME of 'drillfric run'."""
     from drillfric.report import write_well_report
 
-    html = write_well_report(result_dir, pdf=pdf, segments=segments)
+    html = write_well_report(result_dir, pdf=pdf, segments=segments, units=units)
     echo(f"report: {html}")
     if pdf:
         echo(f"report: {html.with_name('report.pdf')}")

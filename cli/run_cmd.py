@@ -14,7 +14,6 @@ from .common import (
     context,
     echo,
     unit_system,
-    units_option,
     warn,
     well_progress,
 )
@@ -93,7 +92,10 @@ def _describe_depth_log(result, units: str) -> str:
               help="Write report.html (--no-report: the result files only).")
 @click.option("--workers", type=int, default=1, show_default=True,
               help="Wells processed in parallel (local processes).")
-@units_option
+@click.option("--units", "units", type=click.Choice(["si", "field"]),
+              help="Units of the printed summary and of the report's axes and tables: si (m, "
+                   "kN, kN·m) or field (ft, klbf, kft·lbf, ppg). Default: the configuration's "
+                   "[well] units, else si. JSON and result files stay SI.")
 def command(wells, out, config, survey, rate, starts, pdf, report, workers, units) -> None:
     """Estimate friction factors (μ_s, μ_k) and bit speed, stand by stand, for each WELL.
 
@@ -108,6 +110,8 @@ def command(wells, out, config, survey, rate, starts, pdf, report, workers, unit
         raise UserError(f"--workers must be at least 1, got {workers}")
     pairs = parse_starts(starts)
     overrides = {"observer.starts": [list(p) for p in pairs]} if pairs else {}
+    if units:  # the run's [well] units: its report is drawn in them too
+        overrides["well.units"] = units
     if workers > 1 and len(wells) > 1:
         _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers)
         return

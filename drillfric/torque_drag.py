@@ -551,11 +551,12 @@ def _as_sections(string_or_sections) -> list[dict]:
     return out
 
 
-def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | None = None):
+def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | None = None,
+                      units: str = "si"):
     """Broomstick plot of a :func:`broomstick` table: hook load and torque versus depth.
 
-    Left: hook load [kN] of every load case and friction factor; right: surface torque
-    [kN·m] of the rotating cases. Depth increases downwards. Returns a matplotlib Figure.
+    Left: hook load of every load case and friction factor; right: surface torque of the
+    rotating cases. Depth increases downwards. Returns a matplotlib Figure.
 
     Parameters
     ----------
@@ -570,10 +571,18 @@ def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | Non
         Figure size [in].
     note : str, optional
         A line printed under the title (e.g. the string-weight check).
+    units : str
+        Display units of the axes, ``"si"`` (m, kN, kN·m) or ``"field"`` (ft, klbf,
+        kft·lbf): :data:`drillfric.units.DISPLAY_UNITS`.
     """
     import matplotlib
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
+
+    from drillfric.units import display_unit, to_display
+
+    def show(values, quantity):
+        return to_display(values, quantity, units)
 
     fig = Figure(figsize=size, layout="constrained")
     ax_h, ax_t = fig.subplots(1, 2, sharey=True)
@@ -586,16 +595,18 @@ def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | Non
     for (case, mu), grp in table.groupby(["load_case", "friction_factor"], sort=False):
         grp = grp.sort_values("bit_depth_m")
         kw = {"color": colours[mu], "linestyle": styles.get(case, "-"), "lw": 1.2}
-        ax_h.plot(grp["hookload_N"] / 1e3, grp["bit_depth_m"], **kw)
+        ax_h.plot(show(grp["hookload_N"], "force"), show(grp["bit_depth_m"], "length"), **kw)
         if case.startswith("rotating"):
-            ax_t.plot(grp["surface_torque_Nm"] / 1e3, grp["bit_depth_m"], **kw)
+            ax_t.plot(show(grp["surface_torque_Nm"], "torque"),
+                      show(grp["bit_depth_m"], "length"), **kw)
     handles = [Line2D([], [], color="k", linestyle=styles.get(c, "-"), label=c.replace("_", " "))
                for c in table["load_case"].unique()]
     handles += [Line2D([], [], color=colours[f], label=f"μ = {f:g}") for f in frictions]
-    handles += _measured_points(ax_h, ax_t, measured)
+    handles += _measured_points(ax_h, ax_t, measured, show)
     ax_h.invert_yaxis()
-    ax_h.set(xlabel="hook load [kN] (model: effective, no block)", ylabel="bit depth MD [m]")
-    ax_t.set(xlabel="surface torque [kN·m]")
+    ax_h.set(xlabel=f"hook load [{display_unit('force', units)}] (model: effective, no block)",
+             ylabel=f"bit depth MD [{display_unit('length', units)}]")
+    ax_t.set(xlabel=f"surface torque [{display_unit('torque', units)}]")
     ax_h.legend(handles=handles, fontsize="small")
     for ax in (ax_h, ax_t):
         ax.grid(alpha=0.3)
@@ -605,8 +616,9 @@ def broomstick_figure(table, measured=None, *, size=(10.0, 7.0), note: str | Non
     return fig
 
 
-def _measured_points(ax_h, ax_t, measured) -> list:
-    """Draw measured points (see :func:`broomstick_figure`); returns legend handles."""
+def _measured_points(ax_h, ax_t, measured, show) -> list:
+    """Draw measured points (see :func:`broomstick_figure`; ``show(values, quantity)``: SI
+    to display units); returns legend handles."""
     from matplotlib.lines import Line2D
 
     if measured is None or not len(measured):
@@ -620,8 +632,9 @@ def _measured_points(ax_h, ax_t, measured) -> list:
             continue
         kw = {"marker": marker, "linestyle": "none", "color": "black",
               "markerfacecolor": face, "markersize": 6, "clip_on": False, "zorder": 5}
-        ax_h.plot(rows["hookload_N"] / 1e3, rows["bit_depth_m"], **kw)
-        ax_t.plot(rows["surface_torque_Nm"] / 1e3, rows["bit_depth_m"], **kw)
+        depth = show(rows["bit_depth_m"], "length")
+        ax_h.plot(show(rows["hookload_N"], "force"), depth, **kw)
+        ax_t.plot(show(rows["surface_torque_Nm"], "torque"), depth, **kw)
         handles.append(Line2D([], [], label=label, **{k: v for k, v in kw.items()
                                                         if k not in ("clip_on", "zorder")}))
     return handles

@@ -24,8 +24,12 @@ import pandas as pd
 
 from drillfric.io.tracks import TrackAccumulator, write_tracks
 
-#: The reason written for a segment whose bit speed is marked not resolved.
-UNRESOLVED_REASON = "stick-slip period shorter than the string's wave travel time"
+#: The reason written for a segment whose bit speed is marked not resolved (worded as
+#: drillfric.estimation.sampling.resolution words it).
+UNRESOLVED_REASON = ("bit speed not resolved: 10-s means give 0.42 per stick-slip cycle "
+                     "(the shortest, 4.2 s, needs ≥ 8); log at ≥ 1.9 Hz to see the bit")
+#: The segment of the demo marked "bit speed not resolved" by :func:`add_evidence_files`.
+UNRESOLVED_SEGMENT = 2
 
 
 def _tracks_from_log(log: pd.DataFrame, cfg) -> pd.DataFrame:
@@ -42,8 +46,9 @@ def add_evidence_files(result_dir: Path, log_csv: Path, *, clock: str | None = N
     ``surface_torque_Nm`` is the demo's noise-free string torque at each estimate time,
     ``surface_torque_est_Nm`` that torque plus a deterministic ripple, and
     ``surface_torque_fit_Nm`` the torque smoothed over 1 s (NaN for segment 1: "the fit
-    did not simulate"). Segment keys come from those columns and the log; segment 2 is
-    marked "bit speed not resolved". ``clock``: an ISO time to give the log clock time.
+    did not simulate"). Segment keys come from those columns and the log; segment
+    :data:`UNRESOLVED_SEGMENT` is marked "bit speed not resolved", its bit columns null as
+    the run writes them then. ``clock``: an ISO time to give the log clock time.
     """
     from drillfric.config import config_from_dict
     from drillfric.torque_drag import solve_config
@@ -63,6 +68,9 @@ def add_evidence_files(result_dir: Path, log_csv: Path, *, clock: str | None = N
     est["surface_torque_est_Nm"] = truth + 150.0 * np.sin(est["time_s"].to_numpy() / 3.0)
     smooth = pd.Series(truth).rolling(21, center=True, min_periods=1).mean().to_numpy()
     est["surface_torque_fit_Nm"] = np.where(est["segment_id"] == 1, np.nan, smooth)
+    unresolved = est["segment_id"] == UNRESOLVED_SEGMENT
+    est.loc[unresolved, ["bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max"]] = np.nan
+    est["bit_stuck"] = est["bit_stuck"].astype("boolean").mask(unresolved)
     est.to_parquet(result_dir / "estimates.parquet", index=False)
     wp = pd.read_parquet(result_dir / "wellpath.parquet")
     path = minimum_curvature(wp["md_m"], wp["inc_rad"], wp["azi_rad"])
@@ -99,10 +107,11 @@ def _segment_keys(seg: dict, rows: pd.DataFrame, span: pd.DataFrame, model_N: fl
     seg.update(torque_rms_misfit_Nm=misfit, torque_swing_Nm=swing,
                fit_quality=None if misfit is None else misfit / swing,
                surface_torque_mean_Nm=float(span["string_torque_Nm"].mean()),
-               hookload_N=float(span["hookload_N"].median()), hookload_model_N=model_N,
-               bit_speed_resolved=seg["id"] != 2,
-               bit_speed_reason="" if seg["id"] != 2 else UNRESOLVED_REASON,
-               friction_zone="open_hole")
+               hookload_N=float(span["hookload_N"].median()), hookload_model_N=model_N)
+    if seg["id"] == UNRESOLVED_SEGMENT:
+        seg.update(bit_speed_resolved=False, bit_speed_reason=UNRESOLVED_REASON,
+                   sample_interval_s=10.0, interval_torque_swing=0.45,
+                   stick_slip_severity=None, stuck_fraction=None)
     for key, t in (("clock_start_utc", seg["t_start_s"]), ("clock_end_utc", seg["t_end_s"])):
         seg[key] = None if origin is None else \
             (pd.Timestamp(origin) + pd.Timedelta(seconds=t)).isoformat()
@@ -222,15 +231,26 @@ def _synthetic_segment(seg_id, t0, segment_s, depth, n_starts, rng) -> dict:
             "starts": [[0.3, 0.2], [0.6, 0.4], [0.9, 0.1], [0.5, 0.3]][:n_starts]}
 
 
+#: Segment keys that results written before issue 16 (and the friction profile and
+#: logging-rate checks after it) do not have.
+NEWER_SEGMENT_KEYS = ("friction_zone", "torque_rms_misfit_Nm", "torque_swing_Nm",
+                      "fit_quality", "surface_torque_mean_Nm", "hookload_N", "hookload_model_N",
+                      "bit_speed_resolved", "bit_speed_reason", "sample_interval_s",
+                      "interval_torque_swing", "clock_start_utc", "clock_end_utc")
+
+
 def older_result(src: Path, dst: Path) -> Path:
     """A copy of a result directory as versions before issue 16 wrote it: no
-    tracks.parquet, no torque columns in estimates.parquet, no hook load per segment."""
+    tracks.parquet, no torque columns in estimates.parquet, none of
+    :data:`NEWER_SEGMENT_KEYS`, no friction zone in the summary."""
     import shutil
 
-    keys = ("hookload_N", "hookload_model_N", "surface_torque_mean_Nm")
+    keys = NEWER_SEGMENT_KEYS
     shutil.copytree(src, dst)
     (dst / "tracks.parquet").unlink(missing_ok=True)
     summary = json.loads((dst / "summary.json").read_text(encoding="utf-8"))
+    for key in ("friction_zone", "friction_profile"):
+        summary.pop(key, None)
     for seg in summary["segments"]:
         for key in keys:
             seg.pop(key, None)

@@ -23,6 +23,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .display import SI, Units
+
 #: Relative tolerance of the weight check: dead-line hook-load sensors are specified to
 #: about ±2–3 % of reading and the mud density (buoyancy) is rarely known better than
 #: ±2 %; 5 % keeps a consistent string from being flagged by those alone.
@@ -116,8 +118,9 @@ def rotating_hookload(table: pd.DataFrame, depths_m) -> np.ndarray:
 
 
 def weight_check(points: pd.DataFrame, table: pd.DataFrame | None = None,
-                 tolerance: float = HOOKLOAD_TOLERANCE) -> dict:
-    """The string-weight check (module docstring) over the off-bottom measured points.
+                 tolerance: float = HOOKLOAD_TOLERANCE, units: Units = SI) -> dict:
+    """The string-weight check (module docstring) over the off-bottom measured points
+    (the warning's loads in display ``units``).
 
     Returns
     -------
@@ -144,13 +147,14 @@ def weight_check(points: pd.DataFrame, table: pd.DataFrame | None = None,
     warning = None
     if bad.size:
         k = int(np.argmax(ratio))
+        force = units.label("force")
         warning = (f"string weight inconsistent with the hook load: in {bad.size} of "
                    f"{measured.size} off-bottom segment(s) the modelled rotating hook load "
                    f"exceeds the measured one by more than {tolerance:.0%} (worst: segment "
-                   f"{ids[k]}, model {model[k] / 1e3:.0f} kN vs measured "
-                   f"{measured[k] / 1e3:.0f} kN). The hook also carries the block, so the "
-                   "model can only be lighter: check the string's linear masses and "
-                   "lengths, the mud density and the hook-load channel's units.")
+                   f"{ids[k]}, model {units.text(model[k], 'force')} {force} vs measured "
+                   f"{units.text(measured[k], 'force')} {force}). The hook also carries the "
+                   "block, so the model can only be lighter: check the string's linear "
+                   "masses and lengths, the mud density and the hook-load channel's units.")
     return {"checked": int(measured.size), "violations": [int(i) for i in bad],
             "worst_ratio": float(ratio.max()),
             "block_weight_N": float(np.median(measured - model)), "warning": warning}

@@ -10,11 +10,14 @@ unless stated):
 3. surface speed — measured and estimated;
 4. speed residual — measured − estimated;
 5. bit speed — estimated (the seeded ensemble's mean with its min–max band), stuck periods
-   shaded, the measured downhole speed where the input had one;
+   shaded, the measured downhole speed where the input had one; left out where the logging
+   rate does not resolve the stick-slip cycle (``bit_speed_resolved`` false: the report
+   gives the reason instead — no trace is drawn from such data);
 6. μ_k and μ_s of every observer start (the paper's Fig. 10 view) and the final pass.
 
-Panels whose columns the file does not hold (results older than the torque columns) are
-left out. :func:`evidence_plot` is the Bokeh version, :func:`evidence_figure` the PDF one.
+Torques are drawn in the report's display units (:mod:`drillfric.report.display`), speeds
+in rpm. Panels whose columns the file does not hold (results older than the torque columns)
+are left out. :func:`evidence_plot` is the Bokeh version, :func:`evidence_figure` the PDF one.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from .data import FINAL_START_ID
+from .display import SI, Units
 from .interactive import float32, time_figure, time_label, time_values
 
 MEASURED = "#555555"
@@ -43,6 +47,12 @@ def final_pass(est: pd.DataFrame) -> pd.DataFrame:
     return est[est["start_id"] == FINAL_START_ID].sort_values("time_s", kind="stable")
 
 
+def stuck_flags(rows: pd.DataFrame) -> np.ndarray:
+    """``bit_stuck`` of ``rows`` as booleans (null — bit speed not resolved — is not
+    stuck)."""
+    return rows["bit_stuck"].astype("boolean").fillna(False).to_numpy(bool)
+
+
 def stuck_runs(time_s: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float]]:
     """``(t0, t1)`` of every run of samples where the estimated bit is stuck [s]."""
     stuck = np.asarray(stuck, dtype=bool)
@@ -53,27 +63,30 @@ def stuck_runs(time_s: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float
     return [(float(time_s[a]), float(time_s[b])) for a, b in zip(first, last, strict=True)]
 
 
-def panel_data(est: pd.DataFrame) -> dict[str, dict[str, np.ndarray]]:
-    """What each panel draws, by panel key and series name (SI → display units).
+def panel_data(est: pd.DataFrame, units: Units = SI, bit: bool = True
+               ) -> dict[str, dict[str, np.ndarray]]:
+    """What each panel draws, by panel key and series name (SI → display ``units``).
 
     Keys present only when the file has the columns: ``torque`` (``measured``,
-    ``observer``, ``fit`` [kN·m]), ``torque_residual`` (``fit``, ``observer`` [kN·m]),
-    ``speed`` (``measured``, ``estimated`` [rpm]), ``speed_residual`` (``residual``),
-    ``bit`` (``estimated``, ``low``, ``high``, ``measured`` [rpm]). Every array is the
-    file's column at the rows of ``est`` (scaled), so a figure shows the file's numbers.
+    ``observer``, ``fit``), ``torque_residual`` (``fit``, ``observer``), ``speed``
+    (``measured``, ``estimated`` [rpm]), ``speed_residual`` (``residual``), ``bit``
+    (``estimated``, ``low``, ``high``, ``measured`` [rpm]; only with ``bit`` — False where
+    the bit speed is not resolved — and an estimated bit speed in the file). Every array
+    is the file's column at the rows of ``est`` (scaled), so a figure shows the file's
+    numbers.
     """
     best = final_pass(est)
     out: dict[str, dict[str, np.ndarray]] = {"time_s": {"t": best["time_s"].to_numpy(float)}}
-    kilo = 1e-3
+    scale = units.factor("torque")
     if has_column(best, "surface_torque_Nm"):
         measured = best["surface_torque_Nm"].to_numpy(float)
-        torque = {"measured": measured * kilo}
+        torque = {"measured": measured * scale}
         residual = {}
         for name, col in (("observer", "surface_torque_est_Nm"),
                           ("fit", "surface_torque_fit_Nm")):
             if has_column(best, col):
-                torque[name] = best[col].to_numpy(float) * kilo
-                residual[name] = (measured - best[col].to_numpy(float)) * kilo
+                torque[name] = best[col].to_numpy(float) * scale
+                residual[name] = (measured - best[col].to_numpy(float)) * scale
         out["torque"] = torque
         if residual:
             out["torque_residual"] = residual
@@ -81,19 +94,24 @@ def panel_data(est: pd.DataFrame) -> dict[str, dict[str, np.ndarray]]:
                     "estimated": best["surface_rpm_est"].to_numpy(float)}
     if has_column(best, "residual_rpm"):
         out["speed_residual"] = {"residual": best["residual_rpm"].to_numpy(float)}
-    bit = {"estimated": best["bit_rpm_est"].to_numpy(float)}
+    if not (bit and has_column(best, "bit_rpm_est")):
+        return out
+    speeds = {"estimated": best["bit_rpm_est"].to_numpy(float)}
     if has_column(best, "bit_rpm_est_min"):
-        bit["low"] = best["bit_rpm_est_min"].to_numpy(float)
-        bit["high"] = best["bit_rpm_est_max"].to_numpy(float)
+        speeds["low"] = best["bit_rpm_est_min"].to_numpy(float)
+        speeds["high"] = best["bit_rpm_est_max"].to_numpy(float)
     if has_column(best, "bit_rpm"):
-        bit["measured"] = best["bit_rpm"].to_numpy(float)
-    out["bit"] = bit
+        speeds["measured"] = best["bit_rpm"].to_numpy(float)
+    out["bit"] = speeds
     return out
 
 
-_LABELS = {"torque": "torque [kN·m]", "torque_residual": "Δ torque [kN·m]",
-           "speed": "surface [rpm]", "speed_residual": "Δ speed [rpm]",
-           "bit": "bit [rpm]", "mu": "μ [-]"}
+def _label(key: str, units: Units) -> str:
+    """Axis label of a panel."""
+    torque = units.label("torque")
+    return {"torque": f"torque [{torque}]", "torque_residual": f"Δ torque [{torque}]",
+            "speed": "surface [rpm]", "speed_residual": "Δ speed [rpm]",
+            "bit": "bit [rpm]", "mu": "μ [-]"}[key]
 _STYLE = {"measured": (MEASURED, 1.0), "observer": (OBSERVER, 1.0), "fit": (FIT, 1.2),
           "estimated": (OBSERVER, 1.0), "residual": (MEASURED, 0.8)}
 _LEGEND = {("torque", "measured"): "measured", ("torque", "observer"): "observer model",
@@ -106,21 +124,23 @@ _LEGEND = {("torque", "measured"): "measured", ("torque", "observer"): "observer
 
 
 # ------------------------------------------------------------------------------ Bokeh
-def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | None
-                     ) -> dict[str, dict[str, np.ndarray]]:
+def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | None, units: Units = SI,
+                     bit: bool = True) -> dict[str, dict[str, np.ndarray]]:
     """The data of every Bokeh source of a segment's evidence, by source name.
 
     ``panel:KEY`` (``x`` and the series of :func:`panel_data`, float32), ``stuck``
-    (``x0``, ``x1``: stuck periods), ``start:ID`` (``x``, ``mu_k``, ``mu_s`` of one
-    observer start; ``start:-1`` the final pass).
+    (``x0``, ``x1``: stuck periods, with the bit panel), ``start:ID`` (``x``, ``mu_k``,
+    ``mu_s`` of one observer start; ``start:-1`` the final pass).
     """
-    data = panel_data(est)
+    data = panel_data(est, units, bit)
     t = data.pop("time_s")["t"]
     x = time_values(t, origin)
     out = {f"panel:{key}": {"x": x, **{k: float32(v) for k, v in series.items()}}
            for key, series in data.items()}
-    runs = np.array(stuck_runs(t, final_pass(est)["bit_stuck"].to_numpy(bool))).reshape(-1, 2)
-    out["stuck"] = {"x0": time_values(runs[:, 0], origin), "x1": time_values(runs[:, 1], origin)}
+    if "bit" in data:
+        runs = np.array(stuck_runs(t, stuck_flags(final_pass(est)))).reshape(-1, 2)
+        out["stuck"] = {"x0": time_values(runs[:, 0], origin),
+                        "x1": time_values(runs[:, 1], origin)}
     for start_id, rows in est.groupby("start_id", sort=True):
         out[f"start:{int(start_id)}"] = {"x": time_values(rows["time_s"], origin),
                                          "mu_k": float32(rows["mu_k"]),
@@ -133,9 +153,10 @@ def signature(sources: dict[str, dict]) -> tuple:
     return tuple((name, tuple(cols)) for name, cols in sources.items())
 
 
-def evidence_plot(sources: dict[str, dict], clock: bool):
+def evidence_plot(sources: dict[str, dict], clock: bool, units: Units = SI):
     """A segment's evidence as a Bokeh layout (panels share the time axis), from
-    :func:`evidence_sources`; each ColumnDataSource is named like its key there."""
+    :func:`evidence_sources` in display ``units``; each ColumnDataSource is named like its
+    key there."""
     from bokeh.layouts import gridplot
     from bokeh.models import ColumnDataSource, HoverTool
 
@@ -144,7 +165,7 @@ def evidence_plot(sources: dict[str, dict], clock: bool):
         if not name.startswith("panel:"):
             continue
         key = name.split(":", 1)[1]
-        fig = time_figure(_PX if key in ("torque", "bit") else 100, _LABELS[key],
+        fig = time_figure(_PX if key in ("torque", "bit") else 100, _label(key, units),
                           x_range=x_range, clock=clock)
         x_range = fig.x_range
         source = ColumnDataSource(columns, name=name)
@@ -191,7 +212,7 @@ def _mu_plot(sources: dict[str, dict], clock: bool, x_range):
     from bokeh.models import ColumnDataSource, HoverTool
     from bokeh.palettes import Category10
 
-    fig = time_figure(_PX, _LABELS["mu"], x_range=x_range, clock=clock,
+    fig = time_figure(_PX, _label("mu", SI), x_range=x_range, clock=clock,
                       x_label="time [UTC]" if clock else "log time [s]")
     lines = []
     for name, columns in sources.items():
@@ -230,9 +251,11 @@ def start_label(segment: dict, start_id: int) -> str:
 
 # ------------------------------------------------------------------------- matplotlib
 def evidence_figure(est: pd.DataFrame, segment: dict, origin: pd.Timestamp | None = None,
-                    size: tuple[float, float] = (9.0, 9.0)) -> Figure:
-    """The segment's evidence as a static figure (the PDF page)."""
-    data = panel_data(est)
+                    size: tuple[float, float] = (9.0, 9.0), units: Units = SI,
+                    bit: bool = True) -> Figure:
+    """The segment's evidence as a static figure (the PDF page) in display ``units``;
+    ``bit`` False leaves the bit speed out (not resolved)."""
+    data = panel_data(est, units, bit)
     t = data.pop("time_s")["t"]
     x = time_values(t, origin)
     keys = [*data, "mu"]
@@ -246,7 +269,7 @@ def evidence_figure(est: pd.DataFrame, segment: dict, origin: pd.Timestamp | Non
             _mu_axes(ax, est, segment, origin)
         else:
             _series_axes(ax, key, data[key], x, t, est, origin)
-        ax.set_ylabel(_LABELS[key], fontsize=7)
+        ax.set_ylabel(_label(key, units), fontsize=7)
         ax.tick_params(labelsize=7)
         ax.grid(True, color="#dddddd", linewidth=0.6)
         ax.legend(fontsize=6, loc="upper right", ncol=3)
@@ -256,7 +279,7 @@ def evidence_figure(est: pd.DataFrame, segment: dict, origin: pd.Timestamp | Non
 
 def _series_axes(ax, key: str, series: dict, x, t, est, origin) -> None:
     if key == "bit":
-        for t0, t1 in stuck_runs(t, final_pass(est)["bit_stuck"].to_numpy(bool)):
+        for t0, t1 in stuck_runs(t, stuck_flags(final_pass(est))):
             left, right = time_values([t0, t1], origin)
             ax.axvspan(left, right, color=STUCK, linewidth=0)
         if "low" in series:

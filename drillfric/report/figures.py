@@ -17,6 +17,9 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from .display import SI, Units
+from .render import zone_text
+
 #: Colours of the friction factors (μ_k, μ_s, torque-and-drag back-calculation).
 MU_K_COLOR = "#1f5fa8"
 MU_S_COLOR = "#c0392b"
@@ -54,7 +57,7 @@ def _depth_axis(ax) -> None:
 
 def wellpath_figure(wellpath: pd.DataFrame | None,
                     no_survey: str = "No survey: the well was taken as vertical.",
-                    size: tuple[float, float] = (_WIDTH_IN, 4.2)) -> Figure:
+                    size: tuple[float, float] = (_WIDTH_IN, 4.2), units: Units = SI) -> Figure:
     """Vertical section (along the azimuth to the last station) and plan view of the well.
 
     Parameters
@@ -65,6 +68,8 @@ def wellpath_figure(wellpath: pd.DataFrame | None,
         The note drawn instead when there is no survey (what the path was taken to be).
     size : (float, float)
         Figure size [in].
+    units : Units
+        Display units of the axes.
     """
     fig = _new(size[1], size[0])
     ax_vs, ax_plan = fig.subplots(1, 2)
@@ -72,17 +77,19 @@ def wellpath_figure(wellpath: pd.DataFrame | None,
         _note(ax_vs, no_survey)
         ax_plan.set_axis_off()
         return fig
-    north, east = wellpath["north_m"].to_numpy(float), wellpath["east_m"].to_numpy(float)
+    scale, unit = units.factor("length"), units.label("length")
+    north = wellpath["north_m"].to_numpy(float) * scale
+    east = wellpath["east_m"].to_numpy(float) * scale
     azimuth = np.arctan2(east[-1], north[-1]) if np.hypot(north[-1], east[-1]) > 0 else 0.0
     section = north * np.cos(azimuth) + east * np.sin(azimuth)
-    ax_vs.plot(section, wellpath["tvd_m"], color=MU_K_COLOR)
-    ax_vs.set(xlabel=f"vertical section along {np.degrees(azimuth) % 360:.0f}° [m]",
-              ylabel="TVD [m]", title="Vertical section")
+    ax_vs.plot(section, wellpath["tvd_m"] * scale, color=MU_K_COLOR)
+    ax_vs.set(xlabel=f"vertical section along {np.degrees(azimuth) % 360:.0f}° [{unit}]",
+              ylabel=f"TVD [{unit}]", title="Vertical section")
     _depth_axis(ax_vs)
     ax_plan.plot(east, north, color=MU_K_COLOR)
     ax_plan.plot(east[:1], north[:1], "o", color=TD_COLOR, label="surface")
     ax_plan.plot(east[-1:], north[-1:], "s", color=MU_S_COLOR, label="last station")
-    ax_plan.set(xlabel="east [m]", ylabel="north [m]", title="Plan")
+    ax_plan.set(xlabel=f"east [{unit}]", ylabel=f"north [{unit}]", title="Plan")
     ax_plan.set_aspect("equal", adjustable="datalim")
     ax_plan.grid(True, color="#dddddd", linewidth=0.6)
     ax_plan.legend(fontsize="small")
@@ -103,7 +110,8 @@ def profile_depths(segments: pd.DataFrame, profiles: pd.DataFrame | None,
 
 
 def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
-                    count: int = 3, size: tuple[float, float] = (_WIDTH_IN, 4.2)) -> Figure:
+                    count: int = 3, size: tuple[float, float] = (_WIDTH_IN, 4.2),
+                    units: Units = SI) -> Figure:
     """Normal force per length and F_c = r·F_n (docs/theory.md §5.1) versus MD at a few bit depths.
 
     Parameters
@@ -116,6 +124,8 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
         Number of bit depths drawn.
     size : (float, float)
         Figure size [in].
+    units : Units
+        Display units of the axes.
     """
     fig = _new(size[1], size[0])
     ax_fn, ax_fc = fig.subplots(1, 2, sharey=True)
@@ -125,13 +135,18 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
         ax_fc.set_axis_off()
         return fig
     depth = segments.set_index("id")["bit_depth_m"]
+    length = units.factor("length")
     for seg_id in ids:
         rows = profiles[profiles["segment_id"] == seg_id]
-        label = f"bit at {depth[seg_id]:.0f} m (segment {seg_id})"
-        ax_fn.plot(rows["normal_force_N_m"] / 1e3, rows["md_m"], label=label)
-        ax_fc.plot(rows["fc_Nm_m"], rows["md_m"], label=label)
-    ax_fn.set(xlabel="normal force F_n [kN/m]", ylabel="MD [m]", title="Normal force")
-    ax_fc.set(xlabel="F_c [N·m/m]", title="Coulomb torque per unit μ, F_c")
+        label = (f"bit at {units.text(depth[seg_id], 'length')} {units.label('length')} "
+                 f"(segment {seg_id})")
+        md = rows["md_m"] * length
+        ax_fn.plot(rows["normal_force_N_m"] * units.factor("side force"), md, label=label)
+        ax_fc.plot(rows["fc_Nm_m"] * units.factor("torque per length"), md, label=label)
+    ax_fn.set(xlabel=units.axis("normal force F_n", "side force"),
+              ylabel=units.axis("MD", "length"), title="Normal force")
+    ax_fc.set(xlabel=units.axis("F_c", "torque per length"),
+              title="Coulomb torque per unit μ, F_c")
     for ax in (ax_fn, ax_fc):
         _depth_axis(ax)
     ax_fn.legend(fontsize="small")
@@ -139,7 +154,8 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
 
 
 def friction_log_figure(segments: pd.DataFrame,
-                        size: tuple[float, float] = (_WIDTH_IN, 5.5)) -> Figure:
+                        size: tuple[float, float] = (_WIDTH_IN, 5.5),
+                        units: Units = SI) -> Figure:
     """μ_s and μ_k versus bit depth, one point per segment (stand), with spread bars, and
     the stick-slip severity versus bit depth beside it.
 
@@ -149,11 +165,12 @@ def friction_log_figure(segments: pd.DataFrame,
     torque-and-drag back-calculated μ (``mu_td``). Bars span the spread across starts.
     Segments without an estimate are grey diamonds on the left edge. Markers are not
     clipped at the axes' edges. Right: severity (ω_max − ω_min)/(2 ω_mean) of the
-    estimated bit speed; beyond the dashed line at 1 the bit stops.
+    estimated bit speed; beyond the dashed line at 1 the bit stops. Depths in display
+    ``units``; the μ axis names the friction zone when the segments share one.
     """
     fig = _new(size[1], size[0], left_in=0.9, wspace=0.08)
     ax, ax_sev = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [2.2, 1]})
-    seg = segments
+    seg = segments.assign(depth=segments["bit_depth_m"] * units.factor("length"))
     ok = seg[seg["status"] == "ok"]
     conv = ok["converged"].to_numpy(bool)
     _mu_points(ax, ok, "mu_k", "mu_k_spread", conv, MU_K_COLOR, "o", "μ_k")
@@ -162,29 +179,31 @@ def friction_log_figure(segments: pd.DataFrame,
                MU_S_COLOR, "s", "μ_s")
     bound = ok[~ok["mu_s_identifiable"] & ok["mu_s_lower_bound"].notna()]
     if len(bound):
-        ax.plot(bound["mu_s_lower_bound"], bound["bit_depth_m"], ">", color=MU_S_COLOR,
+        ax.plot(bound["mu_s_lower_bound"], bound["depth"], ">", color=MU_S_COLOR,
                 markerfacecolor="none", label="μ_s ≥ lower bound", clip_on=False)
-        for x, y in zip(bound["mu_s_lower_bound"], bound["bit_depth_m"], strict=True):
+        for x, y in zip(bound["mu_s_lower_bound"], bound["depth"], strict=True):
             ax.plot([x, x + 0.08], [y, y], ":", color=MU_S_COLOR, linewidth=1.2)
     td = ok[ok["mu_td"].notna()]
     if len(td):
-        ax.plot(td["mu_td"], td["bit_depth_m"], "x", color=TD_COLOR,
+        ax.plot(td["mu_td"], td["depth"], "x", color=TD_COLOR,
                 label="μ from torque and drag", clip_on=False)
-    none = seg[(seg["status"] != "ok") & seg["bit_depth_m"].notna()]
+    none = seg[(seg["status"] != "ok") & seg["depth"].notna()]
     if len(none):
-        ax.plot(np.zeros(len(none)), none["bit_depth_m"], "d", color="#888888",
+        ax.plot(np.zeros(len(none)), none["depth"], "d", color="#888888",
                 markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")
     if not len(ok) and not len(none):
         _note(ax, "No segment: nothing to draw.")
         ax_sev.set_axis_off()
         return fig
-    ax.set(xlabel="friction factor μ [-]", ylabel="bit depth [m]")
+    zone = zone_text(segments)
+    ax.set(xlabel=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
+           ylabel=units.axis("bit depth", "length"))
     ax.margins(x=0.08, y=0.08)
     ax.set_xlim(left=0.0)
     _depth_axis(ax)
     ax.legend(fontsize="small", loc="best")
     sev = ok[ok["stick_slip_severity"].notna()]
-    ax_sev.plot(sev["stick_slip_severity"], sev["bit_depth_m"], "o", color=SEVERITY_COLOR,
+    ax_sev.plot(sev["stick_slip_severity"], sev["depth"], "o", color=SEVERITY_COLOR,
                 clip_on=False)
     ax_sev.axvline(1.0, color=MU_S_COLOR, linestyle="--", linewidth=0.8)
     ax_sev.set(xlabel="stick-slip severity [-]")
@@ -203,7 +222,7 @@ def _mu_points(ax, rows: pd.DataFrame, col: str, spread: str, converged: np.ndar
         if not mask.any():
             continue
         bars = ax.errorbar(rows[col].to_numpy(float)[mask],
-                           rows["bit_depth_m"].to_numpy(float)[mask], xerr=half[mask],
+                           rows["depth"].to_numpy(float)[mask], xerr=half[mask],
                            fmt=marker, color=color, markerfacecolor=face, ecolor=color,
                            elinewidth=1.0, capsize=2, label=name + suffix)
         bars.lines[0].set_clip_on(False)

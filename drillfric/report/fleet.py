@@ -1,5 +1,6 @@
 """The fleet report (``fleet.html``): failures first, one row per well with a link to its
-report, and μ_k versus depth of every well in one interactive figure (Bokeh, inlined)."""
+report, and μ_k versus depth of every well in one interactive figure (Bokeh, inlined).
+Depths are in the wells' common ``[well] units`` (SI when they differ)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from urllib.parse import quote
 from drillfric import __version__
 
 from .data import segments_frame
+from .display import report_units
 from .friction import fleet_plot
 from .interactive import Embedder
 from .render import environment, fmt, mu_s_text, now_utc
@@ -61,6 +63,7 @@ def _row(out_dir: Path, well: dict) -> dict:
             "segments": counts.get("segments", "—"), "estimated": counts.get("estimated", "—"),
             "converged": counts.get("converged", "—"),
             "mu_k": fmt(summary.get("mu_k")),
+            "zone": str(summary.get("friction_zone") or "").replace("_", " "),
             "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                               summary.get("mu_s_lower_bound")) if summary else "—",
             "indicative": bool(summary.get("indicative")),
@@ -68,7 +71,7 @@ def _row(out_dir: Path, well: dict) -> dict:
             "link": _link(out_dir, well.get("result_dir")) if summary else None}
 
 
-def write_fleet_report(out_dir: Path, wells: list[dict]) -> Path:
+def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = None) -> Path:
     """Write ``out_dir/fleet.html``: the morning overview of many wells.
 
     Parameters
@@ -79,6 +82,8 @@ def write_fleet_report(out_dir: Path, wells: list[dict]) -> Path:
         One per well: ``{"well": str, "status": "ok"|"failed"|"skipped", "message": str,
         "result_dir": Path or None (relative link target), "summary": dict or None
         (summary.json)}``.
+    units : {"si", "field"}, optional
+        Display units of the depths; default: the ``[well] units`` all wells share, else SI.
 
     Returns
     -------
@@ -90,8 +95,9 @@ def write_fleet_report(out_dir: Path, wells: list[dict]) -> Path:
     rows = [_row(out_dir, w) for w in wells]
     logs = [(str(w.get("well", "?")), segments_frame(w["summary"].get("segments") or []))
             for w in wells if w.get("summary") and w["summary"].get("segments")]
+    shown = report_units({}, units or _common_units(wells))
     embed = Embedder()
-    plot_id = embed.add(fleet_plot(logs), "fleet") if any(
+    plot_id = embed.add(fleet_plot(logs, shown), "fleet") if any(
         ((seg["status"] == "ok") & seg["mu_k"].notna()).any() for _, seg in logs) else None
     counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
     html = environment().get_template("fleet_report.html.j2").render(
@@ -100,3 +106,9 @@ def write_fleet_report(out_dir: Path, wells: list[dict]) -> Path:
     out = out_dir / "fleet.html"
     _write_text(out, html)
     return out
+
+
+def _common_units(wells: list[dict]) -> str:
+    """The ``[well] units`` every well's run recorded, or "si" when they differ."""
+    systems = {report_units(w["summary"]).system for w in wells if w.get("summary")}
+    return systems.pop() if len(systems) == 1 else "si"

@@ -4,7 +4,9 @@ Marks follow the static friction log (:func:`drillfric.report.figures.friction_l
 docs/reports.md): μ_k ●, μ_s ■ where identified, ▷ μ_s lower bound, × the torque-and-drag
 back-calculation μ_TD, grey ◆ segments without an estimate; hollow = not converged;
 whiskers = spread across observer starts. Beside it the stick-slip severity versus depth.
-Hover names the segment and its numbers.
+Hover names the segment and its numbers. Depths in the report's display units; the μ axis
+names the friction zone (open hole, or effective over the whole string) when the
+segments share one.
 """
 
 from __future__ import annotations
@@ -12,20 +14,26 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .display import SI, Units
 from .figures import MU_K_COLOR, MU_S_COLOR, TD_COLOR
 from .interactive import MIN_WIDTH_PX
-from .render import fmt, mu_s_text
+from .render import fmt, mu_s_text, zone_text
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
-_TIPS = [("segment", "@id (@kind)"), ("bit depth", "@depth{0.0} m"), ("μ_k", "@mu_k_text"),
-         ("μ_s", "@mu_s_text"), ("μ_TD", "@mu_td_text"), ("severity", "@severity_text"),
-         ("friction zone", "@zone"), ("status", "@status")]
 
 
-def _source_frame(seg: pd.DataFrame) -> pd.DataFrame:
-    """One row per segment with the hover texts."""
+def _tips(units: Units) -> list[tuple[str, str]]:
+    """Hover fields of a segment's point."""
+    return [("segment", "@id (@kind)"), ("bit depth", f"@depth{{0.0}} {units.label('length')}"),
+            ("μ_k", "@mu_k_text"), ("μ_s", "@mu_s_text"), ("μ_TD", "@mu_td_text"),
+            ("severity", "@severity_text"), ("friction zone", "@zone"),
+            ("status", "@status")]
+
+
+def _source_frame(seg: pd.DataFrame, units: Units) -> pd.DataFrame:
+    """One row per segment with the hover texts; ``depth`` in display units."""
     rows = seg.copy()
-    rows["depth"] = rows["bit_depth_m"]
+    rows["depth"] = rows["bit_depth_m"] * units.factor("length")
     rows["kind"] = rows["kind"].fillna("—").astype(str).str.replace("_", " ")
     rows["mu_k_text"] = [fmt(v) for v in rows["mu_k"]]
     rows["mu_s_text"] = [mu_s_text(m, i, b) for m, i, b in
@@ -69,17 +77,19 @@ def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: st
     return out
 
 
-def friction_plot(segments: pd.DataFrame):
+def friction_plot(segments: pd.DataFrame, units: Units = SI):
     """μ versus bit depth and stick-slip severity versus bit depth (a Bokeh row)."""
     from bokeh.layouts import gridplot
     from bokeh.models import HoverTool, Span
     from bokeh.plotting import figure
 
     seg = segments[segments["bit_depth_m"].notna()]
-    frame = _source_frame(seg)
+    frame = _source_frame(seg, units)
     ok = frame[frame["status"] == "ok"]
+    zone = zone_text(seg)
     mu = figure(height=520, width=560, tools=_TOOLS,
-                x_axis_label="friction factor μ [-]", y_axis_label="bit depth [m]")
+                x_axis_label=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
+                y_axis_label=units.axis("bit depth", "length"))
     mu.y_range.flipped = True
     renderers = []
     for col, half, color in (("mu_k", "half_k", MU_K_COLOR), ("mu_s", "half_s", MU_S_COLOR)):
@@ -106,7 +116,7 @@ def friction_plot(segments: pd.DataFrame):
         renderers.append(mu.scatter("zero", "depth", source=_cds(none),
                                     marker="diamond", size=10, color="#888888",
                                     fill_color="white", legend_label="no estimate"))
-    mu.add_tools(HoverTool(renderers=renderers, tooltips=_TIPS))
+    mu.add_tools(HoverTool(renderers=renderers, tooltips=_tips(units)))
     mu.legend.location = "bottom_right"
     mu.legend.label_text_font_size = "10px"
     mu.legend.click_policy = "hide"
@@ -116,22 +126,23 @@ def friction_plot(segments: pd.DataFrame):
     if len(sev_rows):
         line = sev.scatter("stick_slip_severity", "depth", source=_cds(sev_rows),
                            marker="circle", size=8, color="#8e44ad")
-        sev.add_tools(HoverTool(renderers=[line], tooltips=_TIPS))
+        sev.add_tools(HoverTool(renderers=[line], tooltips=_tips(units)))
     sev.add_layout(Span(location=1.0, dimension="height", line_dash="dashed",
                         line_color="#c0392b"))
     sev.x_range.start = 0.0
     return gridplot([[mu, sev]], merge_tools=True, toolbar_location="right")
 
 
-def fleet_plot(logs: list[tuple[str, pd.DataFrame]]):
-    """μ_k versus bit depth of every well, a colour per well; legend click hides a well."""
+def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
+    """μ_k versus bit depth (display ``units``) of every well, a colour per well; legend
+    click hides a well."""
     from bokeh.models import HoverTool, Legend, LegendItem
     from bokeh.palettes import Category10, Category20
     from bokeh.plotting import figure
 
     fig = figure(height=560, sizing_mode="stretch_width", min_width=MIN_WIDTH_PX,
                  tools=_TOOLS, active_scroll="wheel_zoom", x_axis_label="μ_k [-]",
-                 y_axis_label="bit depth [m]")
+                 y_axis_label=units.axis("bit depth", "length"))
     fig.y_range.flipped = True
     palette = Category10[10] if len(logs) <= 10 else Category20[20]
     items, renderers = [], []
@@ -140,7 +151,7 @@ def fleet_plot(logs: list[tuple[str, pd.DataFrame]]):
         if not len(ok):
             continue
         color = palette[index % len(palette)]
-        frame = _source_frame(ok.sort_values("bit_depth_m")).assign(well=name)
+        frame = _source_frame(ok.sort_values("bit_depth_m"), units).assign(well=name)
         frame["fill"] = np.where(frame["converged"], color, "white")
         source = _cds(frame)
         line = fig.line("mu_k", "depth", source=source, color=color, line_width=1)
@@ -152,5 +163,6 @@ def fleet_plot(logs: list[tuple[str, pd.DataFrame]]):
         fig.add_layout(Legend(items=items, click_policy="hide", label_text_font_size="10px"),
                        "right")
         fig.add_tools(HoverTool(renderers=renderers,
-                                tooltips=[("well", "@well"), *_TIPS[:3]]))
+                                tooltips=[("well", "@well"), *_tips(units)[:3],
+                                          ("friction zone", "@zone")]))
     return fig

@@ -14,23 +14,28 @@ import warnings
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from importlib.resources import files
+from typing import TYPE_CHECKING
 
 import pandas as pd
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
+if TYPE_CHECKING:
+    from .display import Units
+
 #: Resolution of the figures embedded in HTML [dots per inch].
 HTML_DPI = 90
-#: Columns of the diagnostics table (HTML and PDF), in order.
-DIAGNOSTIC_COLUMNS = ("seg.", "kind", "bit depth [m]", "time", "μ_s", "μ_k", "μ_TD",
-                      "spread μ_s / μ_k", "settling [s]", "residual [rpm]",
-                      "misfit / swing [kN·m]", "severity", "stuck",
-                      "hook load [kN] meas. / model", "bit speed", "observability", "status",
-                      "message")
-#: Positions of the numeric columns of :data:`DIAGNOSTIC_COLUMNS` (right-aligned).
-NUMERIC_COLUMNS = frozenset((2, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13))
-#: Positions of the columns whose text may wrap in the HTML table (the others are short).
-WRAPPING_COLUMNS = frozenset((1, 15, 16, 17))
+#: Columns of the diagnostics table (HTML and PDF), in order: heading, the quantity whose
+#: display unit the heading names (None: no unit or a fixed one) and the cell's CSS class
+#: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap).
+DIAGNOSTIC_COLUMNS = (
+    ("seg.", None, ""), ("kind", None, "wrap"), ("bit depth", "length", "num"),
+    ("time", None, ""), ("μ_s", None, "num"), ("μ_k", None, "num"), ("μ_TD", None, "num"),
+    ("μ zone", None, "wrap"), ("spread μ_s / μ_k", None, "num"), ("settling [s]", None, "num"),
+    ("residual [rpm]", None, "num"), ("misfit / swing (fit quality)", "torque", "num"),
+    ("severity", None, "num"), ("stuck", None, "num"),
+    ("hook load meas. / model", "force", "num"), ("bit speed (log interval)", None, "wrap"),
+    ("observability", None, "wrap"), ("status", None, "wrap"), ("message", None, ""))
 #: Messages longer than this [characters] are folded in the HTML table (click to read).
 MESSAGE_FOLD_CHARS = 90
 
@@ -123,10 +128,9 @@ def clock_span(row: dict, origin) -> str:
     return f"{fmt(row.get('t_start_s'), '.0f')}–{fmt(row.get('t_end_s'), '.0f')} s"
 
 
-def pair(a, b, spec: str = ".3f", scale: float = 1.0) -> str:
-    """``"a / b"`` formatted (scaled), "—" for a missing one; "—" when both are missing."""
-    left = fmt(None if a is None else _scaled(a, scale), spec)
-    right = fmt(None if b is None else _scaled(b, scale), spec)
+def pair(a, b, spec: str = ".3f") -> str:
+    """``"a / b"`` formatted, "—" for a missing one; "—" when both are missing."""
+    left, right = fmt(a, spec), fmt(b, spec)
     return "—" if left == right == "—" else f"{left} / {right}"
 
 
@@ -137,16 +141,56 @@ def _scaled(value, scale: float):
         return None
 
 
+def bit_speed_unresolved(row: dict) -> bool:
+    """Whether the segment says its bit speed is not resolved (older results: no)."""
+    resolved = row.get("bit_speed_resolved")
+    return resolved is not None and not pd.isna(resolved) and not bool(resolved)
+
+
+#: How the estimator's reason begins (drillfric.estimation.sampling); not repeated after
+#: "not resolved".
+_REASON_PREFIX = "bit speed not resolved:"
+
+
 def bit_speed_text(row: dict, reason: bool = True) -> str:
     """Whether the segment's bit speed is resolved (and, with ``reason``, why not)."""
     resolved = row.get("bit_speed_resolved")
-    if row.get("status") != "ok" or resolved is None or (isinstance(resolved, float)
-                                                         and math.isnan(resolved)):
+    if row.get("status") != "ok" or resolved is None or pd.isna(resolved):
         return "—"
-    if bool(resolved):
+    if not bit_speed_unresolved(row):
         return "resolved"
     why = str(row.get("bit_speed_reason") or "").strip()
+    if why.lower().startswith(_REASON_PREFIX):
+        why = why[len(_REASON_PREFIX):].strip()
     return "not resolved" + (f": {why}" if why and reason else "")
+
+
+def interval_text(row: dict) -> str:
+    """The segment's effective logging interval, e.g. "0.05 s" ("" when unknown)."""
+    interval = fmt(row.get("sample_interval_s"), ".3g")
+    return "" if interval == "—" else f"{interval} s"
+
+
+def zone_text(segments: pd.DataFrame) -> str:
+    """The friction zone the estimated segments' μ are for ("open hole", "effective"), or
+    "" when they differ or the results do not say (older results)."""
+    if "friction_zone" not in segments:
+        return ""
+    zones = set(segments.loc[segments["status"] == "ok", "friction_zone"].dropna())
+    return zones.pop().replace("_", " ") if len(zones) == 1 else ""
+
+
+def message_parts(message: str) -> list[str]:
+    """A segment's message as its notes: split at "; " outside parentheses (the notes of
+    the estimation steps are joined with "; ", and a note may hold one in brackets)."""
+    parts, depth, start = [], 0, 0
+    for i, char in enumerate(message):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if depth == 0 and message.startswith("; ", i):
+            parts.append(message[start:i])
+            start = i + 2
+    parts.append(message[start:])
+    return [p.strip() for p in parts if p.strip()]
 
 
 def status_text(row: dict) -> str:
@@ -157,9 +201,16 @@ def status_text(row: dict) -> str:
     return f"ok, {converged}, {row.get('method') or '—'}"
 
 
-def diagnostic_rows(segments: pd.DataFrame, origin=None) -> list[dict]:
-    """One dict per segment: ``cells`` (strings in :data:`DIAGNOSTIC_COLUMNS` order), ``id``,
-    ``cls`` and ``anchor`` (whether the segment has a figure section is set by the caller).
+def diagnostic_columns(units: Units) -> list[tuple[str, str]]:
+    """``(heading, CSS class)`` of the diagnostics table in display ``units``."""
+    return [(units.axis(name, quantity) if quantity else name, cls)
+            for name, quantity, cls in DIAGNOSTIC_COLUMNS]
+
+
+def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None) -> list[dict]:
+    """One dict per segment: ``cells`` (strings in :data:`DIAGNOSTIC_COLUMNS` order, values
+    in display ``units``), ``id``, ``cls`` and ``anchor`` (whether the segment has a figure
+    section is set by the caller).
 
     ``origin``: clock time of log time 0 (UTC), when known.
     """
@@ -168,22 +219,35 @@ def diagnostic_rows(segments: pd.DataFrame, origin=None) -> list[dict]:
         ok = row["status"] == "ok"
         mu_s = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
         flags = ", ".join(row.get("flags") or [])
-        unresolved = bit_speed_text(row) if bit_speed_text(row, False) == "not resolved" \
-            else ""
+        unresolved = bit_speed_text(row) if bit_speed_unresolved(row) and ok else ""
         message = "; ".join(x for x in (str(row.get("message") or ""), unresolved, flags)
                             if x)
         kind = str(row.get("kind") or "—").replace("_rotating", "").replace("_", " ")
-        cells = [str(row["id"]), kind, fmt(row["bit_depth_m"], ".1f"), clock_span(row, origin),
-                 mu_s if ok else "—", fmt(row["mu_k"]), fmt(row["mu_td"]),
+        cells = [str(row["id"]), kind, units.text(row["bit_depth_m"], "length", ".1f"),
+                 clock_span(row, origin), mu_s if ok else "—", fmt(row["mu_k"]),
+                 fmt(row["mu_td"]), str(row.get("friction_zone") or "—").replace("_", " "),
                  pair(row["mu_s_spread"], row["mu_k_spread"]),
                  fmt(row["settling_time_s"], ".1f"), fmt(row["residual_rms_rpm"], ".2f"),
-                 pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"), ".1f", 1e-3),
-                 fmt(row["stick_slip_severity"], ".2f"), fmt(row["stuck_fraction"], ".0%"),
-                 pair(row.get("hookload_N"), row.get("hookload_model_N"), ".0f", 1e-3),
-                 bit_speed_text(row, reason=False), observability(row), status_text(row),
-                 message]
+                 _torque_fit(row, units), fmt(row["stick_slip_severity"], ".2f"),
+                 fmt(row["stuck_fraction"], ".0%"),
+                 units.pair(row.get("hookload_N"), row.get("hookload_model_N"), "force"),
+                 _bit_speed_cell(row), observability(row), status_text(row), message]
         out.append({"id": row["id"], "cls": row_class(row), "cells": cells})
     return out
+
+
+def _torque_fit(row: dict, units: Units) -> str:
+    """``"misfit / swing (quality)"`` of the torque fit, in display units."""
+    text = units.pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"), "torque",
+                      ".1f")
+    quality = fmt(row.get("fit_quality"), ".2f")
+    return text if quality == "—" else f"{text} ({quality})"
+
+
+def _bit_speed_cell(row: dict) -> str:
+    """Resolved or not, with the logging interval that decides it."""
+    text, interval = bit_speed_text(row, reason=False), interval_text(row)
+    return f"{text} ({interval})" if interval and text != "—" else text
 
 
 def config_rows(config: dict) -> list[tuple[str, list[tuple[str, str]]]]:
@@ -201,17 +265,23 @@ def config_rows(config: dict) -> list[tuple[str, list[tuple[str, str]]]]:
     return out
 
 
-#: Columns of the drill-string table: (config key, heading, scale to the shown unit, format).
-STRING_COLUMNS = (("name", "section", 1.0, ""), ("od_m", "OD [mm]", 1e3, ".1f"),
-                  ("id_m", "ID [mm]", 1e3, ".1f"), ("length_m", "length [m]", 1.0, ".1f"),
-                  ("tool_joint_od_m", "tool joint OD [mm]", 1e3, ".1f"),
-                  ("linear_mass_kg_m", "linear mass [kg/m]", 1.0, ".2f"),
-                  ("shear_modulus_Pa", "shear modulus [GPa]", 1e-9, ".1f"),
-                  ("steel_density_kg_m3", "steel density [kg/m³]", 1.0, ".0f"))
+#: Columns of the drill-string table: config key, heading, the quantity whose display unit
+#: the value is shown in (None: the heading's fixed unit and ``scale``), format by unit
+#: system.
+STRING_COLUMNS = (
+    ("name", "section", None, 1.0, {}),
+    ("od_m", "OD", "diameter", 1.0, {"si": ".1f", "field": ".3f"}),
+    ("id_m", "ID", "diameter", 1.0, {"si": ".1f", "field": ".3f"}),
+    ("length_m", "length", "length", 1.0, {"si": ".1f", "field": ".1f"}),
+    ("tool_joint_od_m", "tool joint OD", "diameter", 1.0, {"si": ".1f", "field": ".3f"}),
+    ("linear_mass_kg_m", "linear mass", "linear mass", 1.0, {"si": ".2f", "field": ".2f"}),
+    ("shear_modulus_Pa", "shear modulus [GPa]", None, 1e-9, {"si": ".1f", "field": ".1f"}),
+    ("steel_density_kg_m3", "steel density", "density", 1.0, {"si": ".0f", "field": ".2f"}))
 
 
-def string_table(config: dict) -> tuple[list[str], list[list[str]]]:
-    """The drill string of a configuration as ``(headings, rows)``, top section first.
+def string_table(config: dict, units: Units) -> tuple[list[str], list[list[str]]]:
+    """The drill string of a configuration as ``(headings, rows)`` in display ``units``,
+    top section first.
 
     A missing length is the top section's "to the bit"; other missing values are the
     defaults the run computed (steel area, OD/2 contact), shown as "default".
@@ -220,16 +290,19 @@ def string_table(config: dict) -> tuple[list[str], list[list[str]]]:
     rows = []
     for index, section in enumerate(sections):
         row = []
-        for key, _, scale, spec in STRING_COLUMNS:
+        for key, _, quantity, scale, spec in STRING_COLUMNS:
             value = section.get(key) if isinstance(section, dict) else None
             if value is None:
                 row.append("to the bit" if key == "length_m" and index == 0 else "default")
-            elif spec:
-                row.append(fmt(_scaled(value, scale), spec))
-            else:
+            elif not spec:
                 row.append(str(value))
+            elif quantity:
+                row.append(units.text(value, quantity, spec[units.system]))
+            else:
+                row.append(fmt(_scaled(value, scale), spec[units.system]))
         rows.append(row)
-    return [heading for _, heading, _, _ in STRING_COLUMNS], rows
+    return [units.axis(heading, quantity) if quantity else heading
+            for _, heading, quantity, _, _ in STRING_COLUMNS], rows
 
 
 def value_text(value) -> str:

@@ -1,10 +1,11 @@
 """Time tracks of the whole log (Pason/Totco style) from tracks.parquet.
 
 Stacked tracks on one time axis — hook load, surface torque, rotary speed, bit and hole
-depth, block position, standpipe pressure, WOB, flow — each drawn as its min–max envelope
-per time bin (a one-sample spike stays visible) with the bin mean as a line; below them a
-strip with the rig state of every bin and the segments the run estimated. Segments are
-also shaded across every track. Clock time (UTC) is on the axis when the log had it.
+depth, block position, standpipe pressure, WOB, flow, in the report's display units — each
+drawn as its min–max envelope per time bin (a one-sample spike stays visible) with the bin
+mean as a line; below them a strip with the rig state of every bin and the segments the
+run estimated. Segments are also shaded across every track. Clock time (UTC) is on the
+axis when the log had it.
 
 :func:`tracks_plot` is the interactive (Bokeh) version for report.html,
 :func:`tracks_figure` the static (matplotlib) one for the PDF. tracks.parquet is written by
@@ -21,40 +22,52 @@ from matplotlib.figure import Figure
 
 from drillfric.segmentation import RIG_STATES
 
+from .display import SI, Units
 from .interactive import float32, time_figure, time_label, time_values
 
 
 @dataclass(frozen=True)
 class Trace:
-    """One channel of a track: column prefix in tracks.parquet, legend, display scale."""
+    """One channel of a track: column prefix in tracks.parquet, legend, quantity (its
+    display unit: :class:`~drillfric.report.display.Units`), colour."""
 
     column: str
     label: str
-    scale: float
+    quantity: str
     color: str
 
 
 @dataclass(frozen=True)
 class Panel:
-    """One track: its axis label and the channels drawn in it."""
+    """One track: its name, the quantity of its axis and the channels drawn in it."""
 
-    label: str
+    name: str
+    quantity: str
     traces: tuple[Trace, ...]
     invert: bool = False
 
+    def label(self, units: Units) -> str:
+        """Axis label in display units, e.g. ``"hook load [klbf]"``."""
+        return units.axis(self.name, self.quantity)
 
-#: The tracks, top to bottom (display units: kN, kN·m, rpm, m, MPa, L/min).
+
+#: The tracks, top to bottom.
 PANELS = (
-    Panel("hook load [kN]", (Trace("hookload_N", "hook load", 1e-3, "#1f5fa8"),)),
-    Panel("torque [kN·m]", (Trace("surface_torque_Nm", "surface torque", 1e-3, "#c0392b"),)),
-    Panel("rotary speed [rpm]", (Trace("surface_rpm", "surface speed", 1.0, "#2e7d32"),)),
-    Panel("depth [m]", (Trace("hole_depth_m", "hole depth", 1.0, "#555555"),
-                        Trace("bit_depth_m", "bit depth", 1.0, "#8e44ad")), invert=True),
-    Panel("block [m]", (Trace("block_position_m", "block position", 1.0, "#8c6d31"),)),
-    Panel("SPP [MPa]", (Trace("standpipe_pressure_Pa", "standpipe pressure", 1e-6,
-                              "#d35400"),)),
-    Panel("WOB [kN]", (Trace("wob_N", "weight on bit", 1e-3, "#16a085"),)),
-    Panel("flow in [L/min]", (Trace("flow_in_m3_s", "flow in", 6e4, "#2980b9"),)),
+    Panel("hook load", "force", (Trace("hookload_N", "hook load", "force", "#1f5fa8"),)),
+    Panel("torque", "torque", (Trace("surface_torque_Nm", "surface torque", "torque",
+                                     "#c0392b"),)),
+    Panel("rotary speed", "rotary speed", (Trace("surface_rpm", "surface speed",
+                                                 "rotary speed", "#2e7d32"),)),
+    Panel("depth", "length", (Trace("hole_depth_m", "hole depth", "length", "#555555"),
+                              Trace("bit_depth_m", "bit depth", "length", "#8e44ad")),
+          invert=True),
+    Panel("block", "length", (Trace("block_position_m", "block position", "length",
+                                    "#8c6d31"),)),
+    Panel("SPP", "pressure", (Trace("standpipe_pressure_Pa", "standpipe pressure", "pressure",
+                                    "#d35400"),)),
+    Panel("WOB", "force", (Trace("wob_N", "weight on bit", "force", "#16a085"),)),
+    Panel("flow in", "flow rate", (Trace("flow_in_m3_s", "flow in", "flow rate",
+                                         "#2980b9"),)),
 )
 #: Colour of each rig state (index into drillfric.segmentation.RIG_STATES).
 STATE_COLORS = ("#9ecae1", "#3182bd", "#fdae6b", "#a1d99b", "#d9d9d9", "#f7f7f7", "#9e9ac8")
@@ -70,7 +83,7 @@ def panels_present(tracks: pd.DataFrame) -> list[Panel]:
         traces = tuple(t for t in panel.traces if f"{t.column}_mean" in tracks
                        and tracks[f"{t.column}_max"].notna().any())
         if traces:
-            out.append(Panel(panel.label, traces, panel.invert))
+            out.append(Panel(panel.name, panel.quantity, traces, panel.invert))
     return out
 
 
@@ -109,10 +122,11 @@ def state_runs(time_s: np.ndarray, codes: np.ndarray) -> pd.DataFrame:
 
 
 # ------------------------------------------------------------------------------ Bokeh
-def tracks_plot(tracks: pd.DataFrame, segments: pd.DataFrame, origin: pd.Timestamp | None):
-    """Interactive time tracks (a Bokeh layout): zoom/pan in time on any track zooms all;
-    hover gives the bin's min, mean and max; the bottom strip's hover names the rig state
-    and the segment (id, kind, bit depth, μ_k)."""
+def tracks_plot(tracks: pd.DataFrame, segments: pd.DataFrame, origin: pd.Timestamp | None,
+                units: Units = SI):
+    """Interactive time tracks (a Bokeh layout) in display ``units``: zoom/pan in time on
+    any track zooms all; hover gives the bin's min, mean and max; the bottom strip's hover
+    names the rig state and the segment (id, kind, bit depth, μ_k)."""
     from bokeh.layouts import gridplot
     from bokeh.models import ColumnDataSource
 
@@ -122,13 +136,14 @@ def tracks_plot(tracks: pd.DataFrame, segments: pd.DataFrame, origin: pd.Timesta
     figs = []
     x_range = None
     for panel in panels_present(tracks):
-        fig = time_figure(_TRACK_PX, panel.label, x_range=x_range, clock=clock)
+        fig = time_figure(_TRACK_PX, panel.label(units), x_range=x_range, clock=clock)
         x_range = fig.x_range
         for trace in panel.traces:
+            scale = units.factor(trace.quantity)
             source = ColumnDataSource({
-                "x": x, "lo": float32(data[f"{trace.column}_min"] * trace.scale),
-                "hi": float32(data[f"{trace.column}_max"] * trace.scale),
-                "mean": float32(data[f"{trace.column}_mean"] * trace.scale)})
+                "x": x, "lo": float32(data[f"{trace.column}_min"] * scale),
+                "hi": float32(data[f"{trace.column}_max"] * scale),
+                "mean": float32(data[f"{trace.column}_mean"] * scale)})
             fig.varea("x", "lo", "hi", source=source, color=trace.color, alpha=0.25)
             line = fig.line("x", "mean", source=source, color=trace.color, line_width=1,
                             legend_label=trace.label)
@@ -141,7 +156,7 @@ def tracks_plot(tracks: pd.DataFrame, segments: pd.DataFrame, origin: pd.Timesta
             fig.y_range.flipped = True
         _shade_segments(fig, segments, origin)
         figs.append(fig)
-    figs.append(_strip(data, segments, origin, x_range))
+    figs.append(_strip(data, segments, origin, x_range, units))
     return gridplot([[f] for f in figs], merge_tools=True, toolbar_location="right",
                     sizing_mode="stretch_width")
 
@@ -166,7 +181,7 @@ def _shade_segments(fig, segments: pd.DataFrame, origin) -> None:
                    alpha=0.08, line_alpha=0)
 
 
-def _strip(data: pd.DataFrame, segments: pd.DataFrame, origin, x_range):
+def _strip(data: pd.DataFrame, segments: pd.DataFrame, origin, x_range, units: Units):
     """Rig states (lower row) and segments (upper row) as coloured bands with hover."""
     from bokeh.models import ColumnDataSource, FixedTicker, HoverTool
 
@@ -185,8 +200,9 @@ def _strip(data: pd.DataFrame, segments: pd.DataFrame, origin, x_range):
             "left": time_values(seg["t_start_s"], origin),
             "right": time_values(seg["t_end_s"], origin),
             "color": [SEGMENT_COLORS.get(k, "#777777") for k in seg["kind"]],
-            "what": [f"segment {i}: {str(k).replace('_', ' ')}, bit at {d:.0f} m, "
-                     f"μ_k {m:.3f}, {s}" for i, k, d, m, s in
+            "what": [f"segment {i}: {str(k).replace('_', ' ')}, bit at "
+                     f"{units.text(d, 'length')} {units.label('length')}, μ_k {m:.3f}, {s}"
+                     for i, k, d, m, s in
                      zip(seg["id"], seg["kind"], seg["bit_depth_m"].fillna(np.nan),
                          seg["mu_k"].fillna(np.nan), seg["status"], strict=True)]})
         quads.append(fig.quad(left="left", right="right", bottom=1.2, top=2.2, source=bands,
@@ -202,9 +218,10 @@ def _strip(data: pd.DataFrame, segments: pd.DataFrame, origin, x_range):
 
 # ------------------------------------------------------------------------- matplotlib
 def tracks_figure(tracks: pd.DataFrame, segments: pd.DataFrame,
-                  origin: pd.Timestamp | None, size: tuple[float, float] = (11.69, 8.27)
-                  ) -> Figure:
-    """Static time tracks (the PDF page): envelopes, means, segments and rig states."""
+                  origin: pd.Timestamp | None, size: tuple[float, float] = (11.69, 8.27),
+                  units: Units = SI) -> Figure:
+    """Static time tracks (the PDF page) in display ``units``: envelopes, means, segments
+    and rig states."""
     from matplotlib.patches import Patch
 
     panels = panels_present(tracks)
@@ -218,12 +235,13 @@ def tracks_figure(tracks: pd.DataFrame, segments: pd.DataFrame,
                         gridspec_kw={"height_ratios": ratios}, squeeze=False)[:, 0]
     for ax, panel in zip(axes, panels, strict=False):
         for trace in panel.traces:
-            lo = data[f"{trace.column}_min"] * trace.scale
-            hi = data[f"{trace.column}_max"] * trace.scale
+            scale = units.factor(trace.quantity)
+            lo = data[f"{trace.column}_min"] * scale
+            hi = data[f"{trace.column}_max"] * scale
             ax.fill_between(x, lo, hi, color=trace.color, alpha=0.25, linewidth=0)
-            ax.plot(x, data[f"{trace.column}_mean"] * trace.scale, color=trace.color,
+            ax.plot(x, data[f"{trace.column}_mean"] * scale, color=trace.color,
                     linewidth=0.7, label=trace.label)
-        ax.set_ylabel(panel.label, fontsize=8)
+        ax.set_ylabel(panel.label(units), fontsize=8)
         ax.tick_params(labelsize=7)
         if panel.invert:
             ax.invert_yaxis()

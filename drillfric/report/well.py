@@ -3,8 +3,9 @@
 The HTML draws the time tracks, the friction log and each segment's evidence with Bokeh
 (zoom, hover; :mod:`drillfric.report.interactive`), the broomstick, well path and profiles
 as PNG; the PDF draws everything with matplotlib on A4 landscape pages
-(:mod:`drillfric.report.pdf`). Sections whose files or columns a result directory lacks
-(older results) are left out with a one-line note.
+(:mod:`drillfric.report.pdf`). Lengths, forces and torques are shown in the display units
+of :func:`drillfric.report.display.report_units` (the files stay SI). Sections whose files
+or columns a result directory lacks (older results) are left out with a one-line note.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from drillfric.errors import ConfigError, DrillfricError
 from . import broomstick as broom
 from . import figures
 from .data import ResultData, load_result, segment_estimates
+from .display import Units, report_units
 from .evidence import (
     evidence_figure,
     evidence_plot,
@@ -32,23 +34,24 @@ from .friction import friction_plot
 from .interactive import Embedder
 from .pdf import table_pages, write_pdf
 from .render import (
-    DIAGNOSTIC_COLUMNS,
     MESSAGE_FOLD_CHARS,
-    NUMERIC_COLUMNS,
-    WRAPPING_COLUMNS,
     bit_speed_text,
+    bit_speed_unresolved,
     clock,
     clock_span,
     config_rows,
+    diagnostic_columns,
     diagnostic_rows,
     environment,
     figure_uri,
     fmt,
+    interval_text,
+    message_parts,
     mu_s_text,
     now_utc,
-    pair,
     string_table,
     written_at,
+    zone_text,
 )
 from .tracks import panels_present, tracks_figure, tracks_plot
 
@@ -112,7 +115,7 @@ class Broomstick:
     note: str | None
 
 
-def _header(data: ResultData) -> dict:
+def _header(data: ResultData, units: Units) -> dict:
     summary, seg = data.summary, data.segments
     inputs = summary.get("inputs") or {}
     files = [(kind, str(v.get("path", "—")), str(v.get("sha256", "—")))
@@ -124,7 +127,8 @@ def _header(data: ResultData) -> dict:
                      for t in (seg["t_start_s"].min(), seg["t_end_s"].max()))
     elif len(seg):
         span = (clock(seg["t_start_s"].min()), clock(seg["t_end_s"].max()))
-    string_columns, string_rows = string_table(summary.get("config") or {})
+    string_columns, string_rows = string_table(summary.get("config") or {}, units)
+    zone = str(summary.get("friction_zone") or "").replace("_", " ") or zone_text(seg)
     return {
         "well": str(summary.get("well", data.result_dir.name)),
         "version": str(summary.get("drillfric_version", "—")),
@@ -136,6 +140,8 @@ def _header(data: ResultData) -> dict:
         "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                           summary.get("mu_s_lower_bound")),
         "mu_s_identified": summary.get("mu_s") is not None,
+        "zone": zone, "profile": str(summary.get("friction_profile") or ""),
+        "units": units.system,
         "counts": summary.get("counts") or {}, "assumed": [str(a) for a in
                                                            summary.get("assumed") or []],
         "indicative": bool(summary.get("indicative", bool(summary.get("assumed")))),
@@ -171,14 +177,14 @@ def config_from_summary(summary: dict):
     return config_from_dict(raw, file="summary.json")
 
 
-def _broomstick(data: ResultData) -> Broomstick:
+def _broomstick(data: ResultData, units: Units) -> Broomstick:
     """Model lines from the run's configuration and well path, measured points from the
     segments, and the string-weight check."""
     from drillfric.wellpath import minimum_curvature
 
     points = broom.measured_points(data.segments)
     if not len(points):
-        return Broomstick(None, points, broom.weight_check(points), (
+        return Broomstick(None, points, broom.weight_check(points, units=units), (
             "No measured hook load or torque per segment in these results (written before "
             "drillfric recorded them); rerun 'drillfric run' to get them."))
     try:
@@ -191,32 +197,39 @@ def _broomstick(data: ResultData) -> Broomstick:
             deepest = min(deepest, path.md_max_m)
         table = broom.model_table(cfg, path, broom.default_depths(cfg, deepest))
     except DrillfricError as exc:
-        return Broomstick(None, points, broom.weight_check(points),
+        return Broomstick(None, points, broom.weight_check(points, units=units),
                           f"Model lines not drawn: {exc.message}")
-    return Broomstick(table, points, broom.weight_check(points, table), None)
+    return Broomstick(table, points, broom.weight_check(points, table, units=units), None)
 
 
-def _broomstick_note(check: dict) -> str | None:
+def _broomstick_note(check: dict, units: Units) -> str | None:
     if not check["checked"]:
         return None
     if check["warning"]:
         return check["warning"]
     return (f"String weight consistent with the hook load in {check['checked']} off-bottom "
             f"segment(s): implied travelling-block weight "
-            f"{check['block_weight_N'] / 1e3:.0f} kN (median measured − modelled).")
+            f"{units.text(check['block_weight_N'], 'force')} {units.label('force')} (median "
+            "measured − modelled).")
 
 
-def _segment_head(row: dict, origin) -> dict:
+def _segment_head(row: dict, origin, units: Units) -> dict:
+    """What a segment's header shows (display units)."""
     row = dict(row)
     row["mu_s_text"] = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
     row["span"] = clock_span(row, origin)
-    row["torque"] = pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"), ".1f",
-                         1e-3)
+    row["depth"] = f"{units.text(row['bit_depth_m'], 'length')} {units.label('length')}"
+    row["torque"] = units.pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"),
+                               "torque", ".1f")
     row["quality"] = fmt(row.get("fit_quality"), ".2f")
-    row["hookload"] = pair(row.get("hookload_N"), row.get("hookload_model_N"), ".0f", 1e-3)
+    row["hookload"] = units.pair(row.get("hookload_N"), row.get("hookload_model_N"), "force")
     row["bit_speed"] = bit_speed_text(row)
+    row["bit_unresolved"] = bit_speed_unresolved(row)
+    row["interval"] = interval_text(row)
+    row["interval_swing"] = fmt(row.get("interval_torque_swing"), ".0%")
     row["zone"] = str(row.get("friction_zone") or "—").replace("_", " ")
     row["starts_text"] = starts_text(row)
+    row["notes"] = message_parts(str(row.get("message") or ""))
     return row
 
 
@@ -230,12 +243,13 @@ class Report:
     estimates: dict[int, pd.DataFrame]
     broomstick: Broomstick
     diagnostics: list[dict]
+    units: Units
 
     @property
     def segment_rows(self) -> list[dict]:
         """Header rows of the drawn segments that have estimates, in id order."""
         rows = self.data.segments.set_index("id", drop=False)
-        return [_segment_head(rows.loc[i].to_dict(), self.data.time_origin)
+        return [_segment_head(rows.loc[i].to_dict(), self.data.time_origin, self.units)
                 for i in self.drawn if i in self.estimates and len(self.estimates[i])]
 
     @property
@@ -244,23 +258,27 @@ class Report:
         return tracks is not None and len(tracks) > 0 and bool(panels_present(tracks))
 
 
-def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES) -> Report:
-    """Read a result directory and prepare the report (no figure drawn yet)."""
+def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
+                 units: str | None = None) -> Report:
+    """Read a result directory and prepare the report (no figure drawn yet); ``units``:
+    ``"si"``, ``"field"`` or None (the run's ``[well] units``)."""
     limit = segment_limit(segments)
     data = load_result(Path(result_dir))
+    shown = report_units(data.summary, units)
     drawn = select_segments(data.segments, limit)
     estimates = segment_estimates(data.result_dir, drawn)
-    diag = diagnostic_rows(data.segments, data.time_origin)
+    diag = diagnostic_rows(data.segments, shown, data.time_origin)
     have = {i for i, e in estimates.items() if len(e)}
     for row in diag:
         row["anchor"] = int(row["id"]) in have
-    return Report(data, _header(data), drawn, estimates, _broomstick(data), diag)
+    return Report(data, _header(data, shown), drawn, estimates, _broomstick(data, shown), diag,
+                  shown)
 
 
 def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, str | None]]:
     """``(key, title, Figure or None, note)`` of the matplotlib sections."""
     data, seg = report.data, report.data.segments
-    kw = {} if size is None else {"size": size}
+    kw = {"units": report.units} if size is None else {"size": size, "units": report.units}
     no_survey = _no_survey_note(data.summary)
     no_profile = not figures.profile_depths(seg, data.profiles)
     bs = report.broomstick
@@ -268,7 +286,8 @@ def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, 
     if bs.table is not None:
         from drillfric.torque_drag import broomstick_figure
 
-        broom_fig = broomstick_figure(bs.table, bs.points, size=size or (10.0, 6.5))
+        broom_fig = broomstick_figure(bs.table, bs.points, size=size or (10.0, 6.5),
+                                      units=report.units.system)
     return [
         ("broomstick", "Broomstick: hook load and torque versus depth", broom_fig, bs.note),
         ("wellpath", "Well path", figures.wellpath_figure(data.wellpath, no_survey, **kw),
@@ -279,32 +298,32 @@ def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, 
 
 
 def _html(report: Report) -> str:
-    data = report.data
+    data, units = report.data, report.units
     embed = Embedder()
-    tracks_id = embed.add(tracks_plot(data.tracks, data.segments, data.time_origin),
+    tracks_id = embed.add(tracks_plot(data.tracks, data.segments, data.time_origin, units),
                           "tracks") if report.has_tracks else None
-    friction_id = embed.add(friction_plot(data.segments), "friction") \
+    friction_id = embed.add(friction_plot(data.segments, units), "friction") \
         if data.segments["bit_depth_m"].notna().any() else None
     segments = []
     clock = data.time_origin is not None
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
-        sources = evidence_sources(est, data.time_origin)
+        sources = evidence_sources(est, data.time_origin, units, not row["bit_unresolved"])
         div = embed.add_like(signature(sources),
-                             lambda sources=sources: evidence_plot(sources, clock), sources,
-                             f"segment-{row['id']}")
+                             lambda sources=sources: evidence_plot(sources, clock, units),
+                             sources, f"segment-{row['id']}")
         segments.append((row, div, _missing_evidence(est)))
     sections = [(k, t, figure_uri(f) if f is not None else None, n)
                 for k, t, f, n in _static_sections(report)]
     return environment().get_template("well_report.html.j2").render(
         head=report.head, bokeh=embed.head, tracks_id=tracks_id, no_tracks=_NO_TRACKS,
         friction_id=friction_id, sections=sections, segments=segments,
-        broomstick_check=_broomstick_note(report.broomstick.check),
+        broomstick_check=_broomstick_note(report.broomstick.check, units),
         broomstick_warning=bool(report.broomstick.check["warning"]),
         n_estimated=int((data.segments["status"] == "ok").sum()),
-        columns=DIAGNOSTIC_COLUMNS, numeric=NUMERIC_COLUMNS, fold=MESSAGE_FOLD_CHARS,
-        wrapping=WRAPPING_COLUMNS,
-        diagnostics=report.diagnostics)
+        columns=diagnostic_columns(units), fold=MESSAGE_FOLD_CHARS,
+        diagnostics=report.diagnostics,
+        u={q: units.label(q) for q in ("length", "force", "torque")})
 
 
 def _missing_evidence(est: pd.DataFrame) -> str | None:
@@ -316,7 +335,8 @@ def _missing_evidence(est: pd.DataFrame) -> str | None:
 
 
 def write_well_report(result_dir: Path, *, pdf: bool = False,
-                      segments: int | str = MAX_SEGMENT_FIGURES) -> Path:
+                      segments: int | str = MAX_SEGMENT_FIGURES,
+                      units: str | None = None) -> Path:
     """Write ``report.html`` (and ``report.pdf`` with ``pdf``) into ``result_dir``.
 
     Only the files of ``result_dir`` are read.
@@ -331,6 +351,9 @@ def write_well_report(result_dir: Path, *, pdf: bool = False,
         How many estimated segments get their evidence drawn (default
         :data:`MAX_SEGMENT_FIGURES`: the worst and the latest, :func:`select_segments`);
         "all" draws every one. Every segment is in the diagnostics table.
+    units : {"si", "field"}, optional
+        Display units of axes and tables (the result files stay SI); default: the run's
+        ``[well] units`` (summary.json ``config``), else SI.
 
     Returns
     -------
@@ -342,9 +365,9 @@ def write_well_report(result_dir: Path, *, pdf: bool = False,
     InputError
         ``result_dir`` is not a readable result directory.
     ConfigError
-        ``segments`` is neither "all" nor a number ≥ 0.
+        ``segments`` is neither "all" nor a number ≥ 0, or ``units`` is unknown.
     """
-    report = build_report(result_dir, segments)
+    report = build_report(result_dir, segments, units)
     out = report.data.result_dir / "report.html"
     _write_text(out, _html(report))
     if pdf:
@@ -359,14 +382,15 @@ def write_well_report(result_dir: Path, *, pdf: bool = False,
 def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
     from .pdf import blank_page
 
-    head, data = report.head, report.data
+    head, data, units = report.head, report.data, report.units
     pages = [("", p) for p in table_pages(f"Friction report — {head['well']}",
                                           ["", ""], _header_lines(report), font_pt=9.0)]
     if report.has_tracks:
         pages.append(("Time tracks", tracks_figure(data.tracks, data.segments,
-                                                   data.time_origin, size)))
+                                                   data.time_origin, size, units)))
     if data.segments["bit_depth_m"].notna().any():
-        pages.append(("Friction log", figures.friction_log_figure(data.segments, size)))
+        pages.append(("Friction log", figures.friction_log_figure(data.segments, size,
+                                                                  units)))
     for _, title, fig, note in _static_sections(report, size):
         if fig is None:
             fig = blank_page("")
@@ -374,9 +398,14 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
         pages.append((title, fig))
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
-        pages.append((f"Segment {row['id']} — bit at {fmt(row['bit_depth_m'], '.0f')} m, "
-                      f"{row['span']}", evidence_figure(est, row, data.time_origin, size)))
-    pages += [("", p) for p in table_pages("Diagnostics", list(DIAGNOSTIC_COLUMNS),
+        figure = evidence_figure(est, row, data.time_origin, size, units,
+                                 not row["bit_unresolved"])
+        if row["bit_unresolved"]:
+            figure.text(0.5, 0.5 / size[1], f"Bit speed {row['bit_speed']}", ha="center",
+                        fontsize=7, wrap=True, parse_math=False, color="#555555")
+        pages.append((f"Segment {row['id']} — bit at {row['depth']}, {row['span']}", figure))
+    pages += [("", p) for p in table_pages("Diagnostics",
+                                           [h for h, _ in diagnostic_columns(units)],
                                            [r["cells"] for r in report.diagnostics])]
     config = [[table, key, value] for table, items in head["config"] for key, value in items]
     pages += [("", p) for p in table_pages("Configuration: drill string", *head["string"])]
@@ -391,13 +420,16 @@ def _header_lines(report: Report) -> list[list[str]]:
              ["results written", head["written"]], ["report built", head["built"]],
              ["log time span", " – ".join(head["span"]) if head["span"] else "—"],
              ["μ_k (consensus)", head["mu_k"]], ["μ_s (consensus)", head["mu_s"]],
-             ["segments", ", ".join(f"{k} {v}" for k, v in counts.items())]]
+             ["friction zone", " — ".join(x for x in (head["zone"], head["profile"]) if x)
+              or "—"],
+             ["segments", ", ".join(f"{k} {v}" for k, v in counts.items())],
+             ["units", head["units"]]]
     for kind, path, sha in head["files"]:
         lines += [[f"input {kind}", f"{path}\nsha256 {sha}"]]
     lines += [["rows", fmt(head["rows"], ",.0f")], ["resampled to [Hz]", fmt(head["rate_hz"])]]
     lines += [["ASSUMED", a] for a in head["assumed"]] or [["assumed", "nothing"]]
     lines += [["WARNING", w] for w in head["warnings"]]
-    check = _broomstick_note(report.broomstick.check)
+    check = _broomstick_note(report.broomstick.check, report.units)
     if check:
         lines.append(["WARNING" if report.broomstick.check["warning"] else "string weight",
                       check])

@@ -1,0 +1,90 @@
+"""The units a report shows: SI results in the unit system the reader asked for.
+
+Result files stay SI (docs/outputs.md); the report shows lengths, forces, torques,
+pressures and flows in the ``"si"`` or ``"field"`` system of
+:data:`drillfric.units.DISPLAY_UNITS` — ``drillfric report --units`` (or ``run --units``),
+else the run's ``[well] units``, else SI (:func:`report_units`). Axes, tables, hover texts
+and the notes of the HTML and the PDF all go through one :class:`Units`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from drillfric.units import UNIT_SYSTEMS, display_factor, display_unit
+
+from .render import fmt
+
+#: Display units of quantities the terminal never shows (so not in DISPLAY_UNITS):
+#: ``(label, pint expression of the display unit, pint expression of the stored SI unit)``.
+_EXTRA = {
+    "torque per length": {"si": ("N·m/m", "newton", "newton"),
+                          "field": ("ft·lbf/ft", "force_pound", "newton")},
+}
+
+
+@dataclass(frozen=True)
+class Units:
+    """Display units of one report (``system``: ``"si"`` or ``"field"``)."""
+
+    system: str = "si"
+
+    def label(self, quantity: str) -> str:
+        """Unit label of ``quantity`` (e.g. ``"ft"`` for ``"length"`` in field units)."""
+        if quantity in _EXTRA:
+            return _EXTRA[quantity][self.system][0]
+        return display_unit(quantity, self.system)
+
+    def factor(self, quantity: str) -> float:
+        """Factor from the SI value of ``quantity`` to its display value."""
+        if quantity in _EXTRA:
+            from drillfric.units import registry
+
+            _, shown, stored = _EXTRA[quantity][self.system]
+            return float(registry().Quantity(1.0, stored).to(shown).magnitude)
+        return display_factor(quantity, self.system)
+
+    def axis(self, name: str, quantity: str) -> str:
+        """An axis or column heading: ``"bit depth [ft]"``."""
+        return f"{name} [{self.label(quantity)}]"
+
+    def value(self, value, quantity: str):
+        """An SI value in the display unit (None for a missing or non-numeric value)."""
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            return None
+        return number * self.factor(quantity)
+
+    def text(self, value, quantity: str, spec: str = ".0f") -> str:
+        """An SI value as display text without its unit ("—" when missing)."""
+        return fmt(self.value(value, quantity), spec)
+
+    def pair(self, a, b, quantity: str, spec: str = ".0f") -> str:
+        """``"a / b"`` in display units; "—" when both are missing."""
+        left, right = self.text(a, quantity, spec), self.text(b, quantity, spec)
+        return "—" if left == right == "—" else f"{left} / {right}"
+
+
+#: The default: SI display units (m, kN, kN·m, bar, L/min).
+SI = Units("si")
+
+
+def report_units(summary: dict, option: str | None = None) -> Units:
+    """The units of a report: ``option`` (``--units``), else the run's ``[well] units``
+    recorded in summary.json, else SI.
+
+    Raises
+    ------
+    ConfigError
+        ``option`` names no unit system.
+    """
+    from drillfric.errors import ConfigError
+
+    if option is None:
+        well = ((summary.get("config") or {}).get("well") or {})
+        option = well.get("units") if well.get("units") in UNIT_SYSTEMS else "si"
+    if option not in UNIT_SYSTEMS:
+        raise ConfigError(f"unknown unit system '{option}'",
+                          fix=f"use one of: {', '.join(UNIT_SYSTEMS)}")
+    return Units(str(option))
