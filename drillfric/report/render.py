@@ -26,15 +26,16 @@ if TYPE_CHECKING:
 #: Resolution of the figures embedded in HTML [dots per inch].
 HTML_DPI = 90
 #: Columns of the diagnostics table (HTML and PDF), in order: heading, the quantity whose
-#: display unit the heading names (None: no unit or a fixed one) and the cell's CSS class
+#: display unit the heading names (None: no unit or a fixed one; at ``{unit}``, else at the
+#: end) and the cell's CSS class
 #: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap).
 DIAGNOSTIC_COLUMNS = (
     ("seg.", None, ""), ("kind", None, "wrap"), ("bit depth", "length", "num"),
     ("time", None, ""), ("μ_s", None, "num"), ("μ_k", None, "num"), ("μ_TD", None, "num"),
     ("μ zone", None, "wrap"), ("spread μ_s / μ_k", None, "num"), ("settling [s]", None, "num"),
-    ("residual [rpm]", None, "num"), ("misfit / swing (fit quality)", "torque", "num"),
+    ("residual [rpm]", None, "num"), ("misfit / swing {unit} (quality)", "torque", "num"),
     ("severity", None, "num"), ("stuck", None, "num"),
-    ("hook load meas. / model", "force", "num"), ("bit speed (log interval)", None, "wrap"),
+    ("hook load", "force", "num"), ("bit speed (interval)", None, "wrap"),
     ("observability", None, "wrap"), ("status", None, "wrap"), ("message", None, ""))
 #: Messages longer than this [characters] are folded in the HTML table (click to read).
 MESSAGE_FOLD_CHARS = 90
@@ -193,6 +194,18 @@ def message_parts(message: str) -> list[str]:
     return [p.strip() for p in parts if p.strip()]
 
 
+def flag_items(row: dict) -> list[tuple[str, str]]:
+    """The segment's flags as ``(flag, meaning)`` (docs/outputs.md, flags); an unknown flag
+    (a newer drillfric's) keeps its name with no meaning."""
+    from drillfric.result import FLAG_MEANINGS
+
+    meanings = {str(k): v for k, v in FLAG_MEANINGS.items()}
+    flags = row.get("flags")
+    if not isinstance(flags, list | tuple):
+        return []
+    return [(str(f), meanings.get(str(f), "")) for f in flags]
+
+
 def status_text(row: dict) -> str:
     """Status, convergence and method in one cell."""
     if row.get("status") != "ok":
@@ -203,8 +216,14 @@ def status_text(row: dict) -> str:
 
 def diagnostic_columns(units: Units) -> list[tuple[str, str]]:
     """``(heading, CSS class)`` of the diagnostics table in display ``units``."""
-    return [(units.axis(name, quantity) if quantity else name, cls)
-            for name, quantity, cls in DIAGNOSTIC_COLUMNS]
+    out = []
+    for name, quantity, cls in DIAGNOSTIC_COLUMNS:
+        if quantity and "{unit}" in name:
+            name = name.replace("{unit}", f"[{units.label(quantity)}]")
+        elif quantity:
+            name = units.axis(name, quantity)
+        out.append((name, cls))
+    return out
 
 
 def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None) -> list[dict]:

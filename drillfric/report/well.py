@@ -44,6 +44,7 @@ from .render import (
     diagnostic_rows,
     environment,
     figure_uri,
+    flag_items,
     fmt,
     interval_text,
     message_parts,
@@ -230,6 +231,7 @@ def _segment_head(row: dict, origin, units: Units) -> dict:
     row["zone"] = str(row.get("friction_zone") or "—").replace("_", " ")
     row["starts_text"] = starts_text(row)
     row["notes"] = message_parts(str(row.get("message") or ""))
+    row["flag_items"] = flag_items(row)
     return row
 
 
