@@ -112,6 +112,10 @@ def _label(key: str, units: Units) -> str:
     return {"torque": f"torque [{torque}]", "torque_residual": f"Δ torque [{torque}]",
             "speed": "surface [rpm]", "speed_residual": "Δ speed [rpm]",
             "bit": "bit [rpm]", "mu": "μ [-]"}[key]
+
+
+#: Height of a line of notes at 7 pt [in].
+_NOTE_LINE_IN = 0.13
 _STYLE = {"measured": (MEASURED, 1.0), "observer": (OBSERVER, 1.0), "fit": (FIT, 1.2),
           "estimated": (OBSERVER, 1.0), "residual": (MEASURED, 0.8)}
 _LEGEND = {("torque", "measured"): "measured", ("torque", "observer"): "observer model",
@@ -252,15 +256,21 @@ def start_label(segment: dict, start_id: int) -> str:
 # ------------------------------------------------------------------------- matplotlib
 def evidence_figure(est: pd.DataFrame, segment: dict, origin: pd.Timestamp | None = None,
                     size: tuple[float, float] = (9.0, 9.0), units: Units = SI,
-                    bit: bool = True) -> Figure:
+                    bit: bool = True, notes: list[str] | None = None) -> Figure:
     """The segment's evidence as a static figure (the PDF page) in display ``units``;
-    ``bit`` False leaves the bit speed out (not resolved)."""
+    ``bit`` False leaves the bit speed out (not resolved); ``notes``: lines of text drawn
+    above the panels (under the page title)."""
     data = panel_data(est, units, bit)
     t = data.pop("time_s")["t"]
     x = time_values(t, origin)
     keys = [*data, "mu"]
     fig = Figure(figsize=size)
-    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.8 / size[1], bottom=0.6 / size[1],
+    notes = notes or []
+    if notes:
+        fig.text(0.09, 1 - 0.55 / size[1], "\n".join(notes), ha="left", va="top", fontsize=7,
+                 parse_math=False, color="#333333")
+    top_in = 0.8 + _NOTE_LINE_IN * len(notes)
+    fig.subplots_adjust(left=0.09, right=0.98, top=1 - top_in / size[1], bottom=0.6 / size[1],
                         hspace=0.12)
     ratios = [1.0 if k in ("torque", "bit", "mu") else 0.6 for k in keys]
     axes = fig.subplots(len(keys), 1, sharex=True, gridspec_kw={"height_ratios": ratios})

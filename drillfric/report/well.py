@@ -401,10 +401,7 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
         figure = evidence_figure(est, row, data.time_origin, size, units,
-                                 not row["bit_unresolved"])
-        if row["bit_unresolved"]:
-            figure.text(0.5, 0.5 / size[1], f"Bit speed {row['bit_speed']}", ha="center",
-                        fontsize=7, wrap=True, parse_math=False, color="#555555")
+                                 not row["bit_unresolved"], notes=segment_notes(row, units))
         pages.append((f"Segment {row['id']} — bit at {row['depth']}, {row['span']}", figure))
     pages += [("", p) for p in table_pages("Diagnostics",
                                            [h for h, _ in diagnostic_columns(units)],
@@ -413,6 +410,31 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
     pages += [("", p) for p in table_pages("Configuration: drill string", *head["string"])]
     pages += [("", p) for p in table_pages("Configuration", ["table", "key", "value"], config)]
     return pages
+
+
+#: Characters per line of a segment page's notes (7 pt on A4 landscape) and most lines.
+_NOTE_CHARS, _NOTE_LINES = 190, 7
+
+
+def segment_notes(row: dict, units: Units) -> list[str]:
+    """What a segment's PDF page says above its panels (the HTML header's facts): μ and
+    the friction zone, torque fit, hook load, logging interval, bit speed (why not
+    resolved), flags and the estimators' notes, wrapped to :data:`_NOTE_CHARS`."""
+    import textwrap
+
+    facts = [f"μ_k {fmt(row['mu_k'])} ({row['zone']}), μ_s {row['mu_s_text']}",
+             f"torque misfit / swing {row['torque']} {units.label('torque')} "
+             f"(fit quality {row['quality']})",
+             f"hook load measured / model {row['hookload']} {units.label('force')}"]
+    if row["interval"]:
+        facts.append(f"logged every {row['interval']}")
+    facts.append(f"bit speed {row['bit_speed']}")
+    lines = ["; ".join(facts)]
+    if row["flag_items"]:
+        lines.append("flags: " + ", ".join(flag for flag, _ in row["flag_items"]))
+    lines += row["notes"]
+    wrapped = [w for line in lines for w in textwrap.wrap(line, _NOTE_CHARS)]
+    return wrapped[:_NOTE_LINES - 1] + ["…"] if len(wrapped) > _NOTE_LINES else wrapped
 
 
 def _header_lines(report: Report) -> list[list[str]]:
