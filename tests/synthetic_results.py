@@ -148,14 +148,16 @@ def synthetic_result(out: Path, *, hours: float = 24.0, log_rate_hz: float = 100
     segments = [_synthetic_segment(i + 1, starts_s[i], segment_s, depths[i], n_starts, rng)
                 for i in range(n_segments)]
     summary = {"well": "synthetic-24h", "drillfric_version": "bench", "mu_k": 0.25,
-               "mu_s": None, "mu_s_lower_bound": 0.4, "segments": segments,
+               "mu_s": None, "mu_s_lower_bound": 0.4, "friction_zone": "open_hole",
+               "friction_profile": "open hole below the shoe; cased part known",
+               "segments": segments,
                "inputs": {"rows": int(duration * log_rate_hz)},
                "config": cfg.to_dict(), "assumed": [], "indicative": False,
                "counts": {"segments": n_segments, "estimated": n_segments,
                           "converged": n_segments, "skipped": 0, "failed": 0},
                "time_origin_utc": "2024-05-01T00:00:00+00:00", "warnings": []}
     (out / "summary.json").write_text(json.dumps(summary), encoding="utf-8")
-    pd.DataFrame(segments).drop(columns=["starts"]).to_parquet(out / "segments.parquet")
+    pd.DataFrame(segments).drop(columns=["flags", "starts"]).to_parquet(out / "segments.parquet")
     return out
 
 
@@ -214,6 +216,12 @@ def _write_estimates(path, starts_s, segment_s, n_starts, rate_hz, rng) -> None:
     writer.close()
 
 
+#: The notes of every synthetic stand (worded like the estimators' messages).
+SYNTHETIC_MESSAGE = ("top drive identified from the log as PI speed control: the model "
+                     "replays it; μ_s not identifiable (stick-slip, no creep); μ_s ≥ 0.40 "
+                     "from the stick-slip onset")
+
+
 def _synthetic_segment(seg_id, t0, segment_s, depth, n_starts, rng) -> dict:
     mu_k = 0.25 + 0.02 * rng.standard_normal()
     return {"id": seg_id, "kind": "off_bottom_rotating", "t_start_s": float(t0),
@@ -221,12 +229,13 @@ def _synthetic_segment(seg_id, t0, segment_s, depth, n_starts, rng) -> dict:
             "mu_s": None, "mu_k": mu_k, "mu_s_identifiable": False, "mu_s_lower_bound": 0.4,
             "mu_s_spread": 0.05, "mu_k_spread": 0.01, "converged": True, "method": "batch",
             "settling_time_s": 40.0, "residual_rms_rpm": 1.0, "stick_slip_severity": 0.9,
-            "status": "ok", "message": "synthetic stand", "duration_s": segment_s,
+            "status": "ok", "message": SYNTHETIC_MESSAGE, "duration_s": segment_s,
             "stuck_fraction": 0.2, "mu_td": mu_k + 0.01, "torque_rms_misfit_Nm": 450.0,
             "torque_swing_Nm": 12e3, "fit_quality": 450.0 / 12e3,
             "surface_torque_mean_Nm": 18e3, "hookload_N": 7e5 + 0.1e3 * depth,
             "hookload_model_N": 6.2e5 + 0.1e3 * depth, "bit_speed_resolved": True,
-            "bit_speed_reason": "", "friction_zone": "open_hole",
+            "bit_speed_reason": "", "friction_zone": "open_hole", "flags": [],
+            "sample_interval_s": 0.01, "interval_torque_swing": None,
             "clock_start_utc": None, "clock_end_utc": None,
             "starts": [[0.3, 0.2], [0.6, 0.4], [0.9, 0.1], [0.5, 0.3]][:n_starts]}
 
