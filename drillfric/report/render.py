@@ -31,7 +31,7 @@ HTML_DPI = 90
 #: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap).
 DIAGNOSTIC_COLUMNS = (
     ("seg.", None, ""), ("kind", None, "wrap"), ("bit depth", "length", "num"),
-    ("time", None, ""), ("μ_s", None, "num"), ("μ_k", None, "num"), ("μ_TD", None, "num"),
+    ("time", None, "wrap"), ("μ_s", None, "num"), ("μ_k", None, "num"), ("μ_TD", None, "num"),
     ("μ zone", None, "wrap"), ("spread μ_s / μ_k", None, "num"), ("settling [s]", None, "num"),
     ("residual [rpm]", None, "num"), ("misfit / swing {unit} (quality)", "torque", "num"),
     ("severity", None, "num"), ("stuck", None, "num"),
