@@ -49,7 +49,7 @@ def test_outputs_follow_the_interface(demo_run):
         assert set(SEGMENT_KEYS) <= set(seg)
         assert seg["status"] in ("ok", "skipped", "failed")
     estimates = pd.read_parquet(out / "estimates.parquet")
-    assert set(ESTIMATE_NAMES) - {"bit_rpm"} <= set(estimates.columns)
+    assert set(ESTIMATE_NAMES) - {"bit_rpm", "timestamp"} <= set(estimates.columns)
     assert len(pd.read_parquet(out / "segments.parquet")) == len(summary["segments"])
     assert str(out / "report.html") in printed  # the run ends with the report's path
     assert not list(out.parent.glob(".*tmp*")), "temporary directory left behind"
