@@ -60,10 +60,20 @@ PLANTS = {
     "stribeck": ({"mu_s": 0.6, "mu_k": 0.25, "friction_law": "stribeck",
                   "stribeck_speed_rad_s": 0.5, "stribeck_exponent": 1.0}, {},
                  "μ falls from μ_s at rest to μ_k with v_s = 0.5 rad/s"),
+    "stribeck-slow": ({"mu_s": 0.6, "mu_k": 0.25, "friction_law": "stribeck",
+                       "stribeck_speed_rad_s": 0.2, "stribeck_exponent": 1.0}, {},
+                      "Stribeck with v_s = 0.2 rad/s: the 5-RPM creep slides at ≈ μ_k"),
+    "stribeck-fast": ({"mu_s": 0.6, "mu_k": 0.25, "friction_law": "stribeck",
+                       "stribeck_speed_rad_s": 1.5, "stribeck_exponent": 2.0}, {},
+                      "Gaussian Stribeck decay, v_s = 1.5 rad/s: near-static at creep speed"),
     "cased": ({"mu_s": 0.6, "mu_k": 0.3, "mu_s_cased": 0.35, "mu_k_cased": 0.2},
               {"friction_cased": 0.2}, "cased above 1500 m (known μ_k 0.2), open below"),
     "cased-effective": ({"mu_s": 0.6, "mu_k": 0.3, "mu_s_cased": 0.35, "mu_k_cased": 0.2},
                         None, "the same well without casing keys: an effective factor"),
+    "cased-short-creep": ({"mu_s": 0.6, "mu_k": 0.3, "mu_s_cased": 0.35, "mu_k_cased": 0.2,
+                           "creep_hold_s": 30.0}, None,
+                          "a 30-s creep that winds up little more than the cased part, no "
+                          "casing keys"),
     "soft-torque": ({"mu_s": 0.6, "mu_k": 0.25, "kp_Nms_rad": 900.0, "ki_Nm_rad": 2500.0},
                     {}, "soft-torque drive: the surface speed dips to ~0 between slips"),
     "sensors": ({"mu_s": 0.6, "mu_k": 0.25, "rpm_resolution": 1.0,
@@ -80,7 +90,7 @@ def _config(folder: Path, plant: str) -> tuple[Path, Path]:
     raw["survey"] = {"file": "path.survey.csv"}
     raw["simulate"] = {k: v for k, v in raw["simulate"].items() if v is not None}
     sim = dict(sim)
-    stand = dict(STAND, rpm=sim.pop("rpm", STAND["rpm"]))
+    stand = dict(STAND, **{k: sim.pop(k) for k in ("rpm", "creep_hold_s") if k in sim})
     raw["simulate"].update(rate_hz=100.0, cells=2000, seed=7, scenario=None, **sim)
     raw["simulate"].pop("scenario")
     cased = "mu_k_cased" in sim

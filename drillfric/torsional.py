@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from drillfric.config import default
 from drillfric.drillstring import G_ACCEL, DrillString
 from drillfric.errors import ModelError
 
@@ -220,7 +221,7 @@ class Plant:
     mu_k: float
     omega_c_rad_s: float
     k_t_per_s: float = 0.0
-    top_drive_inertia_kg_m2: float = 2900.0
+    top_drive_inertia_kg_m2: float = default("rig.top_drive_inertia_kg_m2")
     bit_torque_cap_Nm: float = 0.0
     fc_fixed_k_Nm_m: np.ndarray | None = None
     fc_fixed_s_Nm_m: np.ndarray | None = None

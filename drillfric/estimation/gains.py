@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.linalg
 
+from drillfric.config import default
 from drillfric.drillstring import DrillString
 from drillfric.errors import ConfigError, ModelError
 from drillfric.estimation import lumped
@@ -44,10 +45,10 @@ class Tuning:
         The two poles placed for the downhole error (ω_L, d) [1/s].
     """
 
-    kappa1: float = 1.0
-    lambda0_per_s: float = 10.0
-    z_per_s: float = 1.0
-    p_per_s: float = 1.5
+    kappa1: float = default("observer.kappa1")
+    lambda0_per_s: float = default("observer.lambda0_per_s")
+    z_per_s: float = default("observer.poles_per_s")[0]
+    p_per_s: float = default("observer.poles_per_s")[1]
 
     def __post_init__(self):
         if not 0.0 < self.kappa1 < 2.0:

@@ -23,6 +23,7 @@ import numba
 import numpy as np
 from scipy.signal import lfilter
 
+from drillfric.config import default
 from drillfric.errors import InputError, ModelError
 from drillfric.estimation.gains import Gains
 from drillfric.kernels.observer import LAW_CORRECTED, LAW_PAPER, OBS_COLUMNS
@@ -55,7 +56,7 @@ class Observer:
     plant: Plant
     gains: Gains
     law: str = "corrected"
-    mu_max: float = 1.5
+    mu_max: float = default("observer.mu_max")
     deadlock_s: float = 15.0
     hold: bool = False
 
@@ -115,7 +116,8 @@ class Measurements:
 
     @classmethod
     def from_samples(cls, time_s, surface_rad_s, torque_Nm, *, torque_kind: str = "motor",
-                     top_drive_inertia_kg_m2: float = 2900.0, rate_hz: float | None = None,
+                     top_drive_inertia_kg_m2: float = default("rig.top_drive_inertia_kg_m2"),
+                     rate_hz: float | None = None,
                      smooth_s: float = 1.0) -> Measurements:
         """Resample logged samples onto a uniform grid and express the torque as τ_m.
 
