@@ -246,3 +246,33 @@ def test_volve_f4_split_in_two_parts_runs_as_the_whole(volve_f4, tmp_path):
     whole, split = open_well(volve_f4 / "F-4.xml").load(), open_well(store).load()
     pd.testing.assert_frame_equal(whole.surface, split.surface)
     assert whole.timebase.origin == split.timebase.origin
+
+
+# --------------------------------------------------------------------------- hostile sidecars
+BOMB = ('<?xml version="1.0"?><!DOCTYPE lolz [<!ENTITY lol "lol">'
+        + "".join(f'<!ENTITY lol{i} "{("&lol" + str(i - 1) + ";") * 10}">'
+                  for i in range(1, 10)).replace("&lol0;", "&lol;")
+        + ']><tubulars xmlns="http://www.witsml.org/schemas/1series">&lol9;</tubulars>')
+
+
+@pytest.mark.parametrize("sidecar", ["w.tubular.xml", "w.survey.xml"])
+def test_xml_bomb_found_beside_a_log_is_refused_in_one_line(tmp_path, sidecar):
+    """The sidecars are read without being asked for, so they get the hardened parser too:
+    a billion-laughs file (10⁹ "lol"s were it expanded, about 3 GB) in the tubular or
+    survey sidecar's place stops the run with one line naming it, before any expansion."""
+    (tmp_path / "w.xml").write_text(_surface_log(range(5)))
+    (tmp_path / sidecar).write_text(BOMB)
+    result = CliRunner().invoke(cli, ["run", str(tmp_path / "w.xml"), "--out",
+                                      str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and sidecar in lines[0] and "DTD" in lines[0]
+    assert "lol" not in lines[0].replace(sidecar, "")
+
+
+def test_fleet_discovery_keeps_a_hostile_xml_as_a_failing_well(tmp_path):
+    """Discovery looks at each .xml's root to leave out trajectories and tubulars; an XML
+    bomb is not expanded there and stays a well, which then fails on its own."""
+    (tmp_path / "bomb.xml").write_text(BOMB)
+    (tmp_path / "ok.xml").write_text(_surface_log(range(5)))
+    assert sorted(s.data.name for s in discover(tmp_path)) == ["bomb.xml", "ok.xml"]
