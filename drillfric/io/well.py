@@ -533,10 +533,8 @@ def _config(config_path: Path | None, raw: dict, config, overrides,
     where = None if config_path is None else (
         f"{config_path}:/config" if config_path.suffix.lower() in _HDF5_EXT else config_path)
     if string is not None:
-        from drillfric.io.witsml import tubular_sections
-
         table = raw.get("string") if isinstance(raw.get("string"), dict) else {}
-        raw = raw | {"string": table | {"sections": tubular_sections(string)}}
+        raw = raw | {"string": table | {"sections": witsml.tubular_sections(string)}}
     return config_from_dict(raw, file=where, overrides=overrides)
 
 
