@@ -39,7 +39,7 @@ def simulate_well(folder: Path, name: str, duration_s: float, rate_hz: float) ->
             if not ln.startswith(("scenario", "data =", 'name = "demo"'))]
     config = folder / f"{name}.toml"
     config.write_text("\n".join(keep) + "\n", encoding="utf-8")
-    (folder / f"{name}.survey.csv").write_bytes(
+    (folder / "demo.survey.csv").write_bytes(  # the config's [survey] file
         (REPO / "examples/demo/demo.survey.csv").read_bytes())
     out = folder / f"{name}.parquet"
     subprocess.run([*DRILLFRIC, "-q", "simulate", str(config), "--out", str(out),
