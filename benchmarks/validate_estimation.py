@@ -1,8 +1,12 @@
 """Validation table of the friction estimators (issue 5 acceptance; docs/validation.md).
 
 Truths × start-up (creep or not) × logging rate × estimator → estimates and errors.
-Plants differ from the estimators: 1500-cell truth vs 500-cell estimator, a two-section BHA,
-noise 0.5 RPM and 200 N·m. Estimators: the full chain (`estimate_segment`: observer from
+Plants differ from the estimators: truths on 1.6 cells per metre (4000 at 2500 m) against
+500 cells for μ_k and ≈ MD/500 for creep fits, a two-section BHA, noise 0.5 RPM and 200 N·m.
+A truth coarser than the creep fit's grid is itself grid-biased in its creep build-up (a
+1500-cell truth at 2500 m gave halves 0.521 / 0.592 for one μ_s = 0.6: not one friction
+factor on the model's grid), so the truths are finer than every estimator grid.
+Estimators: the full chain (`estimate_segment`: observer from
 4 starts spanning μ_s 0.2–0.9, μ_k 0.05–0.4 → batch → seeded observer), and the observer
 alone with the paper's printed laws (backstepping gains, eqs. 42–43) from the same starts.
 
@@ -36,12 +40,14 @@ TRUTHS = [
 ]
 RATES = (100.0, 5.0, 1.0)
 DURATION_S = 240.0
+#: Truth grid [cells/m]: finer than the creep fit's doubled MD/1000 grid (docs/validation.md).
+TRUTH_CELLS_PER_M = 1.6
 
 
 def record(mu_s, mu_k, depth, path, rpm, creep, cfg):
     string = build_string(cfg.sections, depth)
     td = torque_drag.solve(path, string, load_case="rotating_off_bottom", mud_out_kg_m3=1200.0)
-    grid = torsional.make_grid(string, 1500)
+    grid = torsional.make_grid(string, max(1500, int(TRUTH_CELLS_PER_M * depth)))
     plant = torsional.Plant(grid, td.fc_at(grid.x_m), mu_s, mu_k, 1.0, 0.1, 2900.0)
     t = np.arange(0.0, DURATION_S + 1.0, 0.05)
     knots = ([0, 5, 35, 45, DURATION_S + 1], [0, 5, 5, rpm, rpm]) if creep else \

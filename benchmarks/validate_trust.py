@@ -221,6 +221,15 @@ def run_plant(plant: str, rates, work: Path) -> list[dict]:
     return rows
 
 
+def bit_ok(r: dict) -> bool:
+    """Bit speed where reported: no worse than the surface speed taken as the bit speed, and
+    ≤ 35 RPM RMS in severe stick-slip (severity ≥ 1.5) at 100/5 Hz (issue 14)."""
+    if r["bit_rms_rpm"] is None:
+        return True
+    severe = (r["severity"] or 0.0) >= 1.5 and r["rate"] in ("100 Hz", "5 Hz")
+    return r["bit_rms_rpm"] <= r["surface_rms_rpm"] and not (severe and r["bit_rms_rpm"] > 35)
+
+
 def _fmt(v, spec=".3f"):
     return "—" if v is None else format(v, spec)
 
@@ -232,7 +241,7 @@ def _line(r: dict) -> str:
     bit = ("not resolved" if not r["bit_resolved"] else
            f"{_fmt(r['bit_rms_rpm'], '.1f')} vs {_fmt(r['surface_rms_rpm'], '.1f')}")
     flags = ("" if r["mu_k_ok"] else " μ_k✗") + (" μ_s✗" if r["mu_s_false"] else "") + (
-        " bound✗" if r["bounds_false"] else "")
+        " bound✗" if r["bounds_false"] else "") + ("" if bit_ok(r) else " bit✗")
     return (f"| {r['plant']} | {r['rate']} | {r['ok']}/{r['segments']} | {_fmt(r['mu_k'])} "
             f"({err}) | {claims} | {bounds} | {bit} | {_fmt(r['severity'], '.2f')} |"
             f"{flags or ' ✓'} | {r['run_s']:.0f} |")
@@ -252,6 +261,13 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for plant in args.plants.split(","):
             rows += run_plant(plant, rates, Path(tmp))
+    print(f"\n{len(rows)} records: μ_k within tolerance {sum(r['mu_k_ok'] for r in rows)}, "
+          f"μ_s claimed {sum(len(r['mu_s_claims']) for r in rows)} "
+          f"(false {sum(len(r['mu_s_false']) for r in rows)}), lower bounds "
+          f"{sum(len(r['bounds']) for r in rows)} (at or above truth "
+          f"{sum(len(r['bounds_false']) for r in rows)}), bit speed reported "
+          f"{sum(r['bit_rms_rpm'] is not None for r in rows)} (failing "
+          f"{sum(not bit_ok(r) for r in rows)})")
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1, default=float))
 

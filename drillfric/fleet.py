@@ -37,6 +37,7 @@ import pandas as pd
 
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
+from drillfric.io import witsml
 from drillfric.io.results import (
     check_distinct,
     file_sha256,
@@ -58,8 +59,11 @@ SAVE_EVERY_S = 2.0
 #: Seconds to wait for a ``--scheduler`` to answer.
 CONNECT_TIMEOUT_S = 20
 _LOCK = ".fleet.lock"
-_DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las")
-_SIDECAR_TAGS = (".survey", ".truth")
+_DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las", ".xml", ".dlis",
+             ".xlsx")
+_SIDECAR_TAGS = (".survey", ".truth", ".tubular")
+#: WITSML objects that are not surface data (read beside a log, never a well of their own).
+_NOT_WELLS = frozenset({"trajectory", "tubular", "bhaRun"})
 _MANIFEST_COLUMNS = ("well", "data", "config", "survey")
 
 
@@ -117,16 +121,35 @@ def discover(source, *, config=None) -> list[WellSpec]:
 
 
 def _discover_dir(folder: Path) -> list[WellSpec]:
-    specs = []
+    """Wells of a folder; the numbered parts of one WITSML log (``NAME_1.xml``,
+    ``NAME_2.xml`` …, or a sub-folder of ``00001.xml`` …) are one well."""
+    specs, logs = [], set()
     for path in sorted(folder.iterdir()):
         if path.name.startswith("."):
             continue
+        split = witsml.split_log(path)
+        if split is not None and split[0] in logs:
+            continue
         if path.is_dir():
-            if (path / "well.toml").is_file():
+            if (path / "well.toml").is_file() or split is not None:
                 specs.append(WellSpec(path))
-        elif path.suffix.lower() in _DATA_EXT and not path.stem.endswith(_SIDECAR_TAGS):
+        elif _is_data_file(path):
             specs.append(WellSpec(path))
+        logs |= {split[0]} if split is not None else set()
     return specs
+
+
+def _is_data_file(path: Path) -> bool:
+    """A data file of a well: a data extension, not a sidecar, not a WITSML object that
+    only accompanies a log (a file that does not parse is kept: it fails as its well)."""
+    if path.suffix.lower() not in _DATA_EXT or path.stem.endswith(_SIDECAR_TAGS):
+        return False
+    if path.suffix.lower() != ".xml":
+        return True
+    try:
+        return witsml.object_kind(path) not in _NOT_WELLS
+    except InputError:
+        return True
 
 
 def _read_manifest(path: Path) -> list[WellSpec]:
@@ -249,9 +272,7 @@ def _open_job(spec: WellSpec, out_root: Path, overrides: dict, options: dict) ->
                     f"{exc.filename}: cannot read ({exc.strerror})")
     effective = json.dumps(jsonable({"config": well.config.to_dict(), "options": options}),
                            sort_keys=True, default=str)
-    files = {"data": well.files.data, "config": well.files.config,
-             "survey": well.files.survey}
-    fingerprint = {"inputs": {role: p for role, p in files.items() if p},
+    fingerprint = {"inputs": well.files.inputs,
                    "drillfric_version": __version__,
                    "config_sha256": hashlib.sha256(effective.encode()).hexdigest()}
     task = WellTask(well.name, str(Path(spec.data).resolve()), _abs(spec.config),

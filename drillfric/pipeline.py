@@ -281,7 +281,8 @@ class _SegmentEstimator:
             return _record(seg, depth, Status.FAILED, exc.message, rows), None
         if est.converged and seg.kind == Kind.OFF_BOTTOM:
             self.warm = (est.mu_s_seed, est.mu_k)
-        frames = {"estimates": _estimate_frame(seg.id, est, data, cfg.omega_c_rad_s),
+        frames = {"estimates": _with_clock(_estimate_frame(seg.id, est, data,
+                                                           cfg.omega_c_rad_s), rows),
                   "profile": _profile_frame(seg.id, est)}
         return _record(seg, depth, Status.OK, seg.message, rows, est), frames
 
@@ -400,15 +401,30 @@ def _median(rows: pd.DataFrame, column: str) -> float | None:
     return float(np.nanmedian(rows[column].to_numpy(float)))
 
 
+def _origin(rows: pd.DataFrame) -> pd.Timestamp | None:
+    """Clock time (UTC) of ``time_s = 0`` from a segment's rows, None without absolute time."""
+    if "timestamp" not in rows or rows.empty:
+        return None
+    first = pd.to_datetime(rows["timestamp"].iloc[:1], utc=True).iloc[0]
+    return first - pd.to_timedelta(float(rows["time_s"].iloc[0]), unit="s")
+
+
 def _clock(rows: pd.DataFrame, seg: Segment) -> dict:
     """Clock times of the segment's ends when the log has absolute time."""
-    if "timestamp" not in rows or rows.empty:
+    origin = _origin(rows)
+    if origin is None:
         return {}
-    t = rows["time_s"].to_numpy(float)
-    stamps = pd.to_datetime(rows["timestamp"])
-    origin = stamps.iloc[0] - pd.to_timedelta(t[0], unit="s")
     return {"clock_start_utc": _iso(origin + pd.to_timedelta(seg.t_start_s, unit="s")),
             "clock_end_utc": _iso(origin + pd.to_timedelta(seg.t_end_s, unit="s"))}
+
+
+def _with_clock(frame: pd.DataFrame, rows: pd.DataFrame) -> pd.DataFrame:
+    """estimates rows with their clock time (``timestamp``, UTC) beside ``time_s`` when the
+    log has absolute time."""
+    origin = _origin(rows)
+    if origin is not None:
+        frame.insert(1, "timestamp", origin + pd.to_timedelta(frame["time_s"], unit="s"))
+    return frame
 
 
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
@@ -502,7 +518,8 @@ class _DirectorySink:
         if frames is None:
             return
         if self.writer is None:
-            self.writer = EstimatesWriter(self.folder / "estimates.parquet", with_truth)
+            self.writer = EstimatesWriter(self.folder / "estimates.parquet", with_truth,
+                                          "timestamp" in frames["estimates"])
         self.writer.write(frames["estimates"])
         self.profiles.append(frames["profile"])
 
@@ -599,10 +616,8 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict],
               estimator: _SegmentEstimator, n_rows: int, rate_hz, warnings: list,
               wall_s: float) -> dict:
     """summary.json (docs/outputs.md)."""
-    files = {"data": well.files.data, "config": well.files.config,
-             "survey": well.files.survey}
     inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
-              for k, p in files.items() if p is not None and Path(p).is_file()}
+              for k, p in well.files.inputs.items() if Path(p).is_file()}
     inputs.update(rows=n_rows, resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
     assumed = well.assumed + estimator.assumed
     count = {s: sum(r.status is s for r in records) for s in Status}

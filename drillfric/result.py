@@ -188,9 +188,12 @@ class Column:
     doc: str
 
 
-#: Columns of estimates.parquet in order; ``bit_rpm`` only when the input has the truth.
+#: Columns of estimates.parquet in order; ``timestamp`` only when the log has absolute
+#: time, ``bit_rpm`` only when the input has the truth.
 ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("time_s", "float64", "s", "time of the row"),
+    Column("timestamp", "timestamp[us, UTC]", "UTC", "clock time of time_s (only when the "
+                                                     "log has absolute time)"),
     Column("segment_id", "int32", "", "segment id (segments.parquet)"),
     Column("start_id", "int16", "", "observer start (0…), −1 for the seeded ensemble pass"),
     Column("mu_s", "float64", "-", "μ̂_s of the start"),

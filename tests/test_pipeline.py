@@ -49,7 +49,7 @@ def test_outputs_follow_the_interface(demo_run):
         assert set(SEGMENT_KEYS) <= set(seg)
         assert seg["status"] in ("ok", "skipped", "failed")
     estimates = pd.read_parquet(out / "estimates.parquet")
-    assert set(ESTIMATE_NAMES) - {"bit_rpm"} <= set(estimates.columns)
+    assert set(ESTIMATE_NAMES) - {"bit_rpm", "timestamp"} <= set(estimates.columns)
     assert len(pd.read_parquet(out / "segments.parquet")) == len(summary["segments"])
     assert str(out / "report.html") in printed  # the run ends with the report's path
     assert not list(out.parent.glob(".*tmp*")), "temporary directory left behind"
@@ -302,3 +302,56 @@ def test_bit_depth_from_the_well_config(tmp_path):
                                       "--out", str(tmp_path / "out2")])
     summary = json.loads((tmp_path / "out2" / "demo" / "summary.json").read_text())
     assert any("the survey's last station" in a for a in summary["assumed"])
+
+
+@pytest.fixture(scope="module")
+def clock_twins(first_stand_alone, tmp_path_factory):
+    """The demo's first stand twice, with its configuration and survey: time as seconds
+    (``time_s``) and as ISO 8601 timestamps at +02:00 in a column ``TIME`` that states no
+    unit (the case that used to be noted as an assumed unit of time_s); both run."""
+    frame = pd.read_csv(first_stand_alone)
+    runs = {}
+    for kind in ("seconds", "clock"):
+        folder = tmp_path_factory.mktemp(kind)
+        for name in ("demo.toml", "demo.survey.csv"):
+            shutil.copy(DEMO / name, folder / name)
+        data = frame.copy()
+        if kind == "clock":
+            stamps = CLOCK_ORIGIN.tz_convert("+02:00") + pd.to_timedelta(data.pop("time_s"),
+                                                                          unit="s")
+            data.insert(0, "TIME", [t.isoformat(timespec="milliseconds") for t in stamps])
+        data.to_csv(folder / "demo.csv", index=False)
+        result = CliRunner().invoke(cli, ["run", str(folder / "demo.csv"), "--out",
+                                          str(folder / "out"), "--no-report"])
+        assert result.exit_code == 0, result.output
+        runs[kind] = folder / "out" / "demo"
+    return runs
+
+
+CLOCK_ORIGIN = pd.Timestamp("2024-05-01T04:00:00Z")
+
+
+def test_timestamps_are_kept_in_the_outputs(clock_twins):
+    """Issue 15: a log with timestamps (here +02:00, converted to UTC) gives the same
+    results as its seconds twin, plus the clock: time_origin_utc and each segment's UTC
+    start/end in summary.json, a UTC timestamp column beside time_s in estimates.parquet
+    and tracks.parquet — and no "assumed unit" note for the timestamp column."""
+    seconds, clock = clock_twins["seconds"], clock_twins["clock"]
+    plain = json.loads((seconds / "summary.json").read_text())
+    timed = json.loads((clock / "summary.json").read_text())
+    assert timed["time_origin_utc"] == "2024-05-01T04:00:00+00:00"
+    assert plain["time_origin_utc"] is None
+    assert timed["assumed"] == plain["assumed"] and not any("time" in a for a in timed["assumed"])
+    assert _segments_of(clock) == _segments_of(seconds)
+    for seg in timed["segments"]:
+        for end in ("start", "end"):
+            expected = CLOCK_ORIGIN + pd.to_timedelta(seg[f"t_{end}_s"], unit="s")
+            assert pd.Timestamp(seg[f"clock_{end}_utc"]) == expected.floor("us")
+    for name in ("estimates.parquet", "tracks.parquet"):
+        table = pd.read_parquet(clock / name)
+        assert list(table.columns[:2]) == ["time_s", "timestamp"], name
+        assert str(table["timestamp"].dt.tz) == "UTC"
+        offset = (table["timestamp"] - CLOCK_ORIGIN).dt.total_seconds()
+        # timestamps are stored to the microsecond: 0.5 µs of rounding
+        assert np.abs(offset - table["time_s"]).max() <= 0.5e-6, name
+        assert "timestamp" not in pd.read_parquet(seconds / name).columns

@@ -50,8 +50,11 @@ def test_segments_parquet_has_the_schema_fields_and_types(tmp_path):
 
 
 def test_estimates_writer_columns_are_the_schema():
-    assert tuple(arrow_schema(True).names) == ESTIMATE_NAMES
-    assert tuple(arrow_schema(False).names) == tuple(n for n in ESTIMATE_NAMES if n != "bit_rpm")
+    assert tuple(arrow_schema(True, with_clock=True).names) == ESTIMATE_NAMES
+    assert tuple(arrow_schema(False).names) == tuple(n for n in ESTIMATE_NAMES
+                                                     if n not in ("bit_rpm", "timestamp"))
+    assert arrow_schema(False, with_clock=True).field("timestamp").type == pa.timestamp(
+        "us", tz="UTC")
 
 
 def test_fleet_summary_columns_are_the_schema():

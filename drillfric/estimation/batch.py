@@ -737,8 +737,24 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         flags.append("rotation_too_short")
     else:
         flags.append("no_rotation")
+    mu_s, mu_k, bound, method, used_creeps = _static_stages(
+        model, creeps, wins, mu_k, stick_slip, cells, details, flags, messages,
+        rate_hz=1.0 / max(data.dt, sample_interval_s or 0.0))
+    return BatchResult(mu_k=mu_k, mu_k_method="mean_torque", mu_s=mu_s,
+                       mu_s_identifiable=mu_s is not None, mu_s_lower_bound=bound,
+                       mu_s_method=method, creep_segments=tuple(used_creeps),
+                       flags=tuple(flags), runs=model.runs, messages=tuple(messages),
+                       details=details)
+
+
+def _static_stages(model: _Model, creeps, wins, mu_k, stick_slip: bool, cells: int,
+                   details: BatchDetails, flags: list, messages: list, *, rate_hz: float):
+    """μ_s of a record: the creep fit where a creep was logged fast enough and passes its
+    checks (μ_k refitted when the fitted μ_s moves the stick-slip model), else the
+    stick-slip onset bound (docs/theory.md §6.3–§6.4). Returns (μ_s, μ_k, bound, method,
+    creeps used)."""
+    data = model.data
     mu_s, bound, method, used_creeps = None, None, "none", ()
-    rate_hz = 1.0 / max(data.dt, sample_interval_s or 0.0)
     if creeps and rate_hz < MIN_CREEP_RATE_HZ:
         flags.append("creep_rate_too_low")
         messages.append(f"creep start-up found but logged at {rate_hz:.3g} Hz: the creep "
@@ -750,18 +766,15 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         if mu_s is not None:
             method = "creep_fit"
             if stick_slip and abs(mu_s / details.mu_s_model - 1.0) > 0.2:
-                mu_k = _refit_mu_k(model, wins, target, mu_s, mu_k, cells, details, messages)
+                mu_k = _refit_mu_k(model, wins, details.mean_torque_Nm, mu_s, mu_k, cells,
+                                   details, messages)
     if mu_s is None and mu_k is not None and stick_slip:
         bound = _bound_stage(model, wins, mu_k, cells, details, flags, messages, bool(creeps))
         method = "stick_slip_onset" if bound is not None else "none"
     if mu_s is None and not stick_slip and mu_k is not None:
         messages.append("no stick-slip and no creep start-up: μ_s is not in the data; a creep "
                         "break-over from rest (below ω_c for 10–30 s) would make it measurable")
-    return BatchResult(mu_k=mu_k, mu_k_method="mean_torque", mu_s=mu_s,
-                       mu_s_identifiable=mu_s is not None, mu_s_lower_bound=bound,
-                       mu_s_method=method, creep_segments=tuple(used_creeps),
-                       flags=tuple(flags), runs=model.runs, messages=tuple(messages),
-                       details=details)
+    return mu_s, mu_k, bound, method, used_creeps
 
 
 def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flags, messages):

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.well import CLOCK_UNIT
 
 
 class LogCheck:
@@ -52,19 +53,26 @@ class LogCheck:
             self.rpm_max = max(self.rpm_max, float(rpm.max()))
 
     def _spacing(self, time_s: np.ndarray) -> None:
-        """Every sample a gap: almost surely time in ms read as s (or a max_gap_s too small)."""
+        """Every sample a gap: time in ms read as s, or a log slower than max_gap_s (the
+        only reading for timestamps, whose unit cannot be wrong)."""
         dt = np.diff(time_s)
         dt = dt[dt > 0]
         limit = self.well.config.segmentation.max_gap_s
-        if dt.size and float(np.median(dt)) > limit:
-            time = self.well.mappings["time"]
-            raise InputError(f"time column '{time.column}' has samples {np.median(dt):.4g} "
-                             f"{time.unit} apart: more than segmentation.max_gap_s "
-                             f"({limit:.4g} s), so every sample would be a gap",
-                             file=self.well.files.data,
-                             fix='if the time is in milliseconds, say so: [channels] time = '
-                                 '{ unit = "ms" }; if the log really is this slow, raise '
-                                 "segmentation.max_gap_s")
+        if not dt.size or float(np.median(dt)) <= limit:
+            return
+        time, median = self.well.mappings["time"], float(np.median(dt))
+        slow = (f"raise segmentation.max_gap_s above the spacing, e.g. [segmentation] "
+                f"max_gap_s = {4 * median:.4g} (a log this slow resolves no stick-slip "
+                "cycle: rotations shorter than a few samples are skipped)")
+        clock = time.unit == CLOCK_UNIT
+        raise InputError(f"time column '{time.column}'"
+                         + (" (timestamps)" if clock else "")
+                         + f" has samples {median:.4g} s apart: more than "
+                           f"segmentation.max_gap_s ({limit:.4g} s), so every sample would "
+                           "be a gap", file=self.well.files.data,
+                         fix=slow if clock else 'if the time is in milliseconds, say so: '
+                             '[channels] time = { unit = "ms" }; if the log really is this '
+                             "slow, " + slow)
 
     def finish(self, duplicates: int) -> None:
         """Raise for logs that cannot be meant as read (after the last chunk)."""

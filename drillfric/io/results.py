@@ -334,19 +334,30 @@ def check_distinct(outputs: list[tuple[str, str]]) -> None:
 
 
 # --------------------------------------------------------------------------- files
-def arrow_schema(with_truth: bool) -> pa.Schema:
+def arrow_schema(with_truth: bool, with_clock: bool = False) -> pa.Schema:
     """estimates.parquet's schema from :data:`drillfric.result.ESTIMATE_COLUMNS` (every
-    column nullable: a bit speed the logging cannot resolve is null)."""
-    return pa.schema([(c.name, pa.type_for_alias(c.type)) for c in ESTIMATE_COLUMNS
-                      if with_truth or c.name != "bit_rpm"])
+    column nullable: a bit speed the logging cannot resolve is null); ``timestamp`` with
+    ``with_clock`` (the log has absolute time), ``bit_rpm`` with ``with_truth``."""
+    left_out = {name for name, kept in (("bit_rpm", with_truth), ("timestamp", with_clock))
+                if not kept}
+    return pa.schema([(c.name, _arrow_type(c.type)) for c in ESTIMATE_COLUMNS
+                      if c.name not in left_out])
+
+
+def _arrow_type(alias: str) -> pa.DataType:
+    """Arrow type of a schema alias (``"float64"``; ``"timestamp[us, UTC]"``, a time zone
+    pyarrow's aliases lack)."""
+    if alias == "timestamp[us, UTC]":
+        return pa.timestamp("us", tz="UTC")
+    return pa.type_for_alias(alias)
 
 
 class EstimatesWriter:
     """Append observer records to estimates.parquet, one row group per segment."""
 
-    def __init__(self, path: Path, with_truth: bool):
+    def __init__(self, path: Path, with_truth: bool, with_clock: bool = False):
         self.path = path
-        self.schema = arrow_schema(with_truth)
+        self.schema = arrow_schema(with_truth, with_clock)
         self._writer = pq.ParquetWriter(path, self.schema, compression="zstd")
 
     def write(self, frame: pd.DataFrame) -> None:

@@ -228,6 +228,18 @@ class TimeTracker:
                          fix="write times as seconds or like 2024-05-01T12:00:00")
 
 
+def holds_timestamps(values: pd.Series) -> bool:
+    """Whether a time column holds absolute timestamps (date-time values or text that is
+    not a number), not numbers in a time unit.
+
+    Examples
+    --------
+    >>> holds_timestamps(pd.Series(["2024-05-01T12:00:00Z"])), holds_timestamps(pd.Series([0.5]))
+    (True, False)
+    """
+    return _as_number(values) is None
+
+
 def _as_number(values: pd.Series) -> np.ndarray | None:
     """Numeric time as float with nulls → NaN, or None when the column holds timestamps."""
     if pd.api.types.is_datetime64_any_dtype(values):

@@ -2,17 +2,26 @@
 
 A well is one of
 
-- a data file ``NAME.{parquet,csv,h5,hdf5,las}`` with optional sidecars found by name:
-  ``NAME.toml`` (configuration) and ``NAME.survey.{csv,parquet}`` (survey);
+- a data file ``NAME.{parquet,csv,h5,hdf5,las,xml,dlis,xlsx}`` with optional sidecars found
+  by name: ``NAME.toml`` (configuration), ``NAME.survey.{csv,parquet,xml}`` (survey; ``.xml``
+  a WITSML trajectory) and ``NAME.tubular.xml`` (a WITSML tubular: the string);
+- a WITSML log split over numbered files (``00001.xml``, ``00002.xml`` … in one folder, or
+  ``NAME_1.xml``, ``NAME_2.xml`` … side by side): the folder or any one of the parts is one
+  data file named by the folder (``NAME``) — its parts are read as one log in index order
+  (:func:`drillfric.io.witsml.split_log`, :func:`~drillfric.io.witsml.open_witsml_parts`);
 - an HDF5 file holding the surface table ``/surface``, the survey ``/survey`` and the
   configuration ``/config`` (a TOML text dataset, a ``toml`` attribute, or attributes
   named ``table.key``);
 - a directory holding ``well.toml``, whose ``[well] data`` and ``[survey] file`` name its
-  files (relative to the directory).
+  files (relative to the directory); ``[well] data`` may be left out when the directory
+  holds the numbered parts of a WITSML log.
 
 Precedence: ``--config``/``--survey`` > the configuration's ``[survey] file`` > sidecars
-by name > tables inside an HDF5 file. Without a survey, ``survey`` is None and the
-pipeline assumes a vertical well with the nominal tortuosity ``survey.tortuosity_deg_30m``.
+by name > objects inside the data file (an HDF5 ``/survey``; a WITSML ``<trajectory>`` or
+``<tubular>`` beside the log). Without a survey, ``survey`` is None and the pipeline
+assumes a vertical well with the nominal tortuosity ``survey.tortuosity_deg_30m``; the
+string is the configuration's ``[[string.sections]]``, else a WITSML tubular, else the
+documented default (assumed).
 
 A well is opened **once** (:func:`open_well`): its files found, its configuration and survey
 read, its data file's header mapped to channels, and its name fixed — into a :class:`Well`
@@ -30,7 +39,7 @@ import hashlib
 import tomllib
 import unicodedata
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -38,18 +47,29 @@ import pandas as pd
 
 from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
+from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
 from drillfric.io.text import printable
-from drillfric.io.timebase import TimeBase, TimeTracker, check_plausible_rate, summarize
+from drillfric.io.timebase import (
+    TimeBase,
+    TimeTracker,
+    check_plausible_rate,
+    holds_timestamps,
+    summarize,
+)
 from drillfric.wellpath import WellPath
 
 #: Rows per chunk of :meth:`Well.chunks` (a few tens of MB for a dozen channels).
 CHUNK_ROWS = 200_000
 #: Longest output directory name [bytes of UTF-8]; longer names are cut and given a hash.
 MAX_NAME_BYTES = 100
-_SURVEY_EXT = (".csv", ".parquet")
+_SURVEY_EXT = (".csv", ".parquet", ".xml")
 _HDF5_EXT = (".h5", ".hdf5")
+#: Unit shown for a time column of absolute timestamps (not a unit anything assumed).
+CLOCK_UNIT = "ISO 8601"
+#: Rows read ahead to tell whether a time column without a stated unit holds timestamps.
+_PEEK_ROWS = 64
 
 
 @dataclass(frozen=True)
@@ -66,7 +86,7 @@ class ChannelInfo:
         Source unit as found or assumed.
     source : str
         Where the unit came from: ``"header"``, ``"units row"``, ``"config"``,
-        ``"default"`` or ``"name suffix"``.
+        ``"default"``, ``"name suffix"`` or ``"values"`` (a time column of timestamps).
     null_fraction : float
         Fraction of rows without a value (empty, NaN, -999.25, -9999) [-].
     """
@@ -116,15 +136,33 @@ class WellFiles:
     Attributes
     ----------
     data : Path
-        Surface data file.
+        Surface data file; for a WITSML log split over numbered files the folder of
+        ``00001.xml`` … or ``folder / NAME`` for ``NAME_1.xml`` … (no such file).
     config, survey : Path or None
         Configuration and survey files in effect (for an HDF5 bundle, possibly the data
-        file itself: its ``/config`` and ``/survey``).
+        file itself: its ``/config`` and ``/survey``; for a WITSML file, the file itself
+        when it holds the trajectory beside the log).
+    parts : tuple of Path
+        The numbered part files of a WITSML log split over several files (by number; read
+        in index order), else empty.
+    string : Path or None
+        WITSML tubular read as the string (``NAME.tubular.xml``, or the data file holding a
+        ``<tubular>``) when the configuration has no ``[[string.sections]]``.
     """
 
     data: Path
     config: Path | None
     survey: Path | None
+    parts: tuple[Path, ...] = ()
+    string: Path | None = None
+
+    @property
+    def inputs(self) -> dict[str, Path]:
+        """The files read, by role: ``data`` (for a log split over parts one ``data NAME``
+        per part instead), ``config``, ``survey``, ``string`` — summary.json ``inputs``."""
+        data = {f"data {p.name}": p for p in self.parts} if self.parts else {"data": self.data}
+        roles = data | {"config": self.config, "survey": self.survey, "string": self.string}
+        return {role: path for role, path in roles.items() if path is not None}
 
 
 @dataclass(frozen=True)
@@ -256,9 +294,9 @@ def open_well(path, *, config=None, survey=None, overrides=None, name: str | Non
         One line naming the file, the problem and the fix.
     """
     files, raw = _resolve(path, None if isinstance(config, Config) else config, survey)
-    cfg = _config(files.config, raw, config, overrides)
+    cfg = _config(files.config, raw, config, overrides, files.string)
     shown = printable(name or cfg.well.name or default_name(path, files.data), 4096)
-    source, mappings = _open(files.data, cfg) if header else (None, {})
+    source, mappings = _open(files, cfg) if header else (None, {})
     return Well(name=shown, dir_name=safe_name(shown, files.config or files.data),
                 files=files, config=cfg, survey=_load_survey(files.survey), source=source,
                 mappings=mappings)
@@ -281,15 +319,25 @@ def open_config(config, *, survey=None, overrides=None
     survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw)
     if survey_path is not None and not survey_path.is_file():
         raise InputError("survey file not found", file=survey_path, fix="check the path")
-    return (config_from_dict(raw, file=path, overrides=overrides), survey_path,
+    return (_config(path, raw, None, overrides, _find_string(path, raw)), survey_path,
             _load_survey(survey_path))
 
 
 def default_name(path, data_path: Path) -> str:
     """A well's name when nothing names it: the directory's name (resolved, so ``.`` is the
-    folder it stands for) or the data file's stem."""
+    folder it stands for) or the data file's stem. A WITSML log split over ``NAME_1.xml``,
+    ``NAME_2.xml`` … is ``NAME``; the folder of a log's numbered parts ``00001.xml`` … is
+    named like a directory, except a number (a WITSML store names its folders
+    ``log/1/8/1``): then the log's wellbore and log names (``NO 15/9-F-4 GwdTime``)."""
     path = Path(path)
-    return path.resolve().name if path.is_dir() else data_path.stem
+    if path.is_dir() and path.resolve() != data_path.resolve():
+        return path.resolve().name
+    if data_path.is_dir():
+        name = data_path.resolve().name
+        if name.isdigit():
+            return witsml.log_title(witsml.witsml_log_parts(data_path)[0]) or name
+        return name
+    return data_path.name if not data_path.exists() else data_path.stem
 
 
 def safe_name(raw, where=None) -> str:
@@ -355,15 +403,16 @@ def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
         raise InputError("file not found", file=path, fix="check the path")
     config_path = None if config is None else Path(config)
     raw = None
-    if path.is_dir():
-        data_path, dir_config, dir_raw = _directory_data(path)
+    if path.is_dir() and not (path / "well.toml").is_file() and witsml.split_log(path):
+        data_path, parts = _data(path)
+        config_path = config_path or _sidecar(data_path, ".toml")
+    elif path.is_dir():
+        data_path, parts, dir_config, dir_raw = _directory_data(path)
         if config_path is None:
             config_path, raw = dir_config, dir_raw
     else:
-        data_format(path)
-        data_path = path
-        sidecar = path.with_suffix(".toml")
-        config_path = config_path or (sidecar if sidecar.is_file() else None)
+        data_path, parts = _data(path)
+        config_path = config_path or _sidecar(data_path, ".toml")
     if config_path is not None and not config_path.is_file():
         raise InputError("config file not found", file=config_path, fix="check the path")
     if config_path is None and _h5_has(data_path, "config"):
@@ -374,10 +423,30 @@ def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
                                                                        raw)
     if survey_path is not None and not survey_path.is_file():
         raise InputError("survey file not found", file=survey_path, fix="check the path")
-    return WellFiles(data_path, config_path, survey_path), raw
+    return WellFiles(data_path, config_path, survey_path, parts,
+                     _find_string(data_path, raw)), raw
 
 
-def _directory_data(folder: Path) -> tuple[Path, Path, dict]:
+def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
+    """The data of a well given as ``path``: a data file, or the folder and numbered files
+    of a WITSML log split over parts (``path`` the folder or one of its parts; the name
+    :func:`drillfric.io.witsml.split_log` gives the log and its parts)."""
+    split = witsml.split_log(path)
+    if split is not None:
+        return split
+    data_format(path)
+    return path, ()
+
+
+def _sidecar(data_path: Path, suffix: str) -> Path | None:
+    """``NAME{suffix}`` beside a data file (or the folder or common name of a log's parts)
+    when it exists."""
+    stem = data_path.stem if data_path.is_file() else data_path.name
+    candidate = data_path.with_name(stem + suffix)
+    return candidate if candidate.is_file() else None
+
+
+def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
     well_toml = folder / "well.toml"
     if not well_toml.is_file():
         found = sorted(p.name for p in folder.iterdir() if p.suffix.lower() in FORMATS)
@@ -386,27 +455,49 @@ def _directory_data(folder: Path) -> tuple[Path, Path, dict]:
                              + (f" (data files here: {', '.join(found)})" if found else ""))
     raw = read_toml(well_toml)
     data = raw.get("well", {}).get("data")
+    if data is None and witsml.split_log(folder):
+        return *_data(folder), well_toml, raw
     if not isinstance(data, str):
         raise ConfigError("well.toml does not name its data file", file=well_toml,
                           fix='add [well] data = "surface.parquet" (relative to the folder)')
     data_path = folder / data
-    if not data_path.is_file():
+    if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)):
         raise InputError("data file named by well.toml not found", file=data_path,
                          fix=f"fix [well] data in {well_toml}")
-    data_format(data_path)
-    return data_path, well_toml, raw
+    return *_data(data_path), well_toml, raw
 
 
 def _find_survey(data_path: Path, config_path: Path | None, raw: dict) -> Path | None:
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     if isinstance(named, str) and config_path is not None:
         return config_path.parent / named
-    stem = data_path.with_suffix("")
     for ext in _SURVEY_EXT:
-        candidate = stem.with_name(stem.name + ".survey" + ext)
-        if candidate.is_file():
+        if (candidate := _sidecar(data_path, ".survey" + ext)) is not None:
             return candidate
-    return data_path if _h5_has(data_path, "survey") else None
+    if _h5_has(data_path, "survey") or _witsml_has(data_path, "trajectory"):
+        return data_path
+    return None
+
+
+def _find_string(data_path: Path, raw: dict) -> Path | None:
+    """The WITSML tubular read as the string when the configuration has no sections:
+    ``NAME.tubular.xml`` beside the data (or configuration), else the data file itself when
+    it holds a ``<tubular>`` beside its log."""
+    string = raw.get("string")
+    if isinstance(string, dict) and "sections" in string:
+        return None
+    found = _sidecar(data_path, ".tubular.xml")
+    if found is None and _witsml_has(data_path, "tubular"):
+        found = data_path
+    return found
+
+
+def _witsml_has(path: Path, kind: str) -> bool:
+    """Whether a WITSML data file holds a ``kind`` object (e.g. a trajectory beside its
+    log); False for any other file."""
+    if path.suffix.lower() != ".xml" or not path.is_file() or path.stat().st_size == 0:
+        return False
+    return kind in witsml.object_kinds(path)
 
 
 def _h5_has(path: Path, key: str) -> bool:
@@ -432,13 +523,18 @@ def _raw_config(config_path: Path | None) -> dict:
     return read_toml(config_path)
 
 
-def _config(config_path: Path | None, raw: dict, config, overrides) -> Config:
+def _config(config_path: Path | None, raw: dict, config, overrides,
+            string: Path | None = None) -> Config:
     """The effective configuration: ``config`` when it is a built :class:`Config`, else the
-    validated raw mapping with the command line's ``overrides``."""
+    validated raw mapping with the command line's ``overrides`` and, when the mapping has
+    no ``[[string.sections]]``, the sections of the WITSML tubular ``string``."""
     if isinstance(config, Config):
         return config
     where = None if config_path is None else (
         f"{config_path}:/config" if config_path.suffix.lower() in _HDF5_EXT else config_path)
+    if string is not None:
+        table = raw.get("string") if isinstance(raw.get("string"), dict) else {}
+        raw = raw | {"string": table | {"sections": witsml.tubular_sections(string)}}
     return config_from_dict(raw, file=where, overrides=overrides)
 
 
@@ -492,17 +588,35 @@ def _load_survey(survey_path: Path | None) -> WellPath | None:
 
 
 # --------------------------------------------------------------------------- surface data
-def _open(data_path: Path, cfg: Config) -> tuple[RawSource, dict[str, Mapping]]:
-    """The opened data file and its channel mappings, for a time or a depth log
-    (:func:`~drillfric.io.channels.log_index`); a depth index found by the reader (LAS,
+def _open(files: WellFiles, cfg: Config) -> tuple[RawSource, dict[str, Mapping]]:
+    """The opened data file (or log parts) and its channel mappings, for a time or a depth
+    log (:func:`~drillfric.io.channels.log_index`); a depth index found by the reader (LAS,
     WITSML, DLIS) is the measured depth unless ``[channels] measured_depth`` says otherwise."""
-    raw = open_source(data_path)
-    file = str(data_path)
+    raw = witsml.open_witsml_parts(files.parts) if files.parts else open_source(files.data)
+    file = str(files.data)
     index = log_index(raw.columns, cfg.channels, depth_index=raw.depth_index, file=file)
     channels = cfg.channels
     if index == "depth" and raw.depth_index is not None and "measured_depth" not in channels:
         channels = channels | {"measured_depth": {"column": split_unit(raw.depth_index)[0]}}
-    return raw, map_channels(raw.columns, raw.units, channels, file=file, index=index)
+    mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index)
+    return raw, _clock_time(raw, mappings)
+
+
+def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mapping]:
+    """The mappings with a time column of absolute timestamps marked as such (unit
+    :data:`CLOCK_UNIT`, source ``"values"``): its unit is then nothing assumed. Only a time
+    column no unit was stated for is looked at (its first rows)."""
+    time = mappings.get("time")
+    if time is None or time.source != "default":
+        return mappings
+    chunks = raw.chunks(_PEEK_ROWS)
+    try:
+        head = next(chunks, None)
+    finally:
+        chunks.close()
+    if head is None or not holds_timestamps(head[time.column]):
+        return mappings
+    return mappings | {"time": replace(time, unit=CLOCK_UNIT, source="values")}
 
 
 def _numeric(values: pd.Series) -> np.ndarray:
@@ -583,8 +697,9 @@ def _channel_infos(mappings: dict[str, Mapping], surface: pd.DataFrame,
         if key == "time":
             total = len(surface) + tracker.untimed + tracker.duplicates
             nulls = tracker.untimed / total if total else 0.0
-            unit = "ISO 8601" if tracker.origin is not None else m.unit
-            source = "header" if tracker.origin is not None else m.source
+            clock = tracker.origin is not None
+            unit = CLOCK_UNIT if clock else m.unit
+            source = "values" if clock and m.source == "default" else m.source
         else:
             nulls = float(surface[m.channel.name].isna().mean())
             unit, source = m.unit, m.source

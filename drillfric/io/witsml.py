@@ -50,7 +50,12 @@ DEPTH_INDEX_TYPES = frozenset({"measured depth", "vertical depth", "length"})
 _NO_UNIT = frozenset({"", "unitless", "none", "n/a", "-"})
 #: Trajectory station states whose station is not used.
 _BAD_STATIONS = frozenset({"bad", "rejected"})
-_PART_FILE = re.compile(r"^\d+\.xml$", re.IGNORECASE)
+#: The WITSML objects drillfric reads (a log as surface data, a trajectory as the survey,
+#: a tubular as the string) and the BHA run it recognises.
+OBJECT_KINDS = frozenset({"log", "trajectory", "tubular", "bhaRun"})
+#: A numbered part of an exported log: ``00001.xml`` (a WITSML store's folder of one log) or
+#: ``NAME_1.xml`` (parts named after their log).
+_PART_FILE = re.compile(r"^(?:(?P<log>.+)_)?(?P<number>\d+)\.xml$", re.IGNORECASE)
 _FIX_EXPORT = "export the object again from the WITSML store (version 1.4.1)"
 
 
@@ -75,10 +80,19 @@ def _events(path: Path, events=("start", "end")) -> Iterator[tuple[str, object]]
 
 
 def _tree(path: Path):
-    """Whole element tree of a small object file (trajectory, tubular), hardened."""
+    """Element tree of an object file (trajectory, tubular), hardened; a log's rows
+    (``logData``) leave the tree once read, so a log file that also holds a trajectory or
+    a tubular is held without its data."""
     root = None
-    for _, elem in _events(path, ("start",)):
-        root = elem if root is None else root
+    stack: list = []
+    for event, elem in _events(path):
+        if event == "start":
+            root = elem if root is None else root
+            stack.append(elem)
+            continue
+        stack.pop()
+        if stack and _local(elem.tag) == "logData":
+            stack[-1].remove(elem)
     if root is None:
         raise InputError("XML file has no root element", file=path, fix=_FIX_EXPORT)
     return root
@@ -95,7 +109,8 @@ def object_kind(path) -> str:
     """Kind of WITSML object a file holds (``"log"``, ``"trajectory"``, ``"tubular"`` …).
 
     Reads only the root tag: a plural root names its objects (``logs`` → ``"log"``,
-    ``trajectorys`` → ``"trajectory"``), a singular root is the object itself.
+    ``trajectorys`` → ``"trajectory"``), a singular root is the object itself; any other
+    root (a wrapper holding several kinds, see :func:`object_kinds`) is named as it is.
 
     Raises
     ------
@@ -105,8 +120,44 @@ def object_kind(path) -> str:
     path = Path(path)
     root = _root(path)
     _check_namespace(root, path)
-    name = _local(root.tag)
-    return name[:-1] if name.endswith("s") else name
+    return _root_kind(_local(root.tag)) or _local(root.tag)
+
+
+def _root_kind(name: str) -> str | None:
+    """The object kind a standard root holds (``logs``/``log`` → ``"log"``), else None."""
+    single = name[:-1] if name.endswith("s") else name
+    return single if single in OBJECT_KINDS else None
+
+
+def object_kinds(path) -> frozenset[str]:
+    """The kinds of WITSML object (:data:`OBJECT_KINDS`) a file holds.
+
+    A standard file holds one kind under a plural root (read from the root tag alone); a
+    file whose root is not one (a wrapper such as ``<witsml>`` around ``<logs>`` and
+    ``<trajectorys>``) is scanned, its log rows dropped as they are read.
+
+    Raises
+    ------
+    InputError
+        Not XML, a DTD, or not a WITSML 1.x object.
+    """
+    path = Path(path)
+    root = _root(path)
+    _check_namespace(root, path)
+    kind = _root_kind(_local(root.tag))
+    if kind is not None:
+        return frozenset({kind})
+    found: set[str] = set()
+    stack: list = []
+    for event, elem in _events(path):
+        if event == "start":
+            found |= {_local(elem.tag)} & OBJECT_KINDS
+            stack.append(elem)
+            continue
+        stack.pop()
+        if stack and _local(elem.tag) in OBJECT_KINDS:
+            stack[-1].remove(elem)
+    return frozenset(found)
 
 
 def _check_namespace(root, path: Path) -> None:
@@ -174,6 +225,8 @@ class LogHeader:
         Number of ``data`` rows.
     first_index, last_index : str or None
         Index value of the first and last data row.
+    wellbore : str
+        ``nameWellbore`` of the log, else its ``nameWell`` (``""`` when neither).
     """
 
     position: int
@@ -189,6 +242,7 @@ class LogHeader:
     rows: int
     first_index: str | None
     last_index: str | None
+    wellbore: str = ""
 
     @property
     def depth_indexed(self) -> bool:
@@ -204,7 +258,8 @@ class LogHeader:
 class _LogScan:
     """Accumulates one ``<log>``'s header while its elements stream past."""
 
-    _FIELDS = ("name", "indexType", "indexCurve", "direction", "nullValue")
+    _FIELDS = ("name", "indexType", "indexCurve", "direction", "nullValue", "nameWell",
+               "nameWellbore")
 
     def __init__(self, position: int, uid: str):
         self.position, self.uid = position, uid
@@ -249,7 +304,8 @@ class _LogScan:
         return LogHeader(self.position, self.uid, self.fields.get("name", ""), index_type,
                          index_curve, self.fields.get("direction", "increasing").lower(),
                          tuple(names), tuple(units), nulls, text, self.rows,
-                         _field(self.first_row, at), _field(self.last_row, at))
+                         _field(self.first_row, at), _field(self.last_row, at),
+                         self.fields.get("nameWellbore") or self.fields.get("nameWell", ""))
 
     def _columns(self, path: Path) -> tuple[list[str], list[str]]:
         """Column names in data order and their units (mnemonicList, else logCurveInfo)."""
@@ -460,6 +516,54 @@ def open_witsml(path, *, log: str | None = None) -> RawSource:
 
 
 # --------------------------------------------------------------------------- multi-file logs
+def _part_key(path: Path) -> tuple[str, int] | None:
+    """(log name, number) of a numbered part file (``""`` for ``00001.xml``), else None."""
+    match = _PART_FILE.match(path.name)
+    return None if match is None else (match["log"] or "", int(match["number"]))
+
+
+def _numbered(folder: Path, log: str) -> list[Path]:
+    """The numbered part files of ``log`` in ``folder`` (``log`` ``""``: ``00001.xml`` …), by
+    number."""
+    parts = [(key[1], p) for p in folder.iterdir()
+             if (key := _part_key(p)) is not None and key[0] == log and p.is_file()]
+    return [p for _, p in sorted(parts)]
+
+
+def split_log(path) -> tuple[Path, tuple[Path, ...]] | None:
+    """The log a well given as ``path`` reads from several numbered files, if it does.
+
+    A folder holding numbered parts (``00001.xml``, ``00002.xml`` … as WITSML stores
+    export a growing log) is one log, named by the folder; so is the folder of a numbered
+    part file when it holds another numbered part. A file ``NAME_1.xml`` beside
+    ``NAME_2.xml`` … is one log with its siblings, named ``NAME`` (the folder / ``NAME``,
+    a path that need not exist). A lone numbered file is read alone: None.
+
+    Returns
+    -------
+    (name, parts) or None
+        The path naming the log (the folder, or ``folder / NAME``) and its parts by number.
+    """
+    path = Path(path)
+    if path.is_dir():
+        parts = _numbered(path, "")
+        return (path, tuple(parts)) if parts else None
+    key = _part_key(path)
+    if key is None or not path.is_file():
+        return None
+    parts = _numbered(path.parent, key[0])
+    if len(parts) < 2:
+        return None
+    return (path.parent / key[0] if key[0] else path.parent), tuple(parts)
+
+
+def log_title(path) -> str:
+    """A well name from a WITSML log file: its wellbore and log names (``"NO 15/9-F-4
+    GwdTime"``), for a log whose file names (numbered parts) say nothing; ``""`` if none."""
+    header = pick_log(read_log_headers(path))
+    return " ".join(t for t in (header.wellbore, header.name) if t)
+
+
 def witsml_log_parts(folder) -> list[Path]:
     """The numbered part files of one exported log (``00001.xml``, ``00002.xml`` …), by number.
 
@@ -472,8 +576,7 @@ def witsml_log_parts(folder) -> list[Path]:
         No numbered ``.xml`` file in the folder.
     """
     folder = Path(folder)
-    parts = sorted((p for p in folder.iterdir() if _PART_FILE.match(p.name) and p.is_file()),
-                   key=lambda p: int(p.stem))
+    parts = _numbered(folder, "")
     if not parts:
         raise InputError("no numbered WITSML part files (00001.xml, 00002.xml …) in the "
                          "folder", file=folder, fix="give the folder of one exported log")

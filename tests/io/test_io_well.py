@@ -38,7 +38,7 @@ def test_sidecars_found_by_name(csv_well):
     csv_well.with_suffix(".toml").write_text('[well]\nname = "Alpha"\n'
                                              '[segmentation]\nmax_gap_s = 2.0\n')
     (csv_well.parent / "A-12.survey.csv").write_text(SURVEY_CSV)
-    data, cfg, survey = astuple(resolve_well(csv_well))
+    data, cfg, survey = astuple(resolve_well(csv_well))[:3]
     assert (cfg.name, survey.name) == ("A-12.toml", "A-12.survey.csv")
     pytest.importorskip("drillfric.io.survey")
     w = load_well(csv_well)
@@ -51,7 +51,7 @@ def test_command_line_files_override_sidecars(csv_well, tmp_path):
     other = tmp_path / "other.toml"
     other.write_text('[well]\nname = "explicit"\n')
     (tmp_path / "s.csv").write_text(SURVEY_CSV)
-    _, cfg, survey = astuple(resolve_well(csv_well, config=other, survey=tmp_path / "s.csv"))
+    _, cfg, survey = astuple(resolve_well(csv_well, config=other, survey=tmp_path / "s.csv"))[:3]
     assert (cfg, survey) == (other, tmp_path / "s.csv")
     assert load_well(csv_well, config=other).name == "explicit"
 
