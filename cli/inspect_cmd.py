@@ -11,7 +11,8 @@ from .common import unit_system, units_option
 
 #: Channel quantities shown in the display units of ``--units`` (others as stored).
 _SHOWN = {"length": "length", "force": "force", "torque": "torque",
-          "rotary speed": "rotary speed", "pressure": "pressure", "flow rate": "flow rate"}
+          "rotary speed": "rotary speed", "pressure": "pressure", "flow rate": "flow rate",
+          "speed": "speed"}
 
 
 @click.command("inspect")

@@ -67,10 +67,12 @@ def _describe_depth_log(result, units: str) -> str:
     from drillfric.units import format_value
 
     s, c, log = result.summary, result.summary["counts"], result.summary["friction_log"]
+    off = (f"μ off bottom = {_fmt(s['mu_k'])}" if s["mu_k"] is not None else
+           f"μ off bottom: none ({log.get('mu_k_reason') or 'no off-bottom window'})")
     return (f"{result.well}: friction log of a depth-indexed log, {c['segments']} windows of "
             f"{format_value(log['window_m'], 'length', units, '.0f')} ({c['estimated']} "
             f"estimated, {c['skipped']} skipped, {c['failed']} failed"
-            f"{_depths(s['segments'], units)}); μ off bottom = {_fmt(s['mu_k'])}, apparent "
+            f"{_depths(s['segments'], units)}); {off}, apparent "
             f"μ on bottom = {_fmt(log['mu_apparent'])}; μ_s: no observer in depth data")
 
 

@@ -9,10 +9,12 @@ gives that torque as the bit torque plus μ·T_N, T_N = ∫F_c dx. So, per windo
 ``[friction_log] window_m`` of measured depth (one stand, 30 m, by default):
 
 1. the **rotating rows** (surface RPM above ``segmentation.rotating_rpm``, torque logged) are
-   split by **load case**: on bottom where WOB exceeds ``segmentation.wob_on_bottom_N``;
-   without WOB, where the bit (``bit_depth_m``, else the row's measured depth) is within
-   ``segmentation.on_bottom_m`` of ``hole_depth_m``; with neither, on bottom (a depth log
-   is a drilling log: announced as assumed);
+   split by **load case** (:func:`on_bottom`). A row of a drilling log is a depth of hole
+   drilled, so it is on bottom unless the data say otherwise: a rate of penetration above
+   zero says hole was made there, whatever the WOB channel reads; without it, WOB above
+   ``segmentation.wob_on_bottom_N``; without WOB, the bit (``bit_depth_m``, else the row's
+   measured depth) within ``segmentation.on_bottom_m`` of ``hole_depth_m``; with none of
+   these the load case is unknown (counted on bottom, so apparent, and said so);
 2. the **medians** of the window's rows of one load case (depth, torque, RPM, WOB, hook
    load) stand for it (medians: a few spikes of a reamed connection do not move them);
 3. the **friction factor** is the μ for which the modelled surface torque at the window's
@@ -69,6 +71,8 @@ class Window:
         The window's measured-depth interval [m].
     rows : int
         Rotating rows of this load case in the window.
+    rows_unknown : int
+        Of these, rows whose load case the data do not give (no ROP, WOB or hole depth).
     bit_depth_m : float
         Median bit depth [m] (the measured depth where the log has no bit depth).
     surface_torque_Nm, surface_rpm, wob_N, hookload_N : float
@@ -81,6 +85,7 @@ class Window:
     md_top_m: float
     md_bottom_m: float
     rows: int
+    rows_unknown: int
     bit_depth_m: float
     surface_torque_Nm: float
     surface_rpm: float
@@ -132,23 +137,38 @@ def bit_depth(log: pd.DataFrame) -> np.ndarray:
     return np.where(np.isfinite(bit), bit, log["measured_depth_m"].to_numpy(float))
 
 
-def on_bottom(log: pd.DataFrame, cfg) -> tuple[np.ndarray, str | None]:
-    """Whether each row is on bottom, and what was assumed to decide it (None: nothing).
+def on_bottom(log: pd.DataFrame, cfg) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Whether each row is on bottom, which rows the data leave unknown, and notes.
 
-    WOB above ``segmentation.wob_on_bottom_N`` where logged; else the bit within
-    ``segmentation.on_bottom_m`` of the hole depth where that is logged; else on bottom.
+    A row of a depth-indexed drilling log is a depth of hole drilled: on bottom unless the
+    data say otherwise. In order of evidence:
+
+    1. a rate of penetration above 0: hole was made at that depth, so the bit was on it,
+       whatever the WOB channel reads (a WOB at most ``segmentation.wob_on_bottom_N`` there
+       is read as a zero offset, not the bit off bottom: noted, the WOB kept as logged);
+    2. else the WOB where logged: on bottom above ``segmentation.wob_on_bottom_N``;
+    3. else the bit within ``segmentation.on_bottom_m`` of ``hole_depth_m`` where logged;
+    4. else unknown: counted on bottom, so its friction is apparent (any bit torque is in
+       it), never the string's off-bottom factor.
     """
-    wob = _column(log, "wob_N")
+    wob, rop = _column(log, "wob_N"), _column(log, "rop_m_s")
     gap = _column(log, "hole_depth_m") - bit_depth(log)
-    by_depth = np.isfinite(gap)
-    decided = np.where(np.isfinite(wob), wob > cfg.segmentation.wob_on_bottom_N,
-                       np.where(by_depth, gap <= cfg.segmentation.on_bottom_m, True))
-    blind = ~np.isfinite(wob) & ~by_depth
-    note = None
-    if blind.any():
-        note = (f"bit on bottom in {int(blind.sum())} of {blind.size} rows that log neither "
-                "WOB nor hole depth (a depth log is a drilling log)")
-    return decided, note
+    threshold = cfg.segmentation.wob_on_bottom_N
+    by_wob = np.where(np.isfinite(gap), gap <= cfg.segmentation.on_bottom_m, True)
+    by_wob = np.where(np.isfinite(wob), wob > threshold, by_wob)
+    drilled = rop > 0
+    unknown = ~np.isfinite(rop) & ~np.isfinite(wob) & ~np.isfinite(gap)
+    notes = []
+    light = drilled & (wob <= threshold)
+    if light.any():
+        notes.append(f"on bottom in {int(light.sum())} of {light.size} rows that log WOB ≤ "
+                     f"{threshold / 1e3:g} kN (segmentation.wob_on_bottom_N) while the hole "
+                     "advanced (ROP > 0): read as a WOB zero offset, not the bit off bottom")
+    if unknown.any():
+        notes.append(f"load case unknown in {int(unknown.sum())} of {unknown.size} rows that "
+                     "log neither ROP, WOB nor hole depth: counted on bottom, so their friction "
+                     "is apparent (bit torque in it), not the string's off-bottom factor")
+    return drilled | by_wob, unknown, notes
 
 
 # --------------------------------------------------------------------------- windows
@@ -163,7 +183,7 @@ def windows(log: pd.DataFrame, cfg) -> tuple[list[Window], list[str]]:
     md = log["measured_depth_m"].to_numpy(float)
     rpm, torque = _column(log, "surface_rpm"), _column(log, "surface_torque_Nm")
     rotating = (rpm > cfg.segmentation.rotating_rpm) & np.isfinite(torque)
-    bottom, note = on_bottom(log, cfg)
+    bottom, unknown, notes = on_bottom(log, cfg)
     slot = np.floor(md / width).astype(np.int64)
     out: list[Window] = []
     for k in np.unique(slot):
@@ -174,20 +194,22 @@ def windows(log: pd.DataFrame, cfg) -> tuple[list[Window], list[str]]:
             (Kind.ON_BOTTOM if bottom[here].mean() >= 0.5 else Kind.OFF_BOTTOM, here)]
         for kind, rows in kinds:
             out.append(_window(len(out) + 1, kind, k * width, width, log, rows & rotating,
-                               rows))
-    return out, [note] if note else []
+                               rows, unknown))
+    return out, notes
 
 
 def _window(wid: int, kind: Kind, top: float, width: float, log: pd.DataFrame,
-            rows: np.ndarray, where: np.ndarray) -> Window:
-    """The medians of ``rows`` (the depth of ``where`` when none rotate)."""
+            rows: np.ndarray, where: np.ndarray, unknown: np.ndarray) -> Window:
+    """The medians of ``rows`` (the depth of ``where`` when none rotate); ``unknown`` marks
+    the rows of unknown load case."""
     def median(values: np.ndarray) -> float:
         finite = values[rows & np.isfinite(values)]
         return float(np.median(finite)) if finite.size else float("nan")
 
     depth = median(bit_depth(log)) if rows.any() else float(np.median(bit_depth(log)[where]))
     return Window(id=wid, kind=kind, md_top_m=float(top), md_bottom_m=float(top + width),
-                  rows=int(rows.sum()), bit_depth_m=depth,
+                  rows=int(rows.sum()), rows_unknown=int((rows & unknown).sum()),
+                  bit_depth_m=depth,
                   surface_torque_Nm=median(_column(log, "surface_torque_Nm")),
                   surface_rpm=median(_column(log, "surface_rpm")),
                   wob_N=median(_column(log, "wob_N")),
@@ -268,6 +290,9 @@ def _record(base: dict, window: Window, mu: float, td: TDResult,
     notes = [f"{window.md_top_m:.0f}–{window.md_bottom_m:.0f} m window, {window.rows} "
              "rotating rows, friction factor by torque-and-drag back-calculation"]
     flags = []
+    if window.rows_unknown:
+        notes.append(f"load case unknown in {window.rows_unknown} of {window.rows} rows (no "
+                     "ROP, WOB or hole depth): counted on bottom")
     if window.kind is Kind.ON_BOTTOM:
         flags.append(Flag.BIT_TORQUE_IN_FRICTION)
         notes.append(f"apparent friction: bit torque assumed {torque_bit / 1e3:.2f} kN·m "
@@ -368,14 +393,27 @@ def _assumptions(well: Well, results: list[WindowResult], notes: list[str]) -> l
 
 
 def _log_summary(well: Well, log: pd.DataFrame, results: list[WindowResult]) -> dict:
-    """summary.json ``friction_log``: the windows and the apparent on-bottom consensus."""
+    """summary.json ``friction_log``: the windows, the apparent on-bottom consensus and why
+    there is no off-bottom one (``mu_k_reason``, null when ``mu_k`` is given)."""
     md = log["measured_depth_m"].to_numpy(float)
     apparent = [r.record.mu_k for r in results if r.record.status is Status.OK
                 and r.window.kind is Kind.ON_BOTTOM]
     return {"window_m": well.config.friction_log.window_m, "rows": len(log),
             "md_start_m": float(md.min()), "md_end_m": float(md.max()),
             "bit_mu": well.config.friction_log.bit_mu,
-            "mu_apparent": float(np.median(apparent)) if apparent else None}
+            "mu_apparent": float(np.median(apparent)) if apparent else None,
+            "mu_k_reason": _no_off_bottom_reason(results)}
+
+
+def _no_off_bottom_reason(results: list[WindowResult]) -> str | None:
+    """Why the log gives no off-bottom friction factor (None when it gives one)."""
+    off = [r for r in results if r.window.kind is Kind.OFF_BOTTOM]
+    if any(r.record.status is Status.OK for r in off):
+        return None
+    if off:
+        return f"none of the {len(off)} off-bottom windows was estimated (skipped or failed)"
+    return ("no rotating row is off bottom, so the log holds only apparent on-bottom "
+            "friction, bit torque included")
 
 
 def _no_estimates() -> pd.DataFrame:

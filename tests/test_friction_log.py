@@ -201,6 +201,7 @@ def test_run_writes_the_result_files_of_a_time_log(depth_log, tmp_path):
     assert binding <= set(summary) and summary["index"] == "depth"
     assert summary["mu_k"] == pytest.approx(MU, abs=ROOT_TOL)  # off-bottom consensus
     assert summary["friction_log"]["mu_apparent"] == pytest.approx(MU, abs=ROOT_TOL)
+    assert summary["friction_log"]["mu_k_reason"] is None
     assert any("no observer" in w for w in summary["warnings"])
     segments = pd.read_parquet(folder / "segments.parquet")
     assert list(segments["method"]) == ["td_backcalc"] * WINDOWS
@@ -211,6 +212,67 @@ def test_run_writes_the_result_files_of_a_time_log(depth_log, tmp_path):
     profiles = pd.read_parquet(folder / "profiles.parquet")
     assert set(profiles["segment_id"]) == set(range(1, WINDOWS + 1))
     assert (folder / "wellpath.parquet").is_file() and (folder / "report.html").is_file()
+
+
+def _with_columns(depth_log, folder, drop=(), **columns):
+    """The synthetic depth log written to ``folder/d.csv`` with ``columns`` added (name →
+    values) and ``drop`` removed, beside the fixture's config and survey."""
+    source = depth_log[0]
+    data = pd.read_csv(source).drop(columns=list(drop)).assign(**columns)
+    data.to_csv(folder / "d.csv", index=False)
+    for sidecar in ("d.toml", "d.survey.csv"):
+        (folder / sidecar).write_text((source.parent / sidecar).read_text())
+    return folder / "d.csv"
+
+
+def test_drilled_rows_logging_zero_wob_are_on_bottom_not_off_bottom(depth_log, tmp_path):
+    """Regression (issue 15 item 3): USROP F-5, a log of on-bottom drilling only, logs WOB
+    ≈ 0 (0.01 kkgf) over 731 rows drilled at 7–79 m/h; WOB alone labelled three windows
+    "rotating off bottom" and their apparent on-bottom μ became the summary's off-bottom μ_k
+    (0.168). Here every row makes hole (ROP 20 m/h) and half the windows log WOB 0: every
+    window is on bottom (apparent, flagged), there is no off-bottom μ_k, and the summary says
+    why. The windows logging WOB 0 were made with no WOB or bit torque at the bit, which the
+    back-calculation then also puts there, so μ is still recovered to the root tolerance."""
+    rows = len(depth_log[1])
+    path = _with_columns(depth_log, tmp_path, **{"ROP [m/h]": np.full(rows, 20.0)})
+    well = open_well(path)
+    assert well.channels["rop_m_s"].column == "ROP [m/h]"
+    result = run_depth_log(well)
+    records = friction_log(well)
+    assert [r.kind for r in records] == [Kind.ON_BOTTOM] * WINDOWS
+    assert all(Flag.BIT_TORQUE_IN_FRICTION in r.flags for r in records)
+    np.testing.assert_allclose([r.mu_k for r in records], MU, atol=ROOT_TOL)
+    assert result.summary["mu_k"] is None
+    assert "no rotating row is off bottom" in result.summary["friction_log"]["mu_k_reason"]
+    light = (depth_log[1]["WOB"] == 0).sum()
+    assert any(f"on bottom in {light} of {rows} rows that log WOB ≤ 10 kN" in note
+               for note in result.summary["assumed"])
+    text = CliRunner().invoke(cli, ["run", str(path), "--out", str(tmp_path / "out"),
+                                    "--no-report"])
+    assert text.exit_code == 0, text.output
+    assert "μ off bottom: none (no rotating row is off bottom" in text.output
+
+
+def test_zero_wob_where_the_hole_did_not_advance_is_off_bottom(depth_log, tmp_path):
+    """The counterpart: a logged ROP of 0 with WOB 0 (no hole made) leaves WOB to decide, so
+    those windows stay off bottom and give the string's kinetic factor."""
+    rop = np.where(depth_log[1]["WOB"] > 0, 20.0, 0.0)
+    records = friction_log(open_well(_with_columns(depth_log, tmp_path, **{"ROP [m/h]": rop})))
+    _check_recovered(records)
+
+
+def test_depth_log_without_rop_wob_or_hole_depth_has_an_unknown_load_case(depth_log,
+                                                                          tmp_path):
+    """Nothing in the data tells the load case: every window is counted on bottom (apparent
+    friction, never the off-bottom μ_k) and the summary and each window say it is unknown."""
+    result = run_depth_log(open_well(_with_columns(depth_log, tmp_path, drop=["WOB [kN]"])))
+    kinds = {seg["kind"] for seg in result.summary["segments"]}
+    assert kinds == {Kind.ON_BOTTOM.value} and result.summary["mu_k"] is None
+    assert result.summary["friction_log"]["mu_k_reason"] is not None
+    assert any(f"load case unknown in {5 * WINDOWS} of {5 * WINDOWS} rows" in note
+               for note in result.summary["assumed"])
+    assert all("load case unknown in 5 of 5 rows" in seg["message"]
+               for seg in result.summary["segments"])
 
 
 def test_run_depth_log_in_memory_writes_nothing(depth_log, tmp_path):
@@ -243,17 +305,28 @@ def test_fleet_runs_depth_logs(depth_log, tmp_path):
 # --------------------------------------------------------------------------- real data
 def test_usrop_f5_gives_a_plausible_friction_log(real_data):
     """USROP F-5, 8½in section, with the string of examples/usrop_f5.toml (an assumption)
-    and the operator's survey. The data's README: a 5½in DP / ~150 m BHA soft-string
-    inversion gives apparent factors around 0.13–0.19 (plausibility, not truth); ours also
-    carry the whole bit torque (bit_mu = 0), so the band is widened to 0.25 upwards."""
+    and the operator's survey. The data's README: on-bottom drilling only, and a 5½in DP /
+    ~150 m BHA soft-string inversion gives apparent factors around 0.13–0.19 (plausibility,
+    not truth); ours also carry the whole bit torque (bit_mu = 0), so the band is widened to
+    0.25 upwards. Every window is on bottom, including the rows that log WOB below the
+    on-bottom threshold while the hole advanced (issue 15 item 3), counted from the raw file."""
     path = real_data / "volve_usrop_f5" / "USROP_F-5_depth.csv"
     well = open_well(path, config=REPO / "examples" / "usrop_f5.toml",
                      survey=real_data / "volve_surveys" / "F-5_ACTUAL.txt")
     assert well.depth_indexed
-    records = friction_log(well)
-    assert all(r.status is Status.OK for r in records)
-    depths = [r.bit_depth_m for r in records]
+    summary = run_depth_log(well).summary
+    segments = summary["segments"]
+    assert all(s["status"] == Status.OK.value for s in segments)
+    assert {s["kind"] for s in segments} == {Kind.ON_BOTTOM.value}
+    assert summary["mu_k"] is None and summary["friction_log"]["mu_k_reason"]
+    depths = [s["bit_depth_m"] for s in segments]
     assert min(depths) < 2850 and max(depths) > 3770 and len(set(depths)) > 30
-    apparent = [r.mu_k for r in records if r.kind is Kind.ON_BOTTOM]
+    apparent = [s["mu_k"] for s in segments]
     assert 0.13 <= float(np.median(apparent)) <= 0.25
     assert all(0.1 <= mu <= 0.3 for mu in apparent)
+    raw = pd.read_csv(path)
+    kkgf = well.config.segmentation.wob_on_bottom_N / 9.80665e3  # 1 kkgf = 9.80665 kN
+    light = int(((raw["Weight on Bit kkgf"] <= kkgf)
+                 & (raw["Rate of Penetration m/h"] > 0)).sum())
+    assert light > 0 and any(f"on bottom in {light} of {len(raw)} rows" in note
+                             for note in summary["assumed"])

@@ -90,6 +90,9 @@ CHANNELS: tuple[Channel, ...] = (
              "MDEPTH")),
     Channel("wob", "wob_N", "force", "newton", "kN",
             ("WOB", "SWOB", "WOBA", "WEIGHT ON BIT", "SURFACE WOB", "WOB_AVG")),
+    Channel("rop", "rop_m_s", "speed", "meter/second", "m/h",
+            ("ROP", "ROPA", "ROP_AVG", "RATE OF PENETRATION", "AVERAGE ROP",
+             "AVERAGE RATE OF PENETRATION")),
     Channel("block_position", "block_position_m", "length", "meter", "m",
             ("BPOS", "BLKPOS", "BLOCK POSITION", "BLOCK HEIGHT", "BLOCK", "HOOK POSITION")),
     Channel("bit_rpm", "bit_rpm", "rotary speed", "revolution/minute", "rpm",
@@ -138,7 +141,7 @@ _PER_MINUTE = frozenset({"1/min", "u/min", "min-1", "min^-1", "1/minute", "rev/m
 #: Unit as spelled in the canonical suffix of each channel (``surface_torque_Nm`` → N.m).
 SUFFIX_UNITS = {"time": "s", "measured_depth": "m", "surface_rpm": "rpm",
                 "surface_torque": "N.m", "hookload": "N", "bit_depth": "m", "hole_depth": "m",
-                "wob": "N", "block_position": "m",
+                "wob": "N", "rop": "m/s", "block_position": "m",
                 "bit_rpm": "rpm", "standpipe_pressure": "Pa", "flow_in": "m3/s",
                 "flow_out": "%", "pump_rate": "spm", "surface_torque_min": "N.m",
                 "surface_torque_max": "N.m", "surface_rpm_min": "rpm", "surface_rpm_max": "rpm",
