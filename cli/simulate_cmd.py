@@ -1,7 +1,8 @@
 """`drillfric simulate` (docs/cli.md): synthetic surface data with ground truth.
 
 Thin layer: options become configuration overrides (command line > file > defaults), the
-survey and scenario are resolved, :func:`drillfric.simulator.simulate` runs the plant stand
+survey is resolved, :func:`drillfric.simulator.plan` picks the stands (the scenario, else one
+stand), :func:`drillfric.simulator.simulate` runs the plant stand
 by stand, :func:`drillfric.io.writers.write_well` writes the data file and its sidecars.
 """
 
@@ -39,29 +40,6 @@ def _load(config: Path, survey: Path | None, overrides: dict, omega_c_rpm: float
         value = omega_c_rpm if key.endswith("rpm") else omega_c_rpm * RPM_TO_RAD_S
         cfg = open_config(config, survey=survey, overrides=overrides | {key: value})[0]
     return cfg, survey_path, well_path
-
-
-def _scenario(cfg, config: Path, scenario: Path | None, well_path, single: bool):
-    """The scenario file (--scenario, else the config's), or one stand.
-
-    ``single`` (--bit-depth given without --scenario) ignores the config's scenario.
-    """
-    from drillfric import simulator as sim
-    from drillfric.errors import ConfigError
-
-    name = None if single else cfg.simulate.scenario
-    path = scenario if scenario is not None else (None if name is None
-                                                  else config.parent / name)
-    base = sim.base_stand(cfg)
-    if path is not None:
-        return path, sim.load_scenario(path, base)
-    depth = cfg.simulate.bit_depth_m
-    if depth is None:
-        if well_path is None:
-            raise ConfigError("no bit depth: give --bit-depth, simulate.bit_depth_m, a survey "
-                              "or a scenario", file=config)
-        depth = well_path.md_max_m
-    return None, sim.single_stand(cfg, depth)
 
 
 @click.command("simulate")
@@ -114,8 +92,8 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
                            bit_depth=bit_depth, rpm=rpm, seed=seed, rpm_noise=rpm_noise,
                            torque_noise=torque_noise, wob=wob, cells=cells)
     cfg, survey_path, well_path = _load(config, survey, overrides, omega_c_rpm)
-    _, plan = _scenario(cfg, config, scenario, well_path,
-                        single=bit_depth is not None and scenario is None)
+    _, plan = sim.plan(cfg, config, well_path, scenario,
+                       single=bit_depth is not None and scenario is None)
     sim.check_depths(plan, well_path, survey_path)
     with progress("simulating", plan.total_s) as advance:
         result = sim.simulate(cfg, well_path, plan, progress=advance)
