@@ -1,8 +1,10 @@
 """Validation table of the batch refinement (docs/theory.md §6.4) against synthetic truths (issue
 5).
 
-Each truth is the plant of docs/theory.md §3 in PI mode on a finer grid than the estimator (1500 or
-2000 cells against 500 for μ_k and ≥ MD/1000 for creeps), A&S Well A six-section BHA,
+Each truth is the plant of docs/theory.md §3 in PI mode on a finer grid than every estimator
+grid (2 cells per metre: 5000 at 2500 m, against 500 for μ_k and MD/1000 doubled up to twice
+for creeps; a truth coarser than the creep fit's grid is grid-biased in its creep build-up,
+docs/validation.md), A&S Well A six-section BHA,
 gravity F_c on a build-and-hold well, noise 0.5 RPM / 200 N·m, logged motor torque, at
 100, 5 and 1 Hz. Records are 120 s: a normal start (ramp to the set-point in 10 s) or a
 creep start (0 → 5 RPM in 5 s, hold 30 s, ramp). Verdicts follow issue 5:
@@ -28,6 +30,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from test_batch import estimate, make_case, sample  # noqa: E402
 
+#: Truth grid [cells/m]: finer than the creep fit's finest grid (≈ 1.8/m at 2500 m).
+TRUTH_CELLS_PER_M = 2.0
 #: name: (μ_s, μ_k, MD [m], kick-off [m], hold [deg], truth cells, stick-slip RPM, steady RPM)
 TRUTHS = {
     "paper 2500 m": (0.60, 0.187, 2500.0, 1500.0, 60.0, 1500, 40.0, 100.0),
@@ -75,6 +79,7 @@ def main():
         if steady_rpm:
             records.append(("steady", "normal", steady_rpm))
         for record, kind, rpm in records:
+            cells = max(cells, int(TRUTH_CELLS_PER_M * md))
             string, fc, rec = make_case(mu_s, mu_k, kind, 120.0, rpm, md_m=md, cells=cells,
                                         kop_m=kop, hold_deg=hold)
             stuck = float(np.mean(np.abs(rec.bit_rad_s[rec.time_s > 60]) < 0.1))

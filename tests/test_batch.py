@@ -307,9 +307,29 @@ def test_second_truth_deeper_stick_slip():
 
 
 @pytest.mark.slow
+def test_creep_logged_at_5_hz_is_withheld_for_the_twist_noise():
+    """The model integrates the logged speed into its twist, so speed noise becomes a random
+    walk of the twist, Var = σ_ω²Δt·t (docs/theory.md §6.3, check 2). Its 1-σ on μ_s grows
+    as √Δt: 5 Hz against 100 Hz on the same record is √20 ≈ 4.5× (tolerance 3–6.5×: the two
+    noise draws differ and the slopes τ' come from each fit). With 0.5 RPM of noise it is
+    ≈ 2 % at 100 Hz (claimed) and ≈ 9 % at 5 Hz, above the 10 %/3 a claim needs: withheld
+    with the reason (validation found 5-Hz fits scattered −3…+11 % over three noise seeds),
+    and the fallback bound stays below the truth."""
+    string, fc, rec = cached_case(0.6, 0.187, "creep", 120.0, 40.0, md_m=2500.0,
+                                  kop_m=1500.0)
+    fast = estimate(string, fc, *sample(rec, 100.0, seed=0))
+    slow = estimate(string, fc, *sample(rec, 5.0, seed=0))
+    assert fast.mu_s_identifiable
+    assert not slow.mu_s_identifiable and "mu_s_not_explained" in slow.flags
+    assert any("speed noise integrated into the twist" in m for m in slow.messages)
+    ratio = slow.details.creep_checks.twist_noise / fast.details.creep_checks.twist_noise
+    assert 3.0 < ratio < 6.5
+    assert slow.mu_s_lower_bound is None or slow.mu_s_lower_bound < 0.6
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("mu_s, mu_k, md_m, kop_m, rate_hz", [
     (0.6, 0.187, 2500.0, 1500.0, 100.0),  # the paper's case, creep start
-    (0.6, 0.187, 2500.0, 1500.0, 5.0),
     # docs/reference_cases.md field fit at 2,506 m, on a shallower well:
     (0.43, 0.185, 1800.0, 900.0, 100.0),
 ])

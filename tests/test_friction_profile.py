@@ -132,5 +132,5 @@ def test_smoothed_noise_of_white_noise_on_a_smooth_torque():
     t = np.arange(0.0, 60.0, 0.01)
     tau = 8000.0 * (1.0 - np.exp(-t / 20.0)) + rng.normal(0.0, 200.0, t.size)
     data = batch._Data(t=t, dt=0.01, drive=0 * t, motor=tau, creep_drive=0 * t,
-                       w_bar=0 * t, tau=tau, tau_bar=tau)
+                       w_bar=0 * t, tau=tau, tau_bar=tau, speed=0 * t)
     assert batch._smoothed_noise_Nm(data, np.arange(t.size)) == pytest.approx(20.0, rel=0.05)

@@ -211,6 +211,9 @@ class CreepChecks:
         Standard deviation of the smoothed measured torque's noise [N·m].
     halves : tuple of float
         μ_s fitted on the first and on the second half of the creep alone [-].
+    twist_noise : float
+        Relative 1-σ of μ_s due to the speed noise the model integrates into its twist
+        (a random walk, σ_ω·√(Δt·t)) [-] (docs/theory.md §6.3).
     swing_ratio : float or None
         Model/data ratio of the torque fluctuation in the rotation after the creep at the
         fitted factors (None without stick-slip rotation to compare) [-].
@@ -224,6 +227,7 @@ class CreepChecks:
     sensitivity: float
     noise_Nm: float
     halves: tuple[float, float]
+    twist_noise: float = 0.0
     swing_ratio: float | None = None
     other_hypothesis: float | None = None
 
@@ -286,6 +290,7 @@ class _Data:
     w_bar: np.ndarray  # ω₀ smoothed over TORQUE_SMOOTH_S [rad/s]
     tau: np.ndarray  # measured string torque [N·m]
     tau_bar: np.ndarray  # smoothed string torque [N·m]
+    speed: np.ndarray  # logged ω₀ as sampled [rad/s]
 
     def index(self, t_s: float) -> int:
         return int(np.clip(np.searchsorted(self.t, t_s - 1e-9 * self.dt), 0, self.t.size - 1))
@@ -315,7 +320,7 @@ def _prepare(time_s, surface_rad_s, torque_Nm, torque_kind, itd) -> tuple[_Data,
                  motor=smooth(tau_m, dt, DRIVE_SMOOTH_S),
                  creep_drive=smooth(w, dt, CREEP_DRIVE_SMOOTH_S),
                  w_bar=smooth(w, dt, max(TORQUE_SMOOTH_S, 3 * dt)), tau=tau_s,
-                 tau_bar=smooth(tau_s, dt, TORQUE_SMOOTH_S))
+                 tau_bar=smooth(tau_s, dt, TORQUE_SMOOTH_S), speed=w)
     return data, notes
 
 
@@ -872,13 +877,16 @@ def _creep_checks(model: _Model, wins, mu_s: float, mu_k: float, cells: int,
     g, fc = model.grid(cells)
     est, _, fix_s = model.profile.parts(g.x_m, g.dx_true_m, fc, mu_s, mu_k, model.cased_static)
     capacity = float(np.sum((mu_s * est + fix_s) * g.dx_true_m))
-    base, moved, data = [], [], []
+    base, moved, data, walks = [], [], [], []
     for w in wins:
         for factor, out in ((1.0, base), (1.0 + CREEP_SENSITIVITY_STEP, moved)):
             tau, _ = model.simulate(w, factor * mu_s, min(mu_k, factor * mu_s), cells)
-            out.append(smooth(tau, d.dt, TORQUE_SMOOTH_S)[w.used - w.sim0])
+            out.append(smooth(tau, d.dt, TORQUE_SMOOTH_S))
+        walks.append(_twist_walk(d, w, base[-1], moved[-1], mu_s))
+        base[-1], moved[-1] = (x[-1][w.used - w.sim0] for x in (base, moved))
         data.append(d.tau_bar[w.used])
     base, moved, data = (np.concatenate(x) for x in (base, moved, data))
+    jacobian_sq = float(np.sum((moved - base) ** 2)) / (CREEP_SENSITIVITY_STEP * mu_s) ** 2
     noise = _smoothed_noise_Nm(d, np.concatenate([w.used for w in wins]))
     level = max(float(np.max(np.abs(data))), 1e-9)
     independent = np.sqrt(max(1.0, base.size * d.dt / TORQUE_SMOOTH_S))
@@ -888,7 +896,31 @@ def _creep_checks(model: _Model, wins, mu_s: float, mu_k: float, cells: int,
                        * independent, noise_Nm=noise,
                        swing_ratio=_swing_ratio(model, rotating, mu_s, mu_k, rotating_cells)
                        if stick_slip and rotating else None,
-                       halves=_split_half(model, wins, mu_s, mu_k, cells))
+                       halves=_split_half(model, wins, mu_s, mu_k, cells),
+                       twist_noise=float(np.sqrt(sum(walks))) / max(jacobian_sq, 1e-30) / mu_s)
+
+
+def _twist_walk(d: _Data, w: _Window, base: np.ndarray, moved: np.ndarray,
+                mu_s: float) -> float:
+    """One creep window's share of Var(Σ J_i τ'_i W_i): the speed noise the model integrates
+    into its twist (docs/theory.md §6.3, check 2). W is the random walk of the twist error
+    (increments σ_ω·Δt per sample, σ_ω the logged speed's noise over the window, from its
+    second differences), J = ∂τ/∂μ_s the fit's sensitivity [N·m per unit μ] and τ' = dτ/dθ
+    the slope of the quasi-static creep torque against the top angle [N·m/rad]. Divided by
+    (Σ J²)² it is the variance of μ_s [-]; the caller adds the windows and takes the root."""
+    span = slice(w.sim0, w.end + 1)
+    speed = d.speed[span]
+    if speed.size < 5:
+        return 0.0
+    sigma = 1.4826 * float(np.median(np.abs(np.diff(speed, 2)))) / np.sqrt(6.0)
+    drive = d.creep_drive[span]
+    floor = 0.5 * float(np.median(np.abs(drive[w.used - w.sim0])))
+    slope = np.gradient(base, d.dt) / np.maximum(np.abs(drive), max(floor, 1e-6))
+    a = np.zeros(speed.size)
+    rows = w.used - w.sim0
+    a[rows] = (moved[rows] - base[rows]) / (CREEP_SENSITIVITY_STEP * mu_s) * slope[rows]
+    suffix = np.cumsum(a[::-1])[::-1]
+    return (sigma * d.dt) ** 2 * float(np.sum(suffix ** 2))
 
 
 def _split_half(model: _Model, wins, mu_s: float, mu_k: float,
@@ -919,6 +951,12 @@ def _creep_problems(mu_s: float, c: CreepChecks) -> list[str]:
     if c.sensitivity < MIN_CREEP_SENSITIVITY:
         problems.append("the creep torque hardly depends on μ_s (a 10 % change is "
                         f"{c.sensitivity:.1f}× its noise)")
+    elif np.hypot(CREEP_SENSITIVITY_STEP / c.sensitivity, c.twist_noise) > \
+            CREEP_SENSITIVITY_STEP / MIN_CREEP_SENSITIVITY:
+        problems.append(f"the speed noise integrated into the twist leaves μ_s uncertain by "
+                        f"±{100 * c.twist_noise:.1f} % (1σ; torque noise "
+                        f"±{100 * CREEP_SENSITIVITY_STEP / c.sensitivity:.1f} %): a creep "
+                        "logged faster or with a quieter speed sensor would pin it")
     if c.swing_ratio is not None and c.swing_ratio < MIN_SWING_RATIO:
         problems.append(f"with this μ_s the model's stick-slip after the creep is "
                         f"{c.swing_ratio:.2f}× the data's: the law that fits the creep does "
@@ -942,6 +980,7 @@ def _checks_text(c: CreepChecks) -> str:
     """The checks as one message (the evidence beside a μ_s)."""
     swing = "—" if c.swing_ratio is None else f"{c.swing_ratio:.2f}"
     return (f"creep checks: misfit {100 * c.misfit:.1f} %, sensitivity {c.sensitivity:.0f}, "
+            f"twist noise ±{100 * c.twist_noise:.1f} %, "
             f"string engaged {100 * min(c.engaged, 1.0):.0f} %, halves {c.halves[0]:.3f} / "
             f"{c.halves[1]:.3f}, model/data stick-slip {swing}")
 
