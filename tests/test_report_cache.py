@@ -83,3 +83,25 @@ def test_layouts_in_other_units_are_built_again(evidence):
     text = json.dumps(field["bk-tracks"], ensure_ascii=False)
     assert "hook load [klbf]" in text and "[kN" not in text
     assert "bit depth [ft]" in json.dumps(field["bk-friction"], ensure_ascii=False)
+
+
+def test_cache_keeps_the_most_recent_signatures(monkeypatch):
+    """At most LAYOUT_CACHE_SIZE layouts are kept; the least recently used goes first."""
+    from bokeh.models import ColumnDataSource
+    from bokeh.plotting import figure
+
+    from drillfric.report import interactive
+
+    def build():
+        fig = figure()
+        fig.line("x", "y", source=ColumnDataSource({"x": [0.0], "y": [0.0]}, name="s"))
+        return fig
+
+    monkeypatch.setattr(interactive, "LAYOUT_CACHE_SIZE", 2)
+    forget_layouts()
+    embed = interactive.Embedder()
+    data = {"s": {"x": np.array([1.0]), "y": np.array([2.0])}}
+    for signature in ("a", "b", "a", "c"):  # "a" used again, so "b" is the oldest
+        embed.add_like(signature, build, data, signature)
+    assert list(_LAYOUTS) == ["a", "c"]
+    forget_layouts()

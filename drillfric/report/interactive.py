@@ -95,15 +95,15 @@ class Embedder:
         keys of ``data``; a layout with the same ``signature`` — a hashable value holding
         everything but the sources' data the layout depends on — is not built again."""
         target = f"bk-{key}"
-        template = _LAYOUTS.get(signature)
+        template = _LAYOUTS.pop(signature, None)
         if template is None:
             self.add(build(), key)
-            _LAYOUTS[signature] = self.items[-1]
-            while len(_LAYOUTS) > LAYOUT_CACHE_SIZE:
-                _LAYOUTS.popitem(last=False)
-            return target
-        _LAYOUTS.move_to_end(signature)
-        self.items.append(with_data(template, target, data))
+            template = self.items[-1]
+        else:
+            self.items.append(with_data(template, target, data))
+        _LAYOUTS[signature] = template  # now the most recent
+        while len(_LAYOUTS) > LAYOUT_CACHE_SIZE:
+            _LAYOUTS.popitem(last=False)
         return target
 
     @property
