@@ -7,6 +7,8 @@ Times, in one run on this machine (median of ``--runs``, min–max beside it):
   report included (numba caches already on disk, as after the first run of an install);
 - a 60-s 10 Hz well run in-process after a warm-up well (what a fleet worker does),
   with and without the well's report;
+- where a fresh process spends the 10-minute well's time: importing the run path, the
+  run, importing the report stack, the first report and a second one (layouts cached);
 - the bundled example under CPU load with OpenBLAS allowed 1 or 2 threads, alternated
   (A B A B): the library pins BLAS to one thread around its linear algebra, so the ratio
   should be ≈ 1.
@@ -74,6 +76,37 @@ def warm_worker(data: Path, out: Path, runs: int, report: bool) -> list[float]:
     return times
 
 
+_PHASES = """
+import sys, time
+from pathlib import Path
+t0 = time.perf_counter()
+from drillfric.io.well import open_well
+from drillfric.pipeline import run_well
+t1 = time.perf_counter()
+result = run_well(open_well(sys.argv[1]), Path(sys.argv[2]), report=False)
+t2 = time.perf_counter()
+from drillfric.report import write_well_report
+t3 = time.perf_counter()
+write_well_report(result.out_dir)
+t4 = time.perf_counter()
+write_well_report(result.out_dir)
+t5 = time.perf_counter()
+print(t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4)
+"""
+_PHASE_NAMES = ("import run path", "run (no report)", "import drillfric.report",
+                "first report", "second report, same process")
+
+
+def phases(data: Path, out: Path, runs: int) -> list[list[float]]:
+    """Seconds of each of :data:`_PHASE_NAMES` in ``runs`` fresh processes."""
+    rows = []
+    for i in range(runs):
+        done = subprocess.run([sys.executable, "-c", _PHASES, str(data), str(out / f"p{i}")],
+                              check=True, capture_output=True, text=True, timeout=900)
+        rows.append([float(v) for v in done.stdout.split()])
+    return [list(col) for col in zip(*rows, strict=True)]
+
+
 def blas_pairs(out: Path, runs: int) -> list[tuple[float, float]]:
     """(1 thread, 2 threads) wall seconds of the bundled example, alternated, under load."""
     load = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(2)]
@@ -97,7 +130,7 @@ def blas_pairs(out: Path, runs: int) -> list[tuple[float, float]]:
 
 def show(label: str, times: list[float], target: str) -> None:
     print(f"{label:<52} median {statistics.median(times):6.2f} s "
-          f"({min(times):.2f}–{max(times):.2f})   target {target}")
+          f"({min(times):.2f}–{max(times):.2f})" + (f"   target {target}" if target else ""))
 
 
 def main() -> None:
@@ -122,6 +155,10 @@ def main() -> None:
              warm_worker(short_well, root / "nr", args.runs, report=False), "≤ 0.5 s")
         show("60-s well, warm worker, report",
              warm_worker(short_well, root / "wr", args.runs, report=True), "≤ 1 s")
+        print("where the 10-minute well's fresh process spends its time:")
+        for name, times in zip(_PHASE_NAMES, phases(long_well, root / "phases", args.runs),
+                               strict=True):
+            show(f"  {name}", times, "")
         if not args.skip_blas:
             pairs = blas_pairs(root / "blas", max(2, args.runs // 2))
             ratios = [two / one for one, two in pairs]

@@ -152,9 +152,10 @@ def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | None, units: Unit
     return out
 
 
-def signature(sources: dict[str, dict]) -> tuple:
-    """What the layout of :func:`evidence_plot` depends on besides the data."""
-    return tuple((name, tuple(cols)) for name, cols in sources.items())
+def signature(sources: dict[str, dict], clock: bool, units: Units = SI) -> tuple:
+    """What the layout of :func:`evidence_plot` depends on besides the sources' data."""
+    return ("evidence", clock, units.system,
+            tuple((name, tuple(cols)) for name, cols in sources.items()))
 
 
 def evidence_plot(sources: dict[str, dict], clock: bool, units: Units = SI):

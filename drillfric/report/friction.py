@@ -59,72 +59,129 @@ def _cds(frame: pd.DataFrame):
     return ColumnDataSource({c: frame[c].to_numpy() for c in frame.columns})
 
 
-def _points(fig, frame: pd.DataFrame, x: str, marker: str, color: str, label: str,
-            hollow_unconverged: bool = True, **kw):
-    """Filled markers where converged, hollow where not; returns the renderers."""
+def _columns(frame: pd.DataFrame) -> dict[str, np.ndarray]:
+    """A table's columns as arrays (a ColumnDataSource's data; no index column)."""
+    return {c: frame[c].to_numpy() for c in frame.columns}
 
-    out = []
-    for conv, suffix in ((True, ""), (False, " (not converged)")):
+
+def _span(x0, x1, depth) -> dict[str, np.ndarray]:
+    """Horizontal strokes from ``x0`` to ``x1`` at ``depth`` (a segment glyph's data)."""
+    depth = np.asarray(depth, dtype=float)
+    return {"x0": np.asarray(x0, dtype=float), "y0": depth,
+            "x1": np.asarray(x1, dtype=float), "y1": depth}
+
+
+#: Marker, colour and legend of the points of each μ column.
+_MARKS = {"mu_k": ("circle", MU_K_COLOR, "μ_k"), "mu_s": ("square", MU_S_COLOR, "μ_s"),
+          "mu_td": ("x", TD_COLOR, "μ from torque and drag")}
+
+
+def _add_points(out: dict, frame: pd.DataFrame, col: str, hollow_unconverged: bool = True
+                ) -> None:
+    """``points:COL:converged`` and ``points:COL:unconverged`` (drawn hollow) of ``frame``
+    where ``col`` has a value; every point counts as converged without
+    ``hollow_unconverged``."""
+    for conv, name in ((True, "converged"), (False, "unconverged")):
         part = frame[frame["converged"] == conv] if hollow_unconverged else \
             (frame if conv else frame.iloc[:0])
-        part = part[part[x].notna()]
-        if not len(part):
-            continue
-        out.append(fig.scatter(x, "depth", source=_cds(part), marker=marker,
-                               size=9, line_color=color,
-                               fill_color=color if conv else "white",
-                               legend_label=label + suffix, **kw))
-    return out
+        part = part[part[col].notna()]
+        if len(part):
+            out[f"points:{col}:{name}"] = _columns(part)
 
 
-def friction_plot(segments: pd.DataFrame, units: Units = SI):
-    """μ versus bit depth and stick-slip severity versus bit depth (a Bokeh row)."""
-    from bokeh.layouts import gridplot
-    from bokeh.models import HoverTool, Span
-    from bokeh.plotting import figure
-
-    seg = segments[segments["bit_depth_m"].notna()]
-    frame = _source_frame(seg, units)
+def friction_sources(segments: pd.DataFrame, units: Units = SI
+                     ) -> dict[str, dict[str, np.ndarray]]:
+    """The data of every Bokeh source of :func:`friction_plot`, by source name, in drawing
+    order (only those with rows): ``whisker:mu_k``, ``whisker:mu_s`` (spreads), the
+    ``points:…`` of μ_k, identified μ_s and μ_TD, ``bound_tail`` and ``bound`` (μ_s lower
+    bounds), ``none`` (segments without an estimate) and ``severity``. Depths in display
+    ``units``."""
+    frame = _source_frame(segments[segments["bit_depth_m"].notna()], units)
     ok = frame[frame["status"] == "ok"]
-    zone = zone_text(seg)
-    mu = figure(height=520, width=560, tools=_TOOLS,
-                x_axis_label=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
-                y_axis_label=units.axis("bit depth", "length"))
-    mu.y_range.flipped = True
-    renderers = []
-    for col, half, color in (("mu_k", "half_k", MU_K_COLOR), ("mu_s", "half_s", MU_S_COLOR)):
+    out = {}
+    for col, half in (("mu_k", "half_k"), ("mu_s", "half_s")):
         whisk = ok[ok[col].notna() & (ok[half] > 0)]
         if col == "mu_s":
             whisk = whisk[whisk["identified"]]
         if len(whisk):
-            mu.segment(whisk[col] - whisk[half], whisk["depth"], whisk[col] + whisk[half],
-                       whisk["depth"], color=color, line_width=1)
-    renderers += _points(mu, ok, "mu_k", "circle", MU_K_COLOR, "μ_k")
-    renderers += _points(mu, ok[ok["identified"]], "mu_s", "square", MU_S_COLOR, "μ_s")
+            out[f"whisker:{col}"] = _span(whisk[col] - whisk[half], whisk[col] + whisk[half],
+                                          whisk["depth"])
+    _add_points(out, ok, "mu_k")
+    _add_points(out, ok[ok["identified"]], "mu_s")
     bound = ok[~ok["identified"] & ok["mu_s_lower_bound"].notna()]
     if len(bound):
-        mu.segment(bound["mu_s_lower_bound"], bound["depth"], bound["mu_s_lower_bound"] + 0.08,
-                   bound["depth"], color=MU_S_COLOR, line_dash="dotted")
-        renderers.append(mu.scatter("mu_s_lower_bound", "depth",
-                                    source=_cds(bound), marker="triangle",
-                                    angle=-np.pi / 2, size=10, line_color=MU_S_COLOR,
-                                    fill_color="white", legend_label="μ_s ≥ lower bound"))
-    renderers += _points(mu, ok, "mu_td", "x", TD_COLOR, "μ from torque and drag",
-                         hollow_unconverged=False)
+        out["bound_tail"] = _span(bound["mu_s_lower_bound"],
+                                  bound["mu_s_lower_bound"] + 0.08, bound["depth"])
+        out["bound"] = _columns(bound)
+    _add_points(out, ok, "mu_td", hollow_unconverged=False)
     none = frame[frame["status"] != "ok"].assign(zero=0.0)
     if len(none):
-        renderers.append(mu.scatter("zero", "depth", source=_cds(none),
-                                    marker="diamond", size=10, color="#888888",
-                                    fill_color="white", legend_label="no estimate"))
+        out["none"] = _columns(none)
+    severity = ok[ok["stick_slip_severity"].notna()]
+    if len(severity):
+        out["severity"] = _columns(severity)
+    return out
+
+
+def friction_signature(segments: pd.DataFrame, sources: dict[str, dict],
+                       units: Units = SI) -> tuple:
+    """What the layout of :func:`friction_plot` depends on besides the sources' data."""
+    return ("friction", _zone(segments), units.system,
+            tuple((name, tuple(cols)) for name, cols in sources.items()))
+
+
+def _zone(segments: pd.DataFrame) -> str:
+    return zone_text(segments[segments["bit_depth_m"].notna()])
+
+
+def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units = SI):
+    """μ versus bit depth and stick-slip severity versus bit depth (a Bokeh row) from
+    :func:`friction_sources`; each ColumnDataSource is named like its key there.
+    ``segments`` give the friction zone of the μ axis' label only."""
+    from bokeh.layouts import gridplot
+    from bokeh.models import ColumnDataSource, HoverTool, Span
+    from bokeh.plotting import figure
+
+    zone = _zone(segments)
+    mu = figure(height=520, width=560, tools=_TOOLS,
+                x_axis_label=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
+                y_axis_label=units.axis("bit depth", "length"))
+    mu.y_range.flipped = True
+    cds = {name: ColumnDataSource(columns, name=name) for name, columns in sources.items()}
+    renderers = []
+    for name, source in cds.items():
+        kind, _, col = name.partition(":")
+        if kind == "whisker":
+            mu.segment("x0", "y0", "x1", "y1", source=source, line_width=1,
+                       color=MU_K_COLOR if col == "mu_k" else MU_S_COLOR)
+        elif kind == "points":
+            col, _, part = col.partition(":")
+            marker, color, label = _MARKS[col]
+            conv = part == "converged"
+            renderers.append(mu.scatter(
+                col, "depth", source=source, marker=marker, size=9, line_color=color,
+                fill_color=color if conv else "white",
+                legend_label=label + ("" if conv else " (not converged)")))
+        elif kind == "bound_tail":
+            mu.segment("x0", "y0", "x1", "y1", source=source, color=MU_S_COLOR,
+                       line_dash="dotted")
+        elif kind == "bound":
+            renderers.append(mu.scatter("mu_s_lower_bound", "depth", source=source,
+                                        marker="triangle", angle=-np.pi / 2, size=10,
+                                        line_color=MU_S_COLOR, fill_color="white",
+                                        legend_label="μ_s ≥ lower bound"))
+        elif kind == "none":
+            renderers.append(mu.scatter("zero", "depth", source=source, marker="diamond",
+                                        size=10, color="#888888", fill_color="white",
+                                        legend_label="no estimate"))
     mu.add_tools(HoverTool(renderers=renderers, tooltips=_tips(units)))
     mu.legend.location = "bottom_right"
     mu.legend.label_text_font_size = "10px"
     mu.legend.click_policy = "hide"
     sev = figure(height=520, width=300, tools=_TOOLS, y_range=mu.y_range,
                  x_axis_label="stick-slip severity [-]")
-    sev_rows = ok[ok["stick_slip_severity"].notna()]
-    if len(sev_rows):
-        line = sev.scatter("stick_slip_severity", "depth", source=_cds(sev_rows),
+    if "severity" in cds:
+        line = sev.scatter("stick_slip_severity", "depth", source=cds["severity"],
                            marker="circle", size=8, color="#8e44ad")
         sev.add_tools(HoverTool(renderers=[line], tooltips=_tips(units)))
     sev.add_layout(Span(location=1.0, dimension="height", line_dash="dashed",

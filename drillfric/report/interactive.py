@@ -17,6 +17,7 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from functools import cache
 
@@ -28,6 +29,11 @@ from markupsafe import Markup
 MIN_WIDTH_PX = 600
 #: Tools of every time-axis figure: zoom and pan along time, box zoom, reset, hover, save.
 TIME_TOOLS = "xpan,xwheel_zoom,box_zoom,reset,save"
+#: Most layouts :meth:`Embedder.add_like` keeps per process (a fleet worker meets a few
+#: kinds: the time tracks, the friction log, the evidence by the channels a log has).
+LAYOUT_CACHE_SIZE = 32
+#: ``json_item`` of the layouts built in this process, by signature (least recent first).
+_LAYOUTS: OrderedDict = OrderedDict()
 _LOADER = ("for (const item of JSON.parse(document.getElementById('bokeh-items').textContent))"
            " { Bokeh.embed.embed_item(item); }")
 
@@ -65,15 +71,16 @@ class Embedder:
     ``add(layout, key)`` returns the id of the ``<div>`` to place; :attr:`head` is what
     goes into the template (scripts, data block, CSP script sources).
 
-    Building and serialising Bokeh models costs ~0.2 s per multi-panel layout, whatever
-    the data; a report with 30 segments would spend seconds on it. Layouts that differ only
-    in their data (:meth:`add_like`) are therefore built and serialised once per
-    ``signature``; the others are copies of that JSON with the data of their named
-    ColumnDataSources replaced, encoded by Bokeh's own serializer.
+    Building and serialising Bokeh models costs 0.1–0.3 s per multi-panel layout, whatever
+    the data; a report with 30 segments, or a fleet worker writing a report per well,
+    would spend seconds on it. Layouts that differ only in their data (:meth:`add_like`)
+    are therefore built and serialised once per ``signature`` and process (the last
+    :data:`LAYOUT_CACHE_SIZE` signatures are kept); the others are copies of that JSON
+    with the data of their named ColumnDataSources replaced, encoded by Bokeh's own
+    serializer.
     """
 
     items: list = field(default_factory=list)
-    _templates: dict = field(default_factory=dict)
 
     def add(self, layout, key: str) -> str:
         """Register a Bokeh layout; returns the element id where it is drawn."""
@@ -85,14 +92,18 @@ class Embedder:
 
     def add_like(self, signature, build, data: dict[str, dict], key: str) -> str:
         """Register a layout made by ``build()`` whose ColumnDataSources are named by the
-        keys of ``data``; a layout with the same ``signature`` is not built again."""
+        keys of ``data``; a layout with the same ``signature`` — a hashable value holding
+        everything but the sources' data the layout depends on — is not built again."""
         target = f"bk-{key}"
-        template = self._templates.get(signature)
+        template = _LAYOUTS.pop(signature, None)
         if template is None:
             self.add(build(), key)
-            self._templates[signature] = self.items[-1]
-            return target
-        self.items.append(with_data(template, target, data))
+            template = self.items[-1]
+        else:
+            self.items.append(with_data(template, target, data))
+        _LAYOUTS[signature] = template  # now the most recent
+        while len(_LAYOUTS) > LAYOUT_CACHE_SIZE:
+            _LAYOUTS.popitem(last=False)
         return target
 
     @property
@@ -104,6 +115,11 @@ class Embedder:
         return {"js": Markup(js), "loader": Markup(_LOADER),
                 "data": json_in_script(self.items),
                 "script_src": f"{script_hash(js)} {script_hash(_LOADER)}"}
+
+
+def forget_layouts() -> None:
+    """Empty the process's layout cache (:meth:`Embedder.add_like`)."""
+    _LAYOUTS.clear()
 
 
 def with_data(item: dict, target: str, data: dict[str, dict]) -> dict:
@@ -182,6 +198,8 @@ def time_values(time_s, origin: pd.Timestamp | None) -> np.ndarray:
             + pd.to_timedelta(seconds, unit="s")).to_numpy()
 
 
-def time_label(origin: pd.Timestamp | None) -> str:
-    """Axis label of log time."""
-    return "time [UTC]" if origin is not None else "log time [s]"
+def time_label(origin: pd.Timestamp | bool | None) -> str:
+    """Axis label of log time; ``origin``: the clock time of log time 0, or whether it is
+    known (None: not known)."""
+    clock = origin if isinstance(origin, bool) else origin is not None
+    return "time [UTC]" if clock else "log time [s]"

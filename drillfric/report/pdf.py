@@ -12,7 +12,6 @@ import os
 import textwrap
 from pathlib import Path
 
-from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 
 from .render import quiet_glyphs
@@ -156,6 +155,8 @@ def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str,
     that every page says what it is (and its text can be found in the PDF). The footer
     holds ``footer`` (left) and "page n of N" (right).
     """
+    from matplotlib.backends.backend_pdf import PdfPages  # ~0.2 s: only when a PDF is asked
+
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     count = len(pages)

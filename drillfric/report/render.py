@@ -13,6 +13,7 @@ import math
 import warnings
 from contextlib import contextmanager
 from datetime import UTC, datetime
+from functools import cache
 from importlib.resources import files
 from typing import TYPE_CHECKING
 
@@ -41,8 +42,10 @@ DIAGNOSTIC_COLUMNS = (
 MESSAGE_FOLD_CHARS = 90
 
 
+@cache
 def environment() -> Environment:
-    """The Jinja2 environment of the report templates (autoescaping on for every template)."""
+    """The Jinja2 environment of the report templates (autoescaping on for every template);
+    one per process, so each template is compiled once."""
     env = Environment(loader=FileSystemLoader(str(files("drillfric.templates"))),
                       autoescape=select_autoescape(["html", "j2"], default=True),
                       trim_blocks=True, lstrip_blocks=True)

@@ -122,28 +122,77 @@ def state_runs(time_s: np.ndarray, codes: np.ndarray) -> pd.DataFrame:
 
 
 # ------------------------------------------------------------------------------ Bokeh
-def tracks_plot(tracks: pd.DataFrame, segments: pd.DataFrame, origin: pd.Timestamp | None,
+def tracks_sources(tracks: pd.DataFrame, segments: pd.DataFrame,
+                   origin: pd.Timestamp | None, units: Units = SI
+                   ) -> dict[str, dict[str, np.ndarray]]:
+    """The data of every Bokeh source of the time tracks, by source name.
+
+    ``trace:COLUMN`` (``x``, ``lo``, ``hi``, ``mean`` of one channel in display ``units``,
+    float32) for the channels of :func:`panels_present`, ``states`` (``left``, ``right``,
+    ``color``, ``what``: runs of rig state), and with estimated-or-not segments that have a
+    time span ``shading`` (``x0``, ``x1``, ``color``) and ``bands`` (the strip's segment
+    row: ``left``, ``right``, ``color``, ``what``).
+    """
+    data = with_breaks(tracks)
+    x = time_values(data["time_s"], origin)
+    out = {}
+    for panel in panels_present(tracks):
+        for trace in panel.traces:
+            scale = units.factor(trace.quantity)
+            out[f"trace:{trace.column}"] = {
+                "x": x, "lo": float32(data[f"{trace.column}_min"] * scale),
+                "hi": float32(data[f"{trace.column}_max"] * scale),
+                "mean": float32(data[f"{trace.column}_mean"] * scale)}
+    seg = segments[np.isfinite(segments["t_start_s"]) & np.isfinite(segments["t_end_s"])]
+    left, right = time_values(seg["t_start_s"], origin), time_values(seg["t_end_s"], origin)
+    colors = [SEGMENT_COLORS.get(k, "#777777") for k in seg["kind"]]
+    if len(seg):
+        out["shading"] = {"x0": left, "x1": right, "color": colors}
+    runs = state_runs(data["time_s"].to_numpy(float), data["rig_state"].fillna(-1))
+    out["states"] = {
+        "left": time_values(runs["t0_s"], origin), "right": time_values(runs["t1_s"], origin),
+        "color": [STATE_COLORS[c] for c in runs["code"]],
+        "what": [RIG_STATES[c].replace("_", " ") for c in runs["code"]]}
+    if len(seg):
+        out["bands"] = {
+            "left": left, "right": right, "color": colors,
+            "what": [f"segment {i}: {str(k).replace('_', ' ')}, bit at "
+                     f"{units.text(d, 'length')} {units.label('length')}, μ_k {m:.3f}, {s}"
+                     for i, k, d, m, s in
+                     zip(seg["id"], seg["kind"], seg["bit_depth_m"].fillna(np.nan),
+                         seg["mu_k"].fillna(np.nan), seg["status"], strict=True)]}
+    return out
+
+
+def tracks_signature(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
+                     units: Units = SI) -> tuple:
+    """What the layout of :func:`tracks_plot` depends on besides the sources' data."""
+    panels = tuple((p.name, tuple(t.column for t in p.traces))
+                   for p in panels_present(tracks))
+    return ("tracks", panels, clock, units.system,
+            tuple((name, tuple(cols)) for name, cols in sources.items()))
+
+
+def tracks_plot(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
                 units: Units = SI):
-    """Interactive time tracks (a Bokeh layout) in display ``units``: zoom/pan in time on
-    any track zooms all; hover gives the bin's min, mean and max; the bottom strip's hover
-    names the rig state and the segment (id, kind, bit depth, μ_k)."""
+    """Interactive time tracks (a Bokeh layout) from :func:`tracks_sources` in display
+    ``units``; each ColumnDataSource is named like its key there. Zoom/pan in time on any
+    track zooms all; hover gives the bin's min, mean and max; the bottom strip's hover
+    names the rig state and the segment (id, kind, bit depth, μ_k). ``tracks`` decides
+    which panels are drawn (:func:`panels_present`), not what they show."""
     from bokeh.layouts import gridplot
     from bokeh.models import ColumnDataSource
 
-    data = with_breaks(tracks)
-    clock = origin is not None
-    x = time_values(data["time_s"], origin)
+    shading = ColumnDataSource(sources["shading"], name="shading") \
+        if "shading" in sources else None
     figs = []
     x_range = None
     for panel in panels_present(tracks):
         fig = time_figure(_TRACK_PX, panel.label(units), x_range=x_range, clock=clock)
         x_range = fig.x_range
         for trace in panel.traces:
-            scale = units.factor(trace.quantity)
-            source = ColumnDataSource({
-                "x": x, "lo": float32(data[f"{trace.column}_min"] * scale),
-                "hi": float32(data[f"{trace.column}_max"] * scale),
-                "mean": float32(data[f"{trace.column}_mean"] * scale)})
+            name = f"trace:{trace.column}"
+            source = ColumnDataSource(sources[name], name=name)
             fig.varea("x", "lo", "hi", source=source, color=trace.color, alpha=0.25)
             line = fig.line("x", "mean", source=source, color=trace.color, line_width=1,
                             legend_label=trace.label)
@@ -154,9 +203,11 @@ def tracks_plot(tracks: pd.DataFrame, segments: pd.DataFrame, origin: pd.Timesta
         fig.legend.click_policy = "hide"
         if panel.invert:
             fig.y_range.flipped = True
-        _shade_segments(fig, segments, origin)
+        if shading is not None:  # every segment as a full-height band: one glyph per track
+            fig.vstrip(x0="x0", x1="x1", color="color", source=shading, alpha=0.08,
+                       line_alpha=0)
         figs.append(fig)
-    figs.append(_strip(data, segments, origin, x_range, units))
+    figs.append(_strip(sources, x_range, clock))
     return gridplot([[f] for f in figs], merge_tools=True, toolbar_location="right",
                     sizing_mode="stretch_width")
 
@@ -171,41 +222,17 @@ def _hover(fig, renderer, label: str, clock: bool) -> None:
                             formatters={"@x": "datetime"} if clock else {}))
 
 
-def _shade_segments(fig, segments: pd.DataFrame, origin) -> None:
-    """Every segment as a full-height band: one glyph per track (not an annotation each)."""
-    seg = segments[np.isfinite(segments["t_start_s"]) & np.isfinite(segments["t_end_s"])]
-    if len(seg):
-        fig.vstrip(x0=time_values(seg["t_start_s"], origin),
-                   x1=time_values(seg["t_end_s"], origin),
-                   color=[SEGMENT_COLORS.get(k, "#777777") for k in seg["kind"]],
-                   alpha=0.08, line_alpha=0)
-
-
-def _strip(data: pd.DataFrame, segments: pd.DataFrame, origin, x_range, units: Units):
+def _strip(sources: dict[str, dict], x_range, clock: bool):
     """Rig states (lower row) and segments (upper row) as coloured bands with hover."""
     from bokeh.models import ColumnDataSource, FixedTicker, HoverTool
 
-    clock = origin is not None
-    fig = time_figure(90, "", x_range=x_range, clock=clock, x_label=time_label(origin))
-    runs = state_runs(data["time_s"].to_numpy(float), data["rig_state"].fillna(-1))
-    states = ColumnDataSource({
-        "left": time_values(runs["t0_s"], origin), "right": time_values(runs["t1_s"], origin),
-        "color": [STATE_COLORS[c] for c in runs["code"]],
-        "what": [RIG_STATES[c].replace("_", " ") for c in runs["code"]]})
-    quads = [fig.quad(left="left", right="right", bottom=0.0, top=1.0, source=states,
-                      color="color", line_alpha=0)]
-    seg = segments[np.isfinite(segments["t_start_s"]) & np.isfinite(segments["t_end_s"])]
-    if len(seg):
-        bands = ColumnDataSource({
-            "left": time_values(seg["t_start_s"], origin),
-            "right": time_values(seg["t_end_s"], origin),
-            "color": [SEGMENT_COLORS.get(k, "#777777") for k in seg["kind"]],
-            "what": [f"segment {i}: {str(k).replace('_', ' ')}, bit at "
-                     f"{units.text(d, 'length')} {units.label('length')}, μ_k {m:.3f}, {s}"
-                     for i, k, d, m, s in
-                     zip(seg["id"], seg["kind"], seg["bit_depth_m"].fillna(np.nan),
-                         seg["mu_k"].fillna(np.nan), seg["status"], strict=True)]})
-        quads.append(fig.quad(left="left", right="right", bottom=1.2, top=2.2, source=bands,
+    fig = time_figure(90, "", x_range=x_range, clock=clock, x_label=time_label(clock))
+    quads = [fig.quad(left="left", right="right", bottom=0.0, top=1.0, color="color",
+                      line_alpha=0, source=ColumnDataSource(sources["states"],
+                                                            name="states"))]
+    if "bands" in sources:
+        quads.append(fig.quad(left="left", right="right", bottom=1.2, top=2.2,
+                              source=ColumnDataSource(sources["bands"], name="bands"),
                               color="color", alpha=0.6, line_color="#333333",
                               line_width=0.5))
     fig.add_tools(HoverTool(renderers=quads, tooltips=[("", "@what")]))

@@ -30,7 +30,7 @@ from .evidence import (
     signature,
     starts_text,
 )
-from .friction import friction_plot
+from .friction import friction_plot, friction_signature, friction_sources
 from .interactive import Embedder
 from .pdf import table_pages, write_pdf
 from .render import (
@@ -54,7 +54,13 @@ from .render import (
     written_at,
     zone_text,
 )
-from .tracks import panels_present, tracks_figure, tracks_plot
+from .tracks import (
+    panels_present,
+    tracks_figure,
+    tracks_plot,
+    tracks_signature,
+    tracks_sources,
+)
 
 #: Segments drawn in full by default (the worst and the latest); ``segments="all"`` draws
 #: every estimated one. Every segment is in the diagnostics table.
@@ -301,17 +307,24 @@ def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, 
 
 def _html(report: Report) -> str:
     data, units = report.data, report.units
-    embed = Embedder()
-    tracks_id = embed.add(tracks_plot(data.tracks, data.segments, data.time_origin, units),
-                          "tracks") if report.has_tracks else None
-    friction_id = embed.add(friction_plot(data.segments, units), "friction") \
-        if data.segments["bit_depth_m"].notna().any() else None
-    segments = []
     clock = data.time_origin is not None
+    embed = Embedder()
+    tracks_id = friction_id = None
+    if report.has_tracks:
+        bins = tracks_sources(data.tracks, data.segments, data.time_origin, units)
+        tracks_id = embed.add_like(tracks_signature(data.tracks, bins, clock, units),
+                                   lambda: tracks_plot(data.tracks, bins, clock, units), bins,
+                                   "tracks")
+    if data.segments["bit_depth_m"].notna().any():
+        log = friction_sources(data.segments, units)
+        friction_id = embed.add_like(friction_signature(data.segments, log, units),
+                                     lambda: friction_plot(data.segments, log, units), log,
+                                     "friction")
+    segments = []
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
         sources = evidence_sources(est, data.time_origin, units, not row["bit_unresolved"])
-        div = embed.add_like(signature(sources),
+        div = embed.add_like(signature(sources, clock, units),
                              lambda sources=sources: evidence_plot(sources, clock, units),
                              sources, f"segment-{row['id']}")
         segments.append((row, div, _missing_evidence(est)))
