@@ -290,7 +290,7 @@ class _Data:
     w_bar: np.ndarray  # ω₀ smoothed over TORQUE_SMOOTH_S [rad/s]
     tau: np.ndarray  # measured string torque [N·m]
     tau_bar: np.ndarray  # smoothed string torque [N·m]
-    speed: np.ndarray  # logged ω₀ as sampled [rad/s]
+    speed: np.ndarray  # logged ω₀ on the uniform time base, unsmoothed [rad/s]
 
     def index(self, t_s: float) -> int:
         return int(np.clip(np.searchsorted(self.t, t_s - 1e-9 * self.dt), 0, self.t.size - 1))
@@ -903,24 +903,51 @@ def _creep_checks(model: _Model, wins, mu_s: float, mu_k: float, cells: int,
 def _twist_walk(d: _Data, w: _Window, base: np.ndarray, moved: np.ndarray,
                 mu_s: float) -> float:
     """One creep window's share of Var(Σ J_i τ'_i W_i): the speed noise the model integrates
-    into its twist (docs/theory.md §6.3, check 2). W is the random walk of the twist error
-    (increments σ_ω·Δt per sample, σ_ω the logged speed's noise over the window, from its
-    second differences), J = ∂τ/∂μ_s the fit's sensitivity [N·m per unit μ] and τ' = dτ/dθ
-    the slope of the quasi-static creep torque against the top angle [N·m/rad]. Divided by
-    (Σ J²)² it is the variance of μ_s [-]; the caller adds the windows and takes the root."""
+    into its twist (docs/theory.md §6.3, check 2). W is the random walk of the twist error,
+    Var W(t) = q·t with q its rate (:func:`_walk_rate`); J = ∂τ/∂μ_s the fit's sensitivity
+    [N·m per unit μ] and τ' = dτ/dθ the slope of the quasi-static creep torque against the
+    top angle [N·m/rad]. Divided by (Σ J²)² it is the variance of μ_s [-]; the caller adds
+    the windows and takes the root. A window too short to tell gives inf (not claimed)."""
     span = slice(w.sim0, w.end + 1)
-    speed = d.speed[span]
-    if speed.size < 5:
-        return 0.0
-    sigma = 1.4826 * float(np.median(np.abs(np.diff(speed, 2)))) / np.sqrt(6.0)
     drive = d.creep_drive[span]
-    floor = 0.5 * float(np.median(np.abs(drive[w.used - w.sim0])))
-    slope = np.gradient(base, d.dt) / np.maximum(np.abs(drive), max(floor, 1e-6))
-    a = np.zeros(speed.size)
+    if drive.size < 5:
+        return np.inf
     rows = w.used - w.sim0
+    floor = 0.5 * float(np.median(np.abs(drive[rows])))
+    slope = np.gradient(base, d.dt) / np.maximum(np.abs(drive), max(floor, 1e-6))
+    a = np.zeros(drive.size)
     a[rows] = (moved[rows] - base[rows]) / (CREEP_SENSITIVITY_STEP * mu_s) * slope[rows]
-    suffix = np.cumsum(a[::-1])[::-1]
-    return (sigma * d.dt) ** 2 * float(np.sum(suffix ** 2))
+    creep = slice(w.sim0 + int(rows.min()), w.sim0 + int(rows.max()) + 1)
+    rate = _walk_rate(d.speed[creep] - d.creep_drive[creep], d.dt)
+    return twist_walk_variance(a, rate, d.dt)
+
+
+def twist_walk_variance(a, walk_rate: float, dt_s: float) -> float:
+    """Var(Σ_i a_i W_i) for a random walk W sampled every ``dt_s`` from W_0 = 0 with
+    Var W(t) = ``walk_rate``·t: ``walk_rate``·Δt·Σ_m (Σ_{i≥m} a_i)² (docs/theory.md §6.3)."""
+    suffix = np.cumsum(np.asarray(a, dtype=float)[::-1])[::-1]
+    return walk_rate * dt_s * float(np.sum(suffix ** 2))
+
+
+def _walk_rate(residual_rad_s: np.ndarray, dt: float) -> float:
+    """Rate q [rad²/s] of the random walk that the speed noise adds to the model's twist, from
+    the residual of the logged speed about the creep drive (its 4-s moving average) over the
+    creep: the variance of its integral over 1-s blocks, per second, made robust to the few
+    blocks where the creep's own speed changes (1.4826 × median absolute deviation) and
+    corrected for the part of white noise the moving average keeps (a block of b seconds
+    against an average over L: variance × (1 − b/L − b²/3L²)). Unlike a second-difference
+    estimate of the sample noise it holds for noise averaged or quantised before logging,
+    and reads noise filtered over ~1 s about a third low instead of 12× (the walk is made
+    by the low frequencies)."""
+    block = max(1, int(round(1.0 / dt)))
+    n = residual_rad_s.size // block
+    if n < 5:
+        return np.inf
+    integrals = residual_rad_s[:n * block].reshape(n, block).sum(axis=1) * dt
+    spread = 1.4826 * float(np.median(np.abs(integrals - np.median(integrals))))
+    ratio = block * dt / CREEP_DRIVE_SMOOTH_S
+    kept = max(1.0 - ratio - ratio ** 2 / 3.0, 0.5)
+    return spread ** 2 / (block * dt) / kept
 
 
 def _split_half(model: _Model, wins, mu_s: float, mu_k: float,
@@ -951,8 +978,8 @@ def _creep_problems(mu_s: float, c: CreepChecks) -> list[str]:
     if c.sensitivity < MIN_CREEP_SENSITIVITY:
         problems.append("the creep torque hardly depends on μ_s (a 10 % change is "
                         f"{c.sensitivity:.1f}× its noise)")
-    elif np.hypot(CREEP_SENSITIVITY_STEP / c.sensitivity, c.twist_noise) > \
-            CREEP_SENSITIVITY_STEP / MIN_CREEP_SENSITIVITY:
+    elif not np.hypot(CREEP_SENSITIVITY_STEP / c.sensitivity, c.twist_noise) <= \
+            CREEP_SENSITIVITY_STEP / MIN_CREEP_SENSITIVITY:  # NaN or inf: not pinned
         problems.append(f"the speed noise integrated into the twist leaves μ_s uncertain by "
                         f"±{100 * c.twist_noise:.1f} % (1σ; torque noise "
                         f"±{100 * CREEP_SENSITIVITY_STEP / c.sensitivity:.1f} %): a creep "
