@@ -124,34 +124,38 @@ def bokeh_items(html: str) -> dict[str, dict]:
     return {item["target_id"]: item for item in json.loads(text.split("</script>")[0])}
 
 
-def sources(item: dict) -> dict[str, dict[str, np.ndarray]]:
-    """Named ColumnDataSources of a Bokeh item, decoded to arrays (Bokeh's wire format:
-    base64 bytes, gzip-compressed when large)."""
+def bokeh_nodes(item, name: str):
+    """Every model named ``name`` in a Bokeh item's JSON, depth first."""
+    if isinstance(item, list):
+        for v in item:
+            yield from bokeh_nodes(v, name)
+    elif isinstance(item, dict):
+        if item.get("name") == name:
+            yield item
+        for v in item.values():
+            yield from bokeh_nodes(v, name)
+
+
+def decoded(v) -> np.ndarray:
+    """A column of a ColumnDataSource as an array (Bokeh's wire format: base64 bytes,
+    gzip-compressed when large; or a plain list)."""
     import gzip
 
-    out = {}
+    if isinstance(v, dict) and v.get("type") == "ndarray":
+        if isinstance(v["array"], list):
+            return np.asarray(v["array"])
+        raw = base64.b64decode(v["array"]["data"])
+        raw = gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw
+        return np.frombuffer(raw, dtype=v["dtype"])
+    return np.asarray(v)
 
-    def walk(node):
-        if isinstance(node, list):
-            for v in node:
-                walk(v)
-        elif isinstance(node, dict):
-            attrs = node.get("attributes", {})
-            if node.get("name") == "ColumnDataSource" and attrs.get("name"):
-                out[attrs["name"]] = {k: _array(v) for k, v in attrs["data"]["entries"]}
-            for v in node.values():
-                walk(v)
 
-    def _array(v):
-        if isinstance(v, dict) and v.get("type") == "ndarray":
-            raw = base64.b64decode(v["array"]["data"])
-            if raw[:2] == b"\x1f\x8b":
-                raw = gzip.decompress(raw)
-            return np.frombuffer(raw, dtype=v["dtype"])
-        return np.asarray(v)
-
-    walk(item)
-    return out
+def sources(item: dict) -> dict[str, dict[str, np.ndarray]]:
+    """Named ColumnDataSources of a Bokeh item, decoded to arrays."""
+    return {node["attributes"]["name"]: {k: decoded(v) for k, v in
+                                         node["attributes"]["data"]["entries"]}
+            for node in bokeh_nodes(item, "ColumnDataSource")
+            if node.get("attributes", {}).get("name")}
 
 
 def _png_images(html: str) -> list[bytes]:
@@ -613,45 +617,14 @@ def test_tracks_plot_draws_tracks_parquet(evidence, demo_html):
 
 
 def _unnamed_sources(item: dict) -> list[dict]:
-    import gzip
-
-    out = []
-
-    def walk(node):
-        if isinstance(node, list):
-            for v in node:
-                walk(v)
-        elif isinstance(node, dict):
-            if node.get("name") == "ColumnDataSource":
-                data = {}
-                for key, v in node["attributes"]["data"]["entries"]:
-                    if isinstance(v, dict) and v.get("type") == "ndarray":
-                        raw = base64.b64decode(v["array"]["data"])
-                        raw = gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw
-                        data[key] = np.frombuffer(raw, dtype=v["dtype"])
-                out.append(data)
-            for v in node.values():
-                walk(v)
-
-    walk(item)
-    return out
+    """Every ColumnDataSource's array columns (named or not)."""
+    return [{k: decoded(v) for k, v in node["attributes"]["data"]["entries"]
+             if isinstance(v, dict) and v.get("type") == "ndarray"}
+            for node in bokeh_nodes(item, "ColumnDataSource")]
 
 
 def _legend_items(item: dict) -> list[dict]:
-    found = []
-
-    def walk(node):
-        if isinstance(node, list):
-            for v in node:
-                walk(v)
-        elif isinstance(node, dict):
-            if node.get("name") == "LegendItem":
-                found.append(node)
-            for v in node.values():
-                walk(v)
-
-    walk(item)
-    return found
+    return list(bokeh_nodes(item, "LegendItem"))
 
 
 def test_estimates_are_decimated_per_start(demo):

@@ -29,7 +29,9 @@ from tests.test_report import (
     CLOCK,
     DEMO,
     bokeh_items,
+    bokeh_nodes,
     copy_result,
+    decoded,
     demo_result_dir,
     evidence_dir,
     fleet_wells,
@@ -235,36 +237,13 @@ def test_fleet_figure_draws_every_wells_mu_k_versus_depth(demo, tmp_path):
 def _fleet_points(item: dict) -> dict[str, list[tuple[float, float]]]:
     """(μ_k, depth) of every point of the fleet figure, by well."""
     out: dict[str, list] = {}
-
-    def walk(node):
-        if isinstance(node, list):
-            for v in node:
-                walk(v)
-        elif isinstance(node, dict):
-            if node.get("name") == "ColumnDataSource":
-                data = dict(node["attributes"]["data"]["entries"])
-                if "well" in data:
-                    cols = {k: _values(data[k]) for k in ("well", "mu_k", "depth")}
-                    for w, m, d in zip(cols["well"], cols["mu_k"], cols["depth"], strict=True):
-                        out.setdefault(str(w), []).append((float(m), float(d)))
-            for v in node.values():
-                walk(v)
-
-    walk(item)
+    for node in bokeh_nodes(item, "ColumnDataSource"):
+        data = dict(node["attributes"]["data"]["entries"])
+        if "well" in data:
+            cols = {k: decoded(data[k]) for k in ("well", "mu_k", "depth")}
+            for w, m, d in zip(cols["well"], cols["mu_k"], cols["depth"], strict=True):
+                out.setdefault(str(w), []).append((float(m), float(d)))
     return out
-
-
-def _values(v) -> np.ndarray:
-    import base64
-    import gzip
-
-    if isinstance(v, dict) and v.get("type") == "ndarray":
-        if isinstance(v["array"], list):
-            return np.asarray(v["array"])
-        raw = base64.b64decode(v["array"]["data"])
-        raw = gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw
-        return np.frombuffer(raw, dtype=v["dtype"])
-    return np.asarray(v)
 
 
 # --- progress of `drillfric run` without a terminal -----------------------------------------

@@ -879,11 +879,11 @@ def _creep_checks(model: _Model, wins, mu_s: float, mu_k: float, cells: int,
     capacity = float(np.sum((mu_s * est + fix_s) * g.dx_true_m))
     base, moved, data, walks = [], [], [], []
     for w in wins:
-        for factor, out in ((1.0, base), (1.0 + CREEP_SENSITIVITY_STEP, moved)):
-            tau, _ = model.simulate(w, factor * mu_s, min(mu_k, factor * mu_s), cells)
-            out.append(smooth(tau, d.dt, TORQUE_SMOOTH_S))
-        walks.append(_twist_walk(d, w, base[-1], moved[-1], mu_s))
-        base[-1], moved[-1] = (x[-1][w.used - w.sim0] for x in (base, moved))
+        at, up = (smooth(model.simulate(w, f * mu_s, min(mu_k, f * mu_s), cells)[0], d.dt,
+                         TORQUE_SMOOTH_S) for f in (1.0, 1.0 + CREEP_SENSITIVITY_STEP))
+        walks.append(_twist_walk(d, w, at, up, mu_s))
+        base.append(at[w.used - w.sim0])
+        moved.append(up[w.used - w.sim0])
         data.append(d.tau_bar[w.used])
     base, moved, data = (np.concatenate(x) for x in (base, moved, data))
     jacobian_sq = float(np.sum((moved - base) ** 2)) / (CREEP_SENSITIVITY_STEP * mu_s) ** 2
