@@ -129,7 +129,7 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
     A, B, W = X[0:2], X[2:4], X[4:6]
     fcap, fix_k, fix_s, inj_a, inj_b = X[6], X[7], X[8], X[9], X[10]
     end = padded_size(section_start) - 1
-    cur = 0
+    cur = np.int64(0)  # typed, not Literal[0]: one compiled pass_cells/inflows/bha_speed
     inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
     q_td = 0.5 * zeta[0] * dt * inv_itd
     n_rec = times.size
@@ -138,7 +138,7 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
     om, ms, mk = omega0[s], mu_s[s], mu_k[s]
     stuck_s, events = guard[s, 0], guard[s, 1]
     e_last = om - w_meas[0]
-    w_bha_last = bha_speed(W, 0, section_start)
+    w_bha_last = bha_speed(W, cur, section_start)
     for k in range(n_steps + 1):
         t = t0 + k * dt
         while r < n_rec and times[r] <= t + eps:
@@ -197,7 +197,7 @@ def observer_kernels(law: int, fixed: bool):
         wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         for s in range(alpha.shape[0]):
-            observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
+            observe_member(np.int64(s), alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
                            section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
                            omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum, p0, P0,
                            inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s,
@@ -211,7 +211,7 @@ def observer_kernels(law: int, fixed: bool):
         wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         for s in prange(alpha.shape[0]):
-            observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
+            observe_member(np.int64(s), alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
                            section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
                            omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum, p0, P0,
                            inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s,

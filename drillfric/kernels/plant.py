@@ -381,7 +381,7 @@ def plant_kernel(law: int, fixed: bool):
         X = work_buffer(alpha, beta, section_start, (fcap, fix_s, fix_k))
         A, B, W, fcap_p, fix_s_p, fix_k_p = X[0:2], X[2:4], X[4:6], X[6], X[7], X[8]
         end = padded_size(section_start) - 1
-        cur = 0
+        cur = np.int64(0)  # typed, not Literal[0]: pass_cells and inflows compile once
         inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
         omega0 = top[0]
         integral = top[1]
@@ -394,8 +394,8 @@ def plant_kernel(law: int, fixed: bool):
         for k in range(n_steps + 1):
             t = t0 + k * dt
             if mode == _MODE_FED:
-                u_now = drive_half(u, 0, u_t0, u_dt, t)
-                u_aux = drive_half(u, 1, u_t0, u_dt, t)
+                u_now = drive_half(u, np.int64(0), u_t0, u_dt, t)
+                u_aux = drive_half(u, np.int64(1), u_t0, u_dt, t)
             else:
                 u_now = drive_value(u, u_t0, u_dt, t)
                 u_aux = u_now
