@@ -591,8 +591,8 @@ def _is_number(value) -> bool:
 
 
 def _check_observer_lists(observer: dict, file: str | None) -> None:
-    """List-valued keys: ``starts`` = [[μ_s, μ_k], ...] with 0 ≤ μ_k ≤ μ_s, ``poles_per_s``
-    = two positive numbers."""
+    """List-valued keys: ``starts`` = [[μ_s, μ_k], ...] with 0 ≤ μ_k ≤ μ_s ≤ ``mu_max``,
+    ``poles_per_s`` = two positive numbers."""
     starts = observer["starts"]
     for i, pair in enumerate(starts, start=1):
         ok = (isinstance(pair, list) and len(pair) == 2 and all(map(_is_number, pair))
@@ -604,6 +604,12 @@ def _check_observer_lists(observer: dict, file: str | None) -> None:
     if not starts:
         raise ConfigError("observer.starts is empty", file=file,
                           fix="e.g. starts = [[0.3, 0.2], [0.6, 0.4]]")
+    highest = max(pair[0] for pair in starts)
+    if highest > observer["mu_max"]:
+        raise ConfigError(f"observer.mu_max = {observer['mu_max']:g} is below the observer "
+                          f"starts (μ_s up to {highest:g}), which must lie within the clamp",
+                          file=file, fix="raise observer.mu_max or give observer.starts "
+                                         "within it")
     poles = observer["poles_per_s"]
     if len(poles) != 2 or not all(_is_number(p) and p > 0 for p in poles):
         raise ConfigError(f"observer.poles_per_s = {poles!r} must be two positive numbers "

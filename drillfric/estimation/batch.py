@@ -45,11 +45,6 @@ from drillfric.friction import CASED_STATIC, FrictionProfile
 
 MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
 WOUND_SPAN_S = 0.5  #: rest at a window's start over which a trapped torque is measured [s]
-#: A stop of the top drive at most this long, with the string still loaded (torque at least
-#: DIP_TORQUE_FRACTION of the run's mean), does not end a rotating run (soft-torque drives):
-#: the configuration's segmentation.dip_max_s and dip_torque_fraction [s], [-].
-DIP_MAX_S, DIP_TORQUE_FRACTION = (default("segmentation.dip_max_s"),
-                                  default("segmentation.dip_torque_fraction"))
 PRE_ROLL_S = 2.0  #: model starts this long before a run or creep leaves rest [s]
 DRIVE_SMOOTH_S = 0.2  #: light smoothing of the speed that drives the model [s]
 TORQUE_SMOOTH_S = 1.0  #: smoothing of torques compared in the creep misfit [s]
@@ -60,7 +55,6 @@ REST_BIT = 0.1  #: the bit is near rest below this fraction of ω_c
 SCAN_STEP = 0.02  #: μ_s grid step of the onset scan (docs/theory.md §6.4)
 SCAN_CONFIRM = 3  #: grid points above the first sticking one that must stick too
 SCAN_ROTATION_S = 90.0  #: rotation simulated per onset-scan point (30 s skipped + 60 s) [s]
-MU_MAX = default("observer.mu_max")  #: upper end of every friction search [-]
 CREEP_CELLS_PER_MD = 1000  #: creep fits at Δx ≤ MD/1000 (docs/theory.md §6.4)
 CREEP_CONVERGENCE = 0.03  #: relative move allowed when the creep fit doubles its cells
 CREEP_MAX_S = 60.0  #: longest creep window fitted [s]
@@ -93,6 +87,51 @@ MIN_CREEP_RATE_HZ = 2.0
 PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
 MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
 _GRID_SPREAD = 0.05  # make_grid may take up to 5 % fewer cells than requested (rounding)
+
+
+@dataclass(frozen=True)
+class BatchSettings:
+    """What the configuration sets for the speed-driven fit (docs/configuration.md), SI.
+
+    Built once per segment (:meth:`from_config`) and passed to :func:`refine` and
+    :func:`model_string_torque`, so that every key given reaches every place that uses it.
+
+    Attributes
+    ----------
+    omega_c_rad_s : float
+        Static/kinetic switching speed ω_c [rad/s] (``model.omega_c_rad_s``/``omega_c_rpm``).
+    k_t_per_s : float
+        Viscous damping rate k_t [1/s] (``model.k_t_per_s``).
+    top_drive_inertia_kg_m2 : float
+        I_TD [kg·m²] (``rig.top_drive_inertia_kg_m2``).
+    mu_max : float
+        Upper end of every friction search: μ_k, the creep μ_s, the onset scan [-]
+        (``observer.mu_max``).
+    dip_max_s, dip_torque_fraction : float
+        A stop of the top drive at most ``dip_max_s`` [s], with the string still loaded
+        (torque at least ``dip_torque_fraction`` of the run's mean [-]), does not end a
+        rotating run — the segmentation's rule (``segmentation.dip_max_s``,
+        ``segmentation.dip_torque_fraction``).
+    window_s : float
+        The fit uses the first this-many seconds of a segment [s] (``batch.window_s``).
+    """
+
+    omega_c_rad_s: float
+    k_t_per_s: float
+    top_drive_inertia_kg_m2: float
+    mu_max: float = default("observer.mu_max")
+    dip_max_s: float = default("segmentation.dip_max_s")
+    dip_torque_fraction: float = default("segmentation.dip_torque_fraction")
+    window_s: float = default("batch.window_s")
+
+    @classmethod
+    def from_config(cls, cfg) -> BatchSettings:
+        """The settings of a :class:`drillfric.config.Config`."""
+        return cls(omega_c_rad_s=cfg.omega_c_rad_s, k_t_per_s=cfg.model.k_t_per_s,
+                   top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+                   mu_max=cfg.observer.mu_max, dip_max_s=cfg.segmentation.dip_max_s,
+                   dip_torque_fraction=cfg.segmentation.dip_torque_fraction,
+                   window_s=cfg.batch.window_s)
 
 
 @dataclass(frozen=True)
@@ -342,10 +381,12 @@ class _Model:
     Each window starts from rest, holding the twist the measured torque says the string has
     there (:meth:`drillfric.torsional.State.wound`; none after a released stop)."""
 
-    def __init__(self, string, fc_fn, omega_c, k_t, itd, data: _Data, progress,
+    def __init__(self, string, fc_fn, settings: BatchSettings, data: _Data, progress,
                  profile: FrictionProfile | None = None):
         self.string, self.fc_fn, self.data = string, fc_fn, data
-        self.omega_c, self.k_t, self.itd = omega_c, k_t, itd
+        self.settings = settings
+        self.omega_c, self.k_t = settings.omega_c_rad_s, settings.k_t_per_s
+        self.itd = settings.top_drive_inertia_kg_m2
         self.progress = progress
         self.profile = profile or FrictionProfile()
         self.cased_static = CASED_STATIC[0]  # the hypothesis for an unknown cased μ_s
@@ -421,12 +462,15 @@ def _sticks(bit_rad_s: np.ndarray, omega_c: float) -> bool:
     return bool(np.mean(np.abs(bit_rad_s) <= REST_BIT * omega_c) >= STUCK_FRACTION)
 
 
-def _mu_k_windows(data: _Data, omega_c: float) -> tuple[list[_Window], list[str]]:
-    """One window per rotating run with samples ≥ MU_K_SKIP_S after first exceeding ω_c."""
+def _mu_k_windows(data: _Data, settings: BatchSettings) -> tuple[list[_Window], list[str]]:
+    """One window per rotating run with samples ≥ MU_K_SKIP_S after first exceeding ω_c; a
+    loaded stop within ``settings.dip_max_s`` does not end a run (as in the segmentation)."""
+    omega_c = settings.omega_c_rad_s
     pre = int(round(PRE_ROLL_S / data.dt))
     wins, notes = [], []
     for i0, i1 in bridge_loaded_dips(rotating_runs(data.w_bar, omega_c), data.t, data.tau_bar,
-                                     max_dip_s=DIP_MAX_S, fraction=DIP_TORQUE_FRACTION):
+                                     max_dip_s=settings.dip_max_s,
+                                     fraction=settings.dip_torque_fraction):
         fast = np.flatnonzero(data.w_bar[i0:i1 + 1] > omega_c)
         if fast.size == 0:
             continue
@@ -510,7 +554,7 @@ def _fit_mu_k(model: _Model, wins, target_Nm: float, mu_s_of: Callable[[float], 
         return mean - target_Nm
 
     tol = max(0.01 * abs(target_Nm), 50.0)  # the chaotic jitter of the mean (§6.4)
-    mu_k, res, trace = _secant(residual, x0, t_n, 1e-3, MU_MAX, tol)
+    mu_k, res, trace = _secant(residual, x0, t_n, 1e-3, model.settings.mu_max, tol)
     return mu_k, res, trace, sticks[mu_k]
 
 
@@ -525,7 +569,7 @@ def _onset_scan(model: _Model, win: _Window, mu_k: float,
     """
     scan, first = [], None
     mu_s = mu_k
-    while mu_s + SCAN_STEP <= MU_MAX + 1e-9:
+    while mu_s + SCAN_STEP <= model.settings.mu_max + 1e-9:
         mu_s = round(mu_s + SCAN_STEP, 10)
         _, bit = model.simulate(win, mu_s, mu_k, cells)
         stuck = _sticks(bit[win.used - win.sim0], model.omega_c)
@@ -639,8 +683,7 @@ def _as_fc_fn(fc_Nm_m) -> Callable[[np.ndarray], np.ndarray]:
 
 
 def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
-                        omega_c_rad_s: float, k_t_per_s: float,
-                        top_drive_inertia_kg_m2: float, mu_s: float, mu_k: float,
+                        settings: BatchSettings, mu_s: float, mu_k: float,
                         torque_kind: str = "motor", cells: int = 500,
                         profile: FrictionProfile | None = None
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -655,17 +698,17 @@ def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString
         Sample times on the record's uniform grid [s], the measured string torque and the
         model's string torque at the top [N·m].
     """
-    data, _ = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind, top_drive_inertia_kg_m2)
-    model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
-                   top_drive_inertia_kg_m2, data, None, profile)
+    data, _ = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
+                       settings.top_drive_inertia_kg_m2)
+    model = _Model(string, _as_fc_fn(fc_Nm_m), settings, data, None, profile)
     whole = _Window(0, data.t.size - 1, np.arange(data.t.size))
     tau, _ = model.simulate(whole, max(mu_s, mu_k), mu_k, cells)
     return data.t, data.tau, tau
 
 
 def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
-           omega_c_rad_s: float, k_t_per_s: float, top_drive_inertia_kg_m2: float,
-           torque_kind: str = "motor", cells: int = 500, mu_s_seed: float | None = None,
+           settings: BatchSettings, torque_kind: str = "motor", cells: int = 500,
+           mu_s_seed: float | None = None,
            progress: Callable[[float], None] | None = None,
            profile: FrictionProfile | None = None,
            sample_interval_s: float | None = None) -> BatchResult:
@@ -684,12 +727,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     fc_Nm_m : callable or float
         F_c(x) [N·m/m], a function of measured depth [m] (e.g. ``TDResult.fc_at`` from
         torque and drag, docs/theory.md §2), or a constant.
-    omega_c_rad_s : float
-        Static/kinetic switching speed ω_c [rad/s].
-    k_t_per_s : float
-        Viscous damping rate k_t [1/s].
-    top_drive_inertia_kg_m2 : float
-        I_TD [kg·m²].
+    settings : BatchSettings
+        ω_c, k_t, I_TD and the search settings of the configuration.
     torque_kind : str
         "motor" (τ_m, inertia removed here) or "string".
     cells : int
@@ -711,15 +750,15 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     BatchResult
     """
     data, messages = _prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
-                              top_drive_inertia_kg_m2)
-    model = _Model(string, _as_fc_fn(fc_Nm_m), omega_c_rad_s, k_t_per_s,
-                   top_drive_inertia_kg_m2, data, progress, profile)
+                              settings.top_drive_inertia_kg_m2)
+    model = _Model(string, _as_fc_fn(fc_Nm_m), settings, data, progress, profile)
+    omega_c_rad_s = settings.omega_c_rad_s
     flags: list[str] = []
     details = BatchDetails(cells=cells, T_N_Nm=model.t_n(cells))
     creeps = find_creeps(data.t, data.drive, omega_c_rad_s, torque_Nm=data.tau,
                          smooth_s=TORQUE_SMOOTH_S)
     details.creeps_found = creeps
-    wins, notes = _mu_k_windows(data, omega_c_rad_s)
+    wins, notes = _mu_k_windows(data, settings)
     messages += notes
     if wins:
         model.drive = identify_drive(data.t, data.drive, data.motor, [w.used for w in wins])
@@ -790,7 +829,8 @@ def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flag
                                   * model.grid(cells)[0].dx_true_m))
     viscous = model.k_t * string_inertia * float(np.mean(d.w_bar[used]))
     t_est, t_fixed = model.t_parts(cells)
-    x0 = float(np.clip((target - viscous - t_fixed) / t_est, 0.01, 1.0))
+    top = model.settings.mu_max
+    x0 = float(np.clip((target - viscous - t_fixed) / t_est, min(0.01, top), min(1.0, top)))
     ratios = (PROVISIONAL_RATIO, 4.0) if stick_slip else (1.0,)
     for ratio in ratios:
         def mu_s_of(mu_k, ratio=ratio):
@@ -808,7 +848,9 @@ def _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flag
                         "biased by a few %")
     if abs(res) > 0.02 * abs(target):
         flags.append("mu_k_not_converged")
-        messages.append(f"mean torque matched only to {res:+.0f} N·m of {target:.0f} N·m")
+        messages.append(f"mean torque matched only to {res:+.0f} N·m of {target:.0f} N·m"
+                        + (f": μ_k ran to observer.mu_max = {top:g}, raise it" if
+                           res < 0 and mu_k >= 0.999 * top else ""))
     return mu_k
 
 
@@ -828,17 +870,22 @@ def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages, rot
     less than :data:`CREEP_CONVERGENCE` (docs/theory.md §6.4); None when it never settles."""
     wins = _creep_windows(data, creeps)
     n = _creep_cells(model.string, cells)
-    lo = max(mu_k, 0.02)
-    mu, runs = _fit_creep(model, wins, mu_k, n, lo, MU_MAX)
+    lo, hi = max(mu_k, 0.02), model.settings.mu_max
+    if lo >= hi:
+        flags.append("creep_fit_at_bound")
+        messages.append(f"no μ_s above μ_k = {mu_k:.3f} within observer.mu_max = {hi:g}: "
+                        "creep not fitted")
+        return None, ()
+    mu, runs = _fit_creep(model, wins, mu_k, n, lo, hi)
     fits = [(model.grid(n)[0].n_cells, mu, runs)]
     details.creep_fits = fits
-    if min(mu - lo, MU_MAX - mu) < 0.01 * (MU_MAX - lo):
+    if min(mu - lo, hi - mu) < 0.01 * (hi - lo):
         flags.append("creep_fit_at_bound")
         messages.append(f"creep fit ran to its search bound (μ_s = {mu:.3f}): not reported")
         return None, ()
     for _ in range(CREEP_LEVELS - 1):
         n *= 2
-        new, runs = _refit_creep(model, wins, mu_k, n, mu, lo, MU_MAX)
+        new, runs = _refit_creep(model, wins, mu_k, n, mu, lo, hi)
         fits.append((model.grid(n)[0].n_cells, new, runs))
         move, mu = abs(new - mu) / new, new
         details.creep_grid_move = move
@@ -850,7 +897,7 @@ def _creep_stage(model, data, creeps, mu_k, cells, details, flags, messages, rot
                                    cells)
             if not model.profile.static_known:
                 model.cased_static = CASED_STATIC[1]
-                other, _ = _refit_creep(model, wins, mu_k, n, mu, lo, MU_MAX)
+                other, _ = _refit_creep(model, wins, mu_k, n, mu, lo, hi)
                 model.cased_static = CASED_STATIC[0]
                 checks = replace(checks, other_hypothesis=other)
             details.creep_checks = checks
@@ -1056,7 +1103,8 @@ def _bound_stage(model, wins, mu_k, cells, details, flags, messages, had_creep=F
                         "no lower bound given")
     elif bound is None:
         flags.append("stick_slip_not_reproduced")
-        messages.append(f"the model does not stick-slip for μ_s ≤ {MU_MAX}: no lower bound")
+        messages.append("the model does not stick-slip for μ_s ≤ "
+                        f"{model.settings.mu_max}: no lower bound")
     else:
         weak = " (the model sticks for any μ_s above μ_k: no more than μ_s ≥ μ_k)" \
             if bound == mu_k else ""
