@@ -237,7 +237,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "downhole error (ω_L, d)."),
         Key("starts", list, [[0.3, 0.2], [0.6, 0.4], [0.9, 0.1]], "", "Initial guesses "
             "[[μ_s, μ_k], ...] advanced together in one pass."),
-        _positive("mu_max", 1.5, "", "Physical clamp on the estimated friction factors."),
+        _positive("mu_max", 1.5, "", "Physical clamp on the estimated friction factors: the "
+                  "observer's and every search of the batch fit (μ_k, the creep μ_s, the "
+                  "stick-slip-onset scan). The starts must lie within it."),
         Key("interpolation", str, "linear", "", "Measurements between samples: 'linear' "
             "(default, one sample of lag) or 'hold' (the paper's zero-order hold).",
             choices=("linear", "hold")),
@@ -279,7 +281,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("dip_max_s", float, 10.0, "s", "Longest dip of the surface speed below "
             "rotating_stop_rpm that stays inside a rotation while the string stays loaded "
             "(a soft-torque or slow top-drive controller lets the top drive almost stop "
-            "between slips while the string is wound up). 0: every stop ends the rotation.",
+            "between slips while the string is wound up). 0: every stop ends the rotation. "
+            "The batch fit joins its rotating runs by the same rule.",
             min=0.0, max=600.0),
         Key("dip_torque_fraction", float, 0.5, "", "A speed dip is loaded while the torque "
             "holds at least this fraction of the rotating torque level (a running mean over "

@@ -26,6 +26,7 @@ from drillfric import torsional
 from drillfric.drillstring import DrillString, Section
 from drillfric.errors import InputError
 from drillfric.estimation import batch
+from drillfric.estimation.batch import kinetic
 from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
 
 RPM = np.pi / 30.0
@@ -189,10 +190,10 @@ def test_secant_returns_an_evaluated_point_with_bounded_steps(root, slope, jitte
         calls.append((x, r))
         return r
 
-    x, r, trace = batch._secant(residual, x0, slope, 1e-3, 1.5, tol=20.0)
+    x, r, trace = kinetic.secant(residual, x0, slope, 1e-3, 1.5, tol=20.0)
     assert (x, r) in calls and trace == calls
     assert abs(r) == min(abs(c[1]) for c in calls)
-    assert 1e-3 <= x <= 1.5 and len(calls) <= batch.MU_K_MAX_RUNS
+    assert 1e-3 <= x <= 1.5 and len(calls) <= batch.settings.MU_K_MAX_RUNS
     assert abs(x - root) <= (2 * jitter + 20.0) / slope + 1e-9
 
 
@@ -348,7 +349,7 @@ def test_creep_start_identifies_mu_s(mu_s, mu_k, md_m, kop_m, rate_hz):
     assert res.mu_s == pytest.approx(mu_s, rel=0.10)
     assert res.mu_k == pytest.approx(mu_k, rel=0.05)
     assert len(res.creep_segments) == 1 and res.mu_s_lower_bound is None
-    assert res.details.creep_grid_move < batch.CREEP_CONVERGENCE
+    assert res.details.creep_grid_move < batch.settings.CREEP_CONVERGENCE
 
 
 @pytest.mark.slow
@@ -447,8 +448,8 @@ def test_dip_max_s_cuts_the_fit_where_segmentation_cuts(dip_max_s, runs):
                           "surface_torque_Nm": rec.motor_torque_Nm})
     cfg = config_from_dict({"segmentation": {"dip_max_s": dip_max_s, "min_segment_s": 1.0}})
     assert len(segment(frame, cfg)) == runs
-    settings = batch.BatchSettings.from_config(cfg)
-    assert _short_run_notes(settings.dip_max_s, settings.dip_torque_fraction) == runs - 1
+    told = batch.BatchSettings.from_config(cfg)
+    assert _short_run_notes(told.dip_max_s, told.dip_torque_fraction) == runs - 1
 
 
 def test_dip_torque_fraction_reaches_the_fit():

@@ -28,6 +28,7 @@ from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
 from drillfric.estimation import batch
+from drillfric.estimation.batch.settings import MU_K_SKIP_S, TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
 from drillfric.estimation.gains import gains_from_config
@@ -288,7 +289,7 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
 
 #: Rotation left out after the top drive first exceeds ω_c when the fit is scored [s]
 #: (the start-up transient; the batch fit's μ_k skips the same).
-EVIDENCE_SKIP_S = batch.MU_K_SKIP_S
+EVIDENCE_SKIP_S = MU_K_SKIP_S
 
 
 @dataclass(frozen=True)
@@ -468,7 +469,7 @@ def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | Non
     if scored.sum() < 10:
         return FitEvidence(t, measured, model, None, None, None)
     dt = float(t[1] - t[0]) if t.size > 1 else 1.0
-    misfit = smooth(measured - model, dt, batch.TORQUE_SMOOTH_S)[scored]
+    misfit = smooth(measured - model, dt, TORQUE_SMOOTH_S)[scored]
     low, high = np.percentile(measured[scored], [5.0, 95.0])
     return FitEvidence(t, measured, model, float(np.sqrt(np.mean(misfit ** 2))),
                        float(high - low), float(np.mean(measured[scored])))
