@@ -237,7 +237,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "downhole error (ω_L, d)."),
         Key("starts", list, [[0.3, 0.2], [0.6, 0.4], [0.9, 0.1]], "", "Initial guesses "
             "[[μ_s, μ_k], ...] advanced together in one pass."),
-        _positive("mu_max", 1.5, "", "Physical clamp on the estimated friction factors."),
+        _positive("mu_max", 1.5, "", "Physical clamp on the estimated friction factors: the "
+                  "observer's and every search of the batch fit (μ_k, the creep μ_s, the "
+                  "stick-slip-onset scan). The starts must lie within it."),
         Key("interpolation", str, "linear", "", "Measurements between samples: 'linear' "
             "(default, one sample of lag) or 'hold' (the paper's zero-order hold).",
             choices=("linear", "hold")),
@@ -279,7 +281,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("dip_max_s", float, 10.0, "s", "Longest dip of the surface speed below "
             "rotating_stop_rpm that stays inside a rotation while the string stays loaded "
             "(a soft-torque or slow top-drive controller lets the top drive almost stop "
-            "between slips while the string is wound up). 0: every stop ends the rotation.",
+            "between slips while the string is wound up). 0: every stop ends the rotation. "
+            "The batch fit joins its rotating runs by the same rule.",
             min=0.0, max=600.0),
         Key("dip_torque_fraction", float, 0.5, "", "A speed dip is loaded while the torque "
             "holds at least this fraction of the rotating torque level (a running mean over "
@@ -591,8 +594,8 @@ def _is_number(value) -> bool:
 
 
 def _check_observer_lists(observer: dict, file: str | None) -> None:
-    """List-valued keys: ``starts`` = [[μ_s, μ_k], ...] with 0 ≤ μ_k ≤ μ_s, ``poles_per_s``
-    = two positive numbers."""
+    """List-valued keys: ``starts`` = [[μ_s, μ_k], ...] with 0 ≤ μ_k ≤ μ_s ≤ ``mu_max``,
+    ``poles_per_s`` = two positive numbers."""
     starts = observer["starts"]
     for i, pair in enumerate(starts, start=1):
         ok = (isinstance(pair, list) and len(pair) == 2 and all(map(_is_number, pair))
@@ -604,6 +607,12 @@ def _check_observer_lists(observer: dict, file: str | None) -> None:
     if not starts:
         raise ConfigError("observer.starts is empty", file=file,
                           fix="e.g. starts = [[0.3, 0.2], [0.6, 0.4]]")
+    highest = max(pair[0] for pair in starts)
+    if highest > observer["mu_max"]:
+        raise ConfigError(f"observer.mu_max = {observer['mu_max']:g} is below the observer "
+                          f"starts (μ_s up to {highest:g}), which must lie within the clamp",
+                          file=file, fix="raise observer.mu_max or give observer.starts "
+                                         "within it")
     poles = observer["poles_per_s"]
     if len(poles) != 2 or not all(_is_number(p) and p > 0 for p in poles):
         raise ConfigError(f"observer.poles_per_s = {poles!r} must be two positive numbers "

@@ -14,7 +14,7 @@ The case builders here are also used by benchmarks/validate_batch.py.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from functools import lru_cache
 
 import numpy as np
@@ -26,6 +26,7 @@ from drillfric import torsional
 from drillfric.drillstring import DrillString, Section
 from drillfric.errors import InputError
 from drillfric.estimation import batch
+from drillfric.estimation.batch import kinetic
 from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
 
 RPM = np.pi / 30.0
@@ -106,9 +107,13 @@ def sample(rec, rate_hz, seed=0, noise=True):
     return t, w, tau
 
 
-def estimate(string, fc, t, w, tau, **kw):
-    return batch.refine(t, w, tau, string=string, fc_Nm_m=fc, omega_c_rad_s=OMEGA_C,
-                        k_t_per_s=K_T, top_drive_inertia_kg_m2=I_TD, torque_kind="motor", **kw)
+#: The fit's settings of these truths (ω_c, k_t, I_TD; the schema's defaults otherwise).
+SETTINGS = batch.BatchSettings(omega_c_rad_s=OMEGA_C, k_t_per_s=K_T, top_drive_inertia_kg_m2=I_TD)
+
+
+def estimate(string, fc, t, w, tau, settings=SETTINGS, **kw):
+    return batch.refine(t, w, tau, string=string, fc_Nm_m=fc, settings=settings,
+                        torque_kind="motor", **kw)
 
 
 # --- pure functions -----------------------------------------------------------------------
@@ -185,10 +190,10 @@ def test_secant_returns_an_evaluated_point_with_bounded_steps(root, slope, jitte
         calls.append((x, r))
         return r
 
-    x, r, trace = batch._secant(residual, x0, slope, 1e-3, 1.5, tol=20.0)
+    x, r, trace = kinetic.secant(residual, x0, slope, 1e-3, 1.5, tol=20.0)
     assert (x, r) in calls and trace == calls
     assert abs(r) == min(abs(c[1]) for c in calls)
-    assert 1e-3 <= x <= 1.5 and len(calls) <= batch.MU_K_MAX_RUNS
+    assert 1e-3 <= x <= 1.5 and len(calls) <= batch.settings.MU_K_MAX_RUNS
     assert abs(x - root) <= (2 * jitter + 20.0) / slope + 1e-9
 
 
@@ -292,8 +297,8 @@ def test_steady_rotation_gives_mu_k_and_no_mu_s_bound():
     json.dumps(asdict(res.details))  # goes into summary.json as is
     t, w, _ = sample(rec, 5.0, seed=2)
     tau_string = rec.string_torque_Nm[::20] + np.random.default_rng(2).normal(0, 200, t.size)
-    res = batch.refine(t, w, tau_string, string=string, fc_Nm_m=fc, omega_c_rad_s=OMEGA_C,
-                       k_t_per_s=K_T, top_drive_inertia_kg_m2=I_TD, torque_kind="string")
+    res = batch.refine(t, w, tau_string, string=string, fc_Nm_m=fc, settings=SETTINGS,
+                       torque_kind="string")
     assert res.mu_k == pytest.approx(0.187, rel=0.05)
 
 
@@ -344,7 +349,7 @@ def test_creep_start_identifies_mu_s(mu_s, mu_k, md_m, kop_m, rate_hz):
     assert res.mu_s == pytest.approx(mu_s, rel=0.10)
     assert res.mu_k == pytest.approx(mu_k, rel=0.05)
     assert len(res.creep_segments) == 1 and res.mu_s_lower_bound is None
-    assert res.details.creep_grid_move < batch.CREEP_CONVERGENCE
+    assert res.details.creep_grid_move < batch.settings.CREEP_CONVERGENCE
 
 
 @pytest.mark.slow
@@ -359,3 +364,96 @@ def test_creep_at_1_hz_is_not_fitted():
     assert res.mu_s is None and not res.mu_s_identifiable and res.creep_segments == ()
     assert res.mu_s_lower_bound is None or res.mu_s_lower_bound < 0.6
     assert res.mu_k == pytest.approx(0.187, rel=0.10)
+
+
+# --- the configuration reaches the fit (issue 21: settings bound at import time) ----------
+
+def test_batch_settings_take_every_key_from_the_configuration():
+    """Regression: ``segmentation.dip_max_s``, ``dip_torque_fraction`` and ``observer.mu_max``
+    were bound to the schema defaults at import; every field must come from the file."""
+    from drillfric.config import config_from_dict
+    cfg = config_from_dict({"model": {"omega_c_rpm": 6.0, "k_t_per_s": 0.3},
+                            "rig": {"top_drive_inertia_kg_m2": 1500.0},
+                            "observer": {"mu_max": 0.95},
+                            "segmentation": {"dip_max_s": 25.0, "dip_torque_fraction": 0.3},
+                            "batch": {"window_s": 300.0}})
+    got = batch.BatchSettings.from_config(cfg)
+    assert got == batch.BatchSettings(omega_c_rad_s=6.0 * RPM, k_t_per_s=0.3,
+                                      top_drive_inertia_kg_m2=1500.0, mu_max=0.95,
+                                      dip_max_s=25.0, dip_torque_fraction=0.3, window_s=300.0)
+    defaults = batch.BatchSettings.from_config(config_from_dict({}))
+    assert all(getattr(got, f) != getattr(defaults, f) for f in got.__dataclass_fields__)
+
+
+def test_mu_max_bounds_the_mu_k_search():
+    """Regression: ``observer.mu_max = 0.15`` left the fit searching up to 1.5, and the seeded
+    observer then failed every segment with the wrong reason. With μ_k = 0.187 in the data,
+    the search stops at the clamp and says so (not converged, the key named)."""
+    string, fc, rec = cached_case(0.6, 0.187, "normal", 75.0, 100.0)
+    res = estimate(string, fc, *sample(rec, 5.0, seed=2),
+                   settings=replace(SETTINGS, mu_max=0.15))
+    assert res.mu_k <= 0.15
+    assert all(mu <= 0.15 for mu, _ in res.details.mu_k_trace)
+    assert "mu_k_not_converged" in res.flags
+    assert any("observer.mu_max = 0.15" in m for m in res.messages)
+
+
+def test_mu_max_bounds_the_onset_scan(paper_stick_slip):
+    """The stick-slip-onset scan stops at ``observer.mu_max`` (here below the truth μ_s 0.6):
+    no point above the clamp, and no bound claimed above it."""
+    string, fc, rec = paper_stick_slip
+    res = estimate(string, fc, *sample(rec, 5.0, seed=1), settings=replace(SETTINGS, mu_max=0.3))
+    assert res.details.onset_scan and all(mu <= 0.3 for mu, _ in res.details.onset_scan)
+    assert res.mu_s_lower_bound is None or res.mu_s_lower_bound <= 0.3
+
+
+def _loaded_stop_record():
+    """Rotation at 100 RPM, a 15-s stop of the top drive with the string still wound (the
+    PI drive ramps down over 10 s, the string torque held at ~85 % of the run's mean), rotation
+    again for 25 s; 1500 m, 10 Hz, no noise."""
+    string = well_string(1500.0)
+    inc = build_hold_inc(500.0, 60.0)
+
+    def fc(x):
+        return torsional.gravity_fc(string, inc, x)
+
+    grid = torsional.make_grid(string, 300)
+    plant = torsional.Plant(grid, fc(grid.x_m), 0.4, 0.25, OMEGA_C, K_T, I_TD)
+    knots = ([0, 2, 12, 50, 60, 75, 77, 100], [0, 0, 100, 100, 0, 0, 100, 100])
+    setpoint = np.interp(np.arange(0.0, 101.0, 0.5), *knots) * RPM
+    rec, _ = torsional.run(plant, torsional.Drive("pi", setpoint, 0.5), 100.0, 10.0)
+    return string, fc, rec
+
+
+def _short_run_notes(dip_max_s: float, fraction: float) -> int:
+    """Fit the loaded-stop record; the count of runs left out as too short for μ_k."""
+    string, fc, rec = _loaded_stop_record()
+    res = estimate(string, fc, rec.time_s, rec.surface_rad_s, rec.motor_torque_Nm, cells=300,
+                   settings=replace(SETTINGS, dip_max_s=dip_max_s,
+                                    dip_torque_fraction=fraction))
+    return sum(m.startswith("rotating run 75–100 s shorter") for m in res.messages)
+
+
+@pytest.mark.parametrize("dip_max_s, runs", [(10.0, 2), (25.0, 1)])
+def test_dip_max_s_cuts_the_fit_where_segmentation_cuts(dip_max_s, runs):
+    """Regression: ``segmentation.dip_max_s = 25`` joined a loaded stop into one rotation in
+    the segmentation but not in the fit. Both now cut at the same place: two rotations
+    (the second, 25 s, too short for μ_k) or one."""
+    import pandas as pd
+
+    from drillfric.config import config_from_dict
+    from drillfric.segmentation import segment
+    _, _, rec = _loaded_stop_record()
+    frame = pd.DataFrame({"time_s": rec.time_s, "surface_rpm": rec.surface_rad_s / RPM,
+                          "surface_torque_Nm": rec.motor_torque_Nm})
+    cfg = config_from_dict({"segmentation": {"dip_max_s": dip_max_s, "min_segment_s": 1.0}})
+    assert len(segment(frame, cfg)) == runs
+    told = batch.BatchSettings.from_config(cfg)
+    assert _short_run_notes(told.dip_max_s, told.dip_torque_fraction) == runs - 1
+
+
+def test_dip_torque_fraction_reaches_the_fit():
+    """The stop holds ~85 % of the run's mean string torque: loaded for a fraction of 0.5,
+    released (the run ends there) for 0.9."""
+    assert _short_run_notes(25.0, 0.5) == 0
+    assert _short_run_notes(25.0, 0.9) == 1

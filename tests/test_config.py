@@ -85,6 +85,9 @@ bit_depth = { column = "BITDEP", unit = "m" }
     ({"observer": {"starts": [[0.3]]}}, "observer.starts[1]"),
     ({"observer": {"starts": [[0.3, "x"]]}}, "observer.starts[1]"),
     ({"observer": {"starts": [[0.2, 0.6]]}}, "0 ≤ μ_k ≤ μ_s"),
+    # regression (issue 21): mu_max below the starts failed every segment with "observer
+    # starts must be pairs (μ_s, μ_k) with 0 ≤ μ_k ≤ μ_s" instead of naming mu_max
+    ({"observer": {"mu_max": 0.15}}, "observer.mu_max = 0.15 is below the observer starts"),
     ({"observer": {"poles_per_s": ["a", "b"]}}, "two positive numbers"),
     ({"segmentation": {"rotating_rpm": 1.0, "rotating_stop_rpm": 5.0}}, "rotating_stop_rpm"),
     ({"survey": {"tortuosity_deg_30m": -0.5}}, "outside [0, 10]"),

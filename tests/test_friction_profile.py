@@ -16,6 +16,8 @@ import pytest
 
 from drillfric.config import config_from_dict
 from drillfric.estimation import batch
+from drillfric.estimation.batch import creep_checks, harness, settings
+from drillfric.estimation.creep import smooth
 from drillfric.friction import EFFECTIVE, OPEN_HOLE, FrictionProfile
 
 #: Ten 100-m cells from 0 to 1000 m, F_c = 40 N·m/m, shoe at 350 m (half a cell).
@@ -89,7 +91,7 @@ PASSING = batch.CreepChecks(engaged=0.9, misfit=0.006, sensitivity=25.0, noise_N
 
 
 def test_a_fit_of_the_model_family_passes():
-    assert batch._creep_problems(0.6, PASSING) == []
+    assert creep_checks.problems(0.6, PASSING) == []
 
 
 @pytest.mark.parametrize("change, words", [
@@ -105,25 +107,25 @@ def test_a_fit_of_the_model_family_passes():
 def test_each_failed_check_withholds_mu_s_with_its_reason(change, words):
     """Each check fails alone, and its reason names the physics (issue 14: a μ_s the model
     does not explain is withheld, visibly)."""
-    problems = batch._creep_problems(0.6, replace(PASSING, **change))
+    problems = creep_checks.problems(0.6, replace(PASSING, **change))
     assert len(problems) == 1 and words in problems[0]
 
 
 def test_halves_allow_a_slowly_logged_onset_but_not_a_low_top():
     """The first half may fit up to 15 % high (onset of a slowly logged creep) but at most
     6 % low (a top of lower friction wound up first)."""
-    assert batch._creep_problems(0.6, replace(PASSING, halves=(0.68, 0.60))) == []
-    assert batch._creep_problems(0.6, replace(PASSING, halves=(0.57, 0.60))) == []
-    assert batch._creep_problems(0.6, replace(PASSING, halves=(0.555, 0.60)))
+    assert creep_checks.problems(0.6, replace(PASSING, halves=(0.68, 0.60))) == []
+    assert creep_checks.problems(0.6, replace(PASSING, halves=(0.57, 0.60))) == []
+    assert creep_checks.problems(0.6, replace(PASSING, halves=(0.555, 0.60)))
 
 
 def test_halves_allow_for_their_own_noise():
     """A quiet creep (sensitivity 4: each half's μ_s uncertain by ≈ 3.5 %) may split by
     2σ of the difference, 2 × 2 × 10 %/4 = 10 %; a well-measured one (sensitivity 25) not."""
     quiet = replace(PASSING, sensitivity=4.0, halves=(0.416, 0.443))  # −6.1 %
-    assert batch._creep_problems(0.43, quiet) == []
-    assert batch._creep_problems(0.43, replace(quiet, sensitivity=25.0))
-    assert batch._creep_problems(0.43, replace(quiet, halves=(0.38, 0.443)))  # −14 %
+    assert creep_checks.problems(0.43, quiet) == []
+    assert creep_checks.problems(0.43, replace(quiet, sensitivity=25.0))
+    assert creep_checks.problems(0.43, replace(quiet, halves=(0.38, 0.443)))  # −14 %
 
 
 def test_smoothed_noise_of_white_noise_on_a_smooth_torque():
@@ -133,18 +135,19 @@ def test_smoothed_noise_of_white_noise_on_a_smooth_torque():
     rng = np.random.default_rng(1)
     t = np.arange(0.0, 60.0, 0.01)
     tau = 8000.0 * (1.0 - np.exp(-t / 20.0)) + rng.normal(0.0, 200.0, t.size)
-    data = batch._Data(t=t, dt=0.01, drive=0 * t, motor=tau, creep_drive=0 * t,
+    data = harness.FitData(t=t, dt=0.01, drive=0 * t, motor=tau, creep_drive=0 * t,
                        w_bar=0 * t, tau=tau, tau_bar=tau, speed=0 * t)
-    assert batch._smoothed_noise_Nm(data, np.arange(t.size)) == pytest.approx(20.0, rel=0.05)
+    noise = creep_checks.smoothed_noise_Nm(data, np.arange(t.size))
+    assert noise == pytest.approx(20.0, rel=0.05)
 
 
 def test_twist_and_torque_noise_add_in_quadrature():
     """Each 1-σ alone within 10 %/3 = 3.33 % passes; 2.5 % and 2.5 % together are 3.54 %:
     withheld (docs/theory.md §6.3, check 2)."""
     torque_only = replace(PASSING, sensitivity=4.0)  # 10 %/4 = 2.5 %
-    assert batch._creep_problems(0.6, torque_only) == []
-    assert batch._creep_problems(0.6, replace(PASSING, twist_noise=0.025)) == []
-    assert batch._creep_problems(0.6, replace(torque_only, twist_noise=0.025))
+    assert creep_checks.problems(0.6, torque_only) == []
+    assert creep_checks.problems(0.6, replace(PASSING, twist_noise=0.025)) == []
+    assert creep_checks.problems(0.6, replace(torque_only, twist_noise=0.025))
 
 
 def test_twist_walk_variance_of_a_constant_weight():
@@ -177,7 +180,7 @@ def test_walk_rate_holds_for_noise_filtered_averaged_or_quantised(case, low, hig
     which make the walk (quantisation adds its own step²/12). Tolerances: the robust spread
     of 300 one-second blocks has a sampling error of ≈ 13 % (−25 %/+30 % is ≈ 2σ). Noise
     filtered over 1 s is correlated over the block, so the 4-s average removes more of it
-    than of white noise: it reads ≈ 35 % low (documented in batch._walk_rate), where a
+    than of white noise: it reads ≈ 35 % low (documented in creep_checks.walk_rate), where a
     second-difference estimate of the sample noise reads it 12× low."""
     rng = np.random.default_rng(11)
     fine_dt, sigma = 0.001, 0.5 * np.pi / 30.0
@@ -188,12 +191,12 @@ def test_walk_rate_holds_for_noise_filtered_averaged_or_quantised(case, low, hig
         logged, dt = fine[::step], fine_dt * step
         q_true = sigma ** 2 * dt  # sampled white noise: density σ²·Δt
     elif case == "filtered 1 s at 10 Hz":
-        logged, dt = batch.smooth(fine, fine_dt, 1.0)[::100], 0.1
+        logged, dt = smooth(fine, fine_dt, 1.0)[::100], 0.1
     elif case == "1-s means":
         logged, dt = fine.reshape(-1, 1000).mean(axis=1), 1.0
     else:  # 10 Hz spot samples in 0.5-RPM steps
         step_rad_s, dt = 0.5 * np.pi / 30.0, 0.1
         logged = np.round(fine[::100] / step_rad_s) * step_rad_s
         q_true = (sigma ** 2 + step_rad_s ** 2 / 12.0) * dt
-    residual = logged - batch.smooth(logged, dt, batch.CREEP_DRIVE_SMOOTH_S)
-    assert low < batch._walk_rate(residual, dt) / q_true < high
+    residual = logged - smooth(logged, dt, settings.CREEP_DRIVE_SMOOTH_S)
+    assert low < creep_checks.walk_rate(residual, dt) / q_true < high

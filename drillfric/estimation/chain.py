@@ -28,6 +28,7 @@ from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
 from drillfric.estimation import batch
+from drillfric.estimation.batch.settings import MU_K_SKIP_S, TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
 from drillfric.estimation.gains import gains_from_config
@@ -178,13 +179,14 @@ def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
 
 def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
                    sample_dt_s: float | None = None, mu_s: float = 0.0,
-                   mu_k: float = 0.0) -> Observer:
+                   mu_k: float = 0.0, profile: FrictionProfile | None = None) -> Observer:
     """Observer for this string and F_c profile from the configuration (docs/theory.md §5);
     ``sample_dt_s`` is the logging interval of the measurements [s]. With a cased zone of
     unknown static friction, (``mu_s``, ``mu_k``) tie it to the open hole's ratio (the
-    observer's own μ̂ multiply the open hole's F_c only: docs/theory.md §3.2)."""
+    observer's own μ̂ multiply the open hole's F_c only: docs/theory.md §3.2). ``profile``:
+    the configuration's friction zones when already built."""
     grid = torsional.make_grid(string, cells)
-    plant = FrictionProfile.from_config(cfg).plant(
+    plant = (profile or FrictionProfile.from_config(cfg)).plant(
         grid, td.fc_at(grid.x_m), mu_s, mu_k, omega_c_rad_s=cfg.omega_c_rad_s,
         k_t_per_s=cfg.model.k_t_per_s, top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
         cased_static="tied" if mu_k > 0 else "kinetic")
@@ -255,10 +257,9 @@ def _initial_torque(meas: Measurements, span_s: float = 0.5) -> float:
     return float(np.median(meas.motor_torque_Nm[:n]))
 
 
-def _open_hole_friction(cfg):
+def _open_hole_friction(profile: FrictionProfile):
     """μ → the torque-and-drag friction of the profile with μ in the open hole (None: one
     zone)."""
-    profile = FrictionProfile.from_config(cfg)
     if profile.zone != "open_hole":
         return None
     cased = (lambda mu: profile.ratio * mu) if profile.ratio is not None else (
@@ -278,7 +279,7 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
     try:
         return float(torque_drag.back_calculate_friction(
             models.path, models.string, surface_torque_Nm=float(np.mean(torque[rotating])),
-            load_case="rotating_off_bottom", friction_of=_open_hole_friction(cfg),
+            load_case="rotating_off_bottom", friction_of=_open_hole_friction(models.profile),
             mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
             mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
             element_length_m=cfg.model.element_length_m))
@@ -288,7 +289,7 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
 
 #: Rotation left out after the top drive first exceeds ω_c when the fit is scored [s]
 #: (the start-up transient; the batch fit's μ_k skips the same).
-EVIDENCE_SKIP_S = batch.MU_K_SKIP_S
+EVIDENCE_SKIP_S = MU_K_SKIP_S
 
 
 @dataclass(frozen=True)
@@ -341,6 +342,10 @@ class SegmentModels:
     on_bottom : bool
     logged : LoggingInterval
         The log's effective sample interval (docs/bit_speed.md "Logging rate").
+    profile : FrictionProfile
+        The configuration's friction zones and law (docs/theory.md §3.2).
+    batch_settings : BatchSettings
+        The configuration's settings of the speed-driven fit.
     """
 
     path: WellPath
@@ -350,6 +355,8 @@ class SegmentModels:
     observer: Observer
     on_bottom: bool
     logged: LoggingInterval
+    profile: FrictionProfile
+    batch_settings: batch.BatchSettings
 
 
 def build_models(cfg, path: WellPath | None, data: SegmentData, *,
@@ -380,12 +387,15 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
         torque_kind=cfg.rig.torque_kind,
         top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2, rate_hz=rate_hz)
     string = build_string(cfg.sections, data.bit_depth_m)
-    observer = build_observer(cfg, string, td, cfg.model.cells, sample_dt_s=meas.dt_s)
+    profile = FrictionProfile.from_config(cfg)
+    observer = build_observer(cfg, string, td, cfg.model.cells, sample_dt_s=meas.dt_s,
+                              profile=profile)
     logged = logging_interval(data.time_s, data.surface_rpm, data.surface_torque_Nm,
                               averaging_s=cfg.rig.sample_averaging_s, model_dt_s=meas.dt_s,
                               torque_min_Nm=data.torque_min_Nm,
                               torque_max_Nm=data.torque_max_Nm)
-    return SegmentModels(path, string, td, meas, observer, on_bottom, logged)
+    return SegmentModels(path, string, td, meas, observer, on_bottom, logged, profile,
+                         batch.BatchSettings.from_config(cfg))
 
 
 def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
@@ -404,16 +414,13 @@ def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
 
 def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:
     """Step 3: the speed-driven fit over the first ``batch.window_s`` (docs/theory.md §6.4)."""
-    meas = models.meas
-    n_fit = min(meas.surface_rad_s.size, int(cfg.batch.window_s / meas.dt_s) + 1)
+    meas, settings = models.meas, models.batch_settings
+    n_fit = min(meas.surface_rad_s.size, int(settings.window_s / meas.dt_s) + 1)
     return batch.refine(meas.time_s[:n_fit], meas.surface_rad_s[:n_fit],
                         meas.motor_torque_Nm[:n_fit], string=models.string,
-                        fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
-                        k_t_per_s=cfg.model.k_t_per_s,
-                        top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
-                        torque_kind="motor", cells=_batch_cells(cfg, models.string.bit_depth_m),
-                        profile=FrictionProfile.from_config(cfg),
-                        sample_interval_s=models.logged.interval_s)
+                        fc_Nm_m=models.td.fc_at, settings=settings, torque_kind="motor",
+                        cells=_batch_cells(cfg, models.string.bit_depth_m),
+                        profile=models.profile, sample_interval_s=models.logged.interval_s)
 
 
 def evidence(cfg, models: SegmentModels, diag: Diagnostics,
@@ -435,10 +442,10 @@ def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,
     """Step 5: the ensemble seeded with the verdict's factors over the whole segment, and
     the bit speed it gives (weighted mean and band)."""
     observer = models.observer
-    if not FrictionProfile.from_config(cfg).static_known:  # tie the cased μ_s to the seed
+    if not models.profile.static_known:  # tie the cased μ_s to the seed
         observer = replace(observer, plant=build_observer(
             cfg, models.string, models.td, cfg.model.cells, models.meas.dt_s,
-            verdict.mu_s_seed, verdict.mu_k).plant)
+            verdict.mu_s_seed, verdict.mu_k, models.profile).plant)
     final = _final_pass(cfg, observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
                         adapt=verdict.adapt_final or cfg.observer.adapt_final,
                         output_rate_hz=output_rate_hz)
@@ -454,17 +461,15 @@ def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | Non
     meas = models.meas
     t, measured, model = batch.model_string_torque(
         meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
-        fc_Nm_m=models.td.fc_at, omega_c_rad_s=cfg.omega_c_rad_s,
-        k_t_per_s=cfg.model.k_t_per_s, top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+        fc_Nm_m=models.td.fc_at, settings=models.batch_settings,
         mu_s=mu_s if mu_s is not None else verdict.mu_s_seed, mu_k=verdict.mu_k,
-        cells=_batch_cells(cfg, models.string.bit_depth_m),
-        profile=FrictionProfile.from_config(cfg))
+        cells=_batch_cells(cfg, models.string.bit_depth_m), profile=models.profile)
     fast = np.flatnonzero(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s)
     scored = t >= (t[fast[0]] + EVIDENCE_SKIP_S if fast.size else np.inf)
     if scored.sum() < 10:
         return FitEvidence(t, measured, model, None, None, None)
     dt = float(t[1] - t[0]) if t.size > 1 else 1.0
-    misfit = smooth(measured - model, dt, batch.TORQUE_SMOOTH_S)[scored]
+    misfit = smooth(measured - model, dt, TORQUE_SMOOTH_S)[scored]
     low, high = np.percentile(measured[scored], [5.0, 95.0])
     return FitEvidence(t, measured, model, float(np.sqrt(np.mean(misfit ** 2))),
                        float(high - low), float(np.mean(measured[scored])))
@@ -543,7 +548,7 @@ def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag
         flags=verdict.flags, messages=tuple(messages), starts=starts, first=first,
         final=final, bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data),
         td=models.td, mu_s_seed=verdict.mu_s_seed,
-        friction_zone=FrictionProfile.from_config(cfg).zone)
+        friction_zone=models.profile.zone)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,

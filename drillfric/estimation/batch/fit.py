@@ -1,0 +1,336 @@
+"""The speed-driven fit of one record: the stages wired together (docs/theory.md §6.4).
+
+:func:`refine` runs the μ_k stage (:mod:`.kinetic`), then μ_s from a creep
+(:mod:`.creep_fit`, checked by :mod:`.creep_checks`) where one was logged fast enough, else
+the stick-slip-onset bound (:mod:`.onset`); each stage returns a frozen outcome and
+:func:`refine` alone assembles the :class:`BatchResult`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from drillfric.drillstring import DrillString
+from drillfric.estimation.batch.creep_checks import CreepChecks
+from drillfric.estimation.batch.creep_fit import CreepOutcome, fit_creeps
+from drillfric.estimation.batch.harness import (
+    Model,
+    Window,
+    as_fc_fn,
+    cycle_mean,
+    fluctuation,
+    prepare,
+)
+from drillfric.estimation.batch.kinetic import (
+    KineticOutcome,
+    fit_kinetic,
+    refit_kinetic,
+    rotating_windows,
+)
+from drillfric.estimation.batch.onset import BoundOutcome, onset_bound
+from drillfric.estimation.batch.settings import (
+    MIN_CREEP_RATE_HZ,
+    MU_K_REFIT_MOVE,
+    STICK_SLIP_FLUCTUATION,
+    TORQUE_SMOOTH_S,
+    BatchSettings,
+)
+from drillfric.estimation.creep import find_creeps, rotating_runs
+from drillfric.estimation.drive import DriveModel
+from drillfric.estimation.drive import identify as identify_drive
+from drillfric.friction import FrictionProfile
+from drillfric.result import Flag
+
+
+@dataclass(frozen=True)
+class BatchDetails:
+    """Traces of a speed-driven fit (diagnostics and tests).
+
+    Attributes
+    ----------
+    cells : int
+        Cells of the μ_k model.
+    T_N_Nm : float
+        ∫F_c dx of the model [N·m].
+    creeps_found : list of (float, float)
+        Creep start-ups found, (t_start_s, t_end_s) [s].
+    mean_torque_Nm : float or None
+        Whole-cycle mean measured string torque over the μ_k windows [N·m].
+    torque_fluctuation : float or None
+        std/|mean| of the smoothed measured torque there [-].
+    stick_slip : bool
+        Whether the data stick-slip (fluctuation above :data:`STICK_SLIP_FLUCTUATION`).
+    mu_k_trace : list of (float, float)
+        (μ_k, mean-torque residual [N·m]) of every model run of the root find.
+    mu_k_residual_Nm : float or None
+        Residual at the μ_k reported [N·m].
+    mu_s_model : float or None
+        μ_s the model used while μ_k was fitted (the regime value) [-].
+    creep_fits : list of (int, float, int)
+        (cells, μ_s, model runs) of each creep fit level.
+    creep_grid_move : float or None
+        Relative change of μ_s at the last grid refinement [-].
+    creep_checks : CreepChecks or None
+        What the creep fit was checked against before μ_s is claimed.
+    onset_scan : list of (float, bool)
+        (μ_s, the model's bit sticks) of the stick-slip-onset scan.
+    drive : DriveModel or None
+        The top drive's PI controller identified from the rotation (replayed in closed loop
+        when usable, docs/theory.md §6.4).
+    """
+
+    cells: int = 0
+    T_N_Nm: float = 0.0
+    creeps_found: list = field(default_factory=list)
+    mean_torque_Nm: float | None = None
+    torque_fluctuation: float | None = None
+    stick_slip: bool = False
+    mu_k_trace: list = field(default_factory=list)
+    mu_k_residual_Nm: float | None = None
+    mu_s_model: float | None = None
+    creep_fits: list = field(default_factory=list)
+    creep_grid_move: float | None = None
+    creep_checks: CreepChecks | None = None
+    onset_scan: list = field(default_factory=list)
+    drive: DriveModel | None = None
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Friction factors of one record from the speed-driven fit (docs/theory.md §6.4).
+
+    Attributes
+    ----------
+    mu_k : float or None
+        Kinetic friction factor [-] (None without usable rotation).
+    mu_k_method : str
+        "mean_torque".
+    mu_s : float or None
+        Static friction factor [-], a number only where the data identify it.
+    mu_s_identifiable : bool
+    mu_s_lower_bound : float or None
+        Lower bound on μ_s from the stick-slip onset [-], where the data support one.
+    mu_s_method : str
+        "creep_fit", "stick_slip_onset" or "none".
+    creep_segments : tuple of (float, float)
+        Creeps used for μ_s, (t_start_s, t_end_s) [s].
+    flags : tuple of Flag
+        e.g. ``bistable_regime``, ``creep_not_grid_converged``, ``mu_k_not_converged``,
+        ``no_rotation``, ``rotation_too_short``, ``regime_mismatch``, ``creep_fit_at_bound``,
+        ``creep_rate_too_low``, ``stick_slip_not_reproduced`` (docs/outputs.md).
+    runs : int
+        Model runs spent.
+    messages : tuple of str
+        One line per notable decision, for the report.
+    details : BatchDetails
+        Traces: residuals of the μ_k search, the onset scan, the creep fits, T_N, cells.
+    """
+
+    mu_k: float | None
+    mu_k_method: str
+    mu_s: float | None
+    mu_s_identifiable: bool
+    mu_s_lower_bound: float | None
+    mu_s_method: str
+    creep_segments: tuple[tuple[float, float], ...]
+    flags: tuple[Flag, ...]
+    runs: int
+    messages: tuple[str, ...]
+    details: BatchDetails = field(default_factory=BatchDetails)
+
+
+def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
+                        settings: BatchSettings, mu_s: float, mu_k: float,
+                        torque_kind: str = "motor", cells: int = 500,
+                        profile: FrictionProfile | None = None
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The fitted model against the data over a whole record (the evidence of a fit).
+
+    The speed-driven plant of docs/theory.md §6.4 at (μ_s, μ_k), driven by the measured
+    top-drive speed from rest over the whole record, as :func:`refine`'s fits are.
+
+    Returns
+    -------
+    time_s, measured_Nm, model_Nm : ndarray
+        Sample times on the record's uniform grid [s], the measured string torque and the
+        model's string torque at the top [N·m].
+    """
+    data, _ = prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
+                      settings.top_drive_inertia_kg_m2)
+    model = Model(string, as_fc_fn(fc_Nm_m), settings, data, None, profile)
+    whole = Window(0, data.t.size - 1, np.arange(data.t.size))
+    tau, _ = model.simulate(whole, max(mu_s, mu_k), mu_k, cells)
+    return data.t, data.tau, tau
+
+
+def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
+           settings: BatchSettings, torque_kind: str = "motor", cells: int = 500,
+           mu_s_seed: float | None = None,
+           progress: Callable[[float], None] | None = None,
+           profile: FrictionProfile | None = None,
+           sample_interval_s: float | None = None) -> BatchResult:
+    """Refine μ_k and μ_s of one record with the speed-driven model (docs/theory.md §6.4).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s] (resampled to a uniform base when irregular).
+    surface_rad_s : array_like
+        Measured top-drive speed ω₀ [rad/s].
+    torque_Nm : array_like
+        Logged surface torque [N·m], of kind ``torque_kind``.
+    string : DrillString
+        The string at this record's bit depth.
+    fc_Nm_m : callable or float
+        F_c(x) [N·m/m], a function of measured depth [m] (e.g. ``TDResult.fc_at`` from
+        torque and drag, docs/theory.md §2), or a constant.
+    settings : BatchSettings
+        ω_c, k_t, I_TD and the search settings of the configuration.
+    torque_kind : str
+        "motor" (τ_m, inertia removed here) or "string".
+    cells : int
+        Cells of the μ_k model (the creep fit uses at least MD/1000 resolution).
+    mu_s_seed : float, optional
+        μ_s used by the model while fitting μ_k on stick-slip data (default 2.5·μ_k).
+    progress : callable, optional
+        Called with 1.0 after each model run.
+    profile : FrictionProfile, optional
+        Friction zones and law of the model (docs/theory.md §3.2); default: one zone, the
+        step law. With a known cased zone μ_k, μ_s are the open hole's.
+    sample_interval_s : float, optional
+        Effective interval of the log when coarser than its spacing (means, held values;
+        :mod:`drillfric.estimation.sampling`) [s]: a creep is fitted only when this, too,
+        is within :data:`MIN_CREEP_RATE_HZ`.
+
+    Returns
+    -------
+    BatchResult
+    """
+    data, messages = prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
+                             settings.top_drive_inertia_kg_m2)
+    model = Model(string, as_fc_fn(fc_Nm_m), settings, data, progress, profile)
+    omega_c = settings.omega_c_rad_s
+    creeps = find_creeps(data.t, data.drive, omega_c, torque_Nm=data.tau,
+                         smooth_s=TORQUE_SMOOTH_S)
+    wins, notes = rotating_windows(data, settings)
+    messages += notes
+    flags: list[Flag] = []
+    rotation = _Rotation.of(model, wins)
+    kinetic = None
+    if wins:
+        model.drive = identify_drive(data.t, data.drive, data.motor, [w.used for w in wins])
+        if model.drive is not None:
+            messages.append(model.drive.describe())
+        kinetic = fit_kinetic(model, wins, rotation.target_Nm, rotation.stick_slip, mu_s_seed,
+                              cells)
+        flags += kinetic.flags
+        messages += kinetic.messages
+    elif any(np.any(data.w_bar[i0:i1 + 1] > omega_c)
+             for i0, i1 in rotating_runs(data.w_bar, omega_c)):
+        flags.append(Flag.ROTATION_TOO_SHORT)
+    else:
+        flags.append(Flag.NO_ROTATION)
+    static = _static_stages(model, creeps, wins, kinetic, rotation, cells,
+                            rate_hz=1.0 / max(data.dt, sample_interval_s or 0.0))
+    flags += static.flags
+    messages += static.messages
+    return BatchResult(
+        mu_k=None if static.kinetic is None else static.kinetic.mu_k,
+        mu_k_method="mean_torque", mu_s=static.mu_s, mu_s_identifiable=static.mu_s is not None,
+        mu_s_lower_bound=static.bound, mu_s_method=static.method,
+        creep_segments=static.creeps, flags=tuple(flags), runs=model.runs,
+        messages=tuple(messages),
+        details=_details(model, cells, creeps, rotation, static))
+
+
+@dataclass(frozen=True)
+class _Rotation:
+    """What the rotating windows of the data show: the whole-cycle mean string torque
+    [N·m], its fluctuation [-] and whether the data stick-slip (None/False without
+    windows)."""
+
+    target_Nm: float | None = None
+    fluctuation: float | None = None
+    stick_slip: bool = False
+
+    @classmethod
+    def of(cls, model: Model, wins: list[Window]) -> _Rotation:
+        if not wins:
+            return cls()
+        d = model.data
+        used = np.concatenate([w.used for w in wins])
+        fluct = fluctuation(d.tau_bar[used])
+        return cls(cycle_mean([d.tau[w.used] for w in wins], d.dt), fluct,
+                   fluct > STICK_SLIP_FLUCTUATION)
+
+
+@dataclass(frozen=True)
+class _Static:
+    """What the μ_s stages found: μ_s or a bound, the method, the creeps used, the μ_k
+    outcome after a possible refit, and each stage's outcome (None: not run)."""
+
+    mu_s: float | None
+    kinetic: KineticOutcome | None
+    bound: float | None = None
+    method: str = "none"
+    creeps: tuple = ()
+    creep: CreepOutcome | None = None
+    onset: BoundOutcome | None = None
+    flags: tuple[Flag, ...] = ()
+    messages: tuple[str, ...] = ()
+
+
+def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOutcome | None,
+                   rotation: _Rotation, cells: int, *, rate_hz: float) -> _Static:
+    """μ_s of a record: the creep fit where a creep was logged fast enough and passes its
+    checks (μ_k refitted when the fitted μ_s moves the stick-slip model), else the
+    stick-slip onset bound (docs/theory.md §6.3–§6.4)."""
+    flags, messages = [], []
+    mu_s, method, used, creep, onset = None, "none", (), None, None
+    if creeps and rate_hz < MIN_CREEP_RATE_HZ:
+        flags.append(Flag.CREEP_RATE_TOO_LOW)
+        messages.append(f"creep start-up found but logged at {rate_hz:.3g} Hz: the creep "
+                        f"fit needs ≥ {MIN_CREEP_RATE_HZ:g} Hz (speed noise integrated into "
+                        "the twist); μ_s not fitted")
+    elif kinetic is not None and creeps:
+        creep = fit_creeps(model, creeps, kinetic.mu_k, cells, wins, rotation.stick_slip)
+        flags += creep.flags
+        messages += creep.messages
+        mu_s, used = creep.mu_s, creep.creeps
+        if mu_s is not None:
+            method = "creep_fit"
+            if rotation.stick_slip and abs(mu_s / kinetic.mu_s_model - 1.0) > MU_K_REFIT_MOVE:
+                refit = refit_kinetic(model, wins, rotation.target_Nm, mu_s, kinetic, cells)
+                if refit is not None:
+                    kinetic = refit
+                    messages += refit.messages
+    if mu_s is None and kinetic is not None and rotation.stick_slip:
+        onset = onset_bound(model, wins, kinetic.mu_k, cells, bool(creeps))
+        flags += onset.flags
+        messages += onset.messages
+        method = "stick_slip_onset" if onset.bound is not None else "none"
+    if mu_s is None and not rotation.stick_slip and kinetic is not None:
+        messages.append("no stick-slip and no creep start-up: μ_s is not in the data; a creep "
+                        "break-over from rest (below ω_c for 10–30 s) would make it measurable")
+    return _Static(mu_s, kinetic, None if onset is None else onset.bound, method, used, creep,
+                   onset, tuple(flags), tuple(messages))
+
+
+def _details(model: Model, cells: int, creeps, rotation: _Rotation,
+             static: _Static) -> BatchDetails:
+    """The traces of a fit from its stages' outcomes."""
+    kinetic, creep = static.kinetic, static.creep
+    return BatchDetails(
+        cells=cells, T_N_Nm=model.t_n(cells), creeps_found=creeps,
+        mean_torque_Nm=rotation.target_Nm, torque_fluctuation=rotation.fluctuation,
+        stick_slip=rotation.stick_slip,
+        mu_k_trace=[] if kinetic is None else kinetic.trace,
+        mu_k_residual_Nm=None if kinetic is None else kinetic.residual_Nm,
+        mu_s_model=None if kinetic is None else kinetic.mu_s_model,
+        creep_fits=[] if creep is None else list(creep.fits),
+        creep_grid_move=None if creep is None else creep.grid_move,
+        creep_checks=None if creep is None else creep.checks,
+        onset_scan=[] if static.onset is None else static.onset.scan, drive=model.drive)

@@ -1,0 +1,194 @@
+"""μ_k of a record by mean-torque matching, with the model in the data's regime
+(docs/theory.md §6.4).
+
+The whole-cycle mean of the measured string torque over the rotating samples (the first
+:data:`MU_K_SKIP_S` after the top drive first exceeds ω_c left out) is matched by the model's
+with a secant root find whose slope is bounded and which returns a point it evaluated: the
+model's mean jitters between runs because stick-slip is chaotic.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from drillfric.estimation.batch.harness import FitData, Model, Window, cycle_mean, sticks
+from drillfric.estimation.batch.settings import (
+    MU_K_MAX_RUNS,
+    MU_K_SKIP_S,
+    MU_K_TOLERANCE,
+    PRE_ROLL_S,
+    PROVISIONAL_RATIO,
+    BatchSettings,
+)
+from drillfric.estimation.creep import bridge_loaded_dips, rotating_runs
+from drillfric.result import Flag
+
+
+def rotating_windows(data: FitData, settings: BatchSettings) -> tuple[list[Window], list[str]]:
+    """One window per rotating run with samples ≥ :data:`MU_K_SKIP_S` after first exceeding
+    ω_c; a loaded stop within ``settings.dip_max_s`` does not end a run (the segmentation's
+    rule). Returns the windows and a note per run left out."""
+    omega_c = settings.omega_c_rad_s
+    pre = int(round(PRE_ROLL_S / data.dt))
+    wins, notes = [], []
+    for i0, i1 in bridge_loaded_dips(rotating_runs(data.w_bar, omega_c), data.t, data.tau_bar,
+                                     max_dip_s=settings.dip_max_s,
+                                     fraction=settings.dip_torque_fraction):
+        fast = np.flatnonzero(data.w_bar[i0:i1 + 1] > omega_c)
+        if fast.size == 0:
+            continue
+        first = data.index(data.t[i0 + fast[0]] + MU_K_SKIP_S)
+        if first >= i1:
+            notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s shorter than "
+                         f"{MU_K_SKIP_S:.0f} s after reaching ω_c: not used for μ_k")
+            continue
+        wins.append(Window(max(0, i0 - pre), i1, np.arange(first, i1 + 1)))
+    return wins, notes
+
+
+def secant(residual: Callable[[float], float], x0: float, slope0: float, lo: float,
+           hi: float, tol: float) -> tuple[float, float, list[tuple[float, float]]]:
+    """Root of a jittery monotone residual by secant steps with a bounded slope.
+
+    The slope is kept within [0.5, 2]·``slope0`` so that jitter cannot throw a step far
+    away; the point returned is the evaluated one with the smallest |residual| (§6.4).
+    """
+    trace = [(x0, residual(x0))]
+    slope = slope0
+    while len(trace) < MU_K_MAX_RUNS and abs(trace[-1][1]) > tol:
+        x, r = trace[-1]
+        x_new = float(np.clip(x - r / slope, lo, hi))
+        if x_new == x:
+            break
+        trace.append((x_new, residual(x_new)))
+        step = (trace[-1][1] - r) / (x_new - x)
+        slope = float(np.clip(step, 0.5 * slope0, 2.0 * slope0))
+    best = min(trace, key=lambda p: abs(p[1]))
+    return best[0], best[1], trace
+
+
+def _pooled_mean(model: Model, wins: list[Window], mu_s: float, mu_k: float,
+                 cells: int) -> tuple[float, np.ndarray]:
+    """Whole-cycle mean model torque over the used samples of all windows [N·m], and the
+    bits' speeds there [rad/s]."""
+    taus, bits = [], []
+    for w in wins:
+        tau, bit = model.simulate(w, mu_s, mu_k, cells)
+        taus.append(tau[w.used - w.sim0])
+        bits.append(bit[w.used - w.sim0])
+    return cycle_mean(taus, model.data.dt), np.concatenate(bits)
+
+
+@dataclass(frozen=True)
+class MeanTorqueFit:
+    """One root find of μ_k (model μ_s a function of μ_k).
+
+    Attributes
+    ----------
+    mu_k : float
+        The evaluated μ_k with the smallest residual [-].
+    residual_Nm : float
+        Model minus measured whole-cycle mean torque there [N·m].
+    trace : list of (float, float)
+        (μ_k, residual [N·m]) of every model run.
+    sticks : bool
+        Whether the model's bit sticks at that μ_k.
+    """
+
+    mu_k: float
+    residual_Nm: float
+    trace: list
+    sticks: bool
+
+
+def fit_mean_torque(model: Model, wins, target_Nm: float,
+                    mu_s_of: Callable[[float], float], x0: float, cells: int) -> MeanTorqueFit:
+    """μ_k matching the mean torque ``target_Nm`` [N·m], searched on [0.001, μ_max]."""
+    t_n = model.t_n(cells)
+    stuck = {}
+
+    def residual(mu_k: float) -> float:
+        mean, bit = _pooled_mean(model, wins, max(mu_s_of(mu_k), mu_k), mu_k, cells)
+        stuck[mu_k] = sticks(bit, model.omega_c)
+        return mean - target_Nm
+
+    tol = max(0.01 * abs(target_Nm), 50.0)  # the chaotic jitter of the mean (§6.4)
+    mu_k, res, trace = secant(residual, x0, t_n, 1e-3, model.settings.mu_max, tol)
+    return MeanTorqueFit(mu_k, res, trace, stuck[mu_k])
+
+
+@dataclass(frozen=True)
+class KineticOutcome:
+    """What the μ_k stage found (docs/theory.md §6.4).
+
+    Attributes
+    ----------
+    mu_k : float
+        The fitted kinetic friction factor [-].
+    residual_Nm : float
+        Mean-torque residual there [N·m].
+    trace : list of (float, float)
+        (μ_k, residual [N·m]) of every model run of the last root find.
+    mu_s_model : float
+        μ_s the model used at that μ_k (the regime value) [-].
+    flags : tuple of Flag
+    messages : tuple of str
+    """
+
+    mu_k: float
+    residual_Nm: float
+    trace: list
+    mu_s_model: float
+    flags: tuple[Flag, ...] = ()
+    messages: tuple[str, ...] = ()
+
+
+def fit_kinetic(model: Model, wins: list[Window], target_Nm: float, stick_slip: bool,
+                mu_s_seed: float | None, cells: int) -> KineticOutcome:
+    """μ_k by mean-torque matching with the model in the data's regime (docs/theory.md §6.4):
+    stick-slip data are fitted with μ_s = :data:`PROVISIONAL_RATIO`·μ_k (then 4·μ_k if the
+    model does not stick), steady data with μ_s = μ_k."""
+    d = model.data
+    used = np.concatenate([w.used for w in wins])
+    g = model.grid(cells)[0]
+    string_inertia = float(np.sum(g.rho_j_kg_m * g.dx_true_m))
+    viscous = model.k_t * string_inertia * float(np.mean(d.w_bar[used]))
+    t_est, t_fixed = model.t_parts(cells)
+    top = model.settings.mu_max
+    x0 = float(np.clip((target_Nm - viscous - t_fixed) / t_est, min(0.01, top), min(1.0, top)))
+    for ratio in (PROVISIONAL_RATIO, 4.0) if stick_slip else (1.0,):
+        def mu_s_of(mu_k, ratio=ratio):
+            return max(ratio * mu_k, mu_s_seed or 0.0) if stick_slip else mu_k
+        fit = fit_mean_torque(model, wins, target_Nm, mu_s_of, x0, cells)
+        if fit.sticks == stick_slip:
+            break
+        x0 = fit.mu_k
+    flags, messages = [], []
+    if fit.sticks != stick_slip:
+        flags.append(Flag.REGIME_MISMATCH)
+        messages.append("the model could not be put in the data's regime "
+                        f"({'stick-slip' if stick_slip else 'steady rotation'}); μ_k may be "
+                        "biased by a few %")
+    res = fit.residual_Nm
+    if abs(res) > MU_K_TOLERANCE * abs(target_Nm):
+        flags.append(Flag.MU_K_NOT_CONVERGED)
+        messages.append(f"mean torque matched only to {res:+.0f} N·m of {target_Nm:.0f} N·m"
+                        + (f": μ_k ran to observer.mu_max = {top:g}, raise it" if
+                           res < 0 and fit.mu_k >= 0.999 * top else ""))
+    return KineticOutcome(fit.mu_k, res, fit.trace, mu_s_of(fit.mu_k), tuple(flags),
+                          tuple(messages))
+
+
+def refit_kinetic(model: Model, wins: list[Window], target_Nm: float, mu_s: float,
+                  first: KineticOutcome, cells: int) -> KineticOutcome | None:
+    """μ_k again with the creep μ_s in the model (same regime, better static part); None
+    when the refit matches the mean torque worse (the first fit stands). The outcome's
+    trace holds both fits' runs; its flags and messages are the refit's own."""
+    fit = fit_mean_torque(model, wins, target_Nm, lambda _: mu_s, first.mu_k, cells)
+    if not abs(fit.residual_Nm) <= max(abs(first.residual_Nm), MU_K_TOLERANCE * abs(target_Nm)):
+        return None
+    return KineticOutcome(min(fit.mu_k, mu_s), fit.residual_Nm, first.trace + fit.trace, mu_s,
+                          messages=(f"μ_k refitted with the creep μ_s = {mu_s:.3f}",))

@@ -1,0 +1,117 @@
+"""What the speed-driven fit is told and the thresholds it works by (docs/theory.md §6.2–§6.4).
+
+:class:`BatchSettings` holds every key of the configuration the fit uses, built once per
+segment; the module constants are the fit's own thresholds, grouped by the stage that uses
+them, each with its meaning, unit and reference (docs/batch_refinement.md explains them).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from drillfric.config import default
+
+
+@dataclass(frozen=True)
+class BatchSettings:
+    """What the configuration sets for the speed-driven fit (docs/configuration.md), SI.
+
+    Built once per segment (:meth:`from_config`) and passed to
+    :func:`~drillfric.estimation.batch.refine` and
+    :func:`~drillfric.estimation.batch.model_string_torque`, so that every key given reaches
+    every place that uses it.
+
+    Attributes
+    ----------
+    omega_c_rad_s : float
+        Static/kinetic switching speed ω_c [rad/s] (``model.omega_c_rad_s``/``omega_c_rpm``).
+    k_t_per_s : float
+        Viscous damping rate k_t [1/s] (``model.k_t_per_s``).
+    top_drive_inertia_kg_m2 : float
+        I_TD [kg·m²] (``rig.top_drive_inertia_kg_m2``).
+    mu_max : float
+        Upper end of every friction search: μ_k, the creep μ_s, the onset scan [-]
+        (``observer.mu_max``).
+    dip_max_s, dip_torque_fraction : float
+        A stop of the top drive at most ``dip_max_s`` [s], with the string still loaded
+        (torque at least ``dip_torque_fraction`` of the run's mean [-]), does not end a
+        rotating run — the segmentation's rule (``segmentation.dip_max_s``,
+        ``segmentation.dip_torque_fraction``).
+    window_s : float
+        The fit uses the first this-many seconds of a segment [s] (``batch.window_s``).
+    """
+
+    omega_c_rad_s: float
+    k_t_per_s: float
+    top_drive_inertia_kg_m2: float
+    mu_max: float = default("observer.mu_max")
+    dip_max_s: float = default("segmentation.dip_max_s")
+    dip_torque_fraction: float = default("segmentation.dip_torque_fraction")
+    window_s: float = default("batch.window_s")
+
+    @classmethod
+    def from_config(cls, cfg) -> BatchSettings:
+        """The settings of a :class:`drillfric.config.Config`."""
+        return cls(omega_c_rad_s=cfg.omega_c_rad_s, k_t_per_s=cfg.model.k_t_per_s,
+                   top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+                   mu_max=cfg.observer.mu_max, dip_max_s=cfg.segmentation.dip_max_s,
+                   dip_torque_fraction=cfg.segmentation.dip_torque_fraction,
+                   window_s=cfg.batch.window_s)
+
+
+# --- the series compared (docs/theory.md §6.4) ---------------------------------------------
+PRE_ROLL_S = 2.0  #: model starts this long before a run or creep leaves rest [s]
+WOUND_SPAN_S = 0.5  #: rest at a window's start over which a trapped torque is measured [s]
+DRIVE_SMOOTH_S = 0.2  #: light smoothing of the speed that drives the model [s]
+TORQUE_SMOOTH_S = 1.0  #: smoothing of torques compared in the creep misfit [s]
+CREEP_DRIVE_SMOOTH_S = 4.0  #: smoothing of the speed driving a creep (keeps its angle) [s]
+
+# --- the μ_k fit by mean-torque matching (docs/theory.md §6.4) -----------------------------
+MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
+STICK_SLIP_FLUCTUATION = 0.1  #: data stick-slip when std/mean of the smoothed torque exceeds
+PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
+MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
+MU_K_TOLERANCE = 0.02  #: mean torque matched to worse than this share: not converged [-]
+MU_K_REFIT_MOVE = 0.2  #: μ_k refitted when the creep μ_s moves the model's μ_s by more [-]
+
+# --- sticking and the stick-slip-onset bound (docs/theory.md §6.2, §6.4) --------------------
+STUCK_FRACTION = 0.01  #: the model's bit sticks when this share of samples is near rest
+REST_BIT = 0.1  #: the bit is near rest below this fraction of ω_c
+SCAN_STEP = 0.02  #: μ_s grid step of the onset scan
+SCAN_CONFIRM = 3  #: grid points above the first sticking one that must stick too
+SCAN_ROTATION_S = 90.0  #: rotation simulated per onset-scan point (30 s skipped + 60 s) [s]
+
+# --- the creep fit of μ_s (docs/theory.md §6.3–§6.4) ---------------------------------------
+CREEP_CELLS_PER_MD = 1000  #: creep fits at Δx ≤ MD/1000
+CREEP_CONVERGENCE = 0.03  #: relative move allowed when the creep fit doubles its cells
+CREEP_MAX_S = 60.0  #: longest creep window fitted [s]
+CREEP_LEVELS = 3  #: creep fits at MD/1000, then doubled cells at most twice
+CREEP_STENCIL = 0.04  #: relative half-width of the parabola of a creep refit
+GRID_SPREAD = 0.05  #: make_grid may take up to 5 % fewer cells than requested (rounding)
+CREEP_MU_MIN = 0.02  #: lowest μ_s a creep fit searches (and never below μ_k) [-]
+#: Slowest logging rate for a creep fit [Hz]: the twist is the integral of the logged speed,
+#: and its noise (σ√(Δt·T)) moved μ_s by +17…+33 % at 1 Hz with 0.5 RPM noise, ±6 % at 5 Hz
+#: (docs/validation.md).
+MIN_CREEP_RATE_HZ = 2.0
+
+# --- the checks of a creep fit before its μ_s is claimed (docs/theory.md §6.3) --------------
+# (docs/batch_refinement.md "Checks of a creep fit"; calibrated on the validation plants of
+# benchmarks/validate_trust.py, where fits of the model family stay inside with margin and
+# fits of other laws do not)
+CREEP_SENSITIVITY_STEP = 0.10  #: relative move of μ_s whose effect on the creep is measured
+#: Start of a creep left out of the split-half check (the smoothed drive blurs the onset).
+SPLIT_SKIP = 0.2
+MAX_CREEP_MISFIT = 0.03  #: RMS smoothed residual over the creep torque (model family ≤ 1 %)
+#: A 10 % change of μ_s must move the creep torque by this many noise levels (over the
+#: creep's independent seconds): the fit's 1-σ uncertainty is then ≤ 10 %/3 ≈ 3 %.
+MIN_CREEP_SENSITIVITY = 3.0
+MIN_SWING_RATIO = 0.5  #: model/data stick-slip fluctuation after the creep
+#: First and second half of the creep fitted alone: the first may lie at most this much below
+#: the second (a top of lower friction, e.g. casing, the creep wound up first) and this much
+#: either way (the onset of a slowly logged creep fits high: +4…+13 % at 5 Hz on the plants).
+MAX_HALVES_BELOW, MAX_HALVES_SPLIT = 0.06, 0.15
+#: Both limits widen to this many standard deviations of the halves' difference due to
+#: noise alone: each half holds about half the creep's information, so the relative 1-σ of
+#: their difference is ≈ 2 × CREEP_SENSITIVITY_STEP / sensitivity (4.9 % at sensitivity 4).
+HALVES_SIGMAS = 2.0
+MAX_HYPOTHESIS_SPLIT = 0.05  #: the two hypotheses for an unknown cased static factor

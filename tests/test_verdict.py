@@ -1,0 +1,108 @@
+"""What a segment may claim: :func:`drillfric.estimation.verdict.decide`, rule by rule.
+
+A pure function, so every branch is a row of a table: the evidence changed from a plain
+converged stick-slip segment, what the verdict must then say, and why (the rules are in
+drillfric/estimation/verdict.py and docs/batch_refinement.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from drillfric.estimation.verdict import (
+    DISAGREEMENT,
+    MIN_CONVERGED_ROTATION_S,
+    TYPICAL_MU,
+    Evidence,
+    decide,
+)
+from drillfric.result import Flag, Method
+
+#: Off bottom, batch μ_k 0.2 agreeing with the observer's 0.21, 120 s of rotation, a bound
+#: 0.3, the model's regime μ_s 0.5, no creep μ_s.
+PLAIN = Evidence(batch_mu_k=0.2, batch_flags=(), batch_messages=("fit note",),
+                 mu_s_lower_bound=0.3, mu_s_model=0.5, mu_s=None, observer_mu_k=0.21,
+                 observer_converged=True, observer_flags=(), turning_s=120.0,
+                 on_bottom=False)
+
+CASES = [
+    ("plain", {}, dict(mu_k=0.2, method=Method.BATCH, converged=True, bound=0.3, seed=0.5,
+                       adapt=False, flags=()),
+     "batch μ_k reported, converged, bound shown, seeded with the model's regime μ_s"),
+    ("batch_not_converged", dict(batch_flags=(Flag.MU_K_NOT_CONVERGED,)),
+     dict(converged=False, flags=(Flag.MU_K_NOT_CONVERGED,)),
+     "the fit's own flag makes the μ_k not converged (the number stays)"),
+    ("estimators_disagree", dict(observer_mu_k=0.2 * DISAGREEMENT * 1.01),
+     dict(mu_k=0.2, converged=False, flags=(Flag.ESTIMATORS_DISAGREE,)),
+     "batch and observer differ by more than the factor DISAGREEMENT"),
+    ("estimators_disagree_other_way", dict(observer_mu_k=0.2 / (DISAGREEMENT * 1.01)),
+     dict(converged=False, flags=(Flag.ESTIMATORS_DISAGREE,)),
+     "the ratio counts either way"),
+    ("estimators_just_agree", dict(observer_mu_k=0.2 * DISAGREEMENT * 0.99),
+     dict(converged=True, flags=()),
+     "inside the factor: still converged"),
+    ("too_short", dict(turning_s=MIN_CONVERGED_ROTATION_S - 1.0),
+     dict(converged=False, flags=(Flag.TOO_SHORT_TO_CONVERGE,)),
+     "less rotation than a mean torque needs"),
+    ("no_batch_mu_k", dict(batch_mu_k=None, observer_converged=False),
+     dict(mu_k=0.21, method=Method.OBSERVER, converged=False, adapt=True),
+     "without a fit the observer consensus is reported, converged only as the observer "
+     "says, and the seeded pass keeps adapting"),
+    ("no_batch_mu_k_observer_converged", dict(batch_mu_k=None, turning_s=10.0),
+     dict(mu_k=0.21, method=Method.OBSERVER, converged=True, flags=()),
+     "the rotation rule is the batch fit's: the observer's own convergence stands"),
+    ("low_mu_k", dict(batch_mu_k=0.04, observer_mu_k=0.04, mu_s_model=None,
+                      mu_s_lower_bound=None),
+     dict(mu_k=0.04, flags=(Flag.OUTSIDE_TYPICAL_RANGE,), seed=0.04, bound=None),
+     "below TYPICAL_MU: flagged, not changed; with nothing else the seed is μ_k"),
+    ("high_mu_k", dict(batch_mu_k=0.85, observer_mu_k=0.85),
+     dict(mu_k=0.85, flags=(Flag.OUTSIDE_TYPICAL_RANGE,), seed=0.85),
+     "above TYPICAL_MU: flagged; a seed below μ_k is raised to μ_k"),
+    ("on_bottom", dict(on_bottom=True),
+     dict(bound=None, flags=(Flag.BIT_TORQUE_IN_FRICTION,), seed=0.5),
+     "on bottom the bit drives the swings: no bound, friction apparent"),
+    ("regime_mismatch", dict(batch_flags=(Flag.REGIME_MISMATCH,)),
+     dict(bound=None, converged=True, flags=(Flag.REGIME_MISMATCH,)),
+     "a model not in the data's regime gives no trustworthy bound"),
+    ("bistable", dict(batch_flags=(Flag.BISTABLE_REGIME,)),
+     dict(bound=None, flags=(Flag.BISTABLE_REGIME,)), "bistable onset: no bound"),
+    ("not_reproduced", dict(batch_flags=(Flag.STICK_SLIP_NOT_REPRODUCED,)),
+     dict(bound=None, flags=(Flag.STICK_SLIP_NOT_REPRODUCED,)),
+     "the model never stick-slips: no bound"),
+    ("other_batch_flag_keeps_bound", dict(batch_flags=(Flag.CREEP_RATE_TOO_LOW,)),
+     dict(bound=0.3, converged=True, flags=(Flag.CREEP_RATE_TOO_LOW,)),
+     "a flag outside UNRELIABLE_BOUND neither hides the bound nor the convergence"),
+    ("creep_mu_s_seeds", dict(mu_s=0.55), dict(seed=0.55),
+     "an identified μ_s seeds the final pass before the model's regime value"),
+    ("bound_seeds_without_model", dict(mu_s_model=None), dict(seed=0.3),
+     "without a regime value the bound seeds"),
+    ("flags_ordered_and_unique",
+     dict(observer_flags=(Flag.OBSERVER_NOT_CONVERGED,),
+          batch_flags=(Flag.MU_K_NOT_CONVERGED, Flag.MU_K_NOT_CONVERGED)),
+     dict(flags=(Flag.OBSERVER_NOT_CONVERGED, Flag.MU_K_NOT_CONVERGED)),
+     "observer flags first, then the fit's; each once"),
+]
+
+
+@pytest.mark.parametrize("change, expected, why", [c[1:] for c in CASES],
+                         ids=[c[0] for c in CASES])
+def test_decide(change, expected, why):
+    v = decide(replace(PLAIN, **change))
+    got = dict(mu_k=v.mu_k, method=v.method, converged=v.converged,
+               bound=v.mu_s_lower_bound, seed=v.mu_s_seed, adapt=v.adapt_final,
+               flags=v.flags)
+    assert {k: got[k] for k in expected} == expected, why
+
+
+def test_every_flag_and_withheld_number_is_explained():
+    """Each rule that flags or withholds adds its line; the fit's messages come first."""
+    v = decide(replace(PLAIN, on_bottom=True, turning_s=10.0, observer_mu_k=0.5,
+                       batch_mu_k=0.9))
+    text = " | ".join(v.messages)
+    assert v.messages[0] == "fit note"
+    for words in ("withheld on bottom", "disagree", "of rotation", "outside the range",
+                  "bit torque is not separated"):
+        assert words in text, words
+    assert TYPICAL_MU[1] < 0.9
