@@ -29,6 +29,8 @@ class Kind(StrEnum):
 
     OFF_BOTTOM = "off_bottom_rotating"
     ON_BOTTOM = "on_bottom_rotating"
+    REAMING = "reaming"  #: turning while running in faster than segmentation.ream_speed_m_s
+    BACK_REAMING = "back_reaming"  #: turning while pulling out (μ, bit speed withheld)
 
 
 class Method(StrEnum):
@@ -105,7 +107,8 @@ class SegmentRecord:
     """
 
     id: int = _f("", "segment number, 1-based, in time order", 0)
-    kind: Kind = _f("", "load case: off_bottom_rotating or on_bottom_rotating",
+    kind: Kind = _f("", "load case: off_bottom_rotating, on_bottom_rotating, reaming or "
+                        "back_reaming (the last two skipped)",
                     Kind.OFF_BOTTOM)
     t_start_s: float = _f("s", "time of the segment's first sample", 0.0)
     t_end_s: float = _f("s", "time of the segment's last sample", 0.0)
