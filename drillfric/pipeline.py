@@ -384,12 +384,15 @@ def _evidence_fields(est: SegmentEstimate) -> dict:
 
 
 def _bit_fields(est: SegmentEstimate) -> dict:
-    """The bit-speed statistics, or null with the reason where the rate cannot resolve the
-    stick-slip cycle (never a number drawn from an unresolved trace)."""
+    """The bit-speed statistics, or null with the reason where the trace is withheld (the
+    stuck fraction and severity stay where only the kinematic check withheld it)."""
     logged = dict(sample_interval_s=est.logged.interval_s,
                   interval_torque_swing=est.logged.torque_swing)
     if not est.bit_speed.resolved:
-        return logged | dict(bit_speed_resolved=False, bit_speed_reason=est.bit_speed.reason)
+        kept = dict(stick_slip_severity=est.stick_slip_severity,
+                    stuck_fraction=est.stuck_fraction) if est.bit_statistics else {}
+        return logged | kept | dict(bit_speed_resolved=False,
+                                    bit_speed_reason=est.bit_speed.reason)
     return logged | dict(bit_speed_resolved=True, stick_slip_severity=est.stick_slip_severity,
                          stuck_fraction=est.stuck_fraction,
                          bit_rms_error_rpm=est.bit_rms_error_rpm)

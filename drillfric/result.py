@@ -29,6 +29,8 @@ class Kind(StrEnum):
 
     OFF_BOTTOM = "off_bottom_rotating"
     ON_BOTTOM = "on_bottom_rotating"
+    REAMING = "reaming"  #: turning while running in faster than segmentation.ream_speed_m_s
+    BACK_REAMING = "back_reaming"  #: turning while pulling out (μ, bit speed withheld)
 
 
 class Method(StrEnum):
@@ -105,7 +107,8 @@ class SegmentRecord:
     """
 
     id: int = _f("", "segment number, 1-based, in time order", 0)
-    kind: Kind = _f("", "load case: off_bottom_rotating or on_bottom_rotating",
+    kind: Kind = _f("", "load case: off_bottom_rotating, on_bottom_rotating, reaming or "
+                        "back_reaming (the last two skipped)",
                     Kind.OFF_BOTTOM)
     t_start_s: float = _f("s", "time of the segment's first sample", 0.0)
     t_end_s: float = _f("s", "time of the segment's last sample", 0.0)
@@ -123,11 +126,12 @@ class SegmentRecord:
     settling_time_s: float | None = _f("s", "time the observer starts took to settle")
     residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
     stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated bit "
-                                                "speed")
+                                                "speed (ensemble members pooled; ±12 %)")
     status: Status = _f("", "ok, skipped or failed", Status.OK)
     message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
     duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
-    stuck_fraction: float | None = _f("-", "share of the time the estimated bit is stuck")
+    stuck_fraction: float | None = _f("-", "share of the time the bit is stuck, |ω_bit| ≤ ω_c "
+                                           "(ensemble members pooled; ±0.05)")
     mu_k_observer: float | None = _f("-", "observer consensus μ_k (first pass)")
     mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass)")
     mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")
@@ -149,8 +153,10 @@ class SegmentRecord:
     hookload_N: float | None = _f("N", "median measured hook load over the segment")
     hookload_model_N: float | None = _f("N", "modelled rotating off-bottom hook load at this "
                                              "depth (torque and drag, no block weight)")
-    bit_speed_resolved: bool | None = _f("", "whether the logging rate resolves the stick-slip "
-                                             "cycle (else no bit-speed trace is reported)")
+    bit_speed_resolved: bool | None = _f("", "whether a bit-speed trace is reported: the "
+                                             "logging resolves the stick-slip cycle, the bit "
+                                             "is off bottom and the trace passes the "
+                                             "kinematic check")
     bit_speed_reason: str | None = _f("", "why the bit speed is not reported")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
                                               "the spacing, the averaging interval and the "

@@ -27,16 +27,25 @@ from drillfric.config import Config
 from drillfric.errors import InputError
 from drillfric.kernels.lazy import lazy_jit
 
-#: Rig states, coded by their position (``np.int8``). ``sliding_on_bottom`` (on bottom with
-#: the pumps on but no surface rotation: motor drilling) is drillfric's addition.
+#: Rig states, coded by their position (``np.int8``; new states are appended, codes never
+#: move). ``sliding_on_bottom`` (on bottom with the pumps on but no surface rotation: motor
+#: drilling), ``reaming`` and ``back_reaming`` (rotating off bottom while the pipe runs in
+#: or pulls out faster than ``ream_speed_m_s``) are drillfric's additions.
 RIG_STATES = ("rotating_off_bottom", "rotating_on_bottom", "in_slips", "tripping", "idle",
-              "unknown", "sliding_on_bottom")
+              "unknown", "sliding_on_bottom", "reaming", "back_reaming")
 (ROTATING_OFF_BOTTOM, ROTATING_ON_BOTTOM, IN_SLIPS, TRIPPING, IDLE, UNKNOWN,
- SLIDING_ON_BOTTOM) = range(len(RIG_STATES))
+ SLIDING_ON_BOTTOM, REAMING, BACK_REAMING) = range(len(RIG_STATES))
 #: States that make hole ("drilling"): on bottom, rotating or sliding.
 DRILLING_STATES = (ROTATING_ON_BOTTOM, SLIDING_ON_BOTTOM)
-#: Segment kind of each rotating state (docs/outputs.md ``kind`` values).
-KINDS = {ROTATING_OFF_BOTTOM: "off_bottom_rotating", ROTATING_ON_BOTTOM: "on_bottom_rotating"}
+#: States in which the string turns (a segment is a run of them).
+TURNING_STATES = (ROTATING_OFF_BOTTOM, ROTATING_ON_BOTTOM, REAMING, BACK_REAMING)
+#: Segment kind of each turning state (docs/outputs.md ``kind`` values).
+KINDS = {ROTATING_OFF_BOTTOM: "off_bottom_rotating", ROTATING_ON_BOTTOM: "on_bottom_rotating",
+         REAMING: "reaming", BACK_REAMING: "back_reaming"}
+#: Kinds whose friction factors and bit speed are withheld: the pipe moves along the hole
+#: while it turns, so the wall friction splits between axial and tangential, and the
+#: estimators model pure rotation (docs/segmentation.md "Reaming").
+COMBINED_MOTION_KINDS = ("reaming", "back_reaming")
 
 #: How the bit depth is known: measured channel, reckoned from the block, or not at all.
 _DEPTH_CHANNEL, _DEPTH_BLOCK, _DEPTH_NONE = 0, 1, 2
@@ -53,7 +62,8 @@ class Segment:
     id : int
         Running number, 1-based, in time order.
     kind : str
-        ``"off_bottom_rotating"`` or ``"on_bottom_rotating"``.
+        ``"off_bottom_rotating"``, ``"on_bottom_rotating"``, ``"reaming"`` or
+        ``"back_reaming"`` (always skipped: :data:`COMBINED_MOTION_KINDS`).
     t_start_s, t_end_s : float
         Times of the first and the last sample of the segment [s].
     i_start, i_end : int
@@ -118,7 +128,7 @@ def _still_turning(rpm, torque, t, turning, level, dip_start, rotating_rpm, stop
 
 def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, block_m, wob_N,
                      pumps, depth_mode, rotating_rpm, stop_rpm, dip_s, dip_fraction, slips_N,
-                     on_bottom_m, wob_on_N, trip_m_s, max_rop_m_s,
+                     on_bottom_m, wob_on_N, trip_m_s, max_rop_m_s, ream_m_s,
                      carry):
     """Causal per-sample rig state; updates ``carry`` in place (see :func:`classify`).
 
@@ -178,8 +188,12 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
             state = UNKNOWN
         elif in_slips:
             state = IN_SLIPS
+        elif turning and on_bottom:
+            state = ROTATING_ON_BOTTOM
+        elif turning and abs(v_down) > ream_m_s:
+            state = REAMING if v_down > 0.0 else BACK_REAMING
         elif turning:
-            state = ROTATING_ON_BOTTOM if on_bottom else ROTATING_OFF_BOTTOM
+            state = ROTATING_OFF_BOTTOM
         elif on_bottom and pumps[i] != 0:
             state = SLIDING_ON_BOTTOM  # pumps on, or not recorded
         elif abs(v_down) > trip_m_s:
@@ -260,7 +274,8 @@ def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
         np.nan if slips is None else float(slips),
         float(cfg.segmentation.on_bottom_m), float(cfg.segmentation.wob_on_bottom_N),
         float(cfg.segmentation.trip_speed_m_s),
-        float(cfg.segmentation.max_rop_m_h) / 3600.0, carry)
+        float(cfg.segmentation.max_rop_m_h) / 3600.0, float(cfg.segmentation.ream_speed_m_s),
+        carry)
     absolute = (_depth_mode(frame) == _DEPTH_CHANNEL
                 or cfg.segmentation.start_bit_depth_m is not None)
     return states, bit if absolute else np.full(len(frame), np.nan)
@@ -275,7 +290,8 @@ def classify(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
     1. ``unknown`` when the surface speed is null;
     2. ``in_slips`` when hook load < ``slips_hookload_N`` (string weight off the hook);
     3. rotating (``surface_rpm`` > ``rotating_rpm``): ``rotating_on_bottom`` when on bottom,
-       else ``rotating_off_bottom``;
+       else ``reaming`` / ``back_reaming`` when the smoothed bit speed exceeds
+       ``ream_speed_m_s`` going down / up, else ``rotating_off_bottom``;
     4. not rotating: ``sliding_on_bottom`` when on bottom with the pumps on (or pumps not
        recorded), ``tripping`` when the smoothed bit speed exceeds ``trip_speed_m_s``,
        else ``idle``.
@@ -319,7 +335,7 @@ def _pieces(t: np.ndarray, states: np.ndarray, max_gap_s: float) -> list[tuple[i
     either end are trimmed; bridged unknown samples stay inside (the segment is then
     skipped for nulls).
     """
-    rotating = (states == ROTATING_OFF_BOTTOM) | (states == ROTATING_ON_BOTTOM)
+    rotating = np.isin(states, TURNING_STATES)
     rot_idx = np.flatnonzero(rotating)
     if rot_idx.size == 0:
         return []
@@ -336,17 +352,18 @@ def _pieces(t: np.ndarray, states: np.ndarray, max_gap_s: float) -> list[tuple[i
     return list(zip(starts.tolist(), ends.tolist(), strict=True))
 
 
-def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int, int, bool]]:
+def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int, int, int]]:
     """Cut one piece into runs of constant kind with a minimum dwell (hysteresis).
 
-    ``on`` is the on-bottom flag per sample (unknown samples already carry the previous
-    flag). Runs shorter than ``dwell_s`` (first to last sample, plus one sample interval)
-    take the kind of the run before them (the first run: of the run after it); then equal
-    neighbours merge. Returns (start, end, on_bottom) with indices relative to the piece.
+    ``on`` is the turning state per sample (:data:`TURNING_STATES`; unknown samples already
+    carry the previous one). Runs shorter than ``dwell_s`` (first to last sample, plus one
+    sample interval) take the kind of the run before them (the first run: of the run after
+    it); then equal neighbours merge. Returns (start, end, state) with indices relative to
+    the piece.
     """
     change = np.flatnonzero(on[1:] != on[:-1]) + 1
     bounds = np.concatenate(([0], change, [on.size]))
-    runs = [[int(a), int(b), bool(on[a])] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    runs = [[int(a), int(b), int(on[a])] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
     if len(runs) == 1:
         return [tuple(runs[0])]
     dt = np.diff(t)
@@ -359,7 +376,7 @@ def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int,
         if duration(run) < dwell_s:
             run[2] = runs[k - 1][2] if k > 0 else None
     # leading short runs take the kind of the first long run (or stay as they are)
-    first_kind = next((r[2] for r in runs if r[2] is not None), bool(on[0]))
+    first_kind = next((r[2] for r in runs if r[2] is not None), int(on[0]))
     merged: list[list] = []
     for run in runs:
         kind = first_kind if run[2] is None else run[2]
@@ -392,12 +409,12 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
     """Segments of a block of samples (row indices shifted by ``offset``)."""
     dwell = float(cfg.segmentation.kind_dwell_s)
     min_s = float(cfg.segmentation.min_segment_s)
-    on = pd.Series(np.where(states == ROTATING_ON_BOTTOM, 1.0,
-                            np.where(states == ROTATING_OFF_BOTTOM, 0.0, np.nan)))
-    on = on.ffill().to_numpy() > 0.5  # unknown samples keep the previous kind
+    turning = pd.Series(np.where(np.isin(states, TURNING_STATES), states.astype(float), np.nan))
+    # unknown samples keep the previous kind
+    on = turning.ffill().fillna(ROTATING_OFF_BOTTOM).to_numpy().astype(np.int8)
     out: list[Segment] = []
     for a, b in _pieces(t, states, float(cfg.segmentation.max_gap_s)):
-        for ra, rb, on_bottom in _kind_runs(t[a:b], on[a:b], dwell):
+        for ra, rb, state in _kind_runs(t[a:b], on[a:b], dwell):
             i0, i1 = a + ra, a + rb
             depth = bit[i0:i1]
             finite = depth[np.isfinite(depth)]
@@ -406,15 +423,28 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
             if t1 - t0 < float(cfg.segmentation.min_rotation_s):
                 continue  # a blip of speed noise, not rotation
             status, message = _status(t1 - t0, n_null, i1 - i0, min_s)
+            if KINDS[state] in COMBINED_MOTION_KINDS:
+                status, message = "skipped", _combined_motion(KINDS[state], finite, t1 - t0)
             out.append(Segment(
                 id=first_id + len(out),
-                kind=KINDS[ROTATING_ON_BOTTOM if on_bottom else ROTATING_OFF_BOTTOM],
+                kind=KINDS[state],
                 t_start_s=t0, t_end_s=t1, i_start=offset + i0, i_end=offset + i1,
                 bit_depth_m=float(np.median(finite)) if finite.size else float("nan"),
                 bit_depth_min_m=float(finite.min()) if finite.size else float("nan"),
                 bit_depth_max_m=float(finite.max()) if finite.size else float("nan"),
                 duration_s=t1 - t0, status=status, message=message))
     return out
+
+
+def _combined_motion(kind: str, depth_m: np.ndarray, duration_s: float) -> str:
+    """Why a reaming / back-reaming segment is not estimated."""
+    speed = abs(depth_m[-1] - depth_m[0]) / duration_s if depth_m.size > 1 and \
+        duration_s > 0 else float("nan")
+    way = "running in" if kind == "reaming" else "pulling out"
+    return (f"{kind.replace('_', '-')}: the pipe is {way} at {speed:.2g} m/s while it turns, "
+            "so the wall friction splits between axial and tangential and the rotating model "
+            "(all friction tangential) does not hold: μ and the bit speed are withheld "
+            "(docs/segmentation.md)")
 
 
 def _nulls(frame: pd.DataFrame) -> dict[str, np.ndarray]:
@@ -517,7 +547,7 @@ class Segmenter:
     def _safe_cut(self) -> int:
         """Last buffer index before which no later data can change a segment."""
         t, states = self._buffer["t"], self._buffer["states"]
-        rotating = (states == ROTATING_OFF_BOTTOM) | (states == ROTATING_ON_BOTTOM)
+        rotating = np.isin(states, TURNING_STATES)
         other = np.flatnonzero(~rotating & (states != UNKNOWN))
         with np.errstate(invalid="ignore"):
             gaps = np.flatnonzero(np.diff(t) > self._cfg.segmentation.max_gap_s) + 1

@@ -17,6 +17,7 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
+from drillfric.estimation.diagnostics import stick_slip_severity
 from drillfric.io.well import open_well
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_KEYS
 from tests.conftest import REPO
@@ -90,23 +91,33 @@ def test_mu_s_honest(demo_run, truth):
 
 
 def test_bit_speed_in_severe_stick_slip(demo_run):
-    """Issue 5: estimated bit speed RMS error ≤ 35 RPM in severe stick-slip (the demo's
-    stands: severity 2–3, bit stuck 51–63 %; logged at 20 Hz, between the issue's 100 and
-    5 Hz). The seeded rows are consistent: the estimate lies inside the members' band, the
-    band is NaN on the starts' rows, and the summary's stuck fraction is that of the
-    ``bit_stuck`` rows it reports (after the start-up)."""
+    """Issues 5 and 22: in severe stick-slip (the demo's stands: severity 2–3, bit stuck
+    55–68 % of the time; logged at 20 Hz) a bit-speed trace is reported only when it keeps
+    to its top drive within the twist the torque allows (else withheld with the kinematic
+    reason: on the demo the ensemble runs 4–7 RPM ahead of or behind the top drive for
+    minutes), and then within 35 RPM RMS. The stuck fraction (|ω_bit| ≤ ω_c) and the severity
+    are reported within their stated tolerance, ±0.05 and ±12 % (docs/bit_speed.md), against
+    the truth over the same rows. Where a trace is reported it lies inside its band."""
     out = demo_run[0]
     summary = json.loads((out / "summary.json").read_text())
     est = pd.read_parquet(out / "estimates.parquet")
+    omega_c_rpm = 30.0 / np.pi  # the demo's ω_c = 1 rad/s
     for seg in summary["segments"]:
         if seg["status"] != "ok":
             continue
-        if seg["stick_slip_severity"] > 1.0:
-            assert seg["bit_rms_error_rpm"] <= 35.0, seg
         rows = est[(est["segment_id"] == seg["id"]) & (est["start_id"] == -1)]
         late = rows["time_s"] >= rows["time_s"].iloc[0] + min(30.0, 0.3 * np.ptp(rows["time_s"]))
-        assert rows.loc[late, "bit_stuck"].mean() == pytest.approx(seg["stuck_fraction"])
-    seeded = est[est["start_id"] == -1]
+        truth = rows.loc[late, "bit_rpm"].to_numpy()
+        if seg["bit_speed_resolved"]:
+            assert seg["bit_rms_error_rpm"] <= 35.0, seg
+        else:
+            assert "kinematic check" in seg["bit_speed_reason"], seg
+            assert rows["bit_rpm_est"].isna().all() and seg["bit_rms_error_rpm"] is None
+        assert seg["stuck_fraction"] == pytest.approx(np.mean(np.abs(truth) <= omega_c_rpm),
+                                                      abs=0.05)
+        assert seg["stick_slip_severity"] == pytest.approx(stick_slip_severity(truth),
+                                                           rel=0.12)
+    seeded = est[(est["start_id"] == -1) & est["bit_rpm_est"].notna()]
     assert (seeded["bit_rpm_est_min"] <= seeded["bit_rpm_est"] + 1e-3).all()
     assert (seeded["bit_rpm_est"] <= seeded["bit_rpm_est_max"] + 1e-3).all()
     assert est.loc[est["start_id"] >= 0, "bit_rpm_est_min"].isna().all()

@@ -27,7 +27,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
-from drillfric.estimation import batch
+from drillfric.estimation import batch, bit_trace
 from drillfric.estimation.batch.settings import MU_K_SKIP_S, TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -104,7 +104,9 @@ class SegmentEstimate:
     settling_time_s : float or None
     residual_rms_rpm : float
     stick_slip_severity : float
+        Severity of the ensemble's members pooled with their weights [-].
     stuck_fraction : float
+        Share of the time the pooled members' bit turns no faster than ω_c [-].
     mu_k_observer, mu_s_observer : float
         Observer consensus (first pass) [-].
     mu_td : float or None
@@ -128,7 +130,15 @@ class SegmentEstimate:
     evidence : FitEvidence
         The fitted model's string torque against the measured one.
     bit_speed : Resolution
-        Whether the logging resolves the stick-slip cycle (else no bit-speed trace).
+        Whether a bit-speed trace is reported: the logging resolves the stick-slip cycle,
+        the bit is off bottom and the trace passes the kinematic check
+        (:func:`drillfric.estimation.bit_trace.bit_speed_claim`); else the reason.
+    kinematics : KinematicCheck
+        The trace's kinematic check (docs/bit_speed.md).
+    bit_statistics : bool
+        Whether the stuck fraction and the severity may be reported: the logging resolves
+        the cycle and the bit is off bottom (they are validated within their tolerance also
+        where the kinematic check withholds the trace, docs/bit_speed.md).
     logged : LoggingInterval
         The log's effective interval and, with min/max channels, the torque swing within it.
     friction_zone : str
@@ -163,6 +173,8 @@ class SegmentEstimate:
     mu_s_seed: float | None = None
     evidence: FitEvidence | None = field(default=None, repr=False)
     bit_speed: Resolution | None = None
+    kinematics: bit_trace.KinematicCheck | None = None
+    bit_statistics: bool = False
     logged: LoggingInterval | None = None
     friction_zone: str = "effective"
 
@@ -524,15 +536,22 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     final, bit = seeded_pass(cfg, models, verdict, out_rate)
     tick(0.2)
     estimate = _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
+    kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
+                                               bit.rad_s, cfg.observer.speed_noise_rpm
+                                               * RPM_TO_RAD_S)
+    logging = bit_speed_resolution(models)
     return replace(estimate, evidence=fit_evidence(cfg, models, verdict, refined.mu_s),
-                   bit_speed=bit_speed_resolution(models), logged=models.logged)
+                   bit_speed=bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom),
+                   kinematics=kinematics, bit_statistics=logging.resolved and not models.on_bottom,
+                   logged=models.logged)
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,
               verdict: Verdict, final, bit) -> SegmentEstimate:
     """The segment's estimate from the chain's results (diagnostics of what is reported)."""
     reported = diagnose(bit.record(final), cfg.omega_c_rad_s)
-    stuck = bit.stuck(final, cfg.omega_c_rad_s)[settled_mask(final.time_s)]
+    late = settled_mask(final.time_s)
+    members, weights = final.bit_rad_s_est[late], bit.weights[late]
     messages = list(verdict.messages)
     if Flag.CREEP_FIT_AT_BOUND in verdict.flags:
         messages.append(_creep_advice(models.string, models.td.T_N_Nm, verdict.mu_k, refined,
@@ -542,7 +561,8 @@ def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag
         mu_s_lower_bound=verdict.mu_s_lower_bound, mu_s_spread=_mu_s_spread(cfg, refined, diag),
         mu_k_spread=diag.mu_k_spread, converged=verdict.converged, method=verdict.method,
         settling_time_s=diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
-        stick_slip_severity=reported.stick_slip_severity, stuck_fraction=float(np.mean(stuck)),
+        stick_slip_severity=bit_trace.mixture_severity(members, weights),
+        stuck_fraction=bit_trace.stuck_share(members, weights, cfg.omega_c_rad_s),
         mu_k_observer=diag.mu_k, mu_s_observer=diag.mu_s,
         mu_td=_td_cross_check(models, cfg), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags, messages=tuple(messages), starts=starts, first=first,

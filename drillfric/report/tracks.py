@@ -70,7 +70,8 @@ PANELS = (
                                          "#2980b9"),)),
 )
 #: Colour of each rig state (index into drillfric.segmentation.RIG_STATES).
-STATE_COLORS = ("#9ecae1", "#3182bd", "#fdae6b", "#a1d99b", "#d9d9d9", "#f7f7f7", "#9e9ac8")
+STATE_COLORS = ("#9ecae1", "#3182bd", "#fdae6b", "#a1d99b", "#d9d9d9", "#f7f7f7", "#9e9ac8",
+                "#fdd0a2", "#c994c7")
 #: Shading of segments on the tracks by kind.
 SEGMENT_COLORS = {"off_bottom_rotating": "#1f5fa8", "on_bottom_rotating": "#e67e22"}
 _TRACK_PX = 120

@@ -1,0 +1,227 @@
+"""What a bit-speed trace may claim: the kinematic check, the on-bottom rule, stuck and severity.
+
+**Kinematics** (docs/bit_speed.md "Kinematic check"). The top drive and the bit are the two
+ends of one string. Integrating eq. (1) of docs/theory.md §3, ∂τ/∂t + JG ∂ω/∂x = 0, along
+the string gives ω_bit − ω₀ = −dΘ/dt with Θ = ∫ τ/(GJ) dx the string's twist, so over any
+window [t₁, t₂] of length T
+
+    mean(ω_bit) − mean(ω₀) = −(Θ(t₂) − Θ(t₁)) / T.
+
+The twist is bounded by the torque the string carries: with τ(x) between min(τ_lo, 0) and
+τ_hi (the measured extremes of the surface torque; off bottom the bit end carries 0) and
+the string's compliance C = Σ L_i/(G_i J_i), |ΔΘ| ≤ C·(τ_hi − min(τ_lo, 0)) — twice the twist of
+a string whose torque falls linearly from τ_hi to 0, so a true trace uses about 80 % of it
+(measured on simulated severe stick-slip). A trace whose accumulated angle
+∫(ω̂_bit − ω₀) dt changes by more than that bound, plus the speed noise's random walk and one
+output interval at the peak speed (the trace's samples are integrated), over any window
+claims a bit running ahead of or behind its top drive for longer than any twist allows:
+it is withheld with the window and the mean lag as the reason. A mean lag within the
+accuracy claimed in steady rotation (:data:`MEAN_LAG_TOLERANCE_RPM` × the window) is
+allowed on top: such a trace is not false within its tolerance.
+
+**On bottom** the estimators have no bit–rock torque (docs/theory.md §3, "Bit"): the trace is
+withheld there whatever the check says (issue 22: seven on-bottom traces at 10 Hz were worse
+than the surface speed).
+
+**Stuck and severity.** The bit is stuck while it turns no faster than ω_c: inside the
+static band of the friction law (docs/theory.md §3) the friction holds the bit, which may
+still creep a few RPM under a held torque. The stuck fraction and the stick-slip severity
+are statistics of the ensemble's members pooled with their weights (the mixture), not of
+their weighted mean: members drift apart in phase, and their mean smooths the slips (its
+severity read 7–14 % low on the validation truths, docs/validation.md "Bit-speed
+statistics").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from drillfric.estimation.sampling import Resolution
+from drillfric.units import RPM_TO_RAD_S
+
+#: Percentiles of the measured torque taken as its extremes (a glitch does not widen the
+#: twist bound) [%].
+TORQUE_PERCENTILES = (0.1, 99.9)
+#: Standard deviations of the speed noise's random walk allowed on top of the twist bound.
+NOISE_SIGMAS = 3.0
+#: Mean lag within the bit-speed accuracy claimed in steady rotation (≤ 2 RPM RMS,
+#: docs/validation.md) is not a false claim: a window of length T may drift by this × T more
+#: [RPM]. (On the trust plant "steady" the trace ran 1.3 RPM behind for 5 minutes.)
+MEAN_LAG_TOLERANCE_RPM = 2.0
+
+
+@dataclass(frozen=True)
+class KinematicCheck:
+    """Whether a bit-speed trace keeps to its top drive within what the twist allows.
+
+    Attributes
+    ----------
+    passed : bool
+    drift_rad : float
+        Largest change of ∫(ω̂_bit − ω₀) dt over any window of the trace [rad].
+    allowed_rad : float
+        The twist bound plus the noise and sampling allowance [rad].
+    t_from_s, t_to_s : float
+        The window of that largest change [s].
+    lag_rpm : float
+        mean(ω̂_bit) − mean(ω₀) over that window [RPM] (negative: the bit behind).
+    """
+
+    passed: bool
+    drift_rad: float
+    allowed_rad: float
+    t_from_s: float
+    t_to_s: float
+    lag_rpm: float
+
+    @property
+    def reason(self) -> str:
+        """Why the trace is withheld ("" when it passed)."""
+        if self.passed:
+            return ""
+        side = "behind" if self.lag_rpm < 0 else "ahead of"
+        return (f"bit speed withheld: the estimated bit runs {abs(self.lag_rpm):.1f} RPM "
+                f"{side} the top drive on average over {self.t_from_s:.0f}–{self.t_to_s:.0f} "
+                f"s, a twist change of {self.drift_rad:.0f} rad where the string's torque "
+                f"range allows {self.allowed_rad:.0f} rad (kinematic check, docs/bit_speed.md)")
+
+
+def compliance_rad_Nm(string) -> float:
+    """Torsional compliance of the whole string C = Σ L_i/(G_i J_i) [rad/(N·m)].
+
+    Examples
+    --------
+    >>> from drillfric.drillstring import build_string
+    >>> s = build_string([{"name": "DP", "od_m": 0.127, "id_m": 0.1086}], 1000.0)
+    >>> round(compliance_rad_Nm(s) * 79.3e9 * s.sections[0].polar_moment_m4, 6)
+    1000.0
+    """
+    return float(sum(s.length_m / (s.shear_modulus_Pa * s.polar_moment_m4)
+                     for s in string.sections))
+
+
+def twist_bound_rad(torque_Nm: np.ndarray, compliance: float) -> float:
+    """Largest change of the string's twist the measured torque allows [rad]:
+    C·(τ_hi − min(τ_lo, 0)), τ_lo/τ_hi the :data:`TORQUE_PERCENTILES` of the torque."""
+    q = np.asarray(torque_Nm, dtype=float)
+    q = q[np.isfinite(q)]
+    if q.size == 0:
+        return 0.0
+    lo, hi = np.percentile(q, TORQUE_PERCENTILES)
+    return float(compliance * (max(hi, 0.0) - min(lo, 0.0)))
+
+
+def check_trace(time_s, bit_rad_s, surface_time_s, surface_rad_s, twist_bound: float,
+                noise_rad_s: float) -> KinematicCheck:
+    """Kinematic check of an estimated bit speed against the measured top-drive speed.
+
+    Parameters
+    ----------
+    time_s, bit_rad_s : ndarray
+        The trace: sample times [s] and estimated bit speed [rad/s].
+    surface_time_s, surface_rad_s : ndarray
+        Measured top-drive speed [s], [rad/s] (uniform samples).
+    twist_bound : float
+        Largest twist change the string allows [rad] (:func:`twist_bound_rad`).
+    noise_rad_s : float
+        Standard deviation of the measured speed [rad/s].
+    """
+    t, bit = np.asarray(time_s, dtype=float), np.asarray(bit_rad_s, dtype=float)
+    ts, ws = np.asarray(surface_time_s, dtype=float), np.asarray(surface_rad_s, dtype=float)
+    if t.size < 2 or ts.size < 2 or not np.all(np.isfinite(bit)):
+        return KinematicCheck(t.size >= 2 and np.all(np.isfinite(bit)), 0.0, twist_bound,
+                              0.0, 0.0, 0.0)
+    surface_angle = np.interp(t, ts, _angle(ts, ws))
+    drift = _angle(t, bit) - surface_angle
+    lag = MEAN_LAG_TOLERANCE_RPM * RPM_TO_RAD_S
+    a, b = _worst_window(drift, t, lag)
+    change = float(drift[b] - drift[a])
+    dt_surface = float(np.median(np.diff(ts)))
+    walk = NOISE_SIGMAS * noise_rad_s * np.sqrt(dt_surface * (t[-1] - t[0]))
+    sampling = float(np.max(np.abs(bit))) * float(np.max(np.diff(t)))
+    allowed = twist_bound + walk + sampling + lag * float(t[b] - t[a])
+    span = max(t[b] - t[a], 1e-9)
+    return KinematicCheck(abs(change) <= allowed, abs(change), float(allowed), float(t[a]),
+                          float(t[b]), change / span / RPM_TO_RAD_S)
+
+
+def _worst_window(drift: np.ndarray, time_s: np.ndarray, lag_rad_s: float) -> tuple[int, int]:
+    """Indices (a ≤ b) of the window whose |drift(b) − drift(a)| − ``lag_rad_s``·(t_b − t_a)
+    is largest (O(n): the largest drop of drift + lag·t and rise of drift − lag·t after a
+    running extreme); the last visit of the extreme, so the window is the shortest."""
+    best = (-np.inf, 0, 0)
+    for sign in (1.0, -1.0):
+        rise = sign * drift - lag_rad_s * time_s
+        low = np.minimum.accumulate(rise)
+        b = int(np.argmax(rise - low))
+        a = int(np.flatnonzero(rise[:b + 1] <= low[b] + 1e-12)[-1])
+        if rise[b] - low[b] > best[0]:
+            best = (rise[b] - low[b], a, b)
+    return best[1], best[2]
+
+
+def _angle(time_s: np.ndarray, speed_rad_s: np.ndarray) -> np.ndarray:
+    """Angle turned since the first sample [rad] (trapezoidal rule)."""
+    steps = 0.5 * (speed_rad_s[1:] + speed_rad_s[:-1]) * np.diff(time_s)
+    return np.concatenate(([0.0], np.cumsum(steps)))
+
+
+def check_segment_trace(string, meas, time_s, bit_rad_s, noise_rad_s: float) -> KinematicCheck:
+    """:func:`check_trace` of a segment's trace against its measurements (``meas``:
+    :class:`~drillfric.estimation.observer.Measurements`) on ``string``'s twist bound."""
+    bound = twist_bound_rad(meas.motor_torque_Nm, compliance_rad_Nm(string))
+    return check_trace(time_s, bit_rad_s, meas.time_s, meas.surface_rad_s, bound, noise_rad_s)
+
+
+def bit_speed_claim(resolution: Resolution, check: KinematicCheck,
+                    on_bottom: bool) -> Resolution:
+    """What may be reported of the bit speed: the logging's :class:`Resolution`, withheld
+    (``resolved`` false with the reason) on bottom and where the kinematic check fails."""
+    if not resolution.resolved:
+        return resolution
+    if on_bottom:
+        return replace(resolution, resolved=False, reason=(
+            "bit speed withheld on bottom: the model has no bit–rock torque, and on "
+            "simulated on-bottom records the trace was not better than the surface speed "
+            "(docs/bit_speed.md)"))
+    if not check.passed:
+        return replace(resolution, resolved=False, reason=check.reason)
+    return resolution
+
+
+def stuck_share(member_bit_rad_s: np.ndarray, weights: np.ndarray,
+                omega_c_rad_s: float) -> float:
+    """Share of the time the bit is stuck, |ω_bit| ≤ ω_c, over the members pooled with
+    their weights [-] (``member_bit_rad_s``, ``weights``: shape (R, S), rows of weights sum
+    to 1).
+
+    Examples
+    --------
+    >>> bit = np.array([[0.0, 5.0], [5.0, 5.0]])
+    >>> float(stuck_share(bit, np.full((2, 2), 0.5), 1.0))
+    0.25
+    """
+    stuck = np.abs(member_bit_rad_s) <= omega_c_rad_s
+    return float(np.sum(weights * stuck) / max(weights.shape[0], 1))
+
+
+def mixture_severity(member_bit_rad_s: np.ndarray, weights: np.ndarray) -> float:
+    """Stick-slip severity (ω_99 − ω_1)/(2·ω_mean) of the members pooled with their
+    weights (weighted percentiles) [-]; 0 for a bit at rest.
+
+    Examples
+    --------
+    >>> bit = np.column_stack([np.tile([0.0, 2.0], 50), np.tile([2.0, 0.0], 50)])
+    >>> round(mixture_severity(bit, np.full(bit.shape, 0.5)), 2)
+    1.0
+    """
+    x, w = np.ravel(member_bit_rad_s), np.ravel(weights)
+    mean = float(np.sum(w * x) / max(np.sum(w), 1e-300))
+    if abs(mean) < 1e-9:
+        return 0.0
+    order = np.argsort(x, kind="stable")
+    cum = np.cumsum(w[order])
+    lo, hi = np.interp([0.01 * cum[-1], 0.99 * cum[-1]], cum, x[order])
+    return float((hi - lo) / (2.0 * abs(mean)))

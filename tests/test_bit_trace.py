@@ -1,0 +1,141 @@
+"""The kinematic check of a bit-speed trace, the on-bottom rule, stuck fraction and severity
+(drillfric.estimation.bit_trace; docs/bit_speed.md "Kinematic check")."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drillfric.drillstring import build_string
+from drillfric.estimation.bit_trace import (
+    bit_speed_claim,
+    check_trace,
+    compliance_rad_Nm,
+    mixture_severity,
+    stuck_share,
+    twist_bound_rad,
+)
+from drillfric.estimation.diagnostics import stick_slip_severity
+from drillfric.estimation.sampling import Resolution
+from tests.synthetic import RPM, build_and_hold, config, simulate
+
+NOISE = 0.5 * RPM
+
+
+def _string(depth_m=2300.0):
+    return build_string(config().sections, depth_m)
+
+
+def test_compliance_adds_the_sections_in_series():
+    """C = Σ L_i/(G_i J_i): the pipe alone, then pipe + the BHA's two sections."""
+    string = _string()
+    parts = [s.length_m / (s.shear_modulus_Pa * s.polar_moment_m4) for s in string.sections]
+    assert len(parts) == 3
+    assert compliance_rad_Nm(string) == pytest.approx(sum(parts))
+
+
+def test_twist_bound_spans_zero_to_the_highest_torque():
+    """The twist lies between that of min(τ_lo, 0) and of τ_hi over the whole string; a
+    single glitch (outside the 0.1–99.9 percentiles) does not widen it."""
+    torque = np.r_[np.linspace(5e3, 20e3, 5000), 1e7]
+    assert twist_bound_rad(torque, 1e-3) == pytest.approx(20.0, rel=1e-2)
+    assert twist_bound_rad(np.full(100, -3e3), 1e-3) == pytest.approx(3.0)
+
+
+def test_rigid_string_trace_equal_to_the_surface_passes():
+    """A rigid string: mean bit = mean surface over every window, no drift at all."""
+    t = np.arange(0.0, 300.0, 0.01)
+    surface = 40 * RPM + 2 * RPM * np.sin(t)
+    check = check_trace(t[::10], surface[::10], t, surface, twist_bound=0.0, noise_rad_s=0.0)
+    assert check.passed
+    assert check.drift_rad < 0.05
+
+
+def test_twist_change_within_the_torque_bound_passes():
+    """bit = ω₀ − dΘ/dt with Θ = C·τ/2 swinging with a stick-slip-like torque: the drift is
+    the twist change, inside the bound from the same torque."""
+    t = np.arange(0.0, 300.0, 0.01)
+    c = compliance_rad_Nm(_string())
+    torque = 15e3 + 8e3 * np.sign(np.sin(2 * np.pi * t / 6.0))
+    twist = np.convolve(c * torque / 2, np.ones(50) / 50, mode="same")
+    surface = np.full_like(t, 40 * RPM)
+    bit = surface - np.gradient(twist, t)
+    check = check_trace(t[::10], bit[::10], t, surface, twist_bound_rad(torque, c), NOISE)
+    assert check.passed, check
+
+
+def test_trace_6_rpm_behind_its_top_drive_for_2_minutes_is_withheld():
+    """Issue 22: back-reaming at 0.2 m/s, every member drew the bit at 33–34 RPM for 2 minutes
+    while the top drive and the bit turned at 40 RPM. At 2300 m with a torque swinging
+    10–20 kN·m the string holds at most C·20 kN·m ≈ 31 rad of twist; 6 RPM for 120 s is
+    75 rad: withheld, with the window and the lag in the reason."""
+    t = np.arange(0.0, 150.0, 0.01)
+    surface = np.full_like(t, 40 * RPM)
+    bit = np.where((t > 20) & (t < 140), 34 * RPM, 40 * RPM)
+    torque = 15e3 + 5e3 * np.sin(t)
+    bound = twist_bound_rad(torque, compliance_rad_Nm(_string()))
+    check = check_trace(t[::10], bit[::10], t, surface, bound, NOISE)
+    assert not check.passed
+    assert check.drift_rad == pytest.approx(6 * RPM * 120, rel=0.01)
+    assert check.lag_rpm == pytest.approx(-6.0, abs=0.1)
+    assert 19 < check.t_from_s < 21 and 139 < check.t_to_s < 141
+    claim = bit_speed_claim(Resolution(True, 20.0), check, on_bottom=False)
+    assert not claim.resolved
+    assert "6.0 RPM behind the top drive" in claim.reason and "20–140 s" in claim.reason
+
+
+def test_simulated_stick_slip_truth_passes_the_check():
+    """The true bit speed of a simulated severe stick-slip record (a plant keeps its own
+    kinematics) passes against the record's noisy surface data: the bound is not too tight."""
+    path = build_and_hold(800.0, 45.0, 2000.0)
+    case = simulate(path, 2000.0, 0.8, 0.3, 40.0, 120.0, cells=600, rate_hz=100.0)
+    rec = case.record
+    rng = np.random.default_rng(1)
+    surface = rec.surface_rad_s + rng.normal(0.0, NOISE, rec.time_s.size)
+    assert stick_slip_severity(rec.bit_rad_s[rec.time_s > 30]) > 1.5
+    bound = twist_bound_rad(rec.motor_torque_Nm, compliance_rad_Nm(case.string))
+    truth = check_trace(rec.time_s[::10], rec.bit_rad_s[::10], rec.time_s, surface, bound,
+                        NOISE)
+    assert truth.passed, truth
+    assert truth.drift_rad > 0.5 * bound  # the check is not vacuous: the twist swings a lot
+    lagging = check_trace(rec.time_s[::10], rec.bit_rad_s[::10] - 5 * RPM, rec.time_s,
+                          surface, bound, NOISE)
+    assert not lagging.passed
+
+
+def test_on_bottom_trace_is_withheld_and_unresolved_keeps_its_reason():
+    passed = check_trace(np.arange(3.0), np.ones(3), np.arange(3.0), np.ones(3), 1.0, 0.0)
+    on_bottom = bit_speed_claim(Resolution(True, 20.0), passed, on_bottom=True)
+    assert not on_bottom.resolved and "on bottom" in on_bottom.reason
+    slow = Resolution(False, 2.0, "bit speed not resolved: 5-s means")
+    assert bit_speed_claim(slow, passed, on_bottom=True) is slow
+    assert bit_speed_claim(Resolution(True, 20.0), passed, on_bottom=False).resolved
+
+
+def test_non_finite_trace_never_passes():
+    t = np.arange(10.0)
+    check = check_trace(t, np.r_[np.ones(9), np.nan], t, np.ones(10), 100.0, 0.0)
+    assert not check.passed
+
+
+def test_stuck_fraction_and_severity_of_members_out_of_phase():
+    """Two members, each stuck 60 % of a 10-s cycle and slipping at 100 RPM, half a cycle
+    apart: their weighted mean is rarely below ω_c and swings half as far (stuck fraction
+    0.2, severity halved), the pooled members keep each member's 0.6 and severity."""
+    t = np.arange(0.0, 100.0, 0.1)
+    one = np.where((t % 10.0) < 6.0, 0.0, 100 * RPM)
+    other = np.where(((t + 5.0) % 10.0) < 6.0, 0.0, 100 * RPM)
+    bit = np.column_stack([one, other])
+    w = np.full(bit.shape, 0.5)
+    assert stuck_share(bit, w, 1.0) == pytest.approx(0.6)
+    assert mixture_severity(bit, w) == pytest.approx(stick_slip_severity(one))
+    mean = bit.mean(axis=1)
+    assert np.mean(np.abs(mean) <= 1.0) == pytest.approx(0.2)
+    assert stick_slip_severity(mean) < 0.6 * stick_slip_severity(one)
+
+
+def test_creeping_bit_counts_as_stuck():
+    """A stuck bit may creep a few RPM under a held torque: below ω_c it is stuck."""
+    bit = np.full((10, 1), 3 * RPM)
+    assert stuck_share(bit, np.ones((10, 1)), 1.0) == 1.0
+    assert stuck_share(bit + 10 * RPM, np.ones((10, 1)), 1.0) == 0.0
