@@ -62,6 +62,7 @@ class Flag(StrEnum):
     OUTSIDE_TYPICAL_RANGE = "outside_typical_range"
     BIT_TORQUE_IN_FRICTION = "bit_torque_in_friction"
     POOLED = "pooled"
+    BIT_SPEED_DRIFT = "bit_speed_drift"
 
 
 #: What each flag means (docs/outputs.md).
@@ -88,6 +89,9 @@ FLAG_MEANINGS = {
     Flag.TOO_SHORT_TO_CONVERGE: "less than 90 s of rotation: not converged",
     Flag.OUTSIDE_TYPICAL_RANGE: "μ_k outside 0.05–0.8: check string, survey, torque units",
     Flag.BIT_TORQUE_IN_FRICTION: "on bottom: the bit torque is in the apparent friction",
+    Flag.BIT_SPEED_DRIFT: "the bit-speed trace drifts from the top drive by more than the "
+                          "string's twist allows, by under a third of its stick-slip swing: "
+                          "shown, its phase approximate",
     Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
                  "μ_k agree (summary.json pooled)",
 }

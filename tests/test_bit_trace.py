@@ -11,6 +11,7 @@ from drillfric.estimation.bit_trace import (
     bit_speed_claim,
     check_trace,
     compliance_rad_Nm,
+    drift_note,
     mixture_severity,
     stuck_share,
     twist_bound_rad,
@@ -139,3 +140,22 @@ def test_creeping_bit_counts_as_stuck():
     bit = np.full((10, 1), 3 * RPM)
     assert stuck_share(bit, np.ones((10, 1)), 1.0) == 1.0
     assert stuck_share(bit + 10 * RPM, np.ones((10, 1)), 1.0) == 0.0
+
+
+def test_stick_slip_trace_drifting_under_a_third_of_its_swing_is_shown_flagged():
+    """A trace that fails the check by a mean lag far below its stick-slip swing stays
+    within its stated accuracy (a mean offset ε adds at most ε to the RMS error): shown, with
+    the flag's message; the same lag under a steady top drive (swing ≈ lag) is withheld."""
+    t = np.arange(0.0, 300.0, 0.01)
+    surface = np.full_like(t, 60 * RPM)
+    stick_slip = 60 * RPM * (1.0 + np.sign(np.sin(2 * np.pi * t / 6.0)))  # 0 / 120 RPM
+    bound = twist_bound_rad(15e3 + 5e3 * np.sin(t), compliance_rad_Nm(_string()))
+    drifting = check_trace(t[::10], stick_slip[::10] + 6 * RPM, t, surface, bound, NOISE)
+    assert not drifting.passed and drifting.approximate
+    assert drifting.swing_rpm == pytest.approx(60.3, abs=1.0) and 5.5 < drifting.lag_rpm < 7.0
+    claim = bit_speed_claim(Resolution(True, 20.0), drifting, on_bottom=False)
+    assert claim.resolved
+    assert f"{drifting.lag_rpm:.1f} RPM ahead of the top drive" in drift_note(drifting)
+    steady = check_trace(t[::10], surface[::10] + 6 * RPM, t, surface, bound, NOISE)
+    assert not steady.passed and not steady.approximate
+    assert not bit_speed_claim(Resolution(True, 20.0), steady, on_bottom=False).resolved

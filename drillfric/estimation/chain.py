@@ -540,9 +540,14 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                                                bit.rad_s, cfg.observer.speed_noise_rpm
                                                * RPM_TO_RAD_S)
     logging = bit_speed_resolution(models)
+    claim = bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom)
+    drift = claim.resolved and kinematics.approximate
     return replace(estimate, evidence=fit_evidence(cfg, models, verdict, refined.mu_s),
-                   bit_speed=bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom),
-                   kinematics=kinematics, bit_statistics=logging.resolved and not models.on_bottom,
+                   bit_speed=claim, kinematics=kinematics,
+                   bit_statistics=logging.resolved and not models.on_bottom,
+                   flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ()),
+                   messages=estimate.messages + ((bit_trace.drift_note(kinematics),)
+                                                 if drift else ()),
                    logged=models.logged)
 
 
