@@ -223,12 +223,14 @@ def first_stand_alone(tmp_path_factory):
     return folder / "demo.csv"
 
 
-def test_no_survey_assumes_a_tortuous_vertical_well(first_stand_alone, tmp_path, truth):
+def test_no_survey_assumes_a_tortuous_vertical_well(first_stand_alone, tmp_path):
     """Without a survey the hole is vertical with the nominal tortuosity (1°/30 m): the
     stand gets side force and is estimated, and the assumption is said in the terminal,
-    summary.json and the report. The data identify μ_k·T_N (the mean rotating torque), so
-    μ_k ≈ μ_k,true·T_N,true/T_N,assumed — within the 5 % of the μ_k acceptance (the demo's
-    true path is a 50° build-and-hold with T_N,true = 54.7 kN·m at 2210 m)."""
+    summary.json and the report. The data identify μ_k·T_N only (μ_k would be
+    μ_k,true·T_N,true/T_N,assumed, 19 % low: the true path is a 50° build-and-hold), and the
+    log's own hook load says so: the string hangs ~790 kN on the hook, well below the assumed
+    vertical string's buoyed weight, so μ_k is withheld by the hook-load check
+    (docs/theory.md §2.1; no slips in this stand, so only the gross check applies)."""
     result = CliRunner().invoke(cli, ["run", str(first_stand_alone), "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
     note = "a vertical well with a nominal tortuosity of 1.0°/30 m, no survey found"
@@ -237,8 +239,9 @@ def test_no_survey_assumes_a_tortuous_vertical_well(first_stand_alone, tmp_path,
     assert summary["indicative"] and any(a.startswith(note) for a in summary["assumed"])
     [seg] = summary["segments"]
     assert seg["status"] == "ok" and seg["T_N_Nm"] > 0
-    true_tn = truth["stands"][0]["T_N_Nm"]
-    assert seg["mu_k"] == pytest.approx(truth["mu_k"] * true_tn / seg["T_N_Nm"], rel=0.05)
+    assert seg["mu_k"] is None and "hookload_contradicts_string" in seg["flags"]
+    assert seg["hookload_N"] < 0.9 * seg["hookload_model_N"]
+    assert summary["hookload"]["block_weight_N"] is None and summary["mu_k_reason"]
     html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
     assert "nominal tortuosity of 1.0°/30 m" in html  # the highlighted assumptions
     assert "No survey: the well was taken as vertical with a nominal tortuosity" in html
