@@ -321,6 +321,18 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "depth is reckoned from block position (without it segment depths are unknown).",
             min=0.0),
     ),
+    "hookload": (
+        Key("tolerance", float, 0.10, "", "Relative tolerance of the hook-load check "
+            "(docs/theory.md §2.1): the string weight the log measures (rotating off-bottom "
+            "hook load − block weight in the slips) may differ from the configured string's "
+            "buoyed weight by this share before the friction factors are withheld (sensor "
+            "±2–5 %, block-weight plateau, mud density, hydraulic lift).", min=0.02, max=0.5),
+        Key("calibrate_string_weight", bool, False, "", "When the hook load contradicts the "
+            "configured string, scale the string's buoyed weight to the measured one (a "
+            "first pass over the log; needs the block weight from the slips; scale within "
+            "0.5–2) instead of withholding the friction factors. The result says so "
+            "(flag string_weight_calibrated, summary.json hookload)."),
+    ),
     "friction_log": (
         _positive("window_m", 30.0, "m", "Depth window of the static friction log of a "
                   "depth-indexed log (docs/ingestion.md): the rows of each window give one "

@@ -38,6 +38,7 @@ from drillfric.estimation.chain import (
 )
 from drillfric.estimation.observer import ObserverRecord
 from drillfric.friction import FrictionProfile
+from drillfric.hookload import PlateauFinder, calibrate, judge
 from drillfric.io.logcheck import LogCheck
 from drillfric.io.results import (
     EstimatesWriter,
@@ -188,6 +189,8 @@ def run_well(well: Well, out_root=None, *, rate_hz: float | None = None, pdf: bo
 
 def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
     """Steps 1–4 into ``sink``."""
+    well, calibration = calibrate(well, chunk_rows)  # hook-load evidence (docs/theory.md §2.1)
+    hook = PlateauFinder(well.config)
     estimator = _SegmentEstimator(well)
     check = LogCheck(well)
     tracker = well.time_tracker()
@@ -210,6 +213,7 @@ def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
             estimator.rate_hz = _first_chunk(well, chunk, rate_hz, warnings)
             estimator.has_truth = "bit_rpm" in chunk
         check.feed(chunk)
+        hook.feed(chunk)
         take(stream.feed(chunk))
         tracks.feed(chunk, stream.last_states)
         if progress:
@@ -220,9 +224,12 @@ def _run(well: Well, sink, rate_hz, progress, chunk_rows, t_wall) -> WellResult:
                          fix="check that the file holds samples below its header")
     check.finish(tracker.duplicates)
     warnings += [w for w in (check.nothing_found(len(records)),) if w]
-    records, pools = pool_short_segments(records)
+    weighed = judge(records, hook.close(), well.config, calibration)
+    warnings += weighed.warnings
+    records, pools = pool_short_segments(weighed.records)
     summary = summarise(well, records, pools, estimator, check.rows, rate_hz, warnings,
                         time.perf_counter() - t_wall)
+    summary.update(hookload=weighed.summary, mu_k_reason=weighed.mu_k_reason(summary["mu_k"]))
     summary["time_origin_utc"] = _iso(tracker.origin)
     track_frame = tracks.result()
     sink.finish(well, summary, records, track_frame)

@@ -63,6 +63,8 @@ class Flag(StrEnum):
     BIT_TORQUE_IN_FRICTION = "bit_torque_in_friction"
     POOLED = "pooled"
     BIT_SPEED_DRIFT = "bit_speed_drift"
+    HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
+    STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
 
 
 #: What each flag means (docs/outputs.md).
@@ -94,6 +96,12 @@ FLAG_MEANINGS = {
                           "shown, its phase approximate",
     Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
                  "μ_k agree (summary.json pooled)",
+    Flag.HOOKLOAD_CONTRADICTS_STRING: "the hook load contradicts the configured string's "
+                                      "weight beyond hookload.tolerance (docs/theory.md "
+                                      "§2.1): friction factors withheld (null)",
+    Flag.STRING_WEIGHT_CALIBRATED: "the string's buoyed weight was scaled to the hook load "
+                                   "before estimation (hookload.calibrate_string_weight; "
+                                   "summary.json hookload)",
 }
 
 

@@ -1,0 +1,553 @@
+"""Hook-load calibration: the block weight from the slips, the string weight from the
+rotating hook load, and the check of the configured string against both.
+
+docs/theory.md §2.1. The hook carries the travelling block and top drive (weight B) and,
+off the slips, the string. Rotating off bottom the soft-string model has no axial friction
+(σ = 0, docs/theory.md §2 step 3), so the measured hook load is
+
+    H_rot = B + W_b,            W_b = Σ w_buoyed·Δs·cos Ī  (the model's ``hookload_N``),
+
+and in the slips H_slips = B. The log therefore weighs the string itself:
+W_meas = H_rot − H_slips. The friction factors scale as 1/W (T_N is proportional to the
+string's weight when it rotates off bottom), so a configured string the hook load
+contradicts gives wrong friction factors: they are withheld, or — where the configuration
+allows it (``[hookload] calibrate_string_weight``) — the string's buoyed weight is scaled
+to the measured one before the estimation (:func:`calibrate`).
+
+Layers: pure functions (:func:`modelled_string_weight_N`, :func:`scaled_sections`,
+:func:`block_weight`, :func:`point_problem`), the streaming :class:`PlateauFinder` (the
+in-slips evidence, chunk by chunk), and :func:`judge`, which applies the check to a well's
+segment records.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from drillfric import torque_drag
+from drillfric.drillstring import section_from_config
+from drillfric.kernels.lazy import lazy_jit
+from drillfric.result import Flag, Kind, SegmentRecord, Status
+
+#: Heaviest plausible travelling equipment (block, hook, top drive, elevators) [N]: about
+#: 70 t, above the heaviest offshore top-drive systems. Without an in-slips plateau a hook
+#: load above the modelled string weight by more than this cannot be the configured string.
+MAX_BLOCK_WEIGHT_N = 700e3
+#: Lightest plausible string, buoyed weight per metre [N/m] (2⅜-in tubing, ~6 kg/m in mud).
+#: A quiet plateau is only taken for the slips when it lies below the rotating hook loads by
+#: at least this string's weight at their bit depths (else it is the string hanging).
+MIN_STRING_WEIGHT_N_M = 50.0
+#: Shortest quiet stretch that counts as a plateau [s].
+PLATEAU_MIN_S = 10.0
+#: A plateau's hook load stays within this share of its level (or :data:`PLATEAU_BAND_N`,
+#: the larger) of its running mean; leaving it for :data:`PLATEAU_BREAK_S` ends it.
+PLATEAU_BAND = 0.03
+PLATEAU_BAND_N = 3e3
+PLATEAU_BREAK_S = 2.0
+#: Depth (bit, else block) speed below which the string or block counts as still [m/s].
+STILL_M_S = 0.05
+#: Range of the string-weight scale a calibration may apply; beyond it the configured
+#: string is too far off to be rescued by one factor (fix the string instead).
+CALIBRATION_RANGE = (0.5, 2.0)
+#: Plateaus listed in summary.json as the block weight's evidence (the longest).
+EVIDENCE_LISTED = 20
+
+
+@dataclass(frozen=True)
+class Plateau:
+    """A stretch of steady hook load while the string does not turn or move.
+
+    Attributes
+    ----------
+    t_start_s, t_end_s : float
+        First and last row of the stretch [s].
+    rows : int
+        Rows inside the hook-load band.
+    level_N : float
+        Mean hook load of those rows [N].
+    """
+
+    t_start_s: float
+    t_end_s: float
+    rows: int
+    level_N: float
+
+    @property
+    def duration_s(self) -> float:
+        return self.t_end_s - self.t_start_s
+
+
+@dataclass(frozen=True)
+class BlockWeight:
+    """The block weight the hook load gives, with its evidence.
+
+    Attributes
+    ----------
+    weight_N : float or None
+        Hook load in the slips [N]; None when the log gives none (``reason`` says why).
+    source : str
+        ``"slips_hookload_N"`` (rows below the configured threshold), ``"log"`` (the
+        lowest quiet plateau) or ``"none"``.
+    plateaus : tuple of Plateau
+        The plateaus the weight rests on.
+    reason : str
+        Why there is no block weight ("" when there is one).
+    """
+
+    weight_N: float | None
+    source: str
+    plateaus: tuple = ()
+    reason: str = ""
+
+    def evidence(self) -> dict:
+        """summary.json ``hookload.block_weight_evidence``: rows, seconds, time span and
+        the longest plateaus as [t_start_s, t_end_s, level_N]."""
+        if not self.plateaus:
+            return {"rows": 0, "seconds": 0.0, "plateaus": []}
+        longest = sorted(self.plateaus, key=lambda p: -p.duration_s)[:EVIDENCE_LISTED]
+        return {"rows": int(sum(p.rows for p in self.plateaus)),
+                "seconds": float(sum(p.duration_s for p in self.plateaus)),
+                "first_s": float(min(p.t_start_s for p in self.plateaus)),
+                "last_s": float(max(p.t_end_s for p in self.plateaus)),
+                "plateaus": [[p.t_start_s, p.t_end_s, p.level_N]
+                             for p in sorted(longest, key=lambda p: p.t_start_s)]}
+
+
+# --------------------------------------------------------------------------- physics
+def modelled_string_weight_N(cfg, path, bit_depth_m: float) -> float:
+    """Modelled rotating off-bottom hook load of the configured string [N]: the string's
+    buoyed weight along the path, no block (docs/theory.md §2, σ = 0).
+
+    For a vertical string of one section it is ρ_steel·A·L·g·(1 − ρ_mud/ρ_steel).
+    """
+    td = torque_drag.solve_config(cfg, path, bit_depth_m, load_case="rotating_off_bottom")
+    return float(td.hookload_N)
+
+
+def scaled_sections(sections, scale: float, mud_out_kg_m3: float,
+                    mud_in_kg_m3: float) -> tuple[dict, ...]:
+    """Configured sections whose buoyed weight per metre is ``scale`` times theirs.
+
+    Only the adjusted linear mass changes (diameters, stiffness, inertia stay):
+    m' = c·m + (1 − c)·(ρ_o·A_o − ρ_i·A_i), so that g·(m' − ρ_o·A_o + ρ_i·A_i) = c·w
+    (docs/theory.md §2 step 1). m' > 0 for every c > 0 and m above the mud it displaces.
+    """
+    out = []
+    for entry in sections:
+        sec = section_from_config(entry, 1.0)
+        displaced = mud_out_kg_m3 * sec.outer_area_m2 - mud_in_kg_m3 * sec.inner_area_m2
+        mass = scale * sec.linear_mass_kg_m + (1.0 - scale) * displaced
+        out.append(dict(entry) | {"linear_mass_kg_m": float(mass)})
+    return tuple(out)
+
+
+def band_N(level_N: float) -> float:
+    """Half-width of a plateau's hook-load band at ``level_N`` [N]."""
+    return max(PLATEAU_BAND * abs(level_N), PLATEAU_BAND_N)
+
+
+def point_problem(hookload_N: float, model_N: float, block_N: float | None,
+                  tolerance: float) -> str:
+    """What the hook load of one off-bottom rotating segment says against the model ("" when
+    nothing): with a block weight, the measured string weight H − B off the modelled one by
+    more than ``tolerance``; without one, only what no block weight can explain (H below
+    the modelled string by more than the tolerance, or above it plus
+    :data:`MAX_BLOCK_WEIGHT_N`)."""
+    if block_N is not None:
+        ratio = (hookload_N - block_N) / model_N
+        if abs(ratio - 1.0) <= tolerance:
+            return ""
+        return (f"string weight from the hook load {(hookload_N - block_N) / 1e3:.0f} kN "
+                f"(hook load {hookload_N / 1e3:.0f} − block {block_N / 1e3:.0f} kN) is "
+                f"{ratio:.2f}× the configured string's {model_N / 1e3:.0f} kN")
+    if hookload_N < (1.0 - tolerance) * model_N:
+        return (f"hook load {hookload_N / 1e3:.0f} kN is below the configured string's "
+                f"buoyed weight {model_N / 1e3:.0f} kN: the string cannot be that heavy")
+    if hookload_N > (1.0 + tolerance) * model_N + MAX_BLOCK_WEIGHT_N:
+        return (f"hook load {hookload_N / 1e3:.0f} kN exceeds the configured string's "
+                f"{model_N / 1e3:.0f} kN by more than any block weight "
+                f"({MAX_BLOCK_WEIGHT_N / 1e3:.0f} kN)")
+    return ""
+
+
+# --------------------------------------------------------------------------- plateaus
+def _plateau_kernel(t, hook, quiet, min_s, band_rel, band_abs, break_s, max_gap_s, carry,
+                    out_t0, out_t1, out_n, out_level):
+    """Steady stretches of ``hook`` over ``quiet`` rows; appends finished ones to the
+    ``out_*`` arrays and returns how many (see :class:`PlateauFinder`).
+
+    ``carry`` = [t0, t_last, n, sum, t_out, n_out, sum_out, t_prev]: the open plateau, the
+    rows outside its band since ``t_out`` and the previous row's time.
+    """
+    k = 0
+    t0, t_last, n, total = carry[0], carry[1], carry[2], carry[3]
+    t_out, n_out, sum_out, t_prev = carry[4], carry[5], carry[6], carry[7]
+    for i in range(t.size):
+        gap = not np.isnan(t_prev) and t[i] - t_prev > max_gap_s
+        if not quiet[i] or np.isnan(hook[i]) or gap:
+            if n > 0 and t_last - t0 >= min_s:
+                out_t0[k], out_t1[k], out_n[k], out_level[k] = t0, t_last, n, total / n
+                k += 1
+            n, total, n_out, sum_out = 0.0, 0.0, 0.0, 0.0
+            if gap and quiet[i] and not np.isnan(hook[i]):
+                t0, t_last, n, total = t[i], t[i], 1.0, hook[i]
+        elif n == 0:
+            t0, t_last, n, total, n_out, sum_out = t[i], t[i], 1.0, hook[i], 0.0, 0.0
+        else:
+            level = total / n
+            if abs(hook[i] - level) <= max(band_rel * abs(level), band_abs):
+                t_last, n, total, n_out, sum_out = t[i], n + 1.0, total + hook[i], 0.0, 0.0
+            else:
+                if n_out == 0:
+                    t_out = t[i]
+                n_out, sum_out = n_out + 1.0, sum_out + hook[i]
+                if t[i] - t_out >= break_s:
+                    if t_last - t0 >= min_s:
+                        out_t0[k], out_t1[k], out_n[k], out_level[k] = t0, t_last, n, \
+                            total / n
+                        k += 1
+                    t0, t_last, n, total = t_out, t[i], n_out, sum_out
+                    n_out, sum_out = 0.0, 0.0
+        if not np.isnan(t[i]):
+            t_prev = t[i]
+    carry[0], carry[1], carry[2], carry[3] = t0, t_last, n, total
+    carry[4], carry[5], carry[6], carry[7] = t_out, n_out, sum_out, t_prev
+    return k
+
+
+_compiled_plateaus = lazy_jit(_plateau_kernel)
+_PLAIN_ROWS = 20_000
+
+
+def _column(frame: pd.DataFrame, name: str) -> np.ndarray:
+    return frame[name].to_numpy(float) if name in frame else np.full(len(frame), np.nan)
+
+
+class PlateauFinder:
+    """In-slips evidence of a log, fed chunk by chunk (bounded memory: only the plateaus).
+
+    A row is *quiet* when the top drive does not turn (surface speed at most
+    ``segmentation.rotating_stop_rpm``) and either its hook load is below
+    ``segmentation.slips_hookload_N`` (when configured: the string is in the slips, the
+    block may move) or, without that threshold, the string does not move (bit depth, else
+    block position, changes slower than :data:`STILL_M_S`). Quiet rows whose hook load stays
+    within the band (:func:`band_N`) of their running mean for at least
+    :data:`PLATEAU_MIN_S` make a :class:`Plateau`.
+
+    Parameters
+    ----------
+    cfg : Config
+    """
+
+    def __init__(self, cfg):
+        self._seg = cfg.segmentation
+        self._carry = np.array([np.nan, np.nan, 0.0, 0.0, np.nan, 0.0, 0.0, np.nan])
+        self._last = (np.nan, np.nan)  # time and depth of the previous row
+        self.plateaus: list[Plateau] = []
+
+    @property
+    def configured(self) -> bool:
+        """Whether in-slips rows come from ``slips_hookload_N`` (not from the log alone)."""
+        return self._seg.slips_hookload_N is not None
+
+    def quiet(self, chunk: pd.DataFrame) -> np.ndarray:
+        """The quiet rows of a chunk (class description)."""
+        rpm, hook = _column(chunk, "surface_rpm"), _column(chunk, "hookload_N")
+        still_turning = ~(rpm <= self._seg.rotating_stop_rpm)
+        if self.configured:
+            return ~still_turning & (hook < self._seg.slips_hookload_N)
+        depth = _column(chunk, "bit_depth_m" if "bit_depth_m" in chunk else
+                        "block_position_m")
+        t = _column(chunk, "time_s")
+        prev_t, prev_d = self._last
+        dt = np.diff(np.r_[prev_t, t])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            speed = np.abs(np.diff(np.r_[prev_d, depth])) / np.where(dt > 0, dt, np.nan)
+        if len(chunk):
+            self._last = (t[-1], depth[-1])
+        moving = speed > STILL_M_S if ("bit_depth_m" in chunk or "block_position_m" in chunk) \
+            else np.zeros(len(chunk), bool)
+        return ~still_turning & ~moving
+
+    def feed(self, chunk: pd.DataFrame) -> None:
+        """Consume the next rows (canonical SI columns)."""
+        if "hookload_N" not in chunk or not len(chunk):
+            return
+        self._run(_column(chunk, "time_s"), _column(chunk, "hookload_N"), self.quiet(chunk))
+
+    def close(self) -> list[Plateau]:
+        """The plateaus of the whole log, the last one closed."""
+        self._run(np.array([np.nan]), np.array([np.nan]), np.array([False]))
+        return self.plateaus
+
+    def _run(self, t, hook, quiet) -> None:
+        kernel = _plateau_kernel if t.size <= _PLAIN_ROWS else _compiled_plateaus()
+        out = [np.empty(t.size + 1) for _ in range(4)]
+        k = kernel(t, hook, quiet, PLATEAU_MIN_S, PLATEAU_BAND, PLATEAU_BAND_N,
+                   PLATEAU_BREAK_S, float(self._seg.max_gap_s), self._carry, *out)
+        self.plateaus += [Plateau(float(a), float(b), int(n), float(level))
+                          for a, b, n, level in zip(*(o[:k] for o in out), strict=True)]
+
+
+def find_plateaus(frame: pd.DataFrame, cfg) -> list[Plateau]:
+    """The plateaus of a whole log in memory (:class:`PlateauFinder`)."""
+    finder = PlateauFinder(cfg)
+    finder.feed(frame)
+    return finder.close()
+
+
+# --------------------------------------------------------------------------- block weight
+def _weighted_median(levels: np.ndarray, weights: np.ndarray) -> float:
+    order = np.argsort(levels)
+    cum = np.cumsum(weights[order])
+    return float(levels[order][np.searchsorted(cum, 0.5 * cum[-1])])
+
+
+def block_weight(plateaus: list[Plateau], points: pd.DataFrame,
+                 configured: bool) -> BlockWeight:
+    """The block weight (hook load in the slips) from the plateaus of a log.
+
+    With ``configured`` (rows below ``slips_hookload_N``) every plateau is in the slips:
+    the duration-weighted median of their levels. Otherwise the slips are the lowest
+    plateau — but only plateaus that lie below the off-bottom rotating hook loads
+    (``points``: ``hookload_N``, ``bit_depth_m``) by at least the lightest plausible
+    string's weight (:data:`MIN_STRING_WEIGHT_N_M`) count (a plateau above that is the
+    string hanging, not the slips); the weight is the duration-weighted median of the
+    plateaus within :func:`band_N` of the lowest.
+    """
+    if not plateaus:
+        return BlockWeight(None, "none", (), "no quiet hook-load plateau of "
+                           f"{PLATEAU_MIN_S:g} s without rotation" + (
+                               " below segmentation.slips_hookload_N" if configured else
+                               " and without string movement"))
+    if not configured:
+        if not len(points):
+            return BlockWeight(None, "none", (), "no off-bottom rotating hook load to tell "
+                               "the slips from the string hanging")
+        floor = float(np.median(points["hookload_N"]
+                                - MIN_STRING_WEIGHT_N_M * points["bit_depth_m"]))
+        plateaus = [p for p in plateaus if p.level_N <= floor]
+        if not plateaus:
+            return BlockWeight(None, "none", (), "no quiet plateau lies below the rotating "
+                               f"hook load by the weight of the lightest string "
+                               f"({MIN_STRING_WEIGHT_N_M:g} N/m): no slips in the log")
+        lowest = min(p.level_N for p in plateaus)
+        plateaus = [p for p in plateaus if p.level_N <= lowest + band_N(lowest)]
+    levels = np.array([p.level_N for p in plateaus])
+    weights = np.array([max(p.duration_s, 1e-9) for p in plateaus])
+    return BlockWeight(_weighted_median(levels, weights),
+                       "slips_hookload_N" if configured else "log", tuple(plateaus))
+
+
+# --------------------------------------------------------------------------- the check
+def off_bottom_points(records) -> pd.DataFrame:
+    """The off-bottom rotating segments with a measured and a modelled hook load."""
+    rows = [(r.id, r.bit_depth_m, r.hookload_N, r.hookload_model_N) for r in records
+            if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
+            and r.hookload_N is not None and r.hookload_model_N is not None
+            and np.isfinite(r.hookload_N) and np.isfinite(r.hookload_model_N)
+            and r.hookload_model_N > 0]
+    return pd.DataFrame(rows, columns=["id", "bit_depth_m", "hookload_N", "hookload_model_N"])
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A string-weight calibration done before the estimation (:func:`calibrate`).
+
+    Attributes
+    ----------
+    scale : float or None
+        Factor applied to the string's buoyed weight; None when not calibrated.
+    block : BlockWeight
+    segments : int
+        Off-bottom rotating segments the factor rests on.
+    reason : str
+        Why not calibrated ("" when calibrated).
+    """
+
+    scale: float | None
+    block: BlockWeight
+    segments: int = 0
+    reason: str = ""
+
+
+@dataclass
+class Outcome:
+    """What the hook-load check did to a well (:func:`judge`)."""
+
+    records: list
+    summary: dict
+    warnings: list = field(default_factory=list)
+
+    def mu_k_reason(self, mu_k: float | None) -> str | None:
+        """summary.json ``mu_k_reason``: why the well-level μ_k is null when the hook-load
+        check withheld segments (None otherwise)."""
+        if mu_k is not None or not self.summary.get("withheld_segments"):
+            return None
+        why = self.summary.get("reason") or "their hook load contradicts the configured string"
+        return f"withheld by the hook-load check (docs/theory.md §2.1): {why}"
+
+
+#: The friction numbers a contradicted segment withholds.
+_WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
+             "mu_k_observer", "mu_s_observer", "mu_td")
+
+
+def _withhold(record: SegmentRecord, why: str) -> SegmentRecord:
+    nulls = {name: None for name in _WITHHELD}
+    message = "; ".join(filter(None, [record.message, f"friction factors withheld: {why}"]))
+    return replace(record, **nulls, converged=False, message=message,
+                   flags=record.flags + (Flag.HOOKLOAD_CONTRADICTS_STRING,))
+
+
+def judge(records: list, plateaus: list[Plateau], cfg,
+          calibration: Calibration | None = None) -> Outcome:
+    """Check the configured string against the hook load; withhold what it contradicts.
+
+    Per off-bottom rotating segment: :func:`point_problem`. Well-wide: the median measured
+    string weight over the modelled one (needs the block weight); outside
+    ``1 ± hookload.tolerance`` every segment's friction factors are withheld (all segments
+    share the string). A segment whose own hook load contradicts the model is withheld
+    too. With a ``calibration`` every estimated segment is flagged
+    ``string_weight_calibrated``.
+    """
+    tol = cfg.hookload.tolerance
+    points = off_bottom_points(records)
+    block = calibration.block if calibration is not None and calibration.scale is not None \
+        else block_weight(plateaus, points, cfg.segmentation.slips_hookload_N is not None)
+    summary = _summary_base(cfg, block, calibration, len(points))
+    if not len(points):
+        summary.update(verdict="not_checked", reason="no estimated off-bottom rotating "
+                       "segment with a hook load")
+        return Outcome(list(records), summary)
+    problems = {int(p.id): point_problem(p.hookload_N, p.hookload_model_N, block.weight_N, tol)
+                for p in points.itertuples()}
+    well_problem = ""
+    if block.weight_N is not None:
+        ratio = float(np.median((points["hookload_N"] - block.weight_N)
+                                / points["hookload_model_N"]))
+        summary["string_weight_ratio"] = ratio
+        if abs(ratio - 1.0) > tol:
+            well_problem = (f"the hook load contradicts the configured string: the string "
+                            f"weight it measures is {ratio:.2f}× the modelled one (median of "
+                            f"{len(points)} off-bottom segments, block weight "
+                            f"{block.weight_N / 1e3:.0f} kN from {block.source}), beyond "
+                            f"±{tol:.0%}")
+    else:
+        bad = [i for i, why in problems.items() if why]
+        if len(bad) > len(points) / 2:
+            well_problem = (f"the hook load contradicts the configured string in {len(bad)} of "
+                            f"{len(points)} off-bottom segments ({problems[bad[0]]})")
+    out, withheld = [], []
+    for r in records:
+        why = well_problem or problems.get(r.id, "")
+        if why and r.status is Status.OK:
+            out.append(_withhold(r, why))
+            withheld.append(r.id)
+        elif calibration is not None and calibration.scale is not None \
+                and r.status is Status.OK:
+            out.append(replace(r, flags=r.flags + (Flag.STRING_WEIGHT_CALIBRATED,)))
+        else:
+            out.append(r)
+    summary.update(verdict="contradicted" if well_problem else (
+        "calibrated" if calibration is not None and calibration.scale is not None
+        else "consistent"), withheld_segments=withheld, reason=well_problem or None)
+    warnings = _warnings(well_problem, withheld, problems, block, calibration, cfg)
+    return Outcome(out, summary, warnings)
+
+
+def _summary_base(cfg, block: BlockWeight, calibration: Calibration | None,
+                  checked: int) -> dict:
+    """summary.json ``hookload`` before the verdict."""
+    return {"verdict": None, "reason": None, "tolerance": cfg.hookload.tolerance,
+            "block_weight_N": block.weight_N, "block_weight_source": block.source,
+            "block_weight_reason": block.reason or None,
+            "block_weight_evidence": block.evidence(), "segments_checked": checked,
+            "string_weight_ratio": None, "withheld_segments": [],
+            "calibration_allowed": bool(cfg.hookload.calibrate_string_weight),
+            "calibration_scale": None if calibration is None else calibration.scale,
+            "calibration_reason": None if calibration is None else
+            (calibration.reason or None)}
+
+
+def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWeight,
+              calibration: Calibration | None, cfg) -> list[str]:
+    out = []
+    if well_problem:
+        fix = ("check [[string.sections]] (linear masses, lengths), the mud density and the "
+               "hook-load channel" + ("" if cfg.hookload.calibrate_string_weight else
+                                      ", or allow hookload.calibrate_string_weight"))
+        extra = f" ({calibration.reason})" if calibration and calibration.reason else ""
+        out.append(f"friction factors withheld: {well_problem}{extra}; {fix}")
+    elif withheld:
+        out.append(f"friction factors of segment(s) {', '.join(map(str, withheld))} withheld: "
+                   f"their hook load contradicts the configured string "
+                   f"({problems[withheld[0]]})")
+    if calibration is not None and calibration.scale is not None:
+        out.append(f"string weight calibrated from the hook load: buoyed weight × "
+                   f"{calibration.scale:.3f} (block weight {block.weight_N / 1e3:.0f} kN from "
+                   f"{block.source}, {calibration.segments} off-bottom segments)")
+    if block.weight_N is None and not well_problem:
+        out.append(f"block weight unknown ({block.reason}): the string weight was only "
+                   "checked for gross mismatch")
+    return out
+
+
+# --------------------------------------------------------------------------- calibration
+def calibrate(well, chunk_rows: int):
+    """The well with its string's buoyed weight scaled to the hook load, and the
+    :class:`Calibration` — when ``hookload.calibrate_string_weight`` allows it; else the
+    well unchanged and None.
+
+    A first pass over the log (segmentation and plateaus, no estimation): the block weight
+    (:func:`block_weight`), each off-bottom rotating segment's median hook load and the
+    modelled string weight at its bit depth; the scale is the median of
+    (H − B)/W_model. Not applied (the check then withholds) without a block weight or when
+    the scale is outside :data:`CALIBRATION_RANGE`.
+    """
+    cfg = well.config
+    if not cfg.hookload.calibrate_string_weight:
+        return well, None
+    from drillfric.segmentation import SegmentStream
+
+    stream, finder, rows = SegmentStream(cfg), PlateauFinder(cfg), []
+    for chunk in well.chunks(chunk_rows):
+        finder.feed(chunk)
+        rows += _points(stream.feed(chunk), cfg, well.survey)
+    rows += _points(stream.close(), cfg, well.survey)
+    points = pd.DataFrame(rows, columns=["bit_depth_m", "hookload_N", "hookload_model_N"])
+    block = block_weight(finder.close(), points, finder.configured)
+    if block.weight_N is None or not len(points):
+        why = block.reason if block.weight_N is None else "no off-bottom rotating hook load"
+        return well, Calibration(None, block, len(points), f"not calibrated: {why}")
+    scale = float(np.median((points["hookload_N"] - block.weight_N)
+                            / points["hookload_model_N"]))
+    if not CALIBRATION_RANGE[0] <= scale <= CALIBRATION_RANGE[1]:
+        return well, Calibration(None, block, len(points), (
+            f"not calibrated: a scale of {scale:.2f} is outside {CALIBRATION_RANGE[0]:g}–"
+            f"{CALIBRATION_RANGE[1]:g}, the string is too far off to rescale"))
+    sections = scaled_sections(cfg.sections, scale, cfg.fluid.mud_density_kg_m3,
+                               cfg.inner_mud_density_kg_m3)
+    return replace(well, config=replace(cfg, sections=sections)), Calibration(
+        scale, block, len(points))
+
+
+def _points(done, cfg, path) -> list[tuple]:
+    """(bit depth, median hook load, modelled string weight) of finished off-bottom
+    segments."""
+    out = []
+    for seg, rows in done:
+        if seg.kind != Kind.OFF_BOTTOM.value or seg.status != "ok" or \
+                not np.isfinite(seg.bit_depth_m) or "hookload_N" not in rows:
+            continue
+        hook = rows["hookload_N"].to_numpy(float)
+        if not np.isfinite(hook).any():
+            continue
+        if path is not None and seg.bit_depth_m > path.md_max_m:
+            continue
+        out.append((seg.bit_depth_m, float(np.nanmedian(hook)),
+                    modelled_string_weight_N(cfg, path, seg.bit_depth_m)))
+    return out

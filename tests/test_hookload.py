@@ -1,0 +1,267 @@
+"""The hook load's own evidence (drillfric.hookload, docs/theory.md §2.1): the block weight
+from the slips, the string weight from the rotating hook load, the check of the configured
+string against them, and the calibration.
+
+Analytic references: a vertical string's rotating hook load is its buoyed weight
+ρ_steel·A·L·g·(1 − ρ_mud/ρ_steel) (docs/theory.md §2 step 1, σ = 0); a synthetic log with
+known slips and hanging plateaus for the plateau finder; the demo well's first stand behind
+a slips period with configured strings 30–40 % off. The DSATS regression (issue #22: a
+string 3.4× heavier than its hook load gave μ_k in bold with no warning) is
+tests/test_pipeline.py::test_dsats_runs_end_to_end (one 4-minute run of that log).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric import hookload
+from drillfric.config import config_from_dict, load_config
+from drillfric.drillstring import G_ACCEL
+from drillfric.pipeline import consensus
+from drillfric.result import Flag, Kind, SegmentRecord, Status
+from tests.conftest import REPO
+
+DEMO = REPO / "examples" / "demo"
+PIPE = {"name": "pipe", "od_m": 0.127, "id_m": 0.1086}
+
+
+def _vertical(mud=1200.0, sections=(PIPE,)):
+    return config_from_dict({"survey": {"tortuosity_deg_30m": 0.0},
+                             "fluid": {"mud_density_kg_m3": mud},
+                             "string": {"sections": [{k: v for k, v in s.items() if v is not None}
+                                                     for s in sections]}})
+
+
+# --------------------------------------------------------------------------- physics
+@pytest.mark.parametrize("mud", [0.0, 1200.0, 1800.0])
+def test_vertical_string_weight_is_its_buoyed_weight(mud):
+    """Vertical, one plain-steel section, bit off bottom: hook load = ρ_s·A·L·g·(1 − ρ_m/ρ_s)
+    (to rounding: the march sums the same weights element by element)."""
+    area = np.pi * (PIPE["od_m"] ** 2 - PIPE["id_m"] ** 2) / 4.0
+    expected = 7850.0 * area * 1500.0 * G_ACCEL * (1.0 - mud / 7850.0)
+    got = hookload.modelled_string_weight_N(_vertical(mud), None, 1500.0)
+    assert got == pytest.approx(expected, rel=1e-9)
+
+
+def test_scaled_sections_scale_the_buoyed_weight_only():
+    """Scaling by c multiplies the buoyed weight by c exactly, diameters untouched."""
+    sections = (PIPE, {"name": "dc", "od_m": 0.2032, "id_m": 0.0714, "length_m": 120.0})
+    cfg = _vertical(1300.0, sections)
+    for scale in (0.65, 1.4):
+        scaled = hookload.scaled_sections(cfg.sections, scale, 1300.0, 1300.0)
+        twin = _vertical(1300.0, scaled)
+        assert hookload.modelled_string_weight_N(twin, None, 2000.0) == pytest.approx(
+            scale * hookload.modelled_string_weight_N(cfg, None, 2000.0), rel=1e-9)
+        assert [s["od_m"] for s in scaled] == [s["od_m"] for s in cfg.sections]
+
+
+@pytest.mark.parametrize(("hook", "block", "bad"), [
+    (400e3, 150e3, False),   # string 250 kN = model
+    (400e3, 150e3 - 30e3, True),  # 280 kN: 12 % heavier than the model
+    (200e3, None, True),     # below the modelled string: it cannot be that heavy
+    (240e3, None, False),    # within the tolerance below the model
+    (1200e3, None, True),    # above model + the heaviest block
+    (900e3, None, False),    # a heavy block is possible
+])
+def test_point_problem(hook, block, bad):
+    assert bool(hookload.point_problem(hook, 250e3, block, 0.10)) is bad
+
+
+# --------------------------------------------------------------------------- plateaus
+def _slips_log(seed=3, slips=True):
+    """1-Hz log: 60 s hanging still (block 150 + string 250 kN), 300 s rotating, 120 s in
+    the slips (the first 40 s with the block moving up), 60 s hanging still; noise 1 kN."""
+    rng = np.random.default_rng(seed)
+    parts = [(60, 0.0, 400e3, 0.0), (300, 60.0, 400e3, 0.0),
+             (40, 0.0, 150e3 if slips else 400e3, 0.5), (80, 0.0, 150e3 if slips else 400e3,
+                                                         0.0),
+             (60, 0.0, 400e3, 0.0)]
+    rpm, hook, speed = (np.concatenate([np.full(n, v[i]) for n, *v in parts])
+                        for i in range(3))
+    block = 20.0 + np.cumsum(speed)
+    return pd.DataFrame({"time_s": np.arange(rpm.size, dtype=float), "surface_rpm": rpm,
+                         "hookload_N": hook + rng.normal(0.0, 1e3, rpm.size),
+                         "block_position_m": block})
+
+
+def test_plateau_finder_finds_the_slips_and_the_hanging_string():
+    plateaus = hookload.find_plateaus(_slips_log(), load_config())
+    levels = sorted(round(p.level_N / 1e3) for p in plateaus)
+    assert levels[0] == 150 and levels[-1] == 400
+    [slips] = [p for p in plateaus if p.level_N < 200e3]
+    assert slips.t_start_s >= 400 and slips.t_end_s == 479  # the still part of the slips
+    points = pd.DataFrame({"hookload_N": [400e3], "bit_depth_m": [2000.0]})
+    block = hookload.block_weight(plateaus, points, configured=False)
+    assert block.weight_N == pytest.approx(150e3, rel=0.01) and block.source == "log"
+    evidence = block.evidence()
+    assert evidence["rows"] == slips.rows and evidence["first_s"] == slips.t_start_s
+
+
+def test_plateau_finder_streams():
+    """Fed in chunks of 37 rows, the same plateaus as the whole log."""
+    frame, cfg = _slips_log(), load_config()
+    finder = hookload.PlateauFinder(cfg)
+    for start in range(0, len(frame), 37):
+        finder.feed(frame.iloc[start:start + 37])
+    assert finder.close() == hookload.find_plateaus(frame, cfg)
+
+
+def test_configured_slips_threshold_counts_the_moving_block():
+    cfg = load_config(overrides={"segmentation.slips_hookload_N": 200e3})
+    plateaus = hookload.find_plateaus(_slips_log(), cfg)
+    block = hookload.block_weight(plateaus, pd.DataFrame(), configured=True)
+    assert block.source == "slips_hookload_N"
+    assert block.evidence()["first_s"] == 360 and block.weight_N == pytest.approx(150e3,
+                                                                                  rel=0.01)
+
+
+def test_a_hanging_string_is_not_the_slips():
+    """No slips in the log: the lowest plateau is the string hanging, which lies above the
+    rotating hook load less the lightest string's weight: the block weight is unknown."""
+    plateaus = hookload.find_plateaus(_slips_log(slips=False), load_config())
+    assert plateaus
+    points = pd.DataFrame({"hookload_N": [400e3], "bit_depth_m": [2000.0]})
+    block = hookload.block_weight(plateaus, points, configured=False)
+    assert block.weight_N is None and "no slips" in block.reason
+
+
+# --------------------------------------------------------------------------- the check
+def _record(i, hook, model, kind=Kind.OFF_BOTTOM):
+    return SegmentRecord(id=i, kind=kind, bit_depth_m=2000.0, mu_k=0.25, mu_s_lower_bound=0.3,
+                         converged=True, status=Status.OK, hookload_N=hook,
+                         hookload_model_N=model, duration_s=200.0)
+
+
+def test_judge_withholds_every_segment_when_the_string_is_contradicted():
+    plateaus = [hookload.Plateau(0.0, 60.0, 61, 150e3)]
+    records = [_record(1, 400e3, 400e3), _record(2, 410e3, 400e3),
+               _record(3, 900e3, 1e6, Kind.ON_BOTTOM)]
+    cfg = load_config(overrides={"segmentation.slips_hookload_N": 200e3})
+    out = hookload.judge(records, plateaus, cfg)
+    assert out.summary["verdict"] == "contradicted"
+    assert out.summary["string_weight_ratio"] == pytest.approx(0.6375)
+    for r in out.records:
+        assert r.mu_k is None and r.mu_s_lower_bound is None and not r.converged
+        assert Flag.HOOKLOAD_CONTRADICTS_STRING in r.flags
+    assert consensus(out.records)["mu_k"] is None
+    assert "withheld" in out.mu_k_reason(None) and out.warnings
+
+
+def test_judge_keeps_a_consistent_string_and_withholds_a_lone_outlier():
+    plateaus = [hookload.Plateau(0.0, 60.0, 61, 150e3)]
+    records = [_record(1, 400e3, 250e3), _record(2, 405e3, 252e3), _record(3, 150e3, 250e3)]
+    cfg = load_config(overrides={"segmentation.slips_hookload_N": 200e3})
+    out = hookload.judge(records, plateaus, cfg)
+    assert out.summary["verdict"] == "consistent"
+    assert [r.mu_k for r in out.records] == [0.25, 0.25, None]
+    assert out.summary["withheld_segments"] == [3]
+    assert out.mu_k_reason(0.25) is None
+
+
+# --------------------------------------------------------------------------- end to end
+BLOCK_N = 150e3
+
+
+@pytest.fixture(scope="module")
+def weighed_stand(tmp_path_factory):
+    """The demo's first stand (truth μ_k = 0.28, plant string of demo.toml) behind 60 s in
+    the slips, with a 150-kN block on the hook throughout (the simulator's hook load has
+    none): the log then holds its own calibration."""
+    folder = tmp_path_factory.mktemp("weighed")
+    stand = pd.read_csv(DEMO / "demo.csv")
+    stand = stand[stand["time_s"] < 230.0].copy()
+    rate = 20.0
+    t = np.arange(0.0, 60.0, 1.0 / rate)
+    noise = np.random.default_rng(22).normal(0.0, 2e3, t.size)
+    slips = pd.DataFrame({"time_s": t, "surface_rpm": 0.0, "surface_torque_Nm": 0.0,
+                          "hookload_N": BLOCK_N + noise, "bit_depth_m": 2210.0,
+                          "hole_depth_m": 2215.0, "bit_rpm": 0.0, "string_torque_Nm": 0.0})
+    stand["time_s"] += 60.0
+    stand["hookload_N"] += BLOCK_N
+    pd.concat([slips, stand], ignore_index=True).to_csv(folder / "well.csv", index=False)
+    shutil.copy(DEMO / "demo.survey.csv", folder / "demo.survey.csv")
+    base = (DEMO / "demo.toml").read_text()
+    return folder, base[:base.index("\n[simulate]")].replace('data = "demo.csv"',
+                                                               'data = "well.csv"')
+
+
+def _masses(text: str, factor: float) -> str:
+    """demo.toml with every section's linear mass × factor (collars given one)."""
+    text = text.replace("linear_mass_kg_m = 41.41", f"linear_mass_kg_m = {41.41 * factor}")
+    text = text.replace("linear_mass_kg_m = 74.5", f"linear_mass_kg_m = {74.5 * factor}")
+    collar = 7850.0 * np.pi * (0.2032 ** 2 - 0.0714 ** 2) / 4.0
+    return text.replace('name = "8in collars"', f'name = "8in collars"\nlinear_mass_kg_m = '
+                        f"{collar * factor}")
+
+
+def _run(folder, config_text, name):
+    (folder / f"{name}.toml").write_text(config_text)
+    result = CliRunner().invoke(cli, ["-q", "run", str(folder / "well.csv"), "--config",
+                                      str(folder / f"{name}.toml"), "--out",
+                                      str(folder / name), "--no-report"])
+    assert result.exit_code == 0, result.output
+    return json.loads((folder / name / "demo" / "summary.json").read_text())
+
+
+def _ratio(folder, config_text, plant_text):
+    """Configured string weight / plant string weight at 2210 m."""
+    from drillfric.io.survey import read_survey
+
+    path = read_survey(folder / "demo.survey.csv")
+    weights = []
+    for name, text in (("cfg", config_text), ("plant", plant_text)):
+        (folder / f"{name}.toml").write_text(text)
+        weights.append(hookload.modelled_string_weight_N(load_config(folder / f"{name}.toml"),
+                                                         path, 2210.0))
+    return weights[0] / weights[1]
+
+
+def test_correct_string_unchanged(weighed_stand):
+    folder, base = weighed_stand
+    summary = _run(folder, base, "right")
+    check = summary["hookload"]
+    assert check["verdict"] == "consistent", check
+    assert check["block_weight_N"] == pytest.approx(BLOCK_N, rel=0.01)
+    assert check["block_weight_source"] == "log"
+    assert abs(check["string_weight_ratio"] - 1.0) < 0.02
+    assert abs(summary["mu_k"] / 0.28 - 1.0) <= 0.05
+    assert not any("hook" in w for w in summary["warnings"])
+
+
+@pytest.mark.parametrize(("factor", "weight"), [(0.7, (0.6, 0.7)), (1.3, (1.3, 1.4))])
+def test_wrong_string_withheld(weighed_stand, factor, weight):
+    """A string 30–40 % lighter or heavier (buoyed) than the plant: μ_k withheld well-wide,
+    with the reason in summary.json warnings, mu_k_reason and the segment's flags."""
+    folder, base = weighed_stand
+    text = _masses(base, factor)
+    assert weight[0] <= _ratio(folder, text, base) <= weight[1]
+    summary = _run(folder, text, f"wrong{factor}")
+    assert summary["mu_k"] is None and summary["mu_s"] is None
+    assert summary["mu_s_lower_bound"] is None
+    assert "hook-load check" in summary["mu_k_reason"]
+    assert summary["hookload"]["verdict"] == "contradicted"
+    assert any("contradicts the configured string" in w for w in summary["warnings"])
+    ok = [s for s in summary["segments"] if s["status"] == "ok"]
+    assert ok and all(s["mu_k"] is None and "hookload_contradicts_string" in s["flags"]
+                      for s in ok)
+
+
+def test_wrong_string_calibrated_when_allowed(weighed_stand):
+    folder, base = weighed_stand
+    text = _masses(base, 0.7) + "\n[hookload]\ncalibrate_string_weight = true\n"
+    lighter = _ratio(folder, text, base)
+    summary = _run(folder, text, "calibrated")
+    check = summary["hookload"]
+    assert check["verdict"] == "calibrated" and check["calibration_scale"] == pytest.approx(
+        1 / lighter, rel=0.02)
+    assert abs(summary["mu_k"] / 0.28 - 1.0) <= 0.05
+    assert any("calibrated" in w for w in summary["warnings"])
+    ok = [s for s in summary["segments"] if s["status"] == "ok"]
+    assert all("string_weight_calibrated" in s["flags"] for s in ok)
