@@ -225,10 +225,16 @@ def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str,
 def clear_footer(fig: Figure) -> None:
     """Move a page's axes up until nothing of them — tick labels, axis labels, legends —
     reaches below :data:`FOOTER_CLEAR_IN` (the footer's band): the axes are squeezed
-    towards their top, which stays where it is."""
+    towards their top, which stays where it is (a constrained layout is given a rectangle
+    above the band instead)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     if not fig.axes:
+        return
+    engine = fig.get_layout_engine()
+    if engine is not None and hasattr(engine, "set") and "rect" in engine.get():
+        low = FOOTER_CLEAR_IN / PAGE_IN[1]  # a constrained layout keeps out of the band
+        engine.set(rect=(0.0, low, 1.0, 1.0 - low))
         return
     if fig.canvas is None or not hasattr(fig.canvas, "get_renderer"):
         FigureCanvasAgg(fig)
