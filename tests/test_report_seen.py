@@ -20,7 +20,6 @@ import pytest
 from click.testing import CliRunner
 
 from drillfric.report import figures, write_well_report
-from drillfric.report.reproduction import reproduction
 from drillfric.report.well import build_report
 from tests.synthetic_results import synthetic_result
 from tests.test_report import (
@@ -131,6 +130,8 @@ def _torques(measured, model, rate_hz: float = 10.0) -> pd.DataFrame:
 def test_reproduction_tells_the_four_regimes_apart():
     """Stick-slip (std/mean of the 1-s torque above 0.1) in the model but not the data, the
     other way round, in both, in neither."""
+    from drillfric.report.reproduction import reproduction
+
     t = np.arange(6000) / 10.0
     cycle = 10e3 * np.sin(2 * np.pi * t / 5.0)
     steady = np.full(t.size, 20e3)
