@@ -173,6 +173,8 @@ def _print(result, units: str | None = None) -> None:
     click.echo(_describe(result, system))  # the result: printed even with --quiet
     if result.report is not None:
         echo(f"report: {result.report}")
+        if (pdf := Path(result.report).with_name("report.pdf")).is_file():
+            echo(f"report: {pdf}")
     else:
         echo(f"results: {result.out_dir}")
 

@@ -343,8 +343,9 @@ def test_any_well_name_is_escaped_in_fleet_report(name):
 # --- the PDF ---------------------------------------------------------------------------------
 
 def test_pdf_pages_are_a4_landscape_numbered_and_in_order(evidence):
-    """report.pdf: header, time tracks, friction log, broomstick, well path, profiles, one
-    page per drawn segment, diagnostics, the string as a table, the configuration — every
+    """report.pdf: headline with the friction log, run details, time tracks, broomstick,
+    well path, profiles, one page per drawn segment, diagnostics, the string and the
+    non-default settings as appendices — every
     page A4 landscape (one size), titled, numbered "page n of N", none blank (issue 16,
     item 6). A table longer than a page carries on a "(continued)" page under its title."""
     from pypdf import PdfReader
@@ -353,10 +354,10 @@ def test_pdf_pages_are_a4_landscape_numbered_and_in_order(evidence):
     pdf = evidence / "report.pdf"
     summary = json.loads((evidence / "summary.json").read_text())
     n_segments = sum(s["status"] == "ok" for s in summary["segments"])
-    expected = (["Friction report — demo", "Time tracks", "Friction log", "Broomstick",
+    expected = (["Friction report — demo", "Run details", "Time tracks", "Broomstick",
                  "Well path", "Normal force and F_c profiles"]
                 + [f"Segment {i}" for i in range(1, n_segments + 1)]
-                + ["Diagnostics", "Configuration: drill string", "Configuration"])
+                + ["Diagnostics", "Appendix: drill string", "Appendix: settings"])
     reader = PdfReader(pdf)
     texts = [page.extract_text() for page in reader.pages]
     first_pages = [t for t in texts if "(continued)" not in t]
@@ -367,7 +368,7 @@ def test_pdf_pages_are_a4_landscape_numbered_and_in_order(evidence):
     assert sizes == {(842, 595)}  # A4 landscape in points: 297 × 210 mm
     for number, text in enumerate(texts, start=1):
         assert f"page {number} of {len(texts)}" in text
-    string_page = next(t for t in texts if "Configuration: drill string" in t)
+    string_page = next(t for t in texts if "Appendix: drill string" in t)
     assert "5 7/8in DP" in string_page and "OD [mm]" in string_page
     assert not any('[{"' in t or '{"name"' in t for t in texts)  # no raw JSON
     _assert_pages_not_blank(pdf, len(texts))

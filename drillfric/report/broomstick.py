@@ -55,6 +55,21 @@ def measured_points(segments: pd.DataFrame) -> pd.DataFrame:
                         ).reset_index(drop=True)
 
 
+def measured_points_from_windows(windows: pd.DataFrame) -> pd.DataFrame:
+    """Measured points of a depth-indexed log: one per window of friction_log.parquet, its
+    mean surface torque and hook load at its bit depth (docs/ingestion.md)."""
+    need = ("segment_id", "kind", "bit_depth_m", "surface_torque_Nm", "hookload_N")
+    if any(c not in windows for c in need):
+        return pd.DataFrame(columns=list(POINT_COLUMNS))
+    rows = windows[windows["bit_depth_m"].notna() & (windows["surface_torque_Nm"].notna()
+                                                     | windows["hookload_N"].notna())]
+    return pd.DataFrame({"segment_id": rows["segment_id"].astype(int), "kind": rows["kind"],
+                         "bit_depth_m": rows["bit_depth_m"], "hookload_N": rows["hookload_N"],
+                         "surface_torque_Nm": rows["surface_torque_Nm"],
+                         "hookload_model_N": rows.get("hookload_model_N", np.nan)}
+                        ).reset_index(drop=True)
+
+
 def measured_points_from_log(surface: pd.DataFrame, cfg) -> pd.DataFrame:
     """Measured points straight from a log: segment it (:mod:`drillfric.segmentation`) and
     take each rotating segment's median hook load and mean surface torque [N], [N·m].

@@ -17,6 +17,8 @@ import pandas as pd
 from drillfric.errors import InputError
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_FIELDS, SEGMENT_NUMBER_FIELDS
 
+from .interactive import TimeAxis, time_axis
+
 _NUMERIC = SEGMENT_NUMBER_FIELDS  # None in summary.json becomes NaN
 #: Torque columns of estimates.parquet: measured string torque, the observer's and the
 #: batch fit's modelled surface torque [N·m].
@@ -40,6 +42,9 @@ class ResultData:
         wellpath.parquet (only when the run had a survey).
     tracks : DataFrame or None
         tracks.parquet: the whole log decimated for plotting (absent in older results).
+    friction_log : DataFrame or None
+        friction_log.parquet: one row per depth window of a depth-indexed log (its measured
+        torque, hook load, WOB per window); None for time logs.
     """
 
     result_dir: Path
@@ -48,6 +53,38 @@ class ResultData:
     profiles: pd.DataFrame | None
     wellpath: pd.DataFrame | None
     tracks: pd.DataFrame | None = None
+    friction_log: pd.DataFrame | None = None
+
+    @property
+    def depth_indexed(self) -> bool:
+        """Whether the log was depth-indexed (a static friction log: no time series)."""
+        return self.summary.get("index") == "depth"
+
+    @property
+    def log_span_s(self) -> tuple[float, float] | None:
+        """First and last log time [s]: of tracks.parquet's bins (the whole log, to within
+        a bin: ≤ 1/2000 of its length), else of the segments; None when neither has one."""
+        for frame, first, last in ((self.tracks, "time_s", "time_s"),
+                                   (self.segments, "t_start_s", "t_end_s")):
+            if frame is None or first not in frame or not len(frame):
+                continue
+            low, high = frame[first].min(), frame[last].max()
+            if np.isfinite(low) and np.isfinite(high):
+                return float(low), float(high)
+        return None
+
+    @property
+    def span_from_tracks(self) -> bool:
+        """Whether :attr:`log_span_s` is the whole log's (tracks.parquet), not only the
+        segments'."""
+        return self.tracks is not None and len(self.tracks) > 0
+
+    @property
+    def time_axis(self) -> TimeAxis:
+        """How the report plots log time: clock time when known, log hours for a log longer
+        than an hour, else log seconds (:class:`~drillfric.report.interactive.TimeAxis`)."""
+        span = self.log_span_s
+        return time_axis(self.time_origin, 0.0 if span is None else span[1] - span[0])
 
     @property
     def time_origin(self) -> pd.Timestamp | None:
@@ -113,7 +150,8 @@ def load_result(result_dir: Path) -> ResultData:
     return ResultData(result_dir, summary, segments_frame(summary.get("segments", [])),
                       _optional_parquet(result_dir / "profiles.parquet"),
                       _optional_parquet(result_dir / "wellpath.parquet"),
-                      _optional_parquet(result_dir / "tracks.parquet"))
+                      _optional_parquet(result_dir / "tracks.parquet"),
+                      _optional_parquet(result_dir / "friction_log.parquet"))
 
 
 def _optional_parquet(path: Path) -> pd.DataFrame | None:
@@ -200,3 +238,29 @@ def segment_estimates(result_dir: Path, ids: list[int],
                 parts.append(one.iloc[::max(1, int(np.ceil(len(one) / keep)))])
         out[int(seg_id)] = pd.concat(parts, ignore_index=True)
     return out
+
+
+#: Columns of the final pass that say what the fit reproduces (every sample is read).
+_FIT_COLUMNS = ("segment_id", "start_id", "time_s", "surface_torque_Nm", "surface_torque_fit_Nm")
+
+
+def final_torques(result_dir: Path, ids: list[int]) -> dict[int, pd.DataFrame]:
+    """The measured and fitted-model surface torque of the final pass of the given
+    segments, every sample (:mod:`drillfric.report.reproduction`); empty when the file or
+    its fit column is missing (older results)."""
+    path = Path(result_dir) / "estimates.parquet"
+    if not ids or not path.is_file():
+        return {}
+    import pyarrow.parquet as pq
+
+    try:
+        if "surface_torque_fit_Nm" not in pq.read_schema(path).names:
+            return {}
+        table = pq.read_table(path, columns=list(_FIT_COLUMNS),
+                              filters=[("segment_id", "in", [int(i) for i in ids]),
+                                       ("start_id", "=", FINAL_START_ID)])
+    except (OSError, ValueError) as exc:
+        raise InputError(f"unreadable estimates ({exc})", file=path,
+                         fix="rerun 'drillfric run' to rewrite the results") from None
+    frame = table.to_pandas()
+    return {int(i): rows for i, rows in frame.groupby("segment_id", sort=True)}

@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 
 from .data import FINAL_START_ID
 from .display import SI, Units
-from .interactive import float32, time_figure, time_label, time_values
+from .interactive import TimeAxis, float32, time_figure, time_label, time_values
 
 MEASURED = "#555555"
 OBSERVER = "#1f5fa8"
@@ -128,7 +128,8 @@ _LEGEND = {("torque", "measured"): "measured", ("torque", "observer"): "observer
 
 
 # ------------------------------------------------------------------------------ Bokeh
-def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | None, units: Units = SI,
+def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | TimeAxis | None,
+                     units: Units = SI,
                      bit: bool = True) -> dict[str, dict[str, np.ndarray]]:
     """The data of every Bokeh source of a segment's evidence, by source name.
 
@@ -152,13 +153,13 @@ def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | None, units: Unit
     return out
 
 
-def signature(sources: dict[str, dict], clock: bool, units: Units = SI) -> tuple:
+def signature(sources: dict[str, dict], axis: TimeAxis, units: Units = SI) -> tuple:
     """What the layout of :func:`evidence_plot` depends on besides the sources' data."""
-    return ("evidence", clock, units.system,
+    return ("evidence", axis.kind, units.system,
             tuple((name, tuple(cols)) for name, cols in sources.items()))
 
 
-def evidence_plot(sources: dict[str, dict], clock: bool, units: Units = SI):
+def evidence_plot(sources: dict[str, dict], axis: TimeAxis, units: Units = SI):
     """A segment's evidence as a Bokeh layout (panels share the time axis), from
     :func:`evidence_sources` in display ``units``; each ColumnDataSource is named like its
     key there."""
@@ -171,7 +172,7 @@ def evidence_plot(sources: dict[str, dict], clock: bool, units: Units = SI):
             continue
         key = name.split(":", 1)[1]
         fig = time_figure(_PX if key in ("torque", "bit") else 100, _label(key, units),
-                          x_range=x_range, clock=clock)
+                          x_range=x_range, axis=axis)
         x_range = fig.x_range
         source = ColumnDataSource(columns, name=name)
         if key == "bit":
@@ -186,13 +187,13 @@ def evidence_plot(sources: dict[str, dict], clock: bool, units: Units = SI):
                           line_width=_STYLE.get(c, (MEASURED, 1.0))[1],
                           line_dash="dashed" if (key, c) == ("bit", "measured") else "solid",
                           legend_label=_LEGEND.get((key, c), c)) for c in series]
-        tips = [("time", "@x{%F %T}" if clock else "@x{0.0} s")]
-        tips += [(_LEGEND.get((key, c), c), f"@{{{c}}}{{0.00}}") for c in series]
+        when, formatters = axis.hover()
+        tips = [when, *((_LEGEND.get((key, c), c), f"@{{{c}}}{{0.00}}") for c in series)]
         fig.add_tools(HoverTool(renderers=lines[:1], mode="vline", tooltips=tips,
-                                formatters={"@x": "datetime"} if clock else {}))
+                                formatters=formatters))
         _legend(fig)
         figs.append(fig)
-    figs.append(_mu_plot(sources, clock, x_range))
+    figs.append(_mu_plot(sources, axis, x_range))
     return gridplot([[f] for f in figs], merge_tools=True, toolbar_location="right",
                     sizing_mode="stretch_width")
 
@@ -213,12 +214,11 @@ def _legend(fig) -> None:
     fig.legend.margin = 2
 
 
-def _mu_plot(sources: dict[str, dict], clock: bool, x_range):
+def _mu_plot(sources: dict[str, dict], axis: TimeAxis, x_range):
     from bokeh.models import ColumnDataSource, HoverTool
     from bokeh.palettes import Category10
 
-    fig = time_figure(_PX, _label("mu", SI), x_range=x_range, clock=clock,
-                      x_label="time [UTC]" if clock else "log time [s]")
+    fig = time_figure(_PX, _label("mu", SI), x_range=x_range, axis=axis, x_label=axis.label)
     lines = []
     for name, columns in sources.items():
         if not name.startswith("start:"):
@@ -255,7 +255,8 @@ def start_label(segment: dict, start_id: int) -> str:
 
 
 # ------------------------------------------------------------------------- matplotlib
-def evidence_figure(est: pd.DataFrame, segment: dict, origin: pd.Timestamp | None = None,
+def evidence_figure(est: pd.DataFrame, segment: dict,
+                    origin: pd.Timestamp | TimeAxis | None = None,
                     size: tuple[float, float] = (9.0, 9.0), units: Units = SI,
                     bit: bool = True, notes: list[str] | None = None) -> Figure:
     """The segment's evidence as a static figure (the PDF page) in display ``units``;

@@ -18,18 +18,20 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from .display import SI, Units
-from .render import zone_text
+from .render import is_apparent, zone_text
 
 #: Colours of the friction factors (μ_k, μ_s, torque-and-drag back-calculation).
 MU_K_COLOR = "#1f5fa8"
 MU_S_COLOR = "#c0392b"
+#: Colour of apparent (on-bottom) friction factors: the bit torque is in them.
+APPARENT_COLOR = "#d35400"
 TD_COLOR = "#222222"
 SEVERITY_COLOR = "#8e44ad"
 _WIDTH_IN = 9.0
 
 
 def _new(height_in: float, width_in: float = _WIDTH_IN, *, left_in: float = 0.8,
-         hspace: float = 0.35, wspace: float = 0.25) -> Figure:
+         hspace: float = 0.35, wspace: float = 0.25, top_in: float = 0.75) -> Figure:
     """A figure with fixed margins in inches (room for labels, titles and a page title).
 
     Fixed margins rather than constrained layout: the report is drawn every night and
@@ -37,7 +39,7 @@ def _new(height_in: float, width_in: float = _WIDTH_IN, *, left_in: float = 0.8,
     """
     fig = Figure(figsize=(width_in, height_in))
     fig.subplots_adjust(left=left_in / width_in, right=1 - 0.2 / width_in,
-                        bottom=0.55 / height_in, top=1 - 0.75 / height_in,
+                        bottom=0.55 / height_in, top=1 - top_in / height_in,
                         hspace=hspace, wspace=wspace)
     return fig
 
@@ -155,25 +157,33 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
 
 def friction_log_figure(segments: pd.DataFrame,
                         size: tuple[float, float] = (_WIDTH_IN, 5.5),
-                        units: Units = SI) -> Figure:
+                        units: Units = SI, top_in: float = 0.75) -> Figure:
     """μ_s and μ_k versus bit depth, one point per segment (stand), with spread bars, and
     the stick-slip severity versus bit depth beside it.
+
+    μ_k (●) is drawn for off-bottom segments only; an on-bottom segment's factor is
+    apparent (the bit torque is in it) and drawn as ▲ with its own legend entry.
 
     Filled markers: converged; hollow: not converged. μ_s is drawn as a point only where it
     is identifiable (docs/theory.md §6); where only a lower bound is known it is drawn as a
     right-pointing bound (▷ with a dotted tail: "at least this"). Crosses: the
     torque-and-drag back-calculated μ (``mu_td``). Bars span the spread across starts.
     Segments without an estimate are grey diamonds on the left edge. Markers are not
-    clipped at the axes' edges. Right: severity (ω_max − ω_min)/(2 ω_mean) of the
+    clipped at the axes' edges. ``top_in``: room above the axes [in] (a page's headline).
+    Right: severity (ω_max − ω_min)/(2 ω_mean) of the
     estimated bit speed; beyond the dashed line at 1 the bit stops. Depths in display
     ``units``; the μ axis names the friction zone when the segments share one.
     """
-    fig = _new(size[1], size[0], left_in=0.9, wspace=0.08)
+    fig = _new(size[1], size[0], left_in=0.9, wspace=0.08, top_in=top_in)
     ax, ax_sev = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [2.2, 1]})
     seg = segments.assign(depth=segments["bit_depth_m"] * units.factor("length"))
     ok = seg[seg["status"] == "ok"]
-    conv = ok["converged"].to_numpy(bool)
-    _mu_points(ax, ok, "mu_k", "mu_k_spread", conv, MU_K_COLOR, "o", "μ_k")
+    apparent = np.array([is_apparent(r) for r in ok.to_dict("records")], dtype=bool)
+    for rows, color, marker, name in (
+            (ok[~apparent], MU_K_COLOR, "o", "μ_k (off bottom)"),
+            (ok[apparent], APPARENT_COLOR, "^", "apparent μ (on bottom, bit torque in it)")):
+        _mu_points(ax, rows, "mu_k", "mu_k_spread", rows["converged"].to_numpy(bool), color,
+                   marker, name)
     ident = ok[ok["mu_s_identifiable"] & ok["mu_s"].notna()]
     _mu_points(ax, ident, "mu_s", "mu_s_spread", ident["converged"].to_numpy(bool),
                MU_S_COLOR, "s", "μ_s")
@@ -183,7 +193,7 @@ def friction_log_figure(segments: pd.DataFrame,
                 markerfacecolor="none", label="μ_s ≥ lower bound", clip_on=False)
         for x, y in zip(bound["mu_s_lower_bound"], bound["depth"], strict=True):
             ax.plot([x, x + 0.08], [y, y], ":", color=MU_S_COLOR, linewidth=1.2)
-    td = ok[ok["mu_td"].notna()]
+    td = ok[~apparent & ok["mu_td"].notna()]
     if len(td):
         ax.plot(td["mu_td"], td["depth"], "x", color=TD_COLOR,
                 label="μ from torque and drag", clip_on=False)
@@ -191,8 +201,9 @@ def friction_log_figure(segments: pd.DataFrame,
     if len(none):
         ax.plot(np.zeros(len(none)), none["depth"], "d", color="#888888",
                 markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")
-    if not len(ok) and not len(none):
-        _note(ax, "No segment: nothing to draw.")
+    if not ok["mu_k"].notna().any():
+        _note(ax, "No friction factor to draw: no segment was estimated "
+                  f"({len(none)} without an estimate).")
         ax_sev.set_axis_off()
         return fig
     zone = zone_text(segments)

@@ -1,8 +1,10 @@
 """The friction log versus depth, interactive (Bokeh): one well, and all wells of a fleet.
 
 Marks follow the static friction log (:func:`drillfric.report.figures.friction_log_figure`,
-docs/reports.md): μ_k ●, μ_s ■ where identified, ▷ μ_s lower bound, × the torque-and-drag
-back-calculation μ_TD, grey ◆ segments without an estimate; hollow = not converged;
+docs/reports.md): μ_k ● (off bottom), apparent μ ▲ (on bottom: the bit torque is in it, so
+it is not μ_k and gets its own mark and legend entry), μ_s ■ where identified, ▷ μ_s lower
+bound, × the torque-and-drag back-calculation μ_TD (off bottom), grey ◆ segments without an
+estimate; hollow = not converged;
 whiskers = spread across observer starts. Beside it the stick-slip severity versus depth.
 Hover names the segment and its numbers. Depths in the report's display units; the μ axis
 names the friction zone (open hole, or effective over the whole string) when the
@@ -15,9 +17,9 @@ import numpy as np
 import pandas as pd
 
 from .display import SI, Units
-from .figures import MU_K_COLOR, MU_S_COLOR, TD_COLOR
+from .figures import APPARENT_COLOR, MU_K_COLOR, MU_S_COLOR, TD_COLOR
 from .interactive import MIN_WIDTH_PX
-from .render import fmt, mu_s_text, zone_text
+from .render import fmt, is_apparent, mu_k_cell, mu_s_text, zone_text
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
@@ -25,7 +27,8 @@ _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 def _tips(units: Units) -> list[tuple[str, str]]:
     """Hover fields of a segment's point."""
     return [("segment", "@id (@kind)"), ("bit depth", f"@depth{{0.0}} {units.label('length')}"),
-            ("μ_k", "@mu_k_text"), ("μ_s", "@mu_s_text"), ("μ_TD", "@mu_td_text"),
+            ("μ_k / apparent μ", "@mu_k_text"), ("μ_s", "@mu_s_text"),
+            ("μ_TD", "@mu_td_text"),
             ("severity", "@severity_text"), ("friction zone", "@zone"),
             ("status", "@status")]
 
@@ -35,7 +38,10 @@ def _source_frame(seg: pd.DataFrame, units: Units) -> pd.DataFrame:
     rows = seg.copy()
     rows["depth"] = rows["bit_depth_m"] * units.factor("length")
     rows["kind"] = rows["kind"].fillna("—").astype(str).str.replace("_", " ")
-    rows["mu_k_text"] = [fmt(v) for v in rows["mu_k"]]
+    records = rows.to_dict("records")
+    rows["mu_k_text"] = [mu_k_cell(r) for r in records]
+    rows["apparent"] = [is_apparent(r) for r in records]
+    rows["mu_app"] = rows["mu_k"].where(rows["apparent"])
     rows["mu_s_text"] = [mu_s_text(m, i, b) for m, i, b in
                          zip(rows["mu_s"], rows["mu_s_identifiable"], rows["mu_s_lower_bound"],
                              strict=True)]
@@ -46,9 +52,9 @@ def _source_frame(seg: pd.DataFrame, units: Units) -> pd.DataFrame:
     rows["identified"] = rows["mu_s_identifiable"].astype(bool) & rows["mu_s"].notna()
     rows["half_k"] = rows["mu_k_spread"].fillna(0.0) / 2
     rows["half_s"] = rows["mu_s_spread"].fillna(0.0) / 2
-    keep = ["id", "depth", "kind", "mu_k", "mu_s", "mu_s_lower_bound", "mu_td",
+    keep = ["id", "depth", "kind", "mu_k", "mu_app", "mu_s", "mu_s_lower_bound", "mu_td",
             "stick_slip_severity", "mu_k_text", "mu_s_text", "mu_td_text", "severity_text",
-            "zone", "status", "half_k", "half_s", "converged", "identified"]
+            "zone", "status", "half_k", "half_s", "converged", "identified", "apparent"]
     return rows[keep].astype({"id": int})
 
 
@@ -72,7 +78,9 @@ def _span(x0, x1, depth) -> dict[str, np.ndarray]:
 
 
 #: Marker, colour and legend of the points of each μ column.
-_MARKS = {"mu_k": ("circle", MU_K_COLOR, "μ_k"), "mu_s": ("square", MU_S_COLOR, "μ_s"),
+_MARKS = {"mu_k": ("circle", MU_K_COLOR, "μ_k (off bottom)"),
+          "mu_app": ("triangle", APPARENT_COLOR, "apparent μ (on bottom, bit torque in it)"),
+          "mu_s": ("square", MU_S_COLOR, "μ_s"),
           "mu_td": ("x", TD_COLOR, "μ from torque and drag")}
 
 
@@ -92,28 +100,32 @@ def _add_points(out: dict, frame: pd.DataFrame, col: str, hollow_unconverged: bo
 def friction_sources(segments: pd.DataFrame, units: Units = SI
                      ) -> dict[str, dict[str, np.ndarray]]:
     """The data of every Bokeh source of :func:`friction_plot`, by source name, in drawing
-    order (only those with rows): ``whisker:mu_k``, ``whisker:mu_s`` (spreads), the
-    ``points:…`` of μ_k, identified μ_s and μ_TD, ``bound_tail`` and ``bound`` (μ_s lower
-    bounds), ``none`` (segments without an estimate) and ``severity``. Depths in display
+    order (only those with rows): ``whisker:mu_k``, ``whisker:mu_app``, ``whisker:mu_s``
+    (spreads), the ``points:…`` of μ_k (off bottom), apparent μ (``mu_app``, on bottom),
+    identified μ_s and μ_TD (off bottom), ``bound_tail`` and ``bound`` (μ_s lower bounds),
+    ``none`` (segments without an estimate) and ``severity``. Depths in display
     ``units``."""
     frame = _source_frame(segments[segments["bit_depth_m"].notna()], units)
     ok = frame[frame["status"] == "ok"]
+    off = ok[~ok["apparent"]]
     out = {}
-    for col, half in (("mu_k", "half_k"), ("mu_s", "half_s")):
-        whisk = ok[ok[col].notna() & (ok[half] > 0)]
+    for rows, col, half in ((off, "mu_k", "half_k"), (ok, "mu_app", "half_k"),
+                            (ok, "mu_s", "half_s")):
+        whisk = rows[rows[col].notna() & (rows[half] > 0)]
         if col == "mu_s":
             whisk = whisk[whisk["identified"]]
         if len(whisk):
             out[f"whisker:{col}"] = _span(whisk[col] - whisk[half], whisk[col] + whisk[half],
                                           whisk["depth"])
-    _add_points(out, ok, "mu_k")
+    _add_points(out, off, "mu_k")
+    _add_points(out, ok, "mu_app")
     _add_points(out, ok[ok["identified"]], "mu_s")
     bound = ok[~ok["identified"] & ok["mu_s_lower_bound"].notna()]
     if len(bound):
         out["bound_tail"] = _span(bound["mu_s_lower_bound"],
                                   bound["mu_s_lower_bound"] + 0.08, bound["depth"])
         out["bound"] = _columns(bound)
-    _add_points(out, ok, "mu_td", hollow_unconverged=False)
+    _add_points(out, off, "mu_td", hollow_unconverged=False)
     none = frame[frame["status"] != "ok"].assign(zero=0.0)
     if len(none):
         out["none"] = _columns(none)
@@ -147,13 +159,14 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
                 x_axis_label=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
                 y_axis_label=units.axis("bit depth", "length"))
     mu.y_range.flipped = True
+    mu.x_range.start = 0.0  # a friction factor is ≥ 0: the axis never runs into negatives
     cds = {name: ColumnDataSource(columns, name=name) for name, columns in sources.items()}
     renderers = []
     for name, source in cds.items():
         kind, _, col = name.partition(":")
         if kind == "whisker":
             mu.segment("x0", "y0", "x1", "y1", source=source, line_width=1,
-                       color=MU_K_COLOR if col == "mu_k" else MU_S_COLOR)
+                       color=_MARKS[col][1])
         elif kind == "points":
             col, _, part = col.partition(":")
             marker, color, label = _MARKS[col]

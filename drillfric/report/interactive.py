@@ -152,7 +152,59 @@ def with_data(item: dict, target: str, data: dict[str, dict]) -> dict:
     return out
 
 
-def time_figure(height: int, y_label: str, *, x_range=None, clock: bool = False,
+#: Logs longer than this without clock time are plotted in log hours, not seconds [s].
+LONG_LOG_S = 3600.0
+
+
+@dataclass(frozen=True)
+class TimeAxis:
+    """How log time is plotted: clock time (UTC) when the log has it (``origin``, the clock
+    time of log time 0), else log hours for a log longer than :data:`LONG_LOG_S`
+    (``hours``), else log seconds."""
+
+    origin: pd.Timestamp | None = None
+    hours: bool = False
+
+    @property
+    def clock(self) -> bool:
+        """Whether the axis shows clock time."""
+        return self.origin is not None
+
+    @property
+    def kind(self) -> str:
+        """``"clock"``, ``"hours"`` or ``"seconds"`` (a layout's signature holds it)."""
+        return "clock" if self.clock else ("hours" if self.hours else "seconds")
+
+    def values(self, time_s) -> np.ndarray:
+        """Log time [s] as plotted: naive-UTC datetimes, hours or seconds."""
+        seconds = np.asarray(time_s, dtype=float)
+        if self.origin is not None:
+            return (self.origin.tz_convert("UTC").tz_localize(None)
+                    + pd.to_timedelta(seconds, unit="s")).to_numpy()
+        return seconds / 3600.0 if self.hours else seconds
+
+    @property
+    def label(self) -> str:
+        """Axis label."""
+        return {"clock": "time [UTC]", "hours": "log time [h]",
+                "seconds": "log time [s]"}[self.kind]
+
+    def hover(self) -> tuple[tuple[str, str], dict]:
+        """The hover field of the time and its Bokeh formatters."""
+        if self.clock:
+            return ("time", "@x{%F %T}"), {"@x": "datetime"}
+        return ("time", "@x{0.000} h" if self.hours else "@x{0.0} s"), {}
+
+
+def time_axis(origin: pd.Timestamp | TimeAxis | None, span_s: float = 0.0) -> TimeAxis:
+    """The :class:`TimeAxis` of a log whose time 0 is at clock time ``origin`` (None: no
+    clock) and which lasts ``span_s`` [s]; a TimeAxis is returned as it is."""
+    if isinstance(origin, TimeAxis):
+        return origin
+    return TimeAxis(origin, origin is None and span_s > LONG_LOG_S)
+
+
+def time_figure(height: int, y_label: str, *, x_range=None, axis: TimeAxis | None = None,
                 x_label: str | None = None):
     """A Bokeh figure for a time track: stretches to the page width, shared time axis.
 
@@ -164,15 +216,16 @@ def time_figure(height: int, y_label: str, *, x_range=None, clock: bool = False,
         Axis label (drillfric's text only; see the module docstring).
     x_range : bokeh Range, optional
         Shared with the figures above (zooming one zooms all).
-    clock : bool
-        Clock time (UTC) on the axis instead of seconds of log time.
+    axis : TimeAxis, optional
+        Clock time (UTC), log hours or log seconds (default) on the axis.
     """
     from bokeh.plotting import figure
 
+    axis = axis or TimeAxis()
     kw = {"x_range": x_range} if x_range is not None else {}
     fig = figure(height=height, sizing_mode="stretch_width", min_width=MIN_WIDTH_PX,
                  tools=TIME_TOOLS, active_scroll="xwheel_zoom", active_drag="xpan",
-                 x_axis_type="datetime" if clock else "linear", toolbar_location="right",
+                 x_axis_type="datetime" if axis.clock else "linear", toolbar_location="right",
                  **kw)
     fig.yaxis.axis_label = y_label
     if x_label is not None:
@@ -189,17 +242,11 @@ def float32(values) -> np.ndarray:
     return np.asarray(values, dtype=np.float32)
 
 
-def time_values(time_s, origin: pd.Timestamp | None) -> np.ndarray:
-    """Log time [s] as plotted: seconds, or naive-UTC datetimes when the clock is known."""
-    seconds = np.asarray(time_s, dtype=float)
-    if origin is None:
-        return seconds
-    return (origin.tz_convert("UTC").tz_localize(None)
-            + pd.to_timedelta(seconds, unit="s")).to_numpy()
+def time_values(time_s, origin: pd.Timestamp | TimeAxis | None) -> np.ndarray:
+    """Log time [s] as plotted on ``origin``'s axis (:func:`time_axis`)."""
+    return time_axis(origin).values(time_s)
 
 
-def time_label(origin: pd.Timestamp | bool | None) -> str:
-    """Axis label of log time; ``origin``: the clock time of log time 0, or whether it is
-    known (None: not known)."""
-    clock = origin if isinstance(origin, bool) else origin is not None
-    return "time [UTC]" if clock else "log time [s]"
+def time_label(origin: pd.Timestamp | TimeAxis | None) -> str:
+    """Axis label of log time on ``origin``'s axis (:func:`time_axis`)."""
+    return time_axis(origin).label

@@ -2,8 +2,10 @@
 
 Tables are drawn here rather than with ``Axes.table``: their cells wrap to the column width
 (instead of the font shrinking until a wide table fits), rows grow to the lines they need,
-and a table continues on the next page with its header repeated. Every page carries the
-well's name and "page n of N" in its footer.
+and a table continues on the next page with its header repeated; a row may carry a note
+across the full width (a diagnostics message), wrapped and never cut. Every page carries
+the well's name and "page n of N" in its footer, below every axis and its tick labels
+(:func:`clear_footer`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,10 @@ MAX_CELL_LINES = 14
 _MARGIN_IN = 0.45
 _TOP_IN = 0.85      # room for the page title
 _BOTTOM_IN = 0.55   # room for the footer
+#: Baseline of the footer [in from the bottom of the page].
+FOOTER_IN = 0.22
+#: Nothing but the footer below this [in from the bottom of the page].
+FOOTER_CLEAR_IN = 0.45
 #: Average width of a character of the sans-serif font, in font sizes.
 _CHAR_EM = 0.56
 
@@ -69,8 +75,8 @@ def column_chars(columns: list[str], rows: list[list[str]], budget: int) -> list
 
 
 def table_pages(title: str, columns: list[str], rows: list[list[str]],
-                widths: list[float] | None = None, *, font_pt: float = TABLE_FONT_PT
-                ) -> list[Figure]:
+                widths: list[float] | None = None, *, font_pt: float = TABLE_FONT_PT,
+                notes: list[str] | None = None, lead: str = "") -> list[Figure]:
     """A table over as many A4 landscape pages as it needs, cells wrapped to their column.
 
     Parameters
@@ -85,6 +91,11 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
         Relative column widths (default: :func:`column_chars` — no word is broken).
     font_pt : float
         Font size [pt].
+    notes : list of str, optional
+        A note under each row, across the full width, wrapped and never cut (it carries on
+        to the next page when it must); "" for none.
+    lead : str
+        A paragraph above the table on its first page (wrapped).
     """
     width_in = PAGE_IN[0] - 2 * _MARGIN_IN
     if widths is None:
@@ -95,23 +106,57 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
     line_in = 1.22 * font_pt / 72.0
     head = [wrap_cell(h, c) for h, c in zip(columns, chars, strict=True)]
     body = [[wrap_cell(v, c) for v, c in zip(r, chars, strict=True)] for r in rows]
+    full = int(width_in * 72.0 / (_CHAR_EM * font_pt)) - 4
+    wrapped = [_wrap_note(n, full) for n in (notes or [""] * len(rows))]
     pages: list[Figure] = []
-    y = 0.0
-    usable_bottom = _BOTTOM_IN
-    for cells in body or [None]:
-        height = (max(len(c) for c in cells) if cells else 1) * line_in + 0.06
-        if not pages or y - height < usable_bottom:
-            fig = blank_page(title + (" (continued)" if pages else ""))
-            pages.append(fig)
-            y = PAGE_IN[1] - _TOP_IN
-            if any(columns):  # a table of label–value lines has no heading row
-                y = _draw_row(fig, head, col_in, y, line_in, font_pt, header=True)
-        if cells is None:
-            fig.text(_MARGIN_IN / PAGE_IN[0], y / PAGE_IN[1] - 0.02, "(none)",
-                     fontsize=font_pt, parse_math=False)
-            break
-        y = _draw_row(fig, cells, col_in, y, line_in, font_pt)
+    state = {"y": 0.0}
+
+    def new_page() -> Figure:
+        fig = blank_page(title + (" (continued)" if pages else ""))
+        state["y"] = PAGE_IN[1] - _TOP_IN
+        if lead and not pages:
+            lines = _wrap_note(lead, full)
+            fig.text(_MARGIN_IN / PAGE_IN[0], state["y"] / PAGE_IN[1], "\n".join(lines),
+                     fontsize=font_pt, va="top", parse_math=False)
+            state["y"] -= len(lines) * line_in + 0.12
+        pages.append(fig)
+        if any(columns):  # a table of label–value lines has no heading row
+            state["y"] = _draw_row(fig, head, col_in, state["y"], line_in, font_pt,
+                                   header=True)
+        return fig
+
+    fig = None
+    for cells, note in zip(body, wrapped, strict=True):
+        height = max(len(c) for c in cells) * line_in + 0.06
+        need = height + min(len(note), 2) * 0.9 * line_in  # a row keeps a start of its note
+        if fig is None or state["y"] - need < _BOTTOM_IN:
+            fig = new_page()
+        state["y"] = _draw_row(fig, cells, col_in, state["y"], line_in, font_pt)
+        while note:
+            room = int((state["y"] - _BOTTOM_IN - 0.04) // (0.9 * line_in))
+            if room < 1:
+                fig = new_page()
+                continue
+            part, note = note[:room], note[room:]
+            fig.text((_MARGIN_IN + 0.3) / PAGE_IN[0], (state["y"] - 0.02) / PAGE_IN[1],
+                     "\n".join(part), fontsize=font_pt - 0.5, va="top", ha="left",
+                     linespacing=1.0, color="#333333", parse_math=False)
+            state["y"] -= len(part) * 0.9 * line_in + 0.06
+            fig.add_artist(_hline(fig, _MARGIN_IN / PAGE_IN[0],
+                                  (_MARGIN_IN + sum(col_in)) / PAGE_IN[0],
+                                  state["y"] / PAGE_IN[1]))
+    if fig is None:
+        fig = new_page()
+        fig.text(_MARGIN_IN / PAGE_IN[0], state["y"] / PAGE_IN[1] - 0.02, "(none)",
+                 fontsize=font_pt, parse_math=False)
     return pages
+
+
+def _wrap_note(text: str, chars: int) -> list[str]:
+    """A note wrapped to ``chars`` a line, every line kept."""
+    return [w for part in str(text).splitlines() for w in
+            (textwrap.wrap(part, max(chars, 1), break_on_hyphens=False) or [""])] \
+        if str(text).strip() else []
 
 
 def _draw_row(fig: Figure, cells: list[list[str]], col_in: list[float], y_in: float,
@@ -165,11 +210,50 @@ def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str,
             fig.set_size_inches(*PAGE_IN)
             if page_title:
                 fig.suptitle(page_title, fontsize=13, weight="bold").set_parse_math(False)
-            fig.text(_MARGIN_IN / PAGE_IN[0], 0.25 / PAGE_IN[1], footer, fontsize=7,
+            with quiet_glyphs():
+                clear_footer(fig)
+            fig.text(_MARGIN_IN / PAGE_IN[0], FOOTER_IN / PAGE_IN[1], footer, fontsize=7,
                      color="#555555", parse_math=False)
-            fig.text(1 - _MARGIN_IN / PAGE_IN[0], 0.25 / PAGE_IN[1],
+            fig.text(1 - _MARGIN_IN / PAGE_IN[0], FOOTER_IN / PAGE_IN[1],
                      f"page {number} of {count}", fontsize=7, color="#555555", ha="right")
             with quiet_glyphs():
                 pdf.savefig(fig)
     os.replace(tmp, path)
     return path
+
+
+def clear_footer(fig: Figure) -> None:
+    """Move a page's axes up until nothing of them — tick labels, axis labels, legends —
+    reaches below :data:`FOOTER_CLEAR_IN` (the footer's band): the axes are squeezed
+    towards their top, which stays where it is (a constrained layout is given a rectangle
+    above the band instead)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    if not fig.axes:
+        return
+    engine = fig.get_layout_engine()
+    if engine is not None and hasattr(engine, "set") and "rect" in engine.get():
+        low = FOOTER_CLEAR_IN / PAGE_IN[1]  # a constrained layout keeps out of the band
+        engine.set(rect=(0.0, low, 1.0, 1.0 - low))
+        return
+    if fig.canvas is None or not hasattr(fig.canvas, "get_renderer"):
+        FigureCanvasAgg(fig)
+    renderer = fig.canvas.get_renderer()
+    dpi = fig.dpi
+    boxes = [ax.get_tightbbox(renderer) for ax in fig.axes if ax.get_visible()]
+    boxes += [leg.get_window_extent(renderer) for leg in fig.legends]
+    bottom_in = min(b.y0 for b in boxes if b is not None) / dpi
+    if bottom_in >= FOOTER_CLEAR_IN:
+        return
+    top = max(ax.get_position().y1 for ax in fig.axes)
+    low = min(ax.get_position().y0 for ax in fig.axes)
+    lift = (FOOTER_CLEAR_IN - bottom_in) / PAGE_IN[1]
+    scale = (top - low - lift) / (top - low)
+    for ax in fig.axes:
+        box = ax.get_position()
+        y0 = top - (top - box.y0) * scale
+        ax.set_position([box.x0, y0, box.width, box.height * scale])
+    for legend in fig.legends:  # figure legends at the bottom move up with the axes
+        anchor = legend.get_bbox_to_anchor().transformed(fig.transFigure.inverted())
+        legend.set_bbox_to_anchor((anchor.x0, anchor.y0 + lift, anchor.width,
+                                   anchor.height), transform=fig.transFigure)

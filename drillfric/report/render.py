@@ -32,7 +32,8 @@ HTML_DPI = 90
 #: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap).
 DIAGNOSTIC_COLUMNS = (
     ("seg.", None, ""), ("kind", None, "wrap"), ("bit depth", "length", "num"),
-    ("time", None, "wrap"), ("μ_s", None, "num"), ("μ_k", None, "num"), ("μ_TD", None, "num"),
+    ("time", None, "wrap"), ("μ_s", None, "num"), ("μ_k / apparent μ", None, "num"),
+    ("μ_TD", None, "num"),
     ("μ zone", None, "wrap"), ("spread μ_s / μ_k", None, "num"), ("settling [s]", None, "num"),
     ("residual [rpm]", None, "num"), ("misfit / swing {unit} (quality)", "torque", "num"),
     ("severity", None, "num"), ("stuck", None, "num"),
@@ -197,24 +198,104 @@ def message_parts(message: str) -> list[str]:
     return [p.strip() for p in parts if p.strip()]
 
 
-def flag_items(row: dict) -> list[tuple[str, str]]:
-    """The segment's flags as ``(flag, meaning)`` (docs/outputs.md, flags); an unknown flag
-    (a newer drillfric's) keeps its name with no meaning."""
+def flag_items(row: dict) -> list[tuple[str, str, str]]:
+    """The segment's flags as ``(flag, label, meaning)`` (docs/outputs.md, flags); an
+    unknown flag (a newer drillfric's) keeps its name with no meaning.
+
+    Flags that do not bear on the reported numbers (:func:`is_note_flag`) are left out:
+    they are :func:`note_flags`.
+    """
+    return [item for item in _flag_items(row) if not is_note_flag(row, item[0])]
+
+
+def note_flags(row: dict) -> list[tuple[str, str, str]]:
+    """The segment's flags that are notes, not warnings (:func:`is_note_flag`), as
+    ``(flag, label, meaning)``."""
+    return [item for item in _flag_items(row) if is_note_flag(row, item[0])]
+
+
+def _flag_items(row: dict) -> list[tuple[str, str, str]]:
     from drillfric.result import FLAG_MEANINGS
 
     meanings = {str(k): v for k, v in FLAG_MEANINGS.items()}
     flags = row.get("flags")
     if not isinstance(flags, list | tuple):
         return []
-    return [(str(f), meanings.get(str(f), "")) for f in flags]
+    out = []
+    for flag in map(str, flags):
+        label, meaning = flag.replace("_", " "), meanings.get(flag, "")
+        if is_note_flag(row, flag) and flag in _NOTE_FLAGS:
+            label, meaning = _NOTE_FLAGS[flag]
+        out.append((flag, label, meaning))
+    return out
+
+
+#: Flags that are notes, not warnings, where the segment's μ_k is the batch fit's: the
+#: observer's starts are a cross-check there (docs/reports.md "Converged"). Label, meaning.
+_NOTE_FLAGS = {
+    "observer_not_converged": (
+        "observer starts spread",
+        "the observer's starts did not agree (spread above tolerance); μ_k is the batch "
+        "fit's, whose convergence is judged on its own (status)"),
+    "observer_deadlock_averted": (
+        "observer start released",
+        "an observer start stuck while the top drive turned was released by the deadlock "
+        "guard"),
+}
+
+
+def is_note_flag(row: dict, flag: str) -> bool:
+    """Whether ``flag`` says nothing against the segment's reported numbers: the observer's
+    flags where μ_k is the batch fit's (the observer is then a cross-check, and a
+    disagreement beyond ×1.5 is its own flag, ``estimators_disagree``)."""
+    return flag in _NOTE_FLAGS and row.get("method") == "batch"
+
+
+#: What "converged" means for a segment; the header, the status cell and the badges say it.
+CONVERGED_MEANING = (
+    "converged = the stand's reported μ_k is settled: from the batch fit, the fit matched "
+    "the mean torque within 2 %, agrees with the observer consensus within a factor 1.5 and "
+    "had ≥ 90 s of rotation; from the observer (the fit gave none), its starts agreed")
+
+
+def is_apparent(row: dict) -> bool:
+    """Whether the segment's μ is apparent: on bottom, the bit torque is in it."""
+    flags = row.get("flags")
+    return row.get("kind") == "on_bottom_rotating" or (
+        isinstance(flags, list | tuple) and "bit_torque_in_friction" in flags)
+
+
+def mu_name(row: dict) -> str:
+    """What the segment's μ_k is called: ``"μ_k"`` or ``"apparent μ"`` (on bottom)."""
+    return "apparent μ" if is_apparent(row) else "μ_k"
+
+
+def mu_k_cell(row: dict) -> str:
+    """The segment's μ_k as a table cell; an on-bottom (apparent) value says so."""
+    text = fmt(row.get("mu_k"))
+    return f"{text} apparent" if text != "—" and is_apparent(row) else text
+
+
+def status_word(row: dict) -> str:
+    """The segment's status in the words of its badge: "converged", "not converged",
+    "static" (a depth log's torque-and-drag back-calculation), or skipped / failed."""
+    if row.get("status") != "ok":
+        return str(row.get("status"))
+    if row.get("method") == "td_backcalc":
+        return "static"
+    return "converged" if row.get("converged") else "not converged"
 
 
 def status_text(row: dict) -> str:
-    """Status, convergence and method in one cell."""
+    """Status, convergence (:data:`CONVERGED_MEANING`) and method in one cell."""
+    word = status_word(row)
     if row.get("status") != "ok":
-        return str(row.get("status"))
-    converged = "converged" if row.get("converged") else "not converged"
-    return f"ok, {converged}, {row.get('method') or '—'}"
+        return word
+    if word == "static":
+        return "ok, static torque-and-drag back-calculation"
+    method = {"batch": "batch fit", "observer": "observer"}.get(str(row.get("method")),
+                                                                str(row.get("method") or "—"))
+    return f"ok, μ_k {word} ({method})"
 
 
 def diagnostic_columns(units: Units) -> list[tuple[str, str]]:
@@ -229,28 +310,34 @@ def diagnostic_columns(units: Units) -> list[tuple[str, str]]:
     return out
 
 
-def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None) -> list[dict]:
+def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None,
+                    fits: dict[int, tuple[str, str]] | None = None) -> list[dict]:
     """One dict per segment: ``cells`` (strings in :data:`DIAGNOSTIC_COLUMNS` order, values
     in display ``units``), ``id``, ``cls`` and ``anchor`` (whether the segment has a figure
     section is set by the caller).
 
-    ``origin``: clock time of log time 0 (UTC), when known.
+    ``origin``: clock time of log time 0 (UTC), when known. ``fits``: by segment id, the
+    fit quality to state and a sentence on what the fit does not reproduce ("" when it
+    does; :mod:`drillfric.report.reproduction`).
     """
     out = []
     for row in segments.to_dict("records"):
+        quality, unreproduced = (fits or {}).get(int(row["id"]), (None, ""))
         ok = row["status"] == "ok"
         mu_s = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
-        flags = ", ".join(row.get("flags") or [])
+        flags = ", ".join([flag for flag, _, _ in flag_items(row)]
+                          + [f"{flag} (a note: μ_k is the batch fit's)"
+                             for flag, _, _ in note_flags(row)])
         unresolved = bit_speed_text(row) if bit_speed_unresolved(row) and ok else ""
-        message = "; ".join(x for x in (str(row.get("message") or ""), unresolved, flags)
-                            if x)
+        message = "; ".join(x for x in (unreproduced, str(row.get("message") or ""),
+                                        unresolved, flags) if x)
         kind = str(row.get("kind") or "—").replace("_rotating", "").replace("_", " ")
         cells = [str(row["id"]), kind, units.text(row["bit_depth_m"], "length", ".1f"),
-                 clock_span(row, origin), mu_s if ok else "—", fmt(row["mu_k"]),
+                 clock_span(row, origin), mu_s if ok else "—", mu_k_cell(row),
                  fmt(row["mu_td"]), str(row.get("friction_zone") or "—").replace("_", " "),
                  pair(row["mu_s_spread"], row["mu_k_spread"]),
                  fmt(row["settling_time_s"], ".1f"), fmt(row["residual_rms_rpm"], ".2f"),
-                 _torque_fit(row, units), fmt(row["stick_slip_severity"], ".2f"),
+                 _torque_fit(row, units, quality), fmt(row["stick_slip_severity"], ".2f"),
                  fmt(row["stuck_fraction"], ".0%"),
                  units.pair(row.get("hookload_N"), row.get("hookload_model_N"), "force"),
                  _bit_speed_cell(row), observability(row), status_text(row), message]
@@ -258,11 +345,12 @@ def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None) -> list[d
     return out
 
 
-def _torque_fit(row: dict, units: Units) -> str:
-    """``"misfit / swing (quality)"`` of the torque fit, in display units."""
+def _torque_fit(row: dict, units: Units, quality: str | None = None) -> str:
+    """``"misfit / swing (quality)"`` of the torque fit, in display units; ``quality``: the
+    quality to state (default: the segment's ``fit_quality``)."""
     text = units.pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"), "torque",
                       ".1f")
-    quality = fmt(row.get("fit_quality"), ".2f")
+    quality = quality or fmt(row.get("fit_quality"), ".2f")
     return text if quality == "—" else f"{text} ({quality})"
 
 
@@ -325,6 +413,35 @@ def string_table(config: dict, units: Units) -> tuple[list[str], list[list[str]]
         rows.append(row)
     return [units.axis(heading, quantity) if quantity else heading
             for _, heading, quantity, _, _ in STRING_COLUMNS], rows
+
+
+def non_default_rows(config: dict) -> list[list[str]]:
+    """The settings of a run's effective configuration that differ from the schema's
+    defaults, as ``[setting, value, default]`` text rows (the drill string is its own
+    table: :func:`string_table`); a setting the installed schema does not know is listed
+    with default "—"."""
+    from drillfric.config import load_config
+
+    defaults = load_config().to_dict()
+    rows = []
+    for table, values in config.items():
+        if table == "string":
+            continue
+        known = defaults.get(table)
+        if not isinstance(values, dict):
+            if values != known:
+                rows.append([str(table), value_text(values), value_text(known)])
+            continue
+        known = known if isinstance(known, dict) else {}
+        for key, value in values.items():
+            default = known.get(key, _UNKNOWN)
+            if value != default:
+                rows.append([f"{table}.{key}", value_text(value),
+                             "—" if default is _UNKNOWN else value_text(default)])
+    return rows
+
+
+_UNKNOWN = object()
 
 
 def value_text(value) -> str:

@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 from drillfric.segmentation import RIG_STATES
 
 from .display import SI, Units
-from .interactive import float32, time_figure, time_label, time_values
+from .interactive import TimeAxis, float32, time_figure, time_label, time_values
 
 
 @dataclass(frozen=True)
@@ -124,7 +124,7 @@ def state_runs(time_s: np.ndarray, codes: np.ndarray) -> pd.DataFrame:
 
 # ------------------------------------------------------------------------------ Bokeh
 def tracks_sources(tracks: pd.DataFrame, segments: pd.DataFrame,
-                   origin: pd.Timestamp | None, units: Units = SI
+                   origin: pd.Timestamp | TimeAxis | None, units: Units = SI
                    ) -> dict[str, dict[str, np.ndarray]]:
     """The data of every Bokeh source of the time tracks, by source name.
 
@@ -165,16 +165,16 @@ def tracks_sources(tracks: pd.DataFrame, segments: pd.DataFrame,
     return out
 
 
-def tracks_signature(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
+def tracks_signature(tracks: pd.DataFrame, sources: dict[str, dict], axis: TimeAxis,
                      units: Units = SI) -> tuple:
     """What the layout of :func:`tracks_plot` depends on besides the sources' data."""
     panels = tuple((p.name, tuple(t.column for t in p.traces))
                    for p in panels_present(tracks))
-    return ("tracks", panels, clock, units.system,
+    return ("tracks", panels, axis.kind, units.system,
             tuple((name, tuple(cols)) for name, cols in sources.items()))
 
 
-def tracks_plot(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
+def tracks_plot(tracks: pd.DataFrame, sources: dict[str, dict], axis: TimeAxis,
                 units: Units = SI):
     """Interactive time tracks (a Bokeh layout) from :func:`tracks_sources` in display
     ``units``; each ColumnDataSource is named like its key there. Zoom/pan in time on any
@@ -189,7 +189,7 @@ def tracks_plot(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
     figs = []
     x_range = None
     for panel in panels_present(tracks):
-        fig = time_figure(_TRACK_PX, panel.label(units), x_range=x_range, clock=clock)
+        fig = time_figure(_TRACK_PX, panel.label(units), x_range=x_range, axis=axis)
         x_range = fig.x_range
         for trace in panel.traces:
             name = f"trace:{trace.column}"
@@ -197,7 +197,7 @@ def tracks_plot(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
             fig.varea("x", "lo", "hi", source=source, color=trace.color, alpha=0.25)
             line = fig.line("x", "mean", source=source, color=trace.color, line_width=1,
                             legend_label=trace.label)
-            _hover(fig, line, trace.label, clock)
+            _hover(fig, line, trace.label, axis)
         fig.legend.location = "top_left"
         fig.legend.label_text_font_size = "10px"
         fig.legend.background_fill_alpha = 0.6
@@ -208,29 +208,38 @@ def tracks_plot(tracks: pd.DataFrame, sources: dict[str, dict], clock: bool,
             fig.vstrip(x0="x0", x1="x1", color="color", source=shading, alpha=0.08,
                        line_alpha=0)
         figs.append(fig)
-    figs.append(_strip(sources, x_range, clock))
+    figs.append(_strip(sources, x_range, axis))
     return gridplot([[f] for f in figs], merge_tools=True, toolbar_location="right",
                     sizing_mode="stretch_width")
 
 
-def _hover(fig, renderer, label: str, clock: bool) -> None:
+def _hover(fig, renderer, label: str, axis: TimeAxis) -> None:
     from bokeh.models import HoverTool
 
-    when = ("time", "@x{%F %T}") if clock else ("time", "@x{0.0} s")
+    when, formatters = axis.hover()
     fig.add_tools(HoverTool(renderers=[renderer], mode="vline",
                             tooltips=[when, (label, "@mean{0.00} (min @lo{0.00}, "
                                                     "max @hi{0.00})")],
-                            formatters={"@x": "datetime"} if clock else {}))
+                            formatters=formatters))
 
 
-def _strip(sources: dict[str, dict], x_range, clock: bool):
+def _strip(sources: dict[str, dict], x_range, axis: TimeAxis):
     """Rig states (lower row) and segments (upper row) as coloured bands with hover."""
     from bokeh.models import ColumnDataSource, FixedTicker, HoverTool
 
-    fig = time_figure(90, "", x_range=x_range, clock=clock, x_label=time_label(clock))
+    fig = time_figure(130, "", x_range=x_range, axis=axis, x_label=axis.label)
     quads = [fig.quad(left="left", right="right", bottom=0.0, top=1.0, color="color",
-                      line_alpha=0, source=ColumnDataSource(sources["states"],
-                                                            name="states"))]
+                      line_alpha=0, legend_field="what",
+                      source=ColumnDataSource(sources["states"], name="states"))]
+    legend = fig.legend[0]  # the rig states' colours, one entry per state present
+    legend.orientation = "horizontal"
+    legend.label_text_font_size = "10px"
+    legend.padding = legend.margin = 2
+    legend.title = "rig state:"
+    legend.title_location = "left"
+    legend.title_text_font_size = "10px"
+    fig.center = [r for r in fig.center if r is not legend]
+    fig.add_layout(legend, "below")
     if "bands" in sources:
         quads.append(fig.quad(left="left", right="right", bottom=1.2, top=2.2,
                               source=ColumnDataSource(sources["bands"], name="bands"),
@@ -246,8 +255,8 @@ def _strip(sources: dict[str, dict], x_range, clock: bool):
 
 # ------------------------------------------------------------------------- matplotlib
 def tracks_figure(tracks: pd.DataFrame, segments: pd.DataFrame,
-                  origin: pd.Timestamp | None, size: tuple[float, float] = (11.69, 8.27),
-                  units: Units = SI) -> Figure:
+                  origin: pd.Timestamp | TimeAxis | None,
+                  size: tuple[float, float] = (11.69, 8.27), units: Units = SI) -> Figure:
     """Static time tracks (the PDF page) in display ``units``: envelopes, means, segments
     and rig states."""
     from matplotlib.patches import Patch
@@ -257,7 +266,7 @@ def tracks_figure(tracks: pd.DataFrame, segments: pd.DataFrame,
     x = time_values(data["time_s"], origin)
     fig = Figure(figsize=size)
     ratios = [1.0] * len(panels) + [0.35]
-    fig.subplots_adjust(left=0.08, right=0.985, top=1 - 0.8 / size[1], bottom=0.7 / size[1],
+    fig.subplots_adjust(left=0.08, right=0.985, top=1 - 0.95 / size[1], bottom=0.7 / size[1],
                         hspace=0.08)
     axes = fig.subplots(len(panels) + 1, 1, sharex=True,
                         gridspec_kw={"height_ratios": ratios}, squeeze=False)[:, 0]
@@ -295,6 +304,7 @@ def tracks_figure(tracks: pd.DataFrame, segments: pd.DataFrame,
     strip.tick_params(labelsize=7)
     used = sorted(set(runs["code"]))
     fig.legend(handles=[Patch(color=STATE_COLORS[c], label=RIG_STATES[c].replace("_", " "))
-                        for c in used], loc="lower center", ncol=len(used) or 1, fontsize=7,
-               frameon=False)
+                        for c in used], loc="upper center", ncol=len(used) or 1, fontsize=7,
+               frameon=False, title="rig state", title_fontsize=7,
+               bbox_to_anchor=(0.5, 1 - 0.38 / size[1]))
     return fig

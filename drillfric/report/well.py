@@ -20,7 +20,7 @@ from drillfric.errors import ConfigError, DrillfricError
 
 from . import broomstick as broom
 from . import figures
-from .data import ResultData, load_result, segment_estimates
+from .data import ResultData, final_torques, load_result, segment_estimates
 from .display import Units, report_units
 from .evidence import (
     evidence_figure,
@@ -31,9 +31,10 @@ from .evidence import (
     starts_text,
 )
 from .friction import friction_plot, friction_signature, friction_sources
-from .interactive import Embedder
+from .interactive import LONG_LOG_S, Embedder
 from .pdf import table_pages, write_pdf
 from .render import (
+    CONVERGED_MEANING,
     MESSAGE_FOLD_CHARS,
     bit_speed_text,
     bit_speed_unresolved,
@@ -47,13 +48,19 @@ from .render import (
     flag_items,
     fmt,
     interval_text,
+    is_apparent,
     message_parts,
+    mu_name,
     mu_s_text,
+    non_default_rows,
+    note_flags,
     now_utc,
+    status_word,
     string_table,
     written_at,
     zone_text,
 )
+from .reproduction import Reproduction, reproduction, stated_quality
 from .tracks import (
     panels_present,
     tracks_figure,
@@ -67,6 +74,9 @@ from .tracks import (
 MAX_SEGMENT_FIGURES = 10
 _NO_TRACKS = ("No time tracks: this result directory has no tracks.parquet (results written "
               "before drillfric wrote it); rerun 'drillfric run' to get them.")
+_DEPTH_TRACKS = ("No time tracks: the log is depth-indexed (one row per depth step, no time), "
+                 "so there is nothing to draw against time. The friction log and the "
+                 "broomstick below are its evidence versus depth.")
 
 
 def segment_limit(segments: int | str) -> int | None:
@@ -127,35 +137,86 @@ def _header(data: ResultData, units: Units) -> dict:
     inputs = summary.get("inputs") or {}
     files = [(kind, str(v.get("path", "—")), str(v.get("sha256", "—")))
              for kind, v in inputs.items() if isinstance(v, dict)]
-    origin = data.time_origin
-    span = None
-    if len(seg) and origin is not None:
-        span = tuple(f"{origin + pd.Timedelta(seconds=float(t)):%Y-%m-%d %H:%M:%S} UTC"
-                     for t in (seg["t_start_s"].min(), seg["t_end_s"].max()))
-    elif len(seg):
-        span = (clock(seg["t_start_s"].min()), clock(seg["t_end_s"].max()))
     string_columns, string_rows = string_table(summary.get("config") or {}, units)
     zone = str(summary.get("friction_zone") or "").replace("_", " ") or zone_text(seg)
     return {
         "well": str(summary.get("well", data.result_dir.name)),
         "version": str(summary.get("drillfric_version", "—")),
         "written": written_at(data.result_dir / "summary.json"), "built": now_utc(),
-        "span": span, "files": files, "rows": inputs.get("rows"),
+        "span": _log_span(data, units), "files": files, "rows": inputs.get("rows"),
         "rate_hz": inputs.get("resampled_rate_hz"),
         "run_time_s": summary.get("run_time_s"),
-        "mu_k": fmt(summary.get("mu_k")),
+        "mu_k": fmt(summary.get("mu_k")), "mu_k_reason": _no_mu_k_reason(data),
+        "apparent": _apparent(data),
         "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                           summary.get("mu_s_lower_bound")),
         "mu_s_identified": summary.get("mu_s") is not None,
         "zone": zone, "profile": str(summary.get("friction_profile") or ""),
-        "units": units.system,
+        "units": units.system, "depth_indexed": data.depth_indexed,
         "counts": summary.get("counts") or {}, "assumed": [str(a) for a in
                                                            summary.get("assumed") or []],
         "indicative": bool(summary.get("indicative", bool(summary.get("assumed")))),
         "warnings": [str(w) for w in summary.get("warnings") or []],
         "config": config_rows(summary.get("config") or {}),
+        "non_default": non_default_rows(summary.get("config") or {}),
         "string": (string_columns, string_rows),
+        "converged_meaning": CONVERGED_MEANING,
     }
+
+
+def _log_span(data: ResultData, units: Units) -> tuple[str, str] | None:
+    """``(what, span)`` the header shows: the log's time span (clock time when known), a
+    depth log's depth range, or — without tracks.parquet (older results) — the segments'
+    time span, called so."""
+    if data.depth_indexed:
+        log = data.summary.get("friction_log") or {}
+        top, bottom = log.get("md_start_m"), log.get("md_end_m")
+        if top is None or bottom is None:
+            return None
+        length = units.label("length")
+        return ("log depth", f"{units.text(top, 'length')}–{units.text(bottom, 'length')} "
+                             f"{length} MD")
+    span = data.log_span_s
+    if span is None:
+        return None
+    what = "log time" if data.span_from_tracks else "segments' time"
+    origin = data.time_origin
+    if origin is None:
+        return what, f"{clock(span[0])} – {clock(span[1])} (log time h:mm:ss)"
+    spec = "%Y-%m-%d %H:%M" if span[1] - span[0] > LONG_LOG_S else "%Y-%m-%d %H:%M:%S"
+    a, b = (origin + pd.Timedelta(seconds=t) for t in span)
+    return what, f"{a:{spec}} – {b:{spec}} UTC"
+
+
+def _no_mu_k_reason(data: ResultData) -> str:
+    """Why the headline has no μ_k ("" when it has one)."""
+    summary = data.summary
+    if summary.get("mu_k") is not None:
+        return ""
+    reason = (summary.get("friction_log") or {}).get("mu_k_reason")
+    if reason:
+        return str(reason)
+    ok = data.segments[data.segments["status"] == "ok"]
+    if not len(ok):
+        return "no segment was estimated"
+    off = ok[~ok.apply(lambda r: is_apparent(r.to_dict()), axis=1)]
+    if not len(off):
+        return "no off-bottom stand was estimated: only apparent friction, on bottom"
+    return "no off-bottom stand converged"
+
+
+def _apparent(data: ResultData) -> dict | None:
+    """The headline's apparent (on-bottom) friction factor: a depth log's ``mu_apparent``,
+    else the median over the converged on-bottom stands; None when there is none."""
+    seg = data.segments
+    on = seg[(seg["status"] == "ok") & seg["converged"] & seg["mu_k"].notna()]
+    on = on[[is_apparent(r) for r in on.to_dict("records")]]
+    value = (data.summary.get("friction_log") or {}).get("mu_apparent")
+    if value is None and not len(on):
+        return None
+    if value is None:
+        value = float(on["mu_k"].median())
+    return {"value": fmt(value), "count": len(on)}
 
 
 def _no_survey_note(summary: dict) -> str:
@@ -190,6 +251,8 @@ def _broomstick(data: ResultData, units: Units) -> Broomstick:
     from drillfric.wellpath import minimum_curvature
 
     points = broom.measured_points(data.segments)
+    if data.friction_log is not None and not points["surface_torque_Nm"].notna().any():
+        points = broom.measured_points_from_windows(data.friction_log)
     if not len(points):
         return Broomstick(None, points, broom.weight_check(points, units=units), (
             "No measured hook load or torque per segment in these results (written before "
@@ -220,15 +283,21 @@ def _broomstick_note(check: dict, units: Units) -> str | None:
             "measured − modelled).")
 
 
-def _segment_head(row: dict, origin, units: Units) -> dict:
-    """What a segment's header shows (display units)."""
+def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = None) -> dict:
+    """What a segment's header shows (display units); ``fit``: what the batch fit
+    reproduces over its second half (None: not known)."""
     row = dict(row)
     row["mu_s_text"] = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
     row["span"] = clock_span(row, origin)
     row["depth"] = f"{units.text(row['bit_depth_m'], 'length')} {units.label('length')}"
     row["torque"] = units.pair(row.get("torque_rms_misfit_Nm"), row.get("torque_swing_Nm"),
                                "torque", ".1f")
-    row["quality"] = fmt(row.get("fit_quality"), ".2f")
+    row["quality"] = quality_text(row, fit)
+    row["fit_sentence"] = fit.sentence(_when(fit.t_half_s, origin), units) if fit else ""
+    row["fit_mismatch"] = fit is not None and not fit.regime_reproduced
+    row["mu_name"] = mu_name(row)
+    row["status_word"] = status_word(row)
+    row["note_flags"] = note_flags(row)
     row["hookload"] = units.pair(row.get("hookload_N"), row.get("hookload_model_N"), "force")
     row["bit_speed"] = bit_speed_text(row)
     row["bit_unresolved"] = bit_speed_unresolved(row)
@@ -253,11 +322,14 @@ class Report:
     diagnostics: list[dict]
     units: Units
 
+    fits: dict[int, Reproduction]
+
     @property
     def segment_rows(self) -> list[dict]:
         """Header rows of the drawn segments that have estimates, in id order."""
         rows = self.data.segments.set_index("id", drop=False)
-        return [_segment_head(rows.loc[i].to_dict(), self.data.time_origin, self.units)
+        return [_segment_head(rows.loc[i].to_dict(), self.data.time_origin, self.units,
+                              self.fits.get(i))
                 for i in self.drawn if i in self.estimates and len(self.estimates[i])]
 
     @property
@@ -275,12 +347,37 @@ def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
     shown = report_units(data.summary, units)
     drawn = select_segments(data.segments, limit)
     estimates = segment_estimates(data.result_dir, drawn)
-    diag = diagnostic_rows(data.segments, shown, data.time_origin)
+    ok = [int(i) for i in data.segments.loc[data.segments["status"] == "ok", "id"]]
+    fits = {i: found for i, rows in final_torques(data.result_dir, ok).items()
+            if (found := reproduction(rows)) is not None}
+    rows = data.segments.set_index("id", drop=False)
+    texts = {i: (quality_text(rows.loc[i].to_dict(), fit),
+                 "" if fit.regime_reproduced else
+                 fit.sentence(_when(fit.t_half_s, data.time_origin), shown))
+             for i, fit in fits.items()}
+    diag = diagnostic_rows(data.segments, shown, data.time_origin, texts)
     have = {i for i, e in estimates.items() if len(e)}
     for row in diag:
         row["anchor"] = int(row["id"]) in have
     return Report(data, _header(data, shown), drawn, estimates, _broomstick(data, shown), diag,
-                  shown)
+                  shown, fits)
+
+
+def quality_text(row: dict, fit: Reproduction | None) -> str:
+    """The fit quality stated for a segment: the worse of the whole segment's and its
+    second half's (:func:`~drillfric.report.reproduction.stated_quality`), said which."""
+    value, half = stated_quality(row.get("fit_quality"), fit)
+    text = fmt(value, ".2f")
+    if not half or text == "—":
+        return text
+    return f"{text} over the second half ({fmt(row.get('fit_quality'), '.2f')} over all)"
+
+
+def _when(time_s: float, origin) -> str:
+    """A log time as shown in a sentence: clock time when known, else h:mm:ss log time."""
+    if origin is None:
+        return f"{clock(time_s)} log time"
+    return f"{origin + pd.Timedelta(seconds=time_s):%H:%M:%S} UTC"
 
 
 def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, str | None]]:
@@ -307,15 +404,15 @@ def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, 
 
 def _html(report: Report) -> str:
     data, units = report.data, report.units
-    clock = data.time_origin is not None
+    axis = data.time_axis
     embed = Embedder()
     tracks_id = friction_id = None
     if report.has_tracks:
-        bins = tracks_sources(data.tracks, data.segments, data.time_origin, units)
-        tracks_id = embed.add_like(tracks_signature(data.tracks, bins, clock, units),
-                                   lambda: tracks_plot(data.tracks, bins, clock, units), bins,
+        bins = tracks_sources(data.tracks, data.segments, axis, units)
+        tracks_id = embed.add_like(tracks_signature(data.tracks, bins, axis, units),
+                                   lambda: tracks_plot(data.tracks, bins, axis, units), bins,
                                    "tracks")
-    if data.segments["bit_depth_m"].notna().any():
+    if has_friction(data.segments):
         log = friction_sources(data.segments, units)
         friction_id = embed.add_like(friction_signature(data.segments, log, units),
                                      lambda: friction_plot(data.segments, log, units), log,
@@ -323,22 +420,42 @@ def _html(report: Report) -> str:
     segments = []
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
-        sources = evidence_sources(est, data.time_origin, units, not row["bit_unresolved"])
-        div = embed.add_like(signature(sources, clock, units),
-                             lambda sources=sources: evidence_plot(sources, clock, units),
+        sources = evidence_sources(est, axis, units, not row["bit_unresolved"])
+        div = embed.add_like(signature(sources, axis, units),
+                             lambda sources=sources: evidence_plot(sources, axis, units),
                              sources, f"segment-{row['id']}")
         segments.append((row, div, _missing_evidence(est)))
     sections = [(k, t, figure_uri(f) if f is not None else None, n)
                 for k, t, f, n in _static_sections(report)]
     return environment().get_template("well_report.html.j2").render(
-        head=report.head, bokeh=embed.head, tracks_id=tracks_id, no_tracks=_NO_TRACKS,
-        friction_id=friction_id, sections=sections, segments=segments,
+        head=report.head, bokeh=embed.head, tracks_id=tracks_id,
+        no_tracks=_DEPTH_TRACKS if data.depth_indexed else _NO_TRACKS,
+        friction_id=friction_id, no_friction=no_friction_note(data.segments),
+        sections=sections, segments=segments,
         broomstick_check=_broomstick_note(report.broomstick.check, units),
         broomstick_warning=bool(report.broomstick.check["warning"]),
         n_estimated=int((data.segments["status"] == "ok").sum()),
         columns=diagnostic_columns(units), fold=MESSAGE_FOLD_CHARS,
         diagnostics=report.diagnostics,
         u={q: units.label(q) for q in ("length", "force", "torque")})
+
+
+def has_friction(segments: pd.DataFrame) -> bool:
+    """Whether the friction log has a friction factor to draw (an estimated segment with a
+    bit depth and a μ)."""
+    return bool(((segments["status"] == "ok") & segments["bit_depth_m"].notna()
+                 & segments["mu_k"].notna()).any())
+
+
+def no_friction_note(segments: pd.DataFrame) -> str:
+    """Why the friction log is empty, with the counts."""
+    if not len(segments):
+        return "No friction log: the run found no rotating segment."
+    status = segments["status"].value_counts()
+    parts = ", ".join(f"{int(status[k])} {k}" for k in ("skipped", "failed") if k in status)
+    return (f"No friction factor to draw: none of the {len(segments)} segment(s) was "
+            f"estimated with a bit depth ({parts or 'no bit depth'}); their depths and "
+            "reasons are in the diagnostics table.")
 
 
 def _missing_evidence(est: pd.DataFrame) -> str | None:
@@ -398,14 +515,13 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
     from .pdf import blank_page
 
     head, data, units = report.head, report.data, report.units
-    pages = [("", p) for p in table_pages(f"Friction report — {head['well']}",
-                                          ["", ""], _header_lines(report), font_pt=9.0)]
+    axis = data.time_axis
+    pages = [(f"Friction report — {head['well']}", _first_page(report, size)),
+             *(("", p) for p in table_pages("Run details", ["", ""], _header_lines(report),
+                                            font_pt=9.0))]
     if report.has_tracks:
-        pages.append(("Time tracks", tracks_figure(data.tracks, data.segments,
-                                                   data.time_origin, size, units)))
-    if data.segments["bit_depth_m"].notna().any():
-        pages.append(("Friction log", figures.friction_log_figure(data.segments, size,
-                                                                  units)))
+        pages.append(("Time tracks", tracks_figure(data.tracks, data.segments, axis, size,
+                                                   units)))
     for _, title, fig, note in _static_sections(report, size):
         if fig is None:
             fig = blank_page("")
@@ -413,16 +529,90 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
         pages.append((title, fig))
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
-        figure = evidence_figure(est, row, data.time_origin, size, units,
+        figure = evidence_figure(est, row, axis, size, units,
                                  not row["bit_unresolved"], notes=segment_notes(row, units))
         pages.append((f"Segment {row['id']} — bit at {row['depth']}, {row['span']}", figure))
-    pages += [("", p) for p in table_pages("Diagnostics",
-                                           [h for h, _ in diagnostic_columns(units)],
-                                           [r["cells"] for r in report.diagnostics])]
-    config = [[table, key, value] for table, items in head["config"] for key, value in items]
-    pages += [("", p) for p in table_pages("Configuration: drill string", *head["string"])]
-    pages += [("", p) for p in table_pages("Configuration", ["table", "key", "value"], config)]
+    columns, rows, notes, common = pdf_diagnostics(report.diagnostics, units)
+    lead = ("Each row's message is below it. " + ("In every segment: " + "; ".join(common)
+                                                   if common else "")).strip()
+    pages += [("", p) for p in table_pages("Diagnostics", columns, rows, notes=notes,
+                                           lead=lead)]
+    pages += [("", p) for p in table_pages("Appendix: drill string", *head["string"])]
+    pages += [("", p) for p in table_pages(
+        "Appendix: settings that differ from the defaults", ["setting", "value", "default"],
+        head["non_default"],
+        lead="Every other setting is the default (docs/configuration.md); report.html holds "
+             "the whole effective configuration.")]
     return pages
+
+
+#: Headline lines of the PDF's first page [in from the top of the page, per line].
+_HEADLINE_TOP_IN, _HEADLINE_LINE_IN = 0.75, 0.24
+
+
+def _first_page(report: Report, size):
+    """Page 1: the headline numbers and the friction log versus depth."""
+    lines = headline_lines(report.head)
+    top = _HEADLINE_TOP_IN + _HEADLINE_LINE_IN * len(lines) + 0.35
+    fig = figures.friction_log_figure(report.data.segments, size, report.units, top_in=top)
+    for index, (text, strong) in enumerate(lines):
+        fig.text(0.45 / size[0], 1 - (_HEADLINE_TOP_IN + _HEADLINE_LINE_IN * index) / size[1],
+                 text, fontsize=11 if strong else 9, va="top", parse_math=False,
+                 weight="bold" if strong else "normal",
+                 color="#a04000" if text.startswith(("INDICATIVE", "WARNING")) else "#222222")
+    return fig
+
+
+def headline_lines(head: dict) -> list[tuple[str, bool]]:
+    """The headline of the PDF's first page as ``(text, bold)``."""
+    mu_k = f"μ_k off bottom (consensus): {head['mu_k']}"
+    lines = [(mu_k + (f" — {head['mu_k_reason']}" if head["mu_k_reason"] else ""), True)]
+    if head["apparent"]:
+        what = "window" if head["depth_indexed"] else "stand"
+        lines.append((f"apparent μ on bottom: {head['apparent']['value']} (bit torque "
+                      f"included, not μ_k; median of {head['apparent']['count']} converged "
+                      f"on-bottom {what}(s))", True))
+    lines.append((f"μ_s (consensus): {head['mu_s']}", True))
+    zone = " — ".join(x for x in (head["zone"], head["profile"]) if x)
+    if zone:
+        lines.append((f"friction zone: {zone}", False))
+    counts = head["counts"]
+    converged = "static (torque and drag)" if head["depth_indexed"] else \
+        f"{counts.get('converged', '—')} μ_k converged"
+    lines.append((f"segments {counts.get('segments', '—')}: {counts.get('estimated', '—')} "
+                  f"estimated, {converged}, {counts.get('skipped', '—')} skipped, "
+                  f"{counts.get('failed', '—')} failed", False))
+    if head["span"]:
+        lines.append((f"{head['span'][0]}: {head['span'][1]}", False))
+    if head["indicative"]:
+        lines.append(("INDICATIVE: defaults were assumed (see Run details)", False))
+    if head["warnings"]:
+        lines.append((f"WARNING: {len(head['warnings'])} warning(s), see Run details", False))
+    return lines
+
+
+#: Columns of the PDF's diagnostics table (headings of DIAGNOSTIC_COLUMNS, before units);
+#: the message goes under each row.
+PDF_DIAGNOSTICS = ("seg.", "kind", "bit depth", "time", "μ_s", "μ_k / apparent μ", "μ_TD",
+                   "misfit / swing {unit} (quality)", "severity", "stuck",
+                   "bit speed (interval)", "status")
+
+
+def pdf_diagnostics(diagnostics: list[dict], units: Units
+                    ) -> tuple[list[str], list[list[str]], list[str], list[str]]:
+    """The diagnostics as the PDF prints them: headings, rows of the
+    :data:`PDF_DIAGNOSTICS` columns, each row's message without the notes every row shares,
+    and those shared notes (said once above the table)."""
+    from .render import DIAGNOSTIC_COLUMNS
+
+    names = [name for name, _, _ in DIAGNOSTIC_COLUMNS]
+    keep = [names.index(n) for n in PDF_DIAGNOSTICS]
+    headings = [h for h, _ in diagnostic_columns(units)]
+    parts = [message_parts(r["cells"][-1]) for r in diagnostics]
+    shared = [p for p in parts[0] if all(p in q for q in parts)] if len(parts) > 2 else []
+    notes = ["; ".join(p for p in q if p not in shared) for q in parts]
+    return ([headings[i] for i in keep], [[r["cells"][i] for i in keep] for r in diagnostics],
+            notes, shared)
 
 
 #: Characters per line of a segment page's notes (7 pt on A4 landscape) and most lines.
@@ -432,10 +622,12 @@ _NOTE_CHARS, _NOTE_LINES = 190, 7
 def segment_notes(row: dict, units: Units) -> list[str]:
     """What a segment's PDF page says above its panels (the HTML header's facts): μ and
     the friction zone, torque fit, hook load, logging interval, bit speed (why not
-    resolved), flags and the estimators' notes, wrapped to :data:`_NOTE_CHARS`."""
+    resolved), what the fit reproduces, flags and the estimators' notes, wrapped to
+    :data:`_NOTE_CHARS`."""
     import textwrap
 
-    facts = [f"μ_k {fmt(row['mu_k'])} ({row['zone']}), μ_s {row['mu_s_text']}",
+    facts = [f"{row['mu_name']} {fmt(row['mu_k'])} ({row['zone']}), μ_s {row['mu_s_text']}",
+             f"μ_k {row['status_word']}",
              f"torque misfit / swing {row['torque']} {units.label('torque')} "
              f"(fit quality {row['quality']})",
              f"hook load measured / model {row['hookload']} {units.label('force')}"]
@@ -443,8 +635,12 @@ def segment_notes(row: dict, units: Units) -> list[str]:
         facts.append(f"logged every {row['interval']}")
     facts.append(f"bit speed {row['bit_speed']}")
     lines = ["; ".join(facts)]
+    if row["fit_sentence"]:
+        lines.append(row["fit_sentence"])
     if row["flag_items"]:
-        lines.append("flags: " + ", ".join(flag for flag, _ in row["flag_items"]))
+        lines.append("flags: " + ", ".join(flag for flag, _, _ in row["flag_items"]))
+    if row["note_flags"]:
+        lines.append("notes: " + ", ".join(label for _, label, _ in row["note_flags"]))
     lines += row["notes"]
     wrapped = [w for line in lines for w in textwrap.wrap(line, _NOTE_CHARS)]
     return wrapped[:_NOTE_LINES - 1] + ["…"] if len(wrapped) > _NOTE_LINES else wrapped
@@ -455,8 +651,13 @@ def _header_lines(report: Report) -> list[list[str]]:
     counts = head["counts"]
     lines = [["well", head["well"]], ["drillfric", head["version"]],
              ["results written", head["written"]], ["report built", head["built"]],
-             ["log time span", " – ".join(head["span"]) if head["span"] else "—"],
-             ["μ_k (consensus)", head["mu_k"]], ["μ_s (consensus)", head["mu_s"]],
+             [head["span"][0] if head["span"] else "log time", head["span"][1]
+              if head["span"] else "—"],
+             ["μ_k off bottom (consensus)", head["mu_k"] + (f" — {head['mu_k_reason']}"
+                                                            if head["mu_k_reason"] else "")],
+             ["apparent μ on bottom", head["apparent"]["value"] + " (bit torque included)"
+              if head["apparent"] else "—"],
+             ["μ_s (consensus)", head["mu_s"]],
              ["friction zone", " — ".join(x for x in (head["zone"], head["profile"]) if x)
               or "—"],
              ["segments", ", ".join(f"{k} {v}" for k, v in counts.items())],
