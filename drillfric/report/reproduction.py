@@ -9,7 +9,7 @@ normal, yet for half the segment the model shows a 10–30 kN·m swing the data 
 So the report compares the fitted model's surface torque with the measured one over the
 segment's **second half** (estimates.parquet, final pass, every sample): each is called
 stick-slipping when the standard deviation of its 1-s smoothed torque exceeds
-:data:`~drillfric.estimation.batch.STICK_SLIP_FLUCTUATION` of its mean (the fit's own rule
+:data:`~drillfric.estimation.batch.settings.STICK_SLIP_FLUCTUATION` of its mean (the fit's own rule
 for the data), and the misfit there is stated as a quality of its own — RMS of the 1-s
 smoothed measured − model torque over the measured 5–95 % swing of that half (floored at
 :data:`SWING_FLOOR` of the mean torque, so a steady half does not divide by ~0). Where the
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from drillfric.estimation.batch import STICK_SLIP_FLUCTUATION, TORQUE_SMOOTH_S
+from drillfric.estimation.batch.settings import STICK_SLIP_FLUCTUATION, TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 
 from .display import SI, Units
