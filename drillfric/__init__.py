@@ -15,7 +15,7 @@ Importing the package is cheap: the API's functions load what they need when cal
 
 from pathlib import Path as _Path
 
-__version__ = "0.1.0"
+from drillfric._version import __version__
 
 __all__ = ["open_well", "run", "load_result", "torque_and_drag", "simulate", "__version__"]
 

@@ -209,7 +209,7 @@ class Well:
     @property
     def depth_indexed(self) -> bool:
         """Whether the data file is a depth-indexed log (per-depth averages, no time base):
-        ``run`` turns it into a static friction log (:mod:`drillfric.friction_log`)."""
+        ``run`` turns it into a static friction log (:mod:`drillfric.estimation.friction_log`)."""
         return bool(self.mappings) and "time" not in self.mappings
 
     @property
@@ -248,7 +248,7 @@ class Well:
         """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
         if self.depth_indexed:
             raise InputError("a depth-indexed log has no time base", file=self.files.data,
-                             fix="read it with drillfric.friction_log.read_depth_log")
+                             fix="read it with drillfric.estimation.friction_log.read_depth_log")
         tracker = self.time_tracker()
         chunks = list(self.chunks(chunk_rows, tracker))
         surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()

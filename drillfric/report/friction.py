@@ -14,10 +14,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .display import SI, Units
+from .display import SI, Units, fmt
 from .figures import MU_K_COLOR, MU_S_COLOR, TD_COLOR
 from .interactive import MIN_WIDTH_PX
-from .render import fmt, mu_s_text, zone_text
+from .render import mu_s_text, zone_text
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
