@@ -293,7 +293,7 @@ class RunProgress:
         return min(self.rows_done / self.rows_total, 1.0)
 
 
-@dataclass
+@dataclass(repr=False)
 class WellResult:
     """What a run of one well produced (the API's return value; the CLI prints from it).
 
@@ -313,6 +313,10 @@ class WellResult:
         What the user should know (also ``summary["warnings"]``).
     tracks : pandas.DataFrame or None
         The whole log decimated for plotting (tracks.parquet).
+
+    The headline numbers are typed properties read from ``summary``: :attr:`mu_k`,
+    :attr:`mu_s`, :attr:`mu_s_lower_bound`, :attr:`counts`, :attr:`status`,
+    :attr:`indicative`.
     """
 
     well: str
@@ -337,3 +341,50 @@ class WellResult:
         """report.html when it was written."""
         path = None if self.out_dir is None else self.out_dir / "report.html"
         return path if path is not None and path.is_file() else None
+
+    # the headline numbers, typed, as summary.json has them (docs/outputs.md)
+    @property
+    def mu_k(self) -> float | None:
+        """The well's kinetic friction factor [-] (median of the converged segments), None
+        when no segment gives one."""
+        return self.summary.get("mu_k")
+
+    @property
+    def mu_s(self) -> float | None:
+        """The well's static friction factor [-], only where the data identify it."""
+        return self.summary.get("mu_s")
+
+    @property
+    def mu_s_lower_bound(self) -> float | None:
+        """A lower bound on μ_s [-] where it is only bounded (and ``mu_s`` is None)."""
+        return self.summary.get("mu_s_lower_bound")
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """Segments: ``segments``, ``estimated``, ``converged``, ``skipped``, ``failed``."""
+        return dict(self.summary.get("counts", {}))
+
+    @property
+    def indicative(self) -> bool:
+        """Whether something was assumed (``summary["assumed"]``): the numbers are then
+        indicative."""
+        return bool(self.summary.get("indicative"))
+
+    @property
+    def status(self) -> str:
+        """``"estimated"`` (a well μ_k), ``"not_estimated"`` (segments, none converged: no
+        μ_k is claimed) or ``"no_segments"`` (no rotation found)."""
+        if self.mu_k is not None:
+            return "estimated"
+        return "not_estimated" if self.counts.get("segments") else "no_segments"
+
+    def __repr__(self) -> str:
+        mu_s = (f"{self.mu_s:.3f}" if self.mu_s is not None else
+                f"≥ {self.mu_s_lower_bound:.3f}" if self.mu_s_lower_bound is not None else "—")
+        mu_k = "—" if self.mu_k is None else f"{self.mu_k:.3f}"
+        c = self.counts
+        where = "" if self.out_dir is None else f", out_dir='{self.out_dir}'"
+        return (f"<WellResult {self.well!r}: {self.status}, μ_k {mu_k}, μ_s {mu_s}; "
+                f"{c.get('segments', 0)} segments ({c.get('converged', 0)} converged, "
+                f"{c.get('failed', 0)} failed); {len(self.warnings)} warnings"
+                f"{' (indicative)' * self.indicative}{where}>")

@@ -63,7 +63,7 @@ def _stream(well: Well, sink: Sink, rate_hz, progress, chunk_rows, t_wall) -> We
     estimator = SegmentEstimator(well)
     check = LogCheck(well)
     tracker = well.time_tracker()
-    total = _count_rows(well.files.data)
+    total = well.source.rows if well.source.rows is not None else _count_rows(well.files.data)
     stream = SegmentStream(well.config)
     tracks = TrackAccumulator()
     records: list[SegmentRecord] = []
