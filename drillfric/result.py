@@ -385,6 +385,7 @@ class WellResult:
         c = self.counts
         where = "" if self.out_dir is None else f", out_dir='{self.out_dir}'"
         return (f"<WellResult {self.well!r}: {self.status}, μ_k {mu_k}, μ_s {mu_s}; "
-                f"{c.get('segments', 0)} segments ({c.get('converged', 0)} converged, "
+                f"{c.get('segments', 0)} segment{'s' * (c.get('segments') != 1)} "
+                f"({c.get('converged', 0)} converged, "
                 f"{c.get('failed', 0)} failed); {len(self.warnings)} warnings"
                 f"{' (indicative)' * self.indicative}{where}>")
