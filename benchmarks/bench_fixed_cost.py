@@ -81,9 +81,9 @@ import sys, time
 from pathlib import Path
 t0 = time.perf_counter()
 from drillfric.io.well import open_well
-from drillfric.pipeline import run_well
+from drillfric.runner import run_well
 t1 = time.perf_counter()
-result = run_well(open_well(sys.argv[1]), Path(sys.argv[2]), report=False)
+result = run_well(open_well(sys.argv[1]), Path(sys.argv[2]))
 t2 = time.perf_counter()
 from drillfric.report import write_well_report
 t3 = time.perf_counter()

@@ -144,7 +144,7 @@ def _progress_lines(description: str, total: float | None):
 @contextmanager
 def well_progress(name: str):
     """Progress within one well's run: yields a callback for
-    :class:`drillfric.pipeline.RunProgress` events — a bar with rows read, segments done and
+    :class:`drillfric.result.RunProgress` events — a bar with rows read, segments done and
     the ETA on a terminal, a line per 10 % on stderr without one, nothing with --quiet."""
     if context().quiet:
         yield lambda event: None

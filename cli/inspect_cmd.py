@@ -101,8 +101,8 @@ def _survey(path) -> dict | None:
 def summarize_depth_log(well) -> dict:
     """The ``inspect --json`` document of a depth-indexed log: the interface's keys (no time
     base: ``t_start_s``, ``t_end_s``, ``rate_hz`` null), ``index = "depth"``, the depth span
-    and the windows of its friction log (:mod:`drillfric.friction_log`)."""
-    from drillfric.friction_log import read_depth_log, windows
+    and the windows of its friction log (:mod:`drillfric.estimation.friction_log`)."""
+    from drillfric.estimation.friction_log import read_depth_log, windows
 
     log = read_depth_log(well)
     channels = {m.channel.name: _channel(m.channel.name, m.column, m.unit, m.source,

@@ -157,9 +157,9 @@ def _open_all(wells, config, survey, overrides) -> tuple[list, int]:
 
 
 def _run_one(well, out, rate, pdf, report, tick):
-    from drillfric.pipeline import run_well
+    from drillfric.api import run
 
-    return run_well(well, out, rate_hz=rate, pdf=pdf, report=report, progress=tick)
+    return run(well, out, rate_hz=rate, pdf=pdf, report=report, progress=tick)
 
 
 def _print(result, units: str | None = None) -> None:

@@ -30,10 +30,9 @@ SECTIONS = {"tracks": "tracks", "friction": "friction-log", "broomstick": "broom
 
 
 def _result(tmp: Path) -> tuple[Path, bool]:
-    from drillfric.io.well import open_well
-    from drillfric.pipeline import run_well
+    import drillfric
 
-    run = run_well(open_well(REPO / "examples" / "demo" / "demo.csv"), tmp / "out")
+    run = drillfric.run(REPO / "examples" / "demo" / "demo.csv", tmp / "out")
     completed = not (run.out_dir / "tracks.parquet").is_file()
     if completed:
         from tests.synthetic_results import add_evidence_files

@@ -14,13 +14,15 @@ same layers.
 from __future__ import annotations
 
 import json
+from functools import partial
 from pathlib import Path
 
 import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.well import Well, open_well
-from drillfric.pipeline import RunProgress, WellResult, run_well
+from drillfric.result import RunProgress, WellResult
+from drillfric.runner import run_well
 
 __all__ = ["open_well", "run", "load_result", "torque_and_drag", "simulate", "Well",
            "WellResult", "RunProgress"]
@@ -52,7 +54,15 @@ def run(well, out=None, *, rate_hz: float | None = None, pdf: bool = False,
     """
     if not isinstance(well, Well):
         well = open_well(well, **open_kw)
-    return run_well(well, out, rate_hz=rate_hz, pdf=pdf, report=report, progress=progress)
+    return run_well(well, out, rate_hz=rate_hz, report=_report_writer(pdf) if report else None,
+                    progress=progress)
+
+
+def _report_writer(pdf: bool):
+    """The run's report: report.html (and report.pdf with ``pdf``) of its result directory."""
+    from drillfric.report import write_well_report
+
+    return partial(write_well_report, pdf=pdf)
 
 
 def load_result(result_dir) -> WellResult:

@@ -424,6 +424,9 @@ DEFAULT_SECTIONS: tuple[dict, ...] = (
      "tool_joint_od_m": 0.1651, "linear_mass_kg_m": 74.5},
     {"name": "8in collars (assumed)", "od_m": 0.2032, "id_m": 0.0714, "length_m": 120.0},
 )
+#: The note when ``[rig] top_drive_inertia_kg_m2`` is not given (the schema's default, A&S
+#: 2018); only the observer of a time log uses the inertia, so a depth log does not list it.
+TOP_DRIVE_INERTIA_ASSUMED = "top-drive inertia 2900 kg·m² (A&S 2018)"
 
 #: Channel keys accepted in ``[channels]`` (canonical names without the unit suffix).
 CHANNEL_KEYS = ("time", "measured_depth", "surface_rpm", "surface_torque", "hookload",
@@ -716,7 +719,7 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
         raise ConfigError("give either model.omega_c_rad_s or model.omega_c_rpm, not both",
                           file=fname)
     if raw.get("rig", {}).get("top_drive_inertia_kg_m2") is None:
-        assumed.append("top-drive inertia 2900 kg·m² (A&S 2018)")
+        assumed.append(TOP_DRIVE_INERTIA_ASSUMED)
     if "fluid" not in raw:
         assumed.append("mud density 1200 kg/m³")
     return Config(values=values, sections=sections, channels=channels,

@@ -1,6 +1,6 @@
 """``drillfric fleet``: many wells, incremental and fault-isolated (issue 8, docs/fleet.md).
 
-The unit of work is a well: :func:`process_well` runs :func:`drillfric.pipeline.run_well`
+The unit of work is a well: :func:`process_well` runs :func:`drillfric.runner.run_well`
 on a worker, which writes OUT/NAME itself (temporary directory + rename, so a well directory
 is either complete or absent). The client only prepares tasks (input hashes, effective
 configuration hash), collects small result records and keeps ``OUT/manifest.json``.
@@ -202,8 +202,8 @@ def process_well(task: WellTask) -> dict:
     The worker opens the well itself and writes OUT/NAME (atomically). The record carries
     the status, the message of a failure, the summary, timings and where it ran.
     """
+    from drillfric.api import run as run_well
     from drillfric.io.well import open_well
-    from drillfric.pipeline import run_well
 
     _one_kernel_thread()
     started = _now()
@@ -605,7 +605,7 @@ def _client(workers: int, scheduler: str | None):
         warnings.filterwarnings("ignore", message="Port .* is already in use")
         # Workers fork from a server that imported distributed and the pipeline once
         # (docs/fleet.md: start-up measured faster than spawning each worker).
-        get_mp_context().set_forkserver_preload(["distributed", "drillfric.pipeline"])
+        get_mp_context().set_forkserver_preload(["distributed", "drillfric.runner.time_log"])
         with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                           dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
                 Client(cluster) as client:

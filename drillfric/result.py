@@ -1,4 +1,5 @@
-"""The result of a run, declared once: segments, estimates and the well summary.
+"""The result of a run, declared once: segments, estimates, the well summary and what a run
+returns (:class:`WellResult`) and reports as it goes (:class:`RunProgress`).
 
 Every output that describes a segment — ``summary.json`` ``segments``, ``segments.parquet``,
 the report's tables and ``fleet_summary.parquet`` — is built from :class:`SegmentRecord`;
@@ -12,8 +13,10 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, field, fields
 from enum import StrEnum
+from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 
 class Status(StrEnum):
@@ -281,3 +284,126 @@ def outputs_markdown() -> str:
     lines += ["", "## flags", "", "| flag | meaning |", "|---|---|"]
     lines += [f"| `{f.value}` | {FLAG_MEANINGS[f]} |" for f in Flag]
     return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class RunProgress:
+    """Where a run stands (for a progress bar with an ETA).
+
+    Attributes
+    ----------
+    rows_done : int
+        Input rows read and, up to the last finished segment, estimated.
+    rows_total : int or None
+        Rows of the input when known cheaply (Parquet metadata, a CSV line count).
+    segments_done : int
+    """
+
+    rows_done: int
+    rows_total: int | None
+    segments_done: int
+
+    @property
+    def fraction(self) -> float | None:
+        """Share of the input done [-], None when the size is not known."""
+        if not self.rows_total:
+            return None
+        return min(self.rows_done / self.rows_total, 1.0)
+
+
+@dataclass(repr=False)
+class WellResult:
+    """What a run of one well produced (the API's return value; the CLI prints from it).
+
+    Attributes
+    ----------
+    well : str
+        The well's name.
+    summary : dict
+        summary.json (docs/outputs.md).
+    segments : pandas.DataFrame
+        One row per segment (:class:`SegmentRecord` fields).
+    out_dir : Path or None
+        ``OUT/NAME`` when results were written, else None.
+    failed : int
+        Segments whose estimation failed.
+    warnings : list of str
+        What the user should know (also ``summary["warnings"]``).
+    tracks : pandas.DataFrame or None
+        The whole log decimated for plotting (tracks.parquet).
+
+    The headline numbers are typed properties read from ``summary``: :attr:`mu_k`,
+    :attr:`mu_s`, :attr:`mu_s_lower_bound`, :attr:`counts`, :attr:`status`,
+    :attr:`indicative`.
+    """
+
+    well: str
+    summary: dict
+    segments: pd.DataFrame
+    out_dir: Path | None = None
+    failed: int = 0
+    warnings: list = field(default_factory=list)
+    tracks: pd.DataFrame | None = field(default=None, repr=False)
+    _estimates: pd.DataFrame | None = field(default=None, repr=False)
+
+    @property
+    def estimates(self) -> pd.DataFrame:
+        """estimates.parquet's rows (read from ``out_dir`` when the run wrote them)."""
+        if self._estimates is None and self.out_dir is not None:
+            self._estimates = pd.read_parquet(self.out_dir / "estimates.parquet")
+        return self._estimates if self._estimates is not None else pd.DataFrame(
+            columns=list(ESTIMATE_NAMES))
+
+    @property
+    def report(self) -> Path | None:
+        """report.html when it was written."""
+        path = None if self.out_dir is None else self.out_dir / "report.html"
+        return path if path is not None and path.is_file() else None
+
+    # the headline numbers, typed, as summary.json has them (docs/outputs.md)
+    @property
+    def mu_k(self) -> float | None:
+        """The well's kinetic friction factor [-] (median of the converged segments), None
+        when no segment gives one."""
+        return self.summary.get("mu_k")
+
+    @property
+    def mu_s(self) -> float | None:
+        """The well's static friction factor [-], only where the data identify it."""
+        return self.summary.get("mu_s")
+
+    @property
+    def mu_s_lower_bound(self) -> float | None:
+        """A lower bound on μ_s [-] where it is only bounded (and ``mu_s`` is None)."""
+        return self.summary.get("mu_s_lower_bound")
+
+    @property
+    def counts(self) -> dict[str, int]:
+        """Segments: ``segments``, ``estimated``, ``converged``, ``skipped``, ``failed``."""
+        return dict(self.summary.get("counts", {}))
+
+    @property
+    def indicative(self) -> bool:
+        """Whether something was assumed (``summary["assumed"]``): the numbers are then
+        indicative."""
+        return bool(self.summary.get("indicative"))
+
+    @property
+    def status(self) -> str:
+        """``"estimated"`` (a well μ_k), ``"not_estimated"`` (segments, none converged: no
+        μ_k is claimed) or ``"no_segments"`` (no rotation found)."""
+        if self.mu_k is not None:
+            return "estimated"
+        return "not_estimated" if self.counts.get("segments") else "no_segments"
+
+    def __repr__(self) -> str:
+        mu_s = (f"{self.mu_s:.3f}" if self.mu_s is not None else
+                f"≥ {self.mu_s_lower_bound:.3f}" if self.mu_s_lower_bound is not None else "—")
+        mu_k = "—" if self.mu_k is None else f"{self.mu_k:.3f}"
+        c = self.counts
+        where = "" if self.out_dir is None else f", out_dir='{self.out_dir}'"
+        return (f"<WellResult {self.well!r}: {self.status}, μ_k {mu_k}, μ_s {mu_s}; "
+                f"{c.get('segments', 0)} segment{'s' * (c.get('segments') != 1)} "
+                f"({c.get('converged', 0)} converged, "
+                f"{c.get('failed', 0)} failed); {len(self.warnings)} warnings"
+                f"{' (indicative)' * self.indicative}{where}>")

@@ -469,7 +469,7 @@ class Simulation:
 
     def truth(self) -> dict:
         """Ground truth as plain data (NAME.truth.json, file metadata)."""
-        from drillfric import __version__
+        from drillfric._version import __version__
 
         law = {"friction_law": self.settings.friction_law}
         if self.settings.friction_law == "stribeck":

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from drillfric.pipeline import consensus, pool_short_segments
+from drillfric.estimation.consensus import consensus, pool_short_segments
 from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
 
 

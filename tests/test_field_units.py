@@ -20,7 +20,7 @@ from drillfric.cli.main import cli
 from drillfric.config import load_config
 from drillfric.io.well import open_well
 from drillfric.io.writers import dumps_toml
-from drillfric.pipeline import run_well
+from drillfric.runner import run_well
 from tests.conftest import REPO
 
 DEMO = REPO / "examples" / "demo"
@@ -81,7 +81,7 @@ def twin_runs(tmp_path_factory):
     out = {}
     for config in _configs(folder):
         well = open_well(folder / "stand.csv", config=config, name=config.stem)
-        out[config.stem] = run_well(well, folder / "out", report=False).out_dir
+        out[config.stem] = run_well(well, folder / "out").out_dir
     return out
 
 

@@ -61,7 +61,7 @@ def scheduler(tmp_path_factory):
                   name=f"worker{i}")
         with Client(address, timeout="60s") as client:
             client.wait_for_workers(2, timeout=90)
-            client.run(lambda: __import__("drillfric.pipeline") and None)  # warm imports
+            client.run(lambda: __import__("drillfric.runner.time_log") and None)  # warm imports
         yield address
     finally:
         for proc, log in reversed(procs):

@@ -1,5 +1,6 @@
 """Depth-indexed drilling logs: a static friction log by torque-and-drag back-calculation
-(drillfric.friction_log, docs/ingestion.md "Depth-indexed logs").
+(drillfric.estimation.friction_log and drillfric.runner.depth_log, docs/ingestion.md
+"Depth-indexed logs").
 
 The synthetic depth log is built from the soft-string model itself at a known friction
 factor: each 30 m window holds five rows at depths k·30 + 3, 9, 15, 21, 27 m, so the median
@@ -23,10 +24,11 @@ from drillfric.cli.main import cli
 from drillfric.config import config_from_dict, read_toml
 from drillfric.drillstring import build_string
 from drillfric.errors import InputError
-from drillfric.friction_log import bit_torque_Nm, friction_log, run_depth_log
+from drillfric.estimation.friction_log import bit_torque_Nm, friction_log
 from drillfric.io.survey import read_survey
 from drillfric.io.well import open_well
 from drillfric.result import Flag, Kind, Method, Status
+from drillfric.runner.depth_log import run_depth_log
 from drillfric.torque_drag import solve
 from tests.conftest import REPO
 

@@ -24,7 +24,7 @@ from drillfric.cli.main import cli
 from drillfric import hookload
 from drillfric.config import config_from_dict, load_config
 from drillfric.drillstring import G_ACCEL
-from drillfric.pipeline import consensus
+from drillfric.estimation.consensus import consensus
 from drillfric.result import Flag, Kind, SegmentRecord, Status
 from tests.conftest import REPO
 

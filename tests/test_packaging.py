@@ -47,3 +47,19 @@ def test_wheel_installs_and_runs_outside_repo(tmp_path: Path):
     # 'drillfric.templates'), and the report code with them
     _run([str(py), "-c", "import drillfric.cli.main, drillfric.templates, drillfric.report; "
           "from drillfric.report import write_well_report"], cwd=REPO)
+
+
+def test_source_checkout_exposes_only_cli_and_templates():
+    """A regression: the checkout appended the repository root to ``drillfric.__path__``,
+    so ``drillfric.tests``, ``drillfric.benchmarks`` and ``drillfric.docs`` imported."""
+    code = ("import importlib, drillfric, drillfric.cli.main, drillfric.templates\n"
+            "for name in ('tests', 'benchmarks', 'docs', 'examples'):\n"
+            "    try:\n"
+            "        importlib.import_module('drillfric.' + name)\n"
+            "        print('exposed', name)\n"
+            "    except ImportError:\n"
+            "        pass\n"
+            "print(drillfric.__path__, drillfric.cli.__path__)")
+    out = _run([sys.executable, "-c", code], cwd=REPO).stdout
+    assert "exposed" not in out, out
+    assert str(REPO / "cli") in out and f"['{REPO / 'drillfric'}']" in out

@@ -181,7 +181,7 @@ def test_results_do_not_depend_on_chunking(demo_run, tmp_path):
     """Streaming must not change the answer: small chunks (boundaries inside stands and
     inside the pre-roll) give exactly the segments of a one-chunk run (a regression: the
     pre-roll used to be dropped at chunk boundaries, losing the creep and μ_s)."""
-    from drillfric.pipeline import run_well
+    from drillfric.runner import run_well
 
     run_well(open_well(DEMO / "demo.csv"), tmp_path, chunk_rows=3770)
     assert _segments_of(tmp_path / "demo") == _segments_of(demo_run[0])

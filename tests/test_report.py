@@ -51,10 +51,9 @@ def demo_result_dir(tmp_path_factory) -> Path:
     out = tmp_path_factory.getbasetemp() / "report-demo"
     result = out / "demo"
     if not (result / "summary.json").is_file():
-        from drillfric.io.well import open_well
-        from drillfric.pipeline import run_well
+        import drillfric
 
-        run_well(open_well(DEMO), out)
+        drillfric.run(DEMO, out)
     return result
 
 
@@ -652,7 +651,8 @@ def test_select_segments_keeps_worst_and_latest():
 
 
 def test_fmt_handles_missing_values():
-    from drillfric.report.render import fmt, mu_s_text
+    from drillfric.report.display import fmt
+    from drillfric.report.render import mu_s_text
 
     assert fmt(None) == "—" and fmt(math.nan) == "—" and fmt("x") == "—"
     assert fmt(0.12345) == "0.123" and fmt(True) == "yes"

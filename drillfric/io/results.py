@@ -107,7 +107,7 @@ def output_error(exc: OSError, where: Path) -> OutputError:
 
 # --------------------------------------------------------------------------- directories
 def _marker(path: Path, well: str, state: str) -> None:
-    from drillfric import __version__
+    from drillfric._version import __version__
 
     (path / MARKER).write_text(json.dumps({"drillfric": __version__, "well": well,
                                            "state": state}) + "\n", encoding="utf-8")

@@ -23,6 +23,11 @@ assumes a vertical well with the nominal tortuosity ``survey.tortuosity_deg_30m`
 string is the configuration's ``[[string.sections]]``, else a WITSML tubular, else the
 documented default (assumed).
 
+A well may also be data in memory: ``open_well(frame=DataFrame, survey=DataFrame or
+WellPath, config=dict or path)`` — a notebook's table from a historian or a warehouse goes
+through the same channel mapping, units and checks as a file's (it is read as a data file
+is, in blocks of rows), and no sidecar is looked for.
+
 A well is opened **once** (:func:`open_well`): its files found, its configuration and survey
 read, its data file's header mapped to channels, and its name fixed — into a :class:`Well`
 that ``run``, ``fleet``, ``td`` and ``inspect`` all take. :meth:`Well.chunks` then streams
@@ -36,6 +41,7 @@ A well's name is data, not a path: :func:`safe_name` makes it one safe path comp
 from __future__ import annotations
 
 import hashlib
+import os
 import tomllib
 import unicodedata
 from collections.abc import Iterator
@@ -68,6 +74,10 @@ _SURVEY_EXT = (".csv", ".parquet", ".xml")
 _HDF5_EXT = (".h5", ".hdf5")
 #: Unit shown for a time column of absolute timestamps (not a unit anything assumed).
 CLOCK_UNIT = "ISO 8601"
+#: What errors name as the "file" of a well opened from a DataFrame (``open_well(frame=)``).
+FRAME_LABEL = Path("<DataFrame>")
+#: The name of a well opened from a DataFrame that nothing names (``name=``, ``[well] name``).
+FRAME_NAME = "well"
 #: Rows read ahead to tell whether a time column without a stated unit holds timestamps.
 _PEEK_ROWS = 64
 
@@ -148,6 +158,9 @@ class WellFiles:
     string : Path or None
         WITSML tubular read as the string (``NAME.tubular.xml``, or the data file holding a
         ``<tubular>``) when the configuration has no ``[[string.sections]]``.
+    in_memory : bool
+        The data is a DataFrame (``open_well(frame=)``): ``data`` is :data:`FRAME_LABEL`,
+        no file.
     """
 
     data: Path
@@ -155,12 +168,15 @@ class WellFiles:
     survey: Path | None
     parts: tuple[Path, ...] = ()
     string: Path | None = None
+    in_memory: bool = False
 
     @property
     def inputs(self) -> dict[str, Path]:
         """The files read, by role: ``data`` (for a log split over parts one ``data NAME``
-        per part instead), ``config``, ``survey``, ``string`` — summary.json ``inputs``."""
+        per part instead; none for a DataFrame), ``config``, ``survey``, ``string`` —
+        summary.json ``inputs``."""
         data = {f"data {p.name}": p for p in self.parts} if self.parts else {"data": self.data}
+        data = {} if self.in_memory else data
         roles = data | {"config": self.config, "survey": self.survey, "string": self.string}
         return {role: path for role, path in roles.items() if path is not None}
 
@@ -209,7 +225,7 @@ class Well:
     @property
     def depth_indexed(self) -> bool:
         """Whether the data file is a depth-indexed log (per-depth averages, no time base):
-        ``run`` turns it into a static friction log (:mod:`drillfric.friction_log`)."""
+        ``run`` turns it into a static friction log (:mod:`drillfric.estimation.friction_log`)."""
         return bool(self.mappings) and "time" not in self.mappings
 
     @property
@@ -248,7 +264,7 @@ class Well:
         """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
         if self.depth_indexed:
             raise InputError("a depth-indexed log has no time base", file=self.files.data,
-                             fix="read it with drillfric.friction_log.read_depth_log")
+                             fix="read it with drillfric.estimation.friction_log.read_depth_log")
         tracker = self.time_tracker()
         chunks = list(self.chunks(chunk_rows, tracker))
         surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
@@ -269,18 +285,25 @@ class Well:
                         timebase=timebase, files=files)
 
 
-def open_well(path, *, config=None, survey=None, overrides=None, name: str | None = None,
-              header: bool = True) -> Well:
+def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, survey=None,
+              overrides=None, name: str | None = None, header: bool = True) -> Well:
     """Open a well once: find its files, read its configuration and survey, map its channels.
 
     Parameters
     ----------
-    path : str or Path
+    path : str or Path, optional
         Data file, HDF5 bundle or well directory (docs/ingestion.md "A well on disk").
-    config : str, Path or Config, optional
-        Configuration file (``--config``) or an already built :class:`Config`.
-    survey : str or Path, optional
-        Survey file (``--survey``); the sidecar survey is then not read at all.
+    frame : pandas.DataFrame, optional
+        The surface data in memory instead of ``path``: columns named as a file's header
+        would be (units in the names, or ``[channels]`` in ``config``); an index that is not
+        a plain row number (a clock-time index) is a column named by the index. No sidecar
+        is looked for.
+    config : str, Path, dict or Config, optional
+        Configuration file (``--config``), the configuration as a mapping (the TOML's
+        tables), or an already built :class:`Config`.
+    survey : str, Path, DataFrame or WellPath, optional
+        Survey file (``--survey``; the sidecar survey is then not read at all), a survey
+        table (columns as a survey file's header) or a computed well path.
     overrides : dict, optional
         ``{"table.key": value}`` from the command line.
     name : str, optional
@@ -293,13 +316,18 @@ def open_well(path, *, config=None, survey=None, overrides=None, name: str | Non
     InputError, ConfigError
         One line naming the file, the problem and the fix.
     """
-    files, raw = _resolve(path, None if isinstance(config, Config) else config, survey)
+    if (path is None) == (frame is None):
+        raise InputError("give a well's data file or its data in memory, one of the two",
+                         fix="open_well('well.csv', ...) or open_well(frame=data, ...)")
+    files, raw = (_resolve(path, config, survey) if frame is None else
+                  _frame_files(config, survey))
     cfg = _config(files.config, raw, config, overrides, files.string)
-    shown = printable(name or cfg.well.name or default_name(path, files.data), 4096)
-    source, mappings = _open(files, cfg) if header else (None, {})
+    given = default_name(path, files.data) if frame is None else FRAME_NAME
+    shown = printable(name or cfg.well.name or given, 4096)
+    path_m = _well_path(files.survey, survey)
+    source, mappings = _open(files, cfg, frame) if header else (None, {})
     return Well(name=shown, dir_name=safe_name(shown, files.config or files.data),
-                files=files, config=cfg, survey=_load_survey(files.survey), source=source,
-                mappings=mappings)
+                files=files, config=cfg, survey=path_m, source=source, mappings=mappings)
 
 
 def open_config(config, *, survey=None, overrides=None
@@ -397,34 +425,67 @@ def resolve_well(path, *, config=None, survey=None) -> WellFiles:
 
 
 def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
-    """The files of a well and its raw configuration mapping, each file read once."""
+    """The files of a well and its raw configuration mapping, each file read once; a
+    configuration or survey given in memory (a mapping, a table) stands for its file."""
     path = Path(path)
     if not path.exists():
         raise InputError("file not found", file=path, fix="check the path")
-    config_path = None if config is None else Path(config)
-    raw = None
+    config_path = _file(config)
+    raw = _mapping(config)
+    look = raw is None and config_path is None  # find the configuration beside the data
     if path.is_dir() and not (path / "well.toml").is_file() and witsml.split_log(path):
         data_path, parts = _data(path)
-        config_path = config_path or _sidecar(data_path, ".toml")
+        config_path = _sidecar(data_path, ".toml") if look else config_path
     elif path.is_dir():
         data_path, parts, dir_config, dir_raw = _directory_data(path)
-        if config_path is None:
+        if look:
             config_path, raw = dir_config, dir_raw
     else:
         data_path, parts = _data(path)
-        config_path = config_path or _sidecar(data_path, ".toml")
+        config_path = _sidecar(data_path, ".toml") if look else config_path
     if config_path is not None and not config_path.is_file():
         raise InputError("config file not found", file=config_path, fix="check the path")
-    if config_path is None and _h5_has(data_path, "config"):
+    if look and config_path is None and _h5_has(data_path, "config"):
         config_path = data_path
     if raw is None:
         raw = _raw_config(config_path)
-    survey_path = Path(survey) if survey is not None else _find_survey(data_path, config_path,
-                                                                       raw)
+    survey_path = _file(survey) if survey is not None else _find_survey(data_path, config_path,
+                                                                        raw)
     if survey_path is not None and not survey_path.is_file():
         raise InputError("survey file not found", file=survey_path, fix="check the path")
     return WellFiles(data_path, config_path, survey_path, parts,
                      _find_string(data_path, raw)), raw
+
+
+def _frame_files(config, survey) -> tuple[WellFiles, dict]:
+    """The files of a well whose data is a DataFrame: only those given (a configuration
+    file's ``[survey] file`` too), never a sidecar."""
+    config_path, raw = _file(config), _mapping(config)
+    if config_path is not None and not config_path.is_file():
+        raise InputError("config file not found", file=config_path, fix="check the path")
+    if raw is None:
+        raw = _raw_config(config_path)
+    named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
+    survey_path = _file(survey) if survey is not None else (
+        config_path.parent / named if isinstance(named, str) and config_path else None)
+    if survey_path is not None and not survey_path.is_file():
+        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    return WellFiles(FRAME_LABEL, config_path, survey_path, in_memory=True), raw
+
+
+def _file(given) -> Path | None:
+    """``given`` as a file path when it is one (str or path-like), else None."""
+    return Path(given) if isinstance(given, str | os.PathLike) else None
+
+
+def _mapping(config) -> dict | None:
+    """A configuration given as a mapping (the TOML's tables), else None."""
+    if config is None or isinstance(config, str | os.PathLike | Config):
+        return None
+    if not isinstance(config, dict):
+        raise ConfigError(f"config is a {type(config).__name__}",
+                          fix="give a TOML file, a dict of its tables or a Config")
+    return config
 
 
 def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
@@ -574,6 +635,22 @@ def _plain(value):
     return value.item() if isinstance(value, np.generic) else value
 
 
+def _well_path(survey_path: Path | None, given) -> WellPath | None:
+    """The well path of the survey file, or of a survey given in memory (a table with a
+    survey file's columns, or a :class:`WellPath`)."""
+    if given is None or _file(given) is not None:
+        return _load_survey(survey_path)
+    if isinstance(given, WellPath):
+        return given
+    if not isinstance(given, pd.DataFrame):
+        raise InputError(f"survey is a {type(given).__name__}", file="survey",
+                         fix="give a survey file, a DataFrame (md, inc, azi) or a WellPath")
+    from drillfric.io import survey as survey_io
+
+    table = survey_io.survey_table_from_frame(given, file="survey DataFrame")
+    return survey_io.wellpath_from_table(table)
+
+
 def _load_survey(survey_path: Path | None) -> WellPath | None:
     if survey_path is None:
         return None
@@ -588,11 +665,14 @@ def _load_survey(survey_path: Path | None) -> WellPath | None:
 
 
 # --------------------------------------------------------------------------- surface data
-def _open(files: WellFiles, cfg: Config) -> tuple[RawSource, dict[str, Mapping]]:
-    """The opened data file (or log parts) and its channel mappings, for a time or a depth
-    log (:func:`~drillfric.io.channels.log_index`); a depth index found by the reader (LAS,
-    WITSML, DLIS) is the measured depth unless ``[channels] measured_depth`` says otherwise."""
-    raw = witsml.open_witsml_parts(files.parts) if files.parts else open_source(files.data)
+def _open(files: WellFiles, cfg: Config,
+          frame: pd.DataFrame | None = None) -> tuple[RawSource, dict[str, Mapping]]:
+    """The opened data file (or log parts, or ``frame``) and its channel mappings, for a
+    time or a depth log (:func:`~drillfric.io.channels.log_index`); a depth index found by
+    the reader (LAS, WITSML, DLIS) is the measured depth unless ``[channels]
+    measured_depth`` says otherwise."""
+    raw = (frame_source(frame) if frame is not None else
+           witsml.open_witsml_parts(files.parts) if files.parts else open_source(files.data))
     file = str(files.data)
     index = log_index(raw.columns, cfg.channels, depth_index=raw.depth_index, file=file)
     channels = cfg.channels
@@ -600,6 +680,33 @@ def _open(files: WellFiles, cfg: Config) -> tuple[RawSource, dict[str, Mapping]]
         channels = channels | {"measured_depth": {"column": split_unit(raw.depth_index)[0]}}
     mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index)
     return raw, _clock_time(raw, mappings)
+
+
+def frame_source(frame: pd.DataFrame) -> RawSource:
+    """A DataFrame read as a data file is: its columns (labels as text; an index that is not
+    a plain row number becomes a column), no stated units, rows in blocks.
+
+    Raises
+    ------
+    InputError
+        Not a DataFrame, or two columns of one label.
+    """
+    if not isinstance(frame, pd.DataFrame):
+        raise InputError(f"frame is a {type(frame).__name__}, not a pandas DataFrame",
+                         file=FRAME_LABEL, fix="give the surface data as a DataFrame")
+    if not isinstance(frame.index, pd.RangeIndex):
+        frame = frame.reset_index()
+    frame = frame.set_axis([str(c) for c in frame.columns], axis=1)
+    twice = sorted(set(frame.columns[frame.columns.duplicated()]))
+    if twice:
+        raise InputError(f"column {twice[0]!r} appears twice", file=FRAME_LABEL,
+                         fix="give every column its own label")
+
+    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+        for start in range(0, len(frame), chunk_rows):
+            yield frame.iloc[start:start + chunk_rows]
+
+    return RawSource(FRAME_LABEL, "frame", list(frame.columns), {}, len(frame), read)
 
 
 def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mapping]:

@@ -164,7 +164,7 @@ def _optional_parquet(path: Path) -> pd.DataFrame | None:
                          fix="rerun 'drillfric run' to rewrite the results") from None
 
 
-#: The final (seeded) observer pass in estimates.parquet (pipeline.SEEDED_START_ID).
+#: The final (seeded) observer pass in estimates.parquet (drillfric.result.SEEDED_START_ID).
 FINAL_START_ID = -1
 #: Points per observer start (their μ move slowly: a few hundred points draw them).
 START_POINTS = 300

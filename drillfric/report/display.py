@@ -1,4 +1,5 @@
-"""The units a report shows: SI results in the unit system the reader asked for.
+"""The units a report shows: SI results in the unit system the reader asked for, and how a
+value is written (:func:`fmt`).
 
 Result files stay SI (docs/outputs.md); the report shows lengths, forces, torques,
 pressures and flows in the ``"si"`` or ``"field"`` system of
@@ -9,11 +10,10 @@ and the notes of the HTML and the PDF all go through one :class:`Units`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from drillfric.units import UNIT_SYSTEMS, display_factor, display_unit
-
-from .render import fmt
 
 #: Display units of quantities the terminal never shows (so not in DISPLAY_UNITS):
 #: ``(label, pint expression of the display unit, pint expression of the stored SI unit)``.
@@ -21,6 +21,17 @@ _EXTRA = {
     "torque per length": {"si": ("N·m/m", "newton", "newton"),
                           "field": ("ft·lbf/ft", "force_pound", "newton")},
 }
+
+
+def fmt(value, spec: str = ".3f") -> str:
+    """``value`` formatted with ``spec``, or "—" for None / NaN / non-numbers."""
+    if value is None or isinstance(value, bool):
+        return "—" if value is None else ("yes" if value else "no")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return "—"
+    return "—" if not math.isfinite(number) else format(number, spec)
 
 
 @dataclass(frozen=True)

@@ -9,13 +9,13 @@ import os
 from pathlib import Path
 from urllib.parse import quote
 
-from drillfric import __version__
+from drillfric._version import __version__
 
 from .data import segments_frame
-from .display import report_units
+from .display import fmt, report_units
 from .friction import fleet_plot
 from .interactive import Embedder
-from .render import environment, fmt, mu_s_text, now_utc
+from .render import environment, mu_s_text, now_utc
 from .well import _write_text
 
 

@@ -16,10 +16,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .display import SI, Units
+from .display import SI, Units, fmt
 from .figures import APPARENT_COLOR, MU_K_COLOR, MU_S_COLOR, TD_COLOR
 from .interactive import MIN_WIDTH_PX
-from .render import fmt, is_apparent, mu_k_cell, mu_s_text, zone_text
+from .render import is_apparent, mu_k_cell, mu_s_text, zone_text
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 

@@ -15,14 +15,12 @@ from contextlib import contextmanager
 from datetime import UTC, datetime
 from functools import cache
 from importlib.resources import files
-from typing import TYPE_CHECKING
 
 import pandas as pd
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
-if TYPE_CHECKING:
-    from .display import Units
+from .display import Units, fmt
 
 #: Resolution of the figures embedded in HTML [dots per inch].
 HTML_DPI = 90
@@ -52,17 +50,6 @@ def environment() -> Environment:
                       trim_blocks=True, lstrip_blocks=True)
     env.filters["num"] = fmt
     return env
-
-
-def fmt(value, spec: str = ".3f") -> str:
-    """``value`` formatted with ``spec``, or "—" for None / NaN / non-numbers."""
-    if value is None or isinstance(value, bool):
-        return "—" if value is None else ("yes" if value else "no")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        return "—"
-    return "—" if not math.isfinite(number) else format(number, spec)
 
 
 def figure_uri(fig: Figure, dpi: int = HTML_DPI) -> str:

@@ -21,7 +21,7 @@ from drillfric.errors import ConfigError, DrillfricError
 from . import broomstick as broom
 from . import figures
 from .data import ResultData, final_torques, load_result, segment_estimates
-from .display import Units, report_units
+from .display import Units, fmt, report_units
 from .evidence import (
     evidence_figure,
     evidence_plot,
@@ -46,7 +46,6 @@ from .render import (
     environment,
     figure_uri,
     flag_items,
-    fmt,
     interval_text,
     is_apparent,
     message_parts,

@@ -27,16 +27,15 @@ gives that torque as the bit torque plus μ·T_N, T_N = ∫F_c dx. So, per windo
    ``bit_torque_in_friction``.
 
 One friction factor holds along the whole string at each depth (cased and open hole are
-not separated). The results are written as a time log's are (:func:`run_depth_log`), with
-``method = "td_backcalc"``, μ_s null and no estimates over time.
+not separated). The run writes the results as a time log's are
+(:func:`drillfric.runner.depth_log.run_depth_log`), with ``method = "td_backcalc"``, μ_s
+null and no estimates over time.
 """
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -44,17 +43,14 @@ import pandas as pd
 from drillfric.drillstring import build_string
 from drillfric.errors import InputError, ModelError
 from drillfric.estimation.verdict import TYPICAL_MU
-from drillfric.io.results import EstimatesWriter, ResultDirectory, write_json, write_segments
 from drillfric.io.well import CHUNK_ROWS, Well
-from drillfric.result import Flag, Kind, Method, SegmentRecord, Status, segment_columns
+from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
 from drillfric.torque_drag import TDResult, back_calculate_friction, solve
 from drillfric.wellpath import no_survey_path
 
 #: What a depth log cannot give, said in every summary and segment message.
 NO_OBSERVER = ("depth-indexed log: no time series, so no observer — μ_s is not identifiable "
                "and there is no bit speed")
-#: Spacing of the torque-and-drag profile rows written per window [m].
-PROFILE_STEP_M = 10.0
 
 
 @dataclass(frozen=True)
@@ -115,7 +111,7 @@ def read_depth_log(well: Well, chunk_rows: int = CHUNK_ROWS) -> pd.DataFrame:
     """
     if not well.depth_indexed:
         raise InputError("not a depth-indexed log", file=well.files.data,
-                         fix="run a time log with drillfric.pipeline.run_well")
+                         fix="run a time log with drillfric.run")
     chunks = [c for c in well.chunks(chunk_rows) if len(c)]
     log = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
     if not log.empty:
@@ -327,138 +323,3 @@ def friction_log(well: Well) -> list[SegmentRecord]:
     """The static friction log of a depth-indexed well: one record per window and load
     case (the module's description), in depth order."""
     return [r.record for r in estimate(well)[0]]
-
-
-# --------------------------------------------------------------------------- run
-@dataclass
-class _Assumed:
-    """What :func:`drillfric.pipeline.summarise` reads of an estimator: here, no rate."""
-
-    assumed: list
-    rate_hz: float | None = None
-
-
-def run_depth_log(well: Well, out_root=None, *, rate_hz: float | None = None,
-                  pdf: bool = False, report: bool = True, progress=None,
-                  chunk_rows: int = CHUNK_ROWS):
-    """:func:`drillfric.pipeline.run_well` for a depth-indexed log: the friction log, its
-    summary and, with ``out_root``, the result files of ``OUT/NAME`` and the report.
-
-    Writes summary.json (the keys a time log's has, plus ``index = "depth"`` and
-    ``friction_log``), segments.parquet, profiles.parquet, wellpath.parquet (with a
-    survey), friction_log.parquet (the medians of each window, the bit torque assumed and
-    the modelled hook load) and an estimates.parquet without rows (no time series).
-    Parameters as :func:`drillfric.pipeline.run_well`; ``rate_hz`` does not apply (a
-    warning says so).
-    """
-    from drillfric.pipeline import RunProgress, WellResult, summarise
-
-    t_wall = time.perf_counter()
-    log = read_depth_log(well, chunk_rows)
-    tick = (lambda done: progress(RunProgress(len(log), len(log), done))) if progress else None
-    results, assumed = estimate(well, log, tick)
-    records = [r.record for r in results]
-    warnings = [NO_OBSERVER] + (["--rate does not apply to a depth-indexed log: ignored"]
-                                if rate_hz is not None else [])
-    summary = summarise(well, records, [], _Assumed(_assumptions(well, results, assumed)),
-                        len(log), None, warnings, time.perf_counter() - t_wall)
-    kept = [n for n in summary["assumed"] if not n.startswith("top-drive")]  # not used here
-    summary.update(assumed=kept, indicative=bool(kept), index="depth",
-                   friction_log=_log_summary(well, log, results))
-    result = WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
-                        failed=sum(r.status is Status.FAILED for r in records),
-                        warnings=summary["warnings"], _estimates=_no_estimates())
-    if out_root is None:
-        return result
-    with ResultDirectory(out_root, well.dir_name, well.name) as tmp:
-        _write(tmp, well, summary, results)
-        if report:
-            from drillfric.pipeline import write_report
-
-            write_report(tmp, pdf, result)
-    result.out_dir = Path(out_root) / well.dir_name
-    return result
-
-
-def _assumptions(well: Well, results: list[WindowResult], notes: list[str]) -> list[str]:
-    """What the friction log assumed beyond the well's own: the load-case rule, the bit
-    torque."""
-    out = list(notes)
-    if any(r.window.kind is Kind.ON_BOTTOM and r.td is not None for r in results):
-        cfg = well.config.friction_log
-        out.append("on bottom, apparent friction: the bit torque is not separated" if
-                   cfg.bit_mu == 0 else f"on bottom: bit torque μ_bit·WOB·D_bit/3 with μ_bit "
-                   f"= {cfg.bit_mu:g}, D_bit = {cfg.bit_diameter_m:g} m (friction_log)")
-    return out
-
-
-def _log_summary(well: Well, log: pd.DataFrame, results: list[WindowResult]) -> dict:
-    """summary.json ``friction_log``: the windows, the apparent on-bottom consensus and why
-    there is no off-bottom one (``mu_k_reason``, null when ``mu_k`` is given)."""
-    md = log["measured_depth_m"].to_numpy(float)
-    apparent = [r.record.mu_k for r in results if r.record.status is Status.OK
-                and r.window.kind is Kind.ON_BOTTOM]
-    return {"window_m": well.config.friction_log.window_m, "rows": len(log),
-            "md_start_m": float(md.min()), "md_end_m": float(md.max()),
-            "bit_mu": well.config.friction_log.bit_mu,
-            "mu_apparent": float(np.median(apparent)) if apparent else None,
-            "mu_k_reason": _no_off_bottom_reason(results)}
-
-
-def _no_off_bottom_reason(results: list[WindowResult]) -> str | None:
-    """Why the log gives no off-bottom friction factor (None when it gives one)."""
-    off = [r for r in results if r.window.kind is Kind.OFF_BOTTOM]
-    if any(r.record.status is Status.OK for r in off):
-        return None
-    if off:
-        return f"none of the {len(off)} off-bottom windows was estimated (skipped or failed)"
-    return ("no rotating row is off bottom, so the log holds only apparent on-bottom "
-            "friction, bit torque included")
-
-
-def _no_estimates() -> pd.DataFrame:
-    from drillfric.result import ESTIMATE_NAMES
-
-    return pd.DataFrame(columns=list(ESTIMATE_NAMES))
-
-
-def _write(folder: Path, well: Well, summary: dict, results: list[WindowResult]) -> None:
-    """Every result file but the report."""
-    EstimatesWriter(folder / "estimates.parquet", False).close()
-    write_json(folder / "summary.json", summary)
-    write_segments(folder / "segments.parquet", [r.record for r in results])
-    profiles = [_profile(r.window.id, r.td) for r in results if r.td is not None]
-    if profiles:
-        pd.concat(profiles, ignore_index=True).to_parquet(folder / "profiles.parquet",
-                                                          index=False)
-    if well.survey is not None:
-        pd.DataFrame(well.survey.at(well.survey.md_m)).to_parquet(
-            folder / "wellpath.parquet", index=False)
-    log_table(results).to_parquet(folder / "friction_log.parquet", index=False)
-
-
-def _profile(seg_id: int, td: TDResult) -> pd.DataFrame:
-    """profiles.parquet rows of one window: the solution every ~:data:`PROFILE_STEP_M`."""
-    frame = td.to_frame().drop(columns="azi_deg")
-    step = max(1, int(PROFILE_STEP_M // max(float(np.diff(td.md_m).mean()), 1e-9)))
-    keep = np.unique(np.r_[np.arange(0, len(frame) - 1, step), len(frame) - 2])
-    frame = frame.iloc[keep].reset_index(drop=True)
-    frame.insert(0, "segment_id", np.int32(seg_id))
-    return frame
-
-
-def log_table(results: list[WindowResult]) -> pd.DataFrame:
-    """friction_log.parquet: one row per window and load case, SI (docs/ingestion.md)."""
-    rows = []
-    for r in results:
-        w, rec = r.window, r.record
-        rows.append({"segment_id": w.id, "kind": w.kind.value, "md_top_m": w.md_top_m,
-                     "md_bottom_m": w.md_bottom_m, "bit_depth_m": w.bit_depth_m,
-                     "rows": w.rows, "surface_torque_Nm": w.surface_torque_Nm,
-                     "surface_rpm": w.surface_rpm, "wob_N": w.wob_N,
-                     "hookload_N": w.hookload_N, "bit_torque_Nm": r.bit_torque_Nm,
-                     "mu": np.nan if rec.mu_k is None else rec.mu_k,
-                     "T_N_Nm": np.nan if r.td is None else r.td.T_N_Nm,
-                     "hookload_model_N": np.nan if r.td is None else r.td.hookload_N,
-                     "status": rec.status.value})
-    return pd.DataFrame(rows)

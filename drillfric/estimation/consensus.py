@@ -1,0 +1,86 @@
+"""The well's friction factors from its segments: pooling of short segments and the
+consensus (docs/theory.md "Well consensus", docs/segmentation.md).
+
+Both take the segments' :class:`~drillfric.result.SegmentRecord` and never make a value
+up: a well-level number comes from converged segments (or pools of short ones that agree),
+else it is None.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from drillfric.result import Flag, Kind, SegmentRecord, Status
+
+#: Flags a short segment may carry and still be pooled (it is only too short).
+_POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
+                       "estimators_disagree"})
+#: Short segments pool when their bit depths are within this [m] (one stand's depth)...
+POOL_DEPTH_M = 5.0
+#: ...their μ_k agree within this (max/min − 1) [-]...
+POOL_AGREEMENT = 0.05
+#: ...and together they hold at least this much rotation [s] (the converged minimum).
+POOL_MIN_ROTATION_S = 90.0
+
+
+def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]:
+    """Pool short off-bottom segments at one bit depth whose μ_k agree into one estimate.
+
+    Segments too short to converge alone (only ``too_short_to_converge`` keeps them from
+    it) at one depth (within :data:`POOL_DEPTH_M`), whose batch μ_k agree within
+    :data:`POOL_AGREEMENT` and which together rotate for :data:`POOL_MIN_ROTATION_S`, give a
+    converged estimate: the rotation-weighted mean μ_k. Returns the records (members flagged
+    ``pooled``) and the pools (summary.json ``pooled``).
+    """
+
+    short = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
+             and not r.converged and r.method.value == "batch" and r.mu_k is not None
+             and set(r.flags) <= _POOLABLE]
+    groups: list[list[SegmentRecord]] = []
+    for r in sorted(short, key=lambda r: r.bit_depth_m):
+        if groups and r.bit_depth_m - groups[-1][0].bit_depth_m <= POOL_DEPTH_M:
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    pools, members = [], {}
+    for group in groups:
+        mu = np.array([r.mu_k for r in group])
+        weight = np.array([r.duration_s for r in group])
+        if len(group) < 2 or weight.sum() < POOL_MIN_ROTATION_S or \
+                mu.max() / mu.min() - 1.0 > POOL_AGREEMENT:
+            continue
+        pool = {"segment_ids": [r.id for r in group],
+                "bit_depth_m": float(np.median([r.bit_depth_m for r in group])),
+                "mu_k": float(np.sum(mu * weight) / weight.sum()),
+                "mu_k_spread": float(mu.max() - mu.min()), "rotation_s": float(weight.sum())}
+        pools.append(pool)
+        members |= {r.id: pool for r in group}
+    return [_pooled(r, members[r.id]) if r.id in members else r for r in records], pools
+
+
+def _pooled(record: SegmentRecord, pool: dict) -> SegmentRecord:
+    note = (f"pooled with segments {', '.join(map(str, pool['segment_ids']))} at "
+            f"{pool['bit_depth_m']:.0f} m: μ_k = {pool['mu_k']:.3f} over "
+            f"{pool['rotation_s']:.0f} s of rotation")
+    return replace(record, flags=record.flags + (Flag.POOLED,),
+                   message="; ".join(filter(None, [record.message, note])))
+
+
+def consensus(records: list[SegmentRecord], pools: list[dict] = ()) -> dict:
+    """Well-level friction factors from the segments (never a made-up value).
+
+    Only converged, off-bottom segments with status ok count, and pools of short segments
+    (:func:`pool_short_segments`) as one each. μ_k: their median; μ_s: the median over those
+    that identify it; otherwise the median of their lower bounds (each is claimed valid, so
+    the median is too, and one unreliable segment cannot set it).
+    """
+    ok = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
+          and r.converged]
+    mu_k = [r.mu_k for r in ok if r.mu_k is not None] + [p["mu_k"] for p in pools]
+    mu_s = [r.mu_s for r in ok if r.mu_s_identifiable and r.mu_s is not None]
+    bounds = [r.mu_s_lower_bound for r in ok if r.mu_s_lower_bound is not None]
+    return {"mu_k": float(np.median(mu_k)) if mu_k else None,
+            "mu_s": float(np.median(mu_s)) if mu_s else None,
+            "mu_s_lower_bound": None if mu_s or not bounds else float(np.median(bounds))}

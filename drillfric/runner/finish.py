@@ -1,0 +1,181 @@
+"""What every run of a well ends with, time log or depth log: the summary, the result files
+and the report.
+
+A run hands its output rows to a sink as segments finish — kept in memory
+(:class:`MemorySink`, the Python API without ``out``) or appended to the result files
+(:class:`DirectorySink`, bounded memory) — and ends with :func:`finish`: the files of
+docs/outputs.md and the :class:`~drillfric.result.WellResult`. :func:`deliver` opens the
+result directory (written atomically, :class:`~drillfric.io.results.ResultDirectory`) around
+a run and writes the report into it before it is committed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+
+from drillfric._version import __version__
+from drillfric.estimation.consensus import consensus
+from drillfric.friction import FrictionProfile
+from drillfric.io.results import (
+    EstimatesWriter,
+    ResultDirectory,
+    file_sha256,
+    write_json,
+    write_segments,
+)
+from drillfric.io.tracks import write_tracks
+from drillfric.io.well import Well
+from drillfric.result import SegmentRecord, Status, WellResult, segment_columns
+
+#: Writes the report of a result directory into it (``drillfric.report.write_well_report``
+#: with the options asked for); the run layer calls it and never imports the report.
+ReportWriter = Callable[[Path], None]
+
+
+def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, rows: int,
+              assumed: list[str], warnings: list[str], wall_s: float,
+              resampled_rate_hz: float | None = None,
+              requested_rate_hz: float | None = None) -> dict:
+    """summary.json (docs/outputs.md) from what a run found.
+
+    Parameters
+    ----------
+    well : Well
+        The well run (name, input files, configuration).
+    records, pools : list
+        The segments' records and the pools of short segments
+        (:func:`drillfric.estimation.consensus.pool_short_segments`).
+    rows : int
+        Input rows read.
+    assumed, warnings : list of str
+        What was assumed (makes the numbers indicative) and what the user should know.
+    wall_s : float
+        Run time [s].
+    resampled_rate_hz, requested_rate_hz : float, optional
+        The rate the estimation resampled to and the rate asked for [Hz].
+    """
+    inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
+              for k, p in well.files.inputs.items() if Path(p).is_file()}
+    inputs.update(rows=rows, resampled_rate_hz=resampled_rate_hz,
+                  requested_rate_hz=requested_rate_hz)
+    count = {s: sum(r.status is s for r in records) for s in Status}
+    profile = FrictionProfile.from_config(well.config)
+    return {"well": well.name, "drillfric_version": __version__, **consensus(records, pools),
+            "friction_zone": profile.zone, "friction_profile": profile.describe(),
+            "pooled": pools, "segments": [r.to_json() for r in records], "inputs": inputs,
+            "config": well.config.to_dict(), "assumed": list(assumed),
+            "indicative": bool(assumed),
+            "counts": {"segments": len(records), "estimated": count[Status.OK],
+                       "converged": sum(r.status is Status.OK and r.converged
+                                        for r in records),
+                       "skipped": count[Status.SKIPPED], "failed": count[Status.FAILED]},
+            "run_time_s": wall_s, "warnings": list(warnings)}
+
+
+class MemorySink:
+    """Collects a run's output rows in memory (the Python API without ``out``)."""
+
+    def __init__(self):
+        self.frames: dict[str, list] = {"estimates": [], "profile": []}
+
+    def add(self, frames: dict[str, pd.DataFrame], with_truth: bool) -> None:
+        """Keep a segment's output rows (``estimates``, ``profile``; either may be absent)."""
+        for key, frame in frames.items():
+            self.frames[key].append(frame)
+
+    def finish(self, well: Well, summary: dict, records, tracks, tables) -> None:
+        """Nothing to write."""
+
+    def estimates(self) -> pd.DataFrame | None:
+        """The estimates rows of the run, None when there are none."""
+        parts = self.frames["estimates"]
+        return pd.concat(parts, ignore_index=True) if parts else None
+
+
+class DirectorySink:
+    """Appends a run's output rows to the result files of ``folder`` as segments finish
+    (bounded memory)."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.writer: EstimatesWriter | None = None
+        self.profiles: list[pd.DataFrame] = []
+
+    def add(self, frames: dict[str, pd.DataFrame], with_truth: bool) -> None:
+        """Append a segment's output rows (``estimates``, ``profile``; either may be absent)."""
+        if "estimates" in frames:
+            if self.writer is None:
+                self.writer = EstimatesWriter(self.folder / "estimates.parquet", with_truth,
+                                              "timestamp" in frames["estimates"])
+            self.writer.write(frames["estimates"])
+        if "profile" in frames:
+            self.profiles.append(frames["profile"])
+
+    def finish(self, well: Well, summary: dict, records, tracks: pd.DataFrame | None,
+               tables: dict[str, pd.DataFrame]) -> None:
+        """Write every result file but the report: ``tables`` are extra Parquet files by
+        name (a depth log's friction_log.parquet)."""
+        if self.writer is None:  # no time series: an estimates.parquet without rows
+            self.writer = EstimatesWriter(self.folder / "estimates.parquet", False)
+        self.writer.close()
+        write_json(self.folder / "summary.json", summary)
+        write_segments(self.folder / "segments.parquet", records)
+        if tracks is not None:
+            write_tracks(self.folder / "tracks.parquet", tracks)
+        if self.profiles:
+            pd.concat(self.profiles, ignore_index=True).to_parquet(
+                self.folder / "profiles.parquet", index=False)
+        if well.survey is not None:
+            pd.DataFrame(well.survey.at(well.survey.md_m)).to_parquet(
+                self.folder / "wellpath.parquet", index=False)
+        for name, table in tables.items():
+            table.to_parquet(self.folder / name, index=False)
+
+    def estimates(self) -> None:
+        """None: read back from the file when asked (:attr:`WellResult.estimates`)."""
+        return None
+
+
+Sink = MemorySink | DirectorySink
+
+
+def finish(sink: Sink, well: Well, summary: dict, records: list[SegmentRecord], *,
+           tracks: pd.DataFrame | None = None,
+           tables: dict[str, pd.DataFrame] | None = None) -> WellResult:
+    """The end of every run: the result files (with a :class:`DirectorySink`) and the
+    :class:`~drillfric.result.WellResult`."""
+    sink.finish(well, summary, records, tracks, tables or {})
+    return WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
+                      failed=sum(r.status is Status.FAILED for r in records),
+                      warnings=summary["warnings"], tracks=tracks, _estimates=sink.estimates())
+
+
+def deliver(well: Well, out_root, run: Callable[[Sink], WellResult],
+            report: ReportWriter | None = None) -> WellResult:
+    """``run`` into memory (``out_root`` None: nothing written) or into ``out_root/NAME``,
+    written atomically with the report (``report``) before it is committed."""
+    if out_root is None:
+        return run(MemorySink())
+    with ResultDirectory(out_root, well.dir_name, well.name) as tmp:
+        result = run(DirectorySink(tmp))
+        if report is not None:
+            write_report(tmp, report, result)
+    result.out_dir = Path(out_root) / well.dir_name
+    return result
+
+
+def write_report(result_dir: Path, report: ReportWriter, result: WellResult) -> None:
+    """Write the report; a failure to render is a warning, not a lost run (the results
+    stand), and leaves no partial report file; a failure to write (disk) fails the run."""
+    try:
+        report(result_dir)
+    except OSError:
+        raise
+    except Exception as exc:  # noqa: BLE001 — the estimates are written; say what failed
+        for partial in result_dir.glob("report.*"):
+            partial.unlink(missing_ok=True)
+        result.warnings.append(f"report not written: {type(exc).__name__}: {exc}")
+        write_json(result_dir / "summary.json", result.summary)

@@ -1,0 +1,165 @@
+"""What one estimated segment of a time log gives: its :class:`~drillfric.result.
+SegmentRecord` and its output rows (estimates.parquet, profiles.parquet; docs/outputs.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from drillfric.estimation.chain import SegmentData, SegmentEstimate
+from drillfric.estimation.observer import ObserverRecord
+from drillfric.result import SEEDED_START_ID, Kind, SegmentRecord, Status
+from drillfric.segmentation import Segment
+from drillfric.units import RPM_TO_RAD_S
+
+
+def segment_record(seg: Segment, depth: float, status: Status, message: str, rows: pd.DataFrame,
+            est: SegmentEstimate | None = None) -> SegmentRecord:
+    """A segment's :class:`SegmentRecord` (the estimate's numbers when there is one)."""
+    base = dict(id=seg.id, kind=Kind(seg.kind), t_start_s=seg.t_start_s, t_end_s=seg.t_end_s,
+                bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message,
+                hookload_N=_median(rows, "hookload_N"), **_clock(rows, seg))
+    if est is None:
+        return SegmentRecord(**base)
+    return SegmentRecord(**base | dict(
+        message="; ".join([message] * bool(message) + list(est.messages)),
+        mu_s=est.mu_s, mu_k=est.mu_k, mu_s_identifiable=est.mu_s_identifiable,
+        mu_s_lower_bound=est.mu_s_lower_bound, mu_s_spread=est.mu_s_spread,
+        mu_k_spread=est.mu_k_spread, converged=est.converged, method=est.method,
+        settling_time_s=est.settling_time_s, residual_rms_rpm=est.residual_rms_rpm,
+        mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
+        T_N_Nm=est.T_N_Nm, flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
+        friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
+        **_evidence_fields(est), **_bit_fields(est)))
+
+
+def _evidence_fields(est: SegmentEstimate) -> dict:
+    ev = est.evidence
+    return dict(torque_rms_misfit_Nm=ev.misfit_rms_Nm, torque_swing_Nm=ev.swing_Nm,
+                fit_quality=ev.quality, surface_torque_mean_Nm=ev.mean_Nm)
+
+
+def _bit_fields(est: SegmentEstimate) -> dict:
+    """The bit-speed statistics, or null with the reason where the trace is withheld (the
+    stuck fraction and severity stay where only the kinematic check withheld it)."""
+    logged = dict(sample_interval_s=est.logged.interval_s,
+                  interval_torque_swing=est.logged.torque_swing)
+    if not est.bit_speed.resolved:
+        kept = dict(stick_slip_severity=est.stick_slip_severity,
+                    stuck_fraction=est.stuck_fraction) if est.bit_statistics else {}
+        return logged | kept | dict(bit_speed_resolved=False,
+                                    bit_speed_reason=est.bit_speed.reason)
+    return logged | dict(bit_speed_resolved=True, stick_slip_severity=est.stick_slip_severity,
+                         stuck_fraction=est.stuck_fraction,
+                         bit_rms_error_rpm=est.bit_rms_error_rpm)
+
+
+def _median(rows: pd.DataFrame, column: str) -> float | None:
+    if column not in rows or not rows[column].notna().any():
+        return None
+    return float(np.nanmedian(rows[column].to_numpy(float)))
+
+
+def _origin(rows: pd.DataFrame) -> pd.Timestamp | None:
+    """Clock time (UTC) of ``time_s = 0`` from a segment's rows, None without absolute time."""
+    if "timestamp" not in rows or rows.empty:
+        return None
+    first = pd.to_datetime(rows["timestamp"].iloc[:1], utc=True).iloc[0]
+    return first - pd.to_timedelta(float(rows["time_s"].iloc[0]), unit="s")
+
+
+def _clock(rows: pd.DataFrame, seg: Segment) -> dict:
+    """Clock times of the segment's ends when the log has absolute time."""
+    origin = _origin(rows)
+    if origin is None:
+        return {}
+    return {"clock_start_utc": iso(origin + pd.to_timedelta(seg.t_start_s, unit="s")),
+            "clock_end_utc": iso(origin + pd.to_timedelta(seg.t_end_s, unit="s"))}
+
+
+def _with_clock(frame: pd.DataFrame, rows: pd.DataFrame) -> pd.DataFrame:
+    """estimates rows with their clock time (``timestamp``, UTC) beside ``time_s`` when the
+    log has absolute time."""
+    origin = _origin(rows)
+    if origin is not None:
+        frame.insert(1, "timestamp", origin + pd.to_timedelta(frame["time_s"], unit="s"))
+    return frame
+
+
+def output_frames(seg: Segment, est: SegmentEstimate, data: SegmentData, rows: pd.DataFrame,
+                  omega_c: float) -> dict[str, pd.DataFrame]:
+    """The output rows of an estimated segment: ``estimates`` (with clock time when the log
+    has it) and its torque-and-drag ``profile`` (``omega_c``: the static band [rad/s])."""
+    return {"estimates": _with_clock(_estimate_frame(seg.id, est, data, omega_c), rows),
+            "profile": _profile_frame(seg.id, est)}
+
+
+def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
+                    omega_c: float) -> pd.DataFrame:
+    """estimates.parquet rows of one segment: every start (``start_id`` 0…), then the pass
+    seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): its
+    ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
+    carry most of the weight) with the members' min–max bit speed as
+    ``bit_rpm_est_min/max`` (NaN on the starts' rows). Where the logging does not resolve
+    the stick-slip cycle the bit columns are null: no trace is drawn from such data.
+    """
+    first = _record_frame(seg_id, est.first, 0, data,
+                          np.abs(est.first.bha_rad_s_est) <= omega_c, est)
+    seeded = _record_frame(seg_id, est.bit.record(est.final), SEEDED_START_ID, data,
+                           est.bit.stuck(est.final, omega_c), est)
+    seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
+    seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
+    frame = pd.concat([first, seeded], ignore_index=True)
+    if not est.bit_speed.resolved:
+        frame[["bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max"]] = np.nan
+        frame["bit_stuck"] = pd.array([None] * len(frame), dtype="boolean")
+    return frame
+
+
+def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentData,
+                  stuck: np.ndarray, est: SegmentEstimate) -> pd.DataFrame:
+    """Rows of one observer record, one per time and start (``start_id`` from ``offset``);
+    ``stuck`` is the bit-stuck flag per time and start (R, S) or per time (R,)."""
+    n_t, n_s = rec.mu_k.shape
+    ev = est.evidence
+    at = lambda t, y: np.repeat(np.interp(rec.time_s, t, y), n_s)  # noqa: E731
+    cols = {
+        "time_s": np.repeat(rec.time_s, n_s),
+        "segment_id": np.full(n_t * n_s, seg_id, dtype=np.int32),
+        "start_id": np.tile(np.arange(n_s, dtype=np.int16) + offset, n_t),
+        "mu_s": rec.mu_s.ravel(), "mu_k": rec.mu_k.ravel(),
+        "surface_rpm": at(data.time_s, data.surface_rpm),
+        "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
+        "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,
+        "bit_stuck": np.asarray(stuck, dtype=bool).ravel(),
+        "residual_rpm": rec.residual_rad_s.ravel() / RPM_TO_RAD_S,
+        "surface_torque_Nm": at(ev.time_s, ev.measured_Nm),
+        "surface_torque_est_Nm": rec.surface_torque_est_Nm.ravel(),
+        "surface_torque_fit_Nm": at(ev.time_s, ev.model_Nm),
+        "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
+        "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}
+    if data.bit_rpm is not None:
+        cols["bit_rpm"] = at(data.time_s, data.bit_rpm)
+    return pd.DataFrame(cols)
+
+
+def _profile_frame(seg_id: int, est: SegmentEstimate, step_m: float = 10.0) -> pd.DataFrame:
+    """Torque-and-drag profile of a segment every ~``step_m`` (profiles.parquet)."""
+    td = est.td
+    keep = np.unique(np.r_[np.arange(0, td.md_m.size - 1, max(1, int(step_m // max(
+        np.diff(td.md_m).mean(), 1e-9)))), td.md_m.size - 2])
+    return pd.DataFrame({"segment_id": np.int32(seg_id), "md_m": td.md_m[keep],
+                         "inc_deg": np.degrees(td.inc_rad[keep]),
+                         "tension_N": td.tension_N[keep], "torque_Nm": td.torque_Nm[keep],
+                         "normal_force_N_m": td.normal_force_N_m[keep],
+                         "fc_Nm_m": td.fc_Nm_m[keep]})
+
+
+def iso(stamp) -> str | None:
+    """ISO 8601 UTC text of a timestamp (None when the log has no clock time)."""
+    if stamp is None or pd.isna(stamp):
+        return None
+    stamp = pd.Timestamp(stamp)
+    stamp = stamp.tz_localize("UTC") if stamp.tzinfo is None else stamp.tz_convert("UTC")
+    return stamp.isoformat()
