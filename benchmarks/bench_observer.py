@@ -3,7 +3,7 @@
 Run: ``python benchmarks/bench_observer.py`` — prints a Markdown table for
 docs/performance.md. Case: 500 requested cells, the A&S drill pipe on a build-and-hold well,
 60 s of 100 Hz stick-slip data from the plant, Kalman gains. Serial runs (one thread) are
-timed by the thread's CPU time, parallel ones (members on numba's threads, ``prange``) by
+timed by the thread's CPU time, parallel ones (ranges of members on threads, nogil kernel) by
 wall time; all configurations are timed interleaved (A B C … A B C …, best of
 ``--repeats``) in one process, so their ratios share the machine's state — quote the load.
 Targets: ≤ 0.8 ns per member per cell-step (serial); ≥ 30× the NumPy twin.

@@ -141,6 +141,33 @@ def _progress_lines(description: str, total: float | None):
     yield advance
 
 
+def compile_kernels_once() -> None:
+    """The first run after an install: compile the kernels ahead of the run, in two
+    processes at once (:mod:`drillfric.kernels.warmup`), saying what happens and ticking the
+    elapsed seconds on a terminal (one line at the start and one at the end without one);
+    nothing to do once this installation's kernels are in the per-user cache."""
+    from drillfric.kernels import warmup
+    from drillfric.kernels.cache import cache_dir
+
+    if not warmup.needed():
+        return
+    quiet, tty = context().quiet, sys.stderr.isatty()
+    if not quiet:
+        click.echo("first run of this installation: compiling the numerical kernels once "
+                   f"(about 10–20 s; kept in {cache_dir()})", err=True)
+    t0 = time.monotonic()
+    if quiet or not tty:
+        ok = warmup.warm_up()
+    else:
+        from rich.console import Console
+
+        with Console(stderr=True).status("compiling kernels") as status:
+            ok = warmup.warm_up(lambda s: status.update(f"compiling kernels … {s:.0f} s"))
+    if not quiet:
+        click.echo(f"kernels compiled in {time.monotonic() - t0:.0f} s" if ok else
+                   "kernels will be compiled during the run", err=True)
+
+
 @contextmanager
 def well_progress(name: str):
     """Progress within one well's run: yields a callback for

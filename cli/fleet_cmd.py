@@ -15,7 +15,7 @@ from pathlib import Path
 
 import click
 
-from .common import UserError, echo, interrupted_exit_code, progress
+from .common import UserError, compile_kernels_once, echo, interrupted_exit_code, progress
 
 
 def _default_workers() -> int:
@@ -61,6 +61,8 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
     if config is not None and not config.is_file():
         raise UserError(f"{config}: config file not found — fix: check the --config path")
     specs = discover(source, config=config)
+    if scheduler is None:  # local workers share this user's kernel cache
+        compile_kernels_once()
     try:
         with progress(f"fleet ({len(specs)} wells)", total=len(specs)) as advance:
             result = run_many(specs, out, workers=workers or _default_workers(),

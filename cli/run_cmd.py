@@ -11,6 +11,7 @@ from drillfric.errors import DrillfricError
 from .common import (
     Quantity,
     UserError,
+    compile_kernels_once,
     context,
     echo,
     unit_system,
@@ -115,9 +116,11 @@ def command(wells, out, config, survey, rate, starts, pdf, report, workers, unit
     if units:  # the run's [well] units: its report is drawn in them too
         overrides["well.units"] = units
     if workers > 1 and len(wells) > 1:
+        compile_kernels_once()
         _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers)
         return
     opened, unreadable = _open_all(wells, config, survey, overrides)
+    compile_kernels_once()
     failures = 0
     for well in opened:
         try:

@@ -19,6 +19,7 @@ from importlib.abc import MetaPathFinder as _Finder
 from pathlib import Path as _Path
 
 from drillfric._version import __version__
+from drillfric.kernels.cache import configure as _configure_kernel_cache
 
 __all__ = ["open_well", "run", "load_result", "torque_and_drag", "simulate", "Well",
            "WellResult", "RunProgress", "__version__"]
@@ -45,6 +46,9 @@ _TREE = _Path(__file__).resolve().parent.parent
 if (_TREE / "pyproject.toml").is_file() and (_TREE / "cli" / "main.py").is_file() and not (
         _Path(__file__).parent / "cli").is_dir():
     _sys.meta_path.append(_CheckoutFolders(_TREE))
+
+
+_configure_kernel_cache()  # compiled kernels in one per-user directory (docs/performance.md)
 
 
 def __getattr__(name: str):

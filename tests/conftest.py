@@ -25,6 +25,17 @@ def _strict_numpy():
     np.seterr(**old)
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _kernels_compiled():
+    """Compile the kernels once before any test (what `drillfric run` does on a first run),
+    so that no CLI test sees the first-run lines; tests/test_first_run.py checks those with a
+    cache of its own."""
+    from drillfric.kernels import warmup
+
+    if warmup.needed():
+        warmup.warm_up()
+
+
 @pytest.fixture
 def real_data() -> Path:
     """Path of ../shared/data/real, or skip when it is not there (a user's clone)."""

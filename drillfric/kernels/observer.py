@@ -5,9 +5,11 @@ junction, friction and top-drive steps, called from there, with the friction pro
 of docs/theory.md §3.2) plus output injection of the innovation e = ω̂₀ − ω₀ and the friction
 adaptation laws. Several members (starts: initial guesses of μ_s, μ_k, or ensemble members)
 advance in one call. They are independent, so each runs its whole time window on its own
-(:func:`observe_member`, members outermost, cells innermost); :func:`observer_kernels` gives
-a serial loop over them and a parallel one (numba ``prange``, one member per thread at a
-time) that compute the same numbers. The plain-NumPy twin is
+(:func:`observe_member`, members outermost, cells innermost); :func:`observer_kernel` loops
+over a range of them without the GIL, and :func:`run_observer` runs disjoint ranges on
+threads (as many as numba may use) when asked — the same numbers as one serial call, and one
+compiled kernel instead of a serial and a ``prange`` one (the parallel-loop compilation cost
+~2.5 s of a first run). The plain-NumPy twin is
 :func:`drillfric.kernels.observer_numpy.run_observer`.
 
 [1] U.J.F. Aarsnes, J. Auriol, F. Di Meglio, R.J. Shor, "Estimating friction factors while
@@ -16,8 +18,10 @@ time) that compute the same numbers. The plain-NumPy twin is
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
-from numba import literally, njit, prange
+from numba import get_num_threads, literally, njit
 
 from drillfric.kernels.plant import (
     LAW_STEP,
@@ -180,44 +184,42 @@ def observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, secti
     guard[s, 0], guard[s, 1] = stuck_s, events
 
 
-def observer_kernels(law: int, fixed: bool):
-    """(serial, parallel) compiled observer kernels of one friction variant.
-
-    Both advance every member of the observer ``n_steps`` steps and record at ``times``,
-    with the arguments of :func:`run_observer` (without ``parallel``); the parallel one runs
-    the members on numba's threads (``prange``; honours ``numba.set_num_threads``), the
-    serial one in order, and both give the same numbers (the members do not interact).
-    The variant is a constant of the compiled code (closure variables, cached per variant).
+def observer_kernel(law: int, fixed: bool):
+    """The compiled observer kernel of one friction variant: it advances members
+    ``first`` to ``last - 1`` (rows of the state arrays) ``n_steps`` steps and records at
+    ``times``, with the arguments of :func:`run_observer` (without ``parallel``). It runs
+    without the GIL (``nogil``), so threads advancing disjoint ranges of members run on
+    several cores and give the same numbers as one call over all of them (the members do
+    not interact). The variant is a constant of the compiled code (closure variables, cached
+    per variant).
     """
-    @njit(cache=True)
-    def serial(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
-               junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
-               bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b,
-               P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out):
+    @njit(cache=True, nogil=True)
+    def members(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
+                junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
+                bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b,
+                P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out, first,
+                last):
         wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
         taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
-        for s in range(alpha.shape[0]):
-            observe_member(np.int64(s), alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
+        for s in range(first, last):
+            observe_member(s, alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
                            section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
                            omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum, p0, P0,
                            inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s,
                            omega_turn, times, out, law, fixed)
 
-    @njit(cache=True, parallel=True)
-    def parallel(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start,
-                 junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp,
-                 bit_cap_rel, inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a,
-                 inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s, omega_turn, times, out):
-        wm = measurements_at_steps(w_meas, m_t0, m_dt, t0, dt, n_steps, hold)
-        taum = measurements_at_steps(tau_meas, m_t0, m_dt, t0, dt, n_steps, hold)
-        for s in prange(alpha.shape[0]):
-            observe_member(np.int64(s), alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps,
-                           section_start, junction_z, zeta, fcap, fix_k, fix_s, dt, kt_dt,
-                           omega_c, law_speed, law_exp, bit_cap_rel, inv_itd, wm, taum, p0, P0,
-                           inj_a, inj_b, P1, l_k, l_s, adapt_law, mu_max, deadlock_s,
-                           omega_turn, times, out, law, fixed)
+    return members
 
-    return serial, parallel
+
+def _ranges(members: int, threads: int) -> list[tuple[int, int]]:
+    """``threads`` contiguous, near-equal ranges of ``members`` (none empty).
+
+    >>> _ranges(5, 2)
+    [(0, 3), (3, 5)]
+    """
+    threads = max(1, min(threads, members))
+    cuts = [round(k * members / threads) for k in range(threads + 1)]
+    return list(zip(cuts[:-1], cuts[1:], strict=True))
 
 
 _KERNELS: dict = {}
@@ -250,14 +252,23 @@ def run_observer(alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_st
     20 % if μ̂_s already was there).
 
     ``out[r, s]`` receives :data:`OBS_COLUMNS` at ``times[r]`` (the step at or after it).
-    ``parallel``: run the members on numba's threads (same numbers as serially). Runs the
-    compiled :func:`observer_kernels` of the call's friction variant.
+    ``parallel``: run ranges of members on threads, as many as ``numba.get_num_threads()``
+    (same numbers as serially). Runs the
+    compiled :func:`observer_kernel` of the call's friction variant.
     """
     key = variant(law_speed, law_exp, fix_k, fix_s)
     if key not in _KERNELS:
-        _KERNELS[key] = observer_kernels(*key)
-    _KERNELS[key][1 if parallel else 0](
-        alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start, junction_z, zeta,
-        fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd,
-        w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s, adapt_law,
-        mu_max, deadlock_s, omega_turn, times, out)
+        _KERNELS[key] = observer_kernel(*key)
+    kernel = _KERNELS[key]
+    args = (alpha, beta, omega0, mu_s, mu_k, guard, t0, n_steps, section_start, junction_z,
+            zeta, fcap, fix_k, fix_s, dt, kt_dt, omega_c, law_speed, law_exp, bit_cap_rel,
+            inv_itd, w_meas, tau_meas, m_t0, m_dt, hold, p0, P0, inj_a, inj_b, P1, l_k, l_s,
+            adapt_law, mu_max, deadlock_s, omega_turn, times, out)
+    members = alpha.shape[0]
+    ranges = _ranges(members, get_num_threads() if parallel else 1)
+    if len(ranges) == 1:
+        kernel(*args, 0, members)
+        return
+    with ThreadPoolExecutor(len(ranges)) as pool:
+        for done in [pool.submit(kernel, *args, first, last) for first, last in ranges]:
+            done.result()

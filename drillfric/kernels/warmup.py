@@ -1,0 +1,99 @@
+"""Compile the kernels of a run ahead of it, in two processes at once (the first run).
+
+A run compiles, on first use, the torsional plant (the batch fit), the observer (the starts
+and the ensemble), the rig-state classifier and the torque-and-drag march. Compiled in the
+run's own process they cost ~10 s of one core, in silence. :func:`warm_up` compiles them in
+two short-lived processes side by side — the observer in one, the plant, classifier and
+march in the other — through the same functions a run calls (so with the same types), on a
+small built-in segment; numba writes the machine code to the per-user cache
+(:mod:`drillfric.kernels.cache`) and the run loads it from there. Subprocesses, not
+multiprocessing: a Dask worker's daemonic process cannot start multiprocessing children.
+
+``python -m drillfric.kernels.warmup PART`` compiles one part ("observer" or "plant").
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+
+from drillfric.kernels.cache import is_warm, mark_warm
+
+PARTS = ("observer", "plant")
+#: Name of the stamp :func:`warm_up` leaves in the cache (:func:`~drillfric.kernels.cache.is_warm`).
+STAMP = "run"
+
+
+def needed() -> bool:
+    """Whether this installation's kernels still have to be compiled (no stamp in the cache)."""
+    return not is_warm(STAMP)
+
+
+def warm_up(tick: Callable[[float], None] | None = None, *, timeout_s: float = 600.0,
+            poll_s: float = 0.25) -> bool:
+    """Compile the run's kernels in two processes at once; ``tick(elapsed_s)`` is called
+    every ``poll_s`` while they work. Returns True when both succeeded (and marks the cache
+    warm); False otherwise — the run then compiles what it needs itself."""
+    env = dict(os.environ)  # NUMBA_CACHE_DIR as this process has it
+    procs = [subprocess.Popen([sys.executable, "-m", "drillfric.kernels.warmup", part],
+                              stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, env=env) for part in PARTS]
+    t0 = time.monotonic()
+    try:
+        while any(p.poll() is None for p in procs):
+            elapsed = time.monotonic() - t0
+            if elapsed > timeout_s:
+                return False
+            if tick is not None:
+                tick(elapsed)
+            time.sleep(poll_s)
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+    if all(p.returncode == 0 for p in procs):
+        mark_warm(STAMP)
+        return True
+    return False
+
+
+def _segment():
+    """A short off-bottom rotation (5 s at 100 Hz, 60 RPM, 8 kN·m) at 1000 m, default string."""
+    import numpy as np
+
+    from drillfric.estimation.chain import SegmentData
+
+    time_s = np.arange(501) / 100.0
+    return SegmentData(time_s, np.full(time_s.size, 60.0), np.full(time_s.size, 8e3), 1000.0)
+
+
+def _compile(part: str) -> None:
+    """Run the functions of ``part`` that a run compiles, on :func:`_segment`."""
+    import numpy as np
+    import pandas as pd
+
+    from drillfric.config import config_from_dict
+    from drillfric.estimation import chain
+
+    cfg = config_from_dict({})
+    models = chain.build_models(cfg, None, _segment())
+    if part == "observer":
+        chain.starts_pass(cfg, models, None, 10.0)
+        return
+    from drillfric import torsional
+    from drillfric.segmentation import _PLAIN_ROWS, classify
+
+    drive = torsional.Drive("speed", np.full(10, 6.3), 1.0)  # the batch fit's plant kernel
+    torsional.run(models.observer.plant, drive, 1.0, 10.0)
+
+    rows = _PLAIN_ROWS + 1
+    classify(pd.DataFrame({"time_s": np.arange(rows) / 100.0,
+                           "surface_rpm": np.full(rows, 60.0)}), cfg)
+
+
+if __name__ == "__main__":
+    _compile(sys.argv[1])
