@@ -19,7 +19,6 @@ Library code: no printing, no signal handlers (the CLI turns SIGTERM into
 from __future__ import annotations
 
 import csv
-import fcntl
 import hashlib
 import json
 import os
@@ -28,7 +27,7 @@ import time
 import uuid
 import warnings
 from collections.abc import Callable, Iterator
-from contextlib import closing, contextmanager, nullcontext
+from contextlib import ExitStack, closing, contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
@@ -38,6 +37,7 @@ import pandas as pd
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
 from drillfric.io import witsml
+from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
     check_distinct,
     file_sha256,
@@ -615,21 +615,18 @@ def _client(workers: int, scheduler: str | None):
 @contextmanager
 def _locked(out_root: Path):
     """Hold OUT/.fleet.lock: one fleet run at a time per output directory."""
+    lock = ExitStack()
     try:
         out_root.mkdir(parents=True, exist_ok=True)
-        fh = open(out_root / _LOCK, "w")  # held (locked) for the whole run
+        lock.enter_context(lock_file(out_root / _LOCK))
+    except Busy:
+        raise InputError("another fleet run is writing to this directory", file=out_root,
+                         fix="wait for it to finish or use another --out") from None
     except OSError as exc:
         raise InputError(f"cannot write the output directory ({exc.strerror})",
                          file=out_root, fix="choose a writable --out") from None
-    try:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise InputError("another fleet run is writing to this directory", file=out_root,
-                             fix="wait for it to finish or use another --out") from None
+    with lock:
         yield
-    finally:
-        fh.close()
 
 
 # --------------------------------------------------------------------------- fleet files
