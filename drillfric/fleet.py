@@ -691,12 +691,7 @@ def _client(workers: int, scheduler: str | None):
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
-        except (OSError, TimeoutError) as exc:
-            raise InputError(f"cannot reach the Dask scheduler ({exc})", file=scheduler,
-                             fix="check the address (tcp://HOST:PORT) and that the "
-                                 "scheduler runs") from None
+        client = _connect(scheduler)
         with client:
             yield client
         return
@@ -714,6 +709,27 @@ def _client(workers: int, scheduler: str | None):
                           dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
                 Client(cluster) as client:
             yield client
+
+
+def _connect(address: str):
+    """A client of the scheduler at ``address``, checked and probed first (any failure:
+    one InputError naming the address)."""
+    from distributed import Client
+
+    from drillfric.scheduler import probe, shown
+
+    probe(address)
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"cannot reach the Dask scheduler ({exc})", file=shown(address),
+                         fix="check the address (tcp://HOST:PORT) and that the "
+                             "scheduler runs") from None
+    except Exception as exc:  # noqa: BLE001 — whatever answered, it is not a scheduler
+        raise InputError(f"the address does not answer as a Dask scheduler "
+                         f"({type(exc).__name__})", file=shown(address),
+                         fix="give the address the scheduler prints (tcp://HOST:8786)"
+                         ) from None
 
 
 @contextmanager

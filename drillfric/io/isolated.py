@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -139,8 +140,10 @@ def _crash(name: str, code: int, stderr: bytes) -> str:
     if memory:
         limit = memory_limit_bytes()
         room = f" of {limit / 1024**3:.1f} GiB" if limit else ""
+        asked = re.search(r"memory allocation of (\d+) bytes", text)
+        size = f" ({int(asked[1]) / 1024**3:,.0f} GiB at once)" if asked else ""
         return f"the {name} reader ran out of memory ({what}): the file asks for more than " \
-               f"the reader's limit{room}"
+               f"the reader's limit{room}{size}"
     return f"the {name} reader crashed ({what})"
 
 
