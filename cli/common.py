@@ -143,10 +143,10 @@ def _progress_lines(description: str, total: float | None):
 
 def compile_kernels_once() -> None:
     """The first run after an install: compile the kernels ahead of the run, in two
-    processes at once (:mod:`drillfric.kernels.warmup`), saying what happens and ticking the
+    processes at once (:mod:`drillfric.runner.warmup`), saying what happens and ticking the
     elapsed seconds on a terminal (one line at the start and one at the end without one);
     nothing to do once this installation's kernels are in the per-user cache."""
-    from drillfric.kernels import warmup
+    from drillfric.runner import warmup
     from drillfric.kernels.cache import cache_dir
 
     if not warmup.needed():

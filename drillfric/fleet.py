@@ -19,7 +19,6 @@ Library code: no printing, no signal handlers (the CLI turns SIGTERM into
 from __future__ import annotations
 
 import csv
-import fcntl
 import hashlib
 import json
 import os
@@ -28,7 +27,7 @@ import time
 import uuid
 import warnings
 from collections.abc import Callable, Iterator
-from contextlib import closing, contextmanager, nullcontext
+from contextlib import ExitStack, closing, contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
@@ -38,6 +37,7 @@ import pandas as pd
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
 from drillfric.io import witsml
+from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
     check_distinct,
     file_sha256,
@@ -183,9 +183,15 @@ def _read_manifest(path: Path) -> list[WellSpec]:
 # --------------------------------------------------------------------------- the task
 @dataclass(frozen=True)
 class WellTask:
-    """What a worker receives: plain, picklable, absolute paths."""
+    """What a worker receives: plain, picklable, absolute paths.
 
-    name: str
+    ``name`` is None when the well's name may be stored inside its data file: the worker
+    then resolves it and claims its output directory, refusing the names in ``taken``
+    (other wells of the fleet) and any name another worker of this run claimed first
+    (``OUT/.claim-RUN-…`` files, made with O_EXCL; ``run`` is the run's token).
+    """
+
+    name: str | None
     data: str
     config: str | None
     survey: str | None
@@ -194,13 +200,17 @@ class WellTask:
     rate_hz: float | None = None
     pdf: bool = False
     report: bool = True
+    taken: frozenset = frozenset()
+    run: str = ""
 
 
 def process_well(task: WellTask) -> dict:
     """Run one well on a worker and return its small result record (never raises).
 
-    The worker opens the well itself and writes OUT/NAME (atomically). The record carries
-    the status, the message of a failure, the summary, timings and where it ran.
+    The worker opens the well itself (the fleet's parent never opens a data file) and
+    writes OUT/NAME (atomically). The record carries the status, the message of a failure,
+    the well's name and output directory name, the files it read, the summary, timings and
+    where it ran.
     """
     from drillfric.api import run as run_well
     from drillfric.io.well import open_well
@@ -213,6 +223,10 @@ def process_well(task: WellTask) -> dict:
     try:
         well = open_well(task.data, config=task.config, survey=task.survey,
                          overrides=task.overrides, name=task.name)
+        record.update(well=well.name, dir_name=well.dir_name,
+                      inputs={role: str(p.resolve()) for role, p in well.files.inputs.items()})
+        if task.name is None:
+            _claim(task, well.dir_name)
         result = run_well(well, task.out_root, rate_hz=task.rate_hz, pdf=task.pdf,
                           report=task.report)
         record.update(status="ok", summary=jsonable(result.summary),
@@ -225,6 +239,23 @@ def process_well(task: WellTask) -> dict:
                   task_s=time.perf_counter() - t0, worker=f"{socket.gethostname()}:"
                   f"{os.getpid()}", worker_version=__version__)
     return record
+
+
+def _claim(task: WellTask, dir_name: str) -> None:
+    """Claim OUT/``dir_name`` for a well whose name was resolved on this worker."""
+    key = dir_name.casefold()
+    digest = hashlib.sha256(key.encode()).hexdigest()[:20]
+    claim = Path(task.out_root) / f".claim-{task.run}-{digest}"
+    try:
+        if key in task.taken:
+            raise FileExistsError
+        Path(task.out_root).mkdir(parents=True, exist_ok=True)
+        os.close(os.open(claim, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+    except FileExistsError:
+        raise InputError(f"another well of this fleet writes OUT/{dir_name}: one well's "
+                         "results would be lost", file=task.data,
+                         fix="give each well its own [well] name (or 'well' column in a "
+                             "manifest)") from None
 
 
 def _one_kernel_thread() -> None:
@@ -248,43 +279,54 @@ def _now() -> str:
 # --------------------------------------------------------------------------- preparation
 @dataclass(frozen=True)
 class _Job:
-    """A well after preparation: its task and fingerprint, or why it cannot run."""
+    """A well after preparation: its task and fingerprint, or why it cannot run.
 
+    ``named``: the name is known before the well is opened (else it is the data file's
+    stem until the worker reports the name stored inside the file).
+    """
+
+    index: int
     name: str
     dir_name: str
     task: WellTask | None
     fingerprint: dict
     error: str = ""
+    named: bool = True
 
 
-def _open_job(spec: WellSpec, out_root: Path, overrides: dict, options: dict) -> _Job:
-    """Open the well (files, configuration, name) and make its task (no hashing yet)."""
-    from drillfric.io.well import open_well
+def _open_job(index: int, spec: WellSpec, out_root: Path, overrides: dict,
+              options: dict) -> _Job:
+    """Find the well's files and name from paths and sidecars and make its task; no data
+    file is opened here (a hostile one could stall or crash the fleet), the worker opens it."""
+    from drillfric.io.text import printable
+    from drillfric.io.well import find_well, safe_name
 
-    fallback = spec.name or spec.data.stem
+    fallback = printable(spec.name or spec.data.stem, 4096)
     try:
-        well = open_well(spec.data, config=spec.config, survey=spec.survey,
-                         overrides=overrides, name=spec.name)
+        files, name = find_well(spec.data, config=spec.config, survey=spec.survey,
+                                name=spec.name)
+        dir_name = fallback if name is None else safe_name(name, files.config or files.data)
     except DrillfricError as exc:
-        return _Job(fallback, fallback, None, {}, exc.message)
+        return _Job(index, fallback, fallback, None, {}, exc.message)
     except OSError as exc:
-        return _Job(fallback, fallback, None, {},
+        return _Job(index, fallback, fallback, None, {},
                     f"{exc.filename}: cannot read ({exc.strerror})")
-    effective = json.dumps(jsonable({"config": well.config.to_dict(), "options": options}),
+    # the configuration files are inputs (hashed); defaults change with the version only
+    effective = json.dumps(jsonable({"overrides": overrides, "options": options}),
                            sort_keys=True, default=str)
-    fingerprint = {"inputs": well.files.inputs,
+    fingerprint = {"inputs": files.inputs,
                    "drillfric_version": __version__,
                    "config_sha256": hashlib.sha256(effective.encode()).hexdigest()}
-    task = WellTask(well.name, str(Path(spec.data).resolve()), _abs(spec.config),
+    task = WellTask(name, str(Path(spec.data).resolve()), _abs(spec.config),
                     _abs(spec.survey), str(out_root.resolve()), dict(overrides),
                     options.get("rate_hz"), options.get("pdf", False),
                     options.get("report", True))
-    return _Job(well.name, well.dir_name, task, fingerprint)
+    return _Job(index, name or fallback, dir_name, task, fingerprint, named=name is not None)
 
 
 def _hashed(job: _Job, known: dict) -> _Job:
     """The job with its input files stamped and hashed (hashes of files unchanged in size
-    and mtime since the manifest recorded them are reused)."""
+    and mtime since the manifest recorded them are reused; ``known`` gains the new ones)."""
     if job.task is None:
         return job
     try:
@@ -305,22 +347,46 @@ def _file_stamp(path: Path, known: dict) -> dict:
     old = known.get(key)
     if old and old.get("size") == stat.st_size and old.get("mtime_ns") == stat.st_mtime_ns:
         return stamp | {"sha256": old["sha256"]}
-    return stamp | {"sha256": file_sha256(path)}
+    known[key] = stamp = stamp | {"sha256": file_sha256(path)}
+    return stamp
 
 
-def _same(fingerprint: dict, entry: dict | None) -> bool:
-    """True when ``entry`` (manifest) was an ok run of the same inputs, config, version."""
+def _same(fingerprint: dict, entry: dict | None, known: dict) -> bool:
+    """True when ``entry`` (manifest) was an ok run of the same inputs, config, version:
+    the files found now are the ones recorded, and every file the worker read (some are
+    only found inside a data file) is unchanged."""
     if not entry or entry.get("status") != "ok":
         return False
-
-    def digests(fp):
-        return {role: f["sha256"] for role, f in fp.get("inputs", {}).items()}
-
     outputs = entry.get("outputs", {}).get("summary")
-    return (outputs is not None and Path(outputs).is_file()
-            and digests(fingerprint) == digests(entry)
-            and fingerprint["config_sha256"] == entry.get("config_sha256")
-            and fingerprint["drillfric_version"] == entry.get("drillfric_version"))
+    if (outputs is None or not Path(outputs).is_file()
+            or fingerprint["config_sha256"] != entry.get("config_sha256")
+            or fingerprint["drillfric_version"] != entry.get("drillfric_version")):
+        return False
+    recorded = entry.get("inputs", {})
+    if any(recorded.get(role, {}).get("sha256") != f["sha256"]
+           for role, f in fingerprint["inputs"].items()):
+        return False
+    try:
+        return all(_file_stamp(Path(f["path"]), known)["sha256"] == f["sha256"]
+                   for role, f in recorded.items() if role not in fingerprint["inputs"])
+    except (OSError, KeyError, TypeError):
+        return False
+
+
+def _entry(manifest: _Manifest, job: _Job) -> tuple[str, dict | None]:
+    """The manifest's name and entry of a job: by name, or — a name still to be read from
+    the data file — the entry that read the same data files."""
+    if job.named:
+        return job.name, manifest.wells.get(job.name)
+
+    def data(inputs: dict) -> set:
+        return {f.get("path") for role, f in inputs.items() if role.split()[0] == "data"}
+
+    mine = data(job.fingerprint["inputs"])
+    for name, entry in manifest.wells.items():
+        if isinstance(entry, dict) and data(entry.get("inputs", {})) == mine:
+            return name, entry
+    return job.name, None
 
 
 # --------------------------------------------------------------------------- results
@@ -456,53 +522,91 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
     out_root = Path(out_root)
     advance = progress or (lambda amount=1.0: None)
     options = {"rate_hz": rate_hz, "pdf": pdf, "report": report}
-    jobs = [_open_job(s, out_root, overrides or {}, options) for s in wells]
+    jobs = [_open_job(i, s, out_root, overrides or {}, options) for i, s in enumerate(wells)]
     check_distinct([(j.dir_name, f"well '{j.name}' ({spec.data})")
-                    for j, spec in zip(jobs, wells, strict=True) if j.task is not None])
-    created = missing_dirs(out_root)  # without fleet files: removed again if left empty
-    with _locked(out_root) if fleet_files else nullcontext():
-        if fleet_files:
-            remove_stale(out_root)
-        manifest = _Manifest(out_root if fleet_files else None)
-        known = manifest.known_files()
-        jobs = [_hashed(j, known) for j in jobs]
-        outcomes: dict[str, WellOutcome] = {}
-        todo = []
-        for job in jobs:
-            entry = manifest.wells.get(job.name)
-            if job.task is None:
-                outcomes[job.name] = _record(manifest, job, {"status": "failed",
-                                                             "message": job.error}, 0)
-                advance(1.0)
-            elif not force and _same(job.fingerprint, entry):
-                outcomes[job.name] = _skipped(job.name, entry)
-                advance(1.0)
-            else:
-                todo.append(job)
-        try:
-            with closing(_execute(todo, workers=workers, scheduler=scheduler)) as done:
-                for job, rec, attempts in done:
-                    outcomes[job.name] = _record(manifest, job, rec, attempts)
-                    manifest.save(now=False)
-                    advance(1.0)
-        finally:
-            manifest.save()
-            if scheduler is None:  # local workers are gone: what they left is stale
-                for job in jobs:
-                    remove_stale(out_root, job.dir_name)
-        ordered = tuple(outcomes[j.name] for j in jobs)
-        summary_path, report_path, notes = None, None, ()
-        if fleet_files:
-            summary_path = _write_summary(out_root, ordered)
-            report_path, notes = _write_report(out_root, ordered)
-        else:
-            remove_empty(created)  # several workers may each have made OUT for a failed well
-    return FleetResult(out_root, ordered, time.perf_counter() - t0, manifest.path,
+                    for j, spec in zip(jobs, wells, strict=True) if j.task is not None and j.named])
+    created = missing_dirs(out_root)  # removed again when nothing is left in them
+    run = uuid.uuid4().hex[:8]
+    try:
+        with _locked(out_root) if fleet_files else nullcontext():
+            outcomes, manifest = _run_jobs(jobs, out_root, run, workers=workers,
+                                           scheduler=scheduler, force=force, advance=advance,
+                                           fleet_files=fleet_files)
+            summary_path, report_path, notes = None, None, ()
+            if fleet_files:
+                summary_path = _write_summary(out_root, outcomes)
+                report_path, notes = _write_report(out_root, outcomes)
+    except DrillfricError:
+        if created and fleet_files and not any(p.is_dir() for p in out_root.iterdir()):
+            for name in (MANIFEST, _LOCK):  # failed before any well ran: no OUT left behind
+                (out_root / name).unlink(missing_ok=True)
+        raise
+    finally:
+        for claim in out_root.glob(f".claim-{run}-*"):
+            claim.unlink(missing_ok=True)
+        remove_empty(created)  # OUT made here and left empty (e.g. by workers for failed wells)
+    return FleetResult(out_root, outcomes, time.perf_counter() - t0, manifest.path,
                        summary_path, report_path, notes)
 
 
-def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int) -> WellOutcome:
-    entry = {**job.fingerprint, "status": rec["status"], "message": rec["message"],
+def _run_jobs(jobs: list[_Job], out_root: Path, run: str, *, workers: int,
+              scheduler: str | None, force: bool, advance: Callable,
+              fleet_files: bool) -> tuple[tuple[WellOutcome, ...], _Manifest]:
+    """Skip the unchanged wells, run the others, record every one; outcomes in input order."""
+    if fleet_files:
+        remove_stale(out_root)
+    manifest = _Manifest(out_root if fleet_files else None)
+    known = manifest.known_files()
+    jobs = [_hashed(j, known) for j in jobs]
+    outcomes: dict[int, WellOutcome] = {}
+    todo = []
+    for job in jobs:
+        name, entry = _entry(manifest, job)
+        if job.task is None:
+            outcomes[job.index] = _record(manifest, job, {"status": "failed",
+                                                          "message": job.error}, 0, known)
+            advance(1.0)
+        elif not force and _same(job.fingerprint, entry, known):
+            outcomes[job.index] = _skipped(name, entry)
+            advance(1.0)
+        else:
+            todo.append(job)
+    if any(not j.named for j in todo):  # their names are resolved (and claimed) by workers
+        taken = frozenset({j.dir_name.casefold() for j in jobs if j.named and j.task}
+                          | {Path(o.result_dir).name.casefold() for o in outcomes.values()
+                             if o.result_dir is not None})
+        todo = [j if j.named else replace(j, task=replace(j.task, taken=taken, run=run))
+                for j in todo]
+    written = []
+    try:
+        with closing(_execute(todo, workers=workers, scheduler=scheduler)) as done:
+            for job, rec, attempts in done:
+                outcomes[job.index] = _record(manifest, job, rec, attempts, known)
+                written.append(rec.get("dir_name") or job.dir_name)
+                manifest.save(now=False)
+                advance(1.0)
+    finally:
+        manifest.save()
+        if scheduler is None:  # local workers are gone: what they left is stale
+            for dir_name in {j.dir_name for j in jobs} | set(written):
+                remove_stale(out_root, dir_name)
+    return tuple(outcomes[j.index] for j in jobs), manifest
+
+
+def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
+            known: dict) -> WellOutcome:
+    """Record a well's outcome in the manifest, under the name its worker resolved, with
+    the files it read (those found inside its data file stamped here)."""
+    name = rec.get("well") or job.name
+    inputs = dict(job.fingerprint.get("inputs", {}))
+    for role, path in rec.get("inputs", {}).items():
+        if role not in inputs:
+            try:
+                inputs[role] = _file_stamp(Path(path), known)
+            except OSError:
+                continue
+    entry = {**job.fingerprint, "inputs": inputs, "status": rec["status"],
+             "message": rec["message"],
              "attempts": attempts, "failed_segments": rec.get("failed_segments", 0),
              **{k: rec[k] for k in ("started_utc", "finished_utc", "task_s", "worker")
                 if k in rec}}
@@ -518,8 +622,8 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int) -> WellOut
             entry.update(status="failed", message=f"{out}: the worker wrote its result where "
                          "this machine cannot see it — fix: put OUT on storage shared by the "
                          "client and every worker")
-    manifest.wells[job.name] = entry
-    return WellOutcome(job.name, entry["status"], entry["message"],
+    manifest.wells[name] = entry
+    return WellOutcome(name, entry["status"], entry["message"],
                        Path(rec["out_dir"]) if entry["status"] == "ok" else None,
                        rec.get("summary") if entry["status"] == "ok" else None,
                        entry["failed_segments"], rec.get("task_s", 0.0), attempts)
@@ -587,12 +691,7 @@ def _client(workers: int, scheduler: str | None):
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
-        except (OSError, TimeoutError) as exc:
-            raise InputError(f"cannot reach the Dask scheduler ({exc})", file=scheduler,
-                             fix="check the address (tcp://HOST:PORT) and that the "
-                                 "scheduler runs") from None
+        client = _connect(scheduler)
         with client:
             yield client
         return
@@ -612,24 +711,42 @@ def _client(workers: int, scheduler: str | None):
             yield client
 
 
+def _connect(address: str):
+    """A client of the scheduler at ``address``, checked and probed first (any failure:
+    one InputError naming the address)."""
+    from distributed import Client
+
+    from drillfric.scheduler import probe, shown
+
+    probe(address)
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"cannot reach the Dask scheduler ({exc})", file=shown(address),
+                         fix="check the address (tcp://HOST:PORT) and that the "
+                             "scheduler runs") from None
+    except Exception as exc:  # noqa: BLE001 — whatever answered, it is not a scheduler
+        raise InputError(f"the address does not answer as a Dask scheduler "
+                         f"({type(exc).__name__})", file=shown(address),
+                         fix="give the address the scheduler prints (tcp://HOST:8786)"
+                         ) from None
+
+
 @contextmanager
 def _locked(out_root: Path):
     """Hold OUT/.fleet.lock: one fleet run at a time per output directory."""
+    lock = ExitStack()
     try:
         out_root.mkdir(parents=True, exist_ok=True)
-        fh = open(out_root / _LOCK, "w")  # held (locked) for the whole run
+        lock.enter_context(lock_file(out_root / _LOCK))
+    except Busy:
+        raise InputError("another fleet run is writing to this directory", file=out_root,
+                         fix="wait for it to finish or use another --out") from None
     except OSError as exc:
         raise InputError(f"cannot write the output directory ({exc.strerror})",
                          file=out_root, fix="choose a writable --out") from None
-    try:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise InputError("another fleet run is writing to this directory", file=out_root,
-                             fix="wait for it to finish or use another --out") from None
+    with lock:
         yield
-    finally:
-        fh.close()
 
 
 # --------------------------------------------------------------------------- fleet files

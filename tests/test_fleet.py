@@ -126,7 +126,8 @@ def test_all_wells_unreadable_is_exit_2(tmp_path):
 
 
 def test_wells_that_cannot_be_opened_fail_alone(tmp_path):
-    """Missing and unreadable wells fail before any worker starts; the others go on."""
+    """A missing well fails in the parent, unreadable ones in their workers (the parent
+    never opens a data file); each fails alone."""
     (tmp_path / "a").mkdir()
     (tmp_path / "a" / "x.csv").write_text("garbage\n")
     specs = [WellSpec(tmp_path / "missing.csv"), WellSpec(tmp_path / "a" / "x.csv"),
@@ -136,7 +137,8 @@ def test_wells_that_cannot_be_opened_fail_alone(tmp_path):
     assert status == [("missing", "failed"), ("x", "failed"), ("y", "failed")]
     assert "file not found" in result.wells[0].message
     assert "time_s not found" in result.wells[1].message
-    assert result.wells[2].attempts == 0 and "time_s not found" in result.wells[2].message
+    assert result.wells[0].attempts == 0  # found missing by the parent
+    assert result.wells[2].attempts == 1 and "time_s not found" in result.wells[2].message
     assert len(manifest(tmp_path / "out")) == 3
 
 

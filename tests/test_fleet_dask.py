@@ -158,3 +158,26 @@ def test_killed_worker_loses_no_well(scheduler, wells, tmp_path):
     well, pid = killed
     assert not entries[well]["worker"].endswith(f":{pid}")  # finished by another process
     assert_complete(out)
+
+
+def test_hostile_files_on_a_cluster_fail_alone(scheduler, tmp_path_factory, tmp_path):
+    """Issue #20: the xlsx bomb and the segfaulting DLIS file are opened on the workers (in
+    a contained reader child): no worker dies, the good well is written."""
+    from tests.test_hostile_round_two import (
+        check_hostile_fleet,
+        dlis_zero_length_records,
+        xlsx_cell_at_xfd1048576,
+    )
+
+    folder = tmp_path / "wells"
+    made = make_wells(tmp_path_factory.mktemp("made") / "wells", corrupt=False)
+    folder.mkdir()
+    for path in made.glob("w1.*"):
+        (folder / path.name).write_bytes(path.read_bytes())
+    (tmp_path / "demo.survey.csv").write_bytes((made.parent / "demo.survey.csv").read_bytes())
+    xlsx_cell_at_xfd1048576(folder / "bomb.xlsx")
+    dlis_zero_length_records(folder / "zero.dlis")
+    result = fleet(folder, "--out", tmp_path / "out", "--scheduler", scheduler)
+    assert result.exit_code == 1, result.output
+    check_hostile_fleet(tmp_path / "out", result.output)
+    assert all(e.get("attempts") == 1 for e in manifest(tmp_path / "out").values())

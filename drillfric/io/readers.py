@@ -108,7 +108,7 @@ def open_source(path: str | Path, *, hdf_key: str = "surface") -> RawSource:
 
         return open_delimited(path)
     return {"parquet": _open_parquet, "las": _open_las, "witsml": _open_witsml,
-            "dlis": _open_dlis, "excel": _open_excel}[fmt](path)
+            "dlis": _open_native, "excel": _open_native}[fmt](path)
 
 
 # --------------------------------------------------------------------------- Parquet
@@ -180,13 +180,8 @@ def _open_witsml(path: Path) -> RawSource:
     return open_witsml(path)
 
 
-def _open_dlis(path: Path) -> RawSource:
-    from drillfric.io.dlis import open_dlis
+def _open_native(path: Path) -> RawSource:
+    """DLIS and Excel: native parsers, run in a contained child process."""
+    from drillfric.io.isolated import open_isolated
 
-    return open_dlis(path)
-
-
-def _open_excel(path: Path) -> RawSource:
-    from drillfric.io.excel import open_excel
-
-    return open_excel(path)
+    return open_isolated(path)

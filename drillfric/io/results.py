@@ -21,7 +21,6 @@ docs/security.md describes the rules; the column schema is :mod:`drillfric.resul
 from __future__ import annotations
 
 import errno
-import fcntl
 import hashlib
 import json
 import math
@@ -38,6 +37,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from drillfric.errors import OutputError
+from drillfric.io.locks import lock_directory
 from drillfric.result import (
     ESTIMATE_COLUMNS,
     SEGMENT_FIELDS,
@@ -172,21 +172,6 @@ def _in_use(entry: Path, tail: str) -> bool:
     return pid.isdigit() and _pid_alive(int(pid))
 
 
-class _Locked:
-    """Exclusive advisory lock on a directory (flock on its descriptor) for a short swap."""
-
-    def __init__(self, folder: Path):
-        self.fd = os.open(folder, os.O_RDONLY)
-
-    def __enter__(self):
-        fcntl.flock(self.fd, fcntl.LOCK_EX)
-        return self
-
-    def __exit__(self, *exc):
-        fcntl.flock(self.fd, fcntl.LOCK_UN)
-        os.close(self.fd)
-
-
 class ResultDirectory:
     """``with ResultDirectory(out, name, well) as tmp:`` write into ``tmp``; on success it
     becomes ``out/name`` atomically, on any exception nothing is left behind.
@@ -218,7 +203,7 @@ class ResultDirectory:
     def __enter__(self) -> Path:
         try:
             if self.out_root.is_dir():
-                with _Locked(self.out_root):  # not while another writer swaps
+                with lock_directory(self.out_root):  # not while another writer swaps
                     self.check_replaceable()
             else:
                 self.check_replaceable()
@@ -262,7 +247,7 @@ class ResultDirectory:
 
     def _swap(self) -> None:
         old = self.out_root / f".{self.dir_name}{_OLD}{_token()}"
-        with _Locked(self.out_root):
+        with lock_directory(self.out_root):
             self.check_replaceable()  # another process may have put something there
             if os.path.lexists(self.final):
                 os.replace(self.final, old)

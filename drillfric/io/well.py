@@ -330,6 +330,45 @@ def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, surv
                 files=files, config=cfg, survey=path_m, source=source, mappings=mappings)
 
 
+def find_well(path, *, config=None, survey=None, name: str | None = None
+              ) -> tuple[WellFiles, str | None]:
+    """A well's files and name from its paths and sidecars alone: no data file is opened
+    (a fleet's parent prepares wells this way; its workers open them, docs/fleet.md).
+
+    Parameters
+    ----------
+    path, config, survey
+        As for :func:`open_well`.
+    name : str, optional
+        The well's name (a manifest's ``well`` column).
+
+    Returns
+    -------
+    (WellFiles, str or None)
+        The files found (a configuration, survey or tubular stored inside the data file is
+        not among them) and the name :func:`open_well` gives the well — None when it may be
+        stored inside the data file (an HDF5 bundle without a TOML configuration, or the
+        numbered folder of a WITSML log, named by the log).
+
+    Raises
+    ------
+    InputError, ConfigError
+        Missing files, an unreadable TOML configuration.
+    """
+    files, raw = _resolve(path, config, survey, peek=False)
+    table = raw.get("well") if isinstance(raw.get("well"), dict) else {}
+    given = name or table.get("name") or None
+    if given is not None:
+        return files, printable(given, 4096) if isinstance(given, str) else None
+    path = Path(path)
+    if path.is_dir() and path.resolve() != files.data.resolve():
+        return files, printable(path.resolve().name, 4096)
+    inside = files.config is None and files.data.suffix.lower() in _HDF5_EXT
+    if inside or (files.data.is_dir() and files.data.resolve().name.isdigit()):
+        return files, None
+    return files, printable(default_name(path, files.data), 4096)
+
+
 def open_config(config, *, survey=None, overrides=None
                 ) -> tuple[Config, Path | None, WellPath | None]:
     """A well configuration on its own (``simulate NAME.toml``, ``td NAME.toml``): the
@@ -424,9 +463,11 @@ def resolve_well(path, *, config=None, survey=None) -> WellFiles:
     return _resolve(path, config, survey)[0]
 
 
-def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
+def _resolve(path, config, survey, peek: bool = True) -> tuple[WellFiles, dict]:
     """The files of a well and its raw configuration mapping, each file read once; a
-    configuration or survey given in memory (a mapping, a table) stands for its file."""
+    configuration or survey given in memory (a mapping, a table) stands for its file
+    (``peek=False``: the data file is not opened, so a configuration, survey or tubular
+    stored inside it is not found)."""
     path = Path(path)
     if not path.exists():
         raise InputError("file not found", file=path, fix="check the path")
@@ -445,16 +486,16 @@ def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
         config_path = _sidecar(data_path, ".toml") if look else config_path
     if config_path is not None and not config_path.is_file():
         raise InputError("config file not found", file=config_path, fix="check the path")
-    if look and config_path is None and _h5_has(data_path, "config"):
+    if look and peek and config_path is None and _h5_has(data_path, "config"):
         config_path = data_path
     if raw is None:
         raw = _raw_config(config_path)
     survey_path = _file(survey) if survey is not None else _find_survey(data_path, config_path,
-                                                                        raw)
+                                                                        raw, peek)
     if survey_path is not None and not survey_path.is_file():
         raise InputError("survey file not found", file=survey_path, fix="check the path")
     return WellFiles(data_path, config_path, survey_path, parts,
-                     _find_string(data_path, raw)), raw
+                     _find_string(data_path, raw, peek)), raw
 
 
 def _frame_files(config, survey) -> tuple[WellFiles, dict]:
@@ -528,19 +569,20 @@ def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
     return *_data(data_path), well_toml, raw
 
 
-def _find_survey(data_path: Path, config_path: Path | None, raw: dict) -> Path | None:
+def _find_survey(data_path: Path, config_path: Path | None, raw: dict,
+                 peek: bool = True) -> Path | None:
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     if isinstance(named, str) and config_path is not None:
         return config_path.parent / named
     for ext in _SURVEY_EXT:
         if (candidate := _sidecar(data_path, ".survey" + ext)) is not None:
             return candidate
-    if _h5_has(data_path, "survey") or _witsml_has(data_path, "trajectory"):
+    if peek and (_h5_has(data_path, "survey") or _witsml_has(data_path, "trajectory")):
         return data_path
     return None
 
 
-def _find_string(data_path: Path, raw: dict) -> Path | None:
+def _find_string(data_path: Path, raw: dict, peek: bool = True) -> Path | None:
     """The WITSML tubular read as the string when the configuration has no sections:
     ``NAME.tubular.xml`` beside the data (or configuration), else the data file itself when
     it holds a ``<tubular>`` beside its log."""
@@ -548,7 +590,7 @@ def _find_string(data_path: Path, raw: dict) -> Path | None:
     if isinstance(string, dict) and "sections" in string:
         return None
     found = _sidecar(data_path, ".tubular.xml")
-    if found is None and _witsml_has(data_path, "tubular"):
+    if found is None and peek and _witsml_has(data_path, "tubular"):
         found = data_path
     return found
 

@@ -9,7 +9,7 @@ small built-in segment; numba writes the machine code to the per-user cache
 (:mod:`drillfric.kernels.cache`) and the run loads it from there. Subprocesses, not
 multiprocessing: a Dask worker's daemonic process cannot start multiprocessing children.
 
-``python -m drillfric.kernels.warmup PART`` compiles one part ("observer" or "plant").
+``python -m drillfric.runner.warmup PART`` compiles one part ("observer" or "plant").
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def warm_up(tick: Callable[[float], None] | None = None, *, timeout_s: float = 6
     every ``poll_s`` while they work. Returns True when both succeeded (and marks the cache
     warm); False otherwise — the run then compiles what it needs itself."""
     env = dict(os.environ)  # NUMBA_CACHE_DIR as this process has it
-    procs = [subprocess.Popen([sys.executable, "-m", "drillfric.kernels.warmup", part],
+    procs = [subprocess.Popen([sys.executable, "-m", "drillfric.runner.warmup", part],
                               stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL, env=env) for part in PARTS]
     t0 = time.monotonic()
