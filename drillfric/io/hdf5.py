@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.source import RawSource
 
 _CORRUPT_FIX = "re-export or re-copy the file"
 _PICKLED = "refused: the file stores data as Python pickles, which can run code when read"
@@ -172,7 +173,7 @@ def _index_name(info: bytes) -> str | None:
 def open_hdf5(path: Path, key: str):
     """Open the surface table ``key`` of an HDF5 file (a lone table if ``key`` is absent).
 
-    Returns a :class:`drillfric.io.readers.RawSource`.
+    Returns a :class:`drillfric.io.source.RawSource`.
 
     Raises
     ------
@@ -199,8 +200,6 @@ def open_hdf5(path: Path, key: str):
 
 
 def _source(path: Path, name: str, columns, units, rows, reader):
-    from drillfric.io.readers import RawSource
-
     units = dict(units)
     units.update({("source", c): "header" for c in list(units)})
 

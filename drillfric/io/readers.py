@@ -1,4 +1,4 @@
-"""Format readers for rig surface data: Parquet, CSV, HDF5 and LAS 2.0.
+"""Format readers for rig surface data (Parquet, CSV, HDF5, LAS 2.0) and the dispatch by extension.
 
 Each reader opens a file cheaply (schema, header, units; no data) into a :class:`RawSource`
 whose :meth:`RawSource.chunks` yields the raw columns in blocks of rows, so that a large
@@ -13,59 +13,22 @@ Every failure to read becomes an :class:`~drillfric.errors.InputError` naming th
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.source import RawSource
 
 #: Extensions of surface data files, by format.
 FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",
            ".tsv": "csv", ".h5": "hdf5", ".hdf5": "hdf5", ".las": "las", ".xml": "witsml",
            ".dlis": "dlis", ".xlsx": "excel"}
-#: Values meaning "no value" in rig logs (besides empty fields and NaN).
-NULL_VALUES = (-999.25, -9999.0)
 #: LAS index curves that make a log depth-indexed (LAS 2.0 names the depth index DEPT).
 _DEPTH_INDEX = frozenset({"DEPT", "DEPTH", "MD", "DMEA", "TVD"})
 #: Units of a depth index as LAS headers spell them.
 _DEPTH_UNITS = frozenset({"M", "FT", "F", "METER", "METERS", "METRE", "METRES", "FEET"})
-
-
-@dataclass(frozen=True)
-class RawSource:
-    """An opened surface data file: its columns and stated units, data not yet read.
-
-    Attributes
-    ----------
-    path : Path
-    format : str
-        ``"parquet"``, ``"csv"``, ``"hdf5"`` or ``"las"``.
-    columns : list of str
-        Column labels in file order (``"0"``, ``"1"``, … for a headerless CSV).
-    units : dict
-        Units the file states per column, and ``("source", column)`` → where they came
-        from (``"units row"``, ``"header"``) for :func:`drillfric.io.channels.map_channels`.
-    rows : int or None
-        Row count when known without reading the data.
-    depth_index : str or None
-        The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
-    """
-
-    path: Path
-    format: str
-    columns: list[str]
-    units: dict
-    rows: int | None
-    _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
-    depth_index: str | None = None
-
-    def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
-        """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
-        if chunk_rows < 1:
-            raise ValueError("chunk_rows must be positive")
-        yield from self._read(chunk_rows)
 
 
 def data_format(path: Path) -> str:

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.readers import NULL_VALUES
+from drillfric.io.source import NULL_VALUES
 from drillfric.io.text import printable
 
 

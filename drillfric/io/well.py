@@ -49,7 +49,8 @@ from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
-from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
+from drillfric.io.readers import FORMATS, data_format, open_source
+from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
 from drillfric.io.timebase import (
     TimeBase,

@@ -4,7 +4,7 @@ A WITSML file holds one kind of object under a plural root (``logs``, ``trajecto
 ``tubulars``, ``bhaRuns``; a singular root such as ``log`` is accepted too), in the
 namespace ``http://www.witsml.org/schemas/1series`` or none. Three kinds are read:
 
-- **log** → a :class:`~drillfric.io.readers.RawSource` (:func:`open_witsml`): columns are the
+- **log** → a :class:`~drillfric.io.source.RawSource` (:func:`open_witsml`): columns are the
   ``logData/mnemonicList`` names in data order (which may differ from the order of the
   ``logCurveInfo`` elements), units the ``unitList``, values the comma-separated ``data``
   rows; the log's ``nullValue`` (or a curve's own) becomes NaN. A date-time index stays
@@ -39,7 +39,7 @@ from defusedxml.ElementTree import iterparse
 
 from drillfric.errors import InputError
 from drillfric.io.channels import CHANNELS, find_column
-from drillfric.io.readers import RawSource
+from drillfric.io.source import RawSource
 from drillfric.units import conversion_factor, parse_unit, registry
 
 #: Namespace of WITSML 1.x data objects (1.3.1 and 1.4.1 share it).
