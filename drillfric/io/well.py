@@ -49,6 +49,7 @@ from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
+from drillfric.io.hdf5 import members, node_at
 from drillfric.io.readers import FORMATS, data_format, open_source
 from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
@@ -508,7 +509,7 @@ def _h5_has(path: Path, key: str) -> bool:
 
     try:
         with h5py.File(path, "r") as h5:
-            return key in h5
+            return h5.get(key, getlink=True) is not None  # a link is not followed here
     except OSError as exc:
         raise InputError("not a readable HDF5 file (truncated or corrupt)", file=path,
                          fix="re-export or re-copy the file") from exc
@@ -545,7 +546,7 @@ def _h5_config(path: Path) -> dict:
 
     where = f"{path}:/config"
     with h5py.File(path, "r") as h5:
-        node = h5["config"]
+        node = node_at(h5, "config", path)
         if isinstance(node, h5py.Dataset) or "toml" in node.attrs:
             text = node[()] if isinstance(node, h5py.Dataset) else node.attrs["toml"]
             text = text.decode() if isinstance(text, bytes) else str(text)
@@ -554,7 +555,8 @@ def _h5_config(path: Path) -> dict:
             except tomllib.TOMLDecodeError as exc:
                 raise ConfigError(f"not valid TOML ({exc})", file=where) from exc
         raw: dict = {}
-        for group in [node] + [g for g in node.values() if isinstance(g, h5py.Group)]:
+        for group in [node] + [g for g in members(node, path).values()
+                               if isinstance(g, h5py.Group)]:
             prefix = "" if group is node else group.name.rsplit("/", 1)[-1] + "."
             for key, value in group.attrs.items():
                 table, _, name = (prefix + key).rpartition(".")
