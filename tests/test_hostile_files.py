@@ -11,6 +11,7 @@ the secret in no file under ``--out``, and every command done within
 
 from __future__ import annotations
 
+import os
 import re
 import time
 from pathlib import Path
@@ -19,7 +20,7 @@ import h5py
 import numpy as np
 import pytest
 
-from tests.test_hostile_inputs import SECRET, Case, _check, _config
+from tests.test_hostile_inputs import ESC, SECRET, Case, _check, _config, _log
 
 #: Longest a hostile case may take [s] (the corpus's bound for "bounded time").
 SECONDS = 30.0
@@ -150,6 +151,146 @@ def case_h5_gzip_compressed_constant_log_still_reads(root):
 
     path = _h5_log(root / "w.h5", rows=rows, surface_rpm=packed)
     return [Case(["inspect", path], (0,), ("surface_rpm",))]
+
+
+# --------------------------------------------------------------------------- bounded time
+def _las(path: Path, curves: list[str], rows: int = 3, extra: str = "") -> Path:
+    """A LAS 2.0 file with a TIME index and ``curves`` (each 60.0 in every row)."""
+    header = ["~Version", "VERS. 2.0 :", "WRAP. NO :", "~Well", "NULL. -999.25 :", extra,
+              "~Curve", "TIME.s : time"] + [f"{c} : curve" for c in curves] + ["~ASCII"]
+    data = [" ".join([str(r)] + ["60.0"] * len(curves)) for r in range(rows)]
+    path.write_text("\n".join(header + data) + "\n", encoding="utf-8")
+    return path
+
+
+def case_las_declaring_20000_curves(root):
+    """lasio's header parse is quadratic in the curve count: 20 000 curves took > 120 s."""
+    path = _las(root / "w.las", [f"C{k}.m" for k in range(20_000)])
+    return [Case(["inspect", path], (2,), ("holds 20,001 items", "1,000"))]
+
+
+def case_las_header_line_longer_than_the_line_limit(root):
+    path = _las(root / "w.las", ["RPM.rpm"], extra="DESC. " + "x" * (1 << 21) + " :")
+    return [Case(["inspect", path], (2,), ("header line is longer",))]
+
+
+def case_parquet_declaring_1e8_rows_of_one_run(root):
+    """Run-length-encoded nulls: 10⁸ rows in half a megabyte were read for ten seconds
+    (10¹² rows would be read for ever)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    rows = 5_000_000
+    table = pa.table({c: pa.nulls(rows, pa.float64())
+                      for c in ("time_s", "surface_rpm", "surface_torque_Nm")})
+    pq.write_table(table, root / "w.parquet", row_group_size=rows)
+    return [Case(["inspect", root / "w.parquet"], (2,), ("declares 5e+06 rows",
+                                                          "100 rows per byte"))]
+
+
+def case_survey_parquet_declaring_a_million_stations(root):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({c: pa.nulls(1_000_000, pa.float64()) for c in ("md", "inc", "azi")}),
+                   root / "s.parquet")
+    _config(_log(root / "w.csv").with_suffix(".toml"), '[survey]\nfile = "s.parquet"\n')
+    return [Case(["run", "w.csv", "--out", "out"], (2,), ("s.parquet", "1e+06 stations"))]
+
+
+# --------------------------------------------------------------------------- escapes
+BEL = "\x07"
+
+
+def case_escape_in_column_name_in_the_fix_hint(root):
+    """The fix hint of a missing channel quoted a column name raw (ESC, BEL)."""
+    path = root / "w.csv"
+    path.write_text(f"time_s,surface_rpm,torque{ESC}{BEL}\n" + "1,60,3\n" * 50,
+                    encoding="utf-8")
+    return [Case(["inspect", path], (2,), ("surface_torque_Nm not found", "torque?[2J?"))]
+
+
+def case_escape_in_column_that_turns_backwards(root):
+    """logcheck's "turns backwards" message and its fix quoted the column name raw."""
+    path = _log(root / "w.csv", rpm=-60.0,
+                columns=("time_s", f"RPM{ESC}{BEL}", "surface_torque_Nm"))
+    _config(path.with_suffix(".toml"),
+            '[channels]\nsurface_rpm = { column = "RPM\\u001b[2J\\u0007", unit = "rpm" }\n')
+    return [Case(["run", path, "--out", "out"], (2,), ("turns backwards", "RPM?[2J?"))]
+
+
+def case_las_warning_quotes_an_escape_sequence(root):
+    """lasio's own logged warning printed a curve mnemonic raw (an OSC title sequence)."""
+    path = _las(root / "w.las", ["SURFACE_RPM.rpm", "SURFACE_TORQUE.N.m"])
+    text = path.read_text(encoding="utf-8").replace(
+        "~ASCII", f"GHOST{ESC}]0;pwned{BEL}.m : defined, no data\n~ASCII")
+    path.write_text(text, encoding="utf-8")
+    return [Case(["inspect", path], (0, 2), ("LAS reader", "GHOST?[2J]0;PWNED?"))]
+
+
+def case_escape_in_unit_of_a_units_row(root):
+    path = root / "w.csv"
+    path.write_text(f"time_s,surface_rpm,surface_torque\ns,rpm,kN{ESC}m\n" + "1,60,3\n" * 50,
+                    encoding="utf-8")
+    return [Case(["inspect", path], (2,), ("kN?[2Jm",))]
+
+
+def case_infinite_values_give_no_library_warning(root):
+    """±inf in a log printed pandas/numpy RuntimeWarnings with library paths; an infinite
+    sample is now a null value (counted by inspect)."""
+    path = _log(root / "w.csv")
+    text = path.read_text(encoding="utf-8").splitlines()
+    text[100] = "9.9,inf,-inf"
+    text[101] = "10.0,-inf,inf"
+    path.write_text("\n".join(text) + "\n", encoding="utf-8")
+    return [Case(["inspect", path], (0,), ("2 (0.5%)",)),
+            Case(["run", path, "--out", "out"], (0,), ("1 segments",))]
+
+
+# --------------------------------------------------------------------------- true messages
+def case_fifo_as_the_data_file(root):
+    """A FIFO named as data blocked for ever (open waits for a writer)."""
+    os.mkfifo(root / "w.csv")
+    return [Case(["inspect", root / "w.csv"], (2,), ("not a regular file",))]
+
+
+def case_fifo_as_the_config_sidecar(root):
+    _log(root / "w.csv")
+    os.mkfifo(root / "w.toml")
+    return [Case(["run", root / "w.csv", "--out", "out"], (2,), ("w.toml",
+                                                                  "not a regular file"))]
+
+
+def case_device_as_the_survey(root):
+    """--survey /dev/zero said "survey file not found"."""
+    _config(_log(root / "w.csv").with_suffix(".toml"))
+    return [Case(["run", "w.csv", "--survey", "/dev/zero", "--out", "out"], (2,),
+                 ("/dev/zero", "survey file is not a regular file")),
+            Case(["inspect", "w.csv", "--config", "/dev/null"], (2,),
+                 ("config file is not a regular file",))]
+
+
+def case_parquet_with_a_nested_time_column(root):
+    """A valid Parquet whose time column is a list per row was "truncated or corrupt"."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({"time_s": pa.array([[0.0, 1.0]] * 50, pa.list_(pa.float64())),
+                             "surface_rpm": [60.0] * 50, "surface_torque_Nm": [8.0] * 50}),
+                   root / "w.parquet")
+    return [Case(["inspect", root / "w.parquet"], (2,), ("unsupported column type",
+                                                          "'time_s'", "list<"))]
+
+
+def case_huge_bit_depth_in_the_summary_line(root):
+    """A 1e308 bit depth was printed as a 309-digit number in the run's summary line (1e30
+    here: beyond float32, a value cannot be written to tracks.parquet)."""
+    path = _log(root / "w.csv")
+    frame = path.read_text(encoding="utf-8").splitlines()
+    path.write_text("\n".join([frame[0] + ",bit_depth_m"] + [ln + ",1e30" for ln in frame[1:]])
+                    + "\n", encoding="utf-8")
+    _config(path.with_suffix(".toml"))
+    return [Case(["run", path, "--out", "out"], (0,), ("bit 1e+30–1e+30 m",))]
 
 
 CASES = {name[5:]: fn for name, fn in sorted(globals().items()) if name.startswith("case_")}

@@ -49,6 +49,7 @@ from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
+from drillfric.io.files import require_file, special
 from drillfric.io.hdf5 import members, node_at
 from drillfric.io.readers import FORMATS, data_format, open_source
 from drillfric.io.source import NULL_VALUES, RawSource
@@ -218,8 +219,8 @@ class Well:
     def assumed(self) -> list[str]:
         """What was assumed for this well: configuration defaults, the hole without a
         survey, and channel units nothing stated (docs/ingestion.md)."""
-        units = [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — "
-                 "nothing in the file or the config says"
+        units = [f"unit of {m.channel.name} (column {printable(m.column)}): {m.unit}, the "
+                 "default — nothing in the file or the config says"
                  for m in self.mappings.values() if m.source == "default"]
         return self.config.assumed_with(self.survey) + units
 
@@ -314,13 +315,11 @@ def open_config(config, *, survey=None, overrides=None
     -------
     (Config, survey path or None, WellPath or None)
     """
-    path = Path(config)
-    if not path.is_file():
-        raise InputError("config file not found", file=path, fix="check the path")
+    path = require_file(Path(config), "config file")
     raw = read_toml(path)
     survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw)
-    if survey_path is not None and not survey_path.is_file():
-        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    if survey_path is not None:
+        require_file(survey_path, "survey file")
     return (_config(path, raw, None, overrides, _find_string(path, raw)), survey_path,
             _load_survey(survey_path))
 
@@ -415,16 +414,16 @@ def _resolve(path, config, survey) -> tuple[WellFiles, dict]:
     else:
         data_path, parts = _data(path)
         config_path = config_path or _sidecar(data_path, ".toml")
-    if config_path is not None and not config_path.is_file():
-        raise InputError("config file not found", file=config_path, fix="check the path")
+    if config_path is not None:
+        require_file(config_path, "config file")
     if config_path is None and _h5_has(data_path, "config"):
         config_path = data_path
     if raw is None:
         raw = _raw_config(config_path)
     survey_path = Path(survey) if survey is not None else _find_survey(data_path, config_path,
                                                                        raw)
-    if survey_path is not None and not survey_path.is_file():
-        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    if survey_path is not None:
+        require_file(survey_path, "survey file")
     return WellFiles(data_path, config_path, survey_path, parts,
                      _find_string(data_path, raw)), raw
 
@@ -442,14 +441,19 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
 
 def _sidecar(data_path: Path, suffix: str) -> Path | None:
     """``NAME{suffix}`` beside a data file (or the folder or common name of a log's parts)
-    when it exists."""
+    when it exists; one that is a device or a FIFO is refused (never opened, never passed
+    over in silence)."""
     stem = data_path.stem if data_path.is_file() else data_path.name
     candidate = data_path.with_name(stem + suffix)
+    if special(candidate):
+        require_file(candidate, "sidecar")
     return candidate if candidate.is_file() else None
 
 
 def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
     well_toml = folder / "well.toml"
+    if special(well_toml):
+        require_file(well_toml, "well.toml")
     if not well_toml.is_file():
         found = sorted(p.name for p in folder.iterdir() if p.suffix.lower() in FORMATS)
         raise InputError("well directory has no well.toml", file=folder,
@@ -623,12 +627,13 @@ def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mappi
 
 
 def _numeric(values: pd.Series) -> np.ndarray:
-    """A source column as float64 with null markers → NaN (text that is not a number → NaN)."""
+    """A source column as float64 with null markers and ±inf → NaN (text that is not a number
+    → NaN): no sensor reads an infinite speed or torque, so an infinite sample is no value."""
     if pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values):
         out = values.to_numpy(dtype=float, na_value=np.nan).copy()
     else:
         out = _text_numbers(values.astype("string").str.strip())
-    out[np.isin(out, NULL_VALUES)] = np.nan
+    out[np.isin(out, NULL_VALUES) | np.isinf(out)] = np.nan
     return out
 
 
