@@ -282,15 +282,26 @@ def case_parquet_with_a_nested_time_column(root):
                                                           "'time_s'", "list<"))]
 
 
-def case_huge_bit_depth_in_the_summary_line(root):
-    """A 1e308 bit depth was printed as a 309-digit number in the run's summary line (1e30
-    here: beyond float32, a value cannot be written to tracks.parquet)."""
-    path = _log(root / "w.csv")
-    frame = path.read_text(encoding="utf-8").splitlines()
-    path.write_text("\n".join([frame[0] + ",bit_depth_m"] + [ln + ",1e30" for ln in frame[1:]])
+def _with_bit_depth(path: Path, value: str) -> Path:
+    lines = path.read_text(encoding="utf-8").splitlines()
+    path.write_text("\n".join([lines[0] + ",bit_depth_m"] + [f"{ln},{value}" for ln in lines[1:]])
                     + "\n", encoding="utf-8")
     _config(path.with_suffix(".toml"))
+    return path
+
+
+def case_huge_bit_depth_in_the_summary_line(root):
+    """A huge bit depth was printed as a 31-digit number in the run's summary line."""
+    path = _with_bit_depth(_log(root / "w.csv"), "1e30")
     return [Case(["run", path, "--out", "out"], (0,), ("bit 1e+30–1e+30 m",))]
+
+
+def case_bit_depth_1e308_is_no_value(root):
+    """A 1e308 bit depth was printed as a 309-digit number and overflowed into infinities in
+    tracks.parquet (float32); beyond float32's range a sample is no value."""
+    path = _with_bit_depth(_log(root / "w.csv"), "1e308")
+    return [Case(["inspect", path], (0,), ("400 (100.0%)",)),
+            Case(["run", path, "--out", "out"], (0,), ("bit 2500–2500 m",))]
 
 
 CASES = {name[5:]: fn for name, fn in sorted(globals().items()) if name.startswith("case_")}

@@ -627,16 +627,18 @@ def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mappi
 
 
 def _numeric(values: pd.Series) -> np.ndarray:
-    """A source column as float64 with null markers and ±inf → NaN (text that is not a number
-    → NaN): no sensor reads an infinite speed or torque, so an infinite sample is no value."""
+    """A source column as float64 with null markers, ±inf and magnitudes beyond float32 →
+    NaN (text that is not a number → NaN): no rig sensor reads 10³⁹ of anything, and the
+    result files store float32, where such a value would become an infinity."""
     if pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values):
         out = values.to_numpy(dtype=float, na_value=np.nan).copy()
     else:
         out = _text_numbers(values.astype("string").str.strip())
-    out[np.isin(out, NULL_VALUES) | np.isinf(out)] = np.nan
+    out[np.isin(out, NULL_VALUES) | ~(np.abs(out) <= _FLOAT32_MAX)] = np.nan
     return out
 
 
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
 _DECIMAL_COMMA = r"^-?(?:\d{1,3}(?:\.\d{3})+|\d+),\d+$"  # 17.730,5 or 1234,5
 
 
