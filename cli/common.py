@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import logging
 import signal
 import sys
 import time
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 import click
 
 from drillfric.errors import DrillfricError
+from drillfric.io.text import one_line, terminal_text
 
 
 @dataclass
@@ -22,9 +25,12 @@ class RunContext:
 
 
 class UserError(click.ClickException):
-    """A problem the user can fix: one line on stderr, exit code 2."""
+    """A problem the user can fix: one printable line on stderr, exit code 2."""
 
     exit_code = 2
+
+    def __init__(self, message: str):
+        super().__init__(one_line(message))
 
 
 def context() -> RunContext:
@@ -37,12 +43,45 @@ def context() -> RunContext:
 def echo(message: str = "", *, err: bool = False) -> None:
     """Print unless ``--quiet`` (errors always print)."""
     if err or not context().quiet:
-        click.echo(message, err=err)
+        click.echo(terminal_text(message), err=err)
 
 
 def warn(message: str) -> None:
     """A warning line on stderr (shown even with ``--quiet``: warnings matter at night too)."""
-    click.secho(f"warning: {message}", err=True, fg="yellow")
+    click.secho(f"warning: {one_line(message)}", err=True, fg="yellow")
+
+
+def error(message: str) -> None:
+    """An error line on stderr for one well of several (the others carry on)."""
+    click.secho(f"error: {one_line(message)}", err=True, fg="red")
+
+
+class _WarningLines(logging.Handler):
+    """Library log records (lasio, …) as drillfric warning lines."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        warn(f"{record.name}: {record.getMessage()}")
+
+
+@contextmanager
+def library_output():
+    """Warnings of libraries (Python warnings, logged warnings) while a command runs, as
+    drillfric's own one-line, printable warnings: no raw text from a file, no library path
+    (docs/security.md)."""
+    handler = _WarningLines(logging.WARNING)
+    root = logging.getLogger()
+    root.addHandler(handler)
+    try:
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            yield
+    finally:
+        root.removeHandler(handler)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    ours = category.__module__.startswith("drillfric")
+    warn(f"{message}" if ours else f"{category.__name__}: {message}")
 
 
 #: Signals received while a command ran (SIGTERM is turned into KeyboardInterrupt).
@@ -146,8 +185,8 @@ def compile_kernels_once() -> None:
     processes at once (:mod:`drillfric.runner.warmup`), saying what happens and ticking the
     elapsed seconds on a terminal (one line at the start and one at the end without one);
     nothing to do once this installation's kernels are in the per-user cache."""
-    from drillfric.runner import warmup
     from drillfric.kernels.cache import cache_dir
+    from drillfric.runner import warmup
 
     if not warmup.needed():
         return

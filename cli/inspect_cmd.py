@@ -7,6 +7,8 @@ import json
 import click
 import numpy as np
 
+from drillfric.io.text import terminal_text
+
 from .common import unit_system, units_option
 
 #: Channel quantities shown in the display units of ``--units`` (others as stored).
@@ -44,7 +46,7 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
         return
     system = unit_system(units, opened.config)
     text = render_depth_log(summary, system) if opened.depth_indexed else render(summary, system)
-    click.echo(text)  # the result: printed even with --quiet
+    click.echo(terminal_text(text))  # the result: printed even with --quiet
 
 
 def summarize(data) -> dict:

@@ -8,17 +8,24 @@ import click
 
 from drillfric import __version__
 
-from .common import RunContext, catch_sigterm, interrupted_exit_code, user_errors
+from .common import (
+    RunContext,
+    catch_sigterm,
+    interrupted_exit_code,
+    library_output,
+    user_errors,
+)
 
 
 class _Group(click.Group):
-    """Command group whose sub-commands turn library errors into one readable line, and an
-    interruption (Ctrl-C, SIGTERM) into a clean stop with exit code 128 + signal."""
+    """Command group whose sub-commands turn library errors into one readable line, library
+    warnings into drillfric's own warning lines, and an interruption (Ctrl-C, SIGTERM) into
+    a clean stop with exit code 128 + signal."""
 
     def invoke(self, ctx: click.Context):
         catch_sigterm()
         try:
-            with user_errors():
+            with user_errors(), library_output():
                 return super().invoke(ctx)
         except KeyboardInterrupt:
             click.secho("interrupted: nothing half-written was left; run the command again "

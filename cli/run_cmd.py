@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from drillfric.errors import DrillfricError
+from drillfric.io.text import terminal_text
 
 from .common import (
     Quantity,
@@ -14,6 +15,7 @@ from .common import (
     compile_kernels_once,
     context,
     echo,
+    error,
     unit_system,
     warn,
     well_progress,
@@ -47,7 +49,19 @@ def _depths(segments: list[dict], units: str) -> str:
         return ""
     low, high = to_display(min(depths), "length", units), to_display(max(depths), "length",
                                                                        units)
-    return f", bit {low:.0f}–{high:.0f} {display_unit('length', units)}"
+    return f", bit {_whole(low)}–{_whole(high)} {display_unit('length', units)}"
+
+
+def _whole(value: float) -> str:
+    """A depth to the metre or foot, ``.4g`` beyond a million (a 1e308 from a broken log
+    must not print as a 309-digit number).
+
+    Examples
+    --------
+    >>> _whole(2512.4), _whole(1e308)
+    ('2512', '1e+308')
+    """
+    return f"{value:.0f}" if abs(value) < 1e6 else f"{value:.4g}"
 
 
 def _describe(result, units: str = "si") -> str:
@@ -129,7 +143,7 @@ def command(wells, out, config, survey, rate, starts, pdf, report, workers, unit
         except DrillfricError as exc:
             if context().debug or len(wells) == 1:
                 raise
-            click.secho(f"error: {exc.message}", err=True, fg="red")
+            error(exc.message)
             unreadable += 1
             continue
         _print(result, units)
@@ -153,7 +167,7 @@ def _open_all(wells, config, survey, overrides) -> tuple[list, int]:
         except DrillfricError as exc:
             if context().debug or len(wells) == 1:
                 raise
-            click.secho(f"error: {exc.message}", err=True, fg="red")
+            error(exc.message)
             unreadable += 1
     check_distinct([(w.dir_name, str(w.files.data)) for w in opened])
     return opened, unreadable
@@ -173,7 +187,7 @@ def _print(result, units: str | None = None) -> None:
     for note in result.warnings:
         warn(f"{result.well}: {note}")
     system = unit_system(units, result.summary.get("config", {}))
-    click.echo(_describe(result, system))  # the result: printed even with --quiet
+    click.echo(terminal_text(_describe(result, system)))  # printed even with --quiet
     if result.report is not None:
         echo(f"report: {result.report}")
         if (pdf := Path(result.report).with_name("report.pdf")).is_file():
@@ -196,7 +210,7 @@ def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, work
                           fleet_files=False)
     for well in result.wells:
         if well.status == "failed":
-            click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
+            error(f"{well.well}: {well.message}")
         elif well.result_dir is not None:
             for note in (well.summary or {}).get("warnings", []):
                 warn(f"{well.well}: {note}")

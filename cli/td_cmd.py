@@ -15,7 +15,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from drillfric.errors import InputError
+from drillfric.files import require_file
 
 from .common import Quantity, UserError, echo, unit_system, units_option, warn
 
@@ -35,8 +35,7 @@ def _load(target: Path, config: str | None, survey: str | None, overrides: dict)
     from drillfric.io.well import open_config
 
     if target.suffix.lower() == ".toml":
-        if not target.is_file():
-            raise InputError("config file not found", file=target, fix="check the path")
+        require_file(target, "config file")
         cfg, _, path = open_config(Path(config) if config else target, survey=survey,
                                    overrides=overrides)
         return cfg, path

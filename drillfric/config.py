@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from drillfric.errors import ConfigError
+from drillfric.files import require_file
 
 _NUM = (int, float)
 #: Largest physically plausible value of a key by its unit suffix, where the key declares no
@@ -659,8 +660,7 @@ def _check_friction(model: dict, file: str | None) -> None:
 def read_toml(path: str | Path) -> dict:
     """Read a TOML file, turning syntax errors into one-line ConfigErrors."""
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError("config file not found", file=path, fix="check the path")
+    require_file(path, "config file", error=ConfigError)
     try:
         with path.open("rb") as fh:
             return tomllib.load(fh)

@@ -444,7 +444,7 @@ def _tree(root: Path, out: Path) -> dict:
     return seen
 
 
-def _check(case: Case, root: Path) -> None:
+def _check(case: Case, root: Path) -> str:
     out = root / "out"
     cwd = root / case.cwd
     outside = root.parent / f"{root.name}-outside"
@@ -489,6 +489,7 @@ def _check(case: Case, root: Path) -> None:
         summary = json.loads(summaries[0].read_text())
         assert summary["segments"] or summary["warnings"], "silent empty result: " + label
     assert took < 60, f"took {took:.0f} s: {label}"
+    return text
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

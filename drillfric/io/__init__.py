@@ -2,6 +2,7 @@
 
 - :mod:`drillfric.io.channels` — the mnemonic table: which source column is which canonical
   channel, and in which unit.
+- :mod:`drillfric.io.source` — :class:`RawSource`, the opened file every reader returns.
 - :mod:`drillfric.io.readers` — format readers (Parquet, CSV, HDF5, LAS 2.0) yielding raw
   chunks with the units the file states; :mod:`drillfric.io.witsml` (WITSML 1.4.1 logs,
   trajectories, tubulars), :mod:`drillfric.io.dlis` and :mod:`drillfric.io.excel` for

@@ -224,7 +224,7 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     try:
         return float(registry().Quantity(1.0, source).to(channel.unit).magnitude)
     except pint.errors.DimensionalityError as exc:
-        raise InputError(f"unit '{unit}' of {channel.name} is not a {channel.kind} unit",
+        raise InputError(f"unit '{printable(unit)}' of {channel.name} is not a {channel.kind} unit",
                          file=file, fix=f'give a {channel.kind} unit, e.g. {channel.key} = '
                                         f'{{ unit = "{channel.default_unit}" }}') from exc
 
@@ -238,7 +238,7 @@ def _source_unit(unit: str, channel: Channel, file: str | None):
     try:
         return parse_unit(spelled)
     except InputError as exc:
-        raise InputError(f"unknown unit '{unit}' for {channel.name}", file=file,
+        raise InputError(f"unknown unit '{printable(unit)}' for {channel.name}", file=file,
                          fix=f'state it in [channels], e.g. {channel.key} = '
                              f'{{ unit = "{channel.default_unit}" }}') from exc
 
@@ -390,8 +390,8 @@ def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: 
     if configured is not None:
         if stated is not None and not _same_unit(stated, configured, channel, file):
             raise InputError(f"inconsistent unit for {channel.name}: column "
-                             f"'{printable(column)}' says "
-                             f"'{stated}' but [channels] says '{configured}'", file=file,
+                             f"'{printable(column)}' says '{printable(stated)}' but [channels] "
+                             f"says '{printable(configured)}'", file=file,
                              fix=f"remove unit from [channels] {channel.key} or correct it")
         return configured, "config"
     if stated is not None:
@@ -505,7 +505,7 @@ def _missing(channel: Channel, columns: list[str], file_units: dict, config_chan
         example = free[0] if free else "N"
     else:
         pick = suggest_column(channel, columns, file_units, config_channels, used)
-        example = '"NAME"' if pick is None else f'"{pick}"'
+        example = '"NAME"' if pick is None else f'"{printable(pick)}"'
         if pick is not None and (split_unit(pick)[1] or file_units.get(pick)):
             unit = ""  # the file states it
     shown = listing(columns, recognised=bool(out) or example != '"NAME"')

@@ -22,7 +22,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.readers import NULL_VALUES, RawSource
+from drillfric.io.source import NULL_VALUES, RawSource
 
 #: Longest line read [characters] (documented in docs/ingestion.md): rig exports with a few
 #: hundred channels have lines of a few kB.

@@ -24,7 +24,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.channels import CHANNELS, find_column
-from drillfric.io.readers import RawSource
+from drillfric.io.source import RawSource
 from drillfric.units import conversion_factor
 
 _DEPTH_TYPES = frozenset({"BOREHOLE-DEPTH", "VERTICAL-DEPTH"})

@@ -32,7 +32,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.readers import RawSource
+from drillfric.io.source import RawSource
 
 #: Largest uncompressed size a workbook may declare [bytes] (Excel's own limit of
 #: 1 048 576 rows of a rig log's few dozen columns stays well below).

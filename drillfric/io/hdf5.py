@@ -15,6 +15,13 @@ lets either library open an input file. It reads, with h5py:
 - a **pandas "fixed" frame** (``format="fixed"``): plain arrays of names and values; an
   object block (a pickle per value) is refused.
 
+Nothing outside the named file is read (docs/security.md): a dataset whose raw data live in
+another file (*external storage*), a *virtual dataset* (mapped from other files) and an
+*external link* are refused before any data is read, and every node is reached through
+:func:`node_at`, which never follows a link out of the file. A dataset may declare at most
+:data:`MAX_PACKING_RATIO` times the file's size and at most :data:`MAX_DATASET_BYTES`, so a
+4 kB file declaring 10¹² rows of unwritten chunks is refused instead of read for ever.
+
 Every failure is an :class:`~drillfric.errors.InputError` naming the file.
 """
 
@@ -28,11 +35,24 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.source import RawSource
 
 _CORRUPT_FIX = "re-export or re-copy the file"
 _PICKLED = "refused: the file stores data as Python pickles, which can run code when read"
 _PICKLE_FIX = ("export the data as a pandas 'table' (DataFrame.to_hdf(format='table')) with "
                "numeric columns, or as Parquet/CSV")
+
+
+#: Largest ratio of the bytes a dataset declares to the size of the file holding it.
+#: Deflate (gzip, what pandas and h5py compress with) cannot pack more than 1032:1, so a real
+#: compressed log stays below; a 4 kB file declaring 10¹² rows of float64 is 2·10⁹:1.
+MAX_PACKING_RATIO = 2000
+#: Largest size a dataset may declare [bytes]: 1 TiB, a year of 100 Hz samples of 40
+#: float64 channels.
+MAX_DATASET_BYTES = 1 << 40
+#: Deepest chain of soft links followed (HDF5's own limit is 16).
+_MAX_SOFT_LINKS = 16
+_OUTSIDE_FIX = "copy the data into the file itself (drillfric reads only the files it is given)"
 
 
 class UnsafePickle(ValueError):
@@ -172,7 +192,7 @@ def _index_name(info: bytes) -> str | None:
 def open_hdf5(path: Path, key: str):
     """Open the surface table ``key`` of an HDF5 file (a lone table if ``key`` is absent).
 
-    Returns a :class:`drillfric.io.readers.RawSource`.
+    Returns a :class:`drillfric.io.source.RawSource`.
 
     Raises
     ------
@@ -183,8 +203,8 @@ def open_hdf5(path: Path, key: str):
 
     try:
         with h5py.File(path, "r") as h5:
-            node = _surface_node(h5, key, path)
-            name = node.name
+            name = _surface_name(h5, key, path)
+            node = node_at(h5, name, path)
             kind = _attr_text(node.attrs.get("pandas_type"))
             if kind == "frame_table":
                 layout = _pandas_table_layout(node, path)
@@ -199,8 +219,6 @@ def open_hdf5(path: Path, key: str):
 
 
 def _source(path: Path, name: str, columns, units, rows, reader):
-    from drillfric.io.readers import RawSource
-
     units = dict(units)
     units.update({("source", c): "header" for c in list(units)})
 
@@ -209,7 +227,7 @@ def _source(path: Path, name: str, columns, units, rows, reader):
 
         try:
             with h5py.File(path, "r") as h5:
-                node = h5[name]
+                node = node_at(h5, name, path)
                 for start in range(0, rows, chunk_rows):
                     yield reader(node, start, min(start + chunk_rows, rows))
         except (OSError, KeyError) as exc:
@@ -219,15 +237,92 @@ def _source(path: Path, name: str, columns, units, rows, reader):
     return RawSource(path, "hdf5", columns, units, rows, read)
 
 
-def _surface_node(h5, key: str, path: Path):
-    if key in h5:
-        return h5[key]
+def _surface_name(h5, key: str, path: Path) -> str:
+    """Path of the surface table: ``key``, else the lone table of the file."""
+    if h5.get(key, getlink=True) is not None:
+        return key
     tables = [k for k in h5 if k not in {"survey", "config"}]
     if key == "surface" and len(tables) == 1:  # a lone table is the surface data
-        return h5[tables[0]]
+        return tables[0]
     listed = ", ".join("/" + _printable(k) for k in list(h5)[:10]) or "nothing"
-    raise InputError(f"no '/{key}' table in the HDF5 file (it holds: {listed})", file=path,
-                     fix=f"store the surface data under '/{key}'")
+    raise InputError(f"no '/{_printable(key)}' table in the HDF5 file (it holds: {listed})",
+                     file=path, fix=f"store the surface data under '/{_printable(key)}'")
+
+
+# --------------------------------------------------------------------------- staying inside
+def node_at(h5, name: str, path: Path, depth: int = 0):
+    """The group or dataset at ``name`` in the open file ``h5``, reached without leaving it.
+
+    Each step of the path is looked at as a link first: an external (or user-defined) link
+    is refused, a soft link is resolved inside the file (at most :data:`_MAX_SOFT_LINKS`
+    deep), and a dataset is checked by :func:`check_dataset` before it is returned.
+
+    Raises
+    ------
+    InputError
+        A link out of the file, a missing node, or a dataset :func:`check_dataset` refuses.
+    """
+    import h5py
+
+    node = h5["/"]
+    for part in [p for p in name.split("/") if p]:
+        if not isinstance(node, h5py.Group):
+            raise _missing(name, path)
+        link = node.get(part, getlink=True)
+        here = f"{node.name.rstrip('/')}/{part}"
+        if link is None:
+            raise _missing(name, path)
+        if isinstance(link, h5py.SoftLink):
+            if depth >= _MAX_SOFT_LINKS:
+                raise InputError(f"HDF5 soft link '{_printable(here)}' is part of a loop or a "
+                                 f"chain longer than {_MAX_SOFT_LINKS}", file=path,
+                                 fix=_CORRUPT_FIX)
+            target = link.path if link.path.startswith("/") else f"{node.name}/{link.path}"
+            node = node_at(h5, target, path, depth + 1)
+        elif isinstance(link, h5py.HardLink):
+            node = node[part]
+        else:
+            raise InputError(f"refused: HDF5 link '{_printable(here)}' points into another "
+                             "file", file=path, fix=_OUTSIDE_FIX)
+    if isinstance(node, h5py.Dataset):
+        check_dataset(node, path)
+    return node
+
+
+def members(group, path: Path) -> dict:
+    """The members of ``group`` by name, each reached through :func:`node_at`."""
+    return {k: node_at(group.file, f"{group.name.rstrip('/')}/{k}", path) for k in group}
+
+
+def check_dataset(ds, path: Path) -> None:
+    """Refuse a dataset whose data live outside the file or whose declared size is absurd.
+
+    External storage (raw data in another file, e.g. ``/etc/passwd``) and virtual datasets
+    (mapped from other files) would read outside the named file; a declared size above
+    :data:`MAX_PACKING_RATIO` × the file size or :data:`MAX_DATASET_BYTES` would be read
+    (from fill values) for as long as it takes.
+    """
+    where = _printable(ds.name)
+    if ds.external:
+        raise InputError(f"refused: HDF5 dataset '{where}' keeps its data in another file "
+                         "(external storage)", file=path, fix=_OUTSIDE_FIX)
+    if ds.is_virtual:
+        raise InputError(f"refused: HDF5 dataset '{where}' is a virtual dataset (its data "
+                         "are mapped from other files)", file=path, fix=_OUTSIDE_FIX)
+    declared = ds.dtype.itemsize * float(np.prod(ds.shape, dtype=float)) if ds.shape else 0.0
+    limit = min(MAX_PACKING_RATIO * path.stat().st_size, MAX_DATASET_BYTES)
+    if declared > limit:
+        raise InputError(f"refused: HDF5 dataset '{where}' declares {declared:.4g} bytes "
+                         f"({len(ds) if ds.shape else 1:.4g} rows) in a file of "
+                         f"{path.stat().st_size:.4g} bytes (the limit is {MAX_PACKING_RATIO}× "
+                         f"the file size, at most {MAX_DATASET_BYTES / 2**40:.4g} TiB)",
+                         file=path, fix="re-export the data (the file declares more than it "
+                                        "can hold: truncated, or crafted)")
+
+
+def _missing(name: str, path: Path) -> InputError:
+    return InputError(f"HDF5 node '{_printable(name)}' not found", file=path,
+                      fix=_CORRUPT_FIX)
 
 
 # --------------------------------------------------------------------------- layouts
@@ -247,7 +342,8 @@ def _plain_layout(node, path: Path):
     if not isinstance(node, h5py.Group):
         raise InputError(f"HDF5 node '{_printable(node.name)}' is not a table", file=path,
                          fix="store a group of 1-D datasets or a pandas table")
-    datasets = {k: v for k, v in node.items() if isinstance(v, h5py.Dataset) and v.ndim == 1}
+    datasets = {k: v for k, v in members(node, path).items()
+                if isinstance(v, h5py.Dataset) and v.ndim == 1}
     lengths = {len(v) for v in datasets.values()}
     if not datasets or len(lengths) != 1:
         raise InputError(f"HDF5 group '{_printable(node.name)}' needs 1-D datasets of equal "
@@ -259,7 +355,7 @@ def _plain_layout(node, path: Path):
              for k, v in datasets.items()}
 
     def read(group, a, b):
-        return pd.DataFrame({c: _decoded(group[c][a:b]) for c in columns})
+        return pd.DataFrame({c: _decoded(_member(group, c, path)[a:b]) for c in columns})
 
     return columns, {k: u for k, u in units.items() if u}, lengths.pop(), read
 
@@ -267,8 +363,10 @@ def _plain_layout(node, path: Path):
 def _pandas_table_layout(node, path: Path):
     """``DataFrame.to_hdf(format="table")``: fields ``index`` and ``values_block_k`` (or one
     field per data column)."""
-    table = node.get("table")
-    if table is None or not table.dtype.names:
+    import h5py
+
+    table = _member(node, "table", path, required=False)
+    if not isinstance(table, h5py.Dataset) or not table.dtype.names:
         raise InputError("pandas HDF5 table without its 'table' dataset", file=path,
                          fix=_CORRUPT_FIX)
     fields, columns = [], []
@@ -287,7 +385,7 @@ def _pandas_table_layout(node, path: Path):
         columns = [index_name] + columns
 
     def read(group, a, b):
-        block = group["table"][a:b]
+        block = _member(group, "table", path)[a:b]
         out = {}
         if index_name is not None:
             out[index_name] = _as_datetime(block["index"], index_kind)
@@ -304,29 +402,42 @@ def _pandas_table_layout(node, path: Path):
 def _pandas_fixed_layout(node, path: Path, kind: str):
     """``DataFrame.to_hdf(format="fixed")``: ``axis0`` names, ``blockK_items`` and
     ``blockK_values`` arrays; an object block (``VLARRAY`` of pickles) is refused."""
-    if kind != "frame" or "axis0" not in node:
+    import h5py
+
+    if kind != "frame" or _member(node, "axis0", path, required=False) is None:
         raise InputError(f"pandas HDF5 object of type '{_printable(kind)}' is not a table",
                          file=path, fix=_PICKLE_FIX)
     blocks = []
     for k in range(int(node.attrs.get("nblocks", 0))):
-        values = node.get(f"block{k}_values")
-        if values is None or _attr_text(values.attrs.get("CLASS")) != "ARRAY":
+        values = _member(node, f"block{k}_values", path, required=False)
+        if not isinstance(values, h5py.Dataset) or _attr_text(
+                values.attrs.get("CLASS")) != "ARRAY":
             raise InputError(_PICKLED, file=path, fix=_PICKLE_FIX)
         _refuse_objects(path, [values.dtype])
-        names = [_decoded_text(n) for n in node[f"block{k}_items"][()]]
+        names = [_decoded_text(n) for n in _member(node, f"block{k}_items", path)[()]]
         blocks.append((k, names))
-    columns = [_decoded_text(n) for n in node["axis0"][()]]
-    rows = len(node["axis1"])
+    columns = [_decoded_text(n) for n in _member(node, "axis0", path)[()]]
+    rows = len(_member(node, "axis1", path))
 
     def read(group, a, b):
         out = {}
         for k, names in blocks:
-            values = group[f"block{k}_values"][a:b]
+            values = _member(group, f"block{k}_values", path)[a:b]
             for j, name in enumerate(names):
                 out[name] = _decoded(values[:, j])
         return pd.DataFrame({c: out[c] for c in columns if c in out})
 
     return columns, {}, rows, read
+
+
+def _member(group, name: str, path: Path, *, required: bool = True):
+    """``group[name]`` through :func:`node_at` (None when absent and not ``required``)."""
+    import h5py
+
+    if not required and (not isinstance(group, h5py.Group)
+                         or group.get(name, getlink=True) is None):
+        return None
+    return node_at(group.file, f"{group.name.rstrip('/')}/{name}", path)
 
 
 def _block_names(kind, path: Path) -> list[str]:

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.text import printable
 from drillfric.io.well import CLOCK_UNIT
 
 
@@ -65,7 +66,7 @@ class LogCheck:
                 f"max_gap_s = {4 * median:.4g} (a log this slow resolves no stick-slip "
                 "cycle: rotations shorter than a few samples are skipped)")
         clock = time.unit == CLOCK_UNIT
-        raise InputError(f"time column '{time.column}'"
+        raise InputError(f"time column '{printable(time.column)}'"
                          + (" (timestamps)" if clock else "")
                          + f" has samples {median:.4g} s apart: more than "
                            f"segmentation.max_gap_s ({limit:.4g} s), so every sample would "
@@ -79,25 +80,25 @@ class LogCheck:
         file = self.well.files.data
         if self.rows <= 1 and duplicates > 0:
             time = self.well.mappings["time"]
-            raise InputError(f"time column '{time.column}' holds one value for all "
+            raise InputError(f"time column '{printable(time.column)}' holds one value for all "
                              f"{duplicates + self.rows} rows", file=file,
                              fix="map the column that holds the sample times in [channels] "
                                  'time = { column = "..." }')
         for name, count in self.finite.items():
             if self.rows and count == 0:
                 m = self.well.channels[name]
-                raise InputError(f"column '{m.column}' ({name}) holds no numbers in any of "
-                                 f"{self.rows} rows", file=file,
+                raise InputError(f"column '{printable(m.column)}' ({name}) holds no numbers in "
+                                 f"any of {self.rows} rows", file=file,
                                  fix=f"map the column that holds {m.channel.kind} in "
                                      f'[channels] {m.channel.key} = {{ column = "..." }}')
         if self.turning and self.backwards > 0.9 * self.turning:
             m = self.well.channels["surface_rpm"]
-            raise InputError(f"surface speed column '{m.column}' turns backwards in "
+            raise InputError(f"surface speed column '{printable(m.column)}' turns backwards in "
                              f"{100 * self.backwards / self.turning:.0f} % of the turning "
                              f"samples (min {self.rpm_min:.4g} RPM): the log's sign is the "
                              "opposite of drillfric's (forward rotation positive)",
                              file=file, fix=f"negate it: [channels] {m.channel.key} = "
-                                            f'{{ column = "{m.column}", scale = -1 }}')
+                                            f'{{ column = "{printable(m.column)}", scale = -1 }}')
 
     def nothing_found(self, segments: int) -> str | None:
         """Why a run found no rotating segment at all (a warning), or None."""

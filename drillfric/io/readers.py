@@ -1,71 +1,39 @@
-"""Format readers for rig surface data: Parquet, CSV, HDF5 and LAS 2.0.
+"""Format readers for rig surface data (Parquet, CSV, HDF5, LAS 2.0) and the dispatch by extension.
 
 Each reader opens a file cheaply (schema, header, units; no data) into a :class:`RawSource`
 whose :meth:`RawSource.chunks` yields the raw columns in blocks of rows, so that a large
 file never has to be in memory at once: Parquet by record batches (pyarrow), CSV by pandas
 chunks, HDF5 by row slices through h5py only (:mod:`drillfric.io.hdf5`: nothing in a file is
-ever unpickled), LAS as one block (lasio reads LAS files whole). Channel recognition and unit
-conversion happen later (:mod:`drillfric.io.channels`); readers only report the units the
-file itself states.
+ever unpickled), LAS as one block (:mod:`drillfric.io.las`: lasio reads LAS files whole).
+Channel recognition and unit conversion happen later (:mod:`drillfric.io.channels`);
+readers only report the units the file itself states.
 
 Every failure to read becomes an :class:`~drillfric.errors.InputError` naming the file.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.files import require_file
+from drillfric.io.source import RawSource
+from drillfric.io.text import printable
+
+#: Most rows a Parquet file may declare per byte of file: run-length and delta encoding pack
+#: constant and evenly spaced columns to almost nothing, but a real log (a torque column) needs
+#: bytes per row; a 4 kB file declaring 10¹² rows of one run would be read for ever.
+MAX_ROWS_PER_BYTE = 100
+#: Most rows a Parquet file may declare: 2³², over a year of 100 Hz samples.
+MAX_ROWS = 1 << 32
 
 #: Extensions of surface data files, by format.
 FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",
            ".tsv": "csv", ".h5": "hdf5", ".hdf5": "hdf5", ".las": "las", ".xml": "witsml",
            ".dlis": "dlis", ".xlsx": "excel"}
-#: Values meaning "no value" in rig logs (besides empty fields and NaN).
-NULL_VALUES = (-999.25, -9999.0)
-#: LAS index curves that make a log depth-indexed (LAS 2.0 names the depth index DEPT).
-_DEPTH_INDEX = frozenset({"DEPT", "DEPTH", "MD", "DMEA", "TVD"})
-#: Units of a depth index as LAS headers spell them.
-_DEPTH_UNITS = frozenset({"M", "FT", "F", "METER", "METERS", "METRE", "METRES", "FEET"})
-
-
-@dataclass(frozen=True)
-class RawSource:
-    """An opened surface data file: its columns and stated units, data not yet read.
-
-    Attributes
-    ----------
-    path : Path
-    format : str
-        ``"parquet"``, ``"csv"``, ``"hdf5"`` or ``"las"``.
-    columns : list of str
-        Column labels in file order (``"0"``, ``"1"``, … for a headerless CSV).
-    units : dict
-        Units the file states per column, and ``("source", column)`` → where they came
-        from (``"units row"``, ``"header"``) for :func:`drillfric.io.channels.map_channels`.
-    rows : int or None
-        Row count when known without reading the data.
-    depth_index : str or None
-        The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
-    """
-
-    path: Path
-    format: str
-    columns: list[str]
-    units: dict
-    rows: int | None
-    _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
-    depth_index: str | None = None
-
-    def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
-        """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
-        if chunk_rows < 1:
-            raise ValueError("chunk_rows must be positive")
-        yield from self._read(chunk_rows)
 
 
 def data_format(path: Path) -> str:
@@ -95,8 +63,7 @@ def open_source(path: str | Path, *, hdf_key: str = "surface") -> RawSource:
     """
     path = Path(path)
     fmt = data_format(path)
-    if not path.is_file():
-        raise InputError("file not found", file=path, fix="check the path")
+    require_file(path)
     if path.stat().st_size == 0:
         raise InputError("file is empty", file=path, fix="give a file with data rows")
     if fmt == "hdf5":
@@ -123,6 +90,8 @@ def _open_parquet(path: Path) -> RawSource:
         schema = meta.schema_arrow
     except (pa.ArrowException, OSError) as exc:
         raise corrupt from exc
+    _refuse_nested(schema, path)
+    check_rows(meta.metadata.num_rows, path)
     units = {}
     for fld in schema:
         md = fld.metadata or {}
@@ -142,38 +111,41 @@ def _open_parquet(path: Path) -> RawSource:
     return RawSource(path, "parquet", list(schema.names), units, meta.metadata.num_rows, read)
 
 
-# --------------------------------------------------------------------------- LAS
+def check_rows(rows: int, path: Path) -> None:
+    """Refuse a Parquet file declaring more rows than :data:`MAX_ROWS` or
+    :data:`MAX_ROWS_PER_BYTE` × its size (read before any data)."""
+    size = path.stat().st_size
+    if rows > min(MAX_ROWS_PER_BYTE * size, MAX_ROWS):
+        raise InputError(f"refused: the Parquet file declares {rows:.4g} rows in {size:.4g} "
+                         f"bytes (the limit is {MAX_ROWS_PER_BYTE} rows per byte, at most "
+                         f"{MAX_ROWS:.4g} rows)", file=path,
+                         fix="re-export the data (the file declares more than it can hold: "
+                             "crafted, or split it into parts)")
+
+
+def _refuse_nested(schema, path: Path) -> None:
+    """A nested column (list, struct, map, union) holds many values per row: refused with
+    its name and type (not reported as a corrupt file)."""
+    import pyarrow.types as pt
+
+    for fld in schema:
+        kind = fld.type
+        if pt.is_dictionary(kind):
+            kind = kind.value_type
+        if pt.is_nested(kind):
+            raise InputError(f"unsupported column type: column '{printable(fld.name)}' is a "
+                             f"nested Parquet {printable(kind)} (drillfric reads one number, "
+                             "text or timestamp per row and column)", file=path,
+                             fix="flatten the column to one value per row, or drop it")
+
+
+# ------------------------------------------------------------------ LAS, WITSML, DLIS, Excel
 def _open_las(path: Path) -> RawSource:
-    import lasio
+    from drillfric.io.las import open_las
 
-    try:
-        las = lasio.read(str(path), ignore_header_errors=False)
-        frame = las.df().reset_index()
-    except Exception as exc:  # noqa: BLE001 — lasio raises many types for malformed files
-        raise InputError(f"not a readable LAS 2.0 file ({type(exc).__name__}: {exc})",
-                         file=path, fix="check the ~Curve and ~ASCII sections") from exc
-    columns = [c.mnemonic for c in las.curves]
-    frame.columns = columns
-    units = {c.mnemonic: c.unit for c in las.curves if c.unit}
-    units.update({("source", c): "header" for c in list(units)})
-
-    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
-        for start in range(0, len(frame), chunk_rows):
-            yield frame.iloc[start:start + chunk_rows].reset_index(drop=True)
-
-    return RawSource(path, "las", columns, units, len(frame), read,
-                     depth_index=_depth_index(las.curves[0]) if las.curves else None)
+    return open_las(path)
 
 
-def _depth_index(curve) -> str | None:
-    """``"DEPT [M]"`` when a LAS index curve is a depth (by mnemonic or length unit)."""
-    unit = (curve.unit or "").strip().upper()
-    if curve.mnemonic.strip().upper() in _DEPTH_INDEX or unit in _DEPTH_UNITS:
-        return f"{curve.mnemonic} [{curve.unit}]" if curve.unit else curve.mnemonic
-    return None
-
-
-# --------------------------------------------------------------------------- WITSML, DLIS, Excel
 def _open_witsml(path: Path) -> RawSource:
     from drillfric.io.witsml import open_witsml
 

@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.files import require_file
 from drillfric.io.text import listing, printable
 from drillfric.units import conversion_factor
 from drillfric.wellpath import WellPath, minimum_curvature
@@ -59,6 +60,11 @@ _REQUIRED = ("md", "inc", "azi")
 _NULLS = (-999.25, -9999.0, -999.0)
 _TEXT_EXT = {".csv", ".txt", ".tsv", ".dat", ".prn", ".asc"}
 _PARQUET_EXT = {".parquet", ".pq"}
+#: Largest survey file read [bytes]: surveys are read whole; a station every metre of a
+#: 30 km well is about 2 MB of text.
+MAX_SURVEY_BYTES = 64 << 20
+#: Most stations a Parquet survey may declare (a station every metre of a 100 km well).
+MAX_STATIONS = 100_000
 _FIX_NAMES = "name the columns MD, INC, AZI (or md_m, inc_deg, azi_deg)"
 
 
@@ -85,9 +91,9 @@ def read_survey_table(path) -> pd.DataFrame:
         increasing; inclination outside 0–180° or azimuth outside 0–360°.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputError("survey file not found", file=path,
-                         fix="check the path (or the [survey] file key of the config)")
+    require_file(path, "survey file", fix="check the path (or the [survey] file key of the "
+                                          "config)")
+    _check_size(path)
     ext = path.suffix.lower()
     if ext in _PARQUET_EXT:
         names, units, data = _parquet_columns(path)
@@ -105,6 +111,30 @@ def read_survey_table(path) -> pd.DataFrame:
     table = _canonical(names, units, data, path)
     _validate(table, path)
     return table
+
+
+def _check_size(path: Path) -> None:
+    """Refuse a survey file larger than :data:`MAX_SURVEY_BYTES` (read whole) or, for Parquet,
+    declaring more than :data:`MAX_STATIONS` rows (before reading its data)."""
+    size = path.stat().st_size
+    if size > MAX_SURVEY_BYTES:
+        raise InputError(f"survey file of {size / 2**20:.4g} MiB: more than the "
+                         f"{MAX_SURVEY_BYTES / 2**20:.4g} MiB a survey may have", file=path,
+                         fix="check that the file is the survey (MD, inclination, azimuth)")
+    if path.suffix.lower() in _PARQUET_EXT:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        try:
+            rows = pq.ParquetFile(path).metadata.num_rows
+        except (pa.ArrowException, OSError) as exc:
+            raise InputError(f"cannot read Parquet survey ({type(exc).__name__})", file=path,
+                             fix="re-export the survey as Parquet or CSV") from exc
+        if rows > MAX_STATIONS:
+            raise InputError(f"survey file declares {rows:.4g} stations: more than "
+                             f"{MAX_STATIONS:,}", file=path,
+                             fix="check that the file is the survey (MD, inclination, "
+                                 "azimuth)")
 
 
 def read_survey(path, *, tie_in=None) -> WellPath:

@@ -11,6 +11,8 @@ import unicodedata
 
 #: Longest piece of file text quoted in a message [characters].
 QUOTE_LIMIT = 40
+#: Longest line drillfric prints [characters] (an error or warning line).
+LINE_LIMIT = 4000
 
 
 def printable(text, limit: int = QUOTE_LIMIT) -> str:
@@ -27,6 +29,36 @@ def printable(text, limit: int = QUOTE_LIMIT) -> str:
     clean = "".join("?" if unicodedata.category(c) in ("Cc", "Cf", "Cs", "Co", "Cn")
                     else c for c in text)
     return clean if len(clean) <= limit else clean[:limit - 1] + "…"
+
+
+def one_line(text, limit: int = LINE_LIMIT) -> str:
+    """``text`` as one printable line: line breaks and tabs become spaces, every other
+    control or format character ``?`` (:func:`printable`), cut to ``limit``.
+
+    The last filter of every error and warning line drillfric prints (the CLI applies it),
+    whatever the text carries from a file, a configuration or a library.
+
+    Examples
+    --------
+    >>> one_line("bad\\ncolumn\\x1b[2J\\x07")
+    'bad column?[2J?'
+    """
+    return printable(str(text).replace("\r\n", " ").translate(_BLANKS), limit)
+
+
+def terminal_text(text) -> str:
+    """``text`` with its lines kept and everything else that could drive a terminal (ESC,
+    BEL, CR, DEL, …) replaced as :func:`one_line` does; for multi-line output (tables).
+
+    Examples
+    --------
+    >>> terminal_text("a\\x1b[31m\\nb\\r")
+    'a?[31m\\nb '
+    """
+    return "\n".join(one_line(line) for line in str(text).split("\n"))
+
+
+_BLANKS = str.maketrans({"\n": " ", "\r": " ", "\t": " "})
 
 
 def listing(names, *, recognised: bool, limit: int = 12) -> str:

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.readers import NULL_VALUES
+from drillfric.io.source import NULL_VALUES
 from drillfric.io.text import printable
 
 
@@ -98,8 +98,9 @@ def check_plausible_rate(time_s: np.ndarray, *, file=None, column: str = "time")
     rate = nominal_rate_hz(np.asarray(time_s, dtype=float))
     lo, hi = PLAUSIBLE_RATE_HZ
     if np.isfinite(rate) and rate > 0 and not lo <= rate <= hi:
-        raise InputError(f"time column '{column}' gives {rate:.3g} samples per second, not a "
-                         "rig log's (0.008–5000 Hz): probably another unit (Excel days, ms)",
+        raise InputError(f"time column '{printable(column)}' gives {rate:.3g} samples per "
+                         "second, not a rig log's (0.008–5000 Hz): probably another unit "
+                         "(Excel days, ms)",
                          file=file, fix='state it in [channels], e.g. time = { unit = "ms" }, '
                                         "or export the time in seconds")
 
@@ -188,7 +189,7 @@ class TimeTracker:
         numeric = _as_number(values)
         absolute = numeric is None or (bool(self._absolute) and bool(np.isnan(numeric).all()))
         if self._absolute is not None and absolute != self._absolute:
-            raise InputError(f"time column '{self.column}' mixes numbers and timestamps "
+            raise InputError(f"time column '{printable(self.column)}' mixes numbers and timestamps "
                              f"near data row {self._rows_seen + 1}", file=self.file,
                              fix="write every time as seconds or every time as a timestamp")
         self._absolute = absolute
@@ -201,8 +202,8 @@ class TimeTracker:
             return ((stamps - self.origin) / pd.Timedelta(seconds=1)).to_numpy(
                 dtype=float, na_value=np.nan)
         if not np.isfinite(self.factor):
-            raise InputError(f"time column '{self.column}' holds numbers but its unit is not "
-                             "a time unit", file=self.file,
+            raise InputError(f"time column '{printable(self.column)}' holds numbers but its "
+                             "unit is not a time unit", file=self.file,
                              fix='state it in the config: [channels] time = { unit = "s" }')
         seconds = numeric * self.factor
         if self.source_start_s is None and np.isfinite(seconds).any():
@@ -253,7 +254,7 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
         if unread.any():
             return None
     out = out.copy()
-    out[np.isin(out, NULL_VALUES)] = np.nan
+    out[np.isin(out, NULL_VALUES) | np.isinf(out)] = np.nan  # an infinite time is no value
     return out
 
 

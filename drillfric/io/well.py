@@ -53,9 +53,12 @@ import pandas as pd
 
 from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import ConfigError, InputError
+from drillfric.files import require_file, special
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
-from drillfric.io.readers import FORMATS, NULL_VALUES, RawSource, data_format, open_source
+from drillfric.io.hdf5 import members, node_at
+from drillfric.io.readers import FORMATS, data_format, open_source
+from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
 from drillfric.io.timebase import (
     TimeBase,
@@ -232,8 +235,8 @@ class Well:
     def assumed(self) -> list[str]:
         """What was assumed for this well: configuration defaults, the hole without a
         survey, and channel units nothing stated (docs/ingestion.md)."""
-        units = [f"unit of {m.channel.name} (column {m.column}): {m.unit}, the default — "
-                 "nothing in the file or the config says"
+        units = [f"unit of {m.channel.name} (column {printable(m.column)}): {m.unit}, the "
+                 "default — nothing in the file or the config says"
                  for m in self.mappings.values() if m.source == "default"]
         return self.config.assumed_with(self.survey) + units
 
@@ -379,13 +382,11 @@ def open_config(config, *, survey=None, overrides=None
     -------
     (Config, survey path or None, WellPath or None)
     """
-    path = Path(config)
-    if not path.is_file():
-        raise InputError("config file not found", file=path, fix="check the path")
+    path = require_file(Path(config), "config file")
     raw = read_toml(path)
     survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw)
-    if survey_path is not None and not survey_path.is_file():
-        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    if survey_path is not None:
+        require_file(survey_path, "survey file")
     return (_config(path, raw, None, overrides, _find_string(path, raw)), survey_path,
             _load_survey(survey_path))
 
@@ -484,16 +485,16 @@ def _resolve(path, config, survey, peek: bool = True) -> tuple[WellFiles, dict]:
     else:
         data_path, parts = _data(path)
         config_path = _sidecar(data_path, ".toml") if look else config_path
-    if config_path is not None and not config_path.is_file():
-        raise InputError("config file not found", file=config_path, fix="check the path")
+    if config_path is not None:
+        require_file(config_path, "config file")
     if look and peek and config_path is None and _h5_has(data_path, "config"):
         config_path = data_path
     if raw is None:
         raw = _raw_config(config_path)
     survey_path = _file(survey) if survey is not None else _find_survey(data_path, config_path,
                                                                         raw, peek)
-    if survey_path is not None and not survey_path.is_file():
-        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    if survey_path is not None:
+        require_file(survey_path, "survey file")
     return WellFiles(data_path, config_path, survey_path, parts,
                      _find_string(data_path, raw, peek)), raw
 
@@ -502,15 +503,15 @@ def _frame_files(config, survey) -> tuple[WellFiles, dict]:
     """The files of a well whose data is a DataFrame: only those given (a configuration
     file's ``[survey] file`` too), never a sidecar."""
     config_path, raw = _file(config), _mapping(config)
-    if config_path is not None and not config_path.is_file():
-        raise InputError("config file not found", file=config_path, fix="check the path")
+    if config_path is not None:
+        require_file(config_path, "config file")
     if raw is None:
         raw = _raw_config(config_path)
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     survey_path = _file(survey) if survey is not None else (
         config_path.parent / named if isinstance(named, str) and config_path else None)
-    if survey_path is not None and not survey_path.is_file():
-        raise InputError("survey file not found", file=survey_path, fix="check the path")
+    if survey_path is not None:
+        require_file(survey_path, "survey file")
     return WellFiles(FRAME_LABEL, config_path, survey_path, in_memory=True), raw
 
 
@@ -542,14 +543,19 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
 
 def _sidecar(data_path: Path, suffix: str) -> Path | None:
     """``NAME{suffix}`` beside a data file (or the folder or common name of a log's parts)
-    when it exists."""
+    when it exists; one that is a device or a FIFO is refused (never opened, never passed
+    over in silence)."""
     stem = data_path.stem if data_path.is_file() else data_path.name
     candidate = data_path.with_name(stem + suffix)
+    if special(candidate):
+        require_file(candidate, "sidecar")
     return candidate if candidate.is_file() else None
 
 
 def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
     well_toml = folder / "well.toml"
+    if special(well_toml):
+        require_file(well_toml, "well.toml")
     if not well_toml.is_file():
         found = sorted(p.name for p in folder.iterdir() if p.suffix.lower() in FORMATS)
         raise InputError("well directory has no well.toml", file=folder,
@@ -610,7 +616,7 @@ def _h5_has(path: Path, key: str) -> bool:
 
     try:
         with h5py.File(path, "r") as h5:
-            return key in h5
+            return h5.get(key, getlink=True) is not None  # a link is not followed here
     except OSError as exc:
         raise InputError("not a readable HDF5 file (truncated or corrupt)", file=path,
                          fix="re-export or re-copy the file") from exc
@@ -647,7 +653,7 @@ def _h5_config(path: Path) -> dict:
 
     where = f"{path}:/config"
     with h5py.File(path, "r") as h5:
-        node = h5["config"]
+        node = node_at(h5, "config", path)
         if isinstance(node, h5py.Dataset) or "toml" in node.attrs:
             text = node[()] if isinstance(node, h5py.Dataset) else node.attrs["toml"]
             text = text.decode() if isinstance(text, bytes) else str(text)
@@ -656,7 +662,8 @@ def _h5_config(path: Path) -> dict:
             except tomllib.TOMLDecodeError as exc:
                 raise ConfigError(f"not valid TOML ({exc})", file=where) from exc
         raw: dict = {}
-        for group in [node] + [g for g in node.values() if isinstance(g, h5py.Group)]:
+        for group in [node] + [g for g in members(node, path).values()
+                               if isinstance(g, h5py.Group)]:
             prefix = "" if group is node else group.name.rsplit("/", 1)[-1] + "."
             for key, value in group.attrs.items():
                 table, _, name = (prefix + key).rpartition(".")
@@ -769,15 +776,18 @@ def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mappi
 
 
 def _numeric(values: pd.Series) -> np.ndarray:
-    """A source column as float64 with null markers → NaN (text that is not a number → NaN)."""
+    """A source column as float64 with null markers, ±inf and magnitudes beyond float32 →
+    NaN (text that is not a number → NaN): no rig sensor reads 10³⁹ of anything, and the
+    result files store float32, where such a value would become an infinity."""
     if pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values):
         out = values.to_numpy(dtype=float, na_value=np.nan).copy()
     else:
         out = _text_numbers(values.astype("string").str.strip())
-    out[np.isin(out, NULL_VALUES)] = np.nan
+    out[np.isin(out, NULL_VALUES) | ~(np.abs(out) <= _FLOAT32_MAX)] = np.nan
     return out
 
 
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
 _DECIMAL_COMMA = r"^-?(?:\d{1,3}(?:\.\d{3})+|\d+),\d+$"  # 17.730,5 or 1234,5
 
 

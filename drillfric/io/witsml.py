@@ -4,7 +4,7 @@ A WITSML file holds one kind of object under a plural root (``logs``, ``trajecto
 ``tubulars``, ``bhaRuns``; a singular root such as ``log`` is accepted too), in the
 namespace ``http://www.witsml.org/schemas/1series`` or none. Three kinds are read:
 
-- **log** → a :class:`~drillfric.io.readers.RawSource` (:func:`open_witsml`): columns are the
+- **log** → a :class:`~drillfric.io.source.RawSource` (:func:`open_witsml`): columns are the
   ``logData/mnemonicList`` names in data order (which may differ from the order of the
   ``logCurveInfo`` elements), units the ``unitList``, values the comma-separated ``data``
   rows; the log's ``nullValue`` (or a curve's own) becomes NaN. A date-time index stays
@@ -39,7 +39,8 @@ from defusedxml.ElementTree import iterparse
 
 from drillfric.errors import InputError
 from drillfric.io.channels import CHANNELS, find_column
-from drillfric.io.readers import RawSource
+from drillfric.io.source import RawSource
+from drillfric.io.text import printable
 from drillfric.units import conversion_factor, parse_unit, registry
 
 #: Namespace of WITSML 1.x data objects (1.3.1 and 1.4.1 share it).
@@ -407,8 +408,8 @@ def _choose(logs: list[LogHeader], log: str | None, path: Path) -> LogHeader:
     for header in logs:
         if log in (header.uid, header.name):
             return header
-    names = ", ".join(f"'{h.name or h.uid}'" for h in logs)
-    raise InputError(f"no log '{log}' in the file (it holds {names})", file=path,
+    names = ", ".join(f"'{printable(h.name or h.uid)}'" for h in logs)
+    raise InputError(f"no log '{printable(log)}' in the file (it holds {names})", file=path,
                      fix="give the uid or name of one of the listed logs")
 
 
@@ -618,8 +619,8 @@ def _merged_units(headers: list[LogHeader], paths: list[Path]) -> tuple[list[str
     for header, path in zip(headers, paths, strict=True):
         for column, unit in _units(header).items():
             if not isinstance(column, tuple) and units.get(column, unit) != unit:
-                raise InputError(f"part gives {column} in '{unit}', an earlier part in "
-                                 f"'{units[column]}'", file=path,
+                raise InputError(f"part gives {printable(column)} in '{printable(unit)}', an "
+                                 f"earlier part in '{printable(units[column])}'", file=path,
                                  fix="re-export the log with one unit per curve")
             units[column] = unit
         columns += [c for c in header.mnemonics if c not in columns]

@@ -233,3 +233,60 @@ def test_hdf5_compound_dataset_and_time_in_ms(tmp_path, frame):
         h5["surface"] = rec
     (tmp_path / "w.toml").write_text('[channels]\ntime = { unit = "ms" }\n')
     _same(load_well(tmp_path / "w.h5").surface, frame)
+
+
+# ------------------------------------------------------------------ limits (docs/security.md)
+def _las_text(curves: int) -> str:
+    names = [f"C{k}" for k in range(curves)]
+    return ("~Version\nVERS. 2.0 :\nWRAP. NO :\n~Well\nNULL. -999.25 :\n~Other\nfree text\n"
+            "~Curve\n# a comment\nTIME.s : time\n" + "".join(f"{n}.rpm : speed\n" for n in names)
+            + "~ASCII\n" + "".join(" ".join([str(r)] + ["60"] * curves) + "\n"
+                                   for r in range(3)))
+
+
+def test_las_header_items_are_counted_per_section_without_comments_and_other(tmp_path):
+    from drillfric.io.las import header_items
+
+    path = tmp_path / "w.las"
+    path.write_text(_las_text(5))
+    assert header_items(path) == {"~V": 2, "~W": 1, "~C": 6}
+
+
+def test_las_section_limit_refuses_one_item_more(tmp_path, monkeypatch):
+    from drillfric.io import las
+
+    monkeypatch.setattr(las, "MAX_SECTION_ITEMS", 6)
+    path = tmp_path / "w.las"
+    path.write_text(_las_text(5))  # TIME + 5 curves: 6 items, at the limit
+    assert open_source(path).columns == ["TIME", "C0", "C1", "C2", "C3", "C4"]
+    path.write_text(_las_text(6))
+    with pytest.raises(InputError, match="~C holds 7 items: more than the 6"):
+        open_source(path)
+
+
+def test_parquet_row_limit_is_per_byte_of_file(tmp_path, monkeypatch):
+    from drillfric.io import readers
+
+    path = tmp_path / "w.parquet"
+    pq.write_table(pa.table({"time_s": np.arange(1000.0)}), path)
+    size = path.stat().st_size
+    monkeypatch.setattr(readers, "MAX_ROWS_PER_BYTE", 1000 / size)  # exactly at the limit
+    assert open_source(path).rows == 1000
+    monkeypatch.setattr(readers, "MAX_ROWS_PER_BYTE", 999 / size)
+    with pytest.raises(InputError, match="declares 1000 rows"):
+        open_source(path)
+
+
+def test_hdf5_packing_limit_is_per_byte_of_file(tmp_path, monkeypatch):
+    from drillfric.io import hdf5
+
+    path = tmp_path / "w.h5"
+    with h5py.File(path, "w") as h5:
+        for c in COLS:
+            h5[f"surface/{c}"] = np.arange(1000.0)
+    ratio = 8000 / path.stat().st_size  # each dataset declares 8000 bytes
+    monkeypatch.setattr(hdf5, "MAX_PACKING_RATIO", ratio)
+    assert open_source(path).rows == 1000
+    monkeypatch.setattr(hdf5, "MAX_PACKING_RATIO", ratio * 0.999)
+    with pytest.raises(InputError, match="declares 8000 bytes"):
+        open_source(path)

@@ -1,0 +1,53 @@
+"""An opened surface data file (:class:`RawSource`) and the rig-log null values.
+
+Every format reader (:mod:`drillfric.io.readers`, :mod:`drillfric.io.delimited`,
+:mod:`drillfric.io.hdf5`, :mod:`drillfric.io.witsml`, :mod:`drillfric.io.dlis`,
+:mod:`drillfric.io.excel`) returns a :class:`RawSource`; the dispatch by extension stays in
+:mod:`drillfric.io.readers`, which imports the format modules, never the other way round.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+#: Values meaning "no value" in rig logs (besides empty fields and NaN).
+NULL_VALUES = (-999.25, -9999.0)
+
+
+@dataclass(frozen=True)
+class RawSource:
+    """An opened surface data file: its columns and stated units, data not yet read.
+
+    Attributes
+    ----------
+    path : Path
+    format : str
+        ``"parquet"``, ``"csv"``, ``"hdf5"`` or ``"las"``.
+    columns : list of str
+        Column labels in file order (``"0"``, ``"1"``, … for a headerless CSV).
+    units : dict
+        Units the file states per column, and ``("source", column)`` → where they came
+        from (``"units row"``, ``"header"``) for :func:`drillfric.io.channels.map_channels`.
+    rows : int or None
+        Row count when known without reading the data.
+    depth_index : str or None
+        The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
+    """
+
+    path: Path
+    format: str
+    columns: list[str]
+    units: dict
+    rows: int | None
+    _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
+    depth_index: str | None = None
+
+    def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
+        """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
+        if chunk_rows < 1:
+            raise ValueError("chunk_rows must be positive")
+        yield from self._read(chunk_rows)
