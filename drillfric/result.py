@@ -60,6 +60,7 @@ class Flag(StrEnum):
     OUTSIDE_TYPICAL_RANGE = "outside_typical_range"
     BIT_TORQUE_IN_FRICTION = "bit_torque_in_friction"
     POOLED = "pooled"
+    RELAXATION_CYCLES = "relaxation_cycles"
 
 
 #: What each flag means (docs/outputs.md).
@@ -86,6 +87,9 @@ FLAG_MEANINGS = {
     Flag.TOO_SHORT_TO_CONVERGE: "less than 90 s of rotation: not converged",
     Flag.OUTSIDE_TYPICAL_RANGE: "μ_k outside 0.05–0.8: check string, survey, torque units",
     Flag.BIT_TORQUE_IN_FRICTION: "on bottom: the bit torque is in the apparent friction",
+    Flag.RELAXATION_CYCLES: "the string stalls while a soft top drive crawls below ω_c, "
+                            "then bursts free (a relaxation cycle): the mean torque is "
+                            "mostly static wind-up, μ_k not converged",
     Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
                  "μ_k agree (summary.json pooled)",
 }

@@ -37,7 +37,7 @@ from drillfric import torsional
 from drillfric.config import default
 from drillfric.drillstring import DrillString
 from drillfric.errors import InputError
-from drillfric.estimation import creep
+from drillfric.estimation import creep, relaxation
 from drillfric.estimation.creep import bridge_loaded_dips, find_creeps, rotating_runs, smooth
 from drillfric.estimation.drive import DriveModel
 from drillfric.estimation.drive import identify as identify_drive
@@ -117,7 +117,7 @@ class BatchResult:
     flags : tuple of str
         e.g. "bistable_regime", "creep_not_grid_converged", "mu_k_not_converged",
         "no_rotation", "rotation_too_short", "regime_mismatch", "creep_fit_at_bound",
-        "creep_rate_too_low", "stick_slip_not_reproduced".
+        "creep_rate_too_low", "stick_slip_not_reproduced", "relaxation_cycles".
     runs : int
         Model runs spent.
     messages : tuple of str
@@ -174,6 +174,9 @@ class BatchDetails:
     drive : DriveModel or None
         The top drive's PI controller identified from the rotation (replayed in closed loop
         when usable, docs/theory.md §6.4).
+    relaxation : RelaxationCycles or None
+        Stalls and bursts of a soft top drive found in the log (μ_k then not converged,
+        :mod:`drillfric.estimation.relaxation`).
     """
 
     cells: int = 0
@@ -190,6 +193,7 @@ class BatchDetails:
     creep_checks: CreepChecks | None = None
     onset_scan: list = field(default_factory=list)
     drive: DriveModel | None = None
+    relaxation: relaxation.RelaxationCycles | None = None
 
 
 @dataclass(frozen=True)
@@ -735,6 +739,11 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         stick_slip = fluct > STICK_SLIP_FLUCTUATION
         details.mean_torque_Nm, details.torque_fluctuation = target, fluct
         details.stick_slip = stick_slip
+        details.relaxation = relaxation.find(data.t, data.w_bar, data.tau_bar, omega_c_rad_s,
+                                             target)
+        if details.relaxation is not None:
+            flags.append("relaxation_cycles")
+            messages.append(details.relaxation.describe(max(data.dt, sample_interval_s or 0)))
         mu_k = _mu_k_stage(model, wins, target, stick_slip, mu_s_seed, cells, details, flags,
                            messages)
     elif any(np.any(data.w_bar[i0:i1 + 1] > omega_c_rad_s)
