@@ -10,7 +10,8 @@ start-up), each 600-s record logged at 100 Hz, 5 Hz, 1 Hz and as 1-s means, and 
 through the whole pipeline (:func:`drillfric.run`). Every segment's μ_k is scored:
 
 - converged: within 5 % of the truth at 100/5 Hz and 1-s means, 10 % at 1 Hz, else FALSE;
-- withheld (not converged): its reason is printed (the segment's flags).
+- withheld (not converged): its reason is printed (the segment's flags);
+- the well's consensus μ_k (converged segments and pools of short ones) likewise.
 
 Zero false claims is the line. Run: ``python benchmarks/validate_soft_drive.py
 [--kp 0.3,1,3] [--ki 30,100,300,2500] [--rates '100 Hz,1 Hz']`` (≈ 10 minutes on one core
@@ -31,8 +32,9 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import drillfric  # noqa: E402
 import validate_trust as trust  # noqa: E402
+
+import drillfric  # noqa: E402
 from drillfric.config import load_config  # noqa: E402
 from drillfric.drillstring import build_string  # noqa: E402
 
@@ -68,6 +70,7 @@ def cycle_text(frame: pd.DataFrame) -> str:
 def status(seg: dict, rate: str) -> tuple[str, str]:
     """(status, reason) of a segment's μ_k against the truth (module docstring)."""
     mu = seg["mu_k"]
+    tol = trust.MU_K_TOL[rate]
     if mu is None:
         return "withheld", "no μ_k: " + (seg["message"] or "")[:80]
     tol = trust.MU_K_TOL[rate]
@@ -92,9 +95,14 @@ def run_case(kp: float, ki: float, rates, work: Path, zeta: float) -> list[dict]
         trust.record(frame, rate, name).to_parquet(data, index=False)
         t0 = time.perf_counter()
         well = drillfric.open_well(data, config=est_cfg, survey=folder / "path.survey.csv")
-        segs = [g for g in drillfric.run(well).summary["segments"] if g["status"] == "ok"]
-        for g in segs or [{"mu_k": None, "converged": False, "flags": [], "message":
-                           "no segment estimated"}]:
+        summary = drillfric.run(well).summary
+        segs = [g for g in summary["segments"] if g["status"] == "ok"]
+        pooled = [p["mu_k"] for p in summary["pooled"]]
+        well_row = {"mu_k": summary["mu_k"], "converged": summary["mu_k"] is not None,
+                    "flags": ["well consensus" + (" (pooled)" if pooled else "")],
+                    "message": "no converged segment"}
+        for g in (segs or [{"mu_k": None, "converged": False, "flags": [], "message":
+                            "no segment estimated"}]) + [well_row]:
             st, why = status(g, rate)
             row = {"kp": kp, "ki": ki, "rate": rate, "cycles": cycles, "mu_k": g["mu_k"],
                    "status": st, "reason": why, "s": time.perf_counter() - t0}

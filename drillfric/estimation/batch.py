@@ -739,7 +739,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         stick_slip = fluct > STICK_SLIP_FLUCTUATION
         details.mean_torque_Nm, details.torque_fluctuation = target, fluct
         details.stick_slip = stick_slip
-        details.relaxation = relaxation.find(data.t, data.w_bar, data.tau_bar, omega_c_rad_s,
+        details.relaxation = relaxation.find(data.t, data.speed, data.tau_bar, omega_c_rad_s,
                                              target)
         if details.relaxation is not None:
             flags.append("relaxation_cycles")

@@ -15,8 +15,8 @@ cycle, not μ_k: a model whose stalls last a little longer or shorter than the r
 μ_k by tens of per cent, and replaying the drive does not put its stalls in step (the
 validation saw −15…+35 % at 100 Hz to 1-s means, docs/validation.md). A stall is:
 
-- the 1-s smoothed top-drive speed below ω_c for at least :data:`MIN_STALL_S` (longer than
-  the soft-torque dips of ordinary stick-slip, which the segmentation bridges),
+- the top-drive speed averaged over :data:`STALL_SMOOTH_S` below ω_c for at least
+  :data:`MIN_STALL_S` (longer than the stuck phase of ordinary stick-slip),
 - after the top drive has turned above ω_c in the record (a stall, not a start-up: a creep
   from rest is the same physics, but the fit leaves it out of μ_k),
 - with the top drive still turning (mean speed ≥ the rest threshold) while the torque winds
@@ -30,15 +30,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drillfric.estimation.creep import REST_FRACTION
+from drillfric.estimation.creep import REST_FRACTION, smooth
 
-#: Shortest stall counted [s]: longer than a bridged soft-torque dip (segmentation.dip_max_s,
-#: 10 s) and than any stick-slip period of a string up to ~6 km (4L/c ≈ 7 s).
-MIN_STALL_S = 15.0
+#: Shortest stall counted [s]: as long as the longest bridged soft-torque dip
+#: (segmentation.dip_max_s) and longer than the stick-slip period of a string up to ~6 km
+#: (4L/c ≈ 7 s), whose stuck phase is a part of it.
+MIN_STALL_S = 10.0
 #: Least rise of the smoothed torque over a stall, relative to the mean torque of the
 #: rotation (a stuck string wound from about μ_k to μ_s of its capacity rises by
 #: μ_s/μ_k − 1, > 50 % for μ_s ≥ 1.5 μ_k).
 MIN_WINDUP = 0.25
+#: The speed is averaged over this before the stalls are looked for [s]: the crawl is slow,
+#: and a torsional wave or sensor noise must not split a stall.
+STALL_SMOOTH_S = 3.0
 
 
 @dataclass(frozen=True)
@@ -82,12 +86,13 @@ class RelaxationCycles:
                 "rotation) would make it measurable")
 
 
-def find(time_s, omega_bar_rad_s, torque_bar_Nm, omega_c_rad_s: float,
+def find(time_s, omega_rad_s, torque_bar_Nm, omega_c_rad_s: float,
          mean_torque_Nm: float) -> RelaxationCycles | None:
     """The stalls of a uniform log (module docstring), or None without any.
 
-    ``omega_bar_rad_s`` and ``torque_bar_Nm`` are smoothed over about 1 s;
-    ``mean_torque_Nm`` is the mean torque of the rotation used for μ_k [N·m].
+    ``omega_rad_s`` is the logged top-drive speed, ``torque_bar_Nm`` the string torque
+    smoothed over about 1 s, ``mean_torque_Nm`` the mean torque of the rotation used for
+    μ_k [N·m].
 
     Examples
     --------
@@ -100,15 +105,16 @@ def find(time_s, omega_bar_rad_s, torque_bar_Nm, omega_c_rad_s: float,
     >>> tau = np.where((t >= 40) & (t < 80), 15e3 + 375.0 * (t - 40), 15e3)
     >>> c = find(t, w, tau, 1.0, 16e3)
     >>> c.stalls, c.stall_s, round(c.windup_Nm), round(c.burst_rad_s)
-    (1, 39.5, 14812, 25)
+    (1, 37.0, 13875, 25)
     """
     t = np.asarray(time_s, dtype=float)
-    w = np.asarray(omega_bar_rad_s, dtype=float)
+    w = smooth(np.asarray(omega_rad_s, dtype=float), float(np.median(np.diff(t))),
+               STALL_SMOOTH_S)
     tau = np.asarray(torque_bar_Nm, dtype=float)
     below = np.abs(w) < omega_c_rad_s
     edges = np.flatnonzero(np.diff(np.r_[0, below.astype(np.int8), 0]))
     found = []
-    for i0, i1 in zip(edges[::2], edges[1::2]):  # below ω_c over samples i0 … i1 − 1
+    for i0, i1 in zip(edges[::2], edges[1::2], strict=True):  # below ω_c over samples i0 … i1 − 1
         if i0 == 0 or i1 >= t.size or t[i1 - 1] - t[i0] < MIN_STALL_S:
             continue  # a start-up, the record's end, or a short dip
         windup = float(tau[i1 - 1] - np.min(tau[i0:i1]))
@@ -121,7 +127,7 @@ def find(time_s, omega_bar_rad_s, torque_bar_Nm, omega_c_rad_s: float,
                           float(np.max(np.abs(w[i1:stop])))))
     if not found:
         return None
-    starts, stall, crawl, windup, burst = (np.array(x) for x in zip(*found))
+    starts, stall, crawl, windup, burst = (np.array(x) for x in zip(*found, strict=True))
     return RelaxationCycles(stalls=len(found), stall_s=float(np.median(stall)),
                             crawl_rad_s=float(np.median(crawl)),
                             windup_Nm=float(np.median(windup)), burst_rad_s=float(burst.max()),
