@@ -68,14 +68,14 @@ def cycle_text(frame: pd.DataFrame) -> str:
 
 
 def status(seg: dict, rate: str) -> tuple[str, str]:
-    """(status, reason) of a segment's μ_k against the truth (module docstring)."""
-    mu = seg["mu_k"]
-    tol = trust.MU_K_TOL[rate]
+    """(status, reason) of a segment's μ_k, or of the well's consensus, against the truth
+    (module docstring)."""
+    mu, tol = seg["mu_k"], trust.MU_K_TOL[rate]
     if mu is None:
         return "withheld", "no μ_k: " + (seg["message"] or "")[:80]
-    tol = trust.MU_K_TOL[rate]
     if seg["converged"]:
-        return ("converged" if abs(mu / MU_K - 1.0) <= tol else "FALSE"), ""
+        within = abs(mu / MU_K - 1.0) <= tol
+        return ("converged" if within else "FALSE"), ", ".join(seg["flags"])
     reasons = [f for f in seg["flags"] if f not in ("observer_not_converged",
                                                     "observer_deadlock_averted")]
     return "withheld", ", ".join(reasons) or ", ".join(seg["flags"])
@@ -99,7 +99,8 @@ def run_case(kp: float, ki: float, rates, work: Path, zeta: float) -> list[dict]
         segs = [g for g in summary["segments"] if g["status"] == "ok"]
         pooled = [p["mu_k"] for p in summary["pooled"]]
         well_row = {"mu_k": summary["mu_k"], "converged": summary["mu_k"] is not None,
-                    "flags": ["well consensus" + (" (pooled)" if pooled else "")],
+                    "flags": ["well consensus" + (f" with {len(pooled)} pool(s)" if pooled
+                                                  else "")],
                     "message": "no converged segment"}
         for g in (segs or [{"mu_k": None, "converged": False, "flags": [], "message":
                             "no segment estimated"}]) + [well_row]:
