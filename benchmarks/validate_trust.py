@@ -82,15 +82,18 @@ PLANTS = {
 }
 
 
-def _config(folder: Path, plant: str) -> tuple[Path, Path]:
-    """The simulation config (with the truth) and the estimator's config of a plant."""
-    sim, model, _ = PLANTS[plant]
+def _config(folder: Path, plant: str, spec: tuple | None = None,
+            stand: dict | None = None) -> tuple[Path, Path]:
+    """The simulation config (with the truth) and the estimator's config of a plant (``spec``
+    and ``stand`` default to its :data:`PLANTS` entry and :data:`STAND`)."""
+    sim, model, _ = spec or PLANTS[plant]
     raw = load_config(REPO / "examples" / "demo" / "demo.toml").to_dict()
     raw["well"] = {"name": plant}
     raw["survey"] = {"file": "path.survey.csv"}
     raw["simulate"] = {k: v for k, v in raw["simulate"].items() if v is not None}
     sim = dict(sim)
-    stand = dict(STAND, **{k: sim.pop(k) for k in ("rpm", "creep_hold_s") if k in sim})
+    stand = dict(stand or STAND, **{k: sim.pop(k) for k in ("rpm", "creep_hold_s")
+                                    if k in sim})
     raw["simulate"].update(rate_hz=100.0, cells=2000, seed=7, scenario=None, **sim)
     raw["simulate"].pop("scenario")
     cased = "mu_k_cased" in sim

@@ -18,7 +18,9 @@ from drillfric.result import Flag, Method
 #: Batch flags under which a stick-slip-onset bound on μ_s is not reported (docs/theory.md
 #: §6.4: a bound above the truth is a false claim; prefer none).
 UNRELIABLE_BOUND = frozenset({Flag.REGIME_MISMATCH, Flag.BISTABLE_REGIME,
-                              Flag.STICK_SLIP_NOT_REPRODUCED})
+                              Flag.STICK_SLIP_NOT_REPRODUCED, Flag.RELAXATION_CYCLES})
+#: Batch flags under which a batch μ_k is not converged (docs/batch_refinement.md).
+NOT_CONVERGED = frozenset({Flag.MU_K_NOT_CONVERGED, Flag.RELAXATION_CYCLES})
 #: Friction factors usually seen with steel in mud-filled hole; outside, a segment is flagged
 #: ``outside_typical_range`` (check string, survey, torque units) but not changed.
 TYPICAL_MU = (0.05, 0.8)
@@ -104,7 +106,8 @@ def decide(ev: Evidence) -> Verdict:
 
     1. μ_k is the batch fit's when it has one (``batch``), else the observer consensus
        (``observer``, converged only if the observer says so);
-    2. a batch μ_k is not converged when the fit flags ``mu_k_not_converged``, when batch and
+    2. a batch μ_k is not converged when the fit flags ``mu_k_not_converged`` or
+       ``relaxation_cycles`` (:data:`NOT_CONVERGED`), when batch and
        observer differ by more than :data:`DISAGREEMENT`, or with less than
        :data:`MIN_CONVERGED_ROTATION_S` of rotation;
     3. a μ_s lower bound is withheld on bottom (the bit drives the swings) and under the
@@ -149,6 +152,10 @@ def _shown_bound(ev: Evidence, messages: list) -> float | None:
     if ev.on_bottom:
         messages.append("μ_s lower bound withheld on bottom: the bit drives the torque swings")
         return None
+    if Flag.RELAXATION_CYCLES in ev.batch_flags:
+        messages.append("μ_s lower bound withheld: relaxation cycles (the μ_k the onset scan "
+                        "rests on is not converged)")
+        return None
     if UNRELIABLE_BOUND.intersection(ev.batch_flags):
         messages.append("μ_s lower bound withheld: the model does not reproduce the data's "
                         "stick-slip regime")
@@ -157,7 +164,7 @@ def _shown_bound(ev: Evidence, messages: list) -> float | None:
 
 
 def _batch_converged(ev: Evidence, flags: list, messages: list) -> bool:
-    converged = Flag.MU_K_NOT_CONVERGED not in ev.batch_flags
+    converged = not NOT_CONVERGED.intersection(ev.batch_flags)
     if abs(np.log(ev.batch_mu_k / max(ev.observer_mu_k, 1e-6))) > np.log(DISAGREEMENT):
         converged = False
         flags.append(Flag.ESTIMATORS_DISAGREE)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drillfric.drillstring import DrillString
+from drillfric.estimation import relaxation
 from drillfric.estimation.batch.creep_checks import CreepChecks
 from drillfric.estimation.batch.creep_fit import CreepOutcome, fit_creeps
 from drillfric.estimation.batch.harness import (
@@ -80,6 +81,9 @@ class BatchDetails:
     drive : DriveModel or None
         The top drive's PI controller identified from the rotation (replayed in closed loop
         when usable, docs/theory.md §6.4).
+    relaxation : RelaxationCycles or None
+        Stalls and bursts of a soft top drive found in the log (μ_k then not converged,
+        :mod:`drillfric.estimation.relaxation`).
     """
 
     cells: int = 0
@@ -96,6 +100,7 @@ class BatchDetails:
     creep_checks: CreepChecks | None = None
     onset_scan: list = field(default_factory=list)
     drive: DriveModel | None = None
+    relaxation: relaxation.RelaxationCycles | None = None
 
 
 @dataclass(frozen=True)
@@ -219,8 +224,12 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     messages += notes
     flags: list[Flag] = []
     rotation = _Rotation.of(model, wins)
-    kinetic = None
+    kinetic = cycles = None
     if wins:
+        cycles = relaxation.find(data.t, data.speed, data.tau_bar, omega_c, rotation.target_Nm)
+        if cycles is not None:
+            flags.append(Flag.RELAXATION_CYCLES)
+            messages.append(cycles.describe(max(data.dt, sample_interval_s or 0.0)))
         model.drive = identify_drive(data.t, data.drive, data.motor, [w.used for w in wins])
         if model.drive is not None:
             messages.append(model.drive.describe())
@@ -243,7 +252,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         mu_s_lower_bound=static.bound, mu_s_method=static.method,
         creep_segments=static.creeps, flags=tuple(flags), runs=model.runs,
         messages=tuple(messages),
-        details=_details(model, cells, creeps, rotation, static))
+        details=_details(model, cells, creeps, rotation, static, cycles))
 
 
 @dataclass(frozen=True)
@@ -319,8 +328,8 @@ def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOut
                    onset, tuple(flags), tuple(messages))
 
 
-def _details(model: Model, cells: int, creeps, rotation: _Rotation,
-             static: _Static) -> BatchDetails:
+def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Static,
+             cycles: relaxation.RelaxationCycles | None) -> BatchDetails:
     """The traces of a fit from its stages' outcomes."""
     kinetic, creep = static.kinetic, static.creep
     return BatchDetails(
@@ -333,4 +342,5 @@ def _details(model: Model, cells: int, creeps, rotation: _Rotation,
         creep_fits=[] if creep is None else list(creep.fits),
         creep_grid_move=None if creep is None else creep.grid_move,
         creep_checks=None if creep is None else creep.checks,
-        onset_scan=[] if static.onset is None else static.onset.scan, drive=model.drive)
+        onset_scan=[] if static.onset is None else static.onset.scan, drive=model.drive,
+        relaxation=cycles)
