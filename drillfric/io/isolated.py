@@ -38,7 +38,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.readers import RawSource, data_format
+from drillfric.io.source import RawSource, data_format
 
 #: Readers run in a child process: format → (module, function, what the messages call it).
 READERS = {"excel": ("drillfric.io.excel", "open_excel", "Excel"),

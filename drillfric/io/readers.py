@@ -20,7 +20,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.files import require_file
-from drillfric.io.source import RawSource
+from drillfric.io.source import RawSource, data_format
 from drillfric.io.text import printable
 
 #: Most rows a Parquet file may declare per byte of file: run-length and delta encoding pack
@@ -29,22 +29,6 @@ from drillfric.io.text import printable
 MAX_ROWS_PER_BYTE = 100
 #: Most rows a Parquet file may declare: 2³², over a year of 100 Hz samples.
 MAX_ROWS = 1 << 32
-
-#: Extensions of surface data files, by format.
-FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",
-           ".tsv": "csv", ".h5": "hdf5", ".hdf5": "hdf5", ".las": "las", ".xml": "witsml",
-           ".dlis": "dlis", ".xlsx": "excel"}
-
-
-def data_format(path: Path) -> str:
-    """Format name for a data file's extension, or InputError for an unknown extension."""
-    fmt = FORMATS.get(path.suffix.lower())
-    if fmt is None:
-        known = ", ".join(sorted({e for e in FORMATS}))
-        raise InputError(f"unknown file extension '{path.suffix or '(none)'}'", file=path,
-                         fix=f"give a surface data file ending in one of {known}")
-    return fmt
-
 
 def open_source(path: str | Path, *, hdf_key: str = "surface") -> RawSource:
     """Open a surface data file by its extension.

@@ -2,7 +2,8 @@
 
 Every format reader (:mod:`drillfric.io.readers`, :mod:`drillfric.io.delimited`,
 :mod:`drillfric.io.hdf5`, :mod:`drillfric.io.witsml`, :mod:`drillfric.io.dlis`,
-:mod:`drillfric.io.excel`) returns a :class:`RawSource`; the dispatch by extension stays in
+:mod:`drillfric.io.excel`) returns a :class:`RawSource`. The format table (:data:`FORMATS`,
+:func:`data_format`) is here too; the dispatch by extension stays in
 :mod:`drillfric.io.readers`, which imports the format modules, never the other way round.
 """
 
@@ -13,6 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
+
+from drillfric.errors import InputError
 
 #: Values meaning "no value" in rig logs (besides empty fields and NaN).
 NULL_VALUES = (-999.25, -9999.0)
@@ -51,3 +54,19 @@ class RawSource:
         if chunk_rows < 1:
             raise ValueError("chunk_rows must be positive")
         yield from self._read(chunk_rows)
+
+
+#: Extensions of surface data files, by format.
+FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",
+           ".tsv": "csv", ".h5": "hdf5", ".hdf5": "hdf5", ".las": "las", ".xml": "witsml",
+           ".dlis": "dlis", ".xlsx": "excel"}
+
+
+def data_format(path: Path) -> str:
+    """Format name for a data file's extension, or InputError for an unknown extension."""
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        known = ", ".join(sorted({e for e in FORMATS}))
+        raise InputError(f"unknown file extension '{path.suffix or '(none)'}'", file=path,
+                         fix=f"give a surface data file ending in one of {known}")
+    return fmt

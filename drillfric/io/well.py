@@ -57,8 +57,8 @@ from drillfric.files import require_file, special
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.hdf5 import members, node_at
-from drillfric.io.readers import FORMATS, data_format, open_source
-from drillfric.io.source import NULL_VALUES, RawSource
+from drillfric.io.readers import open_source
+from drillfric.io.source import FORMATS, NULL_VALUES, RawSource, data_format
 from drillfric.io.text import printable
 from drillfric.io.timebase import (
     TimeBase,
