@@ -238,3 +238,45 @@ def test_moves_stream_like_the_whole_log(demo_cfg):
     assert finder.close() == whole
     assert {m.direction for m in whole} == {"pick_up", "slack_off"} and len(whole) == 4
     assert all(abs(m.speed_m_s - 0.3) < 0.01 for m in whole)
+
+
+# --------------------------------------------------------------------------- real log
+def test_dsats_connections(real_data):
+    """The DSATS 1-Hz log (block height, no bit depth, 5–10° hole): the moves are found
+    from the log itself, and no drag-based μ is published — the hook-load check contradicts
+    the assumed string (tests/test_pipeline.py::test_dsats_runs_end_to_end), so every
+    connection is withheld with that reason. Even with the check ignored (diagnostic) the
+    log gives no usable drag log: 2 of its connections have a pick-up/slack-off pair, one of
+    them with the slack-off above the pick-up (withheld: no μ reproduces it), the other
+    μ = 0.04 ± 0.05 (docs/validation.md)."""
+    from drillfric.hookload import PlateauFinder, block_weight
+    from drillfric.io.well import open_well
+    from drillfric.segmentation import SegmentStream
+
+    well = open_well(real_data / "dsats_1hz" / "SampleData1.csv",
+                     config=REPO / "examples" / "dsats_1hz.toml")
+    cfg = well.config
+    stream, plateaus, finder = SegmentStream(cfg), PlateauFinder(cfg), drag.MoveFinder(cfg)
+    for chunk in well.chunks(20_000):
+        plateaus.feed(chunk)
+        stream.feed(chunk)
+        finder.feed(chunk, stream.last_states, stream.last_bit_depth_m)
+    moves = finder.close()
+    assert len(moves) >= 15 and {m.direction for m in moves} == {"pick_up", "slack_off"}
+    block = block_weight(plateaus.close(), pd.DataFrame(columns=["hookload_N",
+                                                                 "bit_depth_m"]), True)
+    hook = {"block_weight_N": block.weight_N, "block_weight_evidence": block.evidence(),
+            "tolerance": 0.1, "string_weight_ratio": None}
+    summary, log = drag.drag_log(moves, finder.too_short, cfg, well.survey,
+                                 hook | {"verdict": "contradicted", "reason": "0.3×"})
+    assert summary["estimated"] == 0 and summary["connections"] >= 10
+    assert log["reason"].str.contains("contradicts the configured string").all()
+    _, diagnostic = drag.drag_log(moves, finder.too_short, cfg, well.survey,
+                                  hook | {"verdict": "consistent"})
+    pairs = diagnostic[diagnostic["pick_up_hookload_N"].notna()
+                       & diagnostic["slack_off_hookload_N"].notna()]
+    assert len(pairs) == 2
+    upside_down = pairs[pairs["slack_off_hookload_N"] > pairs["pick_up_hookload_N"]]
+    assert len(upside_down) == 1 and upside_down["status"].eq("withheld").all()
+    ok = diagnostic[diagnostic["status"] == "ok"]
+    assert (ok["mu_drag_uncertainty"] <= drag.MAX_UNCERTAINTY).all()
