@@ -280,3 +280,33 @@ def test_dsats_connections(real_data):
     assert len(upside_down) == 1 and upside_down["status"].eq("withheld").all()
     ok = diagnostic[diagnostic["status"] == "ok"]
     assert (ok["mu_drag_uncertainty"] <= drag.MAX_UNCERTAINTY).all()
+
+
+# --------------------------------------------------------------------------- report
+def test_report_draws_the_drag_based_log(tmp_path, demo_cfg):
+    """The friction log of report.html and report.pdf has the drag-based μ as its own
+    marker and legend entry, with its uncertainty as bars; withheld connections are not
+    drawn."""
+    from drillfric.report import figures
+    from drillfric.report.data import load_result
+    from drillfric.report.friction import friction_sources
+
+    cfg, path = demo_cfg
+    _run(tmp_path, _connections_log(cfg, path, [2210.0, 2240.0]))
+    result = CliRunner().invoke(cli, ["-q", "report", str(tmp_path / "out" / "demo"),
+                                      "--pdf"])
+    assert result.exit_code == 0, result.output
+    data = load_result(tmp_path / "out" / "demo")
+    assert len(data.drag_log) == 2
+    html = (tmp_path / "out" / "demo" / "report.html").read_text()
+    assert "drag-based" in html and "pick-up/slack-off hook load" in html  # μ is escaped
+    sources = friction_sources(data.segments, drag=data.drag_log)
+    points = sources["points:mu_drag:converged"]
+    assert np.allclose(points["mu_drag"], data.drag_log["mu_drag"])
+    whisker = sources["whisker:mu_drag"]
+    assert np.allclose(whisker["x1"] - whisker["x0"], 2 * data.drag_log["mu_drag_uncertainty"])
+    withheld = data.drag_log.assign(mu_drag=None, status="withheld")
+    assert "points:mu_drag:converged" not in friction_sources(data.segments, drag=withheld)
+    fig = figures.friction_log_figure(data.segments, drag=data.drag_log)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert figures.DRAG_LABEL in labels
