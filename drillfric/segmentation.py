@@ -521,13 +521,14 @@ class Segmenter:
         self._offset = 0  # row index of the first buffered row
         self._next_id = 1
         self.last_states: np.ndarray | None = None  # rig states of the last chunk fed
+        self.last_bit_depth_m: np.ndarray | None = None  # its bit depths (NaN: not known)
 
     def feed(self, chunk: pd.DataFrame) -> list[Segment]:
         """Consume the next rows; return the segments completed by them (maybe none)."""
         if self._carry is None:
             self._carry = _new_carry(chunk, self._cfg)
         states, bit = _classify(chunk, self._cfg, self._carry)
-        self.last_states = states
+        self.last_states, self.last_bit_depth_m = states, bit
         new = {"t": _column(chunk, "time_s"), "states": states, "bit": bit}
         new.update({f"null:{k}": v for k, v in _nulls(chunk).items()})
         self._buffer = {k: np.concatenate((self._buffer[k], v)) if self._buffer else v
@@ -626,6 +627,12 @@ class SegmentStream:
     def last_states(self) -> np.ndarray | None:
         """Rig state codes of the last chunk fed (:data:`RIG_STATES`)."""
         return self._segmenter.last_states
+
+    @property
+    def last_bit_depth_m(self) -> np.ndarray | None:
+        """Bit depth of every row of the last chunk fed [m]: the channel, else reckoned from
+        the block (:func:`classify`); NaN where not known."""
+        return self._segmenter.last_bit_depth_m
 
     def _rows(self, segments: list[Segment]) -> list[tuple[Segment, pd.DataFrame]]:
         out = []

@@ -301,6 +301,10 @@ def test_dsats_runs_end_to_end(real_data, tmp_path):
     assert summary["mu_k"] is None and summary["mu_s"] is None
     assert "hook-load check" in summary["mu_k_reason"]
     assert any("contradicts the configured string" in w for w in summary["warnings"])
+    # nor a drag-based one (issue #22 item 4): the connections are found, all withheld
+    assert summary["drag"]["connections"] >= 10 and summary["drag"]["estimated"] == 0
+    drag_log = pd.read_parquet(out / "drag_log.parquet")
+    assert drag_log["reason"].str.contains("contradicts the configured string").all()
     assert (out / "report.html").stat().st_size > 0
 
 

@@ -9,6 +9,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from drillfric.drag import DRAG_NAMES
 from drillfric.fleet import WellOutcome, summary_frame
 from drillfric.io.results import arrow_schema, write_segments
 from drillfric.io.tracks import TRACK_CHANNELS
@@ -69,7 +70,7 @@ def test_fleet_summary_columns_are_the_schema():
 def test_report_reads_only_columns_the_schema_declares():
     """Every column-like name the report subscripts (unit suffixes, μ names) is a column of a
     result table: a report listing a column the run does not write fails here."""
-    known = set(SEGMENT_FIELDS) | set(ESTIMATE_NAMES) | OTHER_TABLES
+    known = set(SEGMENT_FIELDS) | set(ESTIMATE_NAMES) | OTHER_TABLES | set(DRAG_NAMES)
     known |= {f"{c}_{s}" for c in TRACK_CHANNELS for s in ("min", "max", "mean")}
     pattern = re.compile(r'\["((?:mu_\w+)|(?:\w+_(?:m|s|Nm|N|rpm|Pa|deg|rad|m3_s|N_m|Nm_m)))"\]')
     unknown = {}

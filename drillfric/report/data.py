@@ -45,6 +45,9 @@ class ResultData:
     friction_log : DataFrame or None
         friction_log.parquet: one row per depth window of a depth-indexed log (its measured
         torque, hook load, WOB per window); None for time logs.
+    drag_log : DataFrame or None
+        drag_log.parquet: the drag-based friction per connection (docs/theory.md §2.2);
+        None for depth logs and older results.
     """
 
     result_dir: Path
@@ -54,6 +57,7 @@ class ResultData:
     wellpath: pd.DataFrame | None
     tracks: pd.DataFrame | None = None
     friction_log: pd.DataFrame | None = None
+    drag_log: pd.DataFrame | None = None
 
     @property
     def depth_indexed(self) -> bool:
@@ -151,7 +155,8 @@ def load_result(result_dir: Path) -> ResultData:
                       _optional_parquet(result_dir / "profiles.parquet"),
                       _optional_parquet(result_dir / "wellpath.parquet"),
                       _optional_parquet(result_dir / "tracks.parquet"),
-                      _optional_parquet(result_dir / "friction_log.parquet"))
+                      _optional_parquet(result_dir / "friction_log.parquet"),
+                      _optional_parquet(result_dir / "drag_log.parquet"))
 
 
 def _optional_parquet(path: Path) -> pd.DataFrame | None:

@@ -26,6 +26,10 @@ MU_S_COLOR = "#c0392b"
 #: Colour of apparent (on-bottom) friction factors: the bit torque is in them.
 APPARENT_COLOR = "#d35400"
 TD_COLOR = "#222222"
+#: The drag-based friction factors (pick-up / slack-off hook loads, docs/theory.md §2.2).
+DRAG_COLOR = "#16a085"
+#: Legend of the drag-based points, in the static and the interactive friction log.
+DRAG_LABEL = "drag-based μ (pick-up/slack-off hook load)"
 SEVERITY_COLOR = "#8e44ad"
 _WIDTH_IN = 9.0
 
@@ -157,7 +161,8 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
 
 def friction_log_figure(segments: pd.DataFrame,
                         size: tuple[float, float] = (_WIDTH_IN, 5.5),
-                        units: Units = SI, top_in: float = 0.75) -> Figure:
+                        units: Units = SI, top_in: float = 0.75,
+                        drag: pd.DataFrame | None = None) -> Figure:
     """μ_s and μ_k versus bit depth, one point per segment (stand), with spread bars, and
     the stick-slip severity versus bit depth beside it.
 
@@ -168,6 +173,9 @@ def friction_log_figure(segments: pd.DataFrame,
     is identifiable (docs/theory.md §6); where only a lower bound is known it is drawn as a
     right-pointing bound (▷ with a dotted tail: "at least this"). Crosses: the
     torque-and-drag back-calculated μ (``mu_td``). Bars span the spread across starts.
+    ``drag`` (drag_log.parquet): the drag-based μ of each connection whose μ is given, a
+    green ✚ with its uncertainty as bars and its own legend entry — a second friction log,
+    independent of the torque.
     Segments without an estimate are grey diamonds on the left edge. Markers are not
     clipped at the axes' edges. ``top_in``: room above the axes [in] (a page's headline).
     Right: severity (ω_max − ω_min)/(2 ω_mean) of the
@@ -201,7 +209,8 @@ def friction_log_figure(segments: pd.DataFrame,
     if len(none):
         ax.plot(np.zeros(len(none)), none["depth"], "d", color="#888888",
                 markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")
-    if not ok["mu_k"].notna().any():
+    drawn = _drag_points(ax, drag, units)
+    if not ok["mu_k"].notna().any() and not drawn:
         _note(ax, "No friction factor to draw: no segment was estimated "
                   f"({len(none)} without an estimate).")
         ax_sev.set_axis_off()
@@ -222,6 +231,28 @@ def friction_log_figure(segments: pd.DataFrame,
                     if len(sev) else 1.2)
     ax_sev.grid(True, color="#dddddd", linewidth=0.6)
     return fig
+
+
+def drag_rows(drag: pd.DataFrame | None) -> pd.DataFrame:
+    """The connections of a drag log with a drag-based μ and a bit depth."""
+    if drag is None or "mu_drag" not in drag:
+        return pd.DataFrame(columns=["bit_depth_m", "mu_drag", "mu_drag_uncertainty"])
+    mu = pd.to_numeric(drag["mu_drag"], errors="coerce")
+    return drag[mu.notna() & drag["bit_depth_m"].notna()].assign(mu_drag=mu[mu.notna()])
+
+
+def _drag_points(ax, drag: pd.DataFrame | None, units: Units) -> bool:
+    """Draw the drag-based μ (``drag``: drag_log.parquet); whether any was drawn."""
+    rows = drag_rows(drag)
+    if not len(rows):
+        return False
+    half = pd.to_numeric(rows["mu_drag_uncertainty"], errors="coerce").fillna(0.0)
+    bars = ax.errorbar(rows["mu_drag"].to_numpy(float),
+                       rows["bit_depth_m"].to_numpy(float) * units.factor("length"),
+                       xerr=half.to_numpy(float), fmt="P", color=DRAG_COLOR, ecolor=DRAG_COLOR,
+                       elinewidth=1.0, capsize=2, label=DRAG_LABEL)
+    bars.lines[0].set_clip_on(False)
+    return True
 
 
 def _mu_points(ax, rows: pd.DataFrame, col: str, spread: str, converged: np.ndarray,

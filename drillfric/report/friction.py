@@ -3,8 +3,9 @@
 Marks follow the static friction log (:func:`drillfric.report.figures.friction_log_figure`,
 docs/reports.md): μ_k ● (off bottom), apparent μ ▲ (on bottom: the bit torque is in it, so
 it is not μ_k and gets its own mark and legend entry), μ_s ■ where identified, ▷ μ_s lower
-bound, × the torque-and-drag back-calculation μ_TD (off bottom), grey ◆ segments without an
-estimate; hollow = not converged;
+bound, × the torque-and-drag back-calculation μ_TD (off bottom), green ✚ the drag-based μ
+of the connections (pick-up/slack-off hook loads, docs/theory.md §2.2: a second log,
+independent of the torque), grey ◆ segments without an estimate; hollow = not converged;
 whiskers = spread across observer starts. Beside it the stick-slip severity versus depth.
 Hover names the segment and its numbers. Depths in the report's display units; the μ axis
 names the friction zone (open hole, or effective over the whole string) when the
@@ -17,7 +18,15 @@ import numpy as np
 import pandas as pd
 
 from .display import SI, Units, fmt
-from .figures import APPARENT_COLOR, MU_K_COLOR, MU_S_COLOR, TD_COLOR
+from .figures import (
+    APPARENT_COLOR,
+    DRAG_COLOR,
+    DRAG_LABEL,
+    MU_K_COLOR,
+    MU_S_COLOR,
+    TD_COLOR,
+    drag_rows,
+)
 from .interactive import MIN_WIDTH_PX
 from .render import is_apparent, mu_k_cell, mu_s_text, zone_text
 
@@ -40,7 +49,7 @@ def _source_frame(seg: pd.DataFrame, units: Units) -> pd.DataFrame:
     rows["kind"] = rows["kind"].fillna("—").astype(str).str.replace("_", " ")
     records = rows.to_dict("records")
     rows["mu_k_text"] = [mu_k_cell(r) for r in records]
-    rows["apparent"] = [is_apparent(r) for r in records]
+    rows["apparent"] = np.array([is_apparent(r) for r in records], dtype=bool)
     rows["mu_app"] = rows["mu_k"].where(rows["apparent"])
     rows["mu_s_text"] = [mu_s_text(m, i, b) for m, i, b in
                          zip(rows["mu_s"], rows["mu_s_identifiable"], rows["mu_s_lower_bound"],
@@ -81,7 +90,41 @@ def _span(x0, x1, depth) -> dict[str, np.ndarray]:
 _MARKS = {"mu_k": ("circle", MU_K_COLOR, "μ_k (off bottom)"),
           "mu_app": ("triangle", APPARENT_COLOR, "apparent μ (on bottom, bit torque in it)"),
           "mu_s": ("square", MU_S_COLOR, "μ_s"),
-          "mu_td": ("x", TD_COLOR, "μ from torque and drag")}
+          "mu_td": ("x", TD_COLOR, "μ from torque and drag"),
+          "mu_drag": ("plus", DRAG_COLOR, DRAG_LABEL)}
+
+
+def _drag_tips(units: Units) -> list[tuple[str, str]]:
+    """Hover fields of a drag-based point (a connection of drag_log.parquet)."""
+    return [("drag-based μ", "@mu_drag_text"), ("from", "@source"),
+            ("bit depth", f"@depth{{0.0}} {units.label('length')}"),
+            ("evidence", "@evidence")]
+
+
+def _drag_frame(drag: pd.DataFrame | None, units: Units) -> pd.DataFrame:
+    """The connections with a drag-based μ, with hover texts; ``depth`` in display units."""
+    rows = drag_rows(drag)
+    half = pd.to_numeric(rows["mu_drag_uncertainty"], errors="coerce").fillna(0.0)
+    out = pd.DataFrame({"depth": rows["bit_depth_m"].to_numpy(float) * units.factor("length"),
+                        "mu_drag": rows["mu_drag"].to_numpy(float),
+                        "half": half.to_numpy(float)})
+    out["mu_drag_text"] = [f"{m:.3f} ± {h:.3f}" for m, h in zip(out["mu_drag"], out["half"],
+                                                                   strict=True)]
+    out["source"] = [str(s).replace("_", "-") for s in rows.get("source", [""] * len(rows))]
+    out["evidence"] = [_evidence(r) for r in rows.to_dict("records")]
+    out["converged"] = True
+    return out
+
+
+def _evidence(row: dict) -> str:
+    """Seconds and rows of the pick-up and slack-off a connection rests on."""
+    parts = []
+    for side in ("pick_up", "slack_off"):
+        seconds = row.get(f"{side}_s")
+        if seconds is not None and np.isfinite(seconds):
+            parts.append(f"{side.replace('_', '-')} {seconds:.0f} s "
+                         f"({int(row[f'{side}_rows'])} rows)")
+    return ", ".join(parts)
 
 
 def _add_points(out: dict, frame: pd.DataFrame, col: str, hollow_unconverged: bool = True
@@ -97,14 +140,15 @@ def _add_points(out: dict, frame: pd.DataFrame, col: str, hollow_unconverged: bo
             out[f"points:{col}:{name}"] = _columns(part)
 
 
-def friction_sources(segments: pd.DataFrame, units: Units = SI
-                     ) -> dict[str, dict[str, np.ndarray]]:
+def friction_sources(segments: pd.DataFrame, units: Units = SI,
+                     drag: pd.DataFrame | None = None) -> dict[str, dict[str, np.ndarray]]:
     """The data of every Bokeh source of :func:`friction_plot`, by source name, in drawing
     order (only those with rows): ``whisker:mu_k``, ``whisker:mu_app``, ``whisker:mu_s``
     (spreads), the ``points:…`` of μ_k (off bottom), apparent μ (``mu_app``, on bottom),
     identified μ_s and μ_TD (off bottom), ``bound_tail`` and ``bound`` (μ_s lower bounds),
-    ``none`` (segments without an estimate) and ``severity``. Depths in display
-    ``units``."""
+    ``whisker:mu_drag`` and ``points:mu_drag:converged`` (the drag-based μ of ``drag``,
+    drag_log.parquet), ``none`` (segments without an estimate) and ``severity``. Depths in
+    display ``units``."""
     frame = _source_frame(segments[segments["bit_depth_m"].notna()], units)
     ok = frame[frame["status"] == "ok"]
     off = ok[~ok["apparent"]]
@@ -126,6 +170,13 @@ def friction_sources(segments: pd.DataFrame, units: Units = SI
                                   bound["mu_s_lower_bound"] + 0.08, bound["depth"])
         out["bound"] = _columns(bound)
     _add_points(out, off, "mu_td", hollow_unconverged=False)
+    dragged = _drag_frame(drag, units)
+    if len(dragged):
+        whisk = dragged[dragged["half"] > 0]
+        if len(whisk):
+            out["whisker:mu_drag"] = _span(whisk["mu_drag"] - whisk["half"],
+                                           whisk["mu_drag"] + whisk["half"], whisk["depth"])
+        out["points:mu_drag:converged"] = _columns(dragged)
     none = frame[frame["status"] != "ok"].assign(zero=0.0)
     if len(none):
         out["none"] = _columns(none)
@@ -161,7 +212,7 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
     mu.y_range.flipped = True
     mu.x_range.start = 0.0  # a friction factor is ≥ 0: the axis never runs into negatives
     cds = {name: ColumnDataSource(columns, name=name) for name, columns in sources.items()}
-    renderers = []
+    renderers, drag_renderers = [], []
     for name, source in cds.items():
         kind, _, col = name.partition(":")
         if kind == "whisker":
@@ -171,9 +222,9 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
             col, _, part = col.partition(":")
             marker, color, label = _MARKS[col]
             conv = part == "converged"
-            renderers.append(mu.scatter(
+            (drag_renderers if col == "mu_drag" else renderers).append(mu.scatter(
                 col, "depth", source=source, marker=marker, size=9, line_color=color,
-                fill_color=color if conv else "white",
+                fill_color=color if conv else "white", line_width=2 if col == "mu_drag" else 1,
                 legend_label=label + ("" if conv else " (not converged)")))
         elif kind == "bound_tail":
             mu.segment("x0", "y0", "x1", "y1", source=source, color=MU_S_COLOR,
@@ -188,6 +239,8 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
                                         size=10, color="#888888", fill_color="white",
                                         legend_label="no estimate"))
     mu.add_tools(HoverTool(renderers=renderers, tooltips=_tips(units)))
+    if drag_renderers:
+        mu.add_tools(HoverTool(renderers=drag_renderers, tooltips=_drag_tips(units)))
     mu.legend.location = "bottom_right"
     mu.legend.label_text_font_size = "10px"
     mu.legend.click_policy = "hide"

@@ -411,8 +411,8 @@ def _html(report: Report) -> str:
         tracks_id = embed.add_like(tracks_signature(data.tracks, bins, axis, units),
                                    lambda: tracks_plot(data.tracks, bins, axis, units), bins,
                                    "tracks")
-    if has_friction(data.segments):
-        log = friction_sources(data.segments, units)
+    if has_friction(data.segments) or len(figures.drag_rows(data.drag_log)):
+        log = friction_sources(data.segments, units, data.drag_log)
         friction_id = embed.add_like(friction_signature(data.segments, log, units),
                                      lambda: friction_plot(data.segments, log, units), log,
                                      "friction")
@@ -553,7 +553,8 @@ def _first_page(report: Report, size):
     """Page 1: the headline numbers and the friction log versus depth."""
     lines = headline_lines(report.head)
     top = _HEADLINE_TOP_IN + _HEADLINE_LINE_IN * len(lines) + 0.35
-    fig = figures.friction_log_figure(report.data.segments, size, report.units, top_in=top)
+    fig = figures.friction_log_figure(report.data.segments, size, report.units, top_in=top,
+                                      drag=report.data.drag_log)
     for index, (text, strong) in enumerate(lines):
         fig.text(0.45 / size[0], 1 - (_HEADLINE_TOP_IN + _HEADLINE_LINE_IN * index) / size[1],
                  text, fontsize=11 if strong else 9, va="top", parse_math=False,

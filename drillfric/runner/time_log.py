@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from drillfric.drag import MoveFinder, drag_log
 from drillfric.errors import DrillfricError, InputError
 from drillfric.estimation.chain import SegmentData, SkipSegment, check_segment, estimate_segment
 from drillfric.estimation.consensus import pool_short_segments
@@ -63,6 +64,7 @@ def _stream(well: Well, sink: Sink, rate_hz, progress, chunk_rows, t_wall) -> We
     """Steps 1–4 into ``sink``."""
     well, calibration = calibrate(well, chunk_rows)  # hook-load evidence (docs/theory.md §2.1)
     hook = PlateauFinder(well.config)
+    moves = MoveFinder(well.config)  # pick-ups and slack-offs (docs/theory.md §2.2)
     estimator = SegmentEstimator(well)
     check = LogCheck(well)
     tracker = well.time_tracker()
@@ -88,6 +90,7 @@ def _stream(well: Well, sink: Sink, rate_hz, progress, chunk_rows, t_wall) -> We
         hook.feed(chunk)
         take(stream.feed(chunk))
         tracks.feed(chunk, stream.last_states)
+        moves.feed(chunk, stream.last_states, stream.last_bit_depth_m)
         if progress:
             progress(RunProgress(check.rows, total, len(records)))
     take(stream.close())
@@ -104,8 +107,11 @@ def _stream(well: Well, sink: Sink, rate_hz, progress, chunk_rows, t_wall) -> We
                         wall_s=time.perf_counter() - t_wall,
                         resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
     summary.update(hookload=weighed.summary, mu_k_reason=weighed.mu_k_reason(summary["mu_k"]))
+    summary["drag"], drag_table = drag_log(moves.close(), moves.too_short, well.config,
+                                           well.survey, weighed.summary)
     summary["time_origin_utc"] = iso(tracker.origin)
-    return finish(sink, well, summary, records, tracks=tracks.result())
+    return finish(sink, well, summary, records, tracks=tracks.result(),
+                  tables={"drag_log.parquet": drag_table})
 
 
 def _first_chunk(well: Well, chunk: pd.DataFrame, rate_hz, warnings: list) -> float | None:
