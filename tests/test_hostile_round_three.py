@@ -8,6 +8,7 @@ and the fix, no traceback, nothing written outside ``--out``, nothing unprintabl
 from __future__ import annotations
 
 import json
+import zipfile
 
 import numpy as np
 import pandas as pd
@@ -15,6 +16,7 @@ import pytest
 
 from tests.test_hostile_files import _strict_check
 from tests.test_hostile_inputs import Case, _config, _log
+from tests.test_hostile_round_two import xlsx_cell_at_xfd1048576
 
 
 def _log_with(path, *, header=None, units=None):
@@ -112,6 +114,40 @@ def case_csv_with_100000_columns(root):
             fh.write(f"{t:.1f},60,8000" + ",1" * extra + "\n")
     _config(root / "w.toml")
     return [Case(["inspect", path], (0,), ("rows       40",))]
+
+
+# --------------------------------------------------------------------------- Excel, up front
+def _xlsx_with_sheet(path, edit):
+    """The round-two workbook with its sheet XML changed by ``edit``."""
+    bomb = xlsx_cell_at_xfd1048576(path.with_name("template.xlsx"))
+    with zipfile.ZipFile(bomb) as src, zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            data = src.read(info.filename)
+            if info.filename.endswith("sheet1.xml"):
+                data = edit(data.decode()).encode()
+            dst.writestr(info.filename, data)
+    bomb.unlink()
+    return path
+
+
+_FAR_ROW = '<row r="1048576"><c r="XFD1048576"><v>2</v></c></row>'
+
+
+def case_xlsx_dimension_declaring_the_whole_sheet(root):
+    """<dimension ref="A1:XFD1048576"> on a two-cell sheet: refused from the declaration,
+    in the parent, before any reader child starts."""
+    path = _xlsx_with_sheet(root / "dim.xlsx", lambda t: t.replace(
+        "<sheetData>", '<dimension ref="A1:XFD1048576"/><sheetData>').replace(
+        _FAR_ROW, '<row r="2"><c r="B2"><v>2</v></c></row>'))
+    return [Case(["inspect", path], (2,), ("as its <dimension> declares",))]
+
+
+def case_xlsx_cells_without_references_far_down(root):
+    """Cells without an r attribute follow each other: 40 of them on row 1 048 576 span
+    42 million cells."""
+    path = _xlsx_with_sheet(root / "noref.xlsx", lambda t: t.replace(
+        _FAR_ROW, '<row r="1048576">' + "<c><v>1</v></c>" * 40 + "</row>"))
+    return [Case(["run", path, "--out", "out"], (2,), ("rows 1–1,048,576, columns A–AN",))]
 
 
 CASES = {name[5:]: fn for name, fn in sorted(globals().items()) if name.startswith("case_")}
