@@ -663,14 +663,28 @@ def read_toml(path: str | Path) -> dict:
     require_file(path, "config file", error=ConfigError)
     try:
         with path.open("rb") as fh:
-            return tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"not valid TOML ({exc})", file=path,
-                          fix="check the line it names (quotes around text, = between key "
-                              "and value)") from exc
+            text = fh.read().decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError("not a text file", file=path,
                           fix="save the configuration as UTF-8 TOML text") from exc
+    return parse_toml(text, path)
+
+
+def parse_toml(text: str, where) -> dict:
+    """The tables of TOML ``text``; a syntax error, or arrays and tables nested deeper than
+    Python's parser recurses (``x = [[[[…]]]]`` a hundred thousand deep), is one
+    ConfigError naming ``where``."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"not valid TOML ({exc})", file=where,
+                          fix="check the line it names (quotes around text, = between key "
+                              "and value)") from exc
+    except RecursionError:
+        raise ConfigError("not a configuration drillfric reads (arrays or tables nested too "
+                          "deep to parse)", file=where,
+                          fix="write the configuration's tables and values as "
+                              "docs/configuration.md shows them") from None
 
 
 def config_from_dict(raw: dict, *, file: str | Path | None = None,

@@ -168,12 +168,19 @@ def _read_manifest(path: Path) -> list[WellSpec]:
         raise InputError(f"unreadable manifest ({exc})", file=path,
                          fix="write a CSV/JSON list with columns well, data, config, "
                              "survey") from None
+    except RecursionError:  # json: [[[[…]]]] a hundred thousand deep
+        raise InputError("unreadable manifest (nested too deep)", file=path,
+                         fix="write a CSV/JSON list with columns well, data, config, "
+                             "survey") from None
     if not isinstance(rows, list) or any(not isinstance(r, dict) or not r.get("data")
                                          for r in rows):
         raise InputError("every manifest entry needs a 'data' path", file=path,
                          fix=f"use columns {', '.join(_MANIFEST_COLUMNS)} (data required)")
 
     def where(value) -> Path | None:
+        if value and "\x00" in str(value):  # no path holds NUL: the OS refuses it
+            raise InputError("a manifest path holds a NUL character", file=path,
+                             fix="write each path as plain text")
         return None if not value else (path.parent / str(value)).resolve()
 
     return [WellSpec(where(r["data"]), r.get("well") or None, where(r.get("config")),

@@ -226,16 +226,42 @@ def _candidates(text: str) -> list[str]:
             for spelled in (text.strip(), text.strip().lower())]  # LAS headers are upper case
 
 
+#: Longest unit spelling handed to pint [characters]: real ones (``deg/(100 ft)``,
+#: ``kg.m**2``, ``1/min``) are a few; pint's parser recurses per operator.
+MAX_UNIT_CHARS = 40
+#: A power whose exponent is not one small number (``m**2``, ``s^-1``, ``m**0.5``): pint
+#: computes ``9**9**9`` as an exact integer of 370 million digits (a hang).
+_BIG_POWER = re.compile(r"(\*\*|\^)(?!\s*\(?\s*[-+]?\d{1,2}(\.\d{1,3})?\s*\)?\s*(?:$|[^*^\d.eE]))")
+
+
+def plausible_unit(text: str) -> bool:
+    """Whether ``text`` may be handed to pint: at most :data:`MAX_UNIT_CHARS` characters
+    and every power a small number (a unit from a file is data; pint evaluates numbers).
+
+    Examples
+    --------
+    >>> plausible_unit("kg.m**2"), plausible_unit("deg/(100 ft)"), plausible_unit("s^-1")
+    (True, True, True)
+    >>> plausible_unit("N*m*9**9**9"), plausible_unit("m**99999")
+    (False, False)
+    """
+    return len(text) <= MAX_UNIT_CHARS and not _BIG_POWER.search(text)
+
+
 def _parse(reg, text: str, *, scaled: bool = False):
-    """The units of ``text`` in registry ``reg`` (None when no candidate parses); with
-    ``scaled``, also a scaled unit such as ``deg/(100 ft)``, as a quantity."""
+    """The units of ``text`` in registry ``reg`` (None when no candidate parses, or the
+    spelling is not :func:`plausible_unit`); with ``scaled``, also a scaled unit such as
+    ``deg/(100 ft)``, as a quantity."""
     import pint
 
+    if not plausible_unit(text):
+        return None
     for candidate in _candidates(text):
         try:
             return reg.parse_expression(candidate) if scaled else reg.parse_units(candidate)
         except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError,
-                AttributeError, TypeError, ValueError, AssertionError):  # pint on "#1"
+                AttributeError, TypeError, ValueError, AssertionError,  # pint on "#1"
+                ArithmeticError, RecursionError):  # "N*m/0", "kg*1e308*1e308"
             continue
     return None
 
@@ -426,6 +452,9 @@ def _convert(magnitude: Decimal, spelled: str, expr: str, expected: str, what: s
         target = reg.parse_expression(expr)
         try:
             ratio = (magnitude * source / target).to("dimensionless").magnitude
+        except ArithmeticError:  # decimal Overflow/InvalidOperation: "1e999999 ft*1e308"
+            raise ConfigError(f"{what} is out of range", file=file,
+                              fix=f"give a plain number and unit, e.g. {example}") from None
         except pint.errors.DimensionalityError:
             given = _dimension_name(source)
             raise ConfigError(f"{what} is {given}, not a {expected}", file=file,

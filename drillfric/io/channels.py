@@ -20,6 +20,7 @@ from __future__ import annotations
 import difflib
 import re
 from dataclasses import dataclass
+from functools import lru_cache
 
 from drillfric.errors import InputError
 from drillfric.io.text import listing, printable
@@ -294,7 +295,7 @@ def _rank(column: str, channel: Channel, extra: tuple[str, ...]) -> tuple[tuple,
     """
     if column == channel.name:
         return (3, 0), None
-    names = [normalise(m) for m in extra + channel.mnemonics]
+    names = _normalised(extra + channel.mnemonics)
     base, unit = split_unit(column)
     if normalise(base) in names:
         return (2, -names.index(normalise(base))), unit
@@ -307,6 +308,13 @@ def _rank(column: str, channel: Channel, extra: tuple[str, ...]) -> tuple[tuple,
             return (), None
         return (1, -names.index(head)), words[-1]
     return (), None
+
+
+@lru_cache(maxsize=256)
+def _normalised(mnemonics: tuple[str, ...]) -> list[str]:
+    """:func:`normalise` of each mnemonic, computed once per channel (a file of thousands
+    of columns ranks every column against every channel)."""
+    return [normalise(m) for m in mnemonics]
 
 
 def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | None,

@@ -39,6 +39,11 @@ from drillfric.io.source import RawSource
 MAX_UNPACKED_BYTES = 4 * 1024**3
 #: Largest compression ratio of a member (spreadsheet XML packs 5–50×; zip bombs 1000×).
 MAX_RATIO = 200
+#: Most cells a worksheet may span, from its first to its last filled row and column:
+#: calamine allocates the whole rectangle (32 bytes a cell) before reading a value, so one
+#: cell at ``XFD1048576`` beside ``A1`` asks for 512 GiB. 2²⁵ cells (1 GiB) hold Excel's
+#: 1 048 576 rows of 32 channels.
+MAX_CELLS = 1 << 25
 #: Words in a sheet name that mark the sheet holding the log.
 SHEET_WORDS = ("surface", "log", "data")
 _HEAD_ROWS = 50
@@ -85,6 +90,129 @@ def _check_archive(path: Path) -> None:
                          + (f" with a member packed over {MAX_RATIO}×" if packed_hard else "")
                          + ": refused as a possible zip bomb", file=path,
                          fix="export the sheet as CSV or Parquet")
+
+
+def check_workbook(path: Path) -> None:
+    """Refuse a workbook before any native code reads it: not a zip archive, a zip bomb
+    (:func:`_check_archive`), or a worksheet spanning more than :data:`MAX_CELLS` cells —
+    by its declared ``<dimension ref=…>`` or by the cells it holds (each sheet's XML is
+    streamed through defusedxml, DTDs refused, never unpacked whole).
+
+    Pure Python, so that :mod:`drillfric.io.isolated` runs it in the parent and a hostile
+    workbook costs no reader child (docs/security.md).
+    """
+    _check_archive(path)
+    with zipfile.ZipFile(path) as archive:
+        for member in archive.infolist():
+            if re.fullmatch(r"xl/worksheets/[^/]+\.xml", member.filename):
+                _check_sheet(archive, member, path)
+
+
+def _check_sheet(archive: zipfile.ZipFile, member: zipfile.ZipInfo, path: Path) -> None:
+    """InputError when a worksheet declares or fills more than :data:`MAX_CELLS` cells
+    (the XML streamed in blocks into a parser target: no element tree is built)."""
+    from xml.etree.ElementTree import ParseError
+
+    from defusedxml import DefusedXmlException
+    from defusedxml.ElementTree import DefusedXMLParser
+
+    span = _Span()
+    parser = DefusedXMLParser(target=span, forbid_dtd=True)
+    try:
+        with archive.open(member) as stream:
+            while block := stream.read(1 << 16):
+                parser.feed(block)
+                if span.cells() > MAX_CELLS:
+                    raise _too_big(member, span, path)
+            parser.close()
+    except (ParseError, DefusedXmlException, zipfile.BadZipFile, OSError, ValueError) as exc:
+        raise InputError(f"not a readable Excel workbook (sheet XML {member.filename}: "
+                         f"{type(exc).__name__})", file=path, fix=_FIX) from None
+
+
+def _too_big(member: zipfile.ZipInfo, span: _Span, path: Path) -> InputError:
+    return InputError(f"refused: worksheet {member.filename} spans {span.cells():.3g} cells "
+                      f"({span.shape()}; the limit is {MAX_CELLS:,}): the reader would "
+                      "allocate them all", file=path,
+                      fix="delete stray cells far from the table (Ctrl+End shows the last "
+                          "one) and save again, or export the log as CSV or Parquet")
+
+
+_REF = re.compile(r"\$?([A-Z]{1,3})\$?([0-9]{1,7})")
+
+
+class _Span:
+    """First and last row and column of a worksheet's cells (1-based), as streamed: the
+    target of an XML parser (:meth:`start` is called for every element)."""
+
+    def __init__(self):
+        self.rows: list[int] = []  # [first, last]
+        self.cols: list[int] = []
+        self._row = 0
+        self._col = 0
+        self._declared = 0
+
+    def start(self, tag: str, attrib: dict) -> None:
+        name = tag.rpartition("}")[2]
+        if name == "c":
+            self.cell(attrib.get("r"))
+        elif name == "row":
+            self.row(attrib.get("r"))
+        elif name == "dimension":
+            self.declared(attrib.get("ref", ""))
+
+    def close(self) -> None:
+        return None
+
+    def declared(self, ref: str) -> None:
+        """A ``<dimension ref="A1:XFD1048576">`` (what the writer says the sheet spans)."""
+        corners = [_REF.fullmatch(part) for part in ref.upper().split(":")]
+        if len(corners) == 2 and all(corners):
+            (c0, r0), (c1, r1) = ((_column_number(m[1]), int(m[2])) for m in corners)
+            self._declared = (abs(r1 - r0) + 1) * (abs(c1 - c0) + 1)
+
+    def row(self, ref: str | None) -> None:
+        self._row = int(ref) if ref and ref.isdigit() else self._row + 1
+        self._col = 0
+
+    def cell(self, ref: str | None) -> None:
+        match = _REF.fullmatch(ref or "")
+        if match:
+            self._col, self._row = _column_number(match[1]), int(match[2])
+        else:  # a cell without a reference follows the previous one
+            self._col += 1
+        for bounds, value in ((self.rows, max(self._row, 1)), (self.cols, self._col)):
+            if not bounds:
+                bounds.extend((value, value))
+            bounds[0], bounds[1] = min(bounds[0], value), max(bounds[1], value)
+
+    def cells(self) -> int:
+        filled = ((self.rows[1] - self.rows[0] + 1) * (self.cols[1] - self.cols[0] + 1)
+                  if self.rows else 0)
+        return max(filled, self._declared)
+
+    def shape(self) -> str:
+        filled = self.cells() if self.rows and self.cells() > self._declared else 0
+        if not filled:
+            return "as its <dimension> declares"
+        return (f"rows {self.rows[0]:,}–{self.rows[1]:,}, columns "
+                f"{_letters(self.cols[0])}–{_letters(self.cols[1])}")
+
+
+def _column_number(letters: str) -> int:
+    """1-based column number of ``A``, ``Z``, ``AA`` … ``XFD``."""
+    number = 0
+    for char in letters:
+        number = 26 * number + ord(char) - 64
+    return number
+
+
+def _letters(column: int) -> str:
+    text = ""
+    while column > 0:
+        column, rest = divmod(column - 1, 26)
+        text = chr(65 + rest) + text
+    return text
 
 
 def _workbook(path: Path):

@@ -88,6 +88,10 @@ def open_isolated(path: Path, *, timeout_s: float | None = None) -> RawSource:
     path = Path(path)
     fmt = data_format(path)
     name = READERS[fmt][2]
+    if fmt == "excel":  # what rules the crash out cheaply is checked before any child
+        from drillfric.io.excel import check_workbook
+
+        check_workbook(path)
     limit = time_limit_s(path) if timeout_s is None else timeout_s
     fix = "re-save or re-export the file, or export the log as CSV or Parquet"
     try:

@@ -212,13 +212,14 @@ class TimeTracker:
 
     def _timestamps(self, values: pd.Series) -> pd.Series:
         if pd.api.types.is_datetime64_any_dtype(values):
-            return values.reset_index(drop=True)
+            return self._nanoseconds(values.reset_index(drop=True))
         text = values.astype("string").str.strip()
         for utc in (False, True):  # several UTC offsets (a daylight-saving change): to UTC
             try:
-                return pd.to_datetime(text, format="ISO8601", utc=utc).reset_index(drop=True)
+                stamps = pd.to_datetime(text, format="ISO8601", utc=utc)
             except (ValueError, TypeError):
                 continue
+            return self._nanoseconds(stamps.reset_index(drop=True))
         stamps = pd.to_datetime(text, format="ISO8601", errors="coerce", utc=True)
         bad = np.flatnonzero(stamps.isna().to_numpy() & _present(text))
         row = self._rows_seen + (bad[0] if bad.size else 0) + 1
@@ -227,6 +228,24 @@ class TimeTracker:
                          f"data row "
                          f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
                          fix="write times as seconds or like 2024-05-01T12:00:00")
+
+    def _nanoseconds(self, stamps: pd.Series) -> pd.Series:
+        """``stamps`` at nanosecond resolution, the one times are computed in; a date
+        outside 1677-09-21 … 2262-04-11 (``0001-01-01``, ``9999-12-31``: pandas parses
+        them at a coarser resolution) is an InputError naming its row."""
+        try:
+            return stamps.dt.as_unit("ns")
+        except (OverflowError, ValueError):  # OutOfBoundsDatetime is a ValueError
+            pass
+        low, high = pd.Timestamp.min, pd.Timestamp.max
+        if stamps.dt.tz is not None:
+            low, high = low.tz_localize("UTC"), high.tz_localize("UTC")
+        bad = np.flatnonzero(((stamps < low) | (stamps > high)).to_numpy(dtype=bool))
+        row = self._rows_seen + (int(bad[0]) if bad.size else 0) + 1
+        raise InputError(f"time column '{printable(self.column)}': the timestamp at data row "
+                         f"{row} lies outside the years 1677–2262 drillfric computes in",
+                         file=self.file, fix="check the dates of the time column (a clock "
+                                             "that was never set, a placeholder date)")
 
 
 def holds_timestamps(values: pd.Series) -> bool:

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import tomllib
 import unicodedata
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
@@ -51,7 +50,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from drillfric.config import Config, config_from_dict, read_toml
+from drillfric.config import Config, config_from_dict, parse_toml, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.files import require_file, special
 from drillfric.io import witsml
@@ -656,11 +655,12 @@ def _h5_config(path: Path) -> dict:
         node = node_at(h5, "config", path)
         if isinstance(node, h5py.Dataset) or "toml" in node.attrs:
             text = node[()] if isinstance(node, h5py.Dataset) else node.attrs["toml"]
-            text = text.decode() if isinstance(text, bytes) else str(text)
             try:
-                return tomllib.loads(text)
-            except tomllib.TOMLDecodeError as exc:
-                raise ConfigError(f"not valid TOML ({exc})", file=where) from exc
+                text = text.decode() if isinstance(text, bytes) else str(text)
+            except UnicodeDecodeError:
+                raise ConfigError("not TOML text (not UTF-8)", file=where,
+                                  fix="store the configuration as UTF-8 TOML text") from None
+            return parse_toml(text, where)
         raw: dict = {}
         for group in [node] + [g for g in members(node, path).values()
                                if isinstance(g, h5py.Group)]:
