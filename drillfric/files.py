@@ -29,3 +29,17 @@ def special(path: Path) -> bool:
     """Whether ``path`` exists but is neither a regular file nor a directory (a device, a
     FIFO or a socket): a sidecar there is refused rather than ignored."""
     return path.exists() and not path.is_file() and not path.is_dir()
+
+
+def require_inside(path: Path, folder: Path, what: str, *, fix: str) -> Path:
+    """``path`` when it lies inside ``folder`` once links are resolved; else InputError.
+
+    A file found or named *for* the user — a sidecar beside the data, a file a well's
+    configuration names, a part of a log folder — must not lead out of that folder (a link
+    or ``../`` to ``/etc/passwd`` or to another well's data): drillfric reads only what the
+    user named (docs/security.md). A file elsewhere is given on the command line instead.
+    """
+    if not path.resolve().is_relative_to(folder.resolve()):
+        raise InputError(f"{what} leads outside {folder.name or folder}/ (a link or '..')",
+                         file=path, fix=fix)
+    return path

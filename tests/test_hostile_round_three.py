@@ -150,6 +150,44 @@ def case_xlsx_cells_without_references_far_down(root):
     return [Case(["run", path, "--out", "out"], (2,), ("rows 1–1,048,576, columns A–AN",))]
 
 
+# --------------------------------------------------------------------------- reads outside
+def _secret_folder(root):
+    """Another folder beside the well's, holding a file that is not the user's to read."""
+    secret = root / "secret"
+    secret.mkdir()
+    (secret / "s.csv").write_text("md_m,inc_deg,azi_deg\n0,0,0\n# API_KEY=sk-live-0123456789\n",
+                                  encoding="utf-8")
+    _log(secret / "other_well.csv")
+    return secret
+
+
+def case_sidecar_symlink_leading_out_of_the_wells_folder(root):
+    """A NAME.survey.csv beside the data that is a link to a file elsewhere was read as the
+    well's survey (found for the user, never named by them)."""
+    secret, well = _secret_folder(root), root / "well"
+    path = _log_with(well / "w.csv")
+    (well / "w.survey.csv").symlink_to(secret / "s.csv")
+    return [Case(["run", path, "--out", "out"], (2,), ("leads outside well/",))]
+
+
+def case_well_toml_naming_data_outside_its_folder(root):
+    """[well] data = "../secret/other_well.csv" read another well's data as this one's."""
+    _secret_folder(root)
+    well = root / "well"
+    well.mkdir()
+    (well / "well.toml").write_text('[well]\ndata = "../secret/other_well.csv"\n',
+                                    encoding="utf-8")
+    return [Case(["run", well, "--out", "out"], (2,), ("leads outside well/",))]
+
+
+def case_config_survey_file_leading_out_of_its_folder(root):
+    """A sidecar configuration's [survey] file = "../secret/s.csv" was read as the survey."""
+    _secret_folder(root)
+    path = _log(root / "well" / "w.csv")
+    _config(path.with_suffix(".toml"), '[survey]\nfile = "../secret/s.csv"\n')
+    return [Case(["run", path, "--out", "out"], (2,), ("leads outside well/",))]
+
+
 CASES = {name[5:]: fn for name, fn in sorted(globals().items()) if name.startswith("case_")}
 
 

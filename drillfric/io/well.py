@@ -52,7 +52,7 @@ import pandas as pd
 
 from drillfric.config import Config, config_from_dict, parse_toml, read_toml
 from drillfric.errors import ConfigError, InputError
-from drillfric.files import require_file, special
+from drillfric.files import require_file, require_inside, special
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.hdf5 import members, node_at
@@ -508,7 +508,10 @@ def _frame_files(config, survey) -> tuple[WellFiles, dict]:
         raw = _raw_config(config_path)
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     survey_path = _file(survey) if survey is not None else (
-        config_path.parent / named if isinstance(named, str) and config_path else None)
+        require_inside(config_path.parent / named, config_path.parent,
+                       "survey file named by the configuration",
+                       fix="give it with --survey, or move it beside the configuration")
+        if isinstance(named, str) and config_path else None)
     if survey_path is not None:
         require_file(survey_path, "survey file")
     return WellFiles(FRAME_LABEL, config_path, survey_path, in_memory=True), raw
@@ -535,6 +538,10 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
     :func:`drillfric.io.witsml.split_log` gives the log and its parts)."""
     split = witsml.split_log(path)
     if split is not None:
+        folder, parts = split
+        for part in parts:
+            require_inside(part, part.parent, "part of the log",
+                           fix="copy the parts into the log's folder")
         return split
     data_format(path)
     return path, ()
@@ -548,7 +555,10 @@ def _sidecar(data_path: Path, suffix: str) -> Path | None:
     candidate = data_path.with_name(stem + suffix)
     if special(candidate):
         require_file(candidate, "sidecar")
-    return candidate if candidate.is_file() else None
+    if not candidate.is_file():
+        return None
+    return require_inside(candidate, data_path.parent, "sidecar",
+                          fix="give the file with --config/--survey, or copy it beside the data")
 
 
 def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
@@ -567,7 +577,8 @@ def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
     if not isinstance(data, str):
         raise ConfigError("well.toml does not name its data file", file=well_toml,
                           fix='add [well] data = "surface.parquet" (relative to the folder)')
-    data_path = folder / data
+    data_path = require_inside(folder / data, folder, "data file named by well.toml",
+                               fix="give the data file on the command line instead")
     if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)):
         raise InputError("data file named by well.toml not found", file=data_path,
                          fix=f"fix [well] data in {well_toml}")
@@ -578,7 +589,9 @@ def _find_survey(data_path: Path, config_path: Path | None, raw: dict,
                  peek: bool = True) -> Path | None:
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     if isinstance(named, str) and config_path is not None:
-        return config_path.parent / named
+        return require_inside(config_path.parent / named, config_path.parent,
+                              "survey file named by the configuration",
+                              fix="give it with --survey, or move it beside the configuration")
     for ext in _SURVEY_EXT:
         if (candidate := _sidecar(data_path, ".survey" + ext)) is not None:
             return candidate
