@@ -100,7 +100,7 @@ def covered(value, half_width, truth, tol) -> str:
 
 def score(summary: dict, rate: str, t_bit_true: float, wob_N: float, bit_mu: float) -> dict:
     """Counts of one record's claims (module docstring)."""
-    log = summary["friction_log"]
+    log = summary["off_bottom_friction_log"]
     out = {"log": [(len(e["segment_ids"]), e["mu_k"]) for e in log],
            "log_status": [mu_status(e["mu_k"], rate) for e in log],
            "well": mu_status(summary["mu_k"], rate), "well_mu_k": summary["mu_k"],

@@ -150,7 +150,7 @@ def test_drilling_only_log_gives_a_friction_factor_per_few_stands(tmp_path):
     data = tmp_path / "drilling.parquet"
     drillfric.simulate(config, out=data)
     summary = drillfric.run(drillfric.open_well(data)).summary
-    log = summary["friction_log"]
+    log = summary["off_bottom_friction_log"]
     assert len(log) == 1 and len(log[0]["segment_ids"]) == 3
     assert log[0]["mu_k"] == pytest.approx(0.25, rel=0.05)
     assert summary["mu_k"] == pytest.approx(0.25, rel=0.05)

@@ -165,7 +165,7 @@ def rate_of_penetration_m_h(rows: pd.DataFrame) -> float | None:
 
 # --------------------------------------------------------------------- friction log
 def friction_log(records: list[SegmentRecord], pools: list[dict]) -> list[dict]:
-    """The off-bottom μ_k of a record along depth (summary.json ``friction_log``): each
+    """The off-bottom μ_k of a record along depth (summary.json ``off_bottom_friction_log``): each
     converged segment and each pool of short ones, shallow to deep, with the μ_k's 95 %
     half-width (its validated tolerance, or twice the standard error of the members'
     scatter when larger) and the T_N at its ends (for the distance to an on-bottom

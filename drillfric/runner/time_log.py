@@ -106,7 +106,7 @@ def _stream(well: Well, sink: Sink, rate_hz, progress, chunk_rows, t_wall) -> We
                         wall_s=time.perf_counter() - t_wall,
                         resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
     summary.update(hookload=weighed.summary, mu_k_reason=weighed.mu_k_reason(summary["mu_k"]),
-                   friction_log=friction_log)
+                   off_bottom_friction_log=friction_log)
     summary["time_origin_utc"] = iso(tracker.origin)
     return finish(sink, well, summary, records, tracks=tracks.result())
 
