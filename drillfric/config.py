@@ -152,6 +152,11 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "bit-depth channel (and no block reckoning): a single stand or a test at one "
             "depth. Default: the survey's last station, announced as assumed.", min=0.0,
             min_exclusive=True),
+        Key("bit_diameter_m", float, None, "m", "Bit diameter D_bit of the well's time log: "
+            "with it, on-bottom segments report the bit friction coefficient μ_bit = "
+            "3·T_bit/(WOB·D_bit) and the downhole mechanical specific energy beside the bit "
+            "torque (docs/theory.md §2.3). Default: none, those two are null with the reason.",
+            min=0.0, min_exclusive=True, max=1.5),
         Key("units", str, "si", "", "Units people read: terminal summaries (run, td, inspect) "
             "and report axes and tables — 'si' (m, kN, kN·m, kg/m³) or 'field' (ft, klbf, "
             "kft·lbf, ppg, in); --units overrides. Result files (Parquet, JSON) stay SI.",

@@ -101,8 +101,9 @@ FLAG_MEANINGS = {
     Flag.RELAXATION_CYCLES: "the string stalls while a soft top drive crawls below ω_c, "
                             "then bursts free (a relaxation cycle): the mean torque is "
                             "mostly static wind-up, μ_k not converged",
-    Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
-                 "μ_k agree (summary.json pooled)",
+    Flag.POOLED: "too short alone; pooled with other short segments at neighbouring depths "
+                 "(within 10 % of the string's friction torque) whose μ_k agree (summary.json "
+                 "pooled)",
     Flag.HOOKLOAD_CONTRADICTS_STRING: "the hook load contradicts the configured string's "
                                       "weight beyond hookload.tolerance (docs/theory.md "
                                       "§2.1): friction factors withheld (null)",
@@ -186,6 +187,46 @@ class SegmentRecord:
     clock_start_utc: str | None = _f("", "clock time of t_start_s (ISO 8601, UTC) when the log "
                                          "has absolute time")
     clock_end_utc: str | None = _f("", "clock time of t_end_s (ISO 8601, UTC)")
+    wob_N: float | None = _f("N", "median weight on bit over the segment (on bottom)")
+    rop_m_h: float | None = _f("m/h", "rate of penetration: advance of the hole depth over "
+                                      "the segment (on bottom; null without hole depth)")
+    surface_rpm_mean: float | None = _f("RPM", "mean top-drive speed over the rotation")
+    surface_torque_turning_Nm: float | None = _f("N·m", "mean measured string torque while "
+                                                        "the top drive turns (as "
+                                                        "surface_torque_mean_Nm without the "
+                                                        "torque held after the stop)")
+    surface_torque_sem_Nm: float | None = _f("N·m", "standard error of "
+                                                    "surface_torque_turning_Nm (10-s block "
+                                                    "means)")
+    torque_per_mu_Nm: float | None = _f("N·m", "on bottom: the model's mean string torque "
+                                               "without bit torque is torque_fixed_Nm + "
+                                               "μ_k·torque_per_mu_Nm (speed-driven model at "
+                                               "the on-bottom load case, docs/theory.md §2.3)")
+    torque_fixed_Nm: float | None = _f("N·m", "on bottom: the part of that model torque not "
+                                              "proportional to μ_k (cased hole, viscous, "
+                                              "start-up)")
+    bit_torque_Nm: float | None = _f("N·m", "torque on bit T_bit = T_on − (μ_k·"
+                                            "torque_per_mu_Nm + torque_fixed_Nm), "
+                                            "μ_k from off-bottom rotation nearby "
+                                            "(docs/theory.md §2.3; null: bit_torque_reason)")
+    bit_torque_uncertainty_Nm: float | None = _f("N·m", "95 % half-width of bit_torque_Nm "
+                                                        "(μ_k's uncertainty and the torque "
+                                                        "noise)")
+    bit_torque_mu_k: float | None = _f("-", "the off-bottom μ_k the bit torque rests on")
+    bit_torque_mu_k_uncertainty: float | None = _f("-", "95 % half-width of bit_torque_mu_k: "
+                                                        "its validated tolerance (5 % logged "
+                                                        "at ≤ 0.2 s, else 10 %) or its "
+                                                        "members' scatter")
+    bit_torque_evidence: tuple[int, ...] = _f("", "ids of the off-bottom segments "
+                                                  "bit_torque_mu_k comes from", ())
+    mu_bit: float | None = _f("-", "bit friction coefficient 3·T_bit/(WOB·D_bit) "
+                                   "(well.bit_diameter_m)")
+    mu_bit_uncertainty: float | None = _f("-", "95 % half-width of mu_bit (from T_bit's)")
+    mse_Pa: float | None = _f("Pa", "downhole mechanical specific energy (Teale, with "
+                                    "T_bit): WOB/A + 2π·N·T_bit/(A·ROP), N the mean surface "
+                                    "speed")
+    mse_uncertainty_Pa: float | None = _f("Pa", "95 % half-width of mse_Pa (from T_bit's)")
+    bit_torque_reason: str | None = _f("", "why bit_torque_Nm, mu_bit or mse_Pa is null")
 
     def to_json(self) -> dict:
         """Plain JSON values (enums as text, NaN as None), in field order."""
@@ -197,7 +238,7 @@ SEGMENT_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(SegmentRecord))
 #: The binding keys of the interface (the first fields).
 SEGMENT_KEYS: tuple[str, ...] = SEGMENT_FIELDS[:18]
 #: Fields stored as JSON text in segments.parquet (lists).
-SEGMENT_LIST_FIELDS = ("flags", "starts")
+SEGMENT_LIST_FIELDS = ("flags", "starts", "bit_torque_evidence")
 #: Numeric fields (null is NaN in tables).
 SEGMENT_NUMBER_FIELDS: tuple[str, ...] = tuple(
     f.name for f in fields(SegmentRecord) if f.type in ("float", "float | None"))

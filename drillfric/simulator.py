@@ -66,6 +66,10 @@ class Stand:
         Ramp of the set-point down to 0 and the time held at 0 (torque trapped) [s].
     wob_N : float
         Weight on bit [N]; > 0 puts the bit on bottom.
+    rop_m_h : float
+        Rate of penetration of an on-bottom stand [m/h]: the recorded bit and hole depth
+        advance at it while the set-point is held (the plant stays at ``bit_depth_m``, a few
+        decimetres per stand; docs/simulator.md).
     setpoint_rpm : tuple of (t_s, rpm), optional
         Explicit piecewise-linear set-point from the start of the stand (replaces the
         start-up/hold/stop shape; a repeated time makes a step).
@@ -87,6 +91,7 @@ class Stand:
     stop_s: float = 5.0
     stop_hold_s: float = 10.0
     wob_N: float = 0.0
+    rop_m_h: float = 0.0
     setpoint_rpm: tuple | None = None
     motor_torque_Nm: tuple | None = None
     stop: bool = True
@@ -121,6 +126,12 @@ class Stand:
         if self.stop:
             pts += [(t + self.duration_s + self.stop_s, 0.0), (self.total_s, 0.0)]
         return np.asarray(pts, dtype=float)
+
+    @property
+    def end_depth_m(self) -> float:
+        """Recorded bit depth at the end of the stand [m] (after drilling ``rop_m_h``)."""
+        drilled = self.rop_m_h / 3600.0 * self.duration_s if self.on_bottom else 0.0
+        return self.bit_depth_m + drilled
 
     @property
     def on_bottom(self) -> bool:
@@ -196,7 +207,7 @@ def _check_stand(stand: Stand, where: str, file) -> None:
         if not getattr(stand, key) > 0:
             raise ConfigError(f"{where}.{key} must be > 0, got {getattr(stand, key)}",
                               file=file)
-    for key in ("rpm", "creep_rpm", "idle_s", "stop_s", "stop_hold_s", "wob_N"):
+    for key in ("rpm", "creep_rpm", "idle_s", "stop_s", "stop_hold_s", "wob_N", "rop_m_h"):
         if getattr(stand, key) < 0:
             raise ConfigError(f"{where}.{key} must be ≥ 0, got {getattr(stand, key)}",
                               file=file)
@@ -603,13 +614,13 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
         else rec.string_torque_Nm
     n = rec.time_s.size
     off = 0.0 if stand.on_bottom else cfg.simulate.off_bottom_m
+    depth = stand.bit_depth_m + _drilled_m(stand, rec.time_s)
     rotating = rec.time_s >= stand.idle_s + stand.start_up_s
     stuck = float(np.mean(np.abs(rec.bit_rad_s[rotating]) < 0.1 * settings.omega_c_rad_s)) \
         if rotating.any() else 0.0
     cols = {"time_s": rec.time_s + t0, "surface_rpm": rec.surface_rad_s / RPM_TO_RAD_S,
             "surface_torque_Nm": surface_torque, "hookload_N": np.full(n, td.hookload_N),
-            "bit_depth_m": np.full(n, stand.bit_depth_m),
-            "hole_depth_m": np.full(n, stand.bit_depth_m + off),
+            "bit_depth_m": depth, "hole_depth_m": depth + off,
             "wob_N": np.full(n, stand.wob_N), "bit_rpm": rec.bit_rad_s / RPM_TO_RAD_S,
             "string_torque_Nm": rec.string_torque_Nm}
     grid = plant.grid
@@ -627,12 +638,20 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
     return cols, result
 
 
+def _drilled_m(stand: Stand, time_s: np.ndarray) -> np.ndarray:
+    """Depth drilled since the start of an on-bottom stand [m]: ``rop_m_h`` from the start
+    of the set-point to the start of the stop (0 off bottom)."""
+    if not stand.on_bottom:
+        return np.zeros(time_s.size)
+    return stand.rop_m_h / 3600.0 * np.clip(time_s - stand.idle_s, 0.0, stand.duration_s)
+
+
 def _connection(t0: float, span: float, rate: float, before: Stand, after: Stand, cfg):
     """Rows of a connection: no rotation, torque released, in slips, bit moving down."""
     t = t0 + np.arange(1, int(np.floor(span * rate + 1e-9)) + 1) / rate
     t = t[t < t0 + span - 0.5 / rate]
     frac = (t - t0) / span
-    depth = before.bit_depth_m + frac * (after.bit_depth_m - before.bit_depth_m)
+    depth = before.end_depth_m + frac * (after.bit_depth_m - before.end_depth_m)
     off = cfg.simulate.off_bottom_m
     zero = np.zeros(t.size)
     return {"time_s": t, "surface_rpm": zero, "surface_torque_Nm": zero.copy(),

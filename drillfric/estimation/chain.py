@@ -27,7 +27,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
-from drillfric.estimation import batch, bit_trace
+from drillfric.estimation import batch, bit_torque, bit_trace
 from drillfric.estimation.batch.settings import MU_K_SKIP_S, TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -141,6 +141,9 @@ class SegmentEstimate:
         where the kinematic check withholds the trace, docs/bit_speed.md).
     logged : LoggingInterval
         The log's effective interval and, with min/max channels, the torque swing within it.
+    torque_terms : TorqueTerms or None
+        The mean speed, the mean torque's standard error and the modelled torque not
+        proportional to μ_k (:func:`drillfric.estimation.bit_torque.torque_terms`).
     friction_zone : str
         Which factor μ is: "open_hole" (the cased part's factor given) or "effective"
         (torque-weighted over the whole string).
@@ -176,6 +179,7 @@ class SegmentEstimate:
     kinematics: bit_trace.KinematicCheck | None = None
     bit_statistics: bool = False
     logged: LoggingInterval | None = None
+    torque_terms: bit_torque.TorqueTerms | None = None
     friction_zone: str = "effective"
 
 
@@ -318,6 +322,8 @@ class FitEvidence:
         5th–95th percentile swing of the measured torque there [N·m].
     mean_Nm : float or None
         Mean measured string torque there [N·m].
+    scored : ndarray of bool or None
+        The samples "there" (after the start-up); None when too few.
     """
 
     time_s: np.ndarray
@@ -326,6 +332,7 @@ class FitEvidence:
     misfit_rms_Nm: float | None
     swing_Nm: float | None
     mean_Nm: float | None
+    scored: np.ndarray | None = None
 
     @property
     def quality(self) -> float | None:
@@ -484,7 +491,23 @@ def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | Non
     misfit = smooth(measured - model, dt, TORQUE_SMOOTH_S)[scored]
     low, high = np.percentile(measured[scored], [5.0, 95.0])
     return FitEvidence(t, measured, model, float(np.sqrt(np.mean(misfit ** 2))),
-                       float(high - low), float(np.mean(measured[scored])))
+                       float(high - low), float(np.mean(measured[scored])), scored)
+
+
+def _model_at(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | None):
+    """(μ-scale, bit torque [N·m]) → the evidence's model string torque at (scale·μ_s,
+    scale·μ_k) with that Coulomb bit [N·m] (the torque line of
+    :func:`drillfric.estimation.bit_torque.torque_terms`)."""
+    meas = models.meas
+    mu_s = mu_s if mu_s is not None else verdict.mu_s_seed
+
+    def model_at(scale: float, bit_Nm: float = 0.0) -> np.ndarray:
+        return batch.model_string_torque(
+            meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
+            fc_Nm_m=models.td.fc_at, settings=models.batch_settings, mu_s=scale * mu_s,
+            mu_k=scale * verdict.mu_k, cells=_batch_cells(cfg, models.string.bit_depth_m),
+            profile=models.profile, bit_torque_Nm=bit_Nm)[2]
+    return model_at
 
 
 def bit_speed_resolution(models: SegmentModels) -> Resolution:
@@ -542,7 +565,11 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     logging = bit_speed_resolution(models)
     claim = bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom)
     drift = claim.resolved and kinematics.approximate
-    return replace(estimate, evidence=fit_evidence(cfg, models, verdict, refined.mu_s),
+    fitted = fit_evidence(cfg, models, verdict, refined.mu_s)
+    terms = bit_torque.torque_terms(models.meas, fitted, _model_at(cfg, models, verdict,
+                                                                 refined.mu_s)
+                                    if models.on_bottom else None, verdict.mu_k)
+    return replace(estimate, evidence=fitted, torque_terms=terms,
                    bit_speed=claim, kinematics=kinematics,
                    bit_statistics=logging.resolved and not models.on_bottom,
                    flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ()),

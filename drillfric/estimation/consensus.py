@@ -16,23 +16,72 @@ from drillfric.result import Flag, Kind, SegmentRecord, Status
 
 #: Flags a short segment may carry and still be pooled (it is only too short).
 _POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
-                       "estimators_disagree"})
-#: Short segments pool when their bit depths are within this [m] (one stand's depth)...
+                       "estimators_disagree", "bit_speed_drift"})
+#: Short segments pool when the string's friction torque added between their bit depths is
+#: at most this share of the torque at the deeper one, |ΔT_N|/T_N (docs/theory.md "Pooling
+#: along depth"). The reported μ_k is the torque-weighted mean of μ(x) over the whole
+#: string, so a friction change of ±50 % in the hole drilled between the members moves it
+#: by at most 0.10 × 50 % = 5 %, the converged tolerance: typically 3–5 stands.
+POOL_TORQUE_SHARE = 0.10
+#: Without T_N (no torque and drag) segments pool only within this depth [m] (one stand).
 POOL_DEPTH_M = 5.0
-#: ...their μ_k agree within this (max/min − 1) [-]...
-POOL_AGREEMENT = 0.05
+#: ...the 95 % half-width of their mean, 1.96·sd/√n, is within the converged tolerance
+#: (:func:`mu_k_tolerance`)...
+_Z95 = 1.96
 #: ...and together they hold at least this much rotation [s] (the converged minimum).
 POOL_MIN_ROTATION_S = 90.0
+#: Validated μ_k tolerance (docs/validation.md) by effective sample interval [s]: logged
+#: at ≤ 0.2 s within 5 %, coarser within 10 %; the 95 % half-width of a converged μ_k.
+MU_K_TOLERANCE = ((0.2, 0.05), (np.inf, 0.10))
+
+
+def mu_k_tolerance(sample_interval_s: float | None) -> float:
+    """Relative 95 % half-width of a converged μ_k logged at this interval [-].
+
+    Examples
+    --------
+    >>> mu_k_tolerance(0.01), mu_k_tolerance(1.0)
+    (0.05, 0.1)
+    """
+    interval = 0.0 if sample_interval_s is None else sample_interval_s
+    return next(tol for limit, tol in MU_K_TOLERANCE if interval <= limit)
+
+
+def mean_half_width(mu: np.ndarray) -> float:
+    """95 % half-width of the mean of the pieces ``mu`` [-] (0 for one piece)."""
+    return float(_Z95 * np.std(mu, ddof=1) / np.sqrt(mu.size)) if mu.size > 1 else 0.0
+
+
+def torque_share(a: SegmentRecord, b: SegmentRecord) -> float:
+    """Share of the string's friction torque between the bit depths of ``a`` and ``b``,
+    |T_N,a − T_N,b| / max(T_N) [-] (docs/theory.md "Pooling along depth"); without a T_N,
+    0 within :data:`POOL_DEPTH_M` and infinite beyond.
+
+    Examples
+    --------
+    >>> from drillfric.result import SegmentRecord
+    >>> torque_share(SegmentRecord(T_N_Nm=40e3), SegmentRecord(T_N_Nm=42e3))  # doctest: +ELLIPSIS
+    0.0476...
+    """
+    if a.T_N_Nm and b.T_N_Nm:
+        return abs(a.T_N_Nm - b.T_N_Nm) / max(a.T_N_Nm, b.T_N_Nm)
+    near = abs((a.bit_depth_m or 0.0) - (b.bit_depth_m or 0.0)) <= POOL_DEPTH_M
+    return 0.0 if near else float("inf")
 
 
 def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]:
-    """Pool short off-bottom segments at one bit depth whose μ_k agree into one estimate.
+    """Pool short off-bottom segments at neighbouring bit depths whose μ_k agree into one
+    estimate.
 
     Segments too short to converge alone (only ``too_short_to_converge`` keeps them from
-    it) at one depth (within :data:`POOL_DEPTH_M`), whose batch μ_k agree within
-    :data:`POOL_AGREEMENT` and which together rotate for :data:`POOL_MIN_ROTATION_S`, give a
-    converged estimate: the rotation-weighted mean μ_k. Returns the records (members flagged
-    ``pooled``) and the pools (summary.json ``pooled``).
+    it) whose depths lie within :data:`POOL_TORQUE_SHARE` of the string's friction torque
+    (:func:`torque_share`, from the shallowest of the group; so a change of friction along
+    the hole moves their μ_k little, and their scatter is the estimator's), whose batch
+    μ_k's mean has a 95 % half-width from their scatter within the
+    converged tolerance of their logging (:func:`mu_k_tolerance`) and which together
+    rotate for :data:`POOL_MIN_ROTATION_S`, give a converged estimate: the
+    rotation-weighted mean μ_k. Returns the records (members flagged
+    ``pooled``) and the pools (summary.json ``pooled``: members, depth span, μ_k, spread).
     """
 
     short = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
@@ -40,7 +89,7 @@ def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]
              and set(r.flags) <= _POOLABLE]
     groups: list[list[SegmentRecord]] = []
     for r in sorted(short, key=lambda r: r.bit_depth_m):
-        if groups and r.bit_depth_m - groups[-1][0].bit_depth_m <= POOL_DEPTH_M:
+        if groups and torque_share(groups[-1][0], r) <= POOL_TORQUE_SHARE:
             groups[-1].append(r)
         else:
             groups.append([r])
@@ -48,11 +97,14 @@ def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]
     for group in groups:
         mu = np.array([r.mu_k for r in group])
         weight = np.array([r.duration_s for r in group])
+        tolerance = max(mu_k_tolerance(r.sample_interval_s) for r in group)
         if len(group) < 2 or weight.sum() < POOL_MIN_ROTATION_S or \
-                mu.max() / mu.min() - 1.0 > POOL_AGREEMENT:
+                mean_half_width(mu) > tolerance * mu.mean():
             continue
+        depths = [r.bit_depth_m for r in group]
         pool = {"segment_ids": [r.id for r in group],
-                "bit_depth_m": float(np.median([r.bit_depth_m for r in group])),
+                "bit_depth_m": float(np.median(depths)),
+                "md_from_m": float(min(depths)), "md_to_m": float(max(depths)),
                 "mu_k": float(np.sum(mu * weight) / weight.sum()),
                 "mu_k_spread": float(mu.max() - mu.min()), "rotation_s": float(weight.sum())}
         pools.append(pool)
@@ -61,8 +113,10 @@ def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]
 
 
 def _pooled(record: SegmentRecord, pool: dict) -> SegmentRecord:
+    span = f"{pool['md_from_m']:.0f}–{pool['md_to_m']:.0f} m" \
+        if pool["md_to_m"] - pool["md_from_m"] >= 1.0 else f"{pool['bit_depth_m']:.0f} m"
     note = (f"pooled with segments {', '.join(map(str, pool['segment_ids']))} at "
-            f"{pool['bit_depth_m']:.0f} m: μ_k = {pool['mu_k']:.3f} over "
+            f"{span}: μ_k = {pool['mu_k']:.3f} over "
             f"{pool['rotation_s']:.0f} s of rotation")
     return replace(record, flags=record.flags + (Flag.POOLED,),
                    message="; ".join(filter(None, [record.message, note])))

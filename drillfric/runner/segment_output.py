@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from drillfric.estimation.bit_torque import rate_of_penetration_m_h
 from drillfric.estimation.chain import SegmentData, SegmentEstimate
 from drillfric.estimation.observer import ObserverRecord
 from drillfric.result import SEEDED_START_ID, Kind, SegmentRecord, Status
@@ -19,7 +20,8 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
     """A segment's :class:`SegmentRecord` (the estimate's numbers when there is one)."""
     base = dict(id=seg.id, kind=Kind(seg.kind), t_start_s=seg.t_start_s, t_end_s=seg.t_end_s,
                 bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message,
-                hookload_N=_median(rows, "hookload_N"), **_clock(rows, seg))
+                hookload_N=_median(rows, "hookload_N"), **_clock(rows, seg),
+                **_drilling(seg, rows))
     if est is None:
         return SegmentRecord(**base)
     return SegmentRecord(**base | dict(
@@ -31,7 +33,24 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
         T_N_Nm=est.T_N_Nm, flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
-        **_evidence_fields(est), **_bit_fields(est)))
+        **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est)))
+
+
+def _drilling(seg: Segment, rows: pd.DataFrame) -> dict:
+    """WOB and ROP of an on-bottom segment (docs/theory.md §2.3)."""
+    if seg.kind != Kind.ON_BOTTOM:
+        return {}
+    return dict(wob_N=_median(rows, "wob_N"), rop_m_h=rate_of_penetration_m_h(rows))
+
+
+def _torque_terms(est: SegmentEstimate) -> dict:
+    terms = est.torque_terms
+    if terms is None:
+        return {}
+    return dict(surface_rpm_mean=terms.surface_rpm_mean,
+                surface_torque_turning_Nm=terms.surface_torque_turning_Nm,
+                surface_torque_sem_Nm=terms.surface_torque_sem_Nm,
+                torque_per_mu_Nm=terms.torque_per_mu_Nm, torque_fixed_Nm=terms.torque_fixed_Nm)
 
 
 def _evidence_fields(est: SegmentEstimate) -> dict:

@@ -29,6 +29,7 @@ import pandas as pd
 
 from drillfric.drag import MoveFinder, drag_log
 from drillfric.errors import DrillfricError, InputError
+from drillfric.estimation.bit_torque import assess as assess_bit_torque
 from drillfric.estimation.chain import SegmentData, SkipSegment, check_segment, estimate_segment
 from drillfric.estimation.consensus import pool_short_segments
 from drillfric.hookload import PlateauFinder, calibrate, judge
@@ -102,11 +103,13 @@ def _stream(well: Well, sink: Sink, rate_hz, progress, chunk_rows, t_wall) -> We
     weighed = judge(records, hook.close(), well.config, calibration)
     warnings += weighed.warnings
     records, pools = pool_short_segments(weighed.records)
+    records, friction_log = assess_bit_torque(records, pools, well.config.well.bit_diameter_m)
     summary = summarise(well, records, pools, rows=check.rows,
                         assumed=well.assumed + estimator.assumed, warnings=warnings,
                         wall_s=time.perf_counter() - t_wall,
                         resampled_rate_hz=estimator.rate_hz, requested_rate_hz=rate_hz)
-    summary.update(hookload=weighed.summary, mu_k_reason=weighed.mu_k_reason(summary["mu_k"]))
+    summary.update(hookload=weighed.summary, mu_k_reason=weighed.mu_k_reason(summary["mu_k"]),
+                   off_bottom_friction_log=friction_log)
     summary["drag"], drag_table = drag_log(moves.close(), moves.too_short, well.config,
                                            well.survey, weighed.summary)
     summary["time_origin_utc"] = iso(tracker.origin)

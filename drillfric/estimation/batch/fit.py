@@ -150,12 +150,13 @@ class BatchResult:
 def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                         settings: BatchSettings, mu_s: float, mu_k: float,
                         torque_kind: str = "motor", cells: int = 500,
-                        profile: FrictionProfile | None = None
+                        profile: FrictionProfile | None = None, bit_torque_Nm: float = 0.0
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fitted model against the data over a whole record (the evidence of a fit).
 
     The speed-driven plant of docs/theory.md §6.4 at (μ_s, μ_k), driven by the measured
-    top-drive speed from rest over the whole record, as :func:`refine`'s fits are.
+    top-drive speed from rest over the whole record, as :func:`refine`'s fits are; with
+    ``bit_torque_Nm`` > 0 a Coulomb bit of that torque [N·m] (docs/theory.md §2.3).
 
     Returns
     -------
@@ -166,6 +167,7 @@ def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString
     data, _ = prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
                       settings.top_drive_inertia_kg_m2)
     model = Model(string, as_fc_fn(fc_Nm_m), settings, data, None, profile)
+    model.bit_torque_cap_Nm = max(float(bit_torque_Nm), 0.0)
     whole = Window(0, data.t.size - 1, np.arange(data.t.size))
     tau, _ = model.simulate(whole, max(mu_s, mu_k), mu_k, cells)
     return data.t, data.tau, tau

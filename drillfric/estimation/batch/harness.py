@@ -168,6 +168,7 @@ class Model:
         self.profile = profile or FrictionProfile()
         self.cased_static = CASED_STATIC[0]  # the hypothesis for an unknown cased μ_s
         self.drive: DriveModel | None = None  # replayed in rotation when usable
+        self.bit_torque_cap_Nm = 0.0  # Coulomb bit torque on bottom [N·m] (bit_torque.py)
         self.counter = RunCounter(progress)
         self._grids: dict[int, tuple[torsional.Grid, np.ndarray]] = {}
 
@@ -221,6 +222,7 @@ class Model:
         g, fc = self.grid(cells)
         plant = self.profile.plant(g, fc, mu_s, mu_k, omega_c_rad_s=self.omega_c,
                                    k_t_per_s=self.k_t, top_drive_inertia_kg_m2=self.itd,
+                                   bit_torque_cap_Nm=self.bit_torque_cap_Nm,
                                    cased_static=self.cased_static)
         span = slice(win.sim0, win.end + 1)
         state = self._initial(win, g, fc, mu_k)
