@@ -226,7 +226,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     rotation = _Rotation.of(model, wins)
     kinetic = cycles = None
     if wins:
-        cycles = relaxation.find(data.t, data.speed, data.tau_bar, omega_c, rotation.target_Nm)
+        cycles = relaxation.find(data.t, data.speed, data.tau_bar, omega_c, rotation.target_Nm,
+                                 rotation.mean_speed_rad_s)
         if cycles is not None:
             flags.append(Flag.RELAXATION_CYCLES)
             messages.append(cycles.describe(max(data.dt, sample_interval_s or 0.0)))
@@ -258,12 +259,13 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
 @dataclass(frozen=True)
 class _Rotation:
     """What the rotating windows of the data show: the whole-cycle mean string torque
-    [N·m], its fluctuation [-] and whether the data stick-slip (None/False without
-    windows)."""
+    [N·m], its fluctuation [-], whether the data stick-slip, and the mean top-drive speed
+    (a PI drive's set-point) [rad/s] (None/False/0 without windows)."""
 
     target_Nm: float | None = None
     fluctuation: float | None = None
     stick_slip: bool = False
+    mean_speed_rad_s: float = 0.0
 
     @classmethod
     def of(cls, model: Model, wins: list[Window]) -> _Rotation:
@@ -273,7 +275,7 @@ class _Rotation:
         used = np.concatenate([w.used for w in wins])
         fluct = fluctuation(d.tau_bar[used])
         return cls(cycle_mean([d.tau[w.used] for w in wins], d.dt), fluct,
-                   fluct > STICK_SLIP_FLUCTUATION)
+                   fluct > STICK_SLIP_FLUCTUATION, float(np.mean(d.speed[used])))
 
 
 @dataclass(frozen=True)
