@@ -69,6 +69,7 @@ class Flag(StrEnum):
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
     STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
     RELAXATION_CYCLES = "relaxation_cycles"
+    MU_K_UNCERTAIN = "mu_k_uncertain"
 
 
 #: What each flag means (docs/outputs.md).
@@ -98,9 +99,12 @@ FLAG_MEANINGS = {
     Flag.BIT_SPEED_DRIFT: "the bit-speed trace drifts from the top drive by more than the "
                           "string's twist allows, by under a third of its stick-slip swing: "
                           "shown, its phase approximate",
-    Flag.RELAXATION_CYCLES: "the string stalls while a soft top drive crawls below ω_c, "
-                            "then bursts free (a relaxation cycle): the mean torque is "
-                            "mostly static wind-up, μ_k not converged",
+    Flag.RELAXATION_CYCLES: "the string stalls while a soft top drive crawls far below its "
+                            "set-point (below ω_c or half its mean speed), then bursts free "
+                            "(a relaxation cycle): the mean torque is mostly static wind-up, "
+                            "μ_k not converged",
+    Flag.MU_K_UNCERTAIN: "the mean torque of the record's torque cycles scatters too much: "
+                         "μ_k's 2σ statistical uncertainty exceeds 5 %, not converged",
     Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
                  "μ_k agree (summary.json pooled)",
     Flag.HOOKLOAD_CONTRADICTS_STRING: "the hook load contradicts the configured string's "
