@@ -134,7 +134,17 @@ def find(time_s, omega_rad_s, torque_bar_Nm, omega_c_rad_s: float,
     w = smooth(np.asarray(omega_rad_s, dtype=float), float(np.median(np.diff(t))),
                STALL_SMOOTH_S)
     tau = np.asarray(torque_bar_Nm, dtype=float)
-    line = max(omega_c_rad_s, CRAWL_FRACTION * abs(setpoint_rad_s))
+    # Both lines are tried: the higher one can join a stall below ω_c to a start-up or to
+    # the record's end (neither counts), the lower one misses a crawl around ω_c.
+    found = [_stalls(t, w, tau, line, omega_c_rad_s, mean_torque_Nm)
+             for line in (omega_c_rad_s, max(omega_c_rad_s,
+                                             CRAWL_FRACTION * abs(setpoint_rad_s)))]
+    return max(found, key=lambda c: 0 if c is None else c.stalls)
+
+
+def _stalls(t, w, tau, line: float, omega_c_rad_s: float,
+            mean_torque_Nm: float) -> RelaxationCycles | None:
+    """The stalls below the crawl ``line`` [rad/s] of the smoothed speed ``w`` (:func:`find`)."""
     below = np.abs(w) < line
     edges = np.flatnonzero(np.diff(np.r_[0, below.astype(np.int8), 0]))
     found = []
