@@ -69,6 +69,7 @@ class Flag(StrEnum):
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
     STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
     RELAXATION_CYCLES = "relaxation_cycles"
+    MU_K_UNCERTAIN = "mu_k_uncertain"
 
 
 #: What each flag means (docs/outputs.md).
@@ -104,6 +105,14 @@ FLAG_MEANINGS = {
     Flag.POOLED: "too short alone; pooled with other short segments at neighbouring depths "
                  "(within 10 % of the string's friction torque) whose μ_k agree (summary.json "
                  "pooled)",
+    Flag.RELAXATION_CYCLES: "the string stalls while a soft top drive crawls far below its "
+                            "set-point (below ω_c or half its mean speed), then bursts free "
+                            "(a relaxation cycle): the mean torque is mostly static wind-up, "
+                            "μ_k not converged",
+    Flag.MU_K_UNCERTAIN: "the mean torque of the record's torque cycles scatters too much: "
+                         "μ_k's 2σ statistical uncertainty exceeds 5 %, not converged",
+    Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
+                 "μ_k agree (summary.json pooled)",
     Flag.HOOKLOAD_CONTRADICTS_STRING: "the hook load contradicts the configured string's "
                                       "weight beyond hookload.tolerance (docs/theory.md "
                                       "§2.1): friction factors withheld (null)",

@@ -453,7 +453,8 @@ def evidence(cfg, models: SegmentModels, diag: Diagnostics,
                     mu_s_model=refined.details.mu_s_model, mu_s=refined.mu_s,
                     observer_mu_k=diag.mu_k, observer_converged=diag.converged,
                     observer_flags=tuple(Flag(f"observer_{f}") for f in diag.flags),
-                    turning_s=turning_s, on_bottom=models.on_bottom)
+                    turning_s=turning_s, on_bottom=models.on_bottom,
+                    batch_mu_k_sigma=refined.details.mu_k_sigma)
 
 
 def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,

@@ -3,10 +3,10 @@ cycles").
 
 A PI top drive whose integral gain is too small to deliver the break-away torque quickly
 cannot keep the string turning once it sticks: the string stays stuck while the top drive
-crawls below ω_c, winding it up at the rate the integral grows, until the torque reaches
-μ_s∫F_c dx; the string then breaks free, the wound-up torque and the integral throw the top
-drive to several hundred RPM, the integral unwinds and the string sticks again — a cycle of
-one to a few minutes.
+crawls far below its set-point, winding it up at the rate the integral grows, until the
+torque reaches μ_s∫F_c dx; the string then breaks free, the wound-up torque and the integral
+throw the top drive to several hundred RPM, the integral unwinds and the string sticks
+again — a cycle of one to a few minutes.
 
 Over such a cycle the mean surface torque is mostly *static* torque: the wind-up, which
 rises from about μ_k∫F_c dx to μ_s∫F_c dx over the longest part of the cycle. Matching it
@@ -15,13 +15,19 @@ cycle, not μ_k: a model whose stalls last a little longer or shorter than the r
 μ_k by tens of per cent, and replaying the drive does not put its stalls in step (the
 validation saw −15…+35 % at 100 Hz to 1-s means, docs/validation.md). A stall is:
 
-- the top-drive speed averaged over :data:`STALL_SMOOTH_S` below ω_c for at least
-  :data:`MIN_STALL_S` (longer than the stuck phase of ordinary stick-slip),
-- after the top drive has turned above ω_c in the record (a stall, not a start-up: a creep
-  from rest is the same physics, but the fit leaves it out of μ_k),
+- the top-drive speed averaged over :data:`STALL_SMOOTH_S` below the crawl line for at
+  least :data:`MIN_STALL_S` (longer than the stuck phase of ordinary stick-slip); the crawl
+  line is the larger of ω_c and :data:`CRAWL_FRACTION` of the set-point. The integral action
+  of a PI drive holds its mean speed at the set-point, so the rotation's mean speed is taken
+  for it. A drive a little stiffer than one that crawls below ω_c (k_p = ζ, k_i = 300 N·m/rad
+  on the validation well) winds the stuck string up for 20–30 s at 3–18 RPM — about ω_c, not
+  below it — against a 40-RPM set-point: the same relaxation cycle, which the ω_c line
+  alone missed (its μ_k was reported converged and 6–32 % high, docs/validation.md),
+- after the top drive has turned above the crawl line in the record (a stall, not a
+  start-up: a creep from rest is the same physics, but the fit leaves it out of μ_k),
 - with the top drive still turning (mean speed ≥ the rest threshold) while the torque winds
   up by at least :data:`MIN_WINDUP` of the rotating mean torque,
-- and followed by rotation above ω_c (the break-away burst).
+- and followed by rotation above the crawl line (the break-away burst).
 """
 
 from __future__ import annotations
@@ -40,6 +46,10 @@ MIN_STALL_S = 10.0
 #: rotation (a stuck string wound from about μ_k to μ_s of its capacity rises by
 #: μ_s/μ_k − 1, > 50 % for μ_s ≥ 1.5 μ_k).
 MIN_WINDUP = 0.25
+#: A top drive held below this share of its set-point (the rotation's mean speed) is
+#: crawling [-]: between slips of ordinary stick-slip the 3-s mean speed stays above it, or
+#: dips below it for ≤ 3 s (validation plants, k_i = 2500 N·m/rad, k_p = 0.3–3 ζ).
+CRAWL_FRACTION = 0.5
 #: The speed is averaged over this before the stalls are looked for [s]: the crawl is slow,
 #: and a torsional wave or sensor noise must not split a stall.
 STALL_SMOOTH_S = 3.0
@@ -63,6 +73,9 @@ class RelaxationCycles:
         Highest smoothed top-drive speed after a stall [rad/s].
     period_s : float or None
         Median time between stall starts [s] (None with one stall).
+    crawl_line_rad_s : float
+        The speed below which the top drive counted as crawling [rad/s]: the larger of ω_c
+        and :data:`CRAWL_FRACTION` of the set-point.
     """
 
     stalls: int
@@ -71,13 +84,15 @@ class RelaxationCycles:
     windup_Nm: float
     burst_rad_s: float
     period_s: float | None
+    crawl_line_rad_s: float
 
     def describe(self, interval_s: float) -> str:
         """One line for the messages; ``interval_s`` is the log's effective interval [s]."""
         period = "" if self.period_s is None else f", every {self.period_s:.0f} s"
         return (f"relaxation cycles of a soft top drive ({self.stalls} stall(s) of "
                 f"{self.stall_s:.0f} s: the top drive crawls at "
-                f"{self.crawl_rad_s * 30 / np.pi:.1f} RPM below ω_c while the torque winds up "
+                f"{self.crawl_rad_s * 30 / np.pi:.1f} RPM (below "
+                f"{self.crawl_line_rad_s * 30 / np.pi:.1f} RPM) while the torque winds up "
                 f"by {self.windup_Nm / 1e3:.1f} kN·m, then bursts to "
                 f"{self.burst_rad_s * 30 / np.pi:.0f} RPM{period}; logged every "
                 f"{interval_s:.3g} s): the mean torque of such cycles is mostly the static "
@@ -87,12 +102,13 @@ class RelaxationCycles:
 
 
 def find(time_s, omega_rad_s, torque_bar_Nm, omega_c_rad_s: float,
-         mean_torque_Nm: float) -> RelaxationCycles | None:
+         mean_torque_Nm: float, setpoint_rad_s: float = 0.0) -> RelaxationCycles | None:
     """The stalls of a uniform log (module docstring), or None without any.
 
     ``omega_rad_s`` is the logged top-drive speed, ``torque_bar_Nm`` the string torque
     smoothed over about 1 s, ``mean_torque_Nm`` the mean torque of the rotation used for
-    μ_k [N·m].
+    μ_k [N·m], ``setpoint_rad_s`` the drive's set-point, taken as the mean speed of that
+    rotation [rad/s] (0: the crawl line is ω_c alone).
 
     Examples
     --------
@@ -106,15 +122,33 @@ def find(time_s, omega_rad_s, torque_bar_Nm, omega_c_rad_s: float,
     >>> c = find(t, w, tau, 1.0, 16e3)
     >>> c.stalls, c.stall_s, round(c.windup_Nm), round(c.burst_rad_s)
     (1, 37.0, 13875, 25)
+
+    The same stall crawling at 1.5 rad/s, above ω_c = 1 rad/s but below half the 4-rad/s
+    set-point:
+
+    >>> w[(t >= 40) & (t < 80)] = 1.5
+    >>> find(t, w, tau, 1.0, 16e3) is None, find(t, w, tau, 1.0, 16e3, 4.0).stalls
+    (True, 1)
     """
     t = np.asarray(time_s, dtype=float)
     w = smooth(np.asarray(omega_rad_s, dtype=float), float(np.median(np.diff(t))),
                STALL_SMOOTH_S)
     tau = np.asarray(torque_bar_Nm, dtype=float)
-    below = np.abs(w) < omega_c_rad_s
+    # Both lines are tried: the higher one can join a stall below ω_c to a start-up or to
+    # the record's end (neither counts), the lower one misses a crawl around ω_c.
+    found = [_stalls(t, w, tau, line, omega_c_rad_s, mean_torque_Nm)
+             for line in (omega_c_rad_s, max(omega_c_rad_s,
+                                             CRAWL_FRACTION * abs(setpoint_rad_s)))]
+    return max(found, key=lambda c: 0 if c is None else c.stalls)
+
+
+def _stalls(t, w, tau, line: float, omega_c_rad_s: float,
+            mean_torque_Nm: float) -> RelaxationCycles | None:
+    """The stalls below the crawl ``line`` [rad/s] of the smoothed speed ``w`` (:func:`find`)."""
+    below = np.abs(w) < line
     edges = np.flatnonzero(np.diff(np.r_[0, below.astype(np.int8), 0]))
     found = []
-    for i0, i1 in zip(edges[::2], edges[1::2], strict=True):  # below ω_c over samples i0 … i1 − 1
+    for i0, i1 in zip(edges[::2], edges[1::2], strict=True):  # below the line: i0 … i1 − 1
         if i0 == 0 or i1 >= t.size or t[i1 - 1] - t[i0] < MIN_STALL_S:
             continue  # a start-up, the record's end, or a short dip
         windup = float(tau[i1 - 1] - np.min(tau[i0:i1]))
@@ -132,4 +166,4 @@ def find(time_s, omega_rad_s, torque_bar_Nm, omega_c_rad_s: float,
                             crawl_rad_s=float(np.median(crawl)),
                             windup_Nm=float(np.median(windup)), burst_rad_s=float(burst.max()),
                             period_s=float(np.median(np.diff(starts))) if len(found) > 1
-                            else None)
+                            else None, crawl_line_rad_s=line)

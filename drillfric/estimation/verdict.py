@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drillfric.estimation.batch.settings import MU_K_CLAIM
 from drillfric.result import Flag, Method
 
 #: Batch flags under which a stick-slip-onset bound on μ_s is not reported (docs/theory.md
@@ -55,6 +56,8 @@ class Evidence:
     turning_s : float
         Time the top drive turns faster than ω_c [s].
     on_bottom : bool
+    batch_mu_k_sigma : float or None
+        Statistical 1-σ uncertainty of the batch μ_k [-] (None: not known).
     """
 
     batch_mu_k: float | None
@@ -68,6 +71,7 @@ class Evidence:
     observer_flags: tuple
     turning_s: float
     on_bottom: bool
+    batch_mu_k_sigma: float | None = None
 
 
 @dataclass(frozen=True)
@@ -108,8 +112,10 @@ def decide(ev: Evidence) -> Verdict:
        (``observer``, converged only if the observer says so);
     2. a batch μ_k is not converged when the fit flags ``mu_k_not_converged`` or
        ``relaxation_cycles`` (:data:`NOT_CONVERGED`), when batch and
-       observer differ by more than :data:`DISAGREEMENT`, or with less than
-       :data:`MIN_CONVERGED_ROTATION_S` of rotation;
+       observer differ by more than :data:`DISAGREEMENT`, with less than
+       :data:`MIN_CONVERGED_ROTATION_S` of rotation, or when its 2σ statistical uncertainty
+       exceeds :data:`~drillfric.estimation.batch.settings.MU_K_CLAIM` of it
+       (``mu_k_uncertain``);
     3. a μ_s lower bound is withheld on bottom (the bit drives the swings) and under the
        flags of :data:`UNRELIABLE_BOUND`;
     4. μ_k outside :data:`TYPICAL_MU` is flagged (not changed);
@@ -170,6 +176,12 @@ def _batch_converged(ev: Evidence, flags: list, messages: list) -> bool:
         flags.append(Flag.ESTIMATORS_DISAGREE)
         messages.append(f"batch μ_k = {ev.batch_mu_k:.3f} and observer μ_k = "
                         f"{ev.observer_mu_k:.3f} disagree: not converged")
+    if ev.batch_mu_k_sigma is not None and 2.0 * ev.batch_mu_k_sigma > MU_K_CLAIM * ev.batch_mu_k:
+        converged = False
+        flags.append(Flag.MU_K_UNCERTAIN)
+        messages.append(f"μ_k = {ev.batch_mu_k:.3f} ± {2.0 * ev.batch_mu_k_sigma:.3f} (2σ) is "
+                        f"not known within {100 * MU_K_CLAIM:.0f} %: not converged (a longer "
+                        "record of the same rotation narrows it as 1/√time)")
     if ev.turning_s < MIN_CONVERGED_ROTATION_S:
         converged = False
         flags.append(Flag.TOO_SHORT_TO_CONVERGE)

@@ -22,6 +22,7 @@ from drillfric.estimation.batch.harness import (
     Window,
     as_fc_fn,
     cycle_mean,
+    cycle_mean_error,
     fluctuation,
     prepare,
 )
@@ -84,6 +85,12 @@ class BatchDetails:
     relaxation : RelaxationCycles or None
         Stalls and bursts of a soft top drive found in the log (μ_k then not converged,
         :mod:`drillfric.estimation.relaxation`).
+    mu_k_sigma : float or None
+        Statistical 1-σ uncertainty of μ_k [-]: √2 × the standard error of the data's
+        whole-cycle mean torque over T_N (the model's mean scatters as much); None with fewer
+        than 3 whole cycles (docs/theory.md §6.4).
+    torque_cycles : int
+        Whole torque cycles the uncertainty rests on.
     """
 
     cells: int = 0
@@ -101,6 +108,8 @@ class BatchDetails:
     onset_scan: list = field(default_factory=list)
     drive: DriveModel | None = None
     relaxation: relaxation.RelaxationCycles | None = None
+    mu_k_sigma: float | None = None
+    torque_cycles: int = 0
 
 
 @dataclass(frozen=True)
@@ -228,7 +237,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     rotation = _Rotation.of(model, wins)
     kinetic = cycles = None
     if wins:
-        cycles = relaxation.find(data.t, data.speed, data.tau_bar, omega_c, rotation.target_Nm)
+        cycles = relaxation.find(data.t, data.speed, data.tau_bar, omega_c, rotation.target_Nm,
+                                 rotation.mean_speed_rad_s)
         if cycles is not None:
             flags.append(Flag.RELAXATION_CYCLES)
             messages.append(cycles.describe(max(data.dt, sample_interval_s or 0.0)))
@@ -248,6 +258,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                             rate_hz=1.0 / max(data.dt, sample_interval_s or 0.0))
     flags += static.flags
     messages += static.messages
+    if static.kinetic is not None and rotation.target_error is not None:
+        messages.append(_uncertainty_note(model, rotation, static.kinetic.mu_k, cells))
     return BatchResult(
         mu_k=None if static.kinetic is None else static.kinetic.mu_k,
         mu_k_method="mean_torque", mu_s=static.mu_s, mu_s_identifiable=static.mu_s is not None,
@@ -260,12 +272,14 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
 @dataclass(frozen=True)
 class _Rotation:
     """What the rotating windows of the data show: the whole-cycle mean string torque
-    [N·m], its fluctuation [-] and whether the data stick-slip (None/False without
-    windows)."""
+    [N·m], its fluctuation [-], whether the data stick-slip, and the mean top-drive speed
+    (a PI drive's set-point) [rad/s] (None/False/0 without windows)."""
 
     target_Nm: float | None = None
     fluctuation: float | None = None
     stick_slip: bool = False
+    mean_speed_rad_s: float = 0.0
+    target_error: tuple[float, int] | None = None  # (standard error [N·m], whole cycles)
 
     @classmethod
     def of(cls, model: Model, wins: list[Window]) -> _Rotation:
@@ -274,8 +288,9 @@ class _Rotation:
         d = model.data
         used = np.concatenate([w.used for w in wins])
         fluct = fluctuation(d.tau_bar[used])
-        return cls(cycle_mean([d.tau[w.used] for w in wins], d.dt), fluct,
-                   fluct > STICK_SLIP_FLUCTUATION)
+        series = [d.tau[w.used] for w in wins]
+        return cls(cycle_mean(series, d.dt), fluct, fluct > STICK_SLIP_FLUCTUATION,
+                   float(np.mean(d.speed[used])), cycle_mean_error(series, d.dt))
 
 
 @dataclass(frozen=True)
@@ -330,6 +345,25 @@ def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOut
                    onset, tuple(flags), tuple(messages))
 
 
+def _mu_k_sigma(model: Model, rotation: _Rotation, cells: int) -> float | None:
+    """1-σ statistical uncertainty of μ_k [-] (docs/theory.md §6.4 "Uncertainty of μ_k"): the
+    data's whole-cycle mean torque is known to its standard error, the model's — another
+    realisation of the same chaotic cycles — to as much, and the mean moves by T_N per unit
+    μ_k."""
+    if rotation.target_error is None:
+        return None
+    return float(np.sqrt(2.0) * rotation.target_error[0] / model.t_n(cells))
+
+
+def _uncertainty_note(model: Model, rotation: _Rotation, mu_k: float, cells: int) -> str:
+    """The message stating μ_k's statistical uncertainty."""
+    two_sigma = 2.0 * _mu_k_sigma(model, rotation, cells)
+    err, n = rotation.target_error
+    return (f"μ_k = {mu_k:.3f} ± {two_sigma:.3f} (2σ, ±{100 * two_sigma / mu_k:.1f} %): the "
+            f"mean torque of {n} whole cycles is known to ±{err:.0f} N·m (1σ), the model's "
+            "as well")
+
+
 def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Static,
              cycles: relaxation.RelaxationCycles | None) -> BatchDetails:
     """The traces of a fit from its stages' outcomes."""
@@ -345,4 +379,5 @@ def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Sta
         creep_grid_move=None if creep is None else creep.grid_move,
         creep_checks=None if creep is None else creep.checks,
         onset_scan=[] if static.onset is None else static.onset.scan, drive=model.drive,
-        relaxation=cycles)
+        relaxation=cycles, mu_k_sigma=_mu_k_sigma(model, rotation, cells),
+        torque_cycles=0 if rotation.target_error is None else rotation.target_error[1])

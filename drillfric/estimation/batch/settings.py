@@ -73,6 +73,9 @@ PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-
 MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
 MU_K_TOLERANCE = 0.02  #: mean torque matched to worse than this share: not converged [-]
 MU_K_REFIT_MOVE = 0.2  #: μ_k refitted when the creep μ_s moves the model's μ_s by more [-]
+#: A μ_k is claimed converged within this share [-]: its statistical uncertainty (2σ, from
+#: the scatter of the record's whole torque cycles, data and model alike) must be within it.
+MU_K_CLAIM = 0.05
 
 # --- sticking and the stick-slip-onset bound (docs/theory.md §6.2, §6.4) --------------------
 STUCK_FRACTION = 0.01  #: the model's bit sticks when this share of samples is near rest
