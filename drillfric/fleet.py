@@ -47,7 +47,7 @@ from drillfric.io.results import (
     remove_stale,
     write_json,
 )
-from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS, SEGMENT_LIST_FIELDS
+from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"
@@ -755,7 +755,7 @@ def summary_frame(outcomes) -> pd.DataFrame:
 
     Columns: :data:`drillfric.result.FLEET_WELL_COLUMNS` (well level, prefixed ``well_``),
     then every :class:`~drillfric.result.SegmentRecord` field but ``id`` (as ``segment_id``)
-    under its summary.json name, list fields as JSON text.
+    under its summary.json name, list fields as lists.
     """
     seg_fields = [f for f in SEGMENT_FIELDS if f != "id"]
     rows = []
@@ -768,8 +768,7 @@ def summary_frame(outcomes) -> pd.DataFrame:
                 "drillfric_version": s.get("drillfric_version")}
         for seg in s.get("segments") or [{}]:
             row = base | {"segment_id": seg.get("id")}
-            row |= {f: json.dumps(seg[f]) if f in SEGMENT_LIST_FIELDS and f in seg
-                    else seg.get(f) for f in seg_fields}
+            row |= {f: seg.get(f) for f in seg_fields}
             rows.append(row)
     frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields)
     frame["segment_id"] = frame["segment_id"].astype("Int64")

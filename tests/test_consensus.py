@@ -12,7 +12,7 @@ def _seg(i, mu_k, depth=2000.0, duration=40.0, converged=False, flags=(Flag.TOO_
          **kw):
     return SegmentRecord(id=i, kind=Kind.OFF_BOTTOM, status=Status.OK, mu_k=mu_k,
                          bit_depth_m=depth, duration_s=duration, converged=converged,
-                         method=Method.BATCH, flags=flags, **kw)
+                         method=Method.BATCH, quality_flags=flags, **kw)
 
 
 def test_short_segments_at_one_depth_that_agree_pool_into_a_converged_mu_k():
@@ -24,7 +24,7 @@ def test_short_segments_at_one_depth_that_agree_pool_into_a_converged_mu_k():
     assert len(pools) == 1 and pools[0]["segment_ids"] == [1, 2, 3, 4, 5]
     assert pools[0]["rotation_s"] == 200.0
     assert consensus(pooled, pools)["mu_k"] == pytest.approx(0.25, rel=0.01)
-    assert all(Flag.POOLED in r.flags and "pooled with" in r.message for r in pooled)
+    assert all(Flag.POOLED in r.quality_flags and "pooled with" in r.message for r in pooled)
 
 
 def test_pieces_that_disagree_or_lie_apart_or_are_too_few_do_not_pool():

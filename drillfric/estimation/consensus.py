@@ -37,7 +37,7 @@ def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]
 
     short = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
              and not r.converged and r.method.value == "batch" and r.mu_k is not None
-             and set(r.flags) <= _POOLABLE]
+             and set(r.quality_flags) <= _POOLABLE]
     groups: list[list[SegmentRecord]] = []
     for r in sorted(short, key=lambda r: r.bit_depth_m):
         if groups and r.bit_depth_m - groups[-1][0].bit_depth_m <= POOL_DEPTH_M:
@@ -64,7 +64,7 @@ def _pooled(record: SegmentRecord, pool: dict) -> SegmentRecord:
     note = (f"pooled with segments {', '.join(map(str, pool['segment_ids']))} at "
             f"{pool['bit_depth_m']:.0f} m: μ_k = {pool['mu_k']:.3f} over "
             f"{pool['rotation_s']:.0f} s of rotation")
-    return replace(record, flags=record.flags + (Flag.POOLED,),
+    return replace(record, quality_flags=record.quality_flags + (Flag.POOLED,),
                    message="; ".join(filter(None, [record.message, note])))
 
 

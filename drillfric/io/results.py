@@ -38,12 +38,7 @@ import pyarrow.parquet as pq
 
 from drillfric.errors import OutputError
 from drillfric.io.locks import lock_directory
-from drillfric.result import (
-    ESTIMATE_COLUMNS,
-    SEGMENT_FIELDS,
-    segment_arrow_types,
-    segment_columns,
-)
+from drillfric.result import ESTIMATE_COLUMNS, segment_table
 
 #: The file that marks a directory as written by drillfric (JSON: version, well, state).
 MARKER = ".drillfric-result"
@@ -365,6 +360,4 @@ def write_json(path: Path, payload: dict) -> None:
 def write_segments(path: Path, records) -> None:
     """segments.parquet: one row per :class:`~drillfric.result.SegmentRecord`, with the
     schema's types (a column null in every row keeps its type)."""
-    types = segment_arrow_types()
-    schema = pa.schema([(name, pa.type_for_alias(types[name])) for name in SEGMENT_FIELDS])
-    pq.write_table(pa.table(segment_columns(records), schema=schema), path)
+    pq.write_table(segment_table(records), path)

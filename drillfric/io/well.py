@@ -411,8 +411,9 @@ def default_name(path, data_path: Path) -> str:
 def safe_name(raw, where=None) -> str:
     """One safe path component from a well name (docs/security.md).
 
-    Path separators, NUL and control characters become ``_``; leading and trailing dots
-    and blanks go (no ``.``, ``..`` or hidden names); a name longer than
+    Path separators, NUL, control characters and blanks inside the name become ``_`` (a
+    folder name a shell or a nightly script need not quote; the well keeps its shown name);
+    leading and trailing dots and blanks go (no ``.``, ``..`` or hidden names); a name longer than
     :data:`MAX_NAME_BYTES` is cut and ends with a hash of the whole name, so distinct long
     names stay distinct.
 
@@ -423,12 +424,12 @@ def safe_name(raw, where=None) -> str:
 
     Examples
     --------
-    >>> safe_name("../../x"), safe_name("A-12/ST1"), safe_name(".hidden")
-    ('_.._x', 'A-12_ST1', 'hidden')
+    >>> safe_name("../../x"), safe_name("A-12/ST1"), safe_name(".hidden"), safe_name("Well 7 ST")
+    ('_.._x', 'A-12_ST1', 'hidden', 'Well_7_ST')
     """
-    text = unicodedata.normalize("NFC", str(raw))
-    text = "".join("_" if c in "/\\" or unicodedata.category(c)[0] == "C" else c
-                   for c in text).strip(". \t")
+    text = unicodedata.normalize("NFC", str(raw)).strip(". \t")
+    text = "".join("_" if c in "/\\" or unicodedata.category(c)[0] in "CZ" else c
+                   for c in text).strip(".")
     if not text or set(text) <= {"_", "."}:
         raise ConfigError(f"well name '{printable(raw)}' gives no usable directory name",
                           file=where, fix='name the well, e.g. [well] name = "A-12"')

@@ -28,7 +28,7 @@ from drillfric.io.results import (
 )
 from drillfric.io.tracks import write_tracks
 from drillfric.io.well import Well
-from drillfric.result import SegmentRecord, Status, WellResult, segment_columns
+from drillfric.result import SegmentRecord, Status, WellResult, segments_frame
 
 #: Writes the report of a result directory into it (``drillfric.report.write_well_report``
 #: with the options asked for); the run layer calls it and never imports the report.
@@ -148,7 +148,7 @@ def finish(sink: Sink, well: Well, summary: dict, records: list[SegmentRecord], 
     """The end of every run: the result files (with a :class:`DirectorySink`) and the
     :class:`~drillfric.result.WellResult`."""
     sink.finish(well, summary, records, tracks, tables or {})
-    return WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
+    return WellResult(well.name, summary, segments_frame(records),
                       failed=sum(r.status is Status.FAILED for r in records),
                       warnings=summary["warnings"], tracks=tracks, _estimates=sink.estimates())
 
