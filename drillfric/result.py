@@ -112,6 +112,39 @@ FLAG_MEANINGS = {
 }
 
 
+class WellFlag(StrEnum):
+    """Conditions a reader of a well's headline must know (summary.json ``quality_flags``)."""
+
+    MU_K_WITHHELD = "mu_k_withheld"
+    LOW_SUPPORT = "low_support"
+    WIDE_SPREAD = "wide_spread"
+    INDICATIVE = "indicative"
+    SEGMENTS_OUTSIDE_TYPICAL_RANGE = "segments_outside_typical_range"
+    STRING_WEIGHT_INCONSISTENT = "string_weight_inconsistent"
+    HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
+    SEGMENTS_FAILED = "segments_failed"
+
+
+#: What each well flag means (docs/outputs.md); each comes with a line in ``warnings``.
+WELL_FLAG_MEANINGS = {
+    WellFlag.MU_K_WITHHELD: "segments were estimated but none gives a well μ_k (null): "
+                            "mu_k_reason says why",
+    WellFlag.LOW_SUPPORT: "the well μ_k rests on fewer than 3 segments (mu_k_support)",
+    WellFlag.WIDE_SPREAD: "mu_k_uncertainty is above 25 % of the well μ_k: its segments "
+                          "disagree",
+    WellFlag.INDICATIVE: "defaults were assumed (assumed, e.g. no survey): the numbers are "
+                         "indicative",
+    WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE: "segments flagged outside_typical_range "
+                                             "(μ outside 0.05–0.8)",
+    WellFlag.STRING_WEIGHT_INCONSISTENT: "in off-bottom segments the modelled rotating hook "
+                                         "load exceeds the measured one by more than 5 % "
+                                         "(the report's string-weight check)",
+    WellFlag.HOOKLOAD_CONTRADICTS_STRING: "the hook-load check withheld segments' friction "
+                                          "factors (hookload, docs/theory.md §2.1)",
+    WellFlag.SEGMENTS_FAILED: "segments whose estimation failed (counts.failed)",
+}
+
+
 def _f(unit: str, doc: str, default=None, **kw):
     """A schema field with its unit and meaning."""
     return field(default=default, metadata={"unit": unit, "doc": doc}, **kw)
@@ -314,8 +347,12 @@ def outputs_markdown() -> str:
     lines += ["", "## estimates.parquet", "", "| column | type | unit | meaning |",
               "|---|---|---|---|"]
     lines += [f"| `{c.name}` | {c.type} | {c.unit} | {c.doc} |" for c in ESTIMATE_COLUMNS]
-    lines += ["", "## flags", "", "| flag | meaning |", "|---|---|"]
+    lines += ["", "## flags (segments' `quality_flags`)", "", "| flag | meaning |",
+              "|---|---|"]
     lines += [f"| `{f.value}` | {FLAG_MEANINGS[f]} |" for f in Flag]
+    lines += ["", "## well flags (summary.json `quality_flags`)", "", "| flag | meaning |",
+              "|---|---|"]
+    lines += [f"| `{f.value}` | {WELL_FLAG_MEANINGS[f]} |" for f in WellFlag]
     return "\n".join(lines) + "\n"
 
 

@@ -18,6 +18,7 @@ import pandas as pd
 
 from drillfric._version import __version__
 from drillfric.estimation.consensus import consensus
+from drillfric.estimation.headline import judge as judge_headline
 from drillfric.friction import FrictionProfile
 from drillfric.io.results import (
     EstimatesWriter,
@@ -147,6 +148,7 @@ def finish(sink: Sink, well: Well, summary: dict, records: list[SegmentRecord], 
            tables: dict[str, pd.DataFrame] | None = None) -> WellResult:
     """The end of every run: the result files (with a :class:`DirectorySink`) and the
     :class:`~drillfric.result.WellResult`."""
+    summary.update(judge_headline(summary))
     sink.finish(well, summary, records, tracks, tables or {})
     return WellResult(well.name, summary, segments_frame(records),
                       failed=sum(r.status is Status.FAILED for r in records),
