@@ -52,7 +52,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.config import Config, config_from_dict, read_toml
-from drillfric.errors import ConfigError, InputError
+from drillfric.errors import ConfigError, DrillfricError, InputError
 from drillfric.files import require_file, special
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
@@ -728,8 +728,25 @@ def _open(files: WellFiles, cfg: Config,
     channels = cfg.channels
     if index == "depth" and raw.depth_index is not None and "measured_depth" not in channels:
         channels = channels | {"measured_depth": {"column": split_unit(raw.depth_index)[0]}}
-    mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index)
+    mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index,
+                            log_shaped=lambda: log_shaped(raw))
     return raw, _clock_time(raw, mappings)
+
+
+def log_shaped(raw: RawSource, rows: int = 50) -> bool:
+    """Whether a data file is recognisably a data log though none of its column names is
+    known: its first ``rows`` rows hold numbers in at least two columns, and in at least
+    half of them (then its header may be quoted in a message, docs/security.md; a file named
+    by mistake — a list of secrets — is text)."""
+    try:
+        head = next(iter(raw.chunks(rows)), None)
+    except DrillfricError:
+        return False
+    if head is None or not len(head) or head.shape[1] < 2:
+        return False
+    numeric = sum(pd.to_numeric(head[c], errors="coerce").notna().mean() >= 0.9
+                  for c in head.columns if head[c].notna().any())
+    return numeric >= 2 and numeric >= head.shape[1] / 2
 
 
 def frame_source(frame: pd.DataFrame) -> RawSource:
