@@ -75,10 +75,10 @@ def status(seg: dict, rate: str) -> tuple[str, str]:
         return "withheld", "no μ_k: " + (seg["message"] or "")[:80]
     if seg["converged"]:
         within = abs(mu / MU_K - 1.0) <= tol
-        return ("converged" if within else "FALSE"), ", ".join(seg["flags"])
-    reasons = [f for f in seg["flags"] if f not in ("observer_not_converged",
+        return ("converged" if within else "FALSE"), ", ".join(seg["quality_flags"])
+    reasons = [f for f in seg["quality_flags"] if f not in ("observer_not_converged",
                                                     "observer_deadlock_averted")]
-    return "withheld", ", ".join(reasons) or ", ".join(seg["flags"])
+    return "withheld", ", ".join(reasons) or ", ".join(seg["quality_flags"])
 
 
 def run_case(kp: float, ki: float, rates, work: Path, zeta: float) -> list[dict]:
@@ -99,10 +99,10 @@ def run_case(kp: float, ki: float, rates, work: Path, zeta: float) -> list[dict]
         segs = [g for g in summary["segments"] if g["status"] == "ok"]
         pooled = [p["mu_k"] for p in summary["pooled"]]
         well_row = {"mu_k": summary["mu_k"], "converged": summary["mu_k"] is not None,
-                    "flags": ["well consensus" + (f" with {len(pooled)} pool(s)" if pooled
+                    "quality_flags": ["well consensus" + (f" with {len(pooled)} pool(s)" if pooled
                                                   else "")],
                     "message": "no converged segment"}
-        for g in (segs or [{"mu_k": None, "converged": False, "flags": [], "message":
+        for g in (segs or [{"mu_k": None, "converged": False, "quality_flags": [], "message":
                             "no segment estimated"}]) + [well_row]:
             st, why = status(g, rate)
             row = {"kp": kp, "ki": ki, "rate": rate, "cycles": cycles, "mu_k": g["mu_k"],

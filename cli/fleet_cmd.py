@@ -27,9 +27,12 @@ def _closing_line(result) -> str:
     ok, skipped, failed = (result.count(s) for s in ("ok", "skipped", "failed"))
     total = len(result.wells)
     if skipped == total:
-        return (f"fleet: all {total} wells skipped (unchanged since the last run; --force to "
+        return (f"fleet: all {total} wells ok (unchanged since the last run; --force to "
                 f"redo them) — {result.out_root}")
-    parts = [f"{ok} processed", f"{skipped} skipped (unchanged)", f"{failed} failed"]
+    parts = [f"{ok + skipped} ok ({ok} processed, {skipped} unchanged)", f"{failed} failed"]
+    stale = sum(w.stale_dir is not None for w in result.wells)
+    if stale:
+        parts.append(f"{stale} failed well(s) keep an earlier run's results, marked stale")
     if result.failed_segments:
         parts.append(f"{result.failed_segments} segments failed")
     return (f"fleet: {total} wells — {', '.join(parts)} in {result.wall_s:.1f} s — "

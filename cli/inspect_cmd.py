@@ -37,16 +37,38 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
     from drillfric.io.well import open_well
 
     opened = open_well(well, config=config_file, survey=survey_file)
+    refused = None
     if opened.depth_indexed:
         summary = summarize_depth_log(opened)
     else:
-        summary = summarize(opened.load())
+        data = opened.load()
+        summary = summarize(data)
+        refused = run_refusal(opened, data)
+        summary["run_refuses"] = None if refused is None else refused.message
     if as_json:
         click.echo(json.dumps(summary, indent=2))
-        return
-    system = unit_system(units, opened.config)
-    text = render_depth_log(summary, system) if opened.depth_indexed else render(summary, system)
-    click.echo(terminal_text(text))  # the result: printed even with --quiet
+    else:
+        system = unit_system(units, opened.config)
+        text = render_depth_log(summary, system) if opened.depth_indexed else \
+            render(summary, system)
+        click.echo(terminal_text(text))  # the result: printed even with --quiet
+    if refused is not None:  # what `run` would refuse: the same line and exit code
+        raise refused
+
+
+def run_refusal(well, data):
+    """The error ``drillfric run`` would stop this time log with (the checks of the log as
+    a whole, :class:`drillfric.io.logcheck.LogCheck`), or None."""
+    from drillfric.errors import InputError
+    from drillfric.io.logcheck import LogCheck
+
+    check = LogCheck(well)
+    try:
+        check.feed(data.surface)
+        check.finish(data.timebase.duplicates_dropped)
+    except InputError as exc:
+        return exc
+    return None
 
 
 def summarize(data) -> dict:

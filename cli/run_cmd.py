@@ -74,7 +74,20 @@ def _describe(result, units: str = "si") -> str:
         else "not identifiable")
     return (f"{result.well}: {c['segments']} segments ({c['estimated']} estimated, "
             f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed"
-            f"{_depths(s['segments'], units)}); μ_k = {_fmt(s['mu_k'])}, μ_s = {mu_s}")
+            f"{_depths(s['segments'], units)}); {_mu_k_text(s)}, μ_s = {mu_s}")
+
+
+def _mu_k_text(summary: dict) -> str:
+    """The well μ_k with its uncertainty, support and confidence, or why there is none."""
+    if summary["mu_k"] is None:
+        state = summary.get("mu_k_confidence")
+        return f"μ_k {state}" if state in ("withheld", "none") else "μ_k = —"
+    u, support = summary.get("mu_k_uncertainty"), summary.get("mu_k_support") or {}
+    text = f"μ_k = {_fmt(summary['mu_k'])}" + (f" ± {_fmt(u)}" if u is not None else "")
+    if "of" in support:
+        text += f" ({support['segments']} of {support['of']} off-bottom segments"
+        text += ", low confidence)" if summary.get("mu_k_confidence") == "low" else ")"
+    return text
 
 
 def _describe_depth_log(result, units: str) -> str:
@@ -182,10 +195,13 @@ def _run_one(well, out, rate, pdf, report, tick):
 def _print(result, units: str | None = None) -> None:
     """Warnings, the result line (in ``--units``, else the well's ``[well] units``) and the
     report's path (only when it was written)."""
+    from drillfric.estimation.headline import INDICATIVE_WARNING
+
     for note in result.summary["assumed"]:
         warn(f"{result.well}: assumed {note} — the numbers are indicative")
     for note in result.warnings:
-        warn(f"{result.well}: {note}")
+        if not note.startswith(INDICATIVE_WARNING):  # the assumed lines above say it
+            warn(f"{result.well}: {note}")
     system = unit_system(units, result.summary.get("config", {}))
     click.echo(terminal_text(_describe(result, system)))  # printed even with --quiet
     if result.report is not None:

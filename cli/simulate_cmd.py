@@ -42,6 +42,17 @@ def _load(config: Path, survey: Path | None, overrides: dict, omega_c_rpm: float
     return cfg, survey_path, well_path
 
 
+def _say_scenario_duration(duration: float, used: Path, plan) -> None:
+    """Warn what --duration does with a scenario: it is a stand's rotating time only where
+    the scenario (its stand or its [defaults]) states none, and the record is as long as the
+    scenario's stands and connections."""
+    took = sum(s.duration_s == duration for s in plan.stands)
+    warn(f"--duration {duration:g} s with the scenario {used.name}: the rotating time of the "
+         f"stands that state none ({took} of {len(plan.stands)}); the record lasts "
+         f"{plan.total_s:.0f} s. For one stand of {duration:g} s give --bit-depth (the "
+         "scenario is then not used)")
+
+
 @click.command("simulate")
 @click.argument("config", type=click.Path(path_type=Path))
 @click.option("--out", "out", required=True, type=click.Path(path_type=Path),
@@ -92,9 +103,11 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
                            bit_depth=bit_depth, rpm=rpm, seed=seed, rpm_noise=rpm_noise,
                            torque_noise=torque_noise, wob=wob, cells=cells)
     cfg, survey_path, well_path = _load(config, survey, overrides, omega_c_rpm)
-    _, plan = sim.plan(cfg, config, well_path, scenario,
-                       single=bit_depth is not None and scenario is None)
+    used, plan = sim.plan(cfg, config, well_path, scenario,
+                          single=bit_depth is not None and scenario is None)
     sim.check_depths(plan, well_path, survey_path)
+    if duration is not None and used is not None:
+        _say_scenario_duration(duration, used, plan)
     with progress("simulating", plan.total_s) as advance:
         result = sim.simulate(cfg, well_path, plan, progress=advance)
     for note in result.notes:

@@ -21,7 +21,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.well import Well, open_well
-from drillfric.result import RunProgress, WellResult
+from drillfric.result import RunProgress, WellResult, segments_from_json
 from drillfric.runner import run_well
 
 __all__ = ["open_well", "run", "load_result", "torque_and_drag", "simulate", "Well",
@@ -80,7 +80,8 @@ def load_result(result_dir) -> WellResult:
         raise InputError("not a drillfric result directory (no readable summary.json)",
                          file=folder, fix="give OUT/NAME of a 'drillfric run'") from exc
     segments = pd.read_parquet(folder / "segments.parquet") if (
-        folder / "segments.parquet").is_file() else pd.DataFrame(summary.get("segments", []))
+        folder / "segments.parquet").is_file() else segments_from_json(
+        summary.get("segments", []))
     return WellResult(summary.get("well", folder.name), summary, segments, out_dir=folder,
                       failed=summary.get("counts", {}).get("failed", 0),
                       warnings=list(summary.get("warnings", [])))

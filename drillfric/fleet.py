@@ -42,12 +42,13 @@ from drillfric.io.results import (
     check_distinct,
     file_sha256,
     jsonable,
+    mark_stale,
     missing_dirs,
     remove_empty,
     remove_stale,
     write_json,
 )
-from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS, SEGMENT_LIST_FIELDS
+from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"
@@ -415,6 +416,8 @@ class WellOutcome:
     task_s : float
         Time inside the task (0 when skipped) [s].
     attempts : int
+    stale_dir : Path or None
+        A failed well's OUT/NAME holding an earlier run's results, marked stale.
     """
 
     well: str
@@ -425,6 +428,7 @@ class WellOutcome:
     failed_segments: int = 0
     task_s: float = 0.0
     attempts: int = 0
+    stale_dir: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -629,11 +633,32 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
             entry.update(status="failed", message=f"{out}: the worker wrote its result where "
                          "this machine cannot see it — fix: put OUT on storage shared by the "
                          "client and every worker")
+    stale = _mark_stale(manifest, name, job, rec, entry) if entry["status"] == "failed" \
+        else None
     manifest.wells[name] = entry
     return WellOutcome(name, entry["status"], entry["message"],
                        Path(rec["out_dir"]) if entry["status"] == "ok" else None,
                        rec.get("summary") if entry["status"] == "ok" else None,
-                       entry["failed_segments"], rec.get("task_s", 0.0), attempts)
+                       entry["failed_segments"], rec.get("task_s", 0.0), attempts, stale)
+
+
+def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
+                entry: dict) -> Path | None:
+    """Mark an earlier run's results of a well that failed now as stale (OUT/NAME of its
+    earlier entry, else of its name): they stay, marked (docs/fleet.md "Stale results")."""
+    if manifest.path is None:
+        return None
+    out_root = manifest.path.parent.resolve()
+    earlier = (manifest.wells.get(name) or {}).get("outputs", {}).get("dir")
+    folder = Path(earlier) if earlier else out_root / (rec.get("dir_name") or job.dir_name)
+    try:
+        if folder.resolve().parent != out_root or \
+                not mark_stale(folder, entry["message"], _now()):
+            return None
+    except OSError:
+        return None
+    entry["stale_outputs"] = str(folder)
+    return folder
 
 
 def _skipped(name: str, entry: dict) -> WellOutcome:
@@ -762,7 +787,7 @@ def summary_frame(outcomes) -> pd.DataFrame:
 
     Columns: :data:`drillfric.result.FLEET_WELL_COLUMNS` (well level, prefixed ``well_``),
     then every :class:`~drillfric.result.SegmentRecord` field but ``id`` (as ``segment_id``)
-    under its summary.json name, list fields as JSON text.
+    under its summary.json name, list fields as lists.
     """
     seg_fields = [f for f in SEGMENT_FIELDS if f != "id"]
     rows = []
@@ -770,13 +795,13 @@ def summary_frame(outcomes) -> pd.DataFrame:
         s = o.summary or {}
         base = {"well": o.well, "well_status": o.status, "well_message": o.message,
                 "result_dir": None if o.result_dir is None else str(o.result_dir),
+                "stale_result_dir": None if o.stale_dir is None else str(o.stale_dir),
                 "well_mu_s": s.get("mu_s"), "well_mu_k": s.get("mu_k"),
                 "well_mu_s_lower_bound": s.get("mu_s_lower_bound"),
                 "drillfric_version": s.get("drillfric_version")}
         for seg in s.get("segments") or [{}]:
             row = base | {"segment_id": seg.get("id")}
-            row |= {f: json.dumps(seg[f]) if f in SEGMENT_LIST_FIELDS and f in seg
-                    else seg.get(f) for f in seg_fields}
+            row |= {f: seg.get(f) for f in seg_fields}
             rows.append(row)
     frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields)
     frame["segment_id"] = frame["segment_id"].astype("Int64")
@@ -798,7 +823,8 @@ def _write_report(out_root: Path, outcomes) -> tuple[Path | None, tuple[str, ...
     if not hasattr(report, "write_fleet_report"):
         return None, ("fleet.html not written: this version has no fleet report",)
     items = [{"well": o.well, "status": o.status, "message": o.message,
-              "result_dir": o.result_dir, "summary": o.summary} for o in outcomes]
+              "result_dir": o.result_dir, "summary": o.summary, "stale_dir": o.stale_dir}
+             for o in outcomes]
     try:
         return report.write_fleet_report(out_root, items), ()
     except Exception as exc:  # noqa: BLE001 — the night's results are already written

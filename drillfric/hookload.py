@@ -400,7 +400,7 @@ def _withhold(record: SegmentRecord, why: str) -> SegmentRecord:
     nulls = {name: None for name in _WITHHELD}
     message = "; ".join(filter(None, [record.message, f"friction factors withheld: {why}"]))
     return replace(record, **nulls, converged=False, message=message,
-                   flags=record.flags + (Flag.HOOKLOAD_CONTRADICTS_STRING,))
+                   quality_flags=record.quality_flags + (Flag.HOOKLOAD_CONTRADICTS_STRING,))
 
 
 def judge(records: list, plateaus: list[Plateau], cfg,
@@ -449,7 +449,7 @@ def judge(records: list, plateaus: list[Plateau], cfg,
             withheld.append(r.id)
         elif calibration is not None and calibration.scale is not None \
                 and r.status is Status.OK:
-            out.append(replace(r, flags=r.flags + (Flag.STRING_WEIGHT_CALIBRATED,)))
+            out.append(replace(r, quality_flags=r.quality_flags + (Flag.STRING_WEIGHT_CALIBRATED,)))
         else:
             out.append(r)
     summary.update(verdict="contradicted" if well_problem else (

@@ -10,13 +10,13 @@ every column of ``estimates.parquet`` from :data:`ESTIMATE_COLUMNS`. Units are i
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass, field, fields
 from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 
 
 class Status(StrEnum):
@@ -122,6 +122,39 @@ FLAG_MEANINGS = {
 }
 
 
+class WellFlag(StrEnum):
+    """Conditions a reader of a well's headline must know (summary.json ``quality_flags``)."""
+
+    MU_K_WITHHELD = "mu_k_withheld"
+    LOW_SUPPORT = "low_support"
+    WIDE_SPREAD = "wide_spread"
+    INDICATIVE = "indicative"
+    SEGMENTS_OUTSIDE_TYPICAL_RANGE = "segments_outside_typical_range"
+    STRING_WEIGHT_INCONSISTENT = "string_weight_inconsistent"
+    HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
+    SEGMENTS_FAILED = "segments_failed"
+
+
+#: What each well flag means (docs/outputs.md); each comes with a line in ``warnings``.
+WELL_FLAG_MEANINGS = {
+    WellFlag.MU_K_WITHHELD: "segments were estimated but none gives a well μ_k (null): "
+                            "mu_k_reason says why",
+    WellFlag.LOW_SUPPORT: "the well μ_k rests on fewer than 3 segments (mu_k_support)",
+    WellFlag.WIDE_SPREAD: "mu_k_uncertainty is above 25 % of the well μ_k: its segments "
+                          "disagree",
+    WellFlag.INDICATIVE: "defaults were assumed (assumed, e.g. no survey): the numbers are "
+                         "indicative",
+    WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE: "segments flagged outside_typical_range "
+                                             "(μ outside 0.05–0.8)",
+    WellFlag.STRING_WEIGHT_INCONSISTENT: "in off-bottom segments the modelled rotating hook "
+                                         "load exceeds the measured one by more than 5 % "
+                                         "(the report's string-weight check)",
+    WellFlag.HOOKLOAD_CONTRADICTS_STRING: "the hook-load check withheld segments' friction "
+                                          "factors (hookload, docs/theory.md §2.1)",
+    WellFlag.SEGMENTS_FAILED: "segments whose estimation failed (counts.failed)",
+}
+
+
 def _f(unit: str, doc: str, default=None, **kw):
     """A schema field with its unit and meaning."""
     return field(default=default, metadata={"unit": unit, "doc": doc}, **kw)
@@ -166,9 +199,10 @@ class SegmentRecord:
     mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")
     T_N_Nm: float | None = _f("N·m", "∫F_c dx at this depth: torque per unit friction factor")
     bit_rms_error_rpm: float | None = _f("RPM", "RMS error of the bit speed (synthetic truth)")
-    flags: tuple[Flag, ...] = _f("", "conditions to know (Flag)", ())
-    starts: tuple[tuple[float, float], ...] = _f("-", "observer starts (μ_s, μ_k) by start_id",
-                                                 ())
+    quality_flags: tuple[Flag, ...] = _f("", "conditions to know (Flag; a list, not JSON "
+                                             "text)", ())
+    starts: tuple[tuple[float, float], ...] = _f("-", "observer starts (μ_s, μ_k) by "
+                                                      "start_id (a list of pairs)", ())
     friction_zone: str | None = _f("", "which factor μ is: open_hole (cased part known from "
                                        "the configuration) or effective (torque-weighted over "
                                        "the whole string)")
@@ -246,8 +280,8 @@ class SegmentRecord:
 SEGMENT_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(SegmentRecord))
 #: The binding keys of the interface (the first fields).
 SEGMENT_KEYS: tuple[str, ...] = SEGMENT_FIELDS[:18]
-#: Fields stored as JSON text in segments.parquet (lists).
-SEGMENT_LIST_FIELDS = ("flags", "starts", "bit_torque_evidence")
+#: List fields (Arrow lists in segments.parquet, Python lists in summary.json).
+SEGMENT_LIST_FIELDS = ("quality_flags", "starts", "bit_torque_evidence")
 #: Numeric fields (null is NaN in tables).
 SEGMENT_NUMBER_FIELDS: tuple[str, ...] = tuple(
     f.name for f in fields(SegmentRecord) if f.type in ("float", "float | None"))
@@ -295,7 +329,8 @@ SEEDED_START_ID = -1
 
 
 #: Well-level columns of fleet_summary.parquet (before the segment fields).
-FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "result_dir", "well_mu_s",
+FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "result_dir",
+                      "stale_result_dir", "well_mu_s",
                       "well_mu_k", "well_mu_s_lower_bound", "drillfric_version", "segment_id")
 
 
@@ -312,18 +347,46 @@ def _plain(value):
 
 
 def segment_columns(records) -> dict[str, list]:
-    """segments.parquet as columns (list fields as JSON text)."""
+    """segments.parquet as columns of plain values (list fields as lists)."""
     rows = [r.to_json() for r in records]
-    return {name: [json.dumps(row[name]) if name in SEGMENT_LIST_FIELDS else row[name]
-                   for row in rows] for name in SEGMENT_FIELDS}
+    return {name: [row[name] for row in rows] for name in SEGMENT_FIELDS}
 
 
-def segment_arrow_types() -> dict[str, str]:
+def segment_arrow_types() -> dict[str, pa.DataType]:
     """Arrow type of every segments.parquet column (a column null in every row keeps its
-    type): numbers float64, flags and counts as declared, text and JSON lists string."""
+    type): numbers float64, flags and counts as declared, text string, ``quality_flags``
+    a list of strings and ``starts`` a list of (μ_s, μ_k) pairs."""
     kinds = {"float": "float64", "float | None": "float64", "int": "int32", "bool": "bool",
-             "bool | None": "bool"}
-    return {f.name: kinds.get(f.type, "string") for f in fields(SegmentRecord)}
+             "bool | None": "bool", "tuple[Flag, ...]": "list<string>",
+             "tuple[tuple[float, float], ...]": "list<list<float64>>"}
+    return {f.name: _ARROW[kinds.get(f.type, "string")] for f in fields(SegmentRecord)}
+
+
+def segment_table(records) -> pa.Table:
+    """segments.parquet as an Arrow table with the schema's types (lists as Arrow lists)."""
+    schema = pa.schema(list(segment_arrow_types().items()))
+    return pa.table(segment_columns(records), schema=schema)
+
+
+def segments_frame(records) -> pd.DataFrame:
+    """The segments as pandas reads segments.parquet back: missing numbers NaN, lists as
+    arrays (the same table from :func:`drillfric.api.run` and ``load_result``)."""
+    return segment_table(records).to_pandas()
+
+
+def segments_from_json(rows: list[dict]) -> pd.DataFrame:
+    """summary.json's ``segments`` as :func:`segments_frame` gives them (missing numbers NaN);
+    a key this version does not know is kept as it is."""
+    frame = pd.DataFrame(rows)
+    for name in SEGMENT_NUMBER_FIELDS:
+        if name in frame:
+            frame[name] = pd.to_numeric(frame[name], errors="coerce").astype(float)
+    return frame
+
+
+_ARROW = {"float64": pa.float64(), "int32": pa.int32(), "bool": pa.bool_(),
+          "string": pa.string(), "list<string>": pa.list_(pa.string()),
+          "list<list<float64>>": pa.list_(pa.list_(pa.float64()))}
 
 
 def outputs_markdown() -> str:
@@ -335,8 +398,12 @@ def outputs_markdown() -> str:
     lines += ["", "## estimates.parquet", "", "| column | type | unit | meaning |",
               "|---|---|---|---|"]
     lines += [f"| `{c.name}` | {c.type} | {c.unit} | {c.doc} |" for c in ESTIMATE_COLUMNS]
-    lines += ["", "## flags", "", "| flag | meaning |", "|---|---|"]
+    lines += ["", "## flags (segments' `quality_flags`)", "", "| flag | meaning |",
+              "|---|---|"]
     lines += [f"| `{f.value}` | {FLAG_MEANINGS[f]} |" for f in Flag]
+    lines += ["", "## well flags (summary.json `quality_flags`)", "", "| flag | meaning |",
+              "|---|---|"]
+    lines += [f"| `{f.value}` | {WELL_FLAG_MEANINGS[f]} |" for f in WellFlag]
     return "\n".join(lines) + "\n"
 
 

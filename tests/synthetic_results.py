@@ -81,7 +81,7 @@ def add_evidence_files(result_dir: Path, log_csv: Path, *, clock: str | None = N
         _segment_keys(seg, rows, span, solve_config(cfg, path, seg["bit_depth_m"]).hookload_N,
                       summary.get("time_origin_utc"))
     (result_dir / "summary.json").write_text(json.dumps(summary), encoding="utf-8")
-    pd.DataFrame(summary["segments"]).drop(columns=["flags", "starts"]).to_parquet(
+    pd.DataFrame(summary["segments"]).drop(columns=["quality_flags", "starts"]).to_parquet(
         result_dir / "segments.parquet", index=False)
     return result_dir
 
@@ -157,7 +157,8 @@ def synthetic_result(out: Path, *, hours: float = 24.0, log_rate_hz: float = 100
                           "converged": n_segments, "skipped": 0, "failed": 0},
                "time_origin_utc": "2024-05-01T00:00:00+00:00", "warnings": []}
     (out / "summary.json").write_text(json.dumps(summary), encoding="utf-8")
-    pd.DataFrame(segments).drop(columns=["flags", "starts"]).to_parquet(out / "segments.parquet")
+    pd.DataFrame(segments).drop(columns=["quality_flags", "starts"]).to_parquet(
+        out / "segments.parquet")
     return out
 
 
@@ -234,7 +235,7 @@ def _synthetic_segment(seg_id, t0, segment_s, depth, n_starts, rng) -> dict:
             "torque_swing_Nm": 12e3, "fit_quality": 450.0 / 12e3,
             "surface_torque_mean_Nm": 18e3, "hookload_N": 7e5 + 0.1e3 * depth,
             "hookload_model_N": 6.2e5 + 0.1e3 * depth, "bit_speed_resolved": True,
-            "bit_speed_reason": "", "friction_zone": "open_hole", "flags": [],
+            "bit_speed_reason": "", "friction_zone": "open_hole", "quality_flags": [],
             "sample_interval_s": 0.01, "interval_torque_swing": None,
             "clock_start_utc": None, "clock_end_utc": None,
             "starts": [[0.3, 0.2], [0.6, 0.4], [0.9, 0.1], [0.5, 0.3]][:n_starts]}

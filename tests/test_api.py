@@ -172,3 +172,30 @@ def test_dir_lists_the_public_api():
 
     assert dir(drillfric) == sorted(drillfric.__all__)
     assert {"open_well", "run", "WellResult"} <= set(dir(drillfric))
+
+
+@pytest.mark.slow
+def test_pandas_friendly_results_flags_column_clash_none_vs_nan_json_lists_spaces(stand,
+                                                                                  tmp_path):
+    """Issue 25 item 9: no column shadows a DataFrame attribute (``flags``), missing numbers
+    are NaN from run() as from load_result(), lists are lists (Arrow lists on disk), and a
+    well name with blanks gives a folder name without them (the name shown stays)."""
+    import pandas as pd
+    import pyarrow.parquet as pq
+
+    import drillfric
+
+    ran = drillfric.run(stand, tmp_path, report=False, name="Well 7 ST")
+    loaded = drillfric.load_result(ran.out_dir)
+    assert ran.out_dir.name == "Well_7_ST" and ran.well == loaded.well == "Well 7 ST"
+    for frame in (ran.segments, loaded.segments):
+        assert "flags" not in frame.columns
+        assert isinstance(frame.flags, pd.Flags)  # pandas' own attribute, not a column
+        assert list(frame.quality_flags.iloc[0]) == list(
+            ran.summary["segments"][0]["quality_flags"])
+        assert len(frame.starts.iloc[0]) and len(frame.starts.iloc[0][0]) == 2
+        assert frame["mu_s"].dtype == "float64" and frame["mu_s_spread"].dtype == "float64"
+    pd.testing.assert_frame_equal(ran.segments, loaded.segments)
+    schema = pq.read_schema(ran.out_dir / "segments.parquet")
+    assert str(schema.field("quality_flags").type) == "list<element: string>"
+    assert str(schema.field("starts").type) == "list<element: list<element: double>>"

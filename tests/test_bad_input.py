@@ -186,3 +186,58 @@ def test_torque_in_Nm_read_as_default_kNm_fails_its_segments(tmp_path):
         assert "x the top of the torque-and-drag range" in seg["message"]
         assert "read as kN.m (default)" in seg["message"]
         assert 'set [channels] surface_torque = { unit = "N.m" }' in seg["message"]
+
+
+# ------------------------------------------------------------------ issue 25 item 10
+def test_text_line_at_data_row_3_is_named_as_row_3(tmp_path):
+    """A logger's note among the samples was reported as "cannot read '0' at data row 1"."""
+    bad = tmp_path / "w.csv"
+    bad.write_text("time_s,surface_rpm,surface_torque_Nm\n0,60,10\n0.5,60,10\n"
+                   "logger restarted\n1.0,60,10\n1.5,60,10\n")
+    line = _one_line_error(_invoke("run", bad, "--out", tmp_path / "o"), "w.csv")
+    assert "cannot read 'logger restarted' at data row 3" in line
+    assert "'0'" not in line and not (tmp_path / "o").exists()
+
+
+def test_unknown_column_names_of_a_data_log_are_listed(tmp_path):
+    """A file of numbers under unknown names is recognisably a data log: its header is
+    listed; a text file named by mistake still is not quoted."""
+    log = tmp_path / "w.csv"
+    log.write_text("Zeit,Drehzahl,Moment\n0,60,10\n0.5,61,11\n1.0,62,12\n")
+    line = _one_line_error(_invoke("inspect", log), "w.csv")
+    assert "columns found: Zeit, Drehzahl, Moment" in line
+    secrets = tmp_path / "s.csv"
+    secrets.write_text("API_KEY=hunter2\nTOKEN=abc\n")
+    line = _one_line_error(_invoke("inspect", secrets), "s.csv")
+    assert "hunter2" not in line and "not shown" in line
+
+
+@pytest.mark.parametrize("unit, says", [
+    ("kNmx", "unknown unit 'kNmx' for surface_torque_Nm: no torque unit is spelled so"),
+    ("kg", "unit 'kg' of surface_torque_Nm is not a torque unit (it measures [mass])"),
+])
+def test_bad_unit_in_channels_says_what_is_wrong_and_lists_accepted_units(tmp_path, unit,
+                                                                          says):
+    """A bad [channels] unit was answered with "state it in [channels]" — where it was."""
+    shutil.copy(DEMO / "demo.csv", tmp_path / "w.csv")
+    (tmp_path / "w.toml").write_text(f'[channels]\nsurface_torque = {{ unit = "{unit}" }}\n')
+    line = _one_line_error(_invoke("inspect", tmp_path / "w.csv"), "w.csv")
+    assert says in line and "kn.m, ft.lbf, kft.lbf" in line
+    assert "state it in [channels]" not in line
+
+
+def test_inspect_refuses_what_run_refuses_slow_witsml(tmp_path):
+    """A WITSML log sampled every 30 s passed inspect, then run refused it over
+    segmentation.max_gap_s: inspect now shows the log and ends with run's error (exit 2)."""
+    quirk = REPO / "tests" / "fixtures" / "vendor_quirks" / \
+        "witsml_time_log_after_depth_log_mnemonic_order_unitless_index_cps.xml"
+    slow = tmp_path / "slow.xml"
+    slow.write_text(quirk.read_text().replace("21:23:01.000Z", "21:23:30.000Z")
+                    .replace("21:23:02.000Z", "21:24:00.000Z"))
+    ran = _invoke("run", slow, "--out", tmp_path / "o")
+    inspected = _invoke("inspect", slow)
+    assert ran.exit_code == inspected.exit_code == 2
+    refusal = ran.output.strip().splitlines()[-1]
+    assert "segmentation.max_gap_s" in refusal and inspected.output.strip().endswith(refusal)
+    as_json = _invoke("inspect", slow, "--json")
+    assert as_json.exit_code == 2 and "segmentation.max_gap_s" in as_json.output

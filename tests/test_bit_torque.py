@@ -49,7 +49,7 @@ def test_short_rotations_a_stand_apart_pool_into_a_friction_log():
     assert len(pools) == 1 and pools[0]["segment_ids"] == [2, 4, 6, 8, 10]
     assert pools[0]["mu_k"] == pytest.approx(0.2446, abs=1e-3)
     assert (pools[0]["md_from_m"], pools[0]["md_to_m"]) == (2146.0, 2258.0)
-    assert all(Flag.POOLED in r.flags for r in records)
+    assert all(Flag.POOLED in r.quality_flags for r in records)
 
 
 def test_pieces_too_far_apart_in_friction_torque_or_too_scattered_do_not_pool():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from drillfric.estimation.consensus import consensus, pool_short_segments
@@ -12,7 +13,7 @@ def _seg(i, mu_k, depth=2000.0, duration=40.0, converged=False, flags=(Flag.TOO_
          **kw):
     return SegmentRecord(id=i, kind=Kind.OFF_BOTTOM, status=Status.OK, mu_k=mu_k,
                          bit_depth_m=depth, duration_s=duration, converged=converged,
-                         method=Method.BATCH, flags=flags, **kw)
+                         method=Method.BATCH, quality_flags=flags, **kw)
 
 
 def test_short_segments_at_one_depth_that_agree_pool_into_a_converged_mu_k():
@@ -24,7 +25,7 @@ def test_short_segments_at_one_depth_that_agree_pool_into_a_converged_mu_k():
     assert len(pools) == 1 and pools[0]["segment_ids"] == [1, 2, 3, 4, 5]
     assert pools[0]["rotation_s"] == 200.0
     assert consensus(pooled, pools)["mu_k"] == pytest.approx(0.25, rel=0.01)
-    assert all(Flag.POOLED in r.flags and "pooled with" in r.message for r in pooled)
+    assert all(Flag.POOLED in r.quality_flags and "pooled with" in r.message for r in pooled)
 
 
 def test_pieces_that_disagree_or_lie_apart_or_are_too_few_do_not_pool():
@@ -42,5 +43,26 @@ def test_consensus_uses_converged_segments_and_never_invents_mu_s():
     records = [_seg(1, 0.20, converged=True, flags=(), mu_s_lower_bound=0.3),
                _seg(2, 0.22, converged=True, flags=(), mu_s_lower_bound=0.4),
                _seg(3, 0.9, converged=False)]
-    assert consensus(records) == {"mu_k": pytest.approx(0.21), "mu_s": None,
-                                  "mu_s_lower_bound": pytest.approx(0.35)}
+    found = consensus(records)
+    assert {k: found[k] for k in ("mu_k", "mu_s", "mu_s_lower_bound")} == {
+        "mu_k": pytest.approx(0.21), "mu_s": None, "mu_s_lower_bound": pytest.approx(0.35)}
+
+
+def test_consensus_states_its_uncertainty_and_support():
+    """Issue 25 item 1: the headline's ± combines the supporting segments' scatter with
+    their own uncertainty (never below the fit's 2 % torque match); the support counts the
+    segments behind it of the off-bottom ones, an unconverged outlier in neither."""
+    records = [_seg(i, mu, converged=True, flags=()) for i, mu in
+               enumerate((0.20, 0.21, 0.22, 0.23, 0.24), 1)] + [_seg(6, 0.9)]
+    found = consensus(records)
+    assert found["mu_k_support"] == {"segments": 5, "of": 6}
+    assert found["mu_k_range"] == [0.20, 0.24]
+    scatter = (np.percentile([0.20, 0.21, 0.22, 0.23, 0.24], 84)
+               - np.percentile([0.20, 0.21, 0.22, 0.23, 0.24], 16)) / 2
+    assert found["mu_k_uncertainty"] == pytest.approx(np.hypot(scatter, 0.02 * 0.22))
+    alone = consensus([_seg(1, 0.30, converged=True, flags=())])
+    assert alone["mu_k_uncertainty"] == pytest.approx(0.006)  # the fit's 2 % alone
+    assert alone["mu_k_support"] == {"segments": 1, "of": 1}
+    none = consensus([_seg(1, 0.30)])
+    assert none["mu_k"] is None and none["mu_k_uncertainty"] is None
+    assert none["mu_k_support"] == {"segments": 0, "of": 1}

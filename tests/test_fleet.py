@@ -160,7 +160,7 @@ def test_incremental_skip_append_and_force(good_wells, tmp_path):
 
     second = fleet(source, "--out", out, "--workers", "1")
     assert second.exit_code == 0
-    assert "all 3 wells skipped" in second.output
+    assert "all 3 wells ok (unchanged" in second.output
     assert stamps == {n: (out / n / "summary.json").stat().st_mtime_ns for n in TRUTH}
 
     data = good_wells / "w2.csv"
@@ -169,7 +169,7 @@ def test_incremental_skip_append_and_force(good_wells, tmp_path):
     later.to_csv(data, mode="a", header=False, index=False)
     third = fleet(source, "--out", out, "--workers", "1")
     assert third.exit_code == 0
-    assert "1 processed, 2 skipped" in third.output
+    assert "1 processed, 2 unchanged" in third.output
     after = {n: (out / n / "summary.json").stat().st_mtime_ns for n in TRUTH}
     assert [n for n in TRUTH if after[n] != stamps[n]] == ["w2"]
     summary = json.loads((out / "w2" / "summary.json").read_text())
@@ -185,7 +185,7 @@ def test_incremental_skip_append_and_force(good_wells, tmp_path):
     doc["wells"]["w3"]["drillfric_version"] = "0.0.0"  # as if an older drillfric ran it
     (out / "manifest.json").write_text(json.dumps(doc))
     upgraded = fleet(source, "--out", out, "--workers", "1")
-    assert "1 processed, 2 skipped" in upgraded.output
+    assert "1 processed, 2 unchanged" in upgraded.output
     assert manifest(out)["w3"]["drillfric_version"] != "0.0.0"
 
     forced = run_many([WellSpec(good_wells / "w1.csv")], out, workers=1, force=True)
@@ -218,7 +218,7 @@ def test_sigterm_leaves_no_partial_well_and_rerun_completes(good_wells, tmp_path
 
     rerun = fleet(good_wells, "--out", out, "--workers", "1")
     assert rerun.exit_code == 0, rerun.output
-    assert f"{len(TRUTH) - len(done)} processed, {len(done)} skipped" in rerun.output
+    assert f"{len(TRUTH) - len(done)} processed, {len(done)} unchanged" in rerun.output
     assert_complete(out)
     assert not [p.name for p in out.iterdir() if ".tmp-" in p.name or ".old-" in p.name]
     assert {n for n, e in manifest(out).items() if e["status"] == "ok"} == set(TRUTH)
@@ -235,3 +235,39 @@ def test_second_fleet_run_on_same_out_is_refused(good_wells, tmp_path):
     assert result.exit_code == 2
     assert "another fleet run" in result.output
     assert os.listdir(out) == [".fleet.lock"]
+
+
+# --------------------------------------------------------------------------- stale results
+def test_failed_well_marks_last_nights_results_stale_and_unchanged_wells_are_ok(good_wells,
+                                                                               tmp_path):
+    """Issue 25 item 7: after a well fails, OUT/NAME still held the previous night's
+    summary.json and Parquet files with nothing marking them stale, and unchanged wells were
+    shown as grey "skipped". Now the earlier results are marked (STALE.json, summary.json
+    ``stale``, fleet_summary ``stale_result_dir``, fleet.html) and unchanged wells read "ok
+    (unchanged)"; the next good run replaces the mark with fresh results."""
+    shutil.copytree(good_wells.parent, tmp_path / "src")
+    source, out = tmp_path / "src" / "fleet.csv", tmp_path / "out"
+    assert fleet(source, "--out", out, "--workers", "1").exit_code == 0
+    data = tmp_path / "src" / "wells" / "w2.csv"
+    good = data.read_bytes()
+    data.write_text("time_s,surface_rpm,surface_torque_Nm\n0,60,10\n1,60,10\n0.5,60,10\n")
+    night = fleet(source, "--out", out, "--workers", "1")
+    assert night.exit_code == 1
+    assert "2 ok (0 processed, 2 unchanged), 1 failed" in night.output
+    assert "1 failed well(s) keep an earlier run's results, marked stale" in night.output
+    stale = json.loads((out / "w2" / "STALE.json").read_text())
+    assert "time goes backwards" in stale["reason"] and stale["since_utc"]
+    summary = json.loads((out / "w2" / "summary.json").read_text())
+    assert summary["stale"]["reason"] == stale["reason"]
+    assert "stale" not in json.loads((out / "w1" / "summary.json").read_text())
+    rows = pd.read_parquet(out / "fleet_summary.parquet").drop_duplicates("well")
+    marked = dict(zip(rows["well"], rows["stale_result_dir"], strict=True))
+    assert Path(marked["w2"]) == out / "w2" and pd.isna(marked["w1"])
+    html = (out / "fleet.html").read_text(encoding="utf-8")
+    assert html.count(">ok (unchanged)</span>") == 2 and ">skipped<" not in html
+    assert "2 ok (2 unchanged, results of an earlier run), 1 failed" in html
+    assert "marked stale" in html and "stale report" in html
+    data.write_bytes(good)
+    assert fleet(source, "--out", out, "--workers", "1").exit_code == 0
+    assert not (out / "w2" / "STALE.json").exists()
+    assert "stale" not in json.loads((out / "w2" / "summary.json").read_text())

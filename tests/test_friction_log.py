@@ -100,7 +100,7 @@ def _check_recovered(records, *, apparent: bool = False):
     for r in records:
         assert r.method is Method.TD_BACKCALC and r.mu_td == r.mu_k
         assert r.mu_s is None and not r.mu_s_identifiable and "no observer" in r.message
-        assert (Flag.BIT_TORQUE_IN_FRICTION in r.flags) == (r.kind is Kind.ON_BOTTOM)
+        assert (Flag.BIT_TORQUE_IN_FRICTION in r.quality_flags) == (r.kind is Kind.ON_BOTTOM)
         if not (apparent and r.kind is Kind.ON_BOTTOM):
             assert r.mu_k == pytest.approx(MU, abs=ROOT_TOL)
 
@@ -242,7 +242,7 @@ def test_drilled_rows_logging_zero_wob_are_on_bottom_not_off_bottom(depth_log, t
     result = run_depth_log(well)
     records = friction_log(well)
     assert [r.kind for r in records] == [Kind.ON_BOTTOM] * WINDOWS
-    assert all(Flag.BIT_TORQUE_IN_FRICTION in r.flags for r in records)
+    assert all(Flag.BIT_TORQUE_IN_FRICTION in r.quality_flags for r in records)
     np.testing.assert_allclose([r.mu_k for r in records], MU, atol=ROOT_TOL)
     assert result.summary["mu_k"] is None
     assert "no rotating row is off bottom" in result.summary["friction_log"]["mu_k_reason"]

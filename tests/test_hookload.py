@@ -149,7 +149,7 @@ def test_judge_withholds_every_segment_when_the_string_is_contradicted():
     assert out.summary["string_weight_ratio"] == pytest.approx(0.6375)
     for r in out.records:
         assert r.mu_k is None and r.mu_s_lower_bound is None and not r.converged
-        assert Flag.HOOKLOAD_CONTRADICTS_STRING in r.flags
+        assert Flag.HOOKLOAD_CONTRADICTS_STRING in r.quality_flags
     assert consensus(out.records)["mu_k"] is None
     assert "withheld" in out.mu_k_reason(None) and out.warnings
 
@@ -249,7 +249,7 @@ def test_wrong_string_withheld(weighed_stand, factor, weight):
     assert summary["hookload"]["verdict"] == "contradicted"
     assert any("contradicts the configured string" in w for w in summary["warnings"])
     ok = [s for s in summary["segments"] if s["status"] == "ok"]
-    assert ok and all(s["mu_k"] is None and "hookload_contradicts_string" in s["flags"]
+    assert ok and all(s["mu_k"] is None and "hookload_contradicts_string" in s["quality_flags"]
                       for s in ok)
 
 
@@ -264,4 +264,4 @@ def test_wrong_string_calibrated_when_allowed(weighed_stand):
     assert abs(summary["mu_k"] / 0.28 - 1.0) <= 0.05
     assert any("calibrated" in w for w in summary["warnings"])
     ok = [s for s in summary["segments"] if s["status"] == "ok"]
-    assert all("string_weight_calibrated" in s["flags"] for s in ok)
+    assert all("string_weight_calibrated" in s["quality_flags"] for s in ok)

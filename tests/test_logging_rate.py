@@ -119,5 +119,5 @@ def test_held_values_are_seen_without_configuration(first_stand, tmp_path):
     seg, _ = _run(tmp_path / "w", held, tmp_path)
     assert seg["sample_interval_s"] == pytest.approx(1.0, rel=0.05)
     assert seg["bit_speed_resolved"] is False and "held values" in seg["bit_speed_reason"]
-    assert "creep_rate_too_low" in seg["flags"]
+    assert "creep_rate_too_low" in seg["quality_flags"]
     assert not seg["mu_s_identifiable"]

@@ -250,7 +250,7 @@ def test_no_survey_assumes_a_tortuous_vertical_well(first_stand_alone, tmp_path)
     assert summary["indicative"] and any(a.startswith(note) for a in summary["assumed"])
     [seg] = summary["segments"]
     assert seg["status"] == "ok" and seg["T_N_Nm"] > 0
-    assert seg["mu_k"] is None and "hookload_contradicts_string" in seg["flags"]
+    assert seg["mu_k"] is None and "hookload_contradicts_string" in seg["quality_flags"]
     assert seg["hookload_N"] < 0.9 * seg["hookload_model_N"]
     assert summary["hookload"]["block_weight_N"] is None and summary["mu_k_reason"]
     html = (tmp_path / "demo" / "report.html").read_text(encoding="utf-8")
@@ -297,7 +297,7 @@ def test_dsats_runs_end_to_end(real_data, tmp_path):
     for seg in summary["segments"]:
         assert seg["mu_k"] is None and seg["mu_s_lower_bound"] is None, seg
         if seg["status"] == "ok":
-            assert "hookload_contradicts_string" in seg["flags"]
+            assert "hookload_contradicts_string" in seg["quality_flags"]
     assert summary["mu_k"] is None and summary["mu_s"] is None
     assert "hook-load check" in summary["mu_k_reason"]
     assert any("contradicts the configured string" in w for w in summary["warnings"])

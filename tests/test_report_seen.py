@@ -63,7 +63,8 @@ def _legend_labels(item: dict) -> list[str]:
 
 def _on_bottom(summary: dict, seg_id: int = 3) -> None:
     seg = summary["segments"][seg_id - 1]
-    seg.update(kind="on_bottom_rotating", flags=[*seg["flags"], "bit_torque_in_friction"])
+    seg.update(kind="on_bottom_rotating",
+               quality_flags=[*seg["quality_flags"], "bit_torque_in_friction"])
 
 
 def test_apparent_on_bottom_mu_is_drawn_and_named_apart_from_mu_k(evidence, tmp_path):
@@ -112,7 +113,7 @@ def test_converged_header_status_and_badges_agree(evidence):
         warnings = re.findall(r'<span class="badge flag"[^>]*>([^<]*)</span>', section)
         if seg["converged"]:
             assert not any("not converged" in w for w in warnings), (seg["id"], warnings)
-        if "observer_not_converged" in seg["flags"] and seg["method"] == "batch":
+        if "observer_not_converged" in seg["quality_flags"] and seg["method"] == "batch":
             assert "observer starts spread" in section
     cells = [r.split("</td>")[-3] for r in
              html.split('id="diagnostics-table"')[1].split("</table>")[0].split("<tr")[2:]]

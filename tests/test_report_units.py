@@ -201,7 +201,7 @@ def test_flags_are_badges_with_their_meaning(evidence, tmp_path):
     from drillfric.result import FLAG_MEANINGS, Flag
 
     def unexplained(summary):
-        summary["segments"][0]["flags"] = ["mu_s_not_explained"]
+        summary["segments"][0]["quality_flags"] = ["mu_s_not_explained"]
 
     result = copy_result(evidence, tmp_path / "w", unexplained)
     html = write_well_report(result, segments="all").read_text(encoding="utf-8")

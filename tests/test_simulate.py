@@ -426,3 +426,15 @@ def test_simulate_options_take_quantities(well, tmp_path):
     truth = json.loads((tmp_path / "q.truth.json").read_text())
     assert truth["stands"][0]["bit_depth_m"] == 1524.0
     assert load_config(out.with_suffix(".toml")).simulate.duration_s == 15.0
+
+
+def test_duration_with_a_scenario_says_what_it_did(well, tmp_path):
+    """Issue 25 item 10: --duration with a scenario whose [defaults] set each stand's time
+    changed nothing silently (1800 s asked, 1040 s made); now a warning says how long the
+    record is and how to get one stand of that length."""
+    result = CliRunner().invoke(cli, ["simulate", str(well), "--out", str(tmp_path / "d.csv"),
+                                      "--scenario", str(well.parent / "s.toml"),
+                                      "--duration", "1800"])
+    assert result.exit_code == 0, result.output
+    line = next(ln for ln in result.output.splitlines() if "--duration 1800 s" in ln)
+    assert "the record lasts 180 s" in line and "0 of 2" in line and "--bit-depth" in line

@@ -86,7 +86,7 @@ def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]
 
     short = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
              and not r.converged and r.method.value == "batch" and r.mu_k is not None
-             and set(r.flags) <= _POOLABLE]
+             and set(r.quality_flags) <= _POOLABLE]
     groups: list[list[SegmentRecord]] = []
     for r in sorted(short, key=lambda r: r.bit_depth_m):
         if groups and torque_share(groups[-1][0], r) <= POOL_TORQUE_SHARE:
@@ -118,23 +118,73 @@ def _pooled(record: SegmentRecord, pool: dict) -> SegmentRecord:
     note = (f"pooled with segments {', '.join(map(str, pool['segment_ids']))} at "
             f"{span}: μ_k = {pool['mu_k']:.3f} over "
             f"{pool['rotation_s']:.0f} s of rotation")
-    return replace(record, flags=record.flags + (Flag.POOLED,),
+    return replace(record, quality_flags=record.quality_flags + (Flag.POOLED,),
                    message="; ".join(filter(None, [record.message, note])))
 
 
 def consensus(records: list[SegmentRecord], pools: list[dict] = ()) -> dict:
-    """Well-level friction factors from the segments (never a made-up value).
+    """Well-level friction factors from the segments (never a made-up value), with their
+    uncertainty and support (docs/theory.md "Well consensus").
 
     Only converged, off-bottom segments with status ok count, and pools of short segments
     (:func:`pool_short_segments`) as one each. μ_k: their median; μ_s: the median over those
     that identify it; otherwise the median of their lower bounds (each is claimed valid, so
     the median is too, and one unreliable segment cannot set it).
+
+    ``mu_k_uncertainty`` / ``mu_s_uncertainty`` [-] (:func:`uncertainty`), ``mu_k_range``
+    (lowest and highest supporting value) and ``mu_k_support`` / ``mu_s_support``: the
+    segments behind the number (pool members counted) ``of`` the off-bottom rotating
+    segments of the well.
     """
     ok = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
           and r.converged]
-    mu_k = [r.mu_k for r in ok if r.mu_k is not None] + [p["mu_k"] for p in pools]
-    mu_s = [r.mu_s for r in ok if r.mu_s_identifiable and r.mu_s is not None]
+    off = sum(r.kind is Kind.OFF_BOTTOM for r in records)
+    k_rows = [r for r in ok if r.mu_k is not None]
+    mu_k = [r.mu_k for r in k_rows] + [p["mu_k"] for p in pools]
+    own_k = [_own_mu_k(r) for r in k_rows] + [max(p["mu_k_spread"] / 2.0,
+                                                  MU_K_MATCH * p["mu_k"]) for p in pools]
+    s_rows = [r for r in ok if r.mu_s_identifiable and r.mu_s is not None]
+    mu_s = [r.mu_s for r in s_rows]
     bounds = [r.mu_s_lower_bound for r in ok if r.mu_s_lower_bound is not None]
+    k_support = len(k_rows) + sum(len(p["segment_ids"]) for p in pools)
     return {"mu_k": float(np.median(mu_k)) if mu_k else None,
             "mu_s": float(np.median(mu_s)) if mu_s else None,
-            "mu_s_lower_bound": None if mu_s or not bounds else float(np.median(bounds))}
+            "mu_s_lower_bound": None if mu_s or not bounds else float(np.median(bounds)),
+            "mu_k_uncertainty": uncertainty(mu_k, own_k),
+            "mu_k_range": [float(min(mu_k)), float(max(mu_k))] if mu_k else None,
+            "mu_k_support": {"segments": k_support, "of": off},
+            "mu_s_uncertainty": uncertainty(mu_s, [(r.mu_s_spread or 0.0) for r in s_rows]),
+            "mu_s_support": {"segments": len(s_rows) if mu_s else len(bounds), "of": off}}
+
+
+#: A converged batch μ_k matched the segment's mean measured torque within 2 % (the
+#: ``mu_k_not_converged`` rule); the torque is proportional to μ_k (docs/theory.md §5.1),
+#: so a segment's own μ_k is not known better than this, relative [-].
+MU_K_MATCH = 0.02
+
+
+def _own_mu_k(record: SegmentRecord) -> float:
+    """A segment's own μ_k uncertainty [-]: half its observer starts' spread where the
+    observer gave the number, never below the fit's torque match (:data:`MU_K_MATCH`)."""
+    spread = record.mu_k_spread if record.method.value == "observer" else None
+    return max((spread or 0.0) / 2.0, MU_K_MATCH * record.mu_k)
+
+
+def uncertainty(values: list[float], own: list[float]) -> float | None:
+    """The ± of a well-level factor [-]: √(s² + ū²), with s half the 16–84 % range of the
+    supporting segments' values (their scatter along the well; 0 for one segment) and ū
+    the median of the segments' own uncertainties ``own``. None without values.
+
+    Examples
+    --------
+    >>> round(uncertainty([0.20, 0.22, 0.24], [0.004, 0.004, 0.005]), 4)
+    0.0142
+    >>> uncertainty([0.2], [0.004]), uncertainty([], [])
+    (0.004, None)
+    """
+    if not values:
+        return None
+    lo, hi = np.percentile(values, [16.0, 84.0])
+    scatter = (hi - lo) / 2.0
+    own_median = float(np.median(own)) if len(own) else 0.0
+    return float(np.hypot(scatter, own_median))

@@ -300,7 +300,7 @@ def _record(base: dict, window: Window, mu: float, td: TDResult,
     notes.append(NO_OBSERVER)
     return SegmentRecord(**base, mu_k=mu, mu_td=mu, T_N_Nm=td.T_N_Nm, converged=True,
                          method=Method.TD_BACKCALC, status=Status.OK, message="; ".join(notes),
-                         flags=tuple(flags))
+                         quality_flags=tuple(flags))
 
 
 def estimate(well: Well, log: pd.DataFrame | None = None,

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import difflib
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -225,9 +226,11 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     try:
         return float(registry().Quantity(1.0, source).to(channel.unit).magnitude)
     except pint.errors.DimensionalityError as exc:
-        raise InputError(f"unit '{printable(unit)}' of {channel.name} is not a {channel.kind} unit",
-                         file=file, fix=f'give a {channel.kind} unit, e.g. {channel.key} = '
-                                        f'{{ unit = "{channel.default_unit}" }}') from exc
+        raise InputError(f"unit '{printable(unit)}' of {channel.name} is not a {channel.kind} "
+                         f"unit (it measures {_dimension(source)})", file=file,
+                         fix=f"give a {channel.kind} unit — {accepted_units(channel)} or "
+                             f"another pint spelling — e.g. {channel.key} = "
+                             f'{{ unit = "{channel.default_unit}" }}') from exc
 
 
 def _source_unit(unit: str, channel: Channel, file: str | None):
@@ -239,9 +242,31 @@ def _source_unit(unit: str, channel: Channel, file: str | None):
     try:
         return parse_unit(spelled)
     except InputError as exc:
-        raise InputError(f"unknown unit '{printable(unit)}' for {channel.name}", file=file,
-                         fix=f'state it in [channels], e.g. {channel.key} = '
+        raise InputError(f"unknown unit '{printable(unit)}' for {channel.name}: no {channel.kind} "
+                         f"unit is spelled so (nor any unit pint knows)", file=file,
+                         fix=f"write a {channel.kind} unit drillfric reads — "
+                             f"{accepted_units(channel)} or another pint spelling — in the "
+                             f"file's header or in [channels], e.g. {channel.key} = "
                              f'{{ unit = "{channel.default_unit}" }}') from exc
+
+
+def _dimension(unit) -> str:
+    """What a pint unit measures, in words (``"[mass]"``, ``"[length] / [time]"``)."""
+    return str(registry().Quantity(1.0, unit).dimensionality) or "nothing (dimensionless)"
+
+
+def accepted_units(channel: Channel) -> str:
+    """The common spellings of ``channel``'s quantity drillfric reads (one per unit).
+
+    Examples
+    --------
+    >>> accepted_units(BY_KEY["surface_torque"])
+    'n.m, kn.m, ft.lbf, kft.lbf'
+    """
+    seen: dict[float, str] = {}
+    for spelling, value in _COMMON.get(channel.unit, {}).items():
+        seen.setdefault(value, spelling)
+    return ", ".join(seen.values()) or channel.default_unit
 
 
 def unit_fits(unit: str, channel: Channel) -> bool | None:
@@ -447,7 +472,8 @@ def log_index(columns: list[str], config_channels: dict, *, depth_index: str | N
 
 
 def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
-                 file: str | None = None, index: str = "time") -> dict[str, Mapping]:
+                 file: str | None = None, index: str = "time",
+                 log_shaped: Callable[[], bool] | None = None) -> dict[str, Mapping]:
     """Match source columns to canonical channels.
 
     Parameters
@@ -464,6 +490,9 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
     index : str
         ``"time"`` or ``"depth"`` (:func:`log_index`): which index channel is mapped and
         required (``time`` or ``measured_depth``).
+    log_shaped : callable, optional
+        Asked only when a required channel is missing and no column name is known: whether
+        the file is recognisably a data log all the same (its header is then listed).
 
     Returns
     -------
@@ -485,7 +514,8 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
         column, name_unit = _find_column(columns, channel, spec, file, file_units)
         if column is None:
             if channel.required:
-                raise _missing(channel, columns, file_units, config_channels, out, file)
+                raise _missing(channel, columns, file_units, config_channels, out, file,
+                               log_shaped)
             continue
         unit, source = _unit_for(channel, column, name_unit, file_units, spec, file)
         try:
@@ -500,7 +530,8 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
 
 
 def _missing(channel: Channel, columns: list[str], file_units: dict, config_channels: dict,
-             out: dict[str, Mapping], file: str | None) -> InputError:
+             out: dict[str, Mapping], file: str | None,
+             log_shaped: Callable[[], bool] | None = None) -> InputError:
     """The error for a missing required channel, with a ``[channels]`` line to map it.
 
     The line names a column only when one plausibly holds the channel (see
@@ -516,7 +547,8 @@ def _missing(channel: Channel, columns: list[str], file_units: dict, config_chan
         example = '"NAME"' if pick is None else f'"{printable(pick)}"'
         if pick is not None and (split_unit(pick)[1] or file_units.get(pick)):
             unit = ""  # the file states it
-    shown = listing(columns, recognised=bool(out) or example != '"NAME"')
+    shown = listing(columns, recognised=bool(out) or example != '"NAME"' or (
+        log_shaped is not None and log_shaped()))
     depth_log = ('; a depth-indexed log needs its measured-depth column instead, e.g. '
                  '[channels] measured_depth = { column = "NAME", unit = "m" }'
                  if channel.key == "time" else "")

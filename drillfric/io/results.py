@@ -38,12 +38,7 @@ import pyarrow.parquet as pq
 
 from drillfric.errors import OutputError
 from drillfric.io.locks import lock_directory
-from drillfric.result import (
-    ESTIMATE_COLUMNS,
-    SEGMENT_FIELDS,
-    segment_arrow_types,
-    segment_columns,
-)
+from drillfric.result import ESTIMATE_COLUMNS, segment_table
 
 #: The file that marks a directory as written by drillfric (JSON: version, well, state).
 MARKER = ".drillfric-result"
@@ -318,6 +313,39 @@ def check_distinct(outputs: list[tuple[str, str]]) -> None:
         seen[key] = source
 
 
+#: The file that marks a result directory as stale: a later run of its well failed.
+STALE = "STALE.json"
+
+
+def mark_stale(folder: Path, reason: str, when_utc: str) -> bool:
+    """Mark the results in ``folder`` (a directory drillfric wrote) as stale: a later run
+    of the well failed, so they are an earlier run's. Writes :data:`STALE` (why, when) and
+    ``"stale"`` into summary.json (replaced atomically, so a job reading summary.json alone
+    sees it); the next successful run replaces the directory and the mark with it.
+
+    Returns whether ``folder`` was marked (False: nothing drillfric wrote is there).
+    """
+    if not is_result_dir(folder):
+        return False
+    stale = {"since_utc": when_utc, "reason": reason,
+             "meaning": "these are the results of an earlier run; the latest run of this "
+                        "well failed (reason)"}
+    with lock_directory(folder.parent):
+        if not is_result_dir(folder):
+            return False
+        summary_path = folder / "summary.json"
+        try:
+            summary = json.loads(summary_path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            summary = None
+        if isinstance(summary, dict):
+            tmp = folder / f".summary.json{_TMP}{_token()}"
+            write_json(tmp, summary | {"stale": stale})
+            os.replace(tmp, summary_path)
+        write_json(folder / STALE, stale)
+    return True
+
+
 # --------------------------------------------------------------------------- files
 def arrow_schema(with_truth: bool, with_clock: bool = False) -> pa.Schema:
     """estimates.parquet's schema from :data:`drillfric.result.ESTIMATE_COLUMNS` (every
@@ -365,6 +393,4 @@ def write_json(path: Path, payload: dict) -> None:
 def write_segments(path: Path, records) -> None:
     """segments.parquet: one row per :class:`~drillfric.result.SegmentRecord`, with the
     schema's types (a column null in every row keeps its type)."""
-    types = segment_arrow_types()
-    schema = pa.schema([(name, pa.type_for_alias(types[name])) for name in SEGMENT_FIELDS])
-    pq.write_table(pa.table(segment_columns(records), schema=schema), path)
+    pq.write_table(segment_table(records), path)

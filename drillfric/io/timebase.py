@@ -186,7 +186,15 @@ class TimeTracker:
 
     def _seconds(self, values: pd.Series) -> np.ndarray:
         """Seconds from the first sample (the origin is set by the first valid value)."""
-        numeric = _as_number(values)
+        try:
+            numeric = _as_number(values)
+        except UnreadNumber as bad:
+            raise InputError(f"time column '{printable(self.column)}': cannot read "
+                             f"'{printable(bad.text, 30)}' at data row "
+                             f"{self._rows_seen + bad.index + 1} as a number (the rows before "
+                             "it hold numbers)", file=self.file,
+                             fix="remove or comment out that line (# at its start), or write "
+                                 "it as a number") from None
         absolute = numeric is None or (bool(self._absolute) and bool(np.isnan(numeric).all()))
         if self._absolute is not None and absolute != self._absolute:
             raise InputError(f"time column '{printable(self.column)}' mixes numbers and timestamps "
@@ -257,7 +265,18 @@ def holds_timestamps(values: pd.Series) -> bool:
     >>> holds_timestamps(pd.Series(["2024-05-01T12:00:00Z"])), holds_timestamps(pd.Series([0.5]))
     (True, False)
     """
-    return _as_number(values) is None
+    try:
+        return _as_number(values) is None
+    except UnreadNumber:  # numbers with a text line among them: numbers
+        return False
+
+
+class UnreadNumber(ValueError):
+    """A column of numbers holds text at ``index`` (its first unreadable entry)."""
+
+    def __init__(self, index: int, text: str):
+        super().__init__(text)
+        self.index, self.text = index, text
 
 
 def _as_number(values: pd.Series) -> np.ndarray | None:
@@ -271,7 +290,9 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
         out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
         unread = np.isnan(out) & _present(text)
         if unread.any():
-            return None
+            if (~unread & _present(text)).any() and not unread[np.argmax(_present(text))]:
+                raise UnreadNumber(int(np.argmax(unread)), str(text.iloc[np.argmax(unread)]))
+            return None  # text from the first value on: timestamps
     out = out.copy()
     out[np.isin(out, NULL_VALUES) | np.isinf(out)] = np.nan  # an infinite time is no value
     return out

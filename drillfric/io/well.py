@@ -51,7 +51,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.config import Config, config_from_dict, parse_toml, read_toml
-from drillfric.errors import ConfigError, InputError
+from drillfric.errors import ConfigError, DrillfricError, InputError
 from drillfric.files import require_file, require_inside, special
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
@@ -410,8 +410,9 @@ def default_name(path, data_path: Path) -> str:
 def safe_name(raw, where=None) -> str:
     """One safe path component from a well name (docs/security.md).
 
-    Path separators, NUL and control characters become ``_``; leading and trailing dots
-    and blanks go (no ``.``, ``..`` or hidden names); a name longer than
+    Path separators, NUL, control characters and blanks inside the name become ``_`` (a
+    folder name a shell or a nightly script need not quote; the well keeps its shown name);
+    leading and trailing dots and blanks go (no ``.``, ``..`` or hidden names); a name longer than
     :data:`MAX_NAME_BYTES` is cut and ends with a hash of the whole name, so distinct long
     names stay distinct.
 
@@ -422,12 +423,12 @@ def safe_name(raw, where=None) -> str:
 
     Examples
     --------
-    >>> safe_name("../../x"), safe_name("A-12/ST1"), safe_name(".hidden")
-    ('_.._x', 'A-12_ST1', 'hidden')
+    >>> safe_name("../../x"), safe_name("A-12/ST1"), safe_name(".hidden"), safe_name("Well 7 ST")
+    ('_.._x', 'A-12_ST1', 'hidden', 'Well_7_ST')
     """
-    text = unicodedata.normalize("NFC", str(raw))
-    text = "".join("_" if c in "/\\" or unicodedata.category(c)[0] == "C" else c
-                   for c in text).strip(". \t")
+    text = unicodedata.normalize("NFC", str(raw)).strip(". \t")
+    text = "".join("_" if c in "/\\" or unicodedata.category(c)[0] in "CZ" else c
+                   for c in text).strip(".")
     if not text or set(text) <= {"_", "."}:
         raise ConfigError(f"well name '{printable(raw)}' gives no usable directory name",
                           file=where, fix='name the well, e.g. [well] name = "A-12"')
@@ -740,8 +741,25 @@ def _open(files: WellFiles, cfg: Config,
     channels = cfg.channels
     if index == "depth" and raw.depth_index is not None and "measured_depth" not in channels:
         channels = channels | {"measured_depth": {"column": split_unit(raw.depth_index)[0]}}
-    mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index)
+    mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index,
+                            log_shaped=lambda: log_shaped(raw))
     return raw, _clock_time(raw, mappings)
+
+
+def log_shaped(raw: RawSource, rows: int = 50) -> bool:
+    """Whether a data file is recognisably a data log though none of its column names is
+    known: its first ``rows`` rows hold numbers in at least two columns, and in at least
+    half of them (then its header may be quoted in a message, docs/security.md; a file named
+    by mistake — a list of secrets — is text)."""
+    try:
+        head = next(iter(raw.chunks(rows)), None)
+    except DrillfricError:
+        return False
+    if head is None or not len(head) or head.shape[1] < 2:
+        return False
+    numeric = sum(pd.to_numeric(head[c], errors="coerce").notna().mean() >= 0.9
+                  for c in head.columns if head[c].notna().any())
+    return numeric >= 2 and numeric >= head.shape[1] / 2
 
 
 def frame_source(frame: pd.DataFrame) -> RawSource:

@@ -23,12 +23,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from drillfric.estimation.headline import STRING_WEIGHT_TOLERANCE
+
 from .display import SI, Units
 
-#: Relative tolerance of the weight check: dead-line hook-load sensors are specified to
-#: about ±2–3 % of reading and the mud density (buoyancy) is rarely known better than
-#: ±2 %; 5 % keeps a consistent string from being flagged by those alone.
-HOOKLOAD_TOLERANCE = 0.05
+#: Relative tolerance of the weight check (the run's, which flags it in summary.json).
+HOOKLOAD_TOLERANCE = STRING_WEIGHT_TOLERANCE
 #: Friction factors of the model lines.
 DEFAULT_FRICTIONS = (0.1, 0.2, 0.3, 0.4, 0.5)
 #: Load cases of the model lines.

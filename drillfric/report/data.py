@@ -110,6 +110,16 @@ class ResultData:
         return None
 
 
+def _as_list(value) -> list:
+    """A list field's value as a list (older results: JSON text or missing)."""
+    if isinstance(value, str):
+        try:
+            value = json.loads(value)
+        except ValueError:
+            return []
+    return list(value) if isinstance(value, list | tuple | np.ndarray) else []
+
+
 def segments_frame(rows: list[dict]) -> pd.DataFrame:
     """The ``segments`` list of a summary.json as a table with NaN for missing numbers."""
     frame = pd.DataFrame(rows)
@@ -121,8 +131,10 @@ def segments_frame(rows: list[dict]) -> pd.DataFrame:
     frame["converged"] = frame["converged"].fillna(False).astype(bool)
     frame["mu_s_identifiable"] = frame["mu_s_identifiable"].fillna(False).astype(bool)
     frame["message"] = frame["message"].fillna("").astype(str)
-    frame["flags"] = [list(f) if isinstance(f, list | tuple) else [] for f in frame["flags"]]
-    frame["starts"] = [list(s) if isinstance(s, list | tuple) else [] for s in frame["starts"]]
+    if "flags" in frame:  # results before the rename (issue 25 item 9)
+        frame["quality_flags"] = frame.pop("flags")
+    frame["quality_flags"] = [_as_list(f) for f in frame["quality_flags"]]
+    frame["starts"] = [_as_list(s) for s in frame["starts"]]
     frame["bit_speed_reason"] = frame["bit_speed_reason"].fillna("").astype(str)
     return frame
 

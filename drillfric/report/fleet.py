@@ -54,12 +54,24 @@ def _link(out_dir: Path, result_dir) -> str | None:
     return "./" + quote((target / "report.html").as_posix())
 
 
+#: How a well's status is shown: an unchanged well's results are ok, from an earlier run.
+STATUS_TEXT = {"ok": "ok", "skipped": "ok (unchanged)", "failed": "failed"}
+
+
 def _row(out_dir: Path, well: dict) -> dict:
     summary = well.get("summary") or {}
     counts = summary.get("counts") or {}
     status = str(well.get("status", "failed"))
+    stale = well.get("stale_dir")
+    message = str(well.get("message") or "")
+    if stale is not None:
+        message += (f" — the results in {Path(stale).name}/ are an earlier run's, marked "
+                    "stale (STALE.json, summary.json stale)")
     return {"well": str(well.get("well", "?")), "status": status,
-            "message": str(well.get("message") or ""),
+            "status_text": STATUS_TEXT.get(status, status),
+            "badge": "ok" if status == "skipped" else status,
+            "message": message,
+            "stale_link": _link(out_dir, stale) if stale is not None else None,
             "segments": counts.get("segments", "—"), "estimated": counts.get("estimated", "—"),
             "converged": counts.get("converged", "—"),
             "mu_k": fmt(summary.get("mu_k")),
@@ -81,7 +93,8 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
     wells : list of dict
         One per well: ``{"well": str, "status": "ok"|"failed"|"skipped", "message": str,
         "result_dir": Path or None (relative link target), "summary": dict or None
-        (summary.json)}``.
+        (summary.json), "stale_dir": Path or None (a failed well's earlier results, marked
+        stale)}``; "skipped" (unchanged since an ok run) is shown "ok (unchanged)".
     units : {"si", "field"}, optional
         Display units of the depths; default: the ``[well] units`` all wells share, else SI.
 

@@ -205,7 +205,7 @@ def _flag_items(row: dict) -> list[tuple[str, str, str]]:
     from drillfric.result import FLAG_MEANINGS
 
     meanings = {str(k): v for k, v in FLAG_MEANINGS.items()}
-    flags = row.get("flags")
+    flags = row.get("quality_flags")
     if not isinstance(flags, list | tuple):
         return []
     out = []
@@ -247,7 +247,7 @@ CONVERGED_MEANING = (
 
 def is_apparent(row: dict) -> bool:
     """Whether the segment's μ is apparent: on bottom, the bit torque is in it."""
-    flags = row.get("flags")
+    flags = row.get("quality_flags")
     return row.get("kind") == "on_bottom_rotating" or (
         isinstance(flags, list | tuple) and "bit_torque_in_friction" in flags)
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric.errors import ConfigError, DrillfricError
+from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
 
 from . import broomstick as broom
 from . import figures
@@ -146,6 +147,7 @@ def _header(data: ResultData, units: Units) -> dict:
         "rate_hz": inputs.get("resampled_rate_hz"),
         "run_time_s": summary.get("run_time_s"),
         "mu_k": fmt(summary.get("mu_k")), "mu_k_reason": _no_mu_k_reason(data),
+        "trust": headline_trust(summary),
         "apparent": _apparent(data),
         "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                           summary.get("mu_s_lower_bound")),
@@ -161,6 +163,23 @@ def _header(data: ResultData, units: Units) -> dict:
         "string": (string_columns, string_rows),
         "converged_meaning": CONVERGED_MEANING,
     }
+
+
+def headline_trust(summary: dict) -> dict:
+    """What the headline says about the well μ_k beside its value: ``uncertainty`` ("± 0.012"
+    or ""), ``support`` ("4 of 9 off-bottom segments" or ""), ``confidence`` (summary.json
+    ``mu_k_confidence``; "" for results without it) and ``reasons`` (the warnings of the
+    flags that lower it)."""
+    u, support = summary.get("mu_k_uncertainty"), summary.get("mu_k_support") or {}
+    has_mu = summary.get("mu_k") is not None
+    confidence = str(summary.get("mu_k_confidence") or "")
+    flags = set(summary.get("quality_flags") or [])
+    lowering = [f.value for f in LOWERING if f.value in flags]
+    return {"uncertainty": f"± {fmt(u)}" if has_mu and u is not None else "",
+            "support": (f"{support['segments']} of {support['of']} off-bottom segment"
+                        f"{'s' * (support['of'] != 1)}") if has_mu and "of" in support else "",
+            "confidence": confidence,
+            "reasons": [f.replace("_", " ") for f in lowering] if confidence == "low" else []}
 
 
 def _log_span(data: ResultData, units: Units) -> tuple[str, str] | None:
@@ -192,7 +211,8 @@ def _no_mu_k_reason(data: ResultData) -> str:
     summary = data.summary
     if summary.get("mu_k") is not None:
         return ""
-    reason = (summary.get("friction_log") or {}).get("mu_k_reason")
+    reason = summary.get("mu_k_reason") or (summary.get("friction_log") or {}).get(
+        "mu_k_reason")
     if reason:
         return str(reason)
     ok = data.segments[data.segments["status"] == "ok"]
@@ -358,8 +378,12 @@ def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
     have = {i for i, e in estimates.items() if len(e)}
     for row in diag:
         row["anchor"] = int(row["id"]) in have
-    return Report(data, _header(data, shown), drawn, estimates, _broomstick(data, shown), diag,
-                  shown, fits)
+    broomstick = _broomstick(data, shown)
+    head = _header(data, shown)
+    if broomstick.check["warning"]:  # said there with display units (#weight-warning)
+        head["warnings"] = [w for w in head["warnings"]
+                            if not w.startswith(STRING_WEIGHT_WARNING)]
+    return Report(data, head, drawn, estimates, broomstick, diag, shown, fits)
 
 
 def quality_text(row: dict, fit: Reproduction | None) -> str:
@@ -565,8 +589,15 @@ def _first_page(report: Report, size):
 
 def headline_lines(head: dict) -> list[tuple[str, bool]]:
     """The headline of the PDF's first page as ``(text, bold)``."""
-    mu_k = f"μ_k off bottom (consensus): {head['mu_k']}"
+    trust = head["trust"]
+    mu_k = " ".join(filter(None, [f"μ_k off bottom (consensus): {head['mu_k']}",
+                                  trust["uncertainty"],
+                                  f"({trust['support']})" if trust["support"] else ""]))
     lines = [(mu_k + (f" — {head['mu_k_reason']}" if head["mu_k_reason"] else ""), True)]
+    if trust["confidence"] in ("low", "withheld"):
+        lines.append((f"WARNING: μ_k {trust['confidence']}"
+                      + (f": {', '.join(trust['reasons'])}" if trust["reasons"] else ""),
+                      False))
     if head["apparent"]:
         what = "window" if head["depth_indexed"] else "stand"
         lines.append((f"apparent μ on bottom: {head['apparent']['value']} (bit torque "

@@ -18,6 +18,7 @@ import pandas as pd
 
 from drillfric._version import __version__
 from drillfric.estimation.consensus import consensus
+from drillfric.estimation.headline import judge as judge_headline
 from drillfric.friction import FrictionProfile
 from drillfric.io.results import (
     EstimatesWriter,
@@ -28,7 +29,7 @@ from drillfric.io.results import (
 )
 from drillfric.io.tracks import write_tracks
 from drillfric.io.well import Well
-from drillfric.result import SegmentRecord, Status, WellResult, segment_columns
+from drillfric.result import SegmentRecord, Status, WellResult, segments_frame
 
 #: Writes the report of a result directory into it (``drillfric.report.write_well_report``
 #: with the options asked for); the run layer calls it and never imports the report.
@@ -147,8 +148,9 @@ def finish(sink: Sink, well: Well, summary: dict, records: list[SegmentRecord], 
            tables: dict[str, pd.DataFrame] | None = None) -> WellResult:
     """The end of every run: the result files (with a :class:`DirectorySink`) and the
     :class:`~drillfric.result.WellResult`."""
+    summary.update(judge_headline(summary))
     sink.finish(well, summary, records, tracks, tables or {})
-    return WellResult(well.name, summary, pd.DataFrame(segment_columns(records)),
+    return WellResult(well.name, summary, segments_frame(records),
                       failed=sum(r.status is Status.FAILED for r in records),
                       warnings=summary["warnings"], tracks=tracks, _estimates=sink.estimates())
 
