@@ -355,10 +355,12 @@ def segment_columns(records) -> dict[str, list]:
 def segment_arrow_types() -> dict[str, pa.DataType]:
     """Arrow type of every segments.parquet column (a column null in every row keeps its
     type): numbers float64, flags and counts as declared, text string, ``quality_flags``
-    a list of strings and ``starts`` a list of (μ_s, μ_k) pairs."""
+    a list of strings, ``starts`` a list of (μ_s, μ_k) pairs and segment ids a list of
+    ints."""
     kinds = {"float": "float64", "float | None": "float64", "int": "int32", "bool": "bool",
              "bool | None": "bool", "tuple[Flag, ...]": "list<string>",
-             "tuple[tuple[float, float], ...]": "list<list<float64>>"}
+             "tuple[tuple[float, float], ...]": "list<list<float64>>",
+             "tuple[int, ...]": "list<int32>"}
     return {f.name: _ARROW[kinds.get(f.type, "string")] for f in fields(SegmentRecord)}
 
 
@@ -386,7 +388,8 @@ def segments_from_json(rows: list[dict]) -> pd.DataFrame:
 
 _ARROW = {"float64": pa.float64(), "int32": pa.int32(), "bool": pa.bool_(),
           "string": pa.string(), "list<string>": pa.list_(pa.string()),
-          "list<list<float64>>": pa.list_(pa.list_(pa.float64()))}
+          "list<list<float64>>": pa.list_(pa.list_(pa.float64())),
+          "list<int32>": pa.list_(pa.int32())}
 
 
 def outputs_markdown() -> str:

@@ -20,7 +20,7 @@ def _off(i, depth, mu_k, T_N, duration=50.0, converged=False, interval=0.01):
     flags = () if converged else (Flag.TOO_SHORT_TO_CONVERGE,)
     return SegmentRecord(id=i, kind=Kind.OFF_BOTTOM, status=Status.OK, mu_k=mu_k,
                          bit_depth_m=depth, duration_s=duration, converged=converged,
-                         method=Method.BATCH, flags=flags, T_N_Nm=T_N,
+                         method=Method.BATCH, quality_flags=flags, T_N_Nm=T_N,
                          sample_interval_s=interval)
 
 
