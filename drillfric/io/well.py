@@ -383,7 +383,8 @@ def open_config(config, *, survey=None, overrides=None
     """
     path = require_file(Path(config), "config file")
     raw = read_toml(path)
-    survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw)
+    survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw,
+                                                                       confined=False)
     if survey_path is not None:
         require_file(survey_path, "survey file")
     return (_config(path, raw, None, overrides, _find_string(path, raw)), survey_path,
@@ -491,8 +492,8 @@ def _resolve(path, config, survey, peek: bool = True) -> tuple[WellFiles, dict]:
         config_path = data_path
     if raw is None:
         raw = _raw_config(config_path)
-    survey_path = _file(survey) if survey is not None else _find_survey(data_path, config_path,
-                                                                        raw, peek)
+    survey_path = _file(survey) if survey is not None else _find_survey(
+        data_path, config_path, raw, peek, confined=look)
     if survey_path is not None:
         require_file(survey_path, "survey file")
     return WellFiles(data_path, config_path, survey_path, parts,
@@ -509,10 +510,7 @@ def _frame_files(config, survey) -> tuple[WellFiles, dict]:
         raw = _raw_config(config_path)
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     survey_path = _file(survey) if survey is not None else (
-        require_inside(config_path.parent / named, config_path.parent,
-                       "survey file named by the configuration",
-                       fix="give it with --survey, or move it beside the configuration")
-        if isinstance(named, str) and config_path else None)
+        config_path.parent / named if isinstance(named, str) and config_path else None)
     if survey_path is not None:
         require_file(survey_path, "survey file")
     return WellFiles(FRAME_LABEL, config_path, survey_path, in_memory=True), raw
@@ -587,12 +585,20 @@ def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
 
 
 def _find_survey(data_path: Path, config_path: Path | None, raw: dict,
-                 peek: bool = True) -> Path | None:
+                 peek: bool = True, *, confined: bool = True) -> Path | None:
+    """The survey a well's configuration names, else its sidecar, else one stored in the
+    data file. ``confined``: the configuration travelled with the data (a sidecar, a folder's
+    well.toml), so the file it names must lie in its folder; one given on the command line
+    (``--config``) may name a survey anywhere."""
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     if isinstance(named, str) and config_path is not None:
-        return require_inside(config_path.parent / named, config_path.parent,
+        named_path = config_path.parent / named
+        if not confined:
+            return named_path
+        return require_inside(named_path, config_path.parent,
                               "survey file named by the configuration",
-                              fix="give it with --survey, or move it beside the configuration")
+                              fix="give it with --survey (or the configuration with --config), "
+                                  "or move it beside the configuration")
     for ext in _SURVEY_EXT:
         if (candidate := _sidecar(data_path, ".survey" + ext)) is not None:
             return candidate
