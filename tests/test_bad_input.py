@@ -203,12 +203,19 @@ def test_unknown_column_names_of_a_data_log_are_listed(tmp_path):
     """A file of numbers under unknown names is recognisably a data log: its header is
     listed; a text file named by mistake still is not quoted."""
     log = tmp_path / "w.csv"
-    log.write_text("Zeit,Drehzahl,Moment\n0,60,10\n0.5,61,11\n1.0,62,12\n")
+    log.write_text("Zeit,Drehzahl,Moment\n" + "".join(f"{0.5 * i},{60 + i},{10 + i}\n"
+                                                     for i in range(20)))
     line = _one_line_error(_invoke("inspect", log), "w.csv")
     assert "columns found: Zeit, Drehzahl, Moment" in line
     secrets = tmp_path / "s.csv"
     secrets.write_text("API_KEY=hunter2\nTOKEN=abc\n")
     line = _one_line_error(_invoke("inspect", secrets), "s.csv")
+    assert "hunter2" not in line and "not shown" in line
+    # A regression: two numeric columns under a key=value header read as a "log" and
+    # quoted the secret (tests/test_hostile_inputs.py secret_named_as_the_data_file).
+    keyed = tmp_path / "k.csv"
+    keyed.write_text("API_KEY=hunter2,OTHER=1,X\n" + "1,2,3\n" * 20)
+    line = _one_line_error(_invoke("inspect", keyed), "k.csv")
     assert "hunter2" not in line and "not shown" in line
 
 

@@ -40,9 +40,6 @@ A well's name is data, not a path: :func:`safe_name` makes it one safe path comp
 
 from __future__ import annotations
 
-import hashlib
-import os
-import unicodedata
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -50,14 +47,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from drillfric.config import Config, config_from_dict, parse_toml, read_toml
-from drillfric.errors import ConfigError, DrillfricError, InputError
-from drillfric.files import require_file, require_inside, special
+from drillfric.config import Config, config_from_dict, read_toml
+from drillfric.errors import DrillfricError, InputError
+from drillfric.files import require_file
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
-from drillfric.io.hdf5 import members, node_at
 from drillfric.io.readers import open_source
-from drillfric.io.source import FORMATS, NULL_VALUES, RawSource, data_format
+from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
 from drillfric.io.timebase import (
     TimeBase,
@@ -66,20 +62,28 @@ from drillfric.io.timebase import (
     holds_timestamps,
     summarize,
 )
+from drillfric.io.wellfiles import (
+    FRAME_LABEL,
+    HDF5_EXT,
+    WellFiles,
+    default_name,
+    find_string,
+    find_survey,
+    frame_files,
+    given_file,
+    resolve_files,
+    safe_name,
+)
 from drillfric.wellpath import WellPath
 
 #: Rows per chunk of :meth:`Well.chunks` (a few tens of MB for a dozen channels).
 CHUNK_ROWS = 200_000
-#: Longest output directory name [bytes of UTF-8]; longer names are cut and given a hash.
-MAX_NAME_BYTES = 100
-_SURVEY_EXT = (".csv", ".parquet", ".xml")
-_HDF5_EXT = (".h5", ".hdf5")
 #: Unit shown for a time column of absolute timestamps (not a unit anything assumed).
 CLOCK_UNIT = "ISO 8601"
-#: What errors name as the "file" of a well opened from a DataFrame (``open_well(frame=)``).
-FRAME_LABEL = Path("<DataFrame>")
 #: The name of a well opened from a DataFrame that nothing names (``name=``, ``[well] name``).
 FRAME_NAME = "well"
+#: Fewest rows of a file whose header may be quoted as a data log's (:func:`log_shaped`).
+LOG_MIN_ROWS = 10
 #: Rows read ahead to tell whether a time column without a stated unit holds timestamps.
 _PEEK_ROWS = 64
 
@@ -139,48 +143,6 @@ class WellData:
     channels: dict[str, ChannelInfo]
     timebase: TimeBase
     files: dict[str, Path]
-
-
-@dataclass(frozen=True)
-class WellFiles:
-    """The files of a well on disk.
-
-    Attributes
-    ----------
-    data : Path
-        Surface data file; for a WITSML log split over numbered files the folder of
-        ``00001.xml`` … or ``folder / NAME`` for ``NAME_1.xml`` … (no such file).
-    config, survey : Path or None
-        Configuration and survey files in effect (for an HDF5 bundle, possibly the data
-        file itself: its ``/config`` and ``/survey``; for a WITSML file, the file itself
-        when it holds the trajectory beside the log).
-    parts : tuple of Path
-        The numbered part files of a WITSML log split over several files (by number; read
-        in index order), else empty.
-    string : Path or None
-        WITSML tubular read as the string (``NAME.tubular.xml``, or the data file holding a
-        ``<tubular>``) when the configuration has no ``[[string.sections]]``.
-    in_memory : bool
-        The data is a DataFrame (``open_well(frame=)``): ``data`` is :data:`FRAME_LABEL`,
-        no file.
-    """
-
-    data: Path
-    config: Path | None
-    survey: Path | None
-    parts: tuple[Path, ...] = ()
-    string: Path | None = None
-    in_memory: bool = False
-
-    @property
-    def inputs(self) -> dict[str, Path]:
-        """The files read, by role: ``data`` (for a log split over parts one ``data NAME``
-        per part instead; none for a DataFrame), ``config``, ``survey``, ``string`` —
-        summary.json ``inputs``."""
-        data = {f"data {p.name}": p for p in self.parts} if self.parts else {"data": self.data}
-        data = {} if self.in_memory else data
-        roles = data | {"config": self.config, "survey": self.survey, "string": self.string}
-        return {role: path for role, path in roles.items() if path is not None}
 
 
 @dataclass(frozen=True)
@@ -321,8 +283,8 @@ def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, surv
     if (path is None) == (frame is None):
         raise InputError("give a well's data file or its data in memory, one of the two",
                          fix="open_well('well.csv', ...) or open_well(frame=data, ...)")
-    files, raw = (_resolve(path, config, survey) if frame is None else
-                  _frame_files(config, survey))
+    files, raw = (resolve_files(path, config, survey) if frame is None else
+                  frame_files(config, survey))
     cfg = _config(files.config, raw, config, overrides, files.string)
     given = default_name(path, files.data) if frame is None else FRAME_NAME
     shown = printable(name or cfg.well.name or given, 4096)
@@ -357,7 +319,7 @@ def find_well(path, *, config=None, survey=None, name: str | None = None
     InputError, ConfigError
         Missing files, an unreadable TOML configuration.
     """
-    files, raw = _resolve(path, config, survey, peek=False)
+    files, raw = resolve_files(path, config, survey, peek=False)
     table = raw.get("well") if isinstance(raw.get("well"), dict) else {}
     given = name or table.get("name") or None
     if given is not None:
@@ -365,7 +327,7 @@ def find_well(path, *, config=None, survey=None, name: str | None = None
     path = Path(path)
     if path.is_dir() and path.resolve() != files.data.resolve():
         return files, printable(path.resolve().name, 4096)
-    inside = files.config is None and files.data.suffix.lower() in _HDF5_EXT
+    inside = files.config is None and files.data.suffix.lower() in HDF5_EXT
     if inside or (files.data.is_dir() and files.data.resolve().name.isdigit()):
         return files, None
     return files, printable(default_name(path, files.data), 4096)
@@ -383,272 +345,18 @@ def open_config(config, *, survey=None, overrides=None
     """
     path = require_file(Path(config), "config file")
     raw = read_toml(path)
-    survey_path = Path(survey) if survey is not None else _find_survey(path, path, raw,
+    survey_path = Path(survey) if survey is not None else find_survey(path, path, raw,
                                                                        confined=False)
     if survey_path is not None:
         require_file(survey_path, "survey file")
-    return (_config(path, raw, None, overrides, _find_string(path, raw)), survey_path,
+    return (_config(path, raw, None, overrides, find_string(path, raw)), survey_path,
             _load_survey(survey_path))
 
 
-def default_name(path, data_path: Path) -> str:
-    """A well's name when nothing names it: the directory's name (resolved, so ``.`` is the
-    folder it stands for) or the data file's stem. A WITSML log split over ``NAME_1.xml``,
-    ``NAME_2.xml`` … is ``NAME``; the folder of a log's numbered parts ``00001.xml`` … is
-    named like a directory, except a number (a WITSML store names its folders
-    ``log/1/8/1``): then the log's wellbore and log names (``NO 15/9-F-4 GwdTime``)."""
-    path = Path(path)
-    if path.is_dir() and path.resolve() != data_path.resolve():
-        return path.resolve().name
-    if data_path.is_dir():
-        name = data_path.resolve().name
-        if name.isdigit():
-            return witsml.log_title(witsml.witsml_log_parts(data_path)[0]) or name
-        return name
-    return data_path.name if not data_path.exists() else data_path.stem
-
-
-def safe_name(raw, where=None) -> str:
-    """One safe path component from a well name (docs/security.md).
-
-    Path separators, NUL, control characters and blanks inside the name become ``_`` (a
-    folder name a shell or a nightly script need not quote; the well keeps its shown name);
-    leading and trailing dots and blanks go (no ``.``, ``..`` or hidden names); a name longer than
-    :data:`MAX_NAME_BYTES` is cut and ends with a hash of the whole name, so distinct long
-    names stay distinct.
-
-    Raises
-    ------
-    ConfigError
-        Nothing usable is left (e.g. ``"."`` or ``"///"``).
-
-    Examples
-    --------
-    >>> safe_name("../../x"), safe_name("A-12/ST1"), safe_name(".hidden"), safe_name("Well 7 ST")
-    ('_.._x', 'A-12_ST1', 'hidden', 'Well_7_ST')
-    """
-    text = unicodedata.normalize("NFC", str(raw)).strip(". \t")
-    text = "".join("_" if c in "/\\" or unicodedata.category(c)[0] in "CZ" else c
-                   for c in text).strip(".")
-    if not text or set(text) <= {"_", "."}:
-        raise ConfigError(f"well name '{printable(raw)}' gives no usable directory name",
-                          file=where, fix='name the well, e.g. [well] name = "A-12"')
-    if len(text.encode()) > MAX_NAME_BYTES:
-        digest = hashlib.sha256(str(raw).encode()).hexdigest()[:10]
-        text = text.encode()[:MAX_NAME_BYTES - 11].decode("utf-8", "ignore") + "-" + digest
-    return text
-
-
 # --------------------------------------------------------------------------- resolving
-def resolve_well(path, *, config=None, survey=None) -> WellFiles:
-    """Find a well's data, configuration and survey files without reading the data.
-
-    Parameters
-    ----------
-    path : str or Path
-        Data file, HDF5 bundle or well directory.
-    config, survey : str or Path, optional
-        Explicit files (``--config``, ``--survey``) overriding sidecars.
-
-    Returns
-    -------
-    WellFiles
-        For an HDF5 bundle, ``config``/``survey`` may be the HDF5 file itself (meaning its
-        ``/config`` and ``/survey``).
-
-    Raises
-    ------
-    InputError
-        Missing path, unknown extension, a directory without ``well.toml``, or a file a
-        configuration names that does not exist.
-    """
-    return _resolve(path, config, survey)[0]
-
-
-def _resolve(path, config, survey, peek: bool = True) -> tuple[WellFiles, dict]:
-    """The files of a well and its raw configuration mapping, each file read once; a
-    configuration or survey given in memory (a mapping, a table) stands for its file
-    (``peek=False``: the data file is not opened, so a configuration, survey or tubular
-    stored inside it is not found)."""
-    path = Path(path)
-    if not path.exists():
-        raise InputError("file not found", file=path, fix="check the path")
-    config_path = _file(config)
-    raw = _mapping(config)
-    look = raw is None and config_path is None  # find the configuration beside the data
-    if path.is_dir() and not (path / "well.toml").is_file() and witsml.split_log(path):
-        data_path, parts = _data(path)
-        config_path = _sidecar(data_path, ".toml") if look else config_path
-    elif path.is_dir():
-        data_path, parts, dir_config, dir_raw = _directory_data(path)
-        if look:
-            config_path, raw = dir_config, dir_raw
-    else:
-        data_path, parts = _data(path)
-        config_path = _sidecar(data_path, ".toml") if look else config_path
-    if config_path is not None:
-        require_file(config_path, "config file")
-    if look and peek and config_path is None and _h5_has(data_path, "config"):
-        config_path = data_path
-    if raw is None:
-        raw = _raw_config(config_path)
-    survey_path = _file(survey) if survey is not None else _find_survey(
-        data_path, config_path, raw, peek, confined=look)
-    if survey_path is not None:
-        require_file(survey_path, "survey file")
-    return WellFiles(data_path, config_path, survey_path, parts,
-                     _find_string(data_path, raw, peek)), raw
-
-
-def _frame_files(config, survey) -> tuple[WellFiles, dict]:
-    """The files of a well whose data is a DataFrame: only those given (a configuration
-    file's ``[survey] file`` too), never a sidecar."""
-    config_path, raw = _file(config), _mapping(config)
-    if config_path is not None:
-        require_file(config_path, "config file")
-    if raw is None:
-        raw = _raw_config(config_path)
-    named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
-    survey_path = _file(survey) if survey is not None else (
-        config_path.parent / named if isinstance(named, str) and config_path else None)
-    if survey_path is not None:
-        require_file(survey_path, "survey file")
-    return WellFiles(FRAME_LABEL, config_path, survey_path, in_memory=True), raw
-
-
-def _file(given) -> Path | None:
-    """``given`` as a file path when it is one (str or path-like), else None."""
-    return Path(given) if isinstance(given, str | os.PathLike) else None
-
-
-def _mapping(config) -> dict | None:
-    """A configuration given as a mapping (the TOML's tables), else None."""
-    if config is None or isinstance(config, str | os.PathLike | Config):
-        return None
-    if not isinstance(config, dict):
-        raise ConfigError(f"config is a {type(config).__name__}",
-                          fix="give a TOML file, a dict of its tables or a Config")
-    return config
-
-
-def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
-    """The data of a well given as ``path``: a data file, or the folder and numbered files
-    of a WITSML log split over parts (``path`` the folder or one of its parts; the name
-    :func:`drillfric.io.witsml.split_log` gives the log and its parts)."""
-    split = witsml.split_log(path)
-    if split is not None:
-        folder, parts = split
-        for part in parts:
-            require_inside(part, part.parent, "part of the log",
-                           fix="copy the parts into the log's folder")
-        return split
-    data_format(path)
-    return path, ()
-
-
-def _sidecar(data_path: Path, suffix: str) -> Path | None:
-    """``NAME{suffix}`` beside a data file (or the folder or common name of a log's parts)
-    when it exists; one that is a device or a FIFO is refused (never opened, never passed
-    over in silence)."""
-    stem = data_path.stem if data_path.is_file() else data_path.name
-    candidate = data_path.with_name(stem + suffix)
-    if special(candidate):
-        require_file(candidate, "sidecar")
-    if not candidate.is_file():
-        return None
-    return require_inside(candidate, data_path.parent, "sidecar",
-                          fix="give the file with --config/--survey, or copy it beside the data")
-
-
-def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
-    well_toml = folder / "well.toml"
-    if special(well_toml):
-        require_file(well_toml, "well.toml")
-    if not well_toml.is_file():
-        found = sorted(p.name for p in folder.iterdir() if p.suffix.lower() in FORMATS)
-        raise InputError("well directory has no well.toml", file=folder,
-                         fix='add well.toml with [well] data = "FILE"'
-                             + (f" (data files here: {', '.join(found)})" if found else ""))
-    raw = read_toml(well_toml)
-    data = raw.get("well", {}).get("data")
-    if data is None and witsml.split_log(folder):
-        return *_data(folder), well_toml, raw
-    if not isinstance(data, str):
-        raise ConfigError("well.toml does not name its data file", file=well_toml,
-                          fix='add [well] data = "surface.parquet" (relative to the folder)')
-    data_path = require_inside(folder / data, folder, "data file named by well.toml",
-                               fix="give the data file on the command line instead")
-    if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)):
-        raise InputError("data file named by well.toml not found", file=data_path,
-                         fix=f"fix [well] data in {well_toml}")
-    return *_data(data_path), well_toml, raw
-
-
-def _find_survey(data_path: Path, config_path: Path | None, raw: dict,
-                 peek: bool = True, *, confined: bool = True) -> Path | None:
-    """The survey a well's configuration names, else its sidecar, else one stored in the
-    data file. ``confined``: the configuration travelled with the data (a sidecar, a folder's
-    well.toml), so the file it names must lie in its folder; one given on the command line
-    (``--config``) may name a survey anywhere."""
-    named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
-    if isinstance(named, str) and config_path is not None:
-        named_path = config_path.parent / named
-        if not confined:
-            return named_path
-        return require_inside(named_path, config_path.parent,
-                              "survey file named by the configuration",
-                              fix="give it with --survey (or the configuration with --config), "
-                                  "or move it beside the configuration")
-    for ext in _SURVEY_EXT:
-        if (candidate := _sidecar(data_path, ".survey" + ext)) is not None:
-            return candidate
-    if peek and (_h5_has(data_path, "survey") or _witsml_has(data_path, "trajectory")):
-        return data_path
-    return None
-
-
-def _find_string(data_path: Path, raw: dict, peek: bool = True) -> Path | None:
-    """The WITSML tubular read as the string when the configuration has no sections:
-    ``NAME.tubular.xml`` beside the data (or configuration), else the data file itself when
-    it holds a ``<tubular>`` beside its log."""
-    string = raw.get("string")
-    if isinstance(string, dict) and "sections" in string:
-        return None
-    found = _sidecar(data_path, ".tubular.xml")
-    if found is None and peek and _witsml_has(data_path, "tubular"):
-        found = data_path
-    return found
-
-
-def _witsml_has(path: Path, kind: str) -> bool:
-    """Whether a WITSML data file holds a ``kind`` object (e.g. a trajectory beside its
-    log); False for any other file."""
-    if path.suffix.lower() != ".xml" or not path.is_file() or path.stat().st_size == 0:
-        return False
-    return kind in witsml.object_kinds(path)
-
-
-def _h5_has(path: Path, key: str) -> bool:
-    if path.suffix.lower() not in _HDF5_EXT or not path.is_file() or path.stat().st_size == 0:
-        return False
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as h5:
-            return h5.get(key, getlink=True) is not None  # a link is not followed here
-    except OSError as exc:
-        raise InputError("not a readable HDF5 file (truncated or corrupt)", file=path,
-                         fix="re-export or re-copy the file") from exc
 
 
 # --------------------------------------------------------------------------- config, survey
-def _raw_config(config_path: Path | None) -> dict:
-    """The configuration mapping of a TOML file or an HDF5 bundle's ``/config`` ({} if none)."""
-    if config_path is None:
-        return {}
-    if config_path.suffix.lower() in _HDF5_EXT:
-        return _h5_config(config_path)
-    return read_toml(config_path)
 
 
 def _config(config_path: Path | None, raw: dict, config, overrides,
@@ -659,55 +367,17 @@ def _config(config_path: Path | None, raw: dict, config, overrides,
     if isinstance(config, Config):
         return config
     where = None if config_path is None else (
-        f"{config_path}:/config" if config_path.suffix.lower() in _HDF5_EXT else config_path)
+        f"{config_path}:/config" if config_path.suffix.lower() in HDF5_EXT else config_path)
     if string is not None:
         table = raw.get("string") if isinstance(raw.get("string"), dict) else {}
         raw = raw | {"string": table | {"sections": witsml.tubular_sections(string)}}
     return config_from_dict(raw, file=where, overrides=overrides)
 
 
-def _h5_config(path: Path) -> dict:
-    """The ``/config`` of an HDF5 bundle as a raw TOML mapping."""
-    import h5py
-
-    where = f"{path}:/config"
-    with h5py.File(path, "r") as h5:
-        node = node_at(h5, "config", path)
-        if isinstance(node, h5py.Dataset) or "toml" in node.attrs:
-            text = node[()] if isinstance(node, h5py.Dataset) else node.attrs["toml"]
-            try:
-                text = text.decode() if isinstance(text, bytes) else str(text)
-            except UnicodeDecodeError:
-                raise ConfigError("not TOML text (not UTF-8)", file=where,
-                                  fix="store the configuration as UTF-8 TOML text") from None
-            return parse_toml(text, where)
-        raw: dict = {}
-        for group in [node] + [g for g in members(node, path).values()
-                               if isinstance(g, h5py.Group)]:
-            prefix = "" if group is node else group.name.rsplit("/", 1)[-1] + "."
-            for key, value in group.attrs.items():
-                table, _, name = (prefix + key).rpartition(".")
-                if not table:
-                    raise ConfigError(f"attribute '{key}' of /config is not 'table.key'",
-                                      file=where,
-                                      fix="name attributes like fluid.mud_density_kg_m3")
-                raw.setdefault(table, {})[name] = _plain(value)
-        return raw
-
-
-def _plain(value):
-    """HDF5 attribute value as a plain Python value for the TOML validator."""
-    if isinstance(value, bytes):
-        return value.decode()
-    if isinstance(value, np.ndarray):
-        return [_plain(v) for v in value.tolist()]
-    return value.item() if isinstance(value, np.generic) else value
-
-
 def _well_path(survey_path: Path | None, given) -> WellPath | None:
     """The well path of the survey file, or of a survey given in memory (a table with a
     survey file's columns, or a :class:`WellPath`)."""
-    if given is None or _file(given) is not None:
+    if given is None or given_file(given) is not None:
         return _load_survey(survey_path)
     if isinstance(given, WellPath):
         return given
@@ -725,7 +395,7 @@ def _load_survey(survey_path: Path | None) -> WellPath | None:
         return None
     from drillfric.io import survey as survey_io
 
-    if survey_path.suffix.lower() in _HDF5_EXT:
+    if survey_path.suffix.lower() in HDF5_EXT:
         raw = open_source(survey_path, hdf_key="survey")
         frame = pd.concat(list(raw.chunks(CHUNK_ROWS)), ignore_index=True)
         table = survey_io.survey_table_from_frame(frame, file=f"{survey_path}:/survey")
@@ -754,18 +424,21 @@ def _open(files: WellFiles, cfg: Config,
 
 def log_shaped(raw: RawSource, rows: int = 50) -> bool:
     """Whether a data file is recognisably a data log though none of its column names is
-    known: its first ``rows`` rows hold numbers in at least two columns, and in at least
-    half of them (then its header may be quoted in a message, docs/security.md; a file named
-    by mistake — a list of secrets — is text)."""
+    known: its first ``rows`` rows (at least :data:`LOG_MIN_ROWS`) hold numbers in at least
+    three columns (time, speed and torque at the least), and in at least half of them, and no
+    column name is a ``key=value`` pair (then its header may be quoted in a message,
+    docs/security.md; a file named by mistake — a list of secrets — is not a log)."""
     try:
         head = next(iter(raw.chunks(rows)), None)
     except DrillfricError:
         return False
-    if head is None or not len(head) or head.shape[1] < 2:
+    if head is None or len(head) < LOG_MIN_ROWS or head.shape[1] < 3:
+        return False
+    if any("=" in str(c) for c in head.columns):
         return False
     numeric = sum(pd.to_numeric(head[c], errors="coerce").notna().mean() >= 0.9
                   for c in head.columns if head[c].notna().any())
-    return numeric >= 2 and numeric >= head.shape[1] / 2
+    return numeric >= 3 and numeric >= head.shape[1] / 2
 
 
 def frame_source(frame: pd.DataFrame) -> RawSource:

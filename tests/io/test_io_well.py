@@ -12,7 +12,8 @@ import pytest
 
 from drillfric.config import load_config
 from drillfric.errors import ConfigError, InputError
-from drillfric.io.well import iter_surface, load_well, resolve_well
+from drillfric.io.well import iter_surface, load_well
+from drillfric.io.wellfiles import resolve_well
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
