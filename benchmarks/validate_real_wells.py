@@ -68,6 +68,8 @@ SPEEDS = (0.05, 0.1, 0.2, 0.5)
 STROKE_M = 28.0
 AXIAL_RPM = 60.0
 AXIAL_MOVE_S = 240.0
+MIXED_DELAY_S = 120.0
+MIXED_MOVE_S = 120.0
 
 
 # --------------------------------------------------------------------------- scoring
@@ -167,15 +169,18 @@ def _line(r: dict) -> str:
 
 
 # --------------------------------------------------------------------------- string weight
-def string_config(est_cfg: Path, percent: float, calibrate: bool, name: str) -> Path:
-    """The estimator's configuration with the string's buoyed weight × (1 + percent/100)."""
+def string_config(est_cfg: Path, percent: float, calibrate: bool, block_N: float | None,
+                  name: str) -> Path:
+    """The estimator's configuration with the string's buoyed weight × (1 + percent/100),
+    calibration allowed or not, the block weight configured or not."""
     cfg = load_config(est_cfg)
     raw = cfg.to_dict()
     raw["string"] = {"sections": [{k: v for k, v in s.items() if v is not None} for s in
                                   hookload.scaled_sections(cfg.sections, 1 + percent / 100,
                                                            cfg.fluid.mud_density_kg_m3,
                                                            cfg.inner_mud_density_kg_m3)]}
-    raw["hookload"] = dict(raw["hookload"], calibrate_string_weight=calibrate)
+    raw["hookload"] = dict(raw["hookload"], calibrate_string_weight=calibrate,
+                           block_weight_N=block_N)
     raw.pop("simulate", None)
     out = est_cfg.parent / f"{name}.toml"
     out.write_text(dumps_toml(trust._clean(raw)), encoding="utf-8")
@@ -206,16 +211,17 @@ def string_sweep(work: Path, rates, weights) -> list[dict]:
     sim_cfg, est_cfg = trust._config(folder, "step")
     frame = pd.DataFrame(drillfric.simulate(sim_cfg).columns)
     rows = []
-    for slips in (True, False):
-        log = weighed_log(frame, slips)
+    for evidence in ("slips", "no slips", "no slips, block_weight_N"):
+        log = weighed_log(frame, evidence == "slips")
+        block = BLOCK_N if evidence.endswith("block_weight_N") else None
         for percent in weights:
             for calibrate in (False, True):
-                label = (f"string {percent:+d} % {'slips' if slips else 'no slips'} "
-                         f"{'calibrate' if calibrate else 'check'}")
-                cfg = string_config(est_cfg, percent, calibrate, f"w{percent}{slips}{calibrate}")
+                label = f"string {percent:+d} % {evidence} {'calibrate' if calibrate else 'check'}"
+                cfg = string_config(est_cfg, percent, calibrate, block,
+                                    f"w{percent}{evidence[:6]}{block}{calibrate}")
                 for rate in rates:
                     rows.append(run_record(log, rate, folder, cfg, label) | {
-                        "percent": percent, "slips": slips, "calibrate": calibrate})
+                        "percent": percent, "evidence": evidence, "calibrate": calibrate})
     return rows
 
 
@@ -233,14 +239,16 @@ def tangential_share(est_cfg: Path, speed_m_s: float, rpm: float) -> float:
     return float(np.sum(share * weight) / np.sum(weight))
 
 
-def moving_log(frame: pd.DataFrame, stand: dict, speed_m_s: float) -> pd.DataFrame:
-    """The stand with the pipe moving at ``speed_m_s`` (> 0 running in) from the start of
-    rotation (the idle rows before it) over at most :data:`STROKE_M`; the hole bottom below
-    the deepest bit position by the simulator's 5 m; the block position follows."""
+def moving_log(frame: pd.DataFrame, stand: dict, speed_m_s: float, delay_s: float = 0.0,
+               move_s: float = np.inf) -> pd.DataFrame:
+    """The stand with the pipe moving at ``speed_m_s`` (> 0 running in) from ``delay_s``
+    after the start of rotation, for at most ``move_s`` and :data:`STROKE_M`; the hole
+    bottom below the deepest bit position by the simulator's 5 m; the block position
+    follows."""
     out = frame.copy()
     t = out["time_s"].to_numpy(float)
-    t0 = float(t[np.argmax(out["surface_rpm"].to_numpy(float) > 5.0)])
-    travel = np.clip((t - t0) * abs(speed_m_s), 0.0, STROKE_M)
+    t0 = float(t[np.argmax(out["surface_rpm"].to_numpy(float) > 2.0)]) + delay_s
+    travel = np.clip((t - t0) * abs(speed_m_s), 0.0, min(STROKE_M, move_s * abs(speed_m_s)))
     start = stand["bit_depth_m"] - np.sign(speed_m_s) * STROKE_M / 2
     out["bit_depth_m"] = start + np.sign(speed_m_s) * travel
     out["hole_depth_m"] = stand["bit_depth_m"] + STROKE_M / 2 + 5.0
@@ -285,9 +293,34 @@ def axial_sweep(work: Path, rates, speeds) -> list[dict]:
     return rows
 
 
+def mixed_sweep(work: Path, rates, speeds) -> list[dict]:
+    """The trust sweep's step-law stand (creep start, 300 s at 60 RPM) with the pipe moving
+    at each speed from 120 s after the start of rotation for at most 120 s (one stand at
+    most), then still again while it turns: segments before and after the stroke are
+    estimated. The plant's torque is the pure-rotation one throughout (the simulator has no
+    axial split: the stroke's own rows are the ones that must be withheld)."""
+    folder = work / "mixed"
+    folder.mkdir()
+    sim_cfg, est_cfg = trust._config(folder, "step")
+    frame = pd.DataFrame(drillfric.simulate(sim_cfg).columns)
+    rows = []
+    for speed in (s * way for s in speeds for way in (1, -1)):
+        log = moving_log(frame, {"bit_depth_m": trust.DEPTH_M}, speed, MIXED_DELAY_S,
+                         MIXED_MOVE_S)
+        block_cfg = block_config(est_cfg, float(log["bit_depth_m"].iloc[0]))
+        name = f"still-{'ream' if speed > 0 else 'backream'}-still {abs(speed):g}"
+        for rate in rates:
+            block_only = rate in ("5 Hz", "1-s means")
+            drop = ("bit_depth_m", "hole_depth_m") if block_only else ("block_position_m",)
+            label = f"{name} m/s ({'block position' if block_only else 'bit depth'})"
+            rows.append(run_record(log, rate, folder, block_cfg if block_only else est_cfg,
+                                   label, drop=drop) | {"speed": speed})
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sweeps", default="string,axial")
+    parser.add_argument("--sweeps", default="string,axial,mixed")
     parser.add_argument("--rates", default=",".join(RATES))
     parser.add_argument("--weights", default=",".join(map(str, WEIGHTS)),
                         help="configured string weight against the plant's [%%]")
@@ -302,8 +335,11 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         if "string" in args.sweeps:
             rows += string_sweep(Path(tmp), rates, [int(w) for w in args.weights.split(",")])
+        speeds = [float(v) for v in args.speeds.split(",")]
         if "axial" in args.sweeps:
-            rows += axial_sweep(Path(tmp), rates, [float(v) for v in args.speeds.split(",")])
+            rows += axial_sweep(Path(tmp), rates, speeds)
+        if "mixed" in args.sweeps:
+            rows += mixed_sweep(Path(tmp), rates, speeds)
     segs = [x for r in rows for x in r["segments"]]
     count = {s: sum(x["status"] == s for x in segs) for s in ("ok", "withheld", "FALSE")}
     print(f"\n{len(rows)} records, {len(segs)} μ_k results: within tolerance {count['ok']}, "
