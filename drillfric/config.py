@@ -337,7 +337,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "is 'unverified' (docs/theory.md §2.1).", min=0.0, max=5e6),
         Key("calibrate_string_weight", bool, False, "", "When the hook load contradicts the "
             "configured string, scale the string's buoyed weight to the measured one (a "
-            "first pass over the log; needs the block weight from the slips; scale within "
+            "first pass over the log; needs the block weight, from the slips or "
+            "block_weight_N; scale within "
             "0.5–2) instead of withholding the friction factors. The result says so "
             "(flag string_weight_calibrated, summary.json hookload)."),
     ),
