@@ -5,8 +5,8 @@ configuration the way real logs do, run through the whole pipeline (:func:`drill
 section's linear mass rescaled, :func:`drillfric.hookload.scaled_sections`), on the trust
 sweep's step-law plant (demo string at 2300 m, μ_s 0.6, μ_k 0.25, creep start, 300 s at
 60 RPM) with a travelling block of :data:`BLOCK_N` on the hook, with and without 60 s in
-the slips before the stand (hook load = block weight, string still), hook-load calibration
-off and on.
+the slips before the stand (hook load = block weight, string still) or without them (then
+also with ``hookload.block_weight_N`` configured), hook-load calibration off and on.
 
 **axial** — rotation while the pipe moves at 0.05–0.5 m/s, running in (reaming) and pulling
 out (back-reaming): the bit-depth / block-position channels move at that speed from the
@@ -18,6 +18,10 @@ stand (the normal-force change from the axial drag is not modelled; the truth is
 wall's μ). The depth channel is ``bit_depth_m`` (with ``hole_depth_m``) at 100 Hz and 1 Hz,
 ``block_position_m`` alone at 5 Hz and 1-s means.
 
+**mixed** — the string sweep's stand (no block) turning still, then moving at each speed
+for at most 120 s, then still again (:func:`mixed_sweep`; the plant's torque is the
+pure-rotation one: the stroke's rows are the ones to be withheld).
+
 Each record at 100 Hz, 5 Hz, 1 Hz and 1-s means with the demo's noise (0.5 RPM, 300 N·m,
 2 kN hook load). Scores (docs/validation.md):
 
@@ -27,7 +31,7 @@ Each record at 100 Hz, 5 Hz, 1 Hz and 1-s means with the demo's noise (0.5 RPM, 
 - on segments whose bit trace is reported as resolved, its RMS error against the truth no
   worse than the surface speed's (after the first 30 s).
 
-Run: ``python benchmarks/validate_real_wells.py [--sweeps string,axial] [--rates ...]
+Run: ``python benchmarks/validate_real_wells.py [--sweeps string,axial,mixed] [--rates ...]
 [--weights -40,0,40] [--speeds 0.05,0.5]`` (about 15–20 minutes on one core for the default
 grid).
 """
