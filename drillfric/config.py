@@ -328,14 +328,22 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             min=0.0),
     ),
     "hookload": (
-        Key("tolerance", float, 0.10, "", "Relative tolerance of the hook-load check "
+        Key("tolerance", float, 0.05, "", "Relative tolerance of the hook-load check "
             "(docs/theory.md §2.1): the string weight the log measures (rotating off-bottom "
             "hook load − block weight in the slips) may differ from the configured string's "
-            "buoyed weight by this share before the friction factors are withheld (sensor "
-            "±2–5 %, block-weight plateau, mud density, hydraulic lift).", min=0.02, max=0.5),
+            "buoyed weight by this share before the friction factors are withheld. μ scales "
+            "as 1/string weight, so this is the μ error the check lets through: 5 % = the "
+            "μ_k tolerance (a larger one admits hook-load sensor error, ±2–5 %, at the cost "
+            "of μ_k that far off).", min=0.02, max=0.5),
+        Key("block_weight_N", float, None, "N", "Weight of the travelling block, hook and "
+            "top drive on the hook (rig specification; 0 for a hook load zeroed on the empty "
+            "block), used when the log holds no in-slips plateau to weigh it: without either "
+            "the string weight is only checked for gross mismatch and the hook-load verdict "
+            "is 'unverified' (docs/theory.md §2.1).", min=0.0, max=5e6),
         Key("calibrate_string_weight", bool, False, "", "When the hook load contradicts the "
             "configured string, scale the string's buoyed weight to the measured one (a "
-            "first pass over the log; needs the block weight from the slips; scale within "
+            "first pass over the log; needs the block weight, from the slips or "
+            "block_weight_N; scale within "
             "0.5–2) instead of withholding the friction factors. The result says so "
             "(flag string_weight_calibrated, summary.json hookload)."),
     ),

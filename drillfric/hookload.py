@@ -90,7 +90,8 @@ class BlockWeight:
         Hook load in the slips [N]; None when the log gives none (``reason`` says why).
     source : str
         ``"slips_hookload_N"`` (rows below the configured threshold), ``"log"`` (the
-        lowest quiet plateau) or ``"none"``.
+        lowest quiet plateau), ``"config"`` (``hookload.block_weight_N``, the log giving
+        none) or ``"none"``.
     plateaus : tuple of Plateau
         The plateaus the weight rests on.
     reason : str
@@ -342,6 +343,16 @@ def block_weight(plateaus: list[Plateau], points: pd.DataFrame,
                        "slips_hookload_N" if configured else "log", tuple(plateaus))
 
 
+def block_weight_of(plateaus: list[Plateau], points: pd.DataFrame, cfg) -> BlockWeight:
+    """The block weight of a well: from the log (:func:`block_weight`), else the configured
+    ``hookload.block_weight_N`` (source ``"config"``), else none."""
+    block = block_weight(plateaus, points, cfg.segmentation.slips_hookload_N is not None)
+    configured = cfg.hookload.block_weight_N
+    if block.weight_N is not None or configured is None:
+        return block
+    return BlockWeight(float(configured), "config", (), "")
+
+
 # --------------------------------------------------------------------------- the check
 def off_bottom_points(records) -> pd.DataFrame:
     """The off-bottom rotating segments with a measured and a modelled hook load."""
@@ -417,7 +428,7 @@ def judge(records: list, plateaus: list[Plateau], cfg,
     tol = cfg.hookload.tolerance
     points = off_bottom_points(records)
     block = calibration.block if calibration is not None and calibration.scale is not None \
-        else block_weight(plateaus, points, cfg.segmentation.slips_hookload_N is not None)
+        else block_weight_of(plateaus, points, cfg)
     summary = _summary_base(cfg, block, calibration, len(points))
     if not len(points):
         summary.update(verdict="not_checked", reason="no estimated off-bottom rotating "
@@ -452,11 +463,22 @@ def judge(records: list, plateaus: list[Plateau], cfg,
             out.append(replace(r, quality_flags=r.quality_flags + (Flag.STRING_WEIGHT_CALIBRATED,)))
         else:
             out.append(r)
-    summary.update(verdict="contradicted" if well_problem else (
-        "calibrated" if calibration is not None and calibration.scale is not None
-        else "consistent"), withheld_segments=withheld, reason=well_problem or None)
+    summary.update(verdict=_verdict(well_problem, block, calibration),
+                   withheld_segments=withheld, reason=well_problem or None)
     warnings = _warnings(well_problem, withheld, problems, block, calibration, cfg)
     return Outcome(out, summary, warnings)
+
+
+def _verdict(well_problem: str, block: BlockWeight, calibration: Calibration | None) -> str:
+    """summary.json ``hookload.verdict`` of a checked well: ``contradicted``, ``calibrated``,
+    ``consistent`` (the string weight measured and within the tolerance) or ``unverified``
+    (no block weight: only a gross mismatch could be seen, the friction factors rest on the
+    configured string weight)."""
+    if well_problem:
+        return "contradicted"
+    if calibration is not None and calibration.scale is not None:
+        return "calibrated"
+    return "consistent" if block.weight_N is not None else "unverified"
 
 
 def _summary_base(cfg, block: BlockWeight, calibration: Calibration | None,
@@ -492,7 +514,9 @@ def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWei
                    f"{block.source}, {calibration.segments} off-bottom segments)")
     if block.weight_N is None and not well_problem:
         out.append(f"block weight unknown ({block.reason}): the string weight was only "
-                   "checked for gross mismatch")
+                   "checked for gross mismatch, and the friction factors scale as 1/(string "
+                   "weight): they are as right as the configured string's weight (give "
+                   "hookload.block_weight_N, or a log with the string in the slips)")
     return out
 
 
@@ -519,7 +543,7 @@ def calibrate(well, chunk_rows: int):
         rows += _points(stream.feed(chunk), cfg, well.survey)
     rows += _points(stream.close(), cfg, well.survey)
     points = pd.DataFrame(rows, columns=["bit_depth_m", "hookload_N", "hookload_model_N"])
-    block = block_weight(finder.close(), points, finder.configured)
+    block = block_weight_of(finder.close(), points, cfg)
     if block.weight_N is None or not len(points):
         why = block.reason if block.weight_N is None else "no off-bottom rotating hook load"
         return well, Calibration(None, block, len(points), f"not calibrated: {why}")
