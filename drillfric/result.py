@@ -132,6 +132,7 @@ class WellFlag(StrEnum):
     SEGMENTS_OUTSIDE_TYPICAL_RANGE = "segments_outside_typical_range"
     STRING_WEIGHT_INCONSISTENT = "string_weight_inconsistent"
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
+    STRING_WEIGHT_UNVERIFIED = "string_weight_unverified"
     SEGMENTS_FAILED = "segments_failed"
 
 
@@ -151,6 +152,10 @@ WELL_FLAG_MEANINGS = {
                                          "(the report's string-weight check)",
     WellFlag.HOOKLOAD_CONTRADICTS_STRING: "the hook-load check withheld segments' friction "
                                           "factors (hookload, docs/theory.md §2.1)",
+    WellFlag.STRING_WEIGHT_UNVERIFIED: "the log holds no in-slips period and no "
+                                       "[hookload] block_weight_N is given: the string "
+                                       "weight, which μ scales with (1/W), is checked for "
+                                       "gross mismatch only",
     WellFlag.SEGMENTS_FAILED: "segments whose estimation failed (counts.failed)",
 }
 

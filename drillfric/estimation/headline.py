@@ -31,7 +31,7 @@ STRING_WEIGHT_WARNING = "string weight inconsistent with the hook load"
 #: The flags that make a well μ_k low-confidence (the others are told, not judged).
 LOWERING = (WellFlag.LOW_SUPPORT, WellFlag.WIDE_SPREAD, WellFlag.INDICATIVE,
              WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE, WellFlag.STRING_WEIGHT_INCONSISTENT,
-             WellFlag.HOOKLOAD_CONTRADICTS_STRING)
+             WellFlag.HOOKLOAD_CONTRADICTS_STRING, WellFlag.STRING_WEIGHT_UNVERIFIED)
 
 
 def judge(summary: dict) -> dict:
@@ -118,6 +118,8 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
     hook = summary.get("hookload") or {}
     if hook.get("verdict") == "contradicted" or hook.get("withheld_segments"):
         found.append((WellFlag.HOOKLOAD_CONTRADICTS_STRING, ""))  # the check's own warning
+    elif hook.get("verdict") == "unverified" and mu_k is not None:
+        found.append((WellFlag.STRING_WEIGHT_UNVERIFIED, ""))  # the check's own warning
     failed = [s["id"] for s in segments if s.get("status") == "failed"]
     if failed:
         found.append((WellFlag.SEGMENTS_FAILED, f"{len(failed)} segment(s) failed "
