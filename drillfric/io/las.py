@@ -141,8 +141,11 @@ def _lasio_warnings(path: Path):
         logger.removeHandler(handler)
         logger.propagate = propagate
     for message in dict.fromkeys(handler.messages):
-        warnings.warn(f"{path.name}: LAS reader: {printable(message, _QUOTE)}", LasWarning,
-                      stacklevel=3)
+        # warn_explicit with a fresh registry: each file's warnings are shown, even when an
+        # earlier read in this process gave the same text (the default filter shows a
+        # warning once per code location and text)
+        warnings.warn_explicit(f"{path.name}: LAS reader: {printable(message, _QUOTE)}",
+                               LasWarning, __file__, 0, module=__name__, registry={})
 
 
 def _depth_index(curve) -> str | None:

@@ -215,10 +215,10 @@ def _ranges(members: int, threads: int) -> list[tuple[int, int]]:
     """``threads`` contiguous, near-equal ranges of ``members`` (none empty).
 
     >>> _ranges(5, 2)
-    [(0, 3), (3, 5)]
+    [(0, 2), (2, 5)]
     """
     threads = max(1, min(threads, members))
-    cuts = [round(k * members / threads) for k in range(threads + 1)]
+    cuts = [k * members // threads for k in range(threads + 1)]
     return list(zip(cuts[:-1], cuts[1:], strict=True))
 
 
