@@ -19,7 +19,7 @@ Recognised layouts
   decimal comma. LF, CRLF and old-Mac CR-only line endings.
 - Parquet with the same column names.
 - A WITSML 1.4.1 ``<trajectory>`` (``.xml``): its stations' md, incl, azi (and tvd, dispNs,
-  dispEw, dls) in the units of their ``uom`` (:func:`drillfric.io.witsml.trajectory_table`).
+  dispEw, dls) in the units of their ``uom`` (:func:`drillfric.io.witsml_objects.trajectory_table`).
 """
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ def read_survey_table(path) -> pd.DataFrame:
     elif ext in _TEXT_EXT:
         names, units, data = _text_columns(path)
     elif ext == ".xml":
-        from drillfric.io.witsml import trajectory_table
+        from drillfric.io.witsml_objects import trajectory_table
 
         table = trajectory_table(path)
         _validate(table, path)

@@ -50,7 +50,7 @@ import pandas as pd
 from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import DrillfricError, InputError
 from drillfric.files import require_file
-from drillfric.io import witsml
+from drillfric.io import witsml, witsml_objects
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
@@ -370,7 +370,7 @@ def _config(config_path: Path | None, raw: dict, config, overrides,
         f"{config_path}:/config" if config_path.suffix.lower() in HDF5_EXT else config_path)
     if string is not None:
         table = raw.get("string") if isinstance(raw.get("string"), dict) else {}
-        raw = raw | {"string": table | {"sections": witsml.tubular_sections(string)}}
+        raw = raw | {"string": table | {"sections": witsml_objects.tubular_sections(string)}}
     return config_from_dict(raw, file=where, overrides=overrides)
 
 

@@ -12,9 +12,8 @@ namespace ``http://www.witsml.org/schemas/1series`` or none. Three kinds are rea
   source depth-indexed (``depth_index``). Several logs in one file: the one holding the
   surface channels is read (:func:`pick_log`). A log split over numbered files
   (``00001.xml``, ``00002.xml`` …) is read as one source by :func:`open_witsml_parts`.
-- **trajectory** → the canonical survey table (:func:`trajectory_table`), read by
-  :func:`drillfric.io.survey.read_survey_table` for ``.xml`` surveys.
-- **tubular** → ``[[string.sections]]`` tables, top-down (:func:`tubular_sections`).
+- **trajectory** and **tubular** → the survey and the string
+  (:mod:`drillfric.io.witsml_objects`).
 
 Files are untrusted: they are parsed with defusedxml with any DTD refused (a WITSML file
 never declares one), so entity expansion ("billion laughs") and external entities cannot
@@ -33,7 +32,6 @@ from xml.etree.ElementTree import ParseError
 
 import numpy as np
 import pandas as pd
-import pint
 from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import iterparse
 
@@ -41,7 +39,7 @@ from drillfric.errors import InputError
 from drillfric.io.channels import CHANNELS, find_column
 from drillfric.io.source import RawSource
 from drillfric.io.text import printable
-from drillfric.units import conversion_factor, parse_unit, registry
+from drillfric.units import conversion_factor
 
 #: Namespace of WITSML 1.x data objects (1.3.1 and 1.4.1 share it).
 NAMESPACE = "http://www.witsml.org/schemas/1series"
@@ -49,19 +47,17 @@ NAMESPACE = "http://www.witsml.org/schemas/1series"
 DEPTH_INDEX_TYPES = frozenset({"measured depth", "vertical depth", "length"})
 #: Units meaning "no unit" (the Volve date-time index says "unitless").
 _NO_UNIT = frozenset({"", "unitless", "none", "n/a", "-"})
-#: Trajectory station states whose station is not used.
-_BAD_STATIONS = frozenset({"bad", "rejected"})
 #: The WITSML objects drillfric reads (a log as surface data, a trajectory as the survey,
 #: a tubular as the string) and the BHA run it recognises.
 OBJECT_KINDS = frozenset({"log", "trajectory", "tubular", "bhaRun"})
 #: A numbered part of an exported log: ``00001.xml`` (a WITSML store's folder of one log) or
 #: ``NAME_1.xml`` (parts named after their log).
 _PART_FILE = re.compile(r"^(?:(?P<log>.+)_)?(?P<number>\d+)\.xml$", re.IGNORECASE)
-_FIX_EXPORT = "export the object again from the WITSML store (version 1.4.1)"
+FIX_EXPORT = "export the object again from the WITSML store (version 1.4.1)"
 
 
 # --------------------------------------------------------------------------- parsing
-def _local(tag: str) -> str:
+def local_name(tag: str) -> str:
     """Element name without its namespace."""
     return tag.rsplit("}", 1)[-1]
 
@@ -73,14 +69,14 @@ def _events(path: Path, events=("start", "end")) -> Iterator[tuple[str, object]]
     except DefusedXmlException as exc:
         raise InputError("XML declares a DTD or entities, which a WITSML file never does "
                          "(refused: entity expansion and external entities are unsafe)",
-                         file=path, fix=_FIX_EXPORT) from exc
+                         file=path, fix=FIX_EXPORT) from exc
     except ParseError as exc:
         line, column = exc.position
         raise InputError(f"not well-formed XML (line {line}, column {column}); the file may "
-                         "be truncated", file=path, fix=_FIX_EXPORT) from exc
+                         "be truncated", file=path, fix=FIX_EXPORT) from exc
 
 
-def _tree(path: Path):
+def parse_tree(path: Path):
     """Element tree of an object file (trajectory, tubular), hardened; a log's rows
     (``logData``) leave the tree once read, so a log file that also holds a trajectory or
     a tubular is held without its data."""
@@ -92,10 +88,10 @@ def _tree(path: Path):
             stack.append(elem)
             continue
         stack.pop()
-        if stack and _local(elem.tag) == "logData":
+        if stack and local_name(elem.tag) == "logData":
             stack[-1].remove(elem)
     if root is None:
-        raise InputError("XML file has no root element", file=path, fix=_FIX_EXPORT)
+        raise InputError("XML file has no root element", file=path, fix=FIX_EXPORT)
     return root
 
 
@@ -103,7 +99,7 @@ def _root(path: Path):
     """The root element, read from the file's first start tag only."""
     for _, elem in _events(path, ("start",)):
         return elem
-    raise InputError("XML file has no root element", file=path, fix=_FIX_EXPORT)
+    raise InputError("XML file has no root element", file=path, fix=FIX_EXPORT)
 
 
 def object_kind(path) -> str:
@@ -120,8 +116,8 @@ def object_kind(path) -> str:
     """
     path = Path(path)
     root = _root(path)
-    _check_namespace(root, path)
-    return _root_kind(_local(root.tag)) or _local(root.tag)
+    check_namespace(root, path)
+    return _root_kind(local_name(root.tag)) or local_name(root.tag)
 
 
 def _root_kind(name: str) -> str | None:
@@ -144,60 +140,60 @@ def object_kinds(path) -> frozenset[str]:
     """
     path = Path(path)
     root = _root(path)
-    _check_namespace(root, path)
-    kind = _root_kind(_local(root.tag))
+    check_namespace(root, path)
+    kind = _root_kind(local_name(root.tag))
     if kind is not None:
         return frozenset({kind})
     found: set[str] = set()
     stack: list = []
     for event, elem in _events(path):
         if event == "start":
-            found |= {_local(elem.tag)} & OBJECT_KINDS
+            found |= {local_name(elem.tag)} & OBJECT_KINDS
             stack.append(elem)
             continue
         stack.pop()
-        if stack and _local(elem.tag) in OBJECT_KINDS:
+        if stack and local_name(elem.tag) in OBJECT_KINDS:
             stack[-1].remove(elem)
     return frozenset(found)
 
 
-def _check_namespace(root, path: Path) -> None:
+def check_namespace(root, path: Path) -> None:
     namespace = root.tag[1:].split("}")[0] if root.tag.startswith("{") else ""
     if namespace not in ("", NAMESPACE):
         version = "WITSML 2.x" if "energyml" in namespace else "an XML file that is not WITSML"
         raise InputError(f"{version} (namespace not {NAMESPACE}); drillfric reads WITSML "
-                         "1.3.1/1.4.1 objects", file=path, fix=_FIX_EXPORT)
+                         "1.3.1/1.4.1 objects", file=path, fix=FIX_EXPORT)
 
 
-def _measure(elem, name: str, path: Path, *, required: bool = True):
+def measure(elem, name: str, path: Path, *, required: bool = True):
     """(value, uom) of a measure child such as ``<md uom="m">12.5</md>`` (None if absent)."""
-    child = next((c for c in elem if _local(c.tag) == name), None)
+    child = next((c for c in elem if local_name(c.tag) == name), None)
     if child is None or not (child.text or "").strip():
         if required:
-            raise InputError(f"{_local(elem.tag)} without {name}", file=path, fix=_FIX_EXPORT)
+            raise InputError(f"{local_name(elem.tag)} without {name}", file=path, fix=FIX_EXPORT)
         return None
     try:
         value = float(child.text)
     except ValueError as exc:
-        raise InputError(f"{_local(elem.tag)}/{name} is not a number", file=path,
-                         fix=_FIX_EXPORT) from exc
+        raise InputError(f"{local_name(elem.tag)}/{name} is not a number", file=path,
+                         fix=FIX_EXPORT) from exc
     uom = child.get("uom")
     if not uom:
-        raise InputError(f"{_local(elem.tag)}/{name} has no uom attribute", file=path,
-                         fix=_FIX_EXPORT)
+        raise InputError(f"{local_name(elem.tag)}/{name} has no uom attribute", file=path,
+                         fix=FIX_EXPORT)
     return value, uom
 
 
-def _text(elem, name: str) -> str | None:
-    child = next((c for c in elem if _local(c.tag) == name), None)
+def text_of(elem, name: str) -> str | None:
+    child = next((c for c in elem if local_name(c.tag) == name), None)
     return None if child is None or child.text is None else child.text.strip()
 
 
-def _unit_factor(uom: str, kind: str, what: str, path: Path) -> float:
+def unit_factor(uom: str, kind: str, what: str, path: Path) -> float:
     try:
         return conversion_factor(uom, kind)
     except InputError as exc:
-        raise InputError(f"{what}: {exc.problem}", file=path, fix=_FIX_EXPORT) from exc
+        raise InputError(f"{what}: {exc.problem}", file=path, fix=FIX_EXPORT) from exc
 
 
 # --------------------------------------------------------------------------- logs
@@ -277,7 +273,7 @@ class _LogScan:
         if parent == "log" and name in self._FIELDS:
             self.fields[name] = text
         elif parent == "log" and name == "logCurveInfo":
-            self.curves.append({_local(c.tag): (c.text or "").strip() for c in elem})
+            self.curves.append({local_name(c.tag): (c.text or "").strip() for c in elem})
         elif parent == "logData" and name == "mnemonicList":
             self.mnemonic_list = [m.strip() for m in text.split(",")]
         elif parent == "logData" and name == "unitList":
@@ -294,7 +290,7 @@ class _LogScan:
         index_curve = self.fields.get("indexCurve") or names[0]
         if index_curve not in names:
             raise InputError(f"log index curve '{index_curve}' is not among the data columns",
-                             file=path, fix=_FIX_EXPORT)
+                             file=path, fix=FIX_EXPORT)
         log_null = self.fields.get("nullValue") or None
         nulls = tuple(curves.get(n, {}).get("nullValue") or log_null for n in names)
         dated = index_type.replace(" ", "") == "datetime"
@@ -315,22 +311,22 @@ class _LogScan:
             by_curve = {c.get("mnemonic", ""): c.get("unit", "") for c in self.curves}
             units = self.unit_list or [by_curve.get(n, "") for n in names]
         else:  # WITSML 1.3.1: the curves in columnIndex (else document) order
-            order = sorted(self.curves, key=lambda c: _int(c.get("columnIndex"), 0))
+            order = sorted(self.curves, key=lambda c: parse_int(c.get("columnIndex"), 0))
             names = [c.get("mnemonic", "") for c in order]
             units = [c.get("unit", "") for c in order]
         if not names or not all(names):
             raise InputError("log without column mnemonics (no mnemonicList or logCurveInfo)",
-                             file=path, fix=_FIX_EXPORT)
+                             file=path, fix=FIX_EXPORT)
         if len(units) != len(names):
             raise InputError(f"log unitList has {len(units)} units for {len(names)} "
-                             "mnemonics", file=path, fix=_FIX_EXPORT)
+                             "mnemonics", file=path, fix=FIX_EXPORT)
         if len(set(names)) < len(names):
             raise InputError("log mnemonicList repeats a mnemonic", file=path,
-                             fix=_FIX_EXPORT)
+                             fix=FIX_EXPORT)
         return names, units
 
 
-def _int(text: str | None, default: int) -> int:
+def parse_int(text: str | None, default: int) -> int:
     try:
         return int(text)
     except (TypeError, ValueError):
@@ -357,16 +353,16 @@ def read_log_headers(path) -> list[LogHeader]:
     logs: list[LogHeader] = []
     scan: _LogScan | None = None
     for event, elem in _events(path):
-        name = _local(elem.tag)
+        name = local_name(elem.tag)
         if event == "start":
             if not stack:
-                _check_namespace(elem, path)
+                check_namespace(elem, path)
             if name == "log" and scan is None:
                 scan = _LogScan(len(logs), elem.get("uid", ""))
             stack.append(elem)
             continue
         stack.pop()
-        parent = _local(stack[-1].tag) if stack else ""
+        parent = local_name(stack[-1].tag) if stack else ""
         if scan is not None:
             scan.end(name, parent, elem)
         if name == "log" and scan is not None:
@@ -418,13 +414,13 @@ def _row_texts(path: Path, position: int) -> Iterator[str]:
     stack: list = []
     seen = -1
     for event, elem in _events(path):
-        name = _local(elem.tag)
+        name = local_name(elem.tag)
         if event == "start":
             seen += name == "log"
             stack.append(elem)
             continue
         stack.pop()
-        if name == "data" and seen == position and stack and _local(stack[-1].tag) == "logData":
+        if name == "data" and seen == position and stack and local_name(stack[-1].tag) == "logData":
             yield elem.text or ""
         if name == "log" and seen == position:
             return
@@ -443,10 +439,10 @@ def _frame(rows: list[str], header: LogHeader, path: Path) -> pd.DataFrame:
         frame = pd.DataFrame(index=range(len(rows)))
     except (pd.errors.ParserError, ValueError) as exc:
         raise InputError(f"a log data row has more values than the {len(names)} names of "
-                         "its mnemonicList", file=path, fix=_FIX_EXPORT) from exc
+                         "its mnemonicList", file=path, fix=FIX_EXPORT) from exc
     if frame.shape[1] > len(names):
         raise InputError(f"log data rows have {frame.shape[1]} values for the {len(names)} "
-                         "names of the mnemonicList", file=path, fix=_FIX_EXPORT)
+                         "names of the mnemonicList", file=path, fix=FIX_EXPORT)
     frame = frame.set_axis(names[:frame.shape[1]], axis=1).reindex(columns=names)
     for column, null in zip(names, header.nulls, strict=True):
         if null is not None:
@@ -673,162 +669,3 @@ def open_witsml_parts(paths, *, log: str | None = None) -> RawSource:
     first = headers[0]
     depth = f"{first.index_curve} [{first.index_unit}]" if first.depth_indexed else None
     return RawSource(paths[0], "witsml", columns, units, None, read, depth_index=depth)
-
-
-# --------------------------------------------------------------------------- trajectory
-def _stations(trajectory, path: Path) -> pd.DataFrame:
-    """Stations of one ``<trajectory>`` in canonical columns (md_m, inc_deg, azi_deg …)."""
-    rows = []
-    for station in (s for s in trajectory if _local(s.tag) == "trajectoryStation"):
-        if (_text(station, "statusTrajStation") or "").lower() in _BAD_STATIONS:
-            continue
-        row = {}
-        for name, column, kind in (("md", "md_m", "length"), ("incl", "inc_deg", "angle"),
-                                   ("azi", "azi_deg", "angle"), ("tvd", "tvd_m", "length"),
-                                   ("dispNs", "north_m", "length"),
-                                   ("dispEw", "east_m", "length")):
-            measure = _measure(station, name, path, required=column in ("md_m", "inc_deg",
-                                                                         "azi_deg"))
-            if measure is not None:
-                value = measure[0] * _unit_factor(measure[1], kind, f"station {name}", path)
-                row[column] = np.degrees(value) if kind == "angle" else value
-        dls = _measure(station, "dls", path, required=False)
-        if dls is not None and _dls_factor(dls[1]) is not None:
-            row["dls_deg_30m"] = dls[0] * _dls_factor(dls[1])
-        rows.append(row)
-    table = pd.DataFrame(rows)
-    optional = [c for c in ("tvd_m", "north_m", "east_m", "dls_deg_30m")
-                if c in table and table[c].notna().all()]
-    if table.empty:
-        return table
-    return table[["md_m", "inc_deg", "azi_deg", *optional]].sort_values(
-        "md_m", kind="stable").reset_index(drop=True)
-
-
-def _dls_factor(uom: str) -> float | None:
-    """°/30 m per unit of a dogleg-severity uom (``rad/m``, ``dega/30m``, ``dega/100ft``).
-
-    Examples
-    --------
-    >>> round(_dls_factor("dega/100ft"), 4)
-    0.9843
-    """
-    match = re.fullmatch(r"\s*([A-Za-z]+)\s*/\s*([0-9.]*)\s*([A-Za-z]+)\s*", uom)
-    if match is None:
-        return None
-    try:
-        angle = np.degrees(conversion_factor(match[1], "angle"))
-        per = float(match[2] or 1.0) * conversion_factor(match[3], "length")
-    except (InputError, ValueError):
-        return None
-    return float(angle * 30.0 / per)
-
-
-def trajectory_table(path) -> pd.DataFrame:
-    """The stations of a WITSML trajectory as a canonical survey table.
-
-    Columns ``md_m`` [m], ``inc_deg`` [°], ``azi_deg`` [°], and ``tvd_m``, ``north_m``,
-    ``east_m`` [m], ``dls_deg_30m`` [°/30 m] when every station has them, sorted by MD.
-    Units come from each measure's ``uom`` (``m``, ``ft``, ``rad``, ``dega`` …). Stations
-    marked ``bad`` or ``rejected`` are left out. Several trajectories in one file: the
-    deepest is read. Validation (increasing MD, angle ranges) is the survey reader's.
-
-    Raises
-    ------
-    InputError
-        Unsafe or malformed XML, no trajectory, a station without md/incl/azi or uom.
-    """
-    path = Path(path)
-    root = _tree(path)
-    _check_namespace(root, path)
-    found = [t for t in root.iter() if _local(t.tag) == "trajectory"]
-    if not found:
-        raise InputError(f"WITSML file holds {object_kind(path)} objects, not a trajectory",
-                         file=path, fix="give a WITSML trajectory (or a survey table)")
-    tables = [_stations(t, path) for t in found]
-    best = max(tables, key=lambda t: (t["md_m"].max() if len(t) else -np.inf, len(t)))
-    if best.empty:
-        raise InputError("WITSML trajectory has no stations", file=path,
-                         fix="export the trajectory with its trajectoryStation elements")
-    return best
-
-
-# --------------------------------------------------------------------------- tubular
-def _component(comp, path: Path) -> dict:
-    """One ``tubularComponent`` as a ``[[string.sections]]`` table."""
-    od = _measure(comp, "od", path)
-    inner = _measure(comp, "id", path)
-    length = _measure(comp, "len", path)
-    od_m = od[0] * _unit_factor(od[1], "length", "tubularComponent od", path)
-    section = {"name": "", "od_m": od_m,
-               "id_m": inner[0] * _unit_factor(inner[1], "length", "tubularComponent id", path),
-               "length_m": length[0] * _unit_factor(length[1], "length",
-                                                    "tubularComponent len", path)}
-    kind = _text(comp, "typeTubularComp") or "component"
-    section["name"] = f"{kind} {od_m / 0.0254:.4g}in"
-    if section["length_m"] <= 0 or not 0 <= section["id_m"] < od_m:
-        raise InputError(f"tubular component '{section['name']}' has length "
-                         f"{section['length_m']:g} m, OD {od_m:g} m, ID {section['id_m']:g} m "
-                         "(needs length > 0 and 0 ≤ ID < OD)", file=path, fix=_FIX_EXPORT)
-    mass = _measure(comp, "wtPerLen", path, required=False)
-    if mass is not None and mass[0] > 0:
-        section["linear_mass_kg_m"] = _linear_mass(mass, path)
-    joints = [_measure(c, "od", path, required=False) for c in comp
-              if _local(c.tag) == "connection"]
-    joint_od = max((j[0] * _unit_factor(j[1], "length", "connection od", path)
-                    for j in joints if j is not None), default=0.0)
-    if joint_od > od_m:
-        section["tool_joint_od_m"] = joint_od
-    return section
-
-
-def _linear_mass(measure: tuple[float, str], path: Path) -> float:
-    try:
-        return float(registry().Quantity(measure[0], parse_unit(measure[1])).to("kg/m")
-                     .magnitude)
-    except (InputError, pint.errors.DimensionalityError) as exc:
-        raise InputError(f"tubularComponent wtPerLen unit '{measure[1]}' is not a mass per "
-                         "length", file=path, fix=_FIX_EXPORT) from exc
-
-
-def tubular_sections(path, *, uid: str | None = None) -> list[dict]:
-    """A WITSML tubular (the drill string) as ``[[string.sections]]`` tables, top-down.
-
-    WITSML numbers components by ``sequence`` in the order they entered the hole (1 first,
-    i.e. at the bit), so the top-down order is by decreasing sequence; components without
-    a sequence keep their document order, read as the order they entered the hole.
-    Each table has ``name`` (component type and OD in inches), ``od_m``, ``id_m``,
-    ``length_m`` [m], and ``linear_mass_kg_m`` [kg/m] (from ``wtPerLen``) and
-    ``tool_joint_od_m`` [m] (the largest ``connection/od`` above the body OD) when the file
-    gives them. Every section has its length; the configuration lets the top one's length
-    follow from the bit depth instead (drop its ``length_m`` for that).
-
-    Parameters
-    ----------
-    path : str or Path
-        WITSML file holding ``<tubular>`` objects.
-    uid : str, optional
-        uid or name of the tubular when the file holds several.
-
-    Raises
-    ------
-    InputError
-        Unsafe or malformed XML, no tubular (or several and no ``uid``), a component
-        without od/id/len, or with impossible dimensions.
-    """
-    path = Path(path)
-    root = _tree(path)
-    _check_namespace(root, path)
-    tubulars = [t for t in root.iter() if _local(t.tag) == "tubular"
-                and (uid is None or uid in (t.get("uid"), _text(t, "name")))]
-    if len(tubulars) != 1:
-        problem = ("no tubular" if not tubulars else f"{len(tubulars)} tubulars")
-        raise InputError(f"WITSML file holds {problem}" + ("" if uid is None else
-                                                           f" with uid or name '{uid}'"),
-                         file=path, fix="give a file with one tubular, or its uid")
-    comps = [c for c in tubulars[0] if _local(c.tag) == "tubularComponent"]
-    if not comps:
-        raise InputError("WITSML tubular has no tubularComponent", file=path, fix=_FIX_EXPORT)
-    entered = sorted(range(len(comps)),
-                     key=lambda i: (_int(_text(comps[i], "sequence"), 0), i))
-    return [_component(comps[i], path) for i in reversed(entered)]

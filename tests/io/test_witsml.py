@@ -21,10 +21,9 @@ from drillfric.io.witsml import (
     object_kind,
     open_witsml_parts,
     read_log_headers,
-    trajectory_table,
-    tubular_sections,
     witsml_log_parts,
 )
+from drillfric.io.witsml_objects import trajectory_table, tubular_sections
 
 NS = "http://www.witsml.org/schemas/1series"
 FT = 0.3048

@@ -21,7 +21,7 @@ from drillfric.cli.main import cli
 from drillfric.errors import InputError
 from drillfric.fleet import discover
 from drillfric.io.well import open_well
-from drillfric.io.witsml import tubular_sections
+from drillfric.io.witsml_objects import tubular_sections
 from tests.io.test_witsml import _component, _curve, _doc, _log, _station
 
 T0 = pd.Timestamp("2024-05-01T12:00:00Z")
