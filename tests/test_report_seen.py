@@ -272,6 +272,7 @@ def test_empty_friction_log_is_a_sentence_not_an_axis(demo, tmp_path):
             seg.update(status="skipped", mu_k=None, mu_s=None, mu_td=None, converged=False,
                        message="too short")
     result = copy_result(demo, tmp_path / "w", skipped)
+    (result / "drag_log.parquet").unlink(missing_ok=True)  # nor drag-based factors
     html = write_well_report(result).read_text(encoding="utf-8")
     assert "bk-friction" not in bokeh_items(html)
     note = _section(html, "no-friction").split("</p>")[0]

@@ -133,13 +133,22 @@ def _lasio_warnings(path: Path):
     (made printable, naming the file) instead of reaching stderr raw."""
     logger = logging.getLogger("lasio")
     handler, propagate = _Collect(), logger.propagate
+    # a logging.config.dictConfig elsewhere in the process (Dask's, on import) disables the
+    # loggers that existed then (lasio's module loggers): its warnings would vanish
+    family = [logging.getLogger(n) for n in list(logging.root.manager.loggerDict)
+              if n == "lasio" or n.startswith("lasio.")]
+    disabled = [lg.disabled for lg in family]
     logger.addHandler(handler)
     logger.propagate = False
+    for lg in family:
+        lg.disabled = False
     try:
         yield
     finally:
         logger.removeHandler(handler)
         logger.propagate = propagate
+        for lg, was in zip(family, disabled, strict=True):
+            lg.disabled = was
     for message in dict.fromkeys(handler.messages):
         # warn_explicit with a fresh registry: each file's warnings are shown, even when an
         # earlier read in this process gave the same text (the default filter shows a
