@@ -202,6 +202,7 @@ class WellTask:
     report: bool = True
     taken: frozenset = frozenset()
     run: str = ""
+    resume: bool = True
 
 
 def process_well(task: WellTask) -> dict:
@@ -228,7 +229,7 @@ def process_well(task: WellTask) -> dict:
         if task.name is None:
             _claim(task, well.dir_name)
         result = run_well(well, task.out_root, rate_hz=task.rate_hz, pdf=task.pdf,
-                          report=task.report)
+                          report=task.report, resume=task.resume)
         record.update(status="ok", summary=jsonable(result.summary),
                       out_dir=str(result.out_dir), failed_segments=result.failed)
     except DrillfricError as exc:
@@ -570,7 +571,7 @@ def _run_jobs(jobs: list[_Job], out_root: Path, run: str, *, workers: int,
             outcomes[job.index] = _skipped(name, entry)
             advance(1.0)
         else:
-            todo.append(job)
+            todo.append(replace(job, task=replace(job.task, resume=not force)))
     if any(not j.named for j in todo):  # their names are resolved (and claimed) by workers
         taken = frozenset({j.dir_name.casefold() for j in jobs if j.named and j.task}
                           | {Path(o.result_dir).name.casefold() for o in outcomes.values()

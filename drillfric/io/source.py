@@ -36,6 +36,9 @@ class RawSource:
         Row count when known without reading the data.
     depth_index : str or None
         The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
+    encoding : str or None
+        Text encoding of a delimited text file (its rows can then be read from a byte
+        offset: :meth:`window`), else None.
     """
 
     path: Path
@@ -45,9 +48,18 @@ class RawSource:
     rows: int | None
     _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
     depth_index: str | None = None
+    encoding: str | None = None
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
         if chunk_rows < 1:
             raise ValueError("chunk_rows must be positive")
         yield from self._read(chunk_rows)
+
+    def window(self, start: int, stop: int | None,
+               chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
+        """The rows of a delimited text file's bytes [start, stop) (``start`` 0 or a line's
+        beginning past the header), in blocks as :meth:`chunks`."""
+        if self.encoding is None:
+            raise ValueError("only a delimited text file is read by byte range")
+        yield from self._read(chunk_rows, start, stop)

@@ -261,7 +261,12 @@ class Well:
             raise ValueError("well opened without its data file's header (header=False)")
         tracker = tracker or self.time_tracker()
         for chunk in self.source.chunks(chunk_rows):
-            yield _convert(chunk, self.mappings, tracker)
+            yield self.canonical(chunk, tracker)
+
+    def canonical(self, raw: pd.DataFrame, tracker: TimeTracker | None) -> pd.DataFrame:
+        """One raw chunk of the data (the source's columns) as canonical SI columns, its
+        time checked by ``tracker`` (:meth:`chunks` does this for every chunk)."""
+        return _convert(raw, self.mappings, tracker)
 
     def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
         """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
