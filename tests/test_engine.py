@@ -139,3 +139,50 @@ def test_state_with_pickled_array_or_foreign_table_name_is_refused(tmp_path):
     (tmp_path / "engine.json").write_text(json.dumps(doc))
     with pytest.raises(InputError, match="engine state not readable"):
         read_state(tmp_path)
+
+
+@pytest.fixture(scope="module")
+def weighed_demo(tmp_path_factory):
+    """The demo's four stands behind 60 s in the slips with a 150-kN block on the hook (the
+    first stand's string 3 % heavier), and a configured string 30 % too light that the hook
+    load calibrates (docs/theory.md §2.1)."""
+    from tests.test_hookload import BLOCK_N, _masses
+
+    folder = tmp_path_factory.mktemp("weighed_demo")
+    demo = pd.read_csv(DEMO / "demo.csv")
+    t = np.arange(0.0, 60.0, 0.05)
+    slips = pd.DataFrame({"time_s": t, "surface_rpm": 0.0, "surface_torque_Nm": 0.0,
+                          "hookload_N": BLOCK_N + np.random.default_rng(22).normal(0, 2e3, t.size),
+                          "bit_depth_m": 2210.0, "hole_depth_m": 2215.0, "bit_rpm": 0.0,
+                          "string_torque_Nm": 0.0})
+    demo = demo.assign(time_s=demo["time_s"] + 60.0, hookload_N=demo["hookload_N"] + BLOCK_N)
+    first = demo["time_s"] < 290.0  # the first stand weighs 3 % more: the scale moves later
+    demo.loc[first, "hookload_N"] += 0.03 * (demo.loc[first, "hookload_N"] - BLOCK_N)
+    frame = pd.concat([slips, demo], ignore_index=True)
+    base = (DEMO / "demo.toml").read_text()
+    config = folder / "weighed.toml"
+    config.write_text(_masses(base[:base.index("\n[simulate]")], 0.7)
+                      + "\n[hookload]\ncalibrate_string_weight = true\n")
+    return frame, config
+
+
+def test_a_calibrated_string_streamed_in_chunks_revises_to_the_whole_run(weighed_demo, tmp_path):
+    """With hookload.calibrate_string_weight the scale the rows so far support moves as
+    stands arrive: segments estimated with an earlier scale are re-estimated at the end
+    (summary.json revisions) and the results are those of the whole data in one chunk."""
+    frame, config = weighed_demo
+    survey = DEMO / "demo.survey.csv"
+    whole = run_well(open_well(frame=frame, config=config, survey=survey))
+    assert whole.summary["hookload"]["verdict"] == "calibrated"
+    engine = Engine(open_well(frame=frame.iloc[:100], config=config, survey=survey))
+    for a in range(0, len(frame), 2_500):
+        engine.feed(frame.iloc[a:a + 2_500])
+        if a == 10_000:
+            engine.save(tmp_path / "state")
+            engine = Engine.load(tmp_path / "state", engine.well)
+    result = engine.result()
+    _same_results(result, whole)
+    assert result.summary["hookload"]["calibration_scale"] == pytest.approx(
+        whole.summary["hookload"]["calibration_scale"], rel=1e-12)
+    revised = [r for r in result.summary["revisions"] if "calibration" in r["reason"]]
+    assert revised and revised[0]["segment"] == 1  # the first stand's scale alone was off
