@@ -113,3 +113,38 @@ def _no_report(monkeypatch):
     import drillfric.api
 
     monkeypatch.setattr(drillfric.api, "_report_writer", lambda pdf: None)
+
+
+def _parquet(frame: pd.DataFrame, path, group_rows: int = 7_000) -> None:
+    frame.to_parquet(path, index=False, row_group_size=group_rows)
+
+
+def test_parquet_rewritten_with_more_rows_continues_from_its_row_groups(stands,  # noqa: F811
+                                                                         tmp_path):
+    """A Parquet file rewritten whole with more rows (its last row group now larger): the
+    unchanged row groups are recognised by their bytes, the grown one by its values; only
+    the new rows are read, and the results are the whole file's. An earlier value changed:
+    redone whole with the reason."""
+    path, whole = stands
+    frame = pd.read_csv(path)
+    data = tmp_path / "wells" / "three.parquet"
+    _grow(path, data.with_suffix(".csv"), 0.0)
+    data.with_suffix(".csv").unlink()
+    toml = data.with_suffix(".toml")
+    toml.write_text(toml.read_text().replace('data = "three.csv"', 'data = "three.parquet"'))
+    out = tmp_path / "out"
+    first = int(len(frame) * 0.55)  # not at a row-group boundary
+    _parquet(frame.iloc[:first], data)
+    run_many([WellSpec(data)], out, workers=1)
+    _parquet(frame, data)
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    resumed = _summary(out)["resumed"]
+    assert resumed == {"from_row": first, "reason": ""}
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    edited = frame.copy()
+    edited.loc[10, "surface_rpm"] += 1.0
+    _parquet(edited, data)
+    run_many([WellSpec(data)], out, workers=1)
+    assert "row group 0 differs" in _summary(out)["resumed"]["reason"]

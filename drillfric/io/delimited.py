@@ -38,6 +38,8 @@ _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
 #: Largest share of control characters (other than tab, CR, LF) in the text at the top of a
 #: file that is still read as text.
 _MAX_CONTROL_SHARE = 0.01
+#: Text encodings whose rows can be read from a byte offset (UTF-16/32 are read whole).
+_SEEKABLE = ("utf-8-sig", "latin-1")
 _NOT_TEXT_FIX = "give a delimited text export (CSV) of the log, or a Parquet/HDF5/LAS file"
 
 
@@ -237,7 +239,7 @@ def open_delimited(path: Path) -> RawSource:
                              fix="check that every row has the same number of fields") from exc
 
     return RawSource(path, "csv", layout.columns, layout.units, None, read,
-                     encoding=layout.encoding)
+                     seek="byte" if layout.encoding in _SEEKABLE else None)
 
 
 class _Window(io.RawIOBase):

@@ -36,9 +36,9 @@ class RawSource:
         Row count when known without reading the data.
     depth_index : str or None
         The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
-    encoding : str or None
-        Text encoding of a delimited text file (its rows can then be read from a byte
-        offset: :meth:`window`), else None.
+    seek : str or None
+        How :meth:`window` addresses rows: ``"byte"`` (a delimited text file: byte
+        offsets), ``"row"`` (Parquet: row numbers); None: the source is read whole.
     """
 
     path: Path
@@ -48,7 +48,7 @@ class RawSource:
     rows: int | None
     _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
     depth_index: str | None = None
-    encoding: str | None = None
+    seek: str | None = None
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
@@ -58,8 +58,9 @@ class RawSource:
 
     def window(self, start: int, stop: int | None,
                chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
-        """The rows of a delimited text file's bytes [start, stop) (``start`` 0 or a line's
-        beginning past the header), in blocks as :meth:`chunks`."""
-        if self.encoding is None:
-            raise ValueError("only a delimited text file is read by byte range")
+        """The rows between positions ``start`` and ``stop`` (None: the end) in the unit of
+        :attr:`seek` — bytes (``start`` 0 or a line's beginning past the header) or rows —
+        in blocks as :meth:`chunks`."""
+        if self.seek is None:
+            raise ValueError(f"a {self.format} source is read whole")
         yield from self._read(chunk_rows, start, stop)

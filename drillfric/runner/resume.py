@@ -1,18 +1,27 @@
 """Continue a well's run from the state its last results kept: only the rows appended since
 (docs/fleet.md "Only what is new").
 
-A delimited text file that grew is recognised by its content: the state records the byte
-length of the file it read, a SHA-256 of those bytes and whether they ended with a complete
-line (:func:`csv_mark`); the file continues it when its first bytes hash the same
-(:func:`changed`). Anything else — no state, another drillfric, configuration or rate,
-earlier bytes changed, a format read only whole — is run from the start, and the summary
-says why (summary.json ``resumed``).
+A data file that grew is recognised by its content, not its name or date (:func:`mark`,
+:func:`changed`):
+
+- a delimited text file: the byte length read, a SHA-256 of those bytes and whether they
+  ended with a complete line; it continues when its first bytes hash the same;
+- a Parquet file rewritten with more rows: a SHA-256 of each row group's bytes, and of the
+  last group's values; it continues when the same groups come first — the last one may
+  have been rewritten larger, then its first rows must hold the same values.
+
+Anything else — no state, another drillfric, configuration or rate, earlier rows changed, a
+format read only whole — is run from the start, and the summary says why (summary.json
+``resumed``).
 """
 
 from __future__ import annotations
 
 import hashlib
 from pathlib import Path
+
+import pandas as pd
+import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
 from drillfric.io.well import Well
@@ -22,8 +31,24 @@ from .finish import DirectorySink
 from .state import read_state
 
 _BLOCK = 1 << 22
-#: Text encodings read from a byte offset (a UTF-16/32 file is read whole).
-_SEEKABLE = ("utf-8-sig", "latin-1")
+
+
+def mark(well: Well) -> tuple[dict, int]:
+    """What a run reads of the well's data file now, and where its data ends (bytes or
+    rows: :attr:`~drillfric.io.source.RawSource.seek`)."""
+    path = well.files.data
+    if well.source.seek == "byte":
+        size = path.stat().st_size
+        return csv_mark(path, size), size
+    found = parquet_mark(path, well.source)
+    return found, found["rows"]
+
+
+def start_of(found: dict | None) -> int:
+    """Where the rows not yet read begin (bytes or rows), 0 without a mark."""
+    if found is None:
+        return 0
+    return found["bytes"] if found["format"] == "csv" else found["rows"]
 
 
 def csv_mark(path: Path, size: int) -> dict:
@@ -40,10 +65,55 @@ def csv_mark(path: Path, size: int) -> dict:
             "ends_line": last in (b"\n", b"\r")}
 
 
-def changed(mark: dict | None, path: Path) -> str:
-    """Why ``path`` does not continue what ``mark`` recorded ("" when it does)."""
-    if not mark or mark.get("format") != "csv":
-        return "the earlier run read no delimited text file"
+def parquet_mark(path: Path, source) -> dict:
+    """What a run reads of a Parquet file: its rows, each row group's rows and byte hash,
+    and a hash of the last group's values."""
+    meta = pq.ParquetFile(path).metadata
+    groups = [{"rows": meta.row_group(i).num_rows, "sha256": _group_hash(path, meta, i)}
+              for i in range(meta.num_row_groups)]
+    last = groups[-1]["rows"] if groups else 0
+    return {"format": "parquet", "rows": meta.num_rows, "groups": groups,
+            "last_values": _values_hash(source, meta.num_rows - last, meta.num_rows)}
+
+
+def _group_hash(path: Path, meta, i: int) -> str:
+    """SHA-256 of the bytes of row group ``i`` (its column chunks)."""
+    group = meta.row_group(i)
+    spans = []
+    for c in range(group.num_columns):
+        col = group.column(c)
+        begin = col.dictionary_page_offset if col.has_dictionary_page else col.data_page_offset
+        spans.append((begin, begin + col.total_compressed_size))
+    begin, end = min(a for a, _ in spans), max(b for _, b in spans)
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        fh.seek(begin)
+        left = end - begin
+        while left > 0 and (block := fh.read(min(_BLOCK, left))):
+            digest.update(block)
+            left -= len(block)
+    return digest.hexdigest()
+
+
+def _values_hash(source, start: int, stop: int) -> str:
+    """SHA-256 of the values of rows [start, stop) (column names and contents)."""
+    digest = hashlib.sha256()
+    for chunk in source.window(start, stop):
+        digest.update("\x1f".join(chunk.columns).encode())
+        digest.update(pd.util.hash_pandas_object(chunk, index=False).to_numpy().tobytes())
+    return digest.hexdigest()
+
+
+def changed(found: dict | None, well: Well) -> str:
+    """Why the well's data file does not continue what ``found`` recorded ("" when it
+    does)."""
+    path = well.files.data
+    if not found or found.get("format") != {"byte": "csv", "row": "parquet"}.get(
+            well.source.seek):
+        return "the earlier run read another kind of file"
+    if found["format"] == "parquet":
+        return _parquet_changed(found, path, well.source)
+    mark = found
     size = path.stat().st_size
     if size < mark["bytes"]:
         return f"the file is shorter than the {mark['bytes']} bytes read before"
@@ -54,19 +124,37 @@ def changed(mark: dict | None, path: Path) -> str:
     return ""
 
 
+def _parquet_changed(found: dict, path: Path, source) -> str:
+    meta = pq.ParquetFile(path).metadata
+    if meta.num_rows < found["rows"]:
+        return f"the file holds fewer rows than the {found['rows']} read before"
+    groups = found["groups"]
+    if meta.num_row_groups < len(groups):
+        return "the file holds fewer row groups than before"
+    start = 0
+    for i, group in enumerate(groups):
+        same = meta.row_group(i).num_rows == group["rows"] and \
+            _group_hash(path, meta, i) == group["sha256"]
+        if not same and (i < len(groups) - 1 or meta.row_group(i).num_rows < group["rows"]
+                         or _values_hash(source, start, start + group["rows"])
+                         != found["last_values"]):
+            return f"earlier rows changed (row group {i} differs from the one read before)"
+        start += group["rows"]
+    return ""
+
+
 def resumable(well: Well) -> bool:
-    """Whether the well's data can be continued from a byte offset (a delimited text file
-    in a byte-seekable encoding)."""
-    source = well.source
-    return (not well.files.in_memory and source is not None
-            and source.encoding in _SEEKABLE)
+    """Whether the well's data file can be continued where a run stopped (a delimited text
+    file in a byte-seekable encoding, a Parquet file)."""
+    return not well.files.in_memory and well.source is not None and \
+        well.source.seek is not None
 
 
 def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engine | None, str]:
     """An engine continuing the run of ``previous`` (a result directory), its output rows
     seeded into ``sink``; or None and why it cannot."""
     if not resumable(well):
-        return None, "its data is not a delimited text file read by byte offset"
+        return None, "its data file is read whole (not delimited text or Parquet)"
     folder = previous / "state"
     if not (folder / "engine.json").is_file():
         return None, "no saved state"
@@ -74,13 +162,11 @@ def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engin
         state = read_state(folder)
     except InputError as exc:
         return None, exc.message
-    why = mismatch(state, well, kw.get("rate_hz")) or changed(state.get("source"),
-                                                              well.files.data)
+    why = mismatch(state, well, kw.get("rate_hz")) or changed(state.get("source"), well)
     if why:
         return None, why
     engine = Engine(well, sink=sink, **kw)
     engine.restore(state)
     sink.seed(previous, {r.id for r in engine.records})
-    engine.resumed = {"from_row": engine.raw_rows, "from_byte": state["source"]["bytes"],
-                      "reason": ""}
+    engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
     return engine, ""

@@ -27,7 +27,7 @@ from drillfric.result import RunProgress, WellResult
 
 from .engine import Engine
 from .finish import DirectorySink, ReportWriter, Sink, deliver
-from .resume import csv_mark, resumable
+from .resume import mark, resumable, start_of
 from .resume import resume as continued
 
 #: Folder of a result directory holding the engine's state (docs/outputs.md).
@@ -58,14 +58,14 @@ def run_time_log(well: Well, out_root=None, *, rate_hz: float | None = None,
 
 
 def _rows(well: Well, engine: Engine, chunk_rows: int):
-    """The source rows the engine has not read: a delimited text file by byte range (its
-    length now recorded in the engine's ``source``), else the whole source."""
+    """The source rows the engine has not read — from where its ``source`` mark ends to
+    where the file ends now (the new mark), for a file read by position — else the whole
+    source."""
     if not resumable(well):
         return well.source.chunks(chunk_rows)
-    start = 0 if engine.source is None else engine.source["bytes"]
-    size = well.files.data.stat().st_size
-    engine.source = csv_mark(well.files.data, size)
-    return well.source.window(start, size, chunk_rows)
+    start = start_of(engine.source)
+    engine.source, stop = mark(well)
+    return well.source.window(start, stop, chunk_rows)
 
 
 def finish_engine(engine: Engine, sink: Sink) -> WellResult:
