@@ -272,8 +272,9 @@ class PlateauFinder:
             else np.zeros(len(chunk), bool)
         return ~still_turning & ~moving
 
-    def feed(self, chunk: pd.DataFrame) -> None:
-        """Consume the next rows (canonical SI columns)."""
+    def feed(self, chunk: pd.DataFrame, states=None) -> None:
+        """Consume the next rows (canonical SI columns; ``states``, the rig states, are
+        not needed: quiet rows are judged here)."""
         if "hookload_N" not in chunk or not len(chunk):
             return
         self._run(_column(chunk, "time_s"), _column(chunk, "hookload_N"), self.quiet(chunk))

@@ -148,3 +148,39 @@ def test_parquet_rewritten_with_more_rows_continues_from_its_row_groups(stands, 
     _parquet(edited, data)
     run_many([WellSpec(data)], out, workers=1)
     assert "row group 0 differs" in _summary(out)["resumed"]["reason"]
+
+
+def test_folder_of_hourly_files_continues_with_the_grown_and_the_new_files(stands,  # noqa: F811
+                                                                          tmp_path):
+    """A well directory whose [well] data names a folder of hourly CSV files: the last file
+    read grew and new files came; only their rows are read and the results are the whole
+    log's. A file read before that changed: redone whole, the file named."""
+    path, whole = stands
+    frame = pd.read_csv(path)
+    well = tmp_path / "wells" / "three"
+    (well / "hourly").mkdir(parents=True)
+    shutil.copy(path.with_suffix(".survey.csv"), well / "three.survey.csv")
+    (well / "well.toml").write_text(path.with_suffix(".toml").read_text().replace(
+        'data = "three.csv"', 'data = "hourly"').replace('file = "three.survey.csv"',
+                                                         'file = "three.survey.csv"'))
+    bounds = np.linspace(0, len(frame), 7).astype(int)
+    parts = [frame.iloc[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    for i, part in enumerate(parts[:3]):
+        part.to_csv(well / "hourly" / f"h{i:02d}.csv", index=False)
+    half = len(parts[3]) // 2
+    parts[3].iloc[:half].to_csv(well / "hourly" / "h03.csv", index=False)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(well)], out, workers=1).count("ok") == 1
+    parts[3].iloc[half:].to_csv(well / "hourly" / "h03.csv", mode="a", header=False,
+                                index=False)
+    for i in (4, 5):
+        parts[i].to_csv(well / "hourly" / f"h{i:02d}.csv", index=False)
+    assert run_many([WellSpec(well)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": bounds[3] + half, "reason": ""}
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    parts[1].assign(surface_rpm=parts[1]["surface_rpm"] + 0.5).to_csv(
+        well / "hourly" / "h01.csv", index=False)
+    run_many([WellSpec(well)], out, workers=1)
+    assert _summary(out)["resumed"]["reason"].startswith("h01.csv: earlier rows changed")

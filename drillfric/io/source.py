@@ -36,6 +36,9 @@ class RawSource:
         Row count when known without reading the data.
     depth_index : str or None
         The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
+    parts : tuple of RawSource
+        For a log split over files in a folder (:mod:`drillfric.io.parts`): each file's own
+        source, in reading order; else empty.
     seek : str or None
         How :meth:`window` addresses rows: ``"byte"`` (a delimited text file: byte
         offsets), ``"row"`` (Parquet: row numbers); None: the source is read whole.
@@ -49,6 +52,7 @@ class RawSource:
     _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
     depth_index: str | None = None
     seek: str | None = None
+    parts: tuple = ()
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""

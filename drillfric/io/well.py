@@ -14,7 +14,9 @@ A well is one of
   named ``table.key``);
 - a directory holding ``well.toml``, whose ``[well] data`` and ``[survey] file`` name its
   files (relative to the directory); ``[well] data`` may be left out when the directory
-  holds the numbered parts of a WITSML log.
+  holds the numbered parts of a WITSML log; ``[well] data`` may name a folder of CSV or
+  Parquet files of one log (hourly or daily exports), read in name order
+  (:mod:`drillfric.io.parts`).
 
 Precedence: ``--config``/``--survey`` > the configuration's ``[survey] file`` > sidecars
 by name > objects inside the data file (an HDF5 ``/survey``; a WITSML ``<trajectory>`` or
@@ -57,6 +59,7 @@ from drillfric.files import require_file, special
 from drillfric.io import witsml
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.hdf5 import members, node_at
+from drillfric.io.parts import folder_parts, open_parts
 from drillfric.io.readers import FORMATS, data_format, open_source
 from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
@@ -157,7 +160,8 @@ class WellFiles:
         when it holds the trajectory beside the log).
     parts : tuple of Path
         The numbered part files of a WITSML log split over several files (by number; read
-        in index order), else empty.
+        in index order), or the CSV/Parquet files of a data folder (by name:
+        :mod:`drillfric.io.parts`), else empty.
     string : Path or None
         WITSML tubular read as the string (``NAME.tubular.xml``, or the data file holding a
         ``<tubular>``) when the configuration has no ``[[string.sections]]``.
@@ -542,6 +546,9 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
     split = witsml.split_log(path)
     if split is not None:
         return split
+    parts = folder_parts(path)
+    if parts is not None:
+        return path, parts
     data_format(path)
     return path, ()
 
@@ -574,7 +581,8 @@ def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
         raise ConfigError("well.toml does not name its data file", file=well_toml,
                           fix='add [well] data = "surface.parquet" (relative to the folder)')
     data_path = folder / data
-    if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)):
+    if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)
+                                  and not folder_parts(data_path)):
         raise InputError("data file named by well.toml not found", file=data_path,
                          fix=f"fix [well] data in {well_toml}")
     return *_data(data_path), well_toml, raw
@@ -726,7 +734,9 @@ def _open(files: WellFiles, cfg: Config,
     the reader (LAS, WITSML, DLIS) is the measured depth unless ``[channels]
     measured_depth`` says otherwise."""
     raw = (frame_source(frame) if frame is not None else
-           witsml.open_witsml_parts(files.parts) if files.parts else open_source(files.data))
+           open_parts(files.parts) if files.parts and files.parts[0].suffix.lower() != ".xml"
+           else witsml.open_witsml_parts(files.parts) if files.parts
+           else open_source(files.data))
     file = str(files.data)
     index = log_index(raw.columns, cfg.channels, depth_index=raw.depth_index, file=file)
     channels = cfg.channels

@@ -51,20 +51,6 @@ from .state import read_state, write_state
 REVISE_SCALE = 1e-3
 
 
-class _Check(LogCheck):
-    """The log check as a per-chunk accumulator."""
-
-    def feed(self, chunk: pd.DataFrame, states=None) -> None:
-        super().feed(chunk)
-
-
-class _Plateaus(PlateauFinder):
-    """The hook-load plateau finder as a per-chunk accumulator."""
-
-    def feed(self, chunk: pd.DataFrame, states=None) -> None:
-        super().feed(chunk)
-
-
 class Engine:
     """A time-log run that takes its rows in chunks and can be saved and continued.
 
@@ -99,7 +85,7 @@ class Engine:
         self.progress, self.total_rows = progress, total_rows
         self.t_wall = time.perf_counter()
         self.tracker = well.time_tracker()
-        self.check, self.hook = _Check(well), _Plateaus(cfg)
+        self.check, self.hook = LogCheck(well), PlateauFinder(cfg)
         self.tracks = TrackAccumulator()
         #: Per-chunk accumulators, fed in this order after the segment stream.
         self.accumulators = {"check": self.check, "hook": self.hook, "tracks": self.tracks}

@@ -33,22 +33,37 @@ from .state import read_state
 _BLOCK = 1 << 22
 
 
-def mark(well: Well) -> tuple[dict, int]:
-    """What a run reads of the well's data file now, and where its data ends (bytes or
-    rows: :attr:`~drillfric.io.source.RawSource.seek`)."""
-    path = well.files.data
-    if well.source.seek == "byte":
-        size = path.stat().st_size
-        return csv_mark(path, size), size
-    found = parquet_mark(path, well.source)
-    return found, found["rows"]
+def mark(well: Well) -> dict:
+    """What a run reads of the well's data now (for a folder of files: of each file)."""
+    if well.source.parts:
+        return {"format": "parts", "parts": [{"name": p.path.name} | source_mark(p)
+                                             for p in well.source.parts]}
+    return source_mark(well.source)
 
 
-def start_of(found: dict | None) -> int:
-    """Where the rows not yet read begin (bytes or rows), 0 without a mark."""
-    if found is None:
-        return 0
+def source_mark(source) -> dict:
+    """What a run reads of one delimited text or Parquet file now."""
+    if source.seek == "byte":
+        return csv_mark(source.path, source.path.stat().st_size)
+    return parquet_mark(source.path, source)
+
+
+def _end(found: dict) -> int:
+    """Where the data a mark recorded ends (bytes or rows)."""
     return found["bytes"] if found["format"] == "csv" else found["rows"]
+
+
+def unread(well: Well, before: dict | None, now: dict, chunk_rows: int):
+    """The raw rows between the marks ``before`` (None: the start) and ``now``."""
+    if not well.source.parts:
+        start = 0 if before is None else _end(before)
+        yield from well.source.window(start, _end(now), chunk_rows)
+        return
+    k = len(before["parts"]) - 1 if before else 0
+    for i, (part, found) in enumerate(zip(well.source.parts, now["parts"], strict=True)):
+        if i >= k:
+            start = _end(before["parts"][i]) if before and i == k else 0
+            yield from part.window(start, _end(found), chunk_rows)
 
 
 def csv_mark(path: Path, size: int) -> dict:
@@ -105,21 +120,44 @@ def _values_hash(source, start: int, stop: int) -> str:
 
 
 def changed(found: dict | None, well: Well) -> str:
-    """Why the well's data file does not continue what ``found`` recorded ("" when it
-    does)."""
-    path = well.files.data
-    if not found or found.get("format") != {"byte": "csv", "row": "parquet"}.get(
-            well.source.seek):
+    """Why the well's data does not continue what ``found`` recorded ("" when it does)."""
+    if not well.source.parts:
+        return _source_changed(found, well.source)
+    if not found or found.get("format") != "parts":
+        return "the earlier run read another kind of data"
+    names = [p.path.name for p in well.source.parts]
+    earlier = [p["name"] for p in found["parts"]]
+    if names[:len(earlier)] != earlier:
+        return "earlier files of the data folder changed (renamed, removed or inserted)"
+    for i, (part, before) in enumerate(zip(well.source.parts, found["parts"], strict=False)):
+        why = _source_changed(before, part)
+        if not why and i < len(earlier) - 1 and _size_now(part) != _end(before):
+            why = "it grew, but it is not the last file read"
+        if why:
+            return f"{part.path.name}: {why}"
+    return ""
+
+
+def _size_now(source) -> int:
+    """A file's length now, as a mark counts it (bytes or rows)."""
+    if source.seek == "byte":
+        return source.path.stat().st_size
+    return pq.ParquetFile(source.path).metadata.num_rows
+
+
+def _source_changed(found: dict | None, source) -> str:
+    """Why one file does not continue what ``found`` recorded ("" when it does)."""
+    path = source.path
+    if not found or found.get("format") != {"byte": "csv", "row": "parquet"}.get(source.seek):
         return "the earlier run read another kind of file"
     if found["format"] == "parquet":
-        return _parquet_changed(found, path, well.source)
-    mark = found
+        return _parquet_changed(found, path, source)
     size = path.stat().st_size
-    if size < mark["bytes"]:
-        return f"the file is shorter than the {mark['bytes']} bytes read before"
-    if not mark.get("ends_line"):
+    if size < found["bytes"]:
+        return f"the file is shorter than the {found['bytes']} bytes read before"
+    if not found.get("ends_line"):
         return "the earlier rows did not end with a complete line"
-    if csv_mark(path, mark["bytes"])["sha256"] != mark["sha256"]:
+    if csv_mark(path, found["bytes"])["sha256"] != found["sha256"]:
         return "earlier rows changed (the first bytes differ from those read before)"
     return ""
 
@@ -144,10 +182,12 @@ def _parquet_changed(found: dict, path: Path, source) -> str:
 
 
 def resumable(well: Well) -> bool:
-    """Whether the well's data file can be continued where a run stopped (a delimited text
-    file in a byte-seekable encoding, a Parquet file)."""
-    return not well.files.in_memory and well.source is not None and \
-        well.source.seek is not None
+    """Whether the well's data can be continued where a run stopped (a delimited text file
+    in a byte-seekable encoding, a Parquet file, or a folder of them)."""
+    source = well.source
+    if well.files.in_memory or source is None:
+        return False
+    return all(p.seek is not None for p in source.parts or (source,))
 
 
 def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engine | None, str]:

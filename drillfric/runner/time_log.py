@@ -27,7 +27,7 @@ from drillfric.result import RunProgress, WellResult
 
 from .engine import Engine
 from .finish import DirectorySink, ReportWriter, Sink, deliver
-from .resume import mark, resumable, start_of
+from .resume import mark, resumable, unread
 from .resume import resume as continued
 
 #: Folder of a result directory holding the engine's state (docs/outputs.md).
@@ -58,14 +58,12 @@ def run_time_log(well: Well, out_root=None, *, rate_hz: float | None = None,
 
 
 def _rows(well: Well, engine: Engine, chunk_rows: int):
-    """The source rows the engine has not read — from where its ``source`` mark ends to
-    where the file ends now (the new mark), for a file read by position — else the whole
-    source."""
+    """The source rows the engine has not read — from its ``source`` mark to where the data
+    ends now (the new mark) — for data read by position, else the whole source."""
     if not resumable(well):
         return well.source.chunks(chunk_rows)
-    start = start_of(engine.source)
-    engine.source, stop = mark(well)
-    return well.source.window(start, stop, chunk_rows)
+    before, engine.source = engine.source, mark(well)
+    return unread(well, before, engine.source, chunk_rows)
 
 
 def finish_engine(engine: Engine, sink: Sink) -> WellResult:
