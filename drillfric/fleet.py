@@ -34,7 +34,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from drillfric import __version__
+from drillfric import __version__, overnight
 from drillfric.errors import DrillfricError, InputError
 from drillfric.io import witsml
 from drillfric.io.locks import Busy, lock_file
@@ -409,6 +409,10 @@ class WellOutcome:
     task_s : float
         Time inside the task (0 when skipped) [s].
     attempts : int
+    new_segments : int or None
+        Segments new since the last night (None: the well failed).
+    changes : tuple of str
+        What changed since the last night (:func:`drillfric.overnight.changes`).
     """
 
     well: str
@@ -419,6 +423,8 @@ class WellOutcome:
     failed_segments: int = 0
     task_s: float = 0.0
     attempts: int = 0
+    new_segments: int | None = None
+    changes: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -623,18 +629,31 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
             entry.update(status="failed", message=f"{out}: the worker wrote its result where "
                          "this machine cannot see it — fix: put OUT on storage shared by the "
                          "client and every worker")
+    before = manifest.wells.get(name) or {}
+    history = list(before.get("history", [])) if isinstance(before, dict) else []
+    summary = rec.get("summary") if entry["status"] == "ok" else None
+    changed = overnight.changes(summary, history, ran=True, data_changed_utc=None)
+    if summary is not None:
+        entry["history"] = (history + [overnight.night(summary, _now())])[
+            -overnight.HISTORY_NIGHTS:]
+    elif history:
+        entry["history"] = history
+    entry["data_changed_utc"] = _now()
     manifest.wells[name] = entry
     return WellOutcome(name, entry["status"], entry["message"],
                        Path(rec["out_dir"]) if entry["status"] == "ok" else None,
-                       rec.get("summary") if entry["status"] == "ok" else None,
-                       entry["failed_segments"], rec.get("task_s", 0.0), attempts)
+                       summary, entry["failed_segments"], rec.get("task_s", 0.0), attempts,
+                       changed["new_segments"], tuple(changed["notes"]))
 
 
 def _skipped(name: str, entry: dict) -> WellOutcome:
     out = Path(entry["outputs"]["dir"])
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    changed = overnight.changes(summary, entry.get("history", []), ran=False,
+                                data_changed_utc=entry.get("data_changed_utc"))
     return WellOutcome(name, "skipped", "unchanged since the last run", out, summary,
-                       entry.get("failed_segments", 0))
+                       entry.get("failed_segments", 0), new_segments=0,
+                       changes=tuple(changed["notes"]))
 
 
 def _execute(jobs: list[_Job], *, workers: int,
@@ -756,13 +775,15 @@ def summary_frame(outcomes) -> pd.DataFrame:
 
     Columns: :data:`drillfric.result.FLEET_WELL_COLUMNS` (well level, prefixed ``well_``),
     then every :class:`~drillfric.result.SegmentRecord` field but ``id`` (as ``segment_id``)
-    under its summary.json name, list fields as JSON text.
+    under its summary.json name, list fields as JSON text. Wells with something new tonight
+    (``well_changes`` other than "no new data") come first.
     """
     seg_fields = [f for f in SEGMENT_FIELDS if f != "id"]
     rows = []
-    for o in outcomes:
+    for o in _changed_first(outcomes):
         s = o.summary or {}
         base = {"well": o.well, "well_status": o.status, "well_message": o.message,
+                "well_new_segments": o.new_segments, "well_changes": "; ".join(o.changes),
                 "result_dir": None if o.result_dir is None else str(o.result_dir),
                 "well_mu_s": s.get("mu_s"), "well_mu_k": s.get("mu_k"),
                 "well_mu_s_lower_bound": s.get("mu_s_lower_bound"),
@@ -775,6 +796,12 @@ def summary_frame(outcomes) -> pd.DataFrame:
     frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields)
     frame["segment_id"] = frame["segment_id"].astype("Int64")
     return frame
+
+
+def _changed_first(outcomes) -> list:
+    """Outcomes with news tonight first (new segments, moves, stick-slip), the others after
+    (no new data, failed, nothing new); input order within each."""
+    return sorted(outcomes, key=lambda o: not (o.changes and o.status == "ok"))
 
 
 def _write_summary(out_root: Path, outcomes) -> Path:
@@ -792,7 +819,8 @@ def _write_report(out_root: Path, outcomes) -> tuple[Path | None, tuple[str, ...
     if not hasattr(report, "write_fleet_report"):
         return None, ("fleet.html not written: this version has no fleet report",)
     items = [{"well": o.well, "status": o.status, "message": o.message,
-              "result_dir": o.result_dir, "summary": o.summary} for o in outcomes]
+              "result_dir": o.result_dir, "summary": o.summary, "changes": list(o.changes)}
+             for o in _changed_first(outcomes)]
     try:
         return report.write_fleet_report(out_root, items), ()
     except Exception as exc:  # noqa: BLE001 — the night's results are already written

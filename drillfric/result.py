@@ -260,8 +260,9 @@ SEEDED_START_ID = -1
 
 
 #: Well-level columns of fleet_summary.parquet (before the segment fields).
-FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "result_dir", "well_mu_s",
-                      "well_mu_k", "well_mu_s_lower_bound", "drillfric_version", "segment_id")
+FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "well_new_segments",
+                      "well_changes", "result_dir", "well_mu_s", "well_mu_k",
+                      "well_mu_s_lower_bound", "drillfric_version", "segment_id")
 
 
 def _plain(value):

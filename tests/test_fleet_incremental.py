@@ -54,6 +54,11 @@ def test_appended_rows_continue_from_the_state(stands, tmp_path):  # noqa: F811
     result = run_well(open_well(data))  # whole-file results to compare with
     written = pd.read_parquet(out / "three" / "segments.parquet")
     _same_results(type(result)(result.well, _summary(out), written), whole)
+    rows = pd.read_parquet(out / "fleet_summary.parquet")
+    assert "new segment(s)" in rows["well_changes"].iloc[0]
+    assert rows["well_new_segments"].iloc[0] >= 1
+    assert run_many([WellSpec(data)], out, workers=1).wells[0].changes[0].startswith(
+        "no new data since")
     estimates = pd.read_parquet(out / "three" / "estimates.parquet")
     assert sorted(set(estimates["segment_id"])) == sorted(
         whole.segments.loc[whole.segments["status"] == "ok", "id"])
@@ -72,6 +77,15 @@ def test_changed_earlier_rows_are_redone_whole_with_the_reason(stands, tmp_path)
     assert resumed["from_row"] == 0 and "earlier rows changed" in resumed["reason"]
     forced = run_many([WellSpec(data)], out, workers=1, force=True)
     assert forced.count("ok") == 1 and _summary(out)["resumed"] is None
+
+    state = out / "three" / "state" / "engine.json"  # a state missing a part: redone whole
+    doc = json.loads(state.read_text())
+    del doc["state"]["check"]
+    state.write_text(json.dumps(doc))
+    with open(data, "ab") as fh:
+        fh.write(text.splitlines(keepends=True)[-1])
+    run_many([WellSpec(data)], out, workers=1)
+    assert _summary(out)["resumed"]["reason"].startswith("engine state not readable")
 
 
 def test_sigkill_during_a_rerun_then_rerun_gives_the_uninterrupted_results(stands,  # noqa: F811

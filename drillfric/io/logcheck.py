@@ -36,9 +36,8 @@ class LogCheck:
         self.rpm_min = np.inf
         self.rpm_max = -np.inf
 
-    def feed(self, chunk: pd.DataFrame, states=None) -> None:
-        """Take in one canonical chunk (the first one also checks the sample spacing;
-        ``states``, the rig states, are not needed)."""
+    def feed(self, chunk: pd.DataFrame) -> None:
+        """Take in one canonical chunk (the first one also checks the sample spacing)."""
         if self.rows == 0 and len(chunk) > 1:
             self._spacing(chunk["time_s"].to_numpy(float))
         self.rows += len(chunk)

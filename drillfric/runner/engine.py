@@ -5,12 +5,13 @@ that can be saved and continued (docs/api.md "Feeding a well in chunks", issue 2
 whole file, a fleet re-run feeds it only the rows appended since the state it saved, and a
 notebook feeds it chunks of a DataFrame. Per chunk (:meth:`Engine.feed`):
 
-1. the log check, the hook-load plateaus and the time tracks take the rows
-   (:attr:`Engine.accumulators`: each has ``feed(chunk, states)``, ``state()`` and
-   ``restore()`` — a new per-chunk accumulator is one entry there);
-2. the segment stream cuts rotating segments as they close, and each is estimated
-   (:class:`~drillfric.runner.estimator.SegmentEstimator`, warm-started) into a record and
-   output rows handed to the sink.
+1. the log check takes the rows (it raises for a log that cannot be meant as read);
+2. the segment stream classifies them into rig states and cuts rotating segments;
+3. the per-chunk accumulators — the hook-load plateaus, the time tracks — take the rows and
+   their rig states (:attr:`Engine.accumulators`: each has ``feed(chunk, states)``,
+   ``state()`` and ``restore()``; a new one is one entry there);
+4. each segment that closed is estimated (:class:`~drillfric.runner.estimator.
+   SegmentEstimator`, warm-started) into a record and output rows handed to the sink.
 
 :meth:`Engine.close` ends the data: the open segment is estimated, closed segments are
 **revised** where later rows moved the evidence they rest on (the string-weight calibration:
@@ -87,8 +88,9 @@ class Engine:
         self.tracker = well.time_tracker()
         self.check, self.hook = LogCheck(well), PlateauFinder(cfg)
         self.tracks = TrackAccumulator()
-        #: Per-chunk accumulators, fed in this order after the segment stream.
-        self.accumulators = {"check": self.check, "hook": self.hook, "tracks": self.tracks}
+        #: Per-chunk accumulators, fed in this order after the log check and the segment
+        #: stream: ``feed(chunk, rig_states)``, ``state()``, ``restore(state)``.
+        self.accumulators = {"hook": self.hook, "tracks": self.tracks}
         self.stream = SegmentStream(cfg)
         self.estimator = SegmentEstimator(well)
         self.calibration = StringWeightCalibration(well) \
@@ -109,7 +111,14 @@ class Engine:
     # ------------------------------------------------------------------ rows in
     def feed(self, frame: pd.DataFrame) -> list[SegmentRecord]:
         """Take the next rows of the well (columns as the well's data: the file's or the
-        DataFrame's it was opened with); return the records of the segments they closed."""
+        DataFrame's it was opened with); return the records of the segments they closed.
+
+        Raises
+        ------
+        InputError
+            Rows that cannot be meant as read (time going backwards, a log read in the
+            wrong unit, …: docs/ingestion.md).
+        """
         out = []
         for raw in frame_source(frame).chunks(max(len(frame), 1)):
             out += self.feed_raw(raw)
@@ -122,6 +131,7 @@ class Engine:
         if self.check.rows == 0 and len(chunk):
             self.estimator.rate_hz = first_chunk(self.well, chunk, self.rate_hz, self.warnings)
             self.estimator.has_truth = "bit_rpm" in chunk
+        self.check.feed(chunk)
         done = self.stream.feed(chunk)
         for acc in self.accumulators.values():
             acc.feed(chunk, self.stream.last_states)
@@ -168,6 +178,7 @@ class Engine:
             if self._before_close is not None:
                 self.restore(self.saved_state() | {"sink": None})
                 self.sink.drop(self._open_ids)
+                self._before_close = None  # fed further, the engine's state is its own
         return result
 
     def close(self) -> WellResult:
@@ -191,7 +202,7 @@ class Engine:
             self._revise(well, calibration.scale)
         weighed = judge(self.records, plateaus, self.well.config, calibration)
         records, pools = pool_short_segments(weighed.records)
-        self._note_revisions(records, open_ids)
+        self._note_revisions(records)
         summary = summarise(self.well, records, pools, rows=self.check.rows,
                             assumed=self.well.assumed + self.estimator.assumed,
                             warnings=warnings + weighed.warnings,
@@ -225,8 +236,9 @@ class Engine:
         self.estimator.well = well
         self.estimator.warm = warm if self._kept else self.estimator.warm
 
-    def _note_revisions(self, records: list[SegmentRecord], open_ids: set) -> None:
-        """Record the segments whose published numbers changed since the last results."""
+    def _note_revisions(self, records: list[SegmentRecord]) -> None:
+        """Record the segments whose published numbers changed since the last results
+        (segments the end of the earlier rows closed: :attr:`_open_ids` of that close)."""
         calibrated = {r["segment"] for r in self.revisions}
         was_open = self._open_ids
         for r in records:
@@ -246,6 +258,7 @@ class Engine:
         return {"drillfric_version": __version__, "config": self.well.config.to_dict(),
                 "rate_hz": self.rate_hz, "raw_rows": self.raw_rows, "source": self.source,
                 "tracker": self.tracker.state(), "stream": self.stream.state(),
+                "check": self.check.state(),
                 "accumulators": {k: a.state() for k, a in self.accumulators.items()},
                 "estimator": self.estimator.state(), "warnings": list(self.warnings),
                 "calibration": None if self.calibration is None else self.calibration.state(),
@@ -270,6 +283,7 @@ class Engine:
         self.raw_rows, self.source = int(state["raw_rows"]), state.get("source")
         self.tracker.restore(state["tracker"])
         self.stream.restore(state["stream"])
+        self.check.restore(state["check"])
         for key, acc in self.accumulators.items():
             acc.restore(state["accumulators"][key])
         self.estimator.restore(state["estimator"])
@@ -323,7 +337,11 @@ class Engine:
             raise InputError(f"engine state does not continue this well: {why}",
                              file=Path(folder), fix="run the well from its start")
         engine = cls(well, **kw)
-        engine.restore(state)
+        try:
+            engine.restore(state)
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise InputError(f"engine state not readable ({type(exc).__name__}: {exc})",
+                             file=Path(folder), fix="run the well from its start") from exc
         return engine
 
 

@@ -206,7 +206,10 @@ def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engin
     if why:
         return None, why
     engine = Engine(well, sink=sink, **kw)
-    engine.restore(state)
+    try:
+        engine.restore(state)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:  # not a state we wrote
+        return None, f"engine state not readable ({type(exc).__name__}: {exc})"
     sink.seed(previous, {r.id for r in engine.records})
     engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
     return engine, ""
