@@ -47,7 +47,8 @@ def _closing_line(result) -> str:
 @click.option("--scheduler", metavar="ADDRESS", help="Dask scheduler (tcp://HOST:PORT); "
               "the inputs and OUT must be on storage its workers share.")
 @click.option("--workers", type=int, help="Local worker processes (default: all cores).")
-@click.option("--force", is_flag=True, help="Redo every well, even unchanged ones.")
+@click.option("--force", is_flag=True, help="Redo every well from its start, even unchanged "
+              "ones (a well whose data only grew otherwise continues from its saved state).")
 @click.option("--report/--no-report", default=True, show_default=True,
               help="Write each well's report.html (the fleet report is always written).")
 @click.option("--config", type=click.Path(path_type=Path),

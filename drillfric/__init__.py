@@ -22,7 +22,7 @@ from drillfric._version import __version__
 from drillfric.kernels.cache import configure as _configure_kernel_cache
 
 __all__ = ["open_well", "run", "load_result", "torque_and_drag", "simulate", "Well",
-           "WellResult", "RunProgress", "__version__"]
+           "WellResult", "RunProgress", "Engine", "__version__"]
 
 
 class _CheckoutFolders(_Finder):

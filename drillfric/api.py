@@ -23,13 +23,14 @@ from drillfric.errors import InputError
 from drillfric.io.well import Well, open_well
 from drillfric.result import RunProgress, WellResult, segments_from_json
 from drillfric.runner import run_well
+from drillfric.runner.engine import Engine
 
 __all__ = ["open_well", "run", "load_result", "torque_and_drag", "simulate", "Well",
-           "WellResult", "RunProgress"]
+           "WellResult", "RunProgress", "Engine"]
 
 
 def run(well, out=None, *, rate_hz: float | None = None, pdf: bool = False,
-        report: bool = True, progress=None, **open_kw) -> WellResult:
+        report: bool = True, progress=None, resume: bool = False, **open_kw) -> WellResult:
     """Estimate friction factors and bit speed for one well (``drillfric run`` in Python).
 
     Parameters
@@ -46,6 +47,8 @@ def run(well, out=None, *, rate_hz: float | None = None, pdf: bool = False,
         Report options (with ``out``).
     progress : callable, optional
         Called with :class:`RunProgress` events.
+    resume : bool
+        With ``out``: continue from ``out/NAME/state`` when the data only grew (docs/fleet.md).
 
     Returns
     -------
@@ -55,7 +58,7 @@ def run(well, out=None, *, rate_hz: float | None = None, pdf: bool = False,
     if not isinstance(well, Well):
         well = open_well(well, **open_kw)
     return run_well(well, out, rate_hz=rate_hz, report=_report_writer(pdf) if report else None,
-                    progress=progress)
+                    progress=progress, resume=resume)
 
 
 def _report_writer(pdf: bool):

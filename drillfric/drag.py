@@ -168,6 +168,31 @@ class MoveFinder:
         self._end()
         return self.moves
 
+    def state(self) -> dict:
+        """What continues the finder on later rows (docs/fleet.md): the previous row, the
+        smoothing filter, the open move's rows and the moves found (arrays; a move as the
+        row [direction (−1 pick-up, +1 slack-off), t_start_s, t_end_s, rows, bit_depth_m,
+        speed_m_s, hookload_N, spread_N])."""
+        rows = (np.column_stack([np.concatenate(p) for p in zip(*self._open, strict=True)])
+                if self._open else np.empty((0, 3)))
+        moves = [[-1.0 if m.direction == PICK_UP else 1.0, m.t_start_s, m.t_end_s, m.rows,
+                  m.bit_depth_m, m.speed_m_s, m.hookload_N, m.spread_N] for m in self.moves]
+        return {"prev": np.array(self._prev, float), "zi": self._zi.copy(), "open": rows,
+                "key": self._key, "too_short": self.too_short,
+                "moves": np.array(moves, float).reshape(-1, 8)}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self._prev = tuple(float(v) for v in state["prev"])
+        self._zi = np.array(state["zi"], float)
+        rows = np.asarray(state["open"], float).reshape(-1, 3)
+        self._open = [(rows[:, 0], rows[:, 1], rows[:, 2])] if len(rows) else []
+        self._key, self.too_short = int(state["key"]), int(state["too_short"])
+        self.moves = [Move(PICK_UP if d < 0 else SLACK_OFF, float(a), float(b), int(n),
+                           float(depth), float(v), float(h), float(q))
+                      for d, a, b, n, depth, v, h, q in
+                      np.asarray(state["moves"], float).reshape(-1, 8)]
+
     def _end(self) -> None:
         """Close the open move into windows."""
         if self._open:

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from drillfric import __version__
+from drillfric import __version__, overnight
 from drillfric.errors import DrillfricError, InputError
 from drillfric.io import witsml
 from drillfric.io.locks import Busy, lock_file
@@ -210,6 +210,7 @@ class WellTask:
     report: bool = True
     taken: frozenset = frozenset()
     run: str = ""
+    resume: bool = True
 
 
 def process_well(task: WellTask) -> dict:
@@ -236,7 +237,7 @@ def process_well(task: WellTask) -> dict:
         if task.name is None:
             _claim(task, well.dir_name)
         result = run_well(well, task.out_root, rate_hz=task.rate_hz, pdf=task.pdf,
-                          report=task.report)
+                          report=task.report, resume=task.resume)
         record.update(status="ok", summary=jsonable(result.summary),
                       out_dir=str(result.out_dir), failed_segments=result.failed)
     except DrillfricError as exc:
@@ -418,6 +419,10 @@ class WellOutcome:
     attempts : int
     stale_dir : Path or None
         A failed well's OUT/NAME holding an earlier run's results, marked stale.
+    new_segments : int or None
+        Segments new since the last night (None: the well failed).
+    changes : tuple of str
+        What changed since the last night (:func:`drillfric.overnight.changes`).
     """
 
     well: str
@@ -429,6 +434,8 @@ class WellOutcome:
     task_s: float = 0.0
     attempts: int = 0
     stale_dir: Path | None = None
+    new_segments: int | None = None
+    changes: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -581,7 +588,7 @@ def _run_jobs(jobs: list[_Job], out_root: Path, run: str, *, workers: int,
             outcomes[job.index] = _skipped(name, entry)
             advance(1.0)
         else:
-            todo.append(job)
+            todo.append(replace(job, task=replace(job.task, resume=not force)))
     if any(not j.named for j in todo):  # their names are resolved (and claimed) by workers
         taken = frozenset({j.dir_name.casefold() for j in jobs if j.named and j.task}
                           | {Path(o.result_dir).name.casefold() for o in outcomes.values()
@@ -635,11 +642,22 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
                          "client and every worker")
     stale = _mark_stale(manifest, name, job, rec, entry) if entry["status"] == "failed" \
         else None
+    before = manifest.wells.get(name) or {}
+    history = list(before.get("history", [])) if isinstance(before, dict) else []
+    summary = rec.get("summary") if entry["status"] == "ok" else None
+    changed = overnight.changes(summary, history, ran=True, data_changed_utc=None)
+    if summary is not None:
+        entry["history"] = (history + [overnight.night(summary, _now())])[
+            -overnight.HISTORY_NIGHTS:]
+    elif history:
+        entry["history"] = history
+    entry["data_changed_utc"] = _now()
     manifest.wells[name] = entry
     return WellOutcome(name, entry["status"], entry["message"],
                        Path(rec["out_dir"]) if entry["status"] == "ok" else None,
-                       rec.get("summary") if entry["status"] == "ok" else None,
-                       entry["failed_segments"], rec.get("task_s", 0.0), attempts, stale)
+                       summary, entry["failed_segments"], rec.get("task_s", 0.0), attempts,
+                       stale_dir=stale, new_segments=changed["new_segments"],
+                       changes=tuple(changed["notes"]))
 
 
 def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
@@ -664,8 +682,11 @@ def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
 def _skipped(name: str, entry: dict) -> WellOutcome:
     out = Path(entry["outputs"]["dir"])
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    changed = overnight.changes(summary, entry.get("history", []), ran=False,
+                                data_changed_utc=entry.get("data_changed_utc"))
     return WellOutcome(name, "skipped", "unchanged since the last run", out, summary,
-                       entry.get("failed_segments", 0))
+                       entry.get("failed_segments", 0), new_segments=0,
+                       changes=tuple(changed["notes"]))
 
 
 def _execute(jobs: list[_Job], *, workers: int,
@@ -787,13 +808,15 @@ def summary_frame(outcomes) -> pd.DataFrame:
 
     Columns: :data:`drillfric.result.FLEET_WELL_COLUMNS` (well level, prefixed ``well_``),
     then every :class:`~drillfric.result.SegmentRecord` field but ``id`` (as ``segment_id``)
-    under its summary.json name, list fields as lists.
+    under its summary.json name, list fields as lists. Wells with something new tonight
+    (``well_changes`` other than "no new data") come first.
     """
     seg_fields = [f for f in SEGMENT_FIELDS if f != "id"]
     rows = []
-    for o in outcomes:
+    for o in _changed_first(outcomes):
         s = o.summary or {}
         base = {"well": o.well, "well_status": o.status, "well_message": o.message,
+                "well_new_segments": o.new_segments, "well_changes": "; ".join(o.changes),
                 "result_dir": None if o.result_dir is None else str(o.result_dir),
                 "stale_result_dir": None if o.stale_dir is None else str(o.stale_dir),
                 "well_mu_s": s.get("mu_s"), "well_mu_k": s.get("mu_k"),
@@ -806,6 +829,12 @@ def summary_frame(outcomes) -> pd.DataFrame:
     frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields)
     frame["segment_id"] = frame["segment_id"].astype("Int64")
     return frame
+
+
+def _changed_first(outcomes) -> list:
+    """Outcomes with news tonight first (new segments, moves, stick-slip), the others after
+    (no new data, failed, nothing new); input order within each."""
+    return sorted(outcomes, key=lambda o: not (o.changes and o.status == "ok"))
 
 
 def _write_summary(out_root: Path, outcomes) -> Path:
@@ -823,8 +852,9 @@ def _write_report(out_root: Path, outcomes) -> tuple[Path | None, tuple[str, ...
     if not hasattr(report, "write_fleet_report"):
         return None, ("fleet.html not written: this version has no fleet report",)
     items = [{"well": o.well, "status": o.status, "message": o.message,
-              "result_dir": o.result_dir, "summary": o.summary, "stale_dir": o.stale_dir}
-             for o in outcomes]
+              "result_dir": o.result_dir, "summary": o.summary, "stale_dir": o.stale_dir,
+              "changes": list(o.changes)}
+             for o in _changed_first(outcomes)]
     try:
         return report.write_fleet_report(out_root, items), ()
     except Exception as exc:  # noqa: BLE001 — the night's results are already written

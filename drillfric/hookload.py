@@ -12,7 +12,7 @@ W_meas = H_rot − H_slips. The friction factors scale as 1/W (T_N is proportion
 string's weight when it rotates off bottom), so a configured string the hook load
 contradicts gives wrong friction factors: they are withheld, or — where the configuration
 allows it (``[hookload] calibrate_string_weight``) — the string's buoyed weight is scaled
-to the measured one before the estimation (:func:`calibrate`).
+to the measured one before each segment is estimated (:class:`StringWeightCalibration`).
 
 Layers: pure functions (:func:`modelled_string_weight_N`, :func:`scaled_sections`,
 :func:`block_weight`, :func:`point_problem`), the streaming :class:`PlateauFinder` (the
@@ -273,8 +273,9 @@ class PlateauFinder:
             else np.zeros(len(chunk), bool)
         return ~still_turning & ~moving
 
-    def feed(self, chunk: pd.DataFrame) -> None:
-        """Consume the next rows (canonical SI columns)."""
+    def feed(self, chunk: pd.DataFrame, states=None) -> None:
+        """Consume the next rows (canonical SI columns; ``states``, the rig states, are
+        not needed: quiet rows are judged here)."""
         if "hookload_N" not in chunk or not len(chunk):
             return
         self._run(_column(chunk, "time_s"), _column(chunk, "hookload_N"), self.quiet(chunk))
@@ -283,6 +284,20 @@ class PlateauFinder:
         """The plateaus of the whole log, the last one closed."""
         self._run(np.array([np.nan]), np.array([np.nan]), np.array([False]))
         return self.plateaus
+
+    def state(self) -> dict:
+        """The open plateau's carry, the previous row and the plateaus found (arrays; one
+        row [t_start_s, t_end_s, rows, level_N] per plateau)."""
+        found = [[p.t_start_s, p.t_end_s, p.rows, p.level_N] for p in self.plateaus]
+        return {"carry": self._carry.copy(), "last": np.array(self._last, float),
+                "plateaus": np.array(found, float).reshape(-1, 4)}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self._carry = np.array(state["carry"], float)
+        self._last = tuple(float(v) for v in state["last"])
+        self.plateaus = [Plateau(float(a), float(b), int(n), float(level))
+                         for a, b, n, level in np.asarray(state["plateaus"]).reshape(-1, 4)]
 
     def _run(self, t, hook, quiet) -> None:
         kernel = _plateau_kernel if t.size <= _PLAIN_ROWS else _compiled_plateaus()
@@ -366,7 +381,7 @@ def off_bottom_points(records) -> pd.DataFrame:
 
 @dataclass(frozen=True)
 class Calibration:
-    """A string-weight calibration done before the estimation (:func:`calibrate`).
+    """A string-weight calibration (:class:`StringWeightCalibration`).
 
     Attributes
     ----------
@@ -521,42 +536,60 @@ def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWei
 
 
 # --------------------------------------------------------------------------- calibration
-def calibrate(well, chunk_rows: int):
-    """The well with its string's buoyed weight scaled to the hook load, and the
-    :class:`Calibration` — when ``hookload.calibrate_string_weight`` allows it; else the
-    well unchanged and None.
+class StringWeightCalibration:
+    """The string-weight calibration as the log streams (``hookload.calibrate_string_weight``).
 
-    A first pass over the log (segmentation and plateaus, no estimation): the block weight
-    (:func:`block_weight`), each off-bottom rotating segment's median hook load and the
-    modelled string weight at its bit depth; the scale is the median of
-    (H − B)/W_model. Not applied (the check then withholds) without a block weight or when
-    the scale is outside :data:`CALIBRATION_RANGE`.
+    Each off-bottom rotating segment adds a point — its bit depth, median hook load and the
+    modelled string weight there — as it closes; :meth:`current` gives the calibration the
+    rows seen so far support: the block weight (:func:`block_weight_of`: the plateaus found
+    so far, else ``hookload.block_weight_N``) and the scale, the median of (H − B)/W_model.
+    Not applied (the hook-load check then withholds) without a block weight or when the
+    scale is outside
+    :data:`CALIBRATION_RANGE`. Later rows may move the scale: the run then revises the
+    segments estimated with another one (docs/theory.md §2.1).
+
+    Parameters
+    ----------
+    well : Well
+        The well as opened (its configured string).
     """
-    cfg = well.config
-    if not cfg.hookload.calibrate_string_weight:
-        return well, None
-    from drillfric.segmentation import SegmentStream
 
-    stream, finder, rows = SegmentStream(cfg), PlateauFinder(cfg), []
-    for chunk in well.chunks(chunk_rows):
-        finder.feed(chunk)
-        rows += _points(stream.feed(chunk), cfg, well.survey)
-    rows += _points(stream.close(), cfg, well.survey)
-    points = pd.DataFrame(rows, columns=["bit_depth_m", "hookload_N", "hookload_model_N"])
-    block = block_weight_of(finder.close(), points, cfg)
-    if block.weight_N is None or not len(points):
-        why = block.reason if block.weight_N is None else "no off-bottom rotating hook load"
-        return well, Calibration(None, block, len(points), f"not calibrated: {why}")
-    scale = float(np.median((points["hookload_N"] - block.weight_N)
-                            / points["hookload_model_N"]))
-    if not CALIBRATION_RANGE[0] <= scale <= CALIBRATION_RANGE[1]:
-        return well, Calibration(None, block, len(points), (
-            f"not calibrated: a scale of {scale:.2f} is outside {CALIBRATION_RANGE[0]:g}–"
-            f"{CALIBRATION_RANGE[1]:g}, the string is too far off to rescale"))
-    sections = scaled_sections(cfg.sections, scale, cfg.fluid.mud_density_kg_m3,
-                               cfg.inner_mud_density_kg_m3)
-    return replace(well, config=replace(cfg, sections=sections)), Calibration(
-        scale, block, len(points))
+    def __init__(self, well):
+        self.well = well
+        self.points: list[tuple] = []
+
+    def add(self, done) -> None:
+        """Take the points of finished segments ``done`` (segment, rows)."""
+        self.points += _points(done, self.well.config, self.well.survey)
+
+    def current(self, plateaus: list[Plateau]):
+        """The well with its string's buoyed weight scaled to the hook load (else
+        unchanged) and the :class:`Calibration`."""
+        well, cfg = self.well, self.well.config
+        points = pd.DataFrame(self.points,
+                              columns=["bit_depth_m", "hookload_N", "hookload_model_N"])
+        block = block_weight_of(plateaus, points, cfg)
+        if block.weight_N is None or not len(points):
+            why = block.reason if block.weight_N is None else "no off-bottom rotating hook load"
+            return well, Calibration(None, block, len(points), f"not calibrated: {why}")
+        scale = float(np.median((points["hookload_N"] - block.weight_N)
+                                / points["hookload_model_N"]))
+        if not CALIBRATION_RANGE[0] <= scale <= CALIBRATION_RANGE[1]:
+            return well, Calibration(None, block, len(points), (
+                f"not calibrated: a scale of {scale:.2f} is outside {CALIBRATION_RANGE[0]:g}–"
+                f"{CALIBRATION_RANGE[1]:g}, the string is too far off to rescale"))
+        sections = scaled_sections(cfg.sections, scale, cfg.fluid.mud_density_kg_m3,
+                                   cfg.inner_mud_density_kg_m3)
+        return replace(well, config=replace(cfg, sections=sections)), Calibration(
+            scale, block, len(points))
+
+    def state(self) -> dict:
+        """The points (an array of rows [bit_depth_m, hookload_N, hookload_model_N])."""
+        return {"points": np.array(self.points, float).reshape(-1, 3)}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self.points = [tuple(map(float, p)) for p in np.asarray(state["points"]).reshape(-1, 3)]
 
 
 def _points(done, cfg, path) -> list[tuple]:

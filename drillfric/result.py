@@ -280,6 +280,21 @@ class SegmentRecord:
         """Plain JSON values (enums as text, NaN as None), in field order."""
         return {k: _plain(v) for k, v in asdict(self).items()}
 
+    @classmethod
+    def from_json(cls, values: dict) -> SegmentRecord:
+        """The record of a :meth:`to_json` (an engine state's, docs/api.md): enums and
+        tuples restored; unknown keys are refused (ValueError)."""
+        unknown = set(values) - set(SEGMENT_FIELDS)
+        if unknown:
+            raise ValueError(f"unknown segment fields {sorted(unknown)}")
+        typed = dict(values)
+        for name, enum in (("kind", Kind), ("status", Status), ("method", Method)):
+            if name in typed:
+                typed[name] = enum(typed[name])
+        typed["flags"] = tuple(Flag(f) for f in typed.get("flags", ()))
+        typed["starts"] = tuple(tuple(float(v) for v in s) for s in typed.get("starts", ()))
+        return cls(**typed)
+
 
 #: Field names of :class:`SegmentRecord` in output order.
 SEGMENT_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(SegmentRecord))
@@ -334,8 +349,8 @@ SEEDED_START_ID = -1
 
 
 #: Well-level columns of fleet_summary.parquet (before the segment fields).
-FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "result_dir",
-                      "stale_result_dir", "well_mu_s",
+FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "well_new_segments",
+                      "well_changes", "result_dir", "stale_result_dir", "well_mu_s",
                       "well_mu_k", "well_mu_s_lower_bound", "drillfric_version", "segment_id")
 
 

@@ -545,6 +545,18 @@ class Segmenter:
         """Return the segments still open at the end of the data."""
         return self._emit(final=True)
 
+    def state(self) -> dict:
+        """What continues the segmentation (classifier carry, rows not yet in a segment,
+        next id): plain values and arrays (docs/api.md "Feeding a well in chunks")."""
+        return {"carry": self._carry, "buffer": dict(self._buffer), "offset": self._offset,
+                "next_id": self._next_id}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self._carry = None if state["carry"] is None else np.array(state["carry"], float)
+        self._buffer = {k: np.asarray(v) for k, v in state["buffer"].items()}
+        self._offset, self._next_id = int(state["offset"]), int(state["next_id"])
+
     def _safe_cut(self) -> int:
         """Last buffer index before which no later data can change a segment."""
         t, states = self._buffer["t"], self._buffer["states"]
@@ -622,6 +634,18 @@ class SegmentStream:
     def close(self) -> list[tuple[Segment, pd.DataFrame]]:
         """The segments still open at the end of the data, with their rows."""
         return self._rows(self._segmenter.close())
+
+    def state(self) -> dict:
+        """What continues the stream: the segmenter's state and the rows kept for the
+        segments still open (a DataFrame)."""
+        return {"segmenter": self._segmenter.state(), "rows": self._buffer.copy(),
+                "start": self._start, "last_end": self._last_end}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self._segmenter.restore(state["segmenter"])
+        self._buffer = state["rows"].reset_index(drop=True)
+        self._start, self._last_end = int(state["start"]), int(state["last_end"])
 
     @property
     def last_states(self) -> np.ndarray | None:

@@ -38,6 +38,8 @@ _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
 #: Largest share of control characters (other than tab, CR, LF) in the text at the top of a
 #: file that is still read as text.
 _MAX_CONTROL_SHARE = 0.01
+#: Text encodings whose rows can be read from a byte offset (UTF-16/32 are read whole).
+_SEEKABLE = ("utf-8-sig", "latin-1")
 _NOT_TEXT_FIX = "give a delimited text export (CSV) of the log, or a Parquet/HDF5/LAS file"
 
 
@@ -220,17 +222,42 @@ def open_delimited(path: Path) -> RawSource:
                   na_values=[str(v) for v in NULL_VALUES], skip_blank_lines=True,
                   index_col=False)
 
-    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+    def read(chunk_rows: int, start: int = 0, stop: int | None = None
+             ) -> Iterator[pd.DataFrame]:
+        """Rows of bytes [start, stop) (``start`` at a line's beginning, past the header)."""
+        args = kwargs | {"skiprows": 0} if start else kwargs
         try:
-            with open(path, encoding=layout.encoding, newline="") as fh, \
-                    pd.read_csv(_CommentFree(fh, path), chunksize=chunk_rows, **kwargs) as reader:
-                yield from reader
+            with open(path, "rb") as raw:
+                raw.seek(start)
+                fh = io.TextIOWrapper(io.BufferedReader(_Window(raw, stop)),
+                                      encoding=layout.encoding, newline="")
+                with pd.read_csv(_CommentFree(fh, path), chunksize=chunk_rows, **args) as reader:
+                    yield from reader
         except (pd.errors.ParserError, ValueError, UnicodeDecodeError) as exc:
             raise InputError(f"cannot parse as delimited text ({_parser_problem(exc)})",
                              file=path,
                              fix="check that every row has the same number of fields") from exc
 
-    return RawSource(path, "csv", layout.columns, layout.units, None, read)
+    return RawSource(path, "csv", layout.columns, layout.units, None, read,
+                     seek="byte" if layout.encoding in _SEEKABLE else None)
+
+
+class _Window(io.RawIOBase):
+    """A binary file read up to byte ``stop`` (None: its end), from where it stands."""
+
+    def __init__(self, fh, stop: int | None):
+        self._fh, self._stop = fh, stop
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer) -> int:
+        size = len(buffer)
+        if self._stop is not None:
+            size = max(min(size, self._stop - self._fh.tell()), 0)
+        data = self._fh.read(size)
+        buffer[:len(data)] = data
+        return len(data)
 
 
 

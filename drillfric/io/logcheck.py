@@ -53,6 +53,18 @@ class LogCheck:
             self.rpm_min = min(self.rpm_min, float(rpm.min()))
             self.rpm_max = max(self.rpm_max, float(rpm.max()))
 
+    def state(self) -> dict:
+        """The counters (plain values and arrays)."""
+        return {"rows": self.rows, "finite": dict(self.finite), "turning": self.turning,
+                "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max])}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self.rows, self.turning = int(state["rows"]), int(state["turning"])
+        self.backwards = int(state["backwards"])
+        self.finite = {k: int(v) for k, v in state["finite"].items()}
+        self.rpm_min, self.rpm_max = (float(v) for v in state["rpm_range"])
+
     def _spacing(self, time_s: np.ndarray) -> None:
         """Every sample a gap: time in ms read as s, or a log slower than max_gap_s (the
         only reading for timestamps, whose unit cannot be wrong)."""

@@ -84,15 +84,38 @@ def _open_parquet(path: Path) -> RawSource:
             units[fld.name] = unit.decode()
             units[("source", fld.name)] = "header"
 
-    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+    def read(chunk_rows: int, start: int = 0, stop: int | None = None
+             ) -> Iterator[pd.DataFrame]:
+        """Rows [start, stop) (row numbers; None: to the end)."""
         try:
-            for batch in pq.ParquetFile(path).iter_batches(batch_size=chunk_rows):
-                # ignore_metadata: a pandas index stays a column under its schema name
-                yield pa.Table.from_batches([batch]).to_pandas(ignore_metadata=True)
+            source = pq.ParquetFile(path)
+            groups, skip = _groups_from(source.metadata, start)
+            left = None if stop is None else max(stop - start, 0)
+            for batch in source.iter_batches(batch_size=chunk_rows, row_groups=groups):
+                cut = min(skip, batch.num_rows)
+                batch, skip = batch.slice(cut), skip - cut
+                if left is not None:
+                    batch = batch.slice(0, left)
+                    left -= batch.num_rows
+                if batch.num_rows:
+                    # ignore_metadata: a pandas index stays a column under its schema name
+                    yield pa.Table.from_batches([batch]).to_pandas(ignore_metadata=True)
         except (pa.ArrowException, OSError) as exc:
             raise corrupt from exc
 
-    return RawSource(path, "parquet", list(schema.names), units, meta.metadata.num_rows, read)
+    return RawSource(path, "parquet", list(schema.names), units, meta.metadata.num_rows, read,
+                     seek="row")
+
+
+def _groups_from(metadata, start: int) -> tuple[list[int], int]:
+    """The row groups holding rows from ``start`` on, and the rows of the first to skip."""
+    first = 0
+    for i in range(metadata.num_row_groups):
+        rows = metadata.row_group(i).num_rows
+        if first + rows > start:
+            return list(range(i, metadata.num_row_groups)), start - first
+        first += rows
+    return [], 0
 
 
 def check_rows(rows: int, path: Path) -> None:

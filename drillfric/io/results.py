@@ -379,6 +379,10 @@ class EstimatesWriter:
                                      preserve_index=False)
         self._writer.write_table(table)
 
+    def write_table(self, table: pa.Table) -> None:
+        """Append rows already in this file's schema (one segment's, from an earlier file)."""
+        self._writer.write_table(table.cast(self.schema))
+
     def close(self) -> None:
         """Finish the file."""
         self._writer.close()

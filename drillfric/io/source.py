@@ -39,6 +39,12 @@ class RawSource:
         Row count when known without reading the data.
     depth_index : str or None
         The index curve of a depth-indexed LAS log (e.g. ``"DEPT [M]"``), else None.
+    parts : tuple of RawSource
+        For a log split over files in a folder (:mod:`drillfric.io.parts`): each file's own
+        source, in reading order; else empty.
+    seek : str or None
+        How :meth:`window` addresses rows: ``"byte"`` (a delimited text file: byte
+        offsets), ``"row"`` (Parquet: row numbers); None: the source is read whole.
     """
 
     path: Path
@@ -48,6 +54,8 @@ class RawSource:
     rows: int | None
     _read: Callable[[int], Iterator[pd.DataFrame]] = field(repr=False, compare=False)
     depth_index: str | None = None
+    seek: str | None = None
+    parts: tuple = ()
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
@@ -55,6 +63,14 @@ class RawSource:
             raise ValueError("chunk_rows must be positive")
         yield from self._read(chunk_rows)
 
+    def window(self, start: int, stop: int | None,
+               chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
+        """The rows between positions ``start`` and ``stop`` (None: the end) in the unit of
+        :attr:`seek` — bytes (``start`` 0 or a line's beginning past the header) or rows —
+        in blocks as :meth:`chunks`."""
+        if self.seek is None:
+            raise ValueError(f"a {self.format} source is read whole")
+        yield from self._read(chunk_rows, start, stop)
 
 #: Extensions of surface data files, by format.
 FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",

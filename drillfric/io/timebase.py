@@ -142,6 +142,21 @@ class TimeTracker:
         self._last: float | None = None
         self._absolute: bool | None = None
 
+    def state(self) -> dict:
+        """Where the time base stands (plain values; the origin as ISO 8601 text)."""
+        return {"origin": None if self.origin is None else self.origin.isoformat(),
+                "source_start_s": self.source_start_s, "duplicates": self.duplicates,
+                "untimed": self.untimed, "rows_seen": self._rows_seen, "last": self._last,
+                "absolute": self._absolute}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self.origin = None if state["origin"] is None else pd.Timestamp(state["origin"])
+        self.source_start_s = state["source_start_s"]
+        self.duplicates, self.untimed = int(state["duplicates"]), int(state["untimed"])
+        self._rows_seen, self._last = int(state["rows_seen"]), state["last"]
+        self._absolute = state["absolute"]
+
     def step(self, values: pd.Series) -> tuple[np.ndarray, np.ndarray]:
         """Check one chunk's time column.
 

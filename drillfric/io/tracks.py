@@ -135,6 +135,30 @@ class TrackAccumulator:
                              minlength=(idx[-1] - idx[0] + 1) * _N_STATES)
         self._states[idx[0]:idx[-1] + 1] += counts.reshape(-1, _N_STATES)
 
+    def state(self) -> dict:
+        """The bins held (arrays) and how they are laid out (plain values)."""
+        return {"max_bins": self.max_bins, "width_s": self.width_s,
+                "expected_s": self._expected_s, "t0_s": self.t0_s,
+                "origin": None if self.origin is None else self.origin.isoformat(),
+                "channels": list(self.channels), "n": self._n,
+                "time_sum": self._time_sum, "time_count": self._time_count,
+                "states": self._states,
+                **{f"{stat}:{name}": getattr(self, f"_{stat}")[name]
+                   for stat in ("min", "max", "sum", "count") for name in self.channels}}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state`."""
+        self.max_bins, self.width_s = int(state["max_bins"]), float(state["width_s"])
+        self._expected_s, self.t0_s = float(state["expected_s"]), state["t0_s"]
+        self.origin = None if state["origin"] is None else pd.Timestamp(state["origin"])
+        self.channels, self._n = list(state["channels"]), int(state["n"])
+        self._time_sum = np.asarray(state["time_sum"], float)
+        self._time_count = np.asarray(state["time_count"], np.int64)
+        self._states = np.asarray(state["states"], np.int64).reshape(-1, _N_STATES)
+        for stat in ("min", "max", "sum", "count"):
+            setattr(self, f"_{stat}", {name: np.asarray(state[f"{stat}:{name}"])
+                                       for name in self.channels})
+
     def _note_origin(self, chunk: pd.DataFrame, t: np.ndarray) -> None:
         """Clock time of ``time_s = 0`` from the first row with a timestamp."""
         if self.origin is not None or "timestamp" not in chunk:

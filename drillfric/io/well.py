@@ -14,7 +14,9 @@ A well is one of
   named ``table.key``);
 - a directory holding ``well.toml``, whose ``[well] data`` and ``[survey] file`` name its
   files (relative to the directory); ``[well] data`` may be left out when the directory
-  holds the numbered parts of a WITSML log.
+  holds the numbered parts of a WITSML log; ``[well] data`` may name a folder of CSV or
+  Parquet files of one log (hourly or daily exports), read in name order
+  (:mod:`drillfric.io.parts`).
 
 Precedence: ``--config``/``--survey`` > the configuration's ``[survey] file`` > sidecars
 by name > objects inside the data file (an HDF5 ``/survey``; a WITSML ``<trajectory>`` or
@@ -52,6 +54,7 @@ from drillfric.errors import DrillfricError, InputError
 from drillfric.files import require_file
 from drillfric.io import witsml, witsml_objects
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
+from drillfric.io.parts import open_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
@@ -222,7 +225,12 @@ class Well:
             raise ValueError("well opened without its data file's header (header=False)")
         tracker = tracker or self.time_tracker()
         for chunk in self.source.chunks(chunk_rows):
-            yield _convert(chunk, self.mappings, tracker)
+            yield self.canonical(chunk, tracker)
+
+    def canonical(self, raw: pd.DataFrame, tracker: TimeTracker | None) -> pd.DataFrame:
+        """One raw chunk of the data (the source's columns) as canonical SI columns, its
+        time checked by ``tracker`` (:meth:`chunks` does this for every chunk)."""
+        return _convert(raw, self.mappings, tracker)
 
     def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
         """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
@@ -411,7 +419,9 @@ def _open(files: WellFiles, cfg: Config,
     the reader (LAS, WITSML, DLIS) is the measured depth unless ``[channels]
     measured_depth`` says otherwise."""
     raw = (frame_source(frame) if frame is not None else
-           witsml.open_witsml_parts(files.parts) if files.parts else open_source(files.data))
+           open_parts(files.parts) if files.parts and files.parts[0].suffix.lower() != ".xml"
+           else witsml.open_witsml_parts(files.parts) if files.parts
+           else open_source(files.data))
     file = str(files.data)
     index = log_index(raw.columns, cfg.channels, depth_index=raw.depth_index, file=file)
     channels = cfg.channels

@@ -25,6 +25,7 @@ from drillfric.errors import ConfigError, InputError
 from drillfric.files import require_file, require_inside, special
 from drillfric.io import witsml
 from drillfric.io.hdf5 import members, node_at
+from drillfric.io.parts import folder_parts
 from drillfric.io.source import FORMATS, data_format
 from drillfric.io.text import printable
 
@@ -53,7 +54,8 @@ class WellFiles:
         when it holds the trajectory beside the log).
     parts : tuple of Path
         The numbered part files of a WITSML log split over several files (by number; read
-        in index order), else empty.
+        in index order), or the CSV/Parquet files of a data folder (by name:
+        :mod:`drillfric.io.parts`), else empty.
     string : Path or None
         WITSML tubular read as the string (``NAME.tubular.xml``, or the data file holding a
         ``<tubular>``) when the configuration has no ``[[string.sections]]``.
@@ -230,6 +232,12 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
             require_inside(part, part.parent, "part of the log",
                            fix="copy the parts into the log's folder")
         return split
+    parts = folder_parts(path)
+    if parts is not None:
+        for part in parts:
+            require_inside(part, path, "file of the data folder",
+                           fix="copy the files into the data folder")
+        return path, parts
     data_format(path)
     return path, ()
 
@@ -266,7 +274,8 @@ def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
                           fix='add [well] data = "surface.parquet" (relative to the folder)')
     data_path = require_inside(folder / data, folder, "data file named by well.toml",
                                fix="give the data file on the command line instead")
-    if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)):
+    if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)
+                                  and not folder_parts(data_path)):
         raise InputError("data file named by well.toml not found", file=data_path,
                          fix=f"fix [well] data in {well_toml}")
     return *_data(data_path), well_toml, raw

@@ -94,7 +94,8 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
         One per well: ``{"well": str, "status": "ok"|"failed"|"skipped", "message": str,
         "result_dir": Path or None (relative link target), "summary": dict or None
         (summary.json), "stale_dir": Path or None (a failed well's earlier results, marked
-        stale)}``; "skipped" (unchanged since an ok run) is shown "ok (unchanged)".
+        stale), "changes": list of str (optional: what changed since the last night, shown
+        first)}``; "skipped" (unchanged since an ok run) is shown "ok (unchanged)".
     units : {"si", "field"}, optional
         Display units of the depths; default: the ``[well] units`` all wells share, else SI.
 
@@ -113,8 +114,10 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
     plot_id = embed.add(fleet_plot(logs, shown), "fleet") if any(
         ((seg["status"] == "ok") & seg["mu_k"].notna()).any() for _, seg in logs) else None
     counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
+    news = [(str(w.get("well", "?")), w["changes"]) for w in wells if w.get("changes")]
     html = environment().get_template("fleet_report.html.j2").render(
         rows=rows, failed=[r for r in rows if r["status"] == "failed"], counts=counts,
+        news=news,
         plot_id=plot_id, bokeh=embed.head, version=__version__, built=now_utc())
     out = out_dir / "fleet.html"
     _write_text(out, html)

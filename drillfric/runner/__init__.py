@@ -23,7 +23,7 @@ from .finish import ReportWriter
 def run_well(well: Well, out_root=None, *, rate_hz: float | None = None,
              report: ReportWriter | None = None,
              progress: Callable[[RunProgress], None] | None = None,
-             chunk_rows: int = CHUNK_ROWS) -> WellResult:
+             chunk_rows: int = CHUNK_ROWS, resume: bool = False) -> WellResult:
     """Run the whole estimation on one well; write ``out_root/NAME`` when ``out_root`` is given.
 
     Parameters
@@ -35,7 +35,7 @@ def run_well(well: Well, out_root=None, *, rate_hz: float | None = None,
         memory only (nothing written).
     rate_hz : float, optional
         Resample the input to this rate before estimation; a rate above the data's own is
-        not used (:func:`~drillfric.runner.time_log.effective_rate`: a warning in
+        not used (:func:`~drillfric.runner.estimator.effective_rate`: a warning in
         ``summary["warnings"]``).
     report : callable, optional
         Writes the report into the result directory before it is committed (only with
@@ -45,6 +45,10 @@ def run_well(well: Well, out_root=None, *, rate_hz: float | None = None,
         finish.
     chunk_rows : int
         Rows read per chunk.
+    resume : bool
+        Continue from the state of ``out_root/NAME`` when the data only grew since (a time
+        log in a delimited text file): only the new rows are estimated (docs/fleet.md);
+        otherwise the well is run from its start and summary.json ``resumed`` says why.
 
     Raises
     ------
@@ -53,8 +57,11 @@ def run_well(well: Well, out_root=None, *, rate_hz: float | None = None,
         written then).
     """
     if well.depth_indexed:  # no time series: a static friction log by depth
-        from .depth_log import run_depth_log as run
-    else:
-        from .time_log import run_time_log as run
-    return run(well, out_root, rate_hz=rate_hz, report=report, progress=progress,
-               chunk_rows=chunk_rows)
+        from .depth_log import run_depth_log
+
+        return run_depth_log(well, out_root, rate_hz=rate_hz, report=report,
+                             progress=progress, chunk_rows=chunk_rows)
+    from .time_log import run_time_log
+
+    return run_time_log(well, out_root, rate_hz=rate_hz, report=report, progress=progress,
+                        chunk_rows=chunk_rows, resume=resume)

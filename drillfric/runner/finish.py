@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
+import pyarrow.parquet as pq
 
 from drillfric._version import __version__
 from drillfric.estimation.consensus import consensus
@@ -87,6 +88,30 @@ class MemorySink:
         for key, frame in frames.items():
             self.frames[key].append(frame)
 
+    def replace(self, seg_id: int, frames: dict[str, pd.DataFrame], with_truth: bool) -> None:
+        """A revised segment's output rows instead of those it had."""
+        for key, parts in self.frames.items():
+            kept = [f for f in parts if not (len(f) and f["segment_id"].iloc[0] == seg_id)]
+            self.frames[key] = sorted(kept + [frames[key]] * (key in frames),
+                                      key=lambda f: int(f["segment_id"].iloc[0]) if len(f) else 0)
+
+    def drop(self, ids: set[int]) -> None:
+        """Forget the rows of segments ``ids``."""
+        self.frames = {key: [f for f in parts if not (len(f) and
+                                                      int(f["segment_id"].iloc[0]) in ids)]
+                       for key, parts in self.frames.items()}
+
+    def state(self) -> dict:
+        """The rows held, one table each (an engine state's)."""
+        return {key: pd.concat(parts, ignore_index=True) if parts else None
+                for key, parts in self.frames.items()}
+
+    def restore(self, state: dict) -> None:
+        """Hold the rows of a :meth:`state`, one table per segment."""
+        self.frames = {key: [] if frame is None else
+                       [part for _, part in frame.groupby("segment_id", sort=True)]
+                       for key, frame in state.items()}
+
     def finish(self, well: Well, summary: dict, records, tracks, tables) -> None:
         """Nothing to write."""
 
@@ -104,16 +129,47 @@ class DirectorySink:
         self.folder = folder
         self.writer: EstimatesWriter | None = None
         self.profiles: list[pd.DataFrame] = []
+        self.revised: dict[int, pd.DataFrame | None] = {}  # segment id → its new estimates
 
     def add(self, frames: dict[str, pd.DataFrame], with_truth: bool) -> None:
         """Append a segment's output rows (``estimates``, ``profile``; either may be absent)."""
         if "estimates" in frames:
-            if self.writer is None:
-                self.writer = EstimatesWriter(self.folder / "estimates.parquet", with_truth,
-                                              "timestamp" in frames["estimates"])
-            self.writer.write(frames["estimates"])
+            self._writer(with_truth, "timestamp" in frames["estimates"]).write(
+                frames["estimates"])
         if "profile" in frames:
             self.profiles.append(frames["profile"])
+
+    def replace(self, seg_id: int, frames: dict[str, pd.DataFrame], with_truth: bool) -> None:
+        """A revised segment's output rows instead of those it had (estimates.parquet is
+        rewritten when the run finishes)."""
+        self.profiles = [p for p in self.profiles if p["segment_id"].iloc[0] != seg_id] + (
+            [frames["profile"]] if "profile" in frames else [])
+        self.profiles.sort(key=lambda p: int(p["segment_id"].iloc[0]))
+        if "estimates" in frames:
+            self._writer(with_truth, "timestamp" in frames["estimates"])
+        self.revised[seg_id] = frames.get("estimates")
+
+    def seed(self, previous: Path, ids: set[int]) -> None:
+        """Start with the output rows of segments ``ids`` from an earlier result directory
+        ``previous`` (a resumed run: docs/fleet.md "Only what is new")."""
+        estimates = previous / "estimates.parquet"
+        if estimates.is_file():
+            source = pq.ParquetFile(estimates)
+            names = source.schema_arrow.names
+            for i in range(source.num_row_groups):
+                table = source.read_row_group(i)
+                if table.num_rows and int(table["segment_id"][0].as_py()) in ids:
+                    self._writer("bit_rpm" in names, "timestamp" in names).write_table(table)
+        profiles = previous / "profiles.parquet"
+        if profiles.is_file():
+            frame = pd.read_parquet(profiles)
+            self.profiles += [p for i, p in frame.groupby("segment_id", sort=True) if i in ids]
+
+    def _writer(self, with_truth: bool, with_clock: bool) -> EstimatesWriter:
+        if self.writer is None:
+            self.writer = EstimatesWriter(self.folder / "estimates.parquet", with_truth,
+                                          with_clock)
+        return self.writer
 
     def finish(self, well: Well, summary: dict, records, tracks: pd.DataFrame | None,
                tables: dict[str, pd.DataFrame]) -> None:
@@ -122,6 +178,8 @@ class DirectorySink:
         if self.writer is None:  # no time series: an estimates.parquet without rows
             self.writer = EstimatesWriter(self.folder / "estimates.parquet", False)
         self.writer.close()
+        if self.revised:
+            self._rewrite_revised()
         write_json(self.folder / "summary.json", summary)
         write_segments(self.folder / "segments.parquet", records)
         if tracks is not None:
@@ -138,6 +196,27 @@ class DirectorySink:
     def estimates(self) -> None:
         """None: read back from the file when asked (:attr:`WellResult.estimates`)."""
         return None
+
+    def _rewrite_revised(self) -> None:
+        """estimates.parquet with each revised segment's rows in place of its old ones (one
+        row group per segment, in segment order)."""
+        path = self.folder / "estimates.parquet"
+        old = pq.ParquetFile(path)
+        fresh = self.folder / ".estimates.revised.parquet"
+        writer = EstimatesWriter(fresh, "bit_rpm" in old.schema_arrow.names,
+                                 "timestamp" in old.schema_arrow.names)
+        pending = sorted((i, f) for i, f in self.revised.items() if f is not None)
+        for g in range(old.num_row_groups):
+            table = old.read_row_group(g)
+            seg_id = int(table["segment_id"][0].as_py()) if table.num_rows else 0
+            while pending and pending[0][0] < seg_id:
+                writer.write(pending.pop(0)[1])
+            if seg_id not in self.revised:
+                writer.write_table(table)
+        for _, frame in pending:
+            writer.write(frame)
+        writer.close()
+        fresh.replace(path)
 
 
 Sink = MemorySink | DirectorySink

@@ -1,0 +1,72 @@
+"""A well's log split over several files of one format in a folder — the hourly or daily
+CSV or Parquet exports of a rig recorder — read as one log, its files in name order
+(docs/ingestion.md "A well on disk", docs/fleet.md "Only what is new").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import replace
+from pathlib import Path
+
+import pandas as pd
+
+from drillfric.errors import InputError
+from drillfric.io.readers import data_format, open_source
+from drillfric.io.source import RawSource
+from drillfric.io.text import printable
+
+#: Formats whose files a folder may hold as parts of one log.
+PART_FORMATS = ("csv", "parquet")
+#: Names of files in a data folder that are sidecars, not parts.
+_SIDECAR_TAGS = (".survey.", ".truth.", ".tubular.")
+
+
+def folder_parts(folder: Path) -> tuple[Path, ...] | None:
+    """The data files of a folder holding one log in parts (name order), or None when it
+    holds none. Hidden files and sidecars are not parts.
+
+    Raises
+    ------
+    InputError
+        Files of several formats (or of a format read only whole) in the folder.
+    """
+    if not folder.is_dir():
+        return None
+    files = sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")
+                   and not any(tag in p.name for tag in _SIDECAR_TAGS)
+                   and p.suffix.lower() not in (".toml", ".json", ".md"))
+    if not files:
+        return None
+    formats = {_format(p) for p in files}
+    if len(formats) > 1 or not formats <= set(PART_FORMATS):
+        raise InputError(f"a data folder holds files of {', '.join(sorted(formats))}: its "
+                         "files must be parts of one log of one format", file=folder,
+                         fix="keep only the log's CSV or Parquet files in the folder")
+    return tuple(files)
+
+
+def _format(path: Path) -> str:
+    try:
+        return data_format(path)
+    except InputError:
+        return f"'{printable(path.suffix or path.name)}'"
+
+
+def open_parts(paths) -> RawSource:
+    """One raw source from the parts of a log (each opened as the file it is; every part
+    must have the first part's columns). Its ``parts`` are the parts' own sources."""
+    sources = tuple(open_source(p) for p in paths)
+    first = sources[0]
+    for src in sources[1:]:
+        if src.columns != first.columns:
+            raise InputError(f"columns differ from those of {printable(first.path.name)}",
+                             file=src.path, fix="give every part of the log the same columns")
+    rows = None if any(s.rows is None for s in sources) else sum(s.rows for s in sources)
+
+    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+        for src in sources:
+            yield from src.chunks(chunk_rows)
+
+    return replace(RawSource(first.path.parent, first.format, first.columns, first.units, rows,
+                             read), parts=sources)

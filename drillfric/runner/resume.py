@@ -1,0 +1,215 @@
+"""Continue a well's run from the state its last results kept: only the rows appended since
+(docs/fleet.md "Only what is new").
+
+A data file that grew is recognised by its content, not its name or date (:func:`mark`,
+:func:`changed`):
+
+- a delimited text file: the byte length read, a SHA-256 of those bytes and whether they
+  ended with a complete line; it continues when its first bytes hash the same;
+- a Parquet file rewritten with more rows: a SHA-256 of each row group's bytes, and of the
+  last group's values; it continues when the same groups come first — the last one may
+  have been rewritten larger, then its first rows must hold the same values.
+
+Anything else — no state, another drillfric, configuration or rate, earlier rows changed, a
+format read only whole — is run from the start, and the summary says why (summary.json
+``resumed``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import pandas as pd
+import pyarrow.parquet as pq
+
+from drillfric.errors import InputError
+from drillfric.io.well import Well
+
+from .engine import Engine, mismatch
+from .finish import DirectorySink
+from .state import read_state
+
+_BLOCK = 1 << 22
+
+
+def mark(well: Well) -> dict:
+    """What a run reads of the well's data now (for a folder of files: of each file)."""
+    if well.source.parts:
+        return {"format": "parts", "parts": [{"name": p.path.name} | source_mark(p)
+                                             for p in well.source.parts]}
+    return source_mark(well.source)
+
+
+def source_mark(source) -> dict:
+    """What a run reads of one delimited text or Parquet file now."""
+    if source.seek == "byte":
+        return csv_mark(source.path, source.path.stat().st_size)
+    return parquet_mark(source.path, source)
+
+
+def _end(found: dict) -> int:
+    """Where the data a mark recorded ends (bytes or rows)."""
+    return found["bytes"] if found["format"] == "csv" else found["rows"]
+
+
+def unread(well: Well, before: dict | None, now: dict, chunk_rows: int):
+    """The raw rows between the marks ``before`` (None: the start) and ``now``."""
+    if not well.source.parts:
+        start = 0 if before is None else _end(before)
+        yield from well.source.window(start, _end(now), chunk_rows)
+        return
+    k = len(before["parts"]) - 1 if before else 0
+    for i, (part, found) in enumerate(zip(well.source.parts, now["parts"], strict=True)):
+        if i >= k:
+            start = _end(before["parts"][i]) if before and i == k else 0
+            yield from part.window(start, _end(found), chunk_rows)
+
+
+def csv_mark(path: Path, size: int) -> dict:
+    """What a run read of a delimited text file: its first ``size`` bytes."""
+    digest = hashlib.sha256()
+    last = b""
+    with open(path, "rb") as fh:
+        left = size
+        while left > 0 and (block := fh.read(min(_BLOCK, left))):
+            digest.update(block)
+            left -= len(block)
+            last = block[-1:]
+    return {"format": "csv", "bytes": size, "sha256": digest.hexdigest(),
+            "ends_line": last in (b"\n", b"\r")}
+
+
+def parquet_mark(path: Path, source) -> dict:
+    """What a run reads of a Parquet file: its rows, each row group's rows and byte hash,
+    and a hash of the last group's values."""
+    meta = pq.ParquetFile(path).metadata
+    groups = [{"rows": meta.row_group(i).num_rows, "sha256": _group_hash(path, meta, i)}
+              for i in range(meta.num_row_groups)]
+    last = groups[-1]["rows"] if groups else 0
+    return {"format": "parquet", "rows": meta.num_rows, "groups": groups,
+            "last_values": _values_hash(source, meta.num_rows - last, meta.num_rows)}
+
+
+def _group_hash(path: Path, meta, i: int) -> str:
+    """SHA-256 of the bytes of row group ``i`` (its column chunks)."""
+    group = meta.row_group(i)
+    spans = []
+    for c in range(group.num_columns):
+        col = group.column(c)
+        begin = col.dictionary_page_offset if col.has_dictionary_page else col.data_page_offset
+        spans.append((begin, begin + col.total_compressed_size))
+    begin, end = min(a for a, _ in spans), max(b for _, b in spans)
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        fh.seek(begin)
+        left = end - begin
+        while left > 0 and (block := fh.read(min(_BLOCK, left))):
+            digest.update(block)
+            left -= len(block)
+    return digest.hexdigest()
+
+
+def _values_hash(source, start: int, stop: int) -> str:
+    """SHA-256 of the values of rows [start, stop) (column names and contents)."""
+    digest = hashlib.sha256()
+    for chunk in source.window(start, stop):
+        digest.update("\x1f".join(chunk.columns).encode())
+        digest.update(pd.util.hash_pandas_object(chunk, index=False).to_numpy().tobytes())
+    return digest.hexdigest()
+
+
+def changed(found: dict | None, well: Well) -> str:
+    """Why the well's data does not continue what ``found`` recorded ("" when it does)."""
+    if not well.source.parts:
+        return _source_changed(found, well.source)
+    if not found or found.get("format") != "parts":
+        return "the earlier run read another kind of data"
+    names = [p.path.name for p in well.source.parts]
+    earlier = [p["name"] for p in found["parts"]]
+    if names[:len(earlier)] != earlier:
+        return "earlier files of the data folder changed (renamed, removed or inserted)"
+    for i, (part, before) in enumerate(zip(well.source.parts, found["parts"], strict=False)):
+        why = _source_changed(before, part)
+        if not why and i < len(earlier) - 1 and _size_now(part) != _end(before):
+            why = "it grew, but it is not the last file read"
+        if why:
+            return f"{part.path.name}: {why}"
+    return ""
+
+
+def _size_now(source) -> int:
+    """A file's length now, as a mark counts it (bytes or rows)."""
+    if source.seek == "byte":
+        return source.path.stat().st_size
+    return pq.ParquetFile(source.path).metadata.num_rows
+
+
+def _source_changed(found: dict | None, source) -> str:
+    """Why one file does not continue what ``found`` recorded ("" when it does)."""
+    path = source.path
+    if not found or found.get("format") != {"byte": "csv", "row": "parquet"}.get(source.seek):
+        return "the earlier run read another kind of file"
+    if found["format"] == "parquet":
+        return _parquet_changed(found, path, source)
+    size = path.stat().st_size
+    if size < found["bytes"]:
+        return f"the file is shorter than the {found['bytes']} bytes read before"
+    if not found.get("ends_line"):
+        return "the earlier rows did not end with a complete line"
+    if csv_mark(path, found["bytes"])["sha256"] != found["sha256"]:
+        return "earlier rows changed (the first bytes differ from those read before)"
+    return ""
+
+
+def _parquet_changed(found: dict, path: Path, source) -> str:
+    meta = pq.ParquetFile(path).metadata
+    if meta.num_rows < found["rows"]:
+        return f"the file holds fewer rows than the {found['rows']} read before"
+    groups = found["groups"]
+    if meta.num_row_groups < len(groups):
+        return "the file holds fewer row groups than before"
+    start = 0
+    for i, group in enumerate(groups):
+        same = meta.row_group(i).num_rows == group["rows"] and \
+            _group_hash(path, meta, i) == group["sha256"]
+        if not same and (i < len(groups) - 1 or meta.row_group(i).num_rows < group["rows"]
+                         or _values_hash(source, start, start + group["rows"])
+                         != found["last_values"]):
+            return f"earlier rows changed (row group {i} differs from the one read before)"
+        start += group["rows"]
+    return ""
+
+
+def resumable(well: Well) -> bool:
+    """Whether the well's data can be continued where a run stopped (a delimited text file
+    in a byte-seekable encoding, a Parquet file, or a folder of them)."""
+    source = well.source
+    if well.files.in_memory or source is None:
+        return False
+    return all(p.seek is not None for p in source.parts or (source,))
+
+
+def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engine | None, str]:
+    """An engine continuing the run of ``previous`` (a result directory), its output rows
+    seeded into ``sink``; or None and why it cannot."""
+    if not resumable(well):
+        return None, "its data file is read whole (not delimited text or Parquet)"
+    folder = previous / "state"
+    if not (folder / "engine.json").is_file():
+        return None, "no saved state"
+    try:
+        state = read_state(folder)
+    except InputError as exc:
+        return None, exc.message
+    why = mismatch(state, well, kw.get("rate_hz")) or changed(state.get("source"), well)
+    if why:
+        return None, why
+    engine = Engine(well, sink=sink, **kw)
+    try:
+        engine.restore(state)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:  # not a state we wrote
+        return None, f"engine state not readable ({type(exc).__name__}: {exc})"
+    sink.seed(previous, {r.id for r in engine.records})
+    engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
+    return engine, ""

@@ -1,0 +1,200 @@
+"""Nightly fleets process only what is new (issue 23): a CSV that grew continues from the
+saved state; a CSV whose earlier rows changed is redone whole with the reason; a fleet
+re-run killed with SIGKILL and run again ends with the results of an uninterrupted one."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from drillfric.fleet import WellSpec, run_many
+from drillfric.io.well import open_well
+from drillfric.runner import run_well
+from tests.test_engine import _same_results, stands  # noqa: F401 — the module's well
+
+
+def _grow(src, dst, fraction: float):
+    """``dst`` (with ``src``'s sidecars) holding the first ``fraction`` of ``src``'s lines."""
+    lines = src.read_bytes().splitlines(keepends=True)
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    for sidecar in (".toml", ".survey.csv"):
+        shutil.copy(src.with_suffix(sidecar), dst.with_suffix(sidecar))
+    dst.write_bytes(b"".join(lines[:int(len(lines) * fraction)]))
+    return lines
+
+
+def _summary(out, name="three") -> dict:
+    return json.loads((out / name / "summary.json").read_text())
+
+
+def test_appended_rows_continue_from_the_state(stands, tmp_path):  # noqa: F811
+    """Two appends, each re-run continuing from the last state, end with the whole file's
+    results; only the new rows are read (summary.json resumed.from_row)."""
+    path, whole = stands
+    data = tmp_path / "wells" / path.name
+    lines = _grow(path, data, 0.4)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"]["from_row"] == 0
+    for upto in (0.7, 1.0):
+        first = int(len(lines) * (upto - 0.3 if upto < 1 else 0.7))
+        with open(data, "ab") as fh:
+            fh.write(b"".join(lines[first:int(len(lines) * upto)]))
+        assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+        resumed = _summary(out)["resumed"]
+        assert resumed["reason"] == "" and resumed["from_row"] == first - 1  # header line
+    result = run_well(open_well(data))  # whole-file results to compare with
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(result)(result.well, _summary(out), written), whole)
+    rows = pd.read_parquet(out / "fleet_summary.parquet")
+    assert "new segment(s)" in rows["well_changes"].iloc[0]
+    assert rows["well_new_segments"].iloc[0] >= 1
+    assert run_many([WellSpec(data)], out, workers=1).wells[0].changes[0].startswith(
+        "no new data since")
+    estimates = pd.read_parquet(out / "three" / "estimates.parquet")
+    assert sorted(set(estimates["segment_id"])) == sorted(
+        whole.segments.loc[whole.segments["status"] == "ok", "id"])
+
+
+def test_changed_earlier_rows_are_redone_whole_with_the_reason(stands, tmp_path):  # noqa: F811
+    path, whole = stands
+    data = tmp_path / "wells" / path.name
+    _grow(path, data, 1.0)
+    out = tmp_path / "out"
+    run_many([WellSpec(data)], out, workers=1)
+    text = data.read_bytes()
+    data.write_bytes(text.replace(b"\n1.0", b"\n1.00", 1))  # an earlier row edited
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    resumed = _summary(out)["resumed"]
+    assert resumed["from_row"] == 0 and "earlier rows changed" in resumed["reason"]
+    forced = run_many([WellSpec(data)], out, workers=1, force=True)
+    assert forced.count("ok") == 1 and _summary(out)["resumed"] is None
+
+    state = out / "three" / "state" / "engine.json"  # a state missing a part: redone whole
+    doc = json.loads(state.read_text())
+    del doc["state"]["check"]
+    state.write_text(json.dumps(doc))
+    with open(data, "ab") as fh:
+        fh.write(text.splitlines(keepends=True)[-1])
+    run_many([WellSpec(data)], out, workers=1)
+    assert _summary(out)["resumed"]["reason"].startswith("engine state not readable")
+
+
+def test_sigkill_during_a_rerun_then_rerun_gives_the_uninterrupted_results(stands,  # noqa: F811
+                                                                           tmp_path):
+    path, _ = stands
+    data = tmp_path / "wells" / path.name
+    lines = _grow(path, data, 0.5)
+    out = tmp_path / "out"
+    run_many([WellSpec(data)], out, workers=1)
+    with open(data, "ab") as fh:
+        fh.write(b"".join(lines[len(lines) // 2:]))
+    cmd = [sys.executable, "-m", "drillfric.cli.main", "-q", "fleet", str(data.parent),
+           "--out", str(out), "--workers", "1", "--no-report"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 120
+        while not any(".tmp-" in p.name for p in out.glob(".*")):  # the well is being written
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == -signal.SIGKILL
+    again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    whole = run_well(open_well(data))
+    got = _summary(out)
+    assert [s["id"] for s in got["segments"]] == whole.segments["id"].tolist()
+    mu = np.array([np.nan if s["mu_k"] is None else s["mu_k"] for s in got["segments"]])
+    np.testing.assert_allclose(mu, whole.segments["mu_k"].to_numpy(float), rtol=0.005)
+
+
+@pytest.fixture(autouse=True)
+def _no_report(monkeypatch):
+    """The wells' reports are not what is tested here (and cost seconds each)."""
+    import drillfric.api
+
+    monkeypatch.setattr(drillfric.api, "_report_writer", lambda pdf: None)
+
+
+def _parquet(frame: pd.DataFrame, path, group_rows: int = 7_000) -> None:
+    frame.to_parquet(path, index=False, row_group_size=group_rows)
+
+
+def test_parquet_rewritten_with_more_rows_continues_from_its_row_groups(stands,  # noqa: F811
+                                                                         tmp_path):
+    """A Parquet file rewritten whole with more rows (its last row group now larger): the
+    unchanged row groups are recognised by their bytes, the grown one by its values; only
+    the new rows are read, and the results are the whole file's. An earlier value changed:
+    redone whole with the reason."""
+    path, whole = stands
+    frame = pd.read_csv(path)
+    data = tmp_path / "wells" / "three.parquet"
+    _grow(path, data.with_suffix(".csv"), 0.0)
+    data.with_suffix(".csv").unlink()
+    toml = data.with_suffix(".toml")
+    toml.write_text(toml.read_text().replace('data = "three.csv"', 'data = "three.parquet"'))
+    out = tmp_path / "out"
+    first = int(len(frame) * 0.55)  # not at a row-group boundary
+    _parquet(frame.iloc[:first], data)
+    run_many([WellSpec(data)], out, workers=1)
+    _parquet(frame, data)
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    resumed = _summary(out)["resumed"]
+    assert resumed == {"from_row": first, "reason": ""}
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    edited = frame.copy()
+    edited.loc[10, "surface_rpm"] += 1.0
+    _parquet(edited, data)
+    run_many([WellSpec(data)], out, workers=1)
+    assert "row group 0 differs" in _summary(out)["resumed"]["reason"]
+
+
+def test_folder_of_hourly_files_continues_with_the_grown_and_the_new_files(stands,  # noqa: F811
+                                                                          tmp_path):
+    """A well directory whose [well] data names a folder of hourly CSV files: the last file
+    read grew and new files came; only their rows are read and the results are the whole
+    log's. A file read before that changed: redone whole, the file named."""
+    path, whole = stands
+    frame = pd.read_csv(path)
+    well = tmp_path / "wells" / "three"
+    (well / "hourly").mkdir(parents=True)
+    shutil.copy(path.with_suffix(".survey.csv"), well / "three.survey.csv")
+    (well / "well.toml").write_text(path.with_suffix(".toml").read_text().replace(
+        'data = "three.csv"', 'data = "hourly"').replace('file = "three.survey.csv"',
+                                                         'file = "three.survey.csv"'))
+    bounds = np.linspace(0, len(frame), 7).astype(int)
+    parts = [frame.iloc[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    for i, part in enumerate(parts[:3]):
+        part.to_csv(well / "hourly" / f"h{i:02d}.csv", index=False)
+    half = len(parts[3]) // 2
+    parts[3].iloc[:half].to_csv(well / "hourly" / "h03.csv", index=False)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(well)], out, workers=1).count("ok") == 1
+    parts[3].iloc[half:].to_csv(well / "hourly" / "h03.csv", mode="a", header=False,
+                                index=False)
+    for i in (4, 5):
+        parts[i].to_csv(well / "hourly" / f"h{i:02d}.csv", index=False)
+    assert run_many([WellSpec(well)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": bounds[3] + half, "reason": ""}
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    parts[1].assign(surface_rpm=parts[1]["surface_rpm"] + 0.5).to_csv(
+        well / "hourly" / "h01.csv", index=False)
+    run_many([WellSpec(well)], out, workers=1)
+    assert _summary(out)["resumed"]["reason"].startswith("h01.csv: earlier rows changed")

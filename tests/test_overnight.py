@@ -1,0 +1,34 @@
+"""What changed since the last night (issue 23 §3): the headlines of a fleet's morning."""
+
+from __future__ import annotations
+
+from drillfric.overnight import changes, night
+
+
+def _summary(mu_k, severities):
+    return {"mu_k": mu_k, "segments": [{"id": i + 1, "stick_slip_severity": s}
+                                       for i, s in enumerate(severities)]}
+
+
+def test_new_segments_and_severe_stick_slip_in_them_only():
+    history = [night(_summary(0.25, [1.5, 0.2]), "d1")]
+    out = changes(_summary(0.25, [1.5, 0.2, 0.4, 1.3]), history, ran=True,
+                  data_changed_utc=None)
+    assert out["new_segments"] == 2
+    assert out["notes"] == ["2 new segment(s)",
+                            "severe stick-slip (the bit stops) in segment(s) 4"]
+
+
+def test_mu_k_moved_beyond_its_own_spread_needs_three_nights():
+    history = [night(_summary(mu, [0.2]), f"d{i}") for i, mu in enumerate((0.25, 0.27, 0.26))]
+    within = changes(_summary(0.28, [0.2]), history, ran=True, data_changed_utc=None)
+    assert within["notes"] == []  # 0.02 from the median: inside the spread 0.02
+    moved = changes(_summary(0.30, [0.2]), history, ran=True, data_changed_utc=None)
+    assert moved["notes"][0].startswith("μ_k moved to 0.300 from 0.260")
+    assert changes(_summary(0.40, [0.2]), history[:2], ran=True,
+                   data_changed_utc=None)["notes"] == []  # two nights: no judgement
+
+
+def test_a_well_whose_data_did_not_change_says_since_when():
+    out = changes(_summary(0.25, [0.2]), [], ran=False, data_changed_utc="2026-11-20T02:00:00")
+    assert out == {"new_segments": 0, "notes": ["no new data since 2026-11-20T02:00:00"]}
