@@ -291,8 +291,10 @@ class SegmentRecord:
         for name, enum in (("kind", Kind), ("status", Status), ("method", Method)):
             if name in typed:
                 typed[name] = enum(typed[name])
-        typed["flags"] = tuple(Flag(f) for f in typed.get("flags", ()))
+        typed["quality_flags"] = tuple(Flag(f) for f in typed.get("quality_flags", ()))
         typed["starts"] = tuple(tuple(float(v) for v in s) for s in typed.get("starts", ()))
+        typed["bit_torque_evidence"] = tuple(int(i) for i in
+                                             typed.get("bit_torque_evidence", ()))
         return cls(**typed)
 
 
