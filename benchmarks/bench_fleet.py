@@ -20,7 +20,8 @@ from pathlib import Path
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.fleet import WellSpec, _client, run_many
+from drillfric.discovery import WellSpec
+from drillfric.fleet import _client, run_many
 
 REPO = Path(__file__).resolve().parents[1]
 #: Off-bottom rotating segments per day of rig data: 49 segments in the 50 000 s of the

@@ -58,7 +58,8 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
     """Run every well of DIR_OR_MANIFEST (a directory of wells, or a .csv/.json manifest
     with columns well, data, config, survey), skipping wells unchanged since their last run.
     """
-    from drillfric.fleet import discover, run_many
+    from drillfric.discovery import discover
+    from drillfric.fleet import run_many
 
     if workers is not None and workers < 1:
         raise UserError(f"--workers must be at least 1, got {workers}")

@@ -1,0 +1,144 @@
+"""Which wells a fleet holds: a folder of wells, or a manifest (docs/fleet.md).
+
+:func:`discover` names the wells of a folder (each data file with its sidecars, each
+sub-folder with ``well.toml`` or the numbered parts of a WITSML log) or of a ``.csv``/``.json``
+manifest (columns ``well, data, config, survey``) as :class:`WellSpec` — cheaply: no data
+file is opened here (a name stored inside one is resolved by the worker that runs the well,
+docs/security.md), so no input can stop, crash or stall a night before it starts.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from drillfric.errors import InputError
+from drillfric.io import witsml
+
+_DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las", ".xml", ".dlis",
+             ".xlsx")
+_SIDECAR_TAGS = (".survey", ".truth", ".tubular")
+#: WITSML objects that are not surface data (read beside a log, never a well of their own).
+_NOT_WELLS = frozenset({"trajectory", "tubular", "bhaRun"})
+_MANIFEST_COLUMNS = ("well", "data", "config", "survey")
+
+
+@dataclass(frozen=True)
+class WellSpec:
+    """A well to process: a data file, an HDF5 bundle or a well directory (docs/ingestion.md,
+    docs/fleet.md).
+
+    Attributes
+    ----------
+    data : Path
+        What ``drillfric run`` accepts as WELL.
+    name : str or None
+        Output name (OUT/NAME); None: the configuration's ``well.name``, else the stem.
+    config, survey : Path or None
+        Overrides of the sidecars (``--config``, manifest columns).
+    """
+
+    data: Path
+    name: str | None = None
+    config: Path | None = None
+    survey: Path | None = None
+
+
+def discover(source, *, config=None) -> list[WellSpec]:
+    """The wells of a directory or of a manifest file (CSV or JSON).
+
+    A directory holds data files with their sidecars (``NAME.toml``, ``NAME.survey.csv``,
+    ``NAME.truth.json`` are not wells) and well directories (holding ``well.toml``).
+    A manifest has columns/keys ``well, data, config, survey`` (``data`` required; relative
+    paths are relative to the manifest). ``config`` (``--config``) applies to every well
+    that does not name its own.
+
+    Raises
+    ------
+    InputError
+        Missing source, unreadable manifest, or no well found.
+    """
+    source = Path(source)
+    if not source.exists():
+        raise InputError("not found", file=source, fix="give a directory of wells or a "
+                         "manifest (.csv/.json with columns well, data, config, survey)")
+    if source.is_dir():
+        specs = _discover_dir(source)
+    else:
+        specs = _read_manifest(source)
+    if not specs:
+        raise InputError("no wells found", file=source,
+                         fix=f"put data files ({', '.join(_DATA_EXT)}) or well directories "
+                             "(with well.toml) there")
+    if config is not None:
+        specs = [s if s.config is not None else replace(s, config=Path(config)) for s in specs]
+    return specs
+
+
+def _discover_dir(folder: Path) -> list[WellSpec]:
+    """Wells of a folder; the numbered parts of one WITSML log (``NAME_1.xml``,
+    ``NAME_2.xml`` …, or a sub-folder of ``00001.xml`` …) are one well."""
+    specs, logs = [], set()
+    for path in sorted(folder.iterdir()):
+        if path.name.startswith("."):
+            continue
+        split = witsml.split_log(path)
+        if split is not None and split[0] in logs:
+            continue
+        if path.is_dir():
+            if (path / "well.toml").is_file() or split is not None:
+                specs.append(WellSpec(path))
+        elif _is_data_file(path):
+            specs.append(WellSpec(path))
+        logs |= {split[0]} if split is not None else set()
+    return specs
+
+
+def _is_data_file(path: Path) -> bool:
+    """A data file of a well: a data extension, not a sidecar, not a WITSML object that
+    only accompanies a log (a file that does not parse is kept: it fails as its well)."""
+    if path.suffix.lower() not in _DATA_EXT or path.stem.endswith(_SIDECAR_TAGS):
+        return False
+    if path.suffix.lower() != ".xml":
+        return True
+    try:
+        return witsml.object_kind(path) not in _NOT_WELLS
+    except InputError:
+        return True
+
+
+def _read_manifest(path: Path) -> list[WellSpec]:
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".csv":
+            with open(path, newline="", encoding="utf-8") as fh:
+                rows = list(csv.DictReader(fh))
+        elif suffix == ".json":
+            rows = json.loads(path.read_text(encoding="utf-8"))
+            rows = rows.get("wells", rows) if isinstance(rows, dict) else rows
+        else:
+            raise InputError("a fleet manifest must be .csv or .json", file=path,
+                             fix="give a directory of wells or a .csv/.json manifest")
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, csv.Error) as exc:
+        raise InputError(f"unreadable manifest ({exc})", file=path,
+                         fix="write a CSV/JSON list with columns well, data, config, "
+                             "survey") from None
+    except RecursionError:  # json: [[[[…]]]] a hundred thousand deep
+        raise InputError("unreadable manifest (nested too deep)", file=path,
+                         fix="write a CSV/JSON list with columns well, data, config, "
+                             "survey") from None
+    if not isinstance(rows, list) or any(not isinstance(r, dict) or not r.get("data")
+                                         for r in rows):
+        raise InputError("every manifest entry needs a 'data' path", file=path,
+                         fix=f"use columns {', '.join(_MANIFEST_COLUMNS)} (data required)")
+
+    def where(value) -> Path | None:
+        if value and "\x00" in str(value):  # no path holds NUL: the OS refuses it
+            raise InputError("a manifest path holds a NUL character", file=path,
+                             fix="write each path as plain text")
+        return None if not value else (path.parent / str(value)).resolve()
+
+    return [WellSpec(where(r["data"]), r.get("well") or None, where(r.get("config")),
+                     where(r.get("survey"))) for r in rows]
