@@ -1,12 +1,12 @@
-"""Compile the kernels of a run ahead of it, in two processes at once (the first run).
+"""Compile the kernels of a run ahead of it, on two cores at once (the first run).
 
 A run compiles, on first use, the torsional plant (the batch fit), the observer (the starts
 and the ensemble), the rig-state classifier and the torque-and-drag march. Compiled in the
-run's own process they cost ~10 s of one core, in silence. :func:`warm_up` compiles them in
-two short-lived processes side by side — the observer in one, the plant, classifier and
-march in the other — through the same functions a run calls (so with the same types), on a
-small built-in segment; numba writes the machine code to the per-user cache
-(:mod:`drillfric.kernels.cache`) and the run loads it from there. Subprocesses, not
+run's own process they cost ~10 s of one core, in silence. :func:`warm_up` compiles the
+observer in a short-lived child process while this process compiles the plant, classifier
+and march itself — both through the same functions a run calls (so with the same types), on
+a small built-in segment; numba writes the machine code to the per-user cache
+(:mod:`drillfric.kernels.cache`), from which the run loads the observer. A subprocess, not
 multiprocessing: a Dask worker's daemonic process cannot start multiprocessing children.
 
 ``python -m drillfric.runner.warmup PART`` compiles one part ("observer" or "plant").
@@ -17,6 +17,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable
 
@@ -34,31 +35,45 @@ def needed() -> bool:
 
 def warm_up(tick: Callable[[float], None] | None = None, *, timeout_s: float = 600.0,
             poll_s: float = 0.25) -> bool:
-    """Compile the run's kernels in two processes at once; ``tick(elapsed_s)`` is called
-    every ``poll_s`` while they work. Returns True when both succeeded (and marks the cache
-    warm); False otherwise — the run then compiles what it needs itself."""
+    """Compile the run's kernels: the observer in a child process, the rest here, at once;
+    ``tick(elapsed_s)`` is called about every ``poll_s`` meanwhile (from a thread while this
+    process compiles). Returns True when both succeeded (and marks the cache warm); False
+    otherwise — the run then compiles what it still needs itself."""
     env = dict(os.environ)  # NUMBA_CACHE_DIR as this process has it
-    procs = [subprocess.Popen([sys.executable, "-m", "drillfric.runner.warmup", part],
-                              stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, env=env) for part in PARTS]
-    t0 = time.monotonic()
+    child = subprocess.Popen([sys.executable, "-m", "drillfric.runner.warmup", PARTS[0]],
+                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL, env=env)
+    t0, here = time.monotonic(), threading.Event()
+    ticker = threading.Thread(target=_ticking, args=(tick, t0, poll_s, here), daemon=True)
+    ticker.start()
     try:
-        while any(p.poll() is None for p in procs):
-            elapsed = time.monotonic() - t0
-            if elapsed > timeout_s:
-                return False
-            if tick is not None:
-                tick(elapsed)
+        ok = _compile_here(PARTS[1])
+        while child.poll() is None and time.monotonic() - t0 <= timeout_s:
             time.sleep(poll_s)
     finally:
-        for p in procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
-    if all(p.returncode == 0 for p in procs):
+        here.set()
+        ticker.join()
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    if ok and child.returncode == 0:
         mark_warm(STAMP)
         return True
     return False
+
+
+def _ticking(tick, t0: float, poll_s: float, done: threading.Event) -> None:
+    while tick is not None and not done.wait(poll_s):
+        tick(time.monotonic() - t0)
+
+
+def _compile_here(part: str) -> bool:
+    """:func:`_compile` in this process; False when it failed (the run compiles then)."""
+    try:
+        _compile(part)
+    except Exception:  # noqa: BLE001 — a warm-up that fails costs nothing but its time
+        return False
+    return True
 
 
 def _segment():
