@@ -67,7 +67,7 @@ class Tail:
     """
 
     def __init__(self, path: Path, start: int = 0):
-        self.path, self.end, self._scanned = Path(path), 0, 0
+        self.path, self.end = Path(path), 0
         self._digest = hashlib.sha256()
         if start:
             self._take(start)
@@ -88,14 +88,13 @@ class Tail:
             raise InputError(f"the file shrank to {size} bytes after {self.end} were read",
                              file=self.path, fix="append to the file; restart live on a new "
                                                  "--out for a rewritten file")
-        if size > self._scanned:
+        if size > self.end:  # the partial last line is read again: it may have ended
             with open(self.path, "rb") as fh:
-                fh.seek(self._scanned)
-                block = fh.read(size - self._scanned)
+                fh.seek(self.end)
+                block = fh.read(size - self.end)
             cut = block.rfind(b"\n")
             if cut >= 0:
-                self._take(self._scanned + cut + 1, block[:cut + 1])
-            self._scanned += len(block)
+                self._take(self.end + cut + 1, block[:cut + 1])
         return self.end
 
     def lines(self) -> int:
@@ -109,7 +108,7 @@ class Tail:
                 fh.seek(self.end)
                 block = fh.read(end - self.end)
         self._digest.update(block)
-        self.end = self._scanned = end
+        self.end = end
 
     def mark(self) -> dict:
         """The mark of the bytes read (:func:`drillfric.runner.resume.csv_mark`'s format)."""
