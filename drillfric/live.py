@@ -149,6 +149,7 @@ class LiveRun:
         self.well: Well | None = None
         self.engine: Engine | None = None
         self.stop = threading.Event()
+        self.done = threading.Event()  # the worker ended (final results written or error)
         self.error: BaseException | None = None
         self.result = None
         self.last_data = clock()  # when the file last grew (wall clock)
@@ -179,6 +180,8 @@ class LiveRun:
         except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
             self.error = exc
             self.stop.set()
+        finally:
+            self.done.set()
 
     def _step(self) -> bool:
         """One poll; True when rows were fed or results published."""
@@ -439,11 +442,14 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
 
 
 def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None) -> None:
-    """live.json every :data:`POLL_S` while the worker runs; stop it when idle."""
-    while worker.is_alive():
+    """live.json every :data:`POLL_S` while the worker runs; stop it when idle. (The
+    worker's ``done`` event is waited on, not ``Thread.join``: a join interrupted by a signal
+    can leave ``is_alive()`` False while the thread still runs, CPython gh-90882.)"""
+    while not live.done.is_set():
         live.watch()
         live.write_status(live.target)
         if until_idle_s is not None and live.clock() - live.last_data >= until_idle_s:
             live.stop.set()
-        worker.join(POLL_S)
+        time.sleep(POLL_S)
+    worker.join()
     live.write_status(live.target)
