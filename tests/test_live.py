@@ -167,3 +167,27 @@ def test_no_data_ever_exits_2_with_one_line(tmp_path):
     assert code == 2
     assert "no data arrived" in err and "never.csv" in err and "Traceback" not in err
     assert not (tmp_path / "out" / "never").exists()
+
+
+def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_trend(tmp_path):
+    from drillfric.live import LiveRun, _trend
+    from drillfric.result import SegmentRecord
+
+    now = [0.0]
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: now[0])
+    assert live.status()["alerts"] == []
+    now[0] = 11.0
+    assert [a["kind"] for a in live.status()["alerts"]] == ["data_stale"]
+    live.engine, now[0] = object(), 61.0  # data came once, then stopped
+    assert [a["kind"] for a in live.status()["alerts"]] == ["data_stopped"]
+    live.last_data = now[0]
+    live.view["open_segment"] = {"stick_slip_severity": 1.3}
+    assert [a["kind"] for a in live.status()["alerts"]] == ["severe_stick_slip"]
+
+    def done(*mu_k):
+        return [SegmentRecord(id=i + 1, mu_k=m, converged=True, t_end_s=100.0 * (i + 1))
+                for i, m in enumerate(mu_k)]
+
+    assert _trend(done(0.25, 0.26, 0.25, 0.27)) is None  # within 25 % of the median
+    alert = _trend(done(0.25, 0.26, 0.25, 0.34))
+    assert alert["kind"] == "friction_trend" and alert["time_s"] == 400.0
