@@ -1,4 +1,5 @@
-"""The ``drillfric`` command group (docs/cli.md): run, simulate, td, inspect, fleet, report."""
+"""The ``drillfric`` command group (docs/cli.md): run, simulate, td, inspect, fleet, report,
+live, replay."""
 
 from __future__ import annotations
 
@@ -48,9 +49,19 @@ def cli(ctx: click.Context, debug: bool, quiet: bool) -> None:
 
 
 def _register() -> None:
-    from . import fleet_cmd, inspect_cmd, report_cmd, run_cmd, simulate_cmd, td_cmd
+    from . import (
+        fleet_cmd,
+        inspect_cmd,
+        live_cmd,
+        replay_cmd,
+        report_cmd,
+        run_cmd,
+        simulate_cmd,
+        td_cmd,
+    )
 
-    for module in (run_cmd, simulate_cmd, td_cmd, inspect_cmd, fleet_cmd, report_cmd):
+    for module in (run_cmd, simulate_cmd, td_cmd, inspect_cmd, fleet_cmd, report_cmd, live_cmd,
+                   replay_cmd):
         cli.add_command(module.command)
 
 

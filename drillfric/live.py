@@ -1,0 +1,455 @@
+"""A well estimated while it is drilled: ``drillfric live`` on a CSV file being appended to
+(docs/live.md, issue 24).
+
+Three pieces:
+
+- :class:`Tail` — where the complete lines of a growing text file end (a write may stop
+  mid-line: a partial last line waits for its newline), with the SHA-256 of the bytes up to
+  there (the mark :mod:`drillfric.runner.resume` checks a continued file against);
+- :class:`LiveRun` — a worker thread feeds the new complete lines to an
+  :class:`~drillfric.runner.engine.Engine` (kept in memory) and, when a segment closes (and
+  every :attr:`LiveRun.publish_every_s` with new data), *publishes*: a copy of the engine is
+  closed into ``OUT/NAME`` exactly as ``drillfric run`` writes it (atomically, with the state
+  to continue from), which also estimates the open segment;
+- :func:`status` — live.json, rewritten atomically by the calling thread every
+  :data:`POLL_S` while the worker estimates (the worker never blocks it).
+
+A restarted live run continues from ``OUT/NAME/state`` (the last publication) when the file
+still starts with the bytes it had read, so no row is lost or read twice.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import math
+import os
+import threading
+import time
+from collections.abc import Callable
+from datetime import UTC, datetime, timedelta
+from pathlib import Path
+
+import pandas as pd
+import pyarrow.parquet as pq
+
+from drillfric.errors import InputError
+from drillfric.io.results import write_json
+from drillfric.io.well import CHUNK_ROWS, Well, open_well
+from drillfric.result import SegmentRecord, Status
+from drillfric.runner.engine import Engine, mismatch
+from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
+from drillfric.runner.resume import changed
+from drillfric.runner.state import read_state
+from drillfric.runner.time_log import STATE_DIR, finish_engine
+from drillfric.segmentation import RIG_STATES
+
+#: Seconds between polls of the file and rewrites of live.json (INTERFACE: at least every 0.5 s).
+POLL_S = 0.2
+#: Complete data lines wanted before the file's layout is sniffed (header + rows).
+FIRST_LINES = 20
+#: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
+SEVERE_STICK_SLIP = 1.0
+#: Relative change of a converged μ_k against the median of the previous five that raises a
+#: friction-trend alert.
+TREND_CHANGE = 0.25
+
+
+class Tail:
+    """The complete lines of a growing text file.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    start : int
+        Bytes already read (a line's end), hashed again on creation.
+    """
+
+    def __init__(self, path: Path, start: int = 0):
+        self.path, self.end = Path(path), 0
+        self._digest = hashlib.sha256()
+        if start:
+            self._take(start)
+
+    def poll(self) -> int:
+        """Where the complete lines end now [bytes] (a partial last line is not counted).
+
+        Raises
+        ------
+        InputError
+            The file became shorter than what was read (rewritten, not appended to).
+        """
+        try:
+            size = self.path.stat().st_size
+        except FileNotFoundError:
+            size = 0
+        if size < self.end:
+            raise InputError(f"the file shrank to {size} bytes after {self.end} were read",
+                             file=self.path, fix="append to the file; restart live on a new "
+                                                 "--out for a rewritten file")
+        if size > self.end:  # the partial last line is read again: it may have ended
+            with open(self.path, "rb") as fh:
+                fh.seek(self.end)
+                block = fh.read(size - self.end)
+            cut = block.rfind(b"\n")
+            if cut >= 0:
+                self._take(self.end + cut + 1, block[:cut + 1])
+        return self.end
+
+    def lines(self) -> int:
+        """How many complete lines there are up to :attr:`end` (for the first sniff)."""
+        with open(self.path, "rb") as fh:
+            return fh.read(self.end).count(b"\n")
+
+    def _take(self, end: int, block: bytes | None = None) -> None:
+        if block is None:
+            with open(self.path, "rb") as fh:
+                fh.seek(self.end)
+                block = fh.read(end - self.end)
+        self._digest.update(block)
+        self.end = end
+
+    def mark(self) -> dict:
+        """The mark of the bytes read (:func:`drillfric.runner.resume.csv_mark`'s format)."""
+        return {"format": "csv", "bytes": self.end, "sha256": self._digest.hexdigest(),
+                "ends_line": True}
+
+
+class LiveRun:
+    """A live run of one CSV file being appended to, into ``out_root/NAME``.
+
+    Parameters
+    ----------
+    path : Path
+        The growing CSV file.
+    out_root : Path
+        Output root (``--out``).
+    open_kw : dict
+        :func:`~drillfric.io.well.open_well` keywords (``config``, ``name``).
+    report : callable, optional
+        Writes the report of the final results (none for the intermediate ones).
+    publish_every_s : float
+        Wall seconds between publications of an open segment with new data.
+    stale_s, stopped_s : float
+        Wall seconds without new data before a ``data_stale`` / ``data_stopped`` alert.
+    clock : callable
+        Wall clock [s] (tests).
+    """
+
+    def __init__(self, path: Path, out_root: Path, *, open_kw: dict | None = None,
+                 report: ReportWriter | None = None, publish_every_s: float = 10.0,
+                 stale_s: float = 10.0, stopped_s: float = 60.0,
+                 clock: Callable[[], float] = time.monotonic):
+        self.path, self.out_root, self.open_kw = Path(path), Path(out_root), open_kw or {}
+        self.target = self.out_root / "live.json"
+        self.report, self.publish_every_s = report, publish_every_s
+        self.stale_s, self.stopped_s, self.clock = stale_s, stopped_s, clock
+        self.tail = Tail(self.path)
+        self.well: Well | None = None
+        self.engine: Engine | None = None
+        self.stop = threading.Event()
+        self.done = threading.Event()  # the worker ended (final results written or error)
+        self.error: BaseException | None = None
+        self.result = None
+        self.last_data = clock()  # when the file last grew (wall clock)
+        self.tail_fed, self.published_at, self.dirty = 0, clock(), False
+        self.max_gap_s = 0.0  # the longest wait between two live.json writes
+        self._size, self._written = -1, None
+        self.lock = threading.Lock()
+        self.view: dict = {"last_sample_time_s": None, "last_sample_utc": None,
+                           "rig_state": None, "open_segment": None, "latest": None,
+                           "trend_alert": None, "rows": 0, "segments_closed": 0,
+                           "resumed": None}
+
+    # ------------------------------------------------------------------ worker
+    def work(self) -> None:
+        """The worker thread: feed, publish, and the final results when :attr:`stop` is set
+        (after data came)."""
+        try:
+            while not self.stop.is_set():
+                if not self._step():
+                    self.stop.wait(POLL_S)
+            if self.engine is None and self.tail.poll() and self.tail.lines() >= 2:
+                self._start()  # a header and a few rows: enough to finish with
+            if self.engine is not None:
+                self._feed(self.tail.poll())
+                self.result = self._publish(final=True)
+                with self.lock:  # the end of the data closed every segment
+                    self.view["open_segment"] = None
+        except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
+            self.error = exc
+            self.stop.set()
+        finally:
+            self.done.set()
+
+    def _step(self) -> bool:
+        """One poll; True when rows were fed or results published."""
+        end = self.tail.poll()
+        if self.engine is None:
+            if end == 0 or self.tail.lines() < FIRST_LINES:
+                return False
+            self._start()
+            end = self.tail.poll()
+        if end > self.tail_fed:
+            if self._feed(end) or self.clock() - self.published_at > self.publish_every_s:
+                self._publish()
+            return True
+        if self.dirty and self.clock() - self.published_at > self.publish_every_s:
+            self._publish()
+            return True
+        return False
+
+    def _start(self) -> None:
+        """Open the well and its engine: continued from OUT/NAME/state when it fits."""
+        self.well = open_well(self.path, **self.open_kw)
+        self.folder = self.out_root / self.well.dir_name
+        self.engine, why = _continued(self.well, self.folder)
+        fed = 0 if self.engine is None else self.engine.source["bytes"]
+        if self.engine is None:
+            self.engine = Engine(self.well, sink=MemorySink())
+            self.engine.resumed = {"from_row": 0, "reason": why}
+        self.tail = Tail(self.path, fed)
+        self.tail_fed, self.published_at, self.dirty = fed, self.clock(), False
+        with self.lock:
+            self.view["resumed"] = self.engine.resumed
+
+    def _feed(self, end: int) -> bool:
+        """Feed bytes [fed, end); True when segments closed."""
+        closed = False
+        if self.engine is None or end <= self.tail_fed:
+            return False
+        for raw in self.well.source.window(self.tail_fed, end, CHUNK_ROWS):
+            closed |= bool(self.engine.feed_raw(raw))
+        self.tail_fed, self.engine.source, self.dirty = end, self.tail.mark(), True
+        self._note_rows()
+        return closed
+
+    def _note_rows(self) -> None:
+        engine = self.engine
+        last = engine.tracker.state()["last"] if engine.tracker is not None else None
+        states = engine.stream.last_states
+        with self.lock:
+            self.view.update(
+                last_sample_time_s=last, rows=engine.check.rows,
+                last_sample_utc=_utc(engine.tracker.origin, last) if last is not None
+                else None,
+                rig_state=RIG_STATES[int(states[-1])] if states is not None and len(states)
+                else self.view["rig_state"])
+
+    def _publish(self, final: bool = False):
+        """Close a copy of the engine into OUT/NAME as ``drillfric run`` would (the final
+        results with the report)."""
+        state = copy.deepcopy(self.engine.state())
+        memory = self.engine.sink
+
+        def run(sink: DirectorySink):
+            twin = Engine(self.well, sink=sink, rate_hz=self.engine.rate_hz)
+            twin.restore(state)
+            twin.resumed = self.engine.resumed
+            for key, parts in memory.frames.items():
+                for frame in parts:
+                    sink.add({key: frame}, twin.estimator.has_truth)
+            result = finish_engine(twin, sink)
+            self._note_result(result, twin._open_ids, sink.folder)
+            return result
+
+        result = deliver(self.well, self.out_root, run, self.report if final else None)
+        self.published_at, self.dirty = self.clock(), False
+        return result
+
+    def _note_result(self, result, open_ids: set[int], folder: Path) -> None:
+        records = [SegmentRecord.from_json(r) for r in result.summary["segments"]]
+        closed = [r for r in records if r.id not in open_ids]
+        opened = [r for r in records if r.id in open_ids]
+        done = [r for r in closed if r.status is Status.OK and r.converged]
+        with self.lock:
+            self.view.update(segments_closed=len(closed),
+                             open_segment=_open_view(opened[-1], folder) if opened else None,
+                             latest=None if not done else
+                             {"segment": done[-1].id, "mu_k": done[-1].mu_k,
+                              "mu_s": done[-1].mu_s, "t_end_s": done[-1].t_end_s},
+                             trend_alert=_trend(done))
+
+    # ------------------------------------------------------------------ live.json
+    def status(self) -> dict:
+        """live.json now (docs/live.md)."""
+        with self.lock:
+            view = dict(self.view)
+        idle = self.clock() - self.last_data
+        alerts = []
+        if self.engine is not None and idle >= self.stopped_s:
+            alerts.append(_alert("data_stopped", f"no new data for {idle:.0f} s",
+                                 view["last_sample_time_s"]))
+        elif idle >= self.stale_s:
+            alerts.append(_alert("data_stale", f"no new data for {idle:.0f} s",
+                                 view["last_sample_time_s"]))
+        ssi = (view["open_segment"] or {}).get("stick_slip_severity")
+        if ssi is not None and ssi >= SEVERE_STICK_SLIP:
+            alerts.append(_alert("severe_stick_slip", f"stick-slip severity {ssi:.2f} in the "
+                                 f"open segment (≥ {SEVERE_STICK_SLIP:g})",
+                                 view["last_sample_time_s"]))
+        if view["trend_alert"] is not None:
+            alerts.append(view["trend_alert"])
+        return {"source": str(self.path), "well": None if self.well is None else self.well.name,
+                "last_sample_time_s": view["last_sample_time_s"],
+                "last_sample_utc": view["last_sample_utc"],
+                "updated_utc": datetime.now(UTC).isoformat(timespec="milliseconds"),
+                "rig_state": view["rig_state"], "open_segment": view["open_segment"],
+                "latest": view["latest"], "alerts": alerts, "rows": view["rows"],
+                "segments_closed": view["segments_closed"], "resumed": view["resumed"],
+                "idle_s": round(idle, 3), "max_update_gap_s": round(self.max_gap_s, 3)}
+
+    def watch(self) -> None:
+        """Note whether the file grew (the caller's thread: a busy worker does not make the
+        data look idle)."""
+        try:
+            size = self.path.stat().st_size
+        except OSError:
+            size = -1
+        if size != self._size:
+            self._size, self.last_data = size, self.clock()
+
+    def write_status(self, target: Path) -> None:
+        """live.json written atomically (a temporary file renamed over it)."""
+        now = self.clock()
+        if self._written is not None:
+            self.max_gap_s = max(self.max_gap_s, now - self._written)
+        self._written = now
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+        write_json(tmp, self.status())
+        os.replace(tmp, target)
+
+
+def _continued(well: Well, folder: Path) -> tuple[Engine | None, str]:
+    """An in-memory engine continuing the state published in ``folder``, or None and why."""
+    if not (folder / STATE_DIR / "engine.json").is_file():
+        return None, "no saved state"
+    try:
+        state = read_state(folder / STATE_DIR)
+    except InputError as exc:
+        return None, exc.message
+    source = state.get("source") or {}
+    why = mismatch(state, well, None) or changed(source, well) or \
+        ("" if source.get("format") == "csv" else "the earlier run read another kind of file")
+    if why:
+        return None, why
+    sink = MemorySink()
+    engine = Engine(well, sink=sink)
+    try:
+        engine.restore(state)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:  # not a state we wrote
+        return None, f"engine state not readable ({type(exc).__name__}: {exc})"
+    _seed(sink, folder, {r.id for r in engine.records})
+    engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
+    return engine, ""
+
+
+def _seed(sink: MemorySink, folder: Path, ids: set[int]) -> None:
+    """The published output rows of segments ``ids`` into ``sink``, one frame each."""
+    estimates = folder / "estimates.parquet"
+    if estimates.is_file():
+        source = pq.ParquetFile(estimates)
+        for i in range(source.num_row_groups):
+            frame = source.read_row_group(i).to_pandas()
+            if len(frame) and int(frame["segment_id"].iloc[0]) in ids:
+                sink.frames["estimates"].append(frame)
+    profiles = folder / "profiles.parquet"
+    if profiles.is_file():
+        frame = pd.read_parquet(profiles)
+        sink.frames["profile"] += [p.reset_index(drop=True) for i, p in
+                                   frame.groupby("segment_id", sort=True) if i in ids]
+
+
+def _open_view(record: SegmentRecord, folder: Path) -> dict:
+    """live.json ``open_segment``: the open segment's numbers as estimated so far."""
+    return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
+            "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
+            "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
+            "bit_rpm": _last_bit_rpm(folder, record.id),
+            "stick_slip_severity": record.stick_slip_severity}
+
+
+def _last_bit_rpm(folder: Path, seg_id: int) -> float | None:
+    """The last estimated bit speed [RPM] of segment ``seg_id`` (its last row group)."""
+    path = folder / "estimates.parquet"
+    if not path.is_file():
+        return None
+    source = pq.ParquetFile(path)
+    for i in reversed(range(source.num_row_groups)):
+        table = source.read_row_group(i, columns=["segment_id", "bit_rpm_est"])
+        if table.num_rows and int(table["segment_id"][0].as_py()) == seg_id:
+            value = table["bit_rpm_est"][-1].as_py()
+            return None if value is None or not math.isfinite(value) else float(value)
+    return None
+
+
+def _trend(done: list[SegmentRecord]) -> dict | None:
+    """A friction-trend alert when the newest converged μ_k moved by :data:`TREND_CHANGE`
+    or more against the median of the five before it."""
+    if len(done) < 3 or done[-1].mu_k is None:
+        return None
+    before = sorted(r.mu_k for r in done[-6:-1] if r.mu_k is not None)
+    if not before:
+        return None
+    median = before[len(before) // 2]
+    if median > 0 and abs(done[-1].mu_k / median - 1.0) >= TREND_CHANGE:
+        return _alert("friction_trend", f"μ_k {done[-1].mu_k:.3f} in segment {done[-1].id} "
+                      f"against {median:.3f} before", done[-1].t_end_s)
+    return None
+
+
+def _alert(kind: str, message: str, time_s: float | None) -> dict:
+    return {"kind": kind, "message": message, "time_s": time_s}
+
+
+def _utc(origin, time_s: float) -> str | None:
+    if origin is None:
+        return None
+    return (pd.Timestamp(origin).to_pydatetime() + timedelta(seconds=time_s)).isoformat()
+
+
+def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
+             **kw) -> LiveRun:
+    """Run :class:`LiveRun` (``kw``) until ``until_idle_s`` wall seconds without new data
+    (None: until interrupted), writing ``out_root/live.json`` every :data:`POLL_S` from this
+    thread while the worker feeds and estimates.
+
+    Raises
+    ------
+    InputError
+        No data ever arrived, or the file cannot be read as it grows.
+    KeyboardInterrupt
+        Interrupted (Ctrl-C, SIGTERM): the final results were written first.
+    """
+    live = LiveRun(path, out_root, **kw)
+    worker = threading.Thread(target=live.work, name="drillfric-live", daemon=True)
+    worker.start()
+    try:
+        _tend(live, worker, until_idle_s)
+    except KeyboardInterrupt:
+        live.stop.set()
+        _tend(live, worker, None)
+        raise
+    if live.error is not None:
+        raise live.error
+    if live.engine is None:
+        raise InputError(f"no data arrived in {until_idle_s:g} s", file=live.path,
+                         fix="check that the rig logger writes to this file (a header "
+                             "line and data rows)")
+    return live
+
+
+def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None) -> None:
+    """live.json every :data:`POLL_S` while the worker runs; stop it when idle. (The
+    worker's ``done`` event is waited on, not ``Thread.join``: a join interrupted by a signal
+    can leave ``is_alive()`` False while the thread still runs, CPython gh-90882.)"""
+    while not live.done.is_set():
+        live.watch()
+        live.write_status(live.target)
+        if until_idle_s is not None and live.clock() - live.last_data >= until_idle_s:
+            live.stop.set()
+        time.sleep(POLL_S)
+    worker.join()
+    live.write_status(live.target)

@@ -1,0 +1,193 @@
+"""`drillfric live` and `drillfric replay` (issue 24, docs/live.md): a CSV followed while it
+grows gives the results of `drillfric run` on the whole file — with lines cut across writes,
+after a kill -9 and a restart, after SIGTERM — and live.json carries the binding keys.
+Real subprocesses; each test bounded (≤ ~60 s)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric.io.well import open_well
+from drillfric.live import Tail
+from drillfric.runner import run_well
+from drillfric.runner.resume import csv_mark
+from tests.test_engine import AGREE, DEMO, SCENARIO
+
+REPO = Path(__file__).resolve().parents[1]
+LIVE_KEYS = {"last_sample_time_s", "last_sample_utc", "updated_utc", "rig_state",
+             "open_segment", "latest", "alerts"}
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    """A three-stand 100 Hz simulated well (CSV + sidecars) and its `run` segments."""
+    folder = tmp_path_factory.mktemp("recorded")
+    (folder / "three.scenario.toml").write_text(SCENARIO)
+    done = CliRunner().invoke(cli, ["-q", "simulate", str(DEMO / "demo.toml"), "--scenario",
+                                    str(folder / "three.scenario.toml"), "--out",
+                                    str(folder / "three.csv"), "--cells", "100", "--rate",
+                                    "100", "--seed", "5"])
+    assert done.exit_code == 0, done.output
+    whole = run_well(open_well(folder / "three.csv"))
+    assert len(whole.segments) >= 4 and whole.counts["converged"] >= 2
+    return folder / "three.csv", whole.segments
+
+
+def _feed_folder(recorded, tmp_path) -> Path:
+    """An empty folder with the well's sidecars: the rig logger's file will grow there."""
+    feed = tmp_path / "feed"
+    feed.mkdir()
+    for sidecar in ("three.toml", "three.survey.csv"):
+        shutil.copy(recorded[0].with_name(sidecar), feed / sidecar)
+    return feed / "three.csv"
+
+
+def _drillfric(*args) -> subprocess.Popen:
+    env = os.environ | {"PYTHONPATH": str(REPO)}
+    return subprocess.Popen([sys.executable, "-m", "drillfric.cli.main", *map(str, args)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env, cwd=REPO)
+
+
+def _finish(proc: subprocess.Popen, timeout: float = 60) -> tuple[int, str]:
+    try:
+        _, err = proc.communicate(timeout=timeout)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    return proc.returncode, err
+
+
+def _same_segments(folder: Path, whole: pd.DataFrame) -> None:
+    got = pd.read_parquet(folder / "segments.parquet")
+    assert got["id"].tolist() == whole["id"].tolist()
+    assert got["kind"].tolist() == whole["kind"].tolist()
+    assert got["status"].tolist() == whole["status"].tolist()
+    for name in ("mu_k", "mu_s", "mu_s_lower_bound", "t_end_s"):
+        x, y = got[name].to_numpy(float), whole[name].to_numpy(float)
+        assert (np.isnan(x) == np.isnan(y)).all(), name
+        np.testing.assert_allclose(x[~np.isnan(x)], y[~np.isnan(y)], rtol=AGREE, err_msg=name)
+
+
+def _wait_for(predicate, seconds: float) -> None:
+    deadline = time.monotonic() + seconds
+    while not predicate():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.1)
+
+
+def test_tail_counts_only_complete_lines_and_marks_what_resume_checks(tmp_path):
+    path = tmp_path / "grow.csv"
+    path.write_bytes(b"time_s,surface_rpm\n0,1")
+    tail = Tail(path)
+    assert tail.poll() == len(b"time_s,surface_rpm\n")  # the cut row waits for its newline
+    with open(path, "ab") as fh:
+        fh.write(b"0.5\n0.1,2")
+    assert tail.poll() == len(b"time_s,surface_rpm\n0,10.5\n")
+    assert tail.mark() == csv_mark(path, tail.end)
+    assert Tail(path, tail.end).mark() == tail.mark()  # a restart hashes the same bytes
+    path.write_bytes(b"time_s\n")
+    with pytest.raises(Exception, match="shrank"):
+        tail.poll()
+
+
+def test_replay_cutting_lines_while_live_tails_gives_the_run_of_the_whole_file(recorded,
+                                                                               tmp_path):
+    target, out = _feed_folder(recorded, tmp_path), tmp_path / "out"
+    replay = _drillfric("replay", recorded[0], "--to", target, "--speed", 40, "--tick", 0.05)
+    live = _drillfric("live", target, "--out", out, "--until-idle", 3, "--no-report")
+    assert _finish(replay)[0] == 0
+    code, err = _finish(live)
+    assert code == 0, err
+    assert target.read_bytes() == recorded[0].read_bytes()
+    _same_segments(out / "three", recorded[1])
+    status = json.loads((out / "live.json").read_text())
+    assert LIVE_KEYS <= set(status)
+    assert status["rows"] == 44001 and status["last_sample_time_s"] == pytest.approx(440.0)
+    assert status["open_segment"] is None and status["latest"]["mu_k"] is not None
+    assert status["max_update_gap_s"] < 0.5, "live.json waited on a segment fit"
+    assert not list(out.glob(".*tmp*")), "a temporary file was left"
+
+
+def test_kill_9_and_restart_continue_without_losing_or_repeating_a_row(recorded, tmp_path):
+    target, out = _feed_folder(recorded, tmp_path), tmp_path / "out"
+    replay = _drillfric("replay", recorded[0], "--to", target, "--speed", 25)
+    first = _drillfric("live", target, "--out", out, "--no-report")
+    try:
+        _wait_for(lambda: (out / "three" / "state" / "engine.json").is_file(), 40)
+    finally:
+        first.send_signal(signal.SIGKILL)
+        first.wait()
+    again = _drillfric("live", target, "--out", out, "--until-idle", 3, "--no-report")
+    assert _finish(replay)[0] == 0
+    code, err = _finish(again)
+    assert code == 0, err
+    summary = json.loads((out / "three" / "summary.json").read_text())
+    assert summary["resumed"]["reason"] == "" and summary["resumed"]["from_row"] > 0
+    assert summary["inputs"]["rows"] == 44001
+    _same_segments(out / "three", recorded[1])
+    estimates = pd.read_parquet(out / "three" / "estimates.parquet")
+    assert estimates["segment_id"].is_monotonic_increasing  # no segment written twice
+
+
+def test_sigterm_writes_the_final_results_and_exits_143(recorded, tmp_path):
+    target, out = _feed_folder(recorded, tmp_path), tmp_path / "out"
+    shutil.copy(recorded[0], target)
+    live = _drillfric("live", target, "--out", out, "--no-report")
+    try:
+        _wait_for(lambda: (out / "live.json").is_file() and
+                  json.loads((out / "live.json").read_text())["rows"] == 44001, 50)
+    finally:
+        live.send_signal(signal.SIGTERM)
+    code, err = _finish(live)
+    assert code == 128 + signal.SIGTERM, err
+    assert "Traceback" not in err
+    _same_segments(out / "three", recorded[1])
+    assert json.loads((out / "three" / "summary.json").read_text())["counts"]["segments"] == 5
+    assert not list(out.glob(".three.tmp*")), "the final results were cut short"
+
+
+def test_no_data_ever_exits_2_with_one_line(tmp_path):
+    live = _drillfric("live", tmp_path / "never.csv", "--out", tmp_path / "out",
+                      "--until-idle", 1)
+    code, err = _finish(live, 30)
+    assert code == 2
+    assert "no data arrived" in err and "never.csv" in err and "Traceback" not in err
+    assert not (tmp_path / "out" / "never").exists()
+
+
+def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_trend(tmp_path):
+    from drillfric.live import LiveRun, _trend
+    from drillfric.result import SegmentRecord
+
+    now = [0.0]
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: now[0])
+    assert live.status()["alerts"] == []
+    now[0] = 11.0
+    assert [a["kind"] for a in live.status()["alerts"]] == ["data_stale"]
+    live.engine, now[0] = object(), 61.0  # data came once, then stopped
+    assert [a["kind"] for a in live.status()["alerts"]] == ["data_stopped"]
+    live.last_data = now[0]
+    live.view["open_segment"] = {"stick_slip_severity": 1.3}
+    assert [a["kind"] for a in live.status()["alerts"]] == ["severe_stick_slip"]
+
+    def done(*mu_k):
+        return [SegmentRecord(id=i + 1, mu_k=m, converged=True, t_end_s=100.0 * (i + 1))
+                for i, m in enumerate(mu_k)]
+
+    assert _trend(done(0.25, 0.26, 0.25, 0.27)) is None  # within 25 % of the median
+    alert = _trend(done(0.25, 0.26, 0.25, 0.34))
+    assert alert["kind"] == "friction_trend" and alert["time_s"] == 400.0
