@@ -9,7 +9,7 @@ a small built-in segment; numba writes the machine code to the per-user cache
 (:mod:`drillfric.kernels.cache`), from which the run loads the observer. A subprocess, not
 multiprocessing: a Dask worker's daemonic process cannot start multiprocessing children.
 
-``python -m drillfric.runner.warmup PART`` compiles one part ("observer" or "plant").
+``python -m drillfric.estimation.warmup PART`` compiles one part ("observer" or "plant").
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def warm_up(tick: Callable[[float], None] | None = None, *, timeout_s: float = 6
     process compiles). Returns True when both succeeded (and marks the cache warm); False
     otherwise — the run then compiles what it still needs itself."""
     env = dict(os.environ)  # NUMBA_CACHE_DIR as this process has it
-    child = subprocess.Popen([sys.executable, "-m", "drillfric.runner.warmup", PARTS[0]],
+    child = subprocess.Popen([sys.executable, "-m", "drillfric.estimation.warmup", PARTS[0]],
                              stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, env=env)
     t0, here = time.monotonic(), threading.Event()
