@@ -40,6 +40,12 @@ def test_wheel_installs_and_runs_outside_repo(tmp_path: Path):
     assert str(env) in where, f"imported from outside the clean env: {where}"
     out = _run([str(env / "bin" / "drillfric"), "--help"], cwd=outside).stdout
     assert "simulate" in out and "fleet" in out
+    # every module of the source tree is in the wheel (a regression: drillfric.estimation.batch
+    # was left out of pyproject's package list, and `drillfric run` failed after `pip install .`)
+    names = sorted(".".join(("drillfric", *p.relative_to(REPO / "drillfric").with_suffix("").parts))
+                   .removesuffix(".__init__") for p in (REPO / "drillfric").rglob("*.py"))
+    _run([str(py), "-c", f"import importlib\nfor m in {names!r}: importlib.import_module(m)"],
+         cwd=outside)
     bare = subprocess.run([str(py), "-c", "import cli"], cwd=outside, capture_output=True)
     assert bare.returncode != 0, "a bare top-level package 'cli' must not be installed"
     # from the repository root the source tree's drillfric/ shadows the installed one: its
