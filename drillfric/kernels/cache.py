@@ -55,16 +55,19 @@ def _stamp(kind: str) -> Path:
     """The stamp of one warm-up ``kind`` for this installation's kernels."""
     import numba
 
-    digest = hashlib.sha256(f"{numba.__version__} {sys.version}".encode())
     package = Path(__file__).resolve().parent.parent
-    for name in _KERNEL_SOURCES:
-        digest.update((package / name).read_bytes())
+    # numba keys its cache by the sources' location too: another install (a clone, a venv)
+    # of the same version compiles anew, so its stamp must differ
+    digest = hashlib.sha256(f"{numba.__version__} {sys.version} {package}".encode())
+    for name in _KERNEL_SOURCES:  # numba recompiles when a source's content or time changes
+        source = package / name
+        digest.update(source.read_bytes() + str(source.stat().st_mtime_ns).encode())
     return cache_dir() / f"drillfric-{kind}-{digest.hexdigest()[:16]}.ready"
 
 
 def is_warm(kind: str) -> bool:
     """Whether the kernels of warm-up ``kind`` were compiled into :func:`cache_dir` (by this
-    installation's kernel sources, numba and Python)."""
+    installation — its location and kernel sources — numba and Python)."""
     return _stamp(kind).is_file()
 
 
