@@ -8,50 +8,16 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-from click.testing import CliRunner
-from drillfric.cli.main import cli
 
 from drillfric.errors import InputError
 from drillfric.io.well import open_well
 from drillfric.runner import run_well
 from drillfric.runner.engine import Engine
 from drillfric.runner.state import read_state, write_state
-from tests.conftest import REPO
+from tests.conftest import DEMO
 
-DEMO = REPO / "examples" / "demo"
-#: Three stands (100 s of rotation each, so they converge) with 40-s connections.
-SCENARIO = """connection_s = 40.0
-[defaults]
-duration_s = 100.0
-rpm = 50.0
-ramp_s = 10.0
-[[stand]]
-bit_depth_m = 2210.0
-start = "creep"
-[[stand]]
-bit_depth_m = 2240.0
-rpm = 40.0
-[[stand]]
-bit_depth_m = 2270.0
-rpm = 60.0
-"""
 #: Relative agreement of the friction numbers with the whole-file run (issue 23).
 AGREE = 0.005
-
-
-@pytest.fixture(scope="module")
-def stands(tmp_path_factory):
-    """A three-stand 100 Hz simulated well (CSV with sidecars) and its whole-file run."""
-    folder = tmp_path_factory.mktemp("stands")
-    (folder / "three.scenario.toml").write_text(SCENARIO)
-    done = CliRunner().invoke(cli, ["-q", "simulate", str(DEMO / "demo.toml"), "--scenario",
-                                    str(folder / "three.scenario.toml"), "--out",
-                                    str(folder / "three.csv"), "--cells", "100", "--rate",
-                                    "100", "--seed", "5"])
-    assert done.exit_code == 0, done.output
-    whole = run_well(open_well(folder / "three.csv"))
-    assert len(whole.segments) >= 3 and whole.counts["converged"] >= 2
-    return folder / "three.csv", whole
 
 
 def _same_results(result, whole) -> None:

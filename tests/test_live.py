@@ -17,33 +17,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from click.testing import CliRunner
-from drillfric.cli.main import cli
 
-from drillfric.io.well import open_well
 from drillfric.live import Tail
-from drillfric.runner import run_well
 from drillfric.runner.resume import csv_mark
-from tests.test_engine import AGREE, DEMO, SCENARIO
+from tests.test_engine import AGREE
 
 REPO = Path(__file__).resolve().parents[1]
 LIVE_KEYS = {"last_sample_time_s", "last_sample_utc", "updated_utc", "rig_state",
              "open_segment", "latest", "alerts"}
 
 
-@pytest.fixture(scope="module")
-def recorded(tmp_path_factory):
-    """A three-stand 100 Hz simulated well (CSV + sidecars) and its `run` segments."""
-    folder = tmp_path_factory.mktemp("recorded")
-    (folder / "three.scenario.toml").write_text(SCENARIO)
-    done = CliRunner().invoke(cli, ["-q", "simulate", str(DEMO / "demo.toml"), "--scenario",
-                                    str(folder / "three.scenario.toml"), "--out",
-                                    str(folder / "three.csv"), "--cells", "100", "--rate",
-                                    "100", "--seed", "5"])
-    assert done.exit_code == 0, done.output
-    whole = run_well(open_well(folder / "three.csv"))
-    assert len(whole.segments) >= 4 and whole.counts["converged"] >= 2
-    return folder / "three.csv", whole.segments
+@pytest.fixture
+def recorded(stands):
+    """The shared three-stand well (tests/conftest.py) and its `run` segments."""
+    path, whole = stands
+    return path, whole.segments
 
 
 def _feed_folder(recorded, tmp_path) -> Path:
