@@ -19,7 +19,7 @@ from drillfric.discovery import WellSpec
 from drillfric.fleet import run_many
 from drillfric.io.well import open_well
 from drillfric.runner import run_well
-from tests.test_engine import _same_results, stands  # noqa: F401 — the module's well
+from tests.test_engine import _same_results
 
 
 def _grow(src, dst, fraction: float):
