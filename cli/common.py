@@ -182,11 +182,11 @@ def _progress_lines(description: str, total: float | None):
 
 def compile_kernels_once() -> None:
     """The first run after an install: compile the kernels ahead of the run, in two
-    places at once (:mod:`drillfric.estimation.warmup`), saying what happens and ticking the
+    places at once (:mod:`drillfric.runner.warmup`), saying what happens and ticking the
     elapsed seconds on a terminal (one line at the start and one at the end without one);
     nothing to do once this installation's kernels are in the per-user cache."""
-    from drillfric.estimation import warmup
     from drillfric.kernels.cache import cache_dir
+    from drillfric.runner import warmup
 
     if not warmup.needed():
         return

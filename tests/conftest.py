@@ -47,7 +47,7 @@ def _kernels_compiled():
     """Compile the kernels once before any test (what `drillfric run` does on a first run),
     so that no CLI test sees the first-run lines; tests/test_first_run.py checks those with a
     cache of its own."""
-    from drillfric.estimation import warmup
+    from drillfric.runner import warmup
 
     if warmup.needed():
         warmup.warm_up()

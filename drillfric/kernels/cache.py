@@ -22,7 +22,7 @@ from pathlib import Path
 
 #: Sources whose compiled code the cache holds (relative to the drillfric package).
 _KERNEL_SOURCES = ("kernels/plant.py", "kernels/observer.py", "segmentation.py",
-                   "torque_drag.py")
+                   "torque_drag.py", "hookload.py")
 
 
 def cache_dir() -> Path:

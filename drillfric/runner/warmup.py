@@ -1,7 +1,8 @@
 """Compile the kernels of a run ahead of it, on two cores at once (the first run).
 
 A run compiles, on first use, the torsional plant (the batch fit), the observer (the starts
-and the ensemble), the rig-state classifier and the torque-and-drag march. Compiled in the
+and the ensemble), the rig-state classifier, the hook-load plateau finder and the
+torque-and-drag march. Compiled in the
 run's own process they cost ~10 s of one core, in silence. :func:`warm_up` compiles the
 observer in a short-lived child process while this process compiles the plant, classifier
 and march itself — both through the same functions a run calls (so with the same types), on
@@ -9,7 +10,7 @@ a small built-in segment; numba writes the machine code to the per-user cache
 (:mod:`drillfric.kernels.cache`), from which the run loads the observer. A subprocess, not
 multiprocessing: a Dask worker's daemonic process cannot start multiprocessing children.
 
-``python -m drillfric.estimation.warmup PART`` compiles one part ("observer" or "plant").
+``python -m drillfric.runner.warmup PART`` compiles one part ("observer" or "plant").
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ def warm_up(tick: Callable[[float], None] | None = None, *, timeout_s: float = 6
     process compiles). Returns True when both succeeded (and marks the cache warm); False
     otherwise — the run then compiles what it still needs itself."""
     env = dict(os.environ)  # NUMBA_CACHE_DIR as this process has it
-    child = subprocess.Popen([sys.executable, "-m", "drillfric.estimation.warmup", PARTS[0]],
+    child = subprocess.Popen([sys.executable, "-m", "drillfric.runner.warmup", PARTS[0]],
                              stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, env=env)
     t0, here = time.monotonic(), threading.Event()
@@ -108,6 +109,18 @@ def _compile(part: str) -> None:
     rows = _PLAIN_ROWS + 1
     classify(pd.DataFrame({"time_s": np.arange(rows) / 100.0,
                            "surface_rpm": np.full(rows, 60.0)}), cfg)
+    from drillfric import hookload  # the in-slips plateaus of a long chunk
+
+    rows = hookload._PLAIN_ROWS + 1
+    hookload.find_plateaus(pd.DataFrame({"time_s": np.arange(rows) / 100.0,
+                                         "surface_rpm": np.zeros(rows),
+                                         "hookload_N": np.full(rows, 1e5)}), cfg)
+    from drillfric import hookload  # the in-slips plateaus of a long chunk
+
+    rows = hookload._PLAIN_ROWS + 1
+    hookload.find_plateaus(pd.DataFrame({"time_s": np.arange(rows) / 100.0,
+                                         "surface_rpm": np.zeros(rows),
+                                         "hookload_N": np.full(rows, 1e5)}), cfg)
 
 
 if __name__ == "__main__":
