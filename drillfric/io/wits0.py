@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass, field
 from datetime import datetime
 
-from drillfric.errors import ConfigError
+from drillfric.errors import ConfigError, InputError
 from drillfric.io.channels import BY_KEY, Channel, factor
 from drillfric.io.source import NULL_VALUES
 
@@ -127,7 +127,11 @@ def item_map(channels: dict, units: str = "metric", *, file=None) -> dict[str, S
             raise ConfigError(f"WITS item {code} is the date or time, not {key}",
                               file=where or None, fix="give another item code")
         channel = BY_KEY[key]
-        slots[code] = Slot(code, channel, factor(unit, channel, file=where or None) * scale)
+        try:
+            slots[code] = Slot(code, channel, factor(unit, channel) * scale)
+        except InputError as exc:  # a unit in the configuration: a configuration error
+            raise ConfigError(f"channels.{key}: {exc.problem}", file=where or None,
+                              fix=exc.fix) from None
     return slots
 
 
