@@ -217,7 +217,7 @@ def test_receiver_sends_handshakes_reconnects_and_records_each_frame_once(tmp_pa
     assert heard == [HANDSHAKE, HANDSHAKE] and receiver.connections == 2
     got = pd.read_csv(tmp_path / "t.wits0.csv")
     assert got["surface_rpm"].tolist() == [0.0, 1.0, 2.0]
-    assert got["hookload_N"].tolist() == [1e6, 1e6 + 1, 1e6 + 2]
+    assert got["hookload_N"].tolist() == pytest.approx([1e6, 1e6 + 1, 1e6 + 2], rel=1e-15)
     assert got["time"].tolist() == [f"2026-11-27T14:30:{15 + k}.000000" for k in range(3)]
 
 
