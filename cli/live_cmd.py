@@ -7,11 +7,13 @@ from pathlib import Path
 
 import click
 
+from drillfric.errors import InputError
+
 from .common import UserError, compile_kernels_once, echo
 
 
 @click.command("live")
-@click.argument("source", type=click.Path(path_type=Path))
+@click.argument("source")
 @click.option("--out", "out", type=click.Path(path_type=Path), required=True,
               help="Output directory: OUT/NAME as 'drillfric run' writes it (updated as "
                    "segments close) and OUT/live.json (rewritten every 0.2 s).")
@@ -24,25 +26,52 @@ from .common import UserError, compile_kernels_once, echo
                    "stopped (Ctrl-C, SIGTERM: the final results are written, exit 130/143).")
 @click.option("--report/--no-report", default=True, show_default=True,
               help="Write report.html with the final results.")
-def command(source: Path, out: Path, config: Path | None, name: str | None,
+def command(source: str, out: Path, config: Path | None, name: str | None,
             until_idle: float | None, report: bool) -> None:
-    """Follow SOURCE, a CSV file a rig logger appends to, and estimate its segments as they
+    """Follow SOURCE — a CSV file a rig logger appends to, or wits0://HOST:PORT (a WITS
+    level 0 stream, recorded into OUT/NAME.wits0.csv) — and estimate its segments as they
     close. A restarted live run on the same SOURCE and --out continues where it stopped."""
     from drillfric.live import run_live
     from drillfric.report import write_well_report
 
     if until_idle is not None and not until_idle > 0:
         raise UserError(f"--until-idle must be positive seconds, got {until_idle:g}")
-    if source.suffix.lower() not in (".csv", ".txt", ".tsv"):
-        raise UserError(f"{source}: live follows a delimited text file (.csv, .txt, .tsv); "
-                        "WITS0 and folder sources are not done yet (docs/live.md)")
-    compile_kernels_once()
     kw = {"config": config} if config else {}
-    live = run_live(source, out, until_idle_s=until_idle,
-                    open_kw=kw | ({"name": name} if name else {}),
-                    report=partial(write_well_report, pdf=False) if report else None)
+    kw |= {"name": name} if name else {}
+    receiver = None
+    if source.startswith("wits0:"):
+        path, kw, receiver = _wits0(source, out, config, name)
+    elif Path(source).suffix.lower() in (".csv", ".txt", ".tsv"):
+        path = Path(source)
+    else:
+        raise UserError(f"{source}: live follows a delimited text file (.csv, .txt, .tsv) or "
+                        "wits0://HOST:PORT; folder sources are not done yet (docs/live.md)")
+    compile_kernels_once()
+    try:
+        live = run_live(path, out, until_idle_s=until_idle, open_kw=kw,
+                        report=partial(write_well_report, pdf=False) if report else None)
+    except InputError as exc:
+        if receiver is None or receiver.frames:
+            raise
+        raise InputError(f"no WITS0 frame arrived in {until_idle:g} s", file=source,
+                         fix="check the address and that the recorder streams WITS level 0 "
+                             "there") from exc
+    finally:
+        if receiver is not None:
+            receiver.stop.set()
     from .run_cmd import _print
 
     _print(live.result)
     echo(f"live.json: {live.target} (longest gap between its updates "
          f"{live.max_gap_s:.2f} s)")
+
+
+def _wits0(source: str, out: Path, config: Path | None, name: str | None):
+    """The recording a WITS0 source fills, the keywords to open it, and its receiver
+    (running)."""
+    from drillfric import wits0_receiver as wits0
+
+    address = wits0.parse_address(source)
+    setup = wits0.setup(address, config, name)
+    receiver, _ = wits0.start(address, out, setup)
+    return wits0.recording_path(out, setup), setup.open_kw, receiver

@@ -1,5 +1,5 @@
 """`drillfric replay FILE --to TARGET [--speed X]` (docs/live.md): a recorded well streamed
-into a file as a rig logger would write it."""
+into a file as a rig logger would write it, or served as a WITS level 0 stream."""
 
 from __future__ import annotations
 
@@ -12,8 +12,9 @@ from .common import UserError, echo
 
 @click.command("replay")
 @click.argument("file", type=click.Path(path_type=Path))
-@click.option("--to", "target", type=click.Path(path_type=Path), required=True,
-              help="CSV file to append to (new or empty).")
+@click.option("--to", "target", required=True, metavar="TARGET",
+              help="CSV file to append to (new or empty), or wits0://HOST:PORT to serve the "
+                   "well as WITS level 0 frames on that port (loopback: 127.0.0.1).")
 @click.option("--speed", type=float, default=1.0, show_default=True,
               help="Times real time (the log's span over its bytes).")
 @click.option("--tick", type=float, default=0.1, show_default=True, metavar="SECONDS",
@@ -21,16 +22,46 @@ from .common import UserError, echo
                    "(lines are split across writes, as a logger's buffer does).")
 @click.option("--seed", type=int, default=0, show_default=True,
               help="Seed of the random cuts.")
-def command(file: Path, target: Path, speed: float, tick: float, seed: int) -> None:
+@click.option("--drop-after", "drop_after", type=click.IntRange(min=0), hidden=True,
+              help="Test aid (wits0 only): cut the first connection in the middle of the "
+                   "frame after N frames.")
+def command(file: Path, target: str, speed: float, tick: float, seed: int,
+            drop_after: int | None) -> None:
     """Append FILE (a CSV's own bytes; any other readable well file as CSV of its canonical
-    channels) to TARGET at SPEED times real time."""
-    from drillfric.replay import recorded_text, replay
-
+    channels) to TARGET at SPEED times real time, or serve it over WITS level 0."""
     if not speed > 0 or not tick > 0:
         raise UserError(f"--speed and --tick must be positive, got {speed:g} and {tick:g}")
-    if target.exists() and target.stat().st_size:
+    if target.startswith("wits0:"):
+        _wits0(file, target, speed, drop_after)
+        return
+    from drillfric.replay import recorded_text, replay
+
+    path = Path(target)
+    if path.exists() and path.stat().st_size:
         raise UserError(f"{target}: already holds data; give a new or empty file to replay "
                         "into")
     text, span_s = recorded_text(file)
-    wall = replay(text, target, rate_bps=len(text) / span_s * speed, tick_s=tick, seed=seed)
+    wall = replay(text, path, rate_bps=len(text) / span_s * speed, tick_s=tick, seed=seed)
     echo(f"replayed {len(text)} bytes ({span_s:.0f} s of log) into {target} in {wall:.1f} s")
+
+
+def _wits0(file: Path, target: str, speed: float, drop_after: int | None) -> None:
+    """Serve FILE at ``target`` until every frame was sent whole."""
+    import time
+
+    from drillfric.replay import recorded_frame
+    from drillfric.wits0_receiver import parse_address
+    from drillfric.wits0_server import frames_of, serve, start_clock
+
+    address = parse_address(target)
+    _, canonical, origin = recorded_frame(file)
+    start = start_clock()
+    frames = frames_of(canonical, origin, start)
+    clock = "the log's clock" if origin is not None else f"clock from {start:%Y-%m-%d %H:%M:%S}"
+    t0 = time.monotonic()
+    served = serve(frames, canonical["time_s"].to_numpy(float), address.host, address.port,
+                   speed=speed, drop_after=drop_after,
+                   ready=lambda: echo(f"serving {len(frames)} WITS0 frames ({clock}) on "
+                                      f"{address}"))
+    echo(f"replayed {served.frames} frames of {file} over {served.connections} "
+         f"connection(s) to {address} in {time.monotonic() - t0:.1f} s")

@@ -361,6 +361,23 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         _positive("bit_diameter_m", 0.2159, "m", "Bit diameter D_bit of the assumed bit "
                   "torque (used when bit_mu > 0).", max=1.5),
     ),
+    "wits0": (
+        Key("units", str, "metric", "", "Units the rig recorder sends over WITS level 0 "
+            "(`drillfric live wits0://HOST:PORT`, docs/live.md): 'metric' (m, m/h, KDN = "
+            "10 kN, kN·m, kPa) or 'field' (ft, ft/h, klbf, kft·lbf, psi). Any item's code or "
+            'unit: [channels], e.g. hookload = { column = "0114", unit = "kN" }.',
+            choices=("metric", "field")),
+        Key("utc_offset_h", float, None, "h", "UTC offset of the rig clock that the date and "
+            "time items give (local time = UTC + offset): times are then recorded in UTC. "
+            "Default: recorded as the rig clock gives them, without a zone.",
+            min=-14.0, max=14.0),
+        Key("handshake_s", float, 20.0, "s", "Seconds between the handshake frames sent to "
+            "the recorder (Pason-style recorders stop sending without one at least every "
+            "30 s; others ignore them); 0: none.", min=0.0, max=3600.0),
+        Key("reconnect_max_s", float, 5.0, "s", "Longest wait between two attempts to "
+            "reconnect after the stream dropped (the wait doubles from 0.2 s up to this).",
+            min=0.2, max=600.0),
+    ),
     "simulate": (
         Key("bit_depth_m", float, None, "m", "Bit depth of a single-stand simulation "
             "(default: the survey's last station).", min=0.0, min_exclusive=True),

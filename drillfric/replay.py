@@ -13,9 +13,9 @@ from drillfric.errors import InputError
 from drillfric.io.well import open_well
 
 
-def recorded_text(path: Path) -> tuple[bytes, float]:
-    """The bytes to replay and the time span of the log they hold [s]: a CSV's own bytes,
-    any other well file as CSV of its canonical channels (``time_s``, … SI units)."""
+def recorded_frame(path: Path):
+    """The well at ``path``, its rows as canonical channels (``time_s``, … SI units) and the
+    clock time of ``time_s = 0`` (None when the log has none)."""
     well = open_well(path)
     if well.depth_indexed:
         raise InputError("a depth-indexed log is no time series to replay", file=path,
@@ -28,6 +28,14 @@ def recorded_text(path: Path) -> tuple[bytes, float]:
     span_s = float(canonical["time_s"].iloc[-1] - canonical["time_s"].iloc[0])
     if not span_s > 0:
         raise InputError("the log spans no time", file=path, fix="replay a time log")
+    return well, canonical, tracker.origin
+
+
+def recorded_text(path: Path) -> tuple[bytes, float]:
+    """The bytes to replay and the time span of the log they hold [s]: a CSV's own bytes,
+    any other well file as CSV of its canonical channels (``time_s``, … SI units)."""
+    well, canonical, _ = recorded_frame(path)
+    span_s = float(canonical["time_s"].iloc[-1] - canonical["time_s"].iloc[0])
     if well.source.format == "csv":
         return Path(well.files.data).read_bytes(), span_s
     return canonical.to_csv(index=False).encode(), span_s

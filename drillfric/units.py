@@ -144,6 +144,7 @@ LABEL_UNITS = {
     "N·m·s/rad": ("newton*meter*second/radian", "rotational damping"),
     "Pa": ("pascal", "pressure"),
     "s": ("second", "time"),
+    "h": ("hour", "time"),
     "Hz": ("hertz", "frequency"),
     "1/s": ("1/second", "rate"),
     "1/min": ("1/minute", "rate"),

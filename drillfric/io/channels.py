@@ -191,8 +191,8 @@ _COMMON = {
                      "ft.lbf": _FT * _LBF, "ft-lbf": _FT * _LBF, "ft·lbf": _FT * _LBF,
                      "lbf.ft": _FT * _LBF, "kft.lbf": 1e3 * _FT * _LBF,
                      "kft-lbf": 1e3 * _FT * _LBF},
-    "newton": {"n": 1.0, "kn": 1e3, "dan": 10.0, "lbf": _LBF, "klbf": 1e3 * _LBF,
-               "kgf": _KGF, "kkgf": 1e3 * _KGF},
+    "newton": {"n": 1.0, "kn": 1e3, "dan": 10.0, "kdn": 1e4, "kdan": 1e4, "lbf": _LBF,
+               "klbf": 1e3 * _LBF, "kgf": _KGF, "kkgf": 1e3 * _KGF},  # KDN: WITS kilo-daN
     "meter": {"m": 1.0, "ft": _FT, "cm": 1e-2, "mm": 1e-3, "in": 0.0254},
     "pascal": {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "bar": 1e5, "psi": _LBF / 0.0254 ** 2},
     "meter**3/second": {"m3/s": 1.0, "l/min": 1e-3 / 60.0, "lpm": 1e-3 / 60.0,

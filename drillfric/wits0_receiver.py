@@ -1,0 +1,336 @@
+"""A WITS level 0 stream recorded for ``drillfric live wits0://HOST:PORT`` (docs/live.md).
+
+:class:`Receiver` connects to the recorder, reconnects with a doubling wait when the stream
+drops, sends a handshake frame every ``[wits0] handshake_s`` and writes every complete frame
+as one line of :class:`Recording` — ``OUT/NAME.wits0.csv``, absolute time plus the SI
+channels, flushed per frame. :class:`~drillfric.live.LiveRun` then follows that file as it
+follows any growing CSV, so a restarted live run continues the recording and resumes from
+its saved state, no row lost or read twice.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import socket
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+from drillfric.config import read_toml
+from drillfric.errors import InputError
+from drillfric.io.text import printable
+from drillfric.io.wellfiles import safe_name
+from drillfric.io.wits0 import Decoder, Row, frame_clock, item_map
+
+SCHEME = "wits0://"
+#: Sent to the recorder every ``handshake_s`` (the keep-alive Pason-style recorders expect).
+HANDSHAKE = b"&&\r\n0111-9999\r\n!!\r\n"
+#: First wait before reconnecting [s] (doubles up to ``[wits0] reconnect_max_s``).
+RECONNECT_MIN_S = 0.2
+#: Bytes received without one frame after which the port is reported as not WITS level 0.
+NOT_WITS_BYTES = 65536
+#: Latest place of a frame within its second [s]: frames sharing a one-second stamp are
+#: spaced by their arrival, kept inside that second.
+WITHIN_SECOND_S = 0.999
+_MIN_STEP_S = 0.001
+
+
+@dataclass(frozen=True)
+class Address:
+    """A ``wits0://HOST:PORT`` address."""
+
+    host: str
+    port: int
+
+    def __str__(self) -> str:
+        return f"{SCHEME}{self.host}:{self.port}"
+
+
+def parse_address(text: str) -> Address:
+    """``wits0://HOST:PORT`` (an IPv6 host in brackets).
+
+    Raises
+    ------
+    InputError
+        Not such an address.
+
+    Examples
+    --------
+    >>> parse_address("wits0://127.0.0.1:5000")
+    Address(host='127.0.0.1', port=5000)
+    """
+    match = re.fullmatch(r"wits0://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9.-]{1,253}):(\d{1,5})", text)
+    port = int(match[2]) if match else 0
+    if not match or not 0 < port < 65536:
+        raise InputError(f"'{printable(text, 80)}' is no WITS0 address", file="SOURCE",
+                         fix="write wits0://HOST:PORT with a port 1–65535, e.g. "
+                             "wits0://127.0.0.1:5000")
+    return Address(match[1].strip("[]"), port)
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What a WITS0 live run needs from ``--config``: the items read, the ``[wits0]``
+    settings, and :func:`~drillfric.io.well.open_well` keywords for the recording (its
+    configuration without ``[channels]``, which name WITS items, not recording columns)."""
+
+    row: Row
+    units: str
+    utc_offset_h: float | None
+    handshake_s: float
+    reconnect_max_s: float
+    open_kw: dict
+    name: str
+
+
+def setup(address: Address, config: Path | None, name: str | None) -> Setup:
+    """The :class:`Setup` of ``address`` with ``config`` (a TOML file or None).
+
+    Raises
+    ------
+    ConfigError
+        The configuration cannot be read or maps items wrongly.
+    """
+    from drillfric.config import config_from_dict
+
+    raw = {} if config is None else read_toml(config)
+    rest = {k: v for k, v in raw.items() if k != "channels"}
+    cfg = config_from_dict(raw, file=config)  # every key checked, [channels] too
+    settings = cfg.wits0
+    row = Row(item_map(cfg.channels, settings.units, file=config))
+    open_kw: dict = {"config": rest}
+    named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
+    if isinstance(named, str) and config is not None:
+        open_kw["survey"] = Path(config).parent / named
+    shown = name or cfg.well.name or f"wits0_{address.host}_{address.port}"
+    open_kw["name"] = shown
+    return Setup(row, settings.units, settings.utc_offset_h, settings.handshake_s,
+                 settings.reconnect_max_s, open_kw, safe_name(shown, config))
+
+
+class FrameClock:
+    """The recorded time of each frame [s since 1970 on the recorded clock]: the frame's
+    date and time items, else its arrival; frames sharing a one-second stamp are spaced by
+    their arrival within that second; always increasing.
+
+    Parameters
+    ----------
+    utc_offset_h : float or None
+        The rig clock's UTC offset [h] (None: rig clock kept as is).
+    last_s : float or None
+        The last recorded time (a continued recording).
+    """
+
+    def __init__(self, utc_offset_h: float | None, last_s: float | None = None):
+        self.offset_s = 0.0 if utc_offset_h is None else utc_offset_h * 3600.0
+        self.last_s = last_s
+        self._stamp: float | None = None
+        self._first_arrival = 0.0
+        self.out_of_order = 0
+
+    def time_s(self, clock: datetime | None, arrival_s: float, wall_s: float) -> float | None:
+        """The time of a frame with date/time ``clock`` arriving at ``arrival_s`` (monotonic
+        [s]) and wall time ``wall_s`` (UTC, [s] since 1970); None when it lies before the
+        last recorded frame (counted in :attr:`out_of_order`, not recorded)."""
+        if clock is None:
+            t = wall_s if self.last_s is None else max(wall_s, self.last_s + _MIN_STEP_S)
+            self.last_s, self._stamp = t, None
+            return t
+        stamp = clock.replace(tzinfo=UTC).timestamp() - self.offset_s
+        if stamp != self._stamp:
+            self._stamp, self._first_arrival = stamp, arrival_s
+        latest = stamp + WITHIN_SECOND_S
+        if self.last_s is not None and latest <= self.last_s:
+            self.out_of_order += 1
+            return None
+        t = stamp + min(arrival_s - self._first_arrival, WITHIN_SECOND_S)
+        if self.last_s is not None:
+            t = min(max(t, self.last_s + _MIN_STEP_S), latest)
+        self.last_s = t
+        return t
+
+
+class Recording:
+    """The received frames as a CSV growing in the output folder: a fixed header
+    (``time`` and the SI channel names), one line per frame, flushed per frame.
+
+    Parameters
+    ----------
+    path : Path
+        ``OUT/NAME.wits0.csv``; an existing recording is continued (a last line cut by a
+        kill is removed first: it was never read).
+    names : list of str
+        The channel columns.
+    utc : bool
+        Times are UTC (written with ``+00:00``) rather than the rig clock without zone.
+
+    Raises
+    ------
+    InputError
+        An existing file with another header (another configuration).
+    """
+
+    def __init__(self, path: Path, names: list[str], utc: bool):
+        self.path, self.utc = Path(path), utc
+        self.header = ",".join(["time", *names]) + "\n"
+        self.last_s = self._continue() if self.path.exists() else None
+        self._fh = None
+
+    def _continue(self) -> float | None:
+        """Check the header, cut a partial last line; the last recorded time."""
+        with open(self.path, "rb") as fh:
+            head = fh.readline(len(self.header) + 1).decode("utf-8", "replace")
+        if head != self.header:
+            raise InputError("this recording of a WITS0 stream has other columns "
+                             f"({printable(head.strip(), 120)})", file=self.path,
+                             fix="give another --out (or remove the file) when the "
+                                 "configuration's items changed")
+        with open(self.path, "r+b") as fh:
+            size = fh.seek(0, 2)
+            fh.seek(max(0, size - 4096))
+            tail = fh.read()
+            end = size - len(tail) + tail.rfind(b"\n") + 1
+            fh.truncate(end)
+            lines = tail[:tail.rfind(b"\n")].split(b"\n")
+        last = lines[-1].split(b",")[0].decode() if lines else ""
+        if not last or last == "time":
+            return None
+        stamp = datetime.fromisoformat(last)
+        return stamp.replace(tzinfo=UTC).timestamp() if stamp.tzinfo is None else \
+            stamp.timestamp()
+
+    def write(self, time_s: float, values: dict[str, float]) -> None:
+        """One line: the time (ISO 8601, µs) and the values (empty when NaN)."""
+        if self._fh is None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            fresh = not self.path.exists() or self.path.stat().st_size == 0
+            self._fh = open(self.path, "ab")
+            if fresh:
+                self._fh.write(self.header.encode())
+        stamp = datetime.fromtimestamp(time_s, UTC)
+        text = stamp.isoformat(timespec="microseconds") if self.utc else \
+            stamp.replace(tzinfo=None).isoformat(timespec="microseconds")
+        cells = ["" if math.isnan(v) else repr(v) for v in values.values()]
+        self._fh.write((",".join([text, *cells]) + "\n").encode())
+        self._fh.flush()
+
+    def close(self) -> None:
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None
+
+
+class Receiver:
+    """The WITS0 client: run :meth:`run` in a thread; set :attr:`stop` to end it.
+
+    Parameters
+    ----------
+    address : Address
+        The recorder's address.
+    setup : Setup
+        Items and ``[wits0]`` settings.
+    recording : Recording
+        Where the frames go.
+    warn : callable
+        Prints one warning line (stderr by default).
+    """
+
+    def __init__(self, address: Address, setup: Setup, recording: Recording, *,
+                 warn=None):
+        self.address, self.setup, self.recording = address, setup, recording
+        self.clock = FrameClock(setup.utc_offset_h, recording.last_s)
+        self.decoder = Decoder()
+        self.stop = threading.Event()
+        self.frames = self.connections = 0
+        self.warn = warn or (lambda text: print(f"warning: {text}", file=sys.stderr))
+        self._received = 0
+        self._warned: set[str] = set()
+
+    def run(self) -> None:
+        """Connect, record, reconnect (waiting 0.2 s, doubling to ``reconnect_max_s``)
+        until :attr:`stop`."""
+        wait = RECONNECT_MIN_S
+        try:
+            while not self.stop.is_set():
+                try:
+                    conn = socket.create_connection((self.address.host, self.address.port),
+                                                    timeout=2.0)
+                except OSError as exc:
+                    why = exc.strerror or exc
+                    self._once("connect", f"{self.address}: cannot connect ({why}); retrying")
+                    self.stop.wait(wait)
+                    wait = min(2 * wait, self.setup.reconnect_max_s)
+                    continue
+                self.connections += 1
+                if self._session(conn):
+                    wait = RECONNECT_MIN_S
+                else:
+                    self.stop.wait(wait)
+                    wait = min(2 * wait, self.setup.reconnect_max_s)
+        finally:
+            self.recording.close()
+
+    def _session(self, conn: socket.socket) -> bool:
+        """Record frames until the connection drops; True when a frame came."""
+        got = self.frames
+        handshake_due = time.monotonic()
+        conn.settimeout(0.1)
+        try:
+            with conn:
+                while not self.stop.is_set():
+                    if self.setup.handshake_s and time.monotonic() >= handshake_due:
+                        conn.sendall(HANDSHAKE)
+                        handshake_due = time.monotonic() + self.setup.handshake_s
+                    try:
+                        data = conn.recv(65536)
+                    except TimeoutError:
+                        continue
+                    if not data:
+                        break
+                    self._take(data)
+        except OSError:
+            pass  # dropped: reconnect
+        finally:
+            self.decoder.reset()  # a frame the drop cut is discarded
+        return self.frames > got
+
+    def _take(self, data: bytes) -> None:
+        arrival, wall = time.monotonic(), time.time()
+        self._received += len(data)
+        for frame in self.decoder.feed(data):
+            values = self.setup.row.update(frame)
+            t = self.clock.time_s(frame_clock(frame), arrival, wall)
+            if t is None:
+                self._once("order", f"{self.address}: a frame's date and time lie before the "
+                                    "previous frame's: not recorded (see the rig clock)")
+                continue
+            self.recording.write(t, values)
+            self.frames += 1
+        if not self.frames and self._received > NOT_WITS_BYTES:
+            self._once("garbage", f"{self.address}: {self._received} bytes without one WITS "
+                                  "level 0 frame ('&&' … '!!'): is this a WITS0 port?")
+
+    def _once(self, kind: str, text: str) -> None:
+        if kind not in self._warned:
+            self._warned.add(kind)
+            self.warn(text)
+
+
+def recording_path(out_root: Path, setup: Setup) -> Path:
+    """``OUT/NAME.wits0.csv``: beside OUT/NAME, which each publication replaces."""
+    return Path(out_root) / f"{setup.name}.wits0.csv"
+
+
+def start(address: Address, out_root: Path, setup: Setup) -> tuple[Receiver, threading.Thread]:
+    """A :class:`Receiver` recording into ``OUT/NAME.wits0.csv``, running in a daemon thread."""
+    recording = Recording(recording_path(out_root, setup), setup.row.names,
+                          utc=setup.utc_offset_h is not None)
+    receiver = Receiver(address, setup, recording)
+    thread = threading.Thread(target=receiver.run, name="drillfric-wits0", daemon=True)
+    thread.start()
+    return receiver, thread
+
