@@ -24,8 +24,12 @@ from .common import UserError, compile_kernels_once, echo
                    "stopped (Ctrl-C, SIGTERM: the final results are written, exit 130/143).")
 @click.option("--report/--no-report", default=True, show_default=True,
               help="Write report.html with the final results.")
+@click.option("--serve", metavar="[HOST:]PORT",
+              help="Serve the live page at HOST:PORT while live runs (HOST 127.0.0.1 unless "
+                   "given: only this machine; [::1]:PORT for IPv6; port 0 picks a free port). "
+                   "The address is printed (docs/live.md, 'Live page').")
 def command(source: Path, out: Path, config: Path | None, name: str | None,
-            until_idle: float | None, report: bool) -> None:
+            until_idle: float | None, report: bool, serve: str | None) -> None:
     """Follow SOURCE, a CSV file a rig logger appends to, and estimate its segments as they
     close. A restarted live run on the same SOURCE and --out continues where it stopped."""
     from drillfric.live import run_live
@@ -36,13 +40,31 @@ def command(source: Path, out: Path, config: Path | None, name: str | None,
     if source.suffix.lower() not in (".csv", ".txt", ".tsv"):
         raise UserError(f"{source}: live follows a delimited text file (.csv, .txt, .tsv); "
                         "WITS0 and folder sources are not done yet (docs/live.md)")
+    server = _server(serve) if serve is not None else None
     compile_kernels_once()
     kw = {"config": config} if config else {}
-    live = run_live(source, out, until_idle_s=until_idle,
-                    open_kw=kw | ({"name": name} if name else {}),
-                    report=partial(write_well_report, pdf=False) if report else None)
+    try:
+        live = run_live(source, out, until_idle_s=until_idle,
+                        open_kw=kw | ({"name": name} if name else {}),
+                        report=partial(write_well_report, pdf=False) if report else None,
+                        started=None if server is None else server.start)
+    finally:
+        if server is not None:
+            server.stop()
     from .run_cmd import _print
 
     _print(live.result)
     echo(f"live.json: {live.target} (longest gap between its updates "
          f"{live.max_gap_s:.2f} s)")
+
+
+def _server(address: str):
+    """The live page's server bound at ``address`` (one line and exit 2 when it cannot be)."""
+    from drillfric.livepage import serve
+
+    try:
+        server = serve(address)
+    except ValueError as exc:
+        raise UserError(f"--serve: {exc}") from None
+    echo(f"live page: {server.url}")
+    return server
