@@ -284,7 +284,7 @@ def _layout():
     """The figures, their ColumnDataSources named for the page's script: ``surface``
     (x, rpm, torque_kNm, hookload_kN), ``bit`` (x, rpm, low, high) and ``segments``."""
     from bokeh.layouts import column, row
-    from bokeh.models import ColumnDataSource, HoverTool, Span
+    from bokeh.models import ColumnDataSource, DataRange1d, HoverTool, Span
     from bokeh.plotting import figure
 
     surface = ColumnDataSource({k: [] for k in ("x", "rpm", "torque_kNm", "hookload_kN")},
@@ -302,9 +302,10 @@ def _layout():
     torque.line("x", "torque_kNm", source=surface, color="#2ca02c")
     hook = time_figure(170, "hook load [kN]", x_range=speed.x_range, x_label="log time [s]")
     hook.line("x", "hookload_kN", source=surface, color="#9467bd")
-    mu = figure(height=300, width=420, tools="pan,wheel_zoom,box_zoom,reset,save",
+    depth = DataRange1d(flipped=True, range_padding=0.2, min_interval=10.0)
+    mu = figure(height=300, width=460, tools="pan,wheel_zoom,box_zoom,reset,save",
+                x_range=DataRange1d(start=0.0, range_padding=0.15), y_range=depth,
                 x_axis_label="μ [-]", y_axis_label="bit depth [m]")
-    mu.y_range.flipped = True
     mu.scatter("mu_k", "depth", source=segs, size=9, color="#1f77b4", fill_alpha="fill",
                legend_label="μ_k")
     mu.scatter("mu_app", "depth", source=segs, size=9, marker="triangle", color="#8c564b",
@@ -313,9 +314,12 @@ def _layout():
                fill_alpha="fill", legend_label="μ_s")
     mu.scatter("mu_s_lb", "depth", source=segs, size=9, marker="triangle", angle=-math.pi / 2,
                color="#d62728", fill_alpha=0.0, legend_label="μ_s lower bound")
-    mu.legend.location = "bottom_right"
+    mu.legend.location = "bottom_left"
+    mu.legend.label_text_font_size = "9px"
+    mu.legend.background_fill_alpha = 0.6
     mu.add_tools(HoverTool(tooltips=[("segment", "@id"), ("depth", "@depth{0.0} m")]))
-    severity = figure(height=300, width=300, y_range=mu.y_range,
+    severity = figure(height=300, width=300, y_range=depth,
+                      x_range=DataRange1d(start=0.0, range_padding=0.15),
                       tools="pan,wheel_zoom,box_zoom,reset,save",
                       x_axis_label="stick-slip severity [-]")
     severity.scatter("severity", "depth", source=segs, size=9, color="#7f7f7f")
