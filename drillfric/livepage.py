@@ -28,7 +28,7 @@ import re
 import socket
 import threading
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, partial
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib.resources import files
 from pathlib import Path
@@ -146,16 +146,17 @@ class LivePage:
     def _folder(self) -> Path | None:
         return getattr(self.live, "folder", None)
 
-    def _published(self, name: str, read):
-        """``read(path)`` of OUT/NAME/``name``, cached by the file's identity; the last good
-        value while a publication replaces the folder (None before any)."""
+    def _published(self, name: str, read, extra: tuple = ()):
+        """``read(path)`` of OUT/NAME/``name``, cached by the file's identity and ``extra``
+        (what ``read`` depends on besides the file); the last good value while a publication
+        replaces the folder (None before any)."""
         folder = self._folder()
         if folder is None:
             return None
         path = folder / name
         try:
             stat = path.stat()
-            key = (stat.st_ino, stat.st_mtime_ns, stat.st_size)
+            key = (stat.st_ino, stat.st_mtime_ns, stat.st_size, extra)
         except OSError:
             key = None
         with self._lock:
@@ -199,11 +200,18 @@ class LivePage:
     def bit(self, start_s: float | None) -> dict:
         """The estimated bit speed of the segments after log time ``start_s`` [s], with its
         band; segments whose bit speed is not resolved are listed as withheld instead."""
-        records = {r.get("id"): r for r in self.records()}
-        estimates = self._published("estimates.parquet", _final_bit_rows)
         empty = {c: [] for c in ("time_s", "bit_rpm_est", "bit_rpm_est_min",
                                  "bit_rpm_est_max")}
-        if estimates is None or start_s is None:
+        if start_s is None:
+            return empty | {"withheld": []}
+        records = {r.get("id"): r for r in self.records()
+                   if (r.get("t_end_s") or -math.inf) >= start_s}
+        ids = tuple(sorted(records))  # only these segments are read (memory: the window's)
+        if not ids:
+            return empty | {"withheld": []}
+        estimates = self._published("estimates.parquet", partial(_final_bit_rows, ids=ids),
+                                    ids)
+        if estimates is None:
             return empty | {"withheld": []}
         window = estimates[estimates["time_s"] >= start_s]
         parts, withheld = [], []
@@ -223,11 +231,12 @@ class LivePage:
         return {c: frame[c].to_numpy(float) for c in empty} | {"withheld": withheld}
 
 
-def _final_bit_rows(path: Path) -> pd.DataFrame:
-    """The final pass's bit speed and band of every segment in estimates.parquet."""
+def _final_bit_rows(path: Path, ids: tuple[int, ...]) -> pd.DataFrame:
+    """The final pass's bit speed and band of segments ``ids`` in estimates.parquet."""
     names = pq.read_schema(path).names
     table = pq.read_table(path, columns=[c for c in _BIT_COLUMNS if c in names],
-                          filters=[("start_id", "=", FINAL_START_ID)])
+                          filters=[("start_id", "=", FINAL_START_ID),
+                                   ("segment_id", "in", list(ids))])
     frame = table.to_pandas()
     for column in ("bit_rpm_est_min", "bit_rpm_est_max"):
         if column not in frame:
