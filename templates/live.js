@@ -29,18 +29,19 @@
       return;
     }
     const why = row ? row.message : "";
+    const ok = open.status === "ok";  // a skipped or failed segment's numbers are withheld
     put("open-segment", "segment " + open.segment + " (" + open.kind.replace(/_/g, " ") + ", "
         + fixed(open.t_start_s, 0) + "–" + fixed(open.t_end_s, 0) + " s, " + open.status + ")");
-    put("open-mu-k", known(open.mu_k)
+    put("open-mu-k", ok && known(open.mu_k)
       ? fixed(open.mu_k, 3) + (open.kind === "on_bottom_rotating" ? " apparent" : "")
       : withheld(why));
-    put("open-mu-s", known(open.mu_s) ? fixed(open.mu_s, 3)
-      : known(open.mu_s_lower_bound) ? "≥ " + fixed(open.mu_s_lower_bound, 3) + " (not identifiable)"
-        : withheld(open.status === "ok" ? "not identifiable from these data" : why));
+    put("open-mu-s", ok && known(open.mu_s) ? fixed(open.mu_s, 3)
+      : ok && known(open.mu_s_lower_bound) ? "≥ " + fixed(open.mu_s_lower_bound, 3) + " (not identifiable)"
+        : withheld(ok ? "not identifiable from these data" : why));
     put("open-bit-rpm", row && row.bit_speed_resolved === false
       ? withheld(row.bit_speed_reason || "bit speed not resolved")
-      : known(open.bit_rpm) ? fixed(open.bit_rpm, 1) + " rpm" : withheld(why));
-    put("open-severity", known(open.stick_slip_severity)
+      : ok && known(open.bit_rpm) ? fixed(open.bit_rpm, 1) + " rpm" : withheld(why));
+    put("open-severity", ok && known(open.stick_slip_severity)
       ? fixed(open.stick_slip_severity, 2) : withheld(why));
   }
 

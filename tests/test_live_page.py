@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 
 from drillfric.live import LiveRun, RecentRows
-from drillfric.livepage import LivePage, parse_address, segment_view
+from drillfric.livepage import LivePage, LiveServer, parse_address, segment_view
 from tests.test_live import LIVE_KEYS, _drillfric, _feed_folder, _finish, _wait_for
 from tests.test_report_browser import Browser, PageVisit, _chromium, _record
 
@@ -280,3 +280,39 @@ def test_port_in_use_exits_2_with_one_line(tmp_path):
     assert code == 2 and "Traceback" not in err
     assert f"127.0.0.1:{port}" in err and "in use" in err and len(err.strip().splitlines()) == 1
     assert not Path(tmp_path / "out").exists()
+
+
+def test_open_segment_numbers_that_are_withheld_show_as_withheld_in_the_browser(tmp_path):
+    """The open segment's bit speed is in live.json (45 rpm) but the segment says its bit
+    speed is not resolved; its μ_s is not identified; a skipped open segment has a μ_k in
+    live.json: the page shows each as "withheld: <reason>", never the number."""
+    exe = _chromium()
+    folder = tmp_path / "out" / "w"
+    folder.mkdir(parents=True)
+    reason = "bit speed not resolved: 1 Hz log"
+    (folder / "summary.json").write_text(json.dumps({"segments": [_record_row(
+        id=2, mu_s_lower_bound=None, bit_speed_resolved=False, bit_speed_reason=reason)]}))
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out")
+    live.folder = folder
+    opened = {"segment": 2, "kind": "off_bottom_rotating", "status": "ok", "t_start_s": 0.0,
+              "t_end_s": 100.0, "mu_k": 0.27, "mu_s": None, "mu_s_lower_bound": None,
+              "bit_rpm": 45.0, "stick_slip_severity": 0.5}
+    live.view["open_segment"] = opened
+    server = LiveServer("127.0.0.1", 0)
+    server.start(live)
+    shown = {k: f"document.getElementById('{k}').textContent" for k in (
+        "open-mu-k", "open-mu-s", "open-bit-rpm", "open-severity")}
+    browser = Browser(exe, tmp_path / "profile", tmp_path / "chromium.log")
+    try:
+        first = _visit(browser, server.url, shown)
+        live.view["open_segment"] = opened | {"status": "skipped"}
+        skipped = _visit(browser, server.url, shown)
+    finally:
+        browser.close()
+        server.stop()
+    assert first.console_errors == []
+    assert first.values["open-mu-k"] == "0.270"
+    assert first.values["open-mu-s"] == "withheld: not identifiable from these data"
+    assert first.values["open-bit-rpm"] == f"withheld: {reason}"
+    assert first.values["open-severity"] == "0.50"
+    assert all(v.startswith("withheld") for k, v in skipped.values.items() if k != "polls")
