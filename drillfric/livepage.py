@@ -21,6 +21,7 @@ loopback address (DNS rebinding). The page's Content-Security-Policy is the repo
 
 from __future__ import annotations
 
+import gzip
 import ipaddress
 import json
 import math
@@ -92,12 +93,14 @@ def parse_address(text: str) -> tuple[str, int]:
 
 @dataclass(frozen=True)
 class Answer:
-    """One HTTP answer: status, content type, body and Content-Security-Policy."""
+    """One HTTP answer: status, content type, body, Content-Security-Policy and the body's
+    Content-Encoding (None: as is)."""
 
     status: int
     content_type: str
     body: bytes
     csp: str = _NOTHING
+    encoding: str | None = None
 
 
 def _json_answer(payload) -> Answer:
@@ -121,11 +124,13 @@ class LivePage:
         self._lock = threading.Lock()
         self._cache: dict[str, tuple] = {}
 
-    def answer(self, path: str, query: str) -> Answer:
-        """The answer to a GET of ``path`` with ``query`` (404 for any other path)."""
+    def answer(self, path: str, query: str, gzip_ok: bool = False) -> Answer:
+        """The answer to a GET of ``path`` with ``query`` (404 for any other path); the page
+        gzip-compressed when the browser takes it (``gzip_ok``)."""
         if path == "/":
             html, csp = page()
-            return Answer(200, _HTML, html, csp)
+            return Answer(200, _HTML, page_gzip(), csp, "gzip") if gzip_ok else \
+                Answer(200, _HTML, html, csp)
         if path == "/live.json":
             return _json_answer(self.live.status())
         if path == "/segments.json":
@@ -289,6 +294,12 @@ def page() -> tuple[bytes, str]:
     return html.encode("utf-8"), csp
 
 
+@cache
+def page_gzip() -> bytes:
+    """The page's HTML, gzip-compressed (a third of the bytes; built once per process)."""
+    return gzip.compress(page()[0], compresslevel=6, mtime=0)
+
+
 def _layout():
     """The figures, their ColumnDataSources named for the page's script: ``surface``
     (x, rpm, torque_kNm, hookload_kN), ``bit`` (x, rpm, low, high) and ``segments``."""
@@ -356,7 +367,8 @@ class _Handler(BaseHTTPRequestHandler):
             answer = _error(421, "this page answers only to a loopback host name")
         else:
             try:
-                answer = self.server.page.answer(url.path, url.query)
+                answer = self.server.page.answer(
+                    url.path, url.query, "gzip" in self.headers.get("Accept-Encoding", ""))
             except Exception as exc:  # noqa: BLE001 — one line to the page, the run goes on
                 answer = _error(500, f"the live page failed: {type(exc).__name__}: {exc}")
         self.send_response(answer.status)
@@ -364,6 +376,9 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("Content-Length", str(len(answer.body)))
         self.send_header("Content-Security-Policy", answer.csp)
         self.send_header("Cache-Control", "no-store")
+        self.send_header("Vary", "Accept-Encoding")
+        if answer.encoding:
+            self.send_header("Content-Encoding", answer.encoding)
         self.end_headers()
         if body:
             self.wfile.write(answer.body)

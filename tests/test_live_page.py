@@ -5,6 +5,7 @@ port in use answered in one line. The module's live run lasts ~30 s of replay.""
 
 from __future__ import annotations
 
+import gzip
 import http.client
 import json
 import socket
@@ -141,6 +142,10 @@ def test_page_has_the_strict_csp_and_json_grows_with_the_source(served):
     assert "unsafe-eval" not in csp and "script-src 'sha256-" in csp
     assert "unsafe-inline" not in csp.split("script-src")[1].split(";")[0]
     assert headers["X-Content-Type-Options"] == "nosniff"
+    request = urllib.request.Request(url, headers={"Accept-Encoding": "gzip"})
+    with urllib.request.urlopen(request, timeout=10) as reply:
+        assert reply.headers["Content-Encoding"] == "gzip"
+        assert gzip.decompress(reply.read()) == body
     _wait_for(lambda: _json(url + "tracks.json")["rows"] > 0, 30)
     first, status = _json(url + "tracks.json"), _json(url + "live.json")
     assert LIVE_KEYS <= set(status)
