@@ -26,8 +26,12 @@ from .common import UserError, compile_kernels_once, echo
                    "stopped (Ctrl-C, SIGTERM: the final results are written, exit 130/143).")
 @click.option("--report/--no-report", default=True, show_default=True,
               help="Write report.html with the final results.")
+@click.option("--serve", metavar="[HOST:]PORT",
+              help="Serve the live page at HOST:PORT while live runs (HOST 127.0.0.1 unless "
+                   "given: only this machine; [::1]:PORT for IPv6; port 0 picks a free port). "
+                   "The address is printed (docs/live.md, 'Live page').")
 def command(source: str, out: Path, config: Path | None, name: str | None,
-            until_idle: float | None, report: bool) -> None:
+            until_idle: float | None, report: bool, serve: str | None) -> None:
     """Follow SOURCE — a CSV file a rig logger appends to, or wits0://HOST:PORT (a WITS
     level 0 stream, recorded into OUT/NAME.wits0.csv) — and estimate its segments as they
     close. A restarted live run on the same SOURCE and --out continues where it stopped."""
@@ -38,18 +42,19 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
         raise UserError(f"--until-idle must be positive seconds, got {until_idle:g}")
     kw = {"config": config} if config else {}
     kw |= {"name": name} if name else {}
-    receiver = None
-    if source.startswith("wits0:"):
-        path, kw, receiver = _wits0(source, out, config, name)
-    elif Path(source).suffix.lower() in (".csv", ".txt", ".tsv"):
-        path = Path(source)
-    else:
+    if not source.startswith("wits0:") and \
+            Path(source).suffix.lower() not in (".csv", ".txt", ".tsv"):
         raise UserError(f"{source}: live follows a delimited text file (.csv, .txt, .tsv) or "
                         "wits0://HOST:PORT; folder sources are not done yet (docs/live.md)")
-    compile_kernels_once()
+    server = _server(serve) if serve is not None else None
+    receiver, path = None, Path(source)
     try:
+        if source.startswith("wits0:"):
+            path, kw, receiver = _wits0(source, out, config, name)
+        compile_kernels_once()
         live = run_live(path, out, until_idle_s=until_idle, open_kw=kw,
-                        report=partial(write_well_report, pdf=False) if report else None)
+                        report=partial(write_well_report, pdf=False) if report else None,
+                        started=None if server is None else server.start)
     except InputError as exc:
         if receiver is None or receiver.frames:
             raise
@@ -59,6 +64,8 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
     finally:
         if receiver is not None:
             receiver.stop.set()
+        if server is not None:
+            server.stop()
     from .run_cmd import _print
 
     _print(live.result)
@@ -75,3 +82,15 @@ def _wits0(source: str, out: Path, config: Path | None, name: str | None):
     setup = wits0.setup(address, config, name)
     receiver, _ = wits0.start(address, out, setup)
     return wits0.recording_path(out, setup), setup.open_kw, receiver
+
+
+def _server(address: str):
+    """The live page's server bound at ``address`` (one line and exit 2 when it cannot be)."""
+    from drillfric.livepage import serve
+
+    try:
+        server = serve(address)
+    except ValueError as exc:
+        raise UserError(f"--serve: {exc}") from None
+    echo(f"live page: {server.url}")
+    return server

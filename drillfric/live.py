@@ -26,10 +26,12 @@ import math
 import os
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 
@@ -53,6 +55,52 @@ SEVERE_STICK_SLIP = 1.0
 #: Relative change of a converged μ_k against the median of the previous five that raises a
 #: friction-trend alert.
 TREND_CHANGE = 0.25
+#: Log seconds of surface rows kept for the live page's time tracks (:class:`RecentRows`).
+RECENT_S = 600.0
+#: The channels of :class:`RecentRows` (SI; NaN where the log lacks one).
+RECENT_CHANNELS = ("time_s", "surface_rpm", "surface_torque_Nm", "hookload_N")
+
+
+class RecentRows:
+    """The surface rows of the last ``span_s`` log seconds (a bounded ring of chunks), read
+    by the live page's threads while the worker adds to it."""
+
+    def __init__(self, span_s: float = RECENT_S):
+        self.span_s = span_s
+        self.version = 0  # counts the chunks added (a reader's cache key)
+        self._parts: deque[dict[str, np.ndarray]] = deque()
+        self._lock = threading.Lock()
+
+    def add(self, chunk: pd.DataFrame | None) -> None:
+        """Keep the rows of a canonical chunk; forget chunks older than the span."""
+        if chunk is None or not len(chunk) or "time_s" not in chunk:
+            return
+        part = {c: chunk[c].to_numpy(float, copy=True) if c in chunk
+                else np.full(len(chunk), np.nan) for c in RECENT_CHANNELS}
+        with self._lock:
+            self._parts.append(part)
+            newest = _newest(self._parts)
+            while len(self._parts) > 1 and not \
+                    np.nanmax(self._parts[0]["time_s"], initial=-np.inf) >= newest - self.span_s:
+                self._parts.popleft()
+            self.version += 1
+
+    def rows(self, since_s: float | None = None) -> dict[str, np.ndarray]:
+        """The rows of the last ``span_s`` log seconds, after ``since_s`` [s] if given."""
+        with self._lock:
+            parts = list(self._parts)
+        if not parts:
+            return {c: np.zeros(0) for c in RECENT_CHANNELS}
+        out = {c: np.concatenate([p[c] for p in parts]) for c in RECENT_CHANNELS}
+        t = out["time_s"]
+        keep = t >= _newest(parts) - self.span_s
+        if since_s is not None:
+            keep &= t > since_s
+        return {c: v[keep] for c, v in out.items()}
+
+
+def _newest(parts) -> float:
+    return max(np.nanmax(p["time_s"], initial=-np.inf) for p in parts)
 
 
 class Tail:
@@ -157,6 +205,7 @@ class LiveRun:
         self.max_gap_s = 0.0  # the longest wait between two live.json writes
         self._size, self._written = -1, None
         self.lock = threading.Lock()
+        self.recent = RecentRows()  # the last minutes of surface rows (the live page)
         self.view: dict = {"last_sample_time_s": None, "last_sample_utc": None,
                            "rig_state": None, "open_segment": None, "latest": None,
                            "trend_alert": None, "rows": 0, "segments_closed": 0,
@@ -221,6 +270,7 @@ class LiveRun:
             return False
         for raw in self.well.source.window(self.tail_fed, end, CHUNK_ROWS):
             closed |= bool(self.engine.feed_raw(raw))
+            self.recent.add(self.engine.last_chunk)
         self.tail_fed, self.engine.source, self.dirty = end, self.tail.mark(), True
         self._note_rows()
         return closed
@@ -411,10 +461,11 @@ def _utc(origin, time_s: float) -> str | None:
 
 
 def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
-             **kw) -> LiveRun:
+             started: Callable[[LiveRun], None] | None = None, **kw) -> LiveRun:
     """Run :class:`LiveRun` (``kw``) until ``until_idle_s`` wall seconds without new data
     (None: until interrupted), writing ``out_root/live.json`` every :data:`POLL_S` from this
-    thread while the worker feeds and estimates.
+    thread while the worker feeds and estimates; ``started`` is given the run before its
+    worker starts (the live page serves it).
 
     Raises
     ------
@@ -424,6 +475,8 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
         Interrupted (Ctrl-C, SIGTERM): the final results were written first.
     """
     live = LiveRun(path, out_root, **kw)
+    if started is not None:
+        started(live)
     worker = threading.Thread(target=live.work, name="drillfric-live", daemon=True)
     worker.start()
     try:

@@ -110,6 +110,8 @@ class Engine:
         #: summary.json ``resumed``: where this run continued from, or why it did not.
         self.resumed: dict | None = None
         self._before_close: dict | None = None
+        #: The canonical rows of the last raw chunk fed (SI; ``drillfric live``'s page).
+        self.last_chunk: pd.DataFrame | None = None
 
     # ------------------------------------------------------------------ rows in
     def feed(self, frame: pd.DataFrame) -> list[SegmentRecord]:
@@ -130,7 +132,7 @@ class Engine:
     def feed_raw(self, raw: pd.DataFrame) -> list[SegmentRecord]:
         """:meth:`feed` for a raw chunk of the well's own source (labels already text)."""
         self.raw_rows += len(raw)
-        chunk = self.well.canonical(raw, self.tracker)
+        chunk = self.last_chunk = self.well.canonical(raw, self.tracker)
         if self.check.rows == 0 and len(chunk):
             self.estimator.rate_hz = first_chunk(self.well, chunk, self.rate_hz, self.warnings)
             self.estimator.has_truth = "bit_rpm" in chunk
