@@ -231,7 +231,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     omega_c = settings.omega_c_rad_s
     creeps = find_creeps(data.t, data.drive, omega_c, torque_Nm=data.tau,
                          smooth_s=TORQUE_SMOOTH_S)
-    wins, notes = rotating_windows(data, settings)
+    wins, notes = rotating_windows(data, settings, *model.wind_up(cells))
     messages += notes
     flags: list[Flag] = []
     rotation = _Rotation.of(model, wins)

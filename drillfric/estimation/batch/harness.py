@@ -94,6 +94,10 @@ class FitData:
         """The first sample at or after ``t_s`` [s] (clipped to the record)."""
         return int(np.clip(np.searchsorted(self.t, t_s - 1e-9 * self.dt), 0, self.t.size - 1))
 
+    def turned_rad(self, i0: int, i1: int) -> np.ndarray:
+        """Angle the top drive has turned since sample ``i0``, at samples i0..i1 [rad]."""
+        return np.cumsum(np.abs(self.drive[i0:i1 + 1])) * self.dt
+
 
 def prepare(time_s, surface_rad_s, torque_Nm, torque_kind: str,
             top_drive_inertia_kg_m2: float) -> tuple[FitData, list[str]]:
@@ -196,6 +200,16 @@ class Model:
         """T_N of the estimated part: ∫F_c dx where μ is estimated [N·m]."""
         return self.t_parts(cells)[0]
 
+    def wind_up(self, cells: int) -> tuple[float, float]:
+        """(Θ/T_N, 2L/c) of the string (docs/theory.md §6.4 "Start-up"): the twist of a
+        string wound to break-away per N·m of top torque [rad/(N·m)], Θ/T_N =
+        ∫₀ᴸ τ(x)/(G J) dx / τ(0) with τ(x) = ∫ₓᴸ F_c dξ, and the wave round trip [s]."""
+        g, fc = self.grid(cells)
+        below = np.cumsum((fc * g.dx_true_m)[::-1])[::-1]  # friction torque below [N·m/μ]
+        gj = g.zeta_Nms * np.repeat(g.wave_speed_m_s, np.diff(g.section_start))
+        twist = float(np.sum(below * g.dx_true_m / gj))
+        return (twist / float(below[0]) if below[0] > 0 else 0.0), 2.0 * g.travel_time_s
+
     def t_parts(self, cells: int) -> tuple[float, float]:
         """(T_N of the estimated part, kinetic torque of the fixed part) [N·m]."""
         g, fc = self.grid(cells)
@@ -258,6 +272,46 @@ def fluctuation(tau_bar: np.ndarray) -> float:
 def sticks(bit_rad_s: np.ndarray, omega_c: float) -> bool:
     """Whether the model's bit sticks: a share of samples near rest (docs/theory.md §6.4)."""
     return bool(np.mean(np.abs(bit_rad_s) <= REST_BIT * omega_c) >= STUCK_FRACTION)
+
+
+def start_up_end(tau_Nm, turned_rad, dt_s: float, rad_per_Nm: float,
+                 round_trip_s: float) -> int | None:
+    """First sample past the start-up transient of a rotation that starts from rest, or
+    None when the series ends first (docs/theory.md §6.4 "Start-up").
+
+    The bit cannot break free before the top drive has turned the twist of the string
+    wound to its break-away torque, τ_b·Θ/T_N (:meth:`Model.wind_up`), and τ_b is at most
+    the highest 1-s smoothed torque of the series; one wave round trip later the release
+    of the bit has reached the top and come back.
+
+    Parameters
+    ----------
+    tau_Nm : array_like
+        String torque at the top from the run's start [N·m].
+    turned_rad : array_like
+        Angle the top drive has turned by each sample [rad].
+    dt_s : float
+        Sample interval [s].
+    rad_per_Nm : float
+        Θ/T_N, twist of the wound string per N·m of top torque [rad/(N·m)].
+    round_trip_s : float
+        Wave round trip 2L/c [s].
+
+    Examples
+    --------
+    >>> tau = np.r_[np.linspace(0.0, 10.0, 11), np.full(10, 8.0)]
+    >>> start_up_end(tau, np.arange(21.0), 1.0, 1.0, 2.0)
+    12
+    >>> start_up_end(tau, np.arange(21.0), 1.0, 2.0, 2.0) is None
+    True
+    """
+    tau = np.abs(np.asarray(tau_Nm, dtype=float))
+    peak = float(np.max(smooth(tau, dt_s, TORQUE_SMOOTH_S)))
+    wound = np.flatnonzero(np.abs(np.asarray(turned_rad, dtype=float)) >= peak * rad_per_Nm)
+    if wound.size == 0:
+        return None
+    end = int(wound[0] + np.ceil(round_trip_s / dt_s - 1e-9))
+    return end if end < tau.size else None
 
 
 def whole_cycles(tau_Nm, dt_s: float) -> slice:
