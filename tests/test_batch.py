@@ -26,7 +26,7 @@ from drillfric import torsional
 from drillfric.drillstring import DrillString, Section
 from drillfric.errors import InputError
 from drillfric.estimation import batch
-from drillfric.estimation.batch import kinetic
+from drillfric.estimation.batch import harness, kinetic
 from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
 
 RPM = np.pi / 30.0
@@ -341,8 +341,9 @@ def test_creep_logged_at_5_hz_is_withheld_for_the_twist_noise():
 def test_creep_start_identifies_mu_s(mu_s, mu_k, md_m, kop_m, rate_hz):
     """Records with a creep start (0 → 5 RPM in 5 s, hold 30 s, ramp): μ_s within 10 %
     (issue 5), grid-converged (docs/theory.md §6.4), method recorded; μ_k within 5 %. 120-s records:
-    μ_k uses rotation from 30 s after reaching ω_c (≈ 71 s) on; with only ~6 stick-slip
-    cycles (100 s) the chaotic mean alone moved μ_k by 6 % (docs/batch_refinement.md)."""
+    μ_k uses rotation from the end of its start-up on (docs/theory.md §6.4 "Start-up"); with
+    only ~6 stick-slip cycles the chaotic mean alone moved μ_k by 6 %
+    (docs/batch_refinement.md)."""
     string, fc, rec = cached_case(mu_s, mu_k, "creep", 120.0, 40.0, md_m=md_m, kop_m=kop_m)
     res = estimate(string, fc, *sample(rec, rate_hz, seed=0))
     assert res.mu_s_identifiable and res.mu_s_method == "creep_fit"
@@ -425,20 +426,22 @@ def _loaded_stop_record():
     return string, fc, rec
 
 
-def _short_run_notes(dip_max_s: float, fraction: float) -> int:
-    """Fit the loaded-stop record; the count of runs left out as too short for μ_k."""
+def _fit_runs(dip_max_s: float, fraction: float) -> int:
+    """The rotating runs of the loaded-stop record as the μ_k fit cuts them (used or left
+    out with a note)."""
     string, fc, rec = _loaded_stop_record()
-    res = estimate(string, fc, rec.time_s, rec.surface_rad_s, rec.motor_torque_Nm, cells=300,
-                   settings=replace(SETTINGS, dip_max_s=dip_max_s,
-                                    dip_torque_fraction=fraction))
-    return sum(m.startswith("rotating run 75–100 s shorter") for m in res.messages)
+    settings = replace(SETTINGS, dip_max_s=dip_max_s, dip_torque_fraction=fraction)
+    data, _ = harness.prepare(rec.time_s, rec.surface_rad_s, rec.motor_torque_Nm, "motor", I_TD)
+    model = harness.Model(string, harness.as_fc_fn(fc), settings, data)
+    wins, notes = kinetic.rotating_windows(data, settings, *model.wind_up(300))
+    return len(wins) + len(notes)
 
 
 @pytest.mark.parametrize("dip_max_s, runs", [(10.0, 2), (25.0, 1)])
 def test_dip_max_s_cuts_the_fit_where_segmentation_cuts(dip_max_s, runs):
     """Regression: ``segmentation.dip_max_s = 25`` joined a loaded stop into one rotation in
     the segmentation but not in the fit. Both now cut at the same place: two rotations
-    (the second, 25 s, too short for μ_k) or one."""
+    or one."""
     import pandas as pd
 
     from drillfric.config import config_from_dict
@@ -449,11 +452,11 @@ def test_dip_max_s_cuts_the_fit_where_segmentation_cuts(dip_max_s, runs):
     cfg = config_from_dict({"segmentation": {"dip_max_s": dip_max_s, "min_segment_s": 1.0}})
     assert len(segment(frame, cfg)) == runs
     told = batch.BatchSettings.from_config(cfg)
-    assert _short_run_notes(told.dip_max_s, told.dip_torque_fraction) == runs - 1
+    assert _fit_runs(told.dip_max_s, told.dip_torque_fraction) == runs
 
 
 def test_dip_torque_fraction_reaches_the_fit():
     """The stop holds ~85 % of the run's mean string torque: loaded for a fraction of 0.5,
     released (the run ends there) for 0.9."""
-    assert _short_run_notes(25.0, 0.5) == 0
-    assert _short_run_notes(25.0, 0.9) == 1
+    assert _fit_runs(25.0, 0.5) == 1
+    assert _fit_runs(25.0, 0.9) == 2

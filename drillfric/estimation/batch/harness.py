@@ -19,6 +19,7 @@ from drillfric.estimation import creep
 from drillfric.estimation.batch.settings import (
     CREEP_DRIVE_SMOOTH_S,
     DRIVE_SMOOTH_S,
+    MIN_CYCLES,
     REST_BIT,
     STUCK_FRACTION,
     TORQUE_SMOOTH_S,
@@ -330,9 +331,21 @@ def whole_cycles(tau_Nm, dt_s: float) -> slice:
     (1, 73)
     """
     x = np.asarray(tau_Nm, dtype=float)
-    xb = smooth(x, dt_s, TORQUE_SMOOTH_S)
-    up = np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
+    up = up_crossings(x, dt_s)
     return slice(int(up[0]), int(up[-1])) if up.size >= 2 else slice(0, x.size)
+
+
+def up_crossings(tau_Nm, dt_s: float) -> np.ndarray:
+    """Samples where the 1-s smoothed torque crosses its mean upwards: the bounds of the
+    whole torque cycles of a series (one fewer cycles than crossings).
+
+    Examples
+    --------
+    >>> up_crossings(np.sin(np.linspace(0.0, 5.5 * np.pi, 100)), 1.0).tolist()
+    [1, 37, 73]
+    """
+    xb = smooth(np.asarray(tau_Nm, dtype=float), dt_s, TORQUE_SMOOTH_S)
+    return np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
 
 
 def cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
@@ -342,7 +355,8 @@ def cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
 
 def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int] | None:
     """Standard error of :func:`cycle_mean` from the scatter of its cycles [N·m], and the
-    number of whole cycles; None with fewer than 3 (docs/theory.md §6.4 "Uncertainty of μ_k").
+    number of whole cycles; None with fewer than :data:`MIN_CYCLES` (docs/theory.md §6.4
+    "Uncertainty of μ_k").
 
     Each whole torque cycle (between upward crossings of the 1-s smoothed torque through its
     mean) gives one mean; the pooled mean is their length-weighted average, and its standard
@@ -359,11 +373,10 @@ def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int]
     means, lengths = [], []
     for x in series:
         x = np.asarray(x, dtype=float)
-        xb = smooth(x, dt_s, TORQUE_SMOOTH_S)
-        up = np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
+        up = up_crossings(x, dt_s)
         means += [float(np.mean(x[a:b])) for a, b in zip(up[:-1], up[1:], strict=True)]
         lengths += [float(b - a) for a, b in zip(up[:-1], up[1:], strict=True)]
-    if len(means) < 3:
+    if len(means) < MIN_CYCLES:
         return None
     m, w = np.asarray(means), np.asarray(lengths)
     mean = float(np.sum(w * m) / np.sum(w))

@@ -22,8 +22,10 @@ from drillfric.estimation.batch.harness import (
     cycle_mean,
     start_up_end,
     sticks,
+    up_crossings,
 )
 from drillfric.estimation.batch.settings import (
+    MIN_CYCLES,
     MU_K_MAX_RUNS,
     MU_K_TOLERANCE,
     PRE_ROLL_S,
@@ -38,7 +40,8 @@ def rotating_windows(data: FitData, settings: BatchSettings, rad_per_Nm: float,
                      round_trip_s: float) -> tuple[list[Window], list[str]]:
     """One window per rotating run that outlasts its start-up transient (:func:`start_up_end`
     with Θ/T_N ``rad_per_Nm`` [rad/(N·m)] and the wave round trip ``round_trip_s`` [s],
-    docs/theory.md §6.4 "Start-up"), compared from there to the run's end; a loaded stop
+    docs/theory.md §6.4 "Start-up") by :data:`MIN_CYCLES` whole torque cycles, compared
+    from there to the run's end; a loaded stop
     within ``settings.dip_max_s`` does not end a run (the segmentation's rule). Returns the
     windows and a note per run left out."""
     omega_c = settings.omega_c_rad_s
@@ -58,6 +61,14 @@ def rotating_windows(data: FitData, settings: BatchSettings, rad_per_Nm: float,
                          f"{peak * rad_per_Nm:.0f} rad of top-drive turning and a "
                          f"{round_trip_s:.1f}-s wave round trip, the run turned "
                          f"{turned[-1]:.0f} rad: not used for μ_k")
+            continue
+        cycles = up_crossings(data.tau[i0 + end:i1 + 1], data.dt).size - 1
+        if cycles < MIN_CYCLES:
+            notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s holds "
+                         f"{max(cycles, 0)} whole torque cycles after its start-up (ended "
+                         f"{data.t[i0 + end] - data.t[i0]:.0f} s in), fewer than "
+                         f"{MIN_CYCLES}: its mean torque has no stated uncertainty, not used "
+                         "for μ_k")
             continue
         wins.append(Window(max(0, i0 - pre), i1, np.arange(i0 + end, i1 + 1)))
     return wins, notes
