@@ -206,10 +206,11 @@ class Model:
         string wound to break-away per N·m of top torque [rad/(N·m)], Θ/T_N =
         ∫₀ᴸ τ(x)/(G J) dx / τ(0) with τ(x) = ∫ₓᴸ F_c dξ, and the wave round trip [s]."""
         g, fc = self.grid(cells)
-        below = np.cumsum((fc * g.dx_true_m)[::-1])[::-1]  # friction torque below [N·m/μ]
+        cell = fc * g.dx_true_m
+        below = np.cumsum(cell[::-1])[::-1] - 0.5 * cell  # below each cell's centre [N·m/μ]
         gj = g.zeta_Nms * np.repeat(g.wave_speed_m_s, np.diff(g.section_start))
-        twist = float(np.sum(below * g.dx_true_m / gj))
-        return (twist / float(below[0]) if below[0] > 0 else 0.0), 2.0 * g.travel_time_s
+        twist, t_n = float(np.sum(below * g.dx_true_m / gj)), float(np.sum(cell))
+        return (twist / t_n if t_n > 0 else 0.0), 2.0 * g.travel_time_s
 
     def t_parts(self, cells: int) -> tuple[float, float]:
         """(T_N of the estimated part, kinetic torque of the fixed part) [N·m]."""
