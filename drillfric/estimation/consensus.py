@@ -16,9 +16,11 @@ from scipy.stats import t as student_t
 from drillfric.result import Flag, Kind, SegmentRecord, Status
 
 #: Flags a short segment may carry and still be pooled (it is only too short: a few torque
-#: cycles leave its own μ_k uncertain, which is what pooling answers).
+#: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``
+#: concerns only the μ_s bound, withheld, not μ_k).
 _POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
-                       "estimators_disagree", "bit_speed_drift", "mu_k_uncertain"})
+                       "estimators_disagree", "bit_speed_drift", "mu_k_uncertain",
+                       "bistable_regime"})
 #: Short segments pool when the string's friction torque added between their bit depths is
 #: at most this share of the torque at the deeper one, |ΔT_N|/T_N (docs/theory.md "Pooling
 #: along depth"). The reported μ_k is the torque-weighted mean of μ(x) over the whole
