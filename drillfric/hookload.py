@@ -234,7 +234,8 @@ class PlateauFinder:
     ``segmentation.rotating_stop_rpm``) and either its hook load is below
     ``segmentation.slips_hookload_N`` (when configured: the string is in the slips, the
     block may move) or, without that threshold, the string does not move (bit depth, else
-    block position, changes slower than :data:`STILL_M_S`). Quiet rows whose hook load stays
+    block position, changes slower than :data:`STILL_M_S`) and the bit is off bottom
+    (:meth:`on_bottom`). Quiet rows whose hook load stays
     within the band (:func:`band_N`) of their running mean for at least
     :data:`PLATEAU_MIN_S` make a :class:`Plateau`.
 
@@ -271,7 +272,18 @@ class PlateauFinder:
             self._last = (t[-1], depth[-1])
         moving = speed > STILL_M_S if ("bit_depth_m" in chunk or "block_position_m" in chunk) \
             else np.zeros(len(chunk), bool)
-        return ~still_turning & ~moving
+        return ~still_turning & ~moving & ~self.on_bottom(chunk)
+
+    def on_bottom(self, chunk: pd.DataFrame) -> np.ndarray:
+        """Rows with the bit on bottom, by the segmentation's rule (hole − bit depth ≤
+        ``segmentation.on_bottom_m``, else WOB > ``segmentation.wob_on_bottom_N``): a string
+        standing on bottom hangs lighter by the weight set on the bit, so a stop there is
+        neither the slips nor the string hanging free (a 12-t WOB held through a stop after
+        drilling was taken for the slips: docs/validation.md)."""
+        if "bit_depth_m" in chunk and "hole_depth_m" in chunk:
+            gap = _column(chunk, "hole_depth_m") - _column(chunk, "bit_depth_m")
+            return gap <= self._seg.on_bottom_m
+        return _column(chunk, "wob_N") > self._seg.wob_on_bottom_N
 
     def feed(self, chunk: pd.DataFrame, states=None) -> None:
         """Consume the next rows (canonical SI columns; ``states``, the rig states, are

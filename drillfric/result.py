@@ -78,7 +78,8 @@ FLAG_MEANINGS = {
     Flag.OBSERVER_DEADLOCK_AVERTED: "an observer start stuck while the top drive turned was "
                                     "released by the deadlock guard",
     Flag.NO_ROTATION: "the fit window holds no rotation above ω_c",
-    Flag.ROTATION_TOO_SHORT: "no rotating run lasts 30 s after reaching ω_c (μ_k unfitted)",
+    Flag.ROTATION_TOO_SHORT: "no rotating run outlasts its start-up transient by 3 whole "
+                             "torque cycles (μ_k unfitted)",
     Flag.REGIME_MISMATCH: "the model could not be put in the data's regime (stick-slip or "
                           "steady): μ_k may be biased by a few %",
     Flag.MU_K_NOT_CONVERGED: "the mean torque was matched to worse than 2 %",

@@ -39,6 +39,17 @@ def test_pieces_that_disagree_or_lie_apart_or_are_too_few_do_not_pool():
         assert pool_short_segments(records)[1] == []
 
 
+def test_pieces_short_of_cycles_or_with_a_withheld_mu_s_bound_pool():
+    """Regression (issue 22, 60-s rotations): two of five stands carried ``bistable_regime``
+    (their μ_s bound withheld, μ_k unaffected) or ``mu_k_uncertain`` (few torque cycles)
+    and were left out of the pool; the friction log showed 3 stands where 5 agree."""
+    extra = [(Flag.TOO_SHORT_TO_CONVERGE, Flag.BISTABLE_REGIME),
+             (Flag.TOO_SHORT_TO_CONVERGE, Flag.MU_K_UNCERTAIN)]
+    records = [_seg(i, 0.249 + 0.001 * (i % 2), flags=extra[i % 2] if i < 3 else
+                    (Flag.TOO_SHORT_TO_CONVERGE,)) for i in range(1, 6)]
+    assert pool_short_segments(records)[1][0]["segment_ids"] == [1, 2, 3, 4, 5]
+
+
 def test_consensus_uses_converged_segments_and_never_invents_mu_s():
     records = [_seg(1, 0.20, converged=True, flags=(), mu_s_lower_bound=0.3),
                _seg(2, 0.22, converged=True, flags=(), mu_s_lower_bound=0.4),

@@ -132,6 +132,28 @@ def test_a_hanging_string_is_not_the_slips():
     assert block.weight_N is None and "no slips" in block.reason
 
 
+def test_stop_on_bottom_with_wob_held_is_not_the_slips():
+    """Regression (issue 22, the 1 Hz heavy-WOB gap): a 12-t WOB held through a 10-s stop
+    after drilling hangs the string 118 kN lighter than off bottom, more than the lightest
+    string's weight at 2150 m; logged at 1 Hz the stop made a plateau that was taken for the
+    slips, every friction factor of the well withheld (string weight "0.16×"). The bit on
+    bottom (hole − bit depth ≤ on_bottom_m) is neither the slips nor the string hanging."""
+    wob, free = 118e3, 775e3
+    t = np.arange(0.0, 60.0)
+    on = t < 30.0
+    frame = pd.DataFrame({"time_s": t, "surface_rpm": np.zeros(t.size),
+                          "hookload_N": np.where(on, free - wob, free),
+                          "bit_depth_m": np.where(on, 2150.0, 2145.0),
+                          "hole_depth_m": np.full(t.size, 2150.0)})
+    frame.loc[29, "bit_depth_m"] = 2147.5  # the lift
+    plateaus = hookload.find_plateaus(frame, load_config())
+    assert [round(p.level_N / 1e3) for p in plateaus] == [775]  # the string hanging only
+    points = pd.DataFrame({"hookload_N": [free], "bit_depth_m": [2145.0]})
+    assert hookload.block_weight(plateaus, points, configured=False).weight_N is None
+    off = frame.assign(hole_depth_m=2160.0)  # the same stop 10 m off bottom: a plateau
+    assert len(hookload.find_plateaus(off, load_config())) == 2
+
+
 # --------------------------------------------------------------------------- the check
 def _record(i, hook, model, kind=Kind.OFF_BOTTOM):
     return SegmentRecord(id=i, kind=kind, bit_depth_m=2000.0, mu_k=0.25, mu_s_lower_bound=0.3,

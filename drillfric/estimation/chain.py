@@ -28,7 +28,7 @@ from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError
 from drillfric.estimation import batch, bit_torque, bit_trace
-from drillfric.estimation.batch.settings import MU_K_SKIP_S, TORQUE_SMOOTH_S
+from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
 from drillfric.estimation.gains import gains_from_config
@@ -303,9 +303,10 @@ def _td_cross_check(models: SegmentModels, cfg) -> float | None:
         return None
 
 
-#: Rotation left out after the top drive first exceeds ω_c when the fit is scored [s]
-#: (the start-up transient; the batch fit's μ_k skips the same).
-EVIDENCE_SKIP_S = MU_K_SKIP_S
+#: Rotation left out after the top drive first exceeds ω_c when the fit's evidence is scored
+#: [s]: a fixed start-up allowance for the misfit and swing shown beside a segment (the μ_k
+#: fit itself leaves out each run's own start-up, docs/theory.md §6.4 "Start-up").
+EVIDENCE_SKIP_S = 30.0
 
 
 @dataclass(frozen=True)

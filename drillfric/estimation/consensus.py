@@ -11,12 +11,16 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from scipy.stats import t as student_t
 
 from drillfric.result import Flag, Kind, SegmentRecord, Status
 
-#: Flags a short segment may carry and still be pooled (it is only too short).
+#: Flags a short segment may carry and still be pooled (it is only too short: a few torque
+#: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``
+#: concerns only the μ_s bound, withheld, not μ_k).
 _POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
-                       "estimators_disagree", "bit_speed_drift"})
+                       "estimators_disagree", "bit_speed_drift", "mu_k_uncertain",
+                       "bistable_regime"})
 #: Short segments pool when the string's friction torque added between their bit depths is
 #: at most this share of the torque at the deeper one, |ΔT_N|/T_N (docs/theory.md "Pooling
 #: along depth"). The reported μ_k is the torque-weighted mean of μ(x) over the whole
@@ -25,9 +29,10 @@ _POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
 POOL_TORQUE_SHARE = 0.10
 #: Without T_N (no torque and drag) segments pool only within this depth [m] (one stand).
 POOL_DEPTH_M = 5.0
-#: ...the 95 % half-width of their mean, 1.96·sd/√n, is within the converged tolerance
+#: ...the 95 % half-width of their mean, t₀.₉₇₅,ₙ₋₁·sd/√n (Student's t: 3–5 pieces hold
+#: little information on their own scatter), is within the converged tolerance
 #: (:func:`mu_k_tolerance`)...
-_Z95 = 1.96
+_P95 = 0.975
 #: ...and together they hold at least this much rotation [s] (the converged minimum).
 POOL_MIN_ROTATION_S = 90.0
 #: Validated μ_k tolerance (docs/validation.md) by effective sample interval [s]: logged
@@ -48,8 +53,18 @@ def mu_k_tolerance(sample_interval_s: float | None) -> float:
 
 
 def mean_half_width(mu: np.ndarray) -> float:
-    """95 % half-width of the mean of the pieces ``mu`` [-] (0 for one piece)."""
-    return float(_Z95 * np.std(mu, ddof=1) / np.sqrt(mu.size)) if mu.size > 1 else 0.0
+    """95 % half-width of the mean of the pieces ``mu`` [-], t₀.₉₇₅,ₙ₋₁·sd/√n (0 for one
+    piece): the sd of n pieces is itself uncertain, so the normal 1.96 would understate it
+    (by 6.5× for two pieces, 2.2× for three).
+
+    Examples
+    --------
+    >>> round(mean_half_width(np.array([0.24, 0.25, 0.26])), 4)
+    0.0248
+    """
+    if mu.size < 2:
+        return 0.0
+    return float(student_t.ppf(_P95, mu.size - 1) * np.std(mu, ddof=1) / np.sqrt(mu.size))
 
 
 def torque_share(a: SegmentRecord, b: SegmentRecord) -> float:

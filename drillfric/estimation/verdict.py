@@ -28,8 +28,9 @@ TYPICAL_MU = (0.05, 0.8)
 #: Ratio between batch and observer μ_k (either way) beyond which a segment is not
 #: converged (on synthetic truths the observer consensus is within ~25 %: docs/validation.md).
 DISAGREEMENT = 1.5
-#: Rotation a segment needs to count as converged [s]: the fit skips the first ~30 s of each
-#: run and its mean torque needs about a minute of stick-slip cycles (docs/batch_refinement.md).
+#: Rotation a segment needs to count as converged [s]: the fit leaves out each run's start-up
+#: (~10 s) and its mean torque needs about a minute of stick-slip cycles; shorter pieces
+#: count through pooling (docs/batch_refinement.md).
 MIN_CONVERGED_ROTATION_S = 90.0
 
 

@@ -5,9 +5,10 @@ smoothed, interpolated to the model step), α(0) = 2ω₀(t) − β(0), starting
 twist; its output is the string torque at the top τ(0) = ζ(ω₀ − β(0)), compared with the
 measured string torque τ_s = τ_m − I_TD dω̄₀/dt. From that model:
 
-- μ_k matches the **mean** string torque over the rotating samples (the first 30 s after
-  the top drive first exceeds ω_c in each rotating run are left out; data and model each
-  averaged over whole torque cycles) by a secant root find with a bounded slope that
+- μ_k matches the **mean** string torque over the rotating samples (each run's start-up
+  left out: until the top drive has turned the twist of the string wound to the run's
+  highest torque, plus a wave round trip; data and model each averaged over whole torque
+  cycles) by a secant root find with a bounded slope that
   returns a point it evaluated (the mean jitters between runs because stick-slip is
   chaotic), with the model in the data's regime (§6.4);
 - μ_s is fitted only where the data hold it, on creep start-ups logged at ≥ 2 Hz
@@ -19,7 +20,7 @@ measured string torque τ_s = τ_m − I_TD dω̄₀/dt. From that model:
   is given where sticking is not monotone in μ_s ("bistable_regime", §6.2, §6.4).
 
 Only the needed parts of a record are simulated: each rotating run (from just before its
-start) for μ_k, the first 90 s of rotation of one run for the onset scan, and each creep
+start) for μ_k, the start-up and the next 60 s of one run for the onset scan, and each creep
 (from the preceding rest) for μ_s. Everything is SI (rad/s, N·m, m, s).
 
 Modules (docs/batch_refinement.md "Code"):

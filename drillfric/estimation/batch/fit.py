@@ -231,7 +231,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     omega_c = settings.omega_c_rad_s
     creeps = find_creeps(data.t, data.drive, omega_c, torque_Nm=data.tau,
                          smooth_s=TORQUE_SMOOTH_S)
-    wins, notes = rotating_windows(data, settings)
+    wins, notes = rotating_windows(data, settings, *model.wind_up(cells))
     messages += notes
     flags: list[Flag] = []
     rotation = _Rotation.of(model, wins)
@@ -272,8 +272,9 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
 @dataclass(frozen=True)
 class _Rotation:
     """What the rotating windows of the data show: the whole-cycle mean string torque
-    [N·m], its fluctuation [-], whether the data stick-slip, and the mean top-drive speed
-    (a PI drive's set-point) [rad/s] (None/False/0 without windows)."""
+    [N·m], its fluctuation over the later half of each window [-], whether the data
+    stick-slip, and the mean top-drive speed (a PI drive's set-point) [rad/s]
+    (None/False/0 without windows)."""
 
     target_Nm: float | None = None
     fluctuation: float | None = None
@@ -287,7 +288,10 @@ class _Rotation:
             return cls()
         d = model.data
         used = np.concatenate([w.used for w in wins])
-        fluct = fluctuation(d.tau_bar[used])
+        # the regime where the start-up has had longest to die out: the later half of each
+        # window (a steady rotation's release still rings early on, docs/theory.md §6.4)
+        fluct = fluctuation(d.tau_bar[np.concatenate([w.used[w.used.size // 2:]
+                                                      for w in wins])])
         series = [d.tau[w.used] for w in wins]
         return cls(cycle_mean(series, d.dt), fluct, fluct > STICK_SLIP_FLUCTUATION,
                    float(np.mean(d.speed[used])), cycle_mean_error(series, d.dt))

@@ -19,6 +19,7 @@ from drillfric.estimation import creep
 from drillfric.estimation.batch.settings import (
     CREEP_DRIVE_SMOOTH_S,
     DRIVE_SMOOTH_S,
+    MIN_CYCLES,
     REST_BIT,
     STUCK_FRACTION,
     TORQUE_SMOOTH_S,
@@ -93,6 +94,10 @@ class FitData:
     def index(self, t_s: float) -> int:
         """The first sample at or after ``t_s`` [s] (clipped to the record)."""
         return int(np.clip(np.searchsorted(self.t, t_s - 1e-9 * self.dt), 0, self.t.size - 1))
+
+    def turned_rad(self, i0: int, i1: int) -> np.ndarray:
+        """Angle the top drive has turned since sample ``i0``, at samples i0..i1 [rad]."""
+        return np.cumsum(np.abs(self.drive[i0:i1 + 1])) * self.dt
 
 
 def prepare(time_s, surface_rad_s, torque_Nm, torque_kind: str,
@@ -196,6 +201,17 @@ class Model:
         """T_N of the estimated part: ∫F_c dx where μ is estimated [N·m]."""
         return self.t_parts(cells)[0]
 
+    def wind_up(self, cells: int) -> tuple[float, float]:
+        """(Θ/T_N, 2L/c) of the string (docs/theory.md §6.4 "Start-up"): the twist of a
+        string wound to break-away per N·m of top torque [rad/(N·m)], Θ/T_N =
+        ∫₀ᴸ τ(x)/(G J) dx / τ(0) with τ(x) = ∫ₓᴸ F_c dξ, and the wave round trip [s]."""
+        g, fc = self.grid(cells)
+        cell = fc * g.dx_true_m
+        below = np.cumsum(cell[::-1])[::-1] - 0.5 * cell  # below each cell's centre [N·m/μ]
+        gj = g.zeta_Nms * np.repeat(g.wave_speed_m_s, np.diff(g.section_start))
+        twist, t_n = float(np.sum(below * g.dx_true_m / gj)), float(np.sum(cell))
+        return (twist / t_n if t_n > 0 else 0.0), 2.0 * g.travel_time_s
+
     def t_parts(self, cells: int) -> tuple[float, float]:
         """(T_N of the estimated part, kinetic torque of the fixed part) [N·m]."""
         g, fc = self.grid(cells)
@@ -260,6 +276,46 @@ def sticks(bit_rad_s: np.ndarray, omega_c: float) -> bool:
     return bool(np.mean(np.abs(bit_rad_s) <= REST_BIT * omega_c) >= STUCK_FRACTION)
 
 
+def start_up_end(tau_Nm, turned_rad, dt_s: float, rad_per_Nm: float,
+                 round_trip_s: float) -> int | None:
+    """First sample past the start-up transient of a rotation that starts from rest, or
+    None when the series ends first (docs/theory.md §6.4 "Start-up").
+
+    The bit cannot break free before the top drive has turned the twist of the string
+    wound to its break-away torque, τ_b·Θ/T_N (:meth:`Model.wind_up`), and τ_b is at most
+    the highest 1-s smoothed torque of the series; one wave round trip later the release
+    of the bit has reached the top and come back.
+
+    Parameters
+    ----------
+    tau_Nm : array_like
+        String torque at the top from the run's start [N·m].
+    turned_rad : array_like
+        Angle the top drive has turned by each sample [rad].
+    dt_s : float
+        Sample interval [s].
+    rad_per_Nm : float
+        Θ/T_N, twist of the wound string per N·m of top torque [rad/(N·m)].
+    round_trip_s : float
+        Wave round trip 2L/c [s].
+
+    Examples
+    --------
+    >>> tau = np.r_[np.linspace(0.0, 10.0, 11), np.full(10, 8.0)]
+    >>> start_up_end(tau, np.arange(21.0), 1.0, 1.0, 2.0)
+    12
+    >>> start_up_end(tau, np.arange(21.0), 1.0, 2.0, 2.0) is None
+    True
+    """
+    tau = np.abs(np.asarray(tau_Nm, dtype=float))
+    peak = float(np.max(smooth(tau, dt_s, TORQUE_SMOOTH_S)))
+    wound = np.flatnonzero(np.abs(np.asarray(turned_rad, dtype=float)) >= peak * rad_per_Nm)
+    if wound.size == 0:
+        return None
+    end = int(wound[0] + np.ceil(round_trip_s / dt_s - 1e-9))
+    return end if end < tau.size else None
+
+
 def whole_cycles(tau_Nm, dt_s: float) -> slice:
     """Samples spanning whole torque cycles: from the first to the last upward crossing of
     the 1-s smoothed torque through its mean (all samples with fewer than two crossings).
@@ -276,9 +332,21 @@ def whole_cycles(tau_Nm, dt_s: float) -> slice:
     (1, 73)
     """
     x = np.asarray(tau_Nm, dtype=float)
-    xb = smooth(x, dt_s, TORQUE_SMOOTH_S)
-    up = np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
+    up = up_crossings(x, dt_s)
     return slice(int(up[0]), int(up[-1])) if up.size >= 2 else slice(0, x.size)
+
+
+def up_crossings(tau_Nm, dt_s: float) -> np.ndarray:
+    """Samples where the 1-s smoothed torque crosses its mean upwards: the bounds of the
+    whole torque cycles of a series (one fewer cycles than crossings).
+
+    Examples
+    --------
+    >>> up_crossings(np.sin(np.linspace(0.0, 5.5 * np.pi, 100)), 1.0).tolist()
+    [1, 37, 73]
+    """
+    xb = smooth(np.asarray(tau_Nm, dtype=float), dt_s, TORQUE_SMOOTH_S)
+    return np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
 
 
 def cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
@@ -288,7 +356,8 @@ def cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
 
 def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int] | None:
     """Standard error of :func:`cycle_mean` from the scatter of its cycles [N·m], and the
-    number of whole cycles; None with fewer than 3 (docs/theory.md §6.4 "Uncertainty of μ_k").
+    number of whole cycles; None with fewer than :data:`MIN_CYCLES` (docs/theory.md §6.4
+    "Uncertainty of μ_k").
 
     Each whole torque cycle (between upward crossings of the 1-s smoothed torque through its
     mean) gives one mean; the pooled mean is their length-weighted average, and its standard
@@ -305,11 +374,10 @@ def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int]
     means, lengths = [], []
     for x in series:
         x = np.asarray(x, dtype=float)
-        xb = smooth(x, dt_s, TORQUE_SMOOTH_S)
-        up = np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
+        up = up_crossings(x, dt_s)
         means += [float(np.mean(x[a:b])) for a, b in zip(up[:-1], up[1:], strict=True)]
         lengths += [float(b - a) for a, b in zip(up[:-1], up[1:], strict=True)]
-    if len(means) < 3:
+    if len(means) < MIN_CYCLES:
         return None
     m, w = np.asarray(means), np.asarray(lengths)
     mean = float(np.sum(w * m) / np.sum(w))

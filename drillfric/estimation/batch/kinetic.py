@@ -1,8 +1,9 @@
 """μ_k of a record by mean-torque matching, with the model in the data's regime
 (docs/theory.md §6.4).
 
-The whole-cycle mean of the measured string torque over the rotating samples (the first
-:data:`MU_K_SKIP_S` after the top drive first exceeds ω_c left out) is matched by the model's
+The whole-cycle mean of the measured string torque over the rotating samples (each run's
+start-up transient left out, :func:`~drillfric.estimation.batch.harness.start_up_end`) is
+matched by the model's
 with a secant root find whose slope is bounded and which returns a point it evaluated: the
 model's mean jitters between runs because stick-slip is chaotic.
 """
@@ -14,10 +15,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drillfric.estimation.batch.harness import FitData, Model, Window, cycle_mean, sticks
+from drillfric.estimation.batch.harness import (
+    FitData,
+    Model,
+    Window,
+    cycle_mean,
+    start_up_end,
+    sticks,
+    up_crossings,
+)
 from drillfric.estimation.batch.settings import (
+    MIN_CYCLES,
     MU_K_MAX_RUNS,
-    MU_K_SKIP_S,
     MU_K_TOLERANCE,
     PRE_ROLL_S,
     PROVISIONAL_RATIO,
@@ -27,25 +36,41 @@ from drillfric.estimation.creep import bridge_loaded_dips, rotating_runs
 from drillfric.result import Flag
 
 
-def rotating_windows(data: FitData, settings: BatchSettings) -> tuple[list[Window], list[str]]:
-    """One window per rotating run with samples ≥ :data:`MU_K_SKIP_S` after first exceeding
-    ω_c; a loaded stop within ``settings.dip_max_s`` does not end a run (the segmentation's
-    rule). Returns the windows and a note per run left out."""
+def rotating_windows(data: FitData, settings: BatchSettings, rad_per_Nm: float,
+                     round_trip_s: float) -> tuple[list[Window], list[str]]:
+    """One window per rotating run that outlasts its start-up transient (:func:`start_up_end`
+    with Θ/T_N ``rad_per_Nm`` [rad/(N·m)] and the wave round trip ``round_trip_s`` [s],
+    docs/theory.md §6.4 "Start-up") by :data:`MIN_CYCLES` whole torque cycles, compared
+    from there to the run's end; a loaded stop
+    within ``settings.dip_max_s`` does not end a run (the segmentation's rule). Returns the
+    windows and a note per run left out."""
     omega_c = settings.omega_c_rad_s
     pre = int(round(PRE_ROLL_S / data.dt))
     wins, notes = [], []
     for i0, i1 in bridge_loaded_dips(rotating_runs(data.w_bar, omega_c), data.t, data.tau_bar,
                                      max_dip_s=settings.dip_max_s,
                                      fraction=settings.dip_torque_fraction):
-        fast = np.flatnonzero(data.w_bar[i0:i1 + 1] > omega_c)
-        if fast.size == 0:
+        if not np.any(data.w_bar[i0:i1 + 1] > omega_c):
             continue
-        first = data.index(data.t[i0 + fast[0]] + MU_K_SKIP_S)
-        if first >= i1:
-            notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s shorter than "
-                         f"{MU_K_SKIP_S:.0f} s after reaching ω_c: not used for μ_k")
+        turned = data.turned_rad(i0, i1)
+        end = start_up_end(data.tau[i0:i1 + 1], turned, data.dt, rad_per_Nm, round_trip_s)
+        if end is None:
+            peak = float(np.max(data.tau_bar[i0:i1 + 1]))
+            notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s ended within its "
+                         f"start-up: winding the string to {peak / 1e3:.1f} kN·m takes "
+                         f"{peak * rad_per_Nm:.0f} rad of top-drive turning and a "
+                         f"{round_trip_s:.1f}-s wave round trip, the run turned "
+                         f"{turned[-1]:.0f} rad: not used for μ_k")
             continue
-        wins.append(Window(max(0, i0 - pre), i1, np.arange(first, i1 + 1)))
+        cycles = up_crossings(data.tau[i0 + end:i1 + 1], data.dt).size - 1
+        if cycles < MIN_CYCLES:
+            notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s holds "
+                         f"{max(cycles, 0)} whole torque cycles after its start-up (ended "
+                         f"{data.t[i0 + end] - data.t[i0]:.0f} s in), fewer than "
+                         f"{MIN_CYCLES}: its mean torque has no stated uncertainty, not used "
+                         "for μ_k")
+            continue
+        wins.append(Window(max(0, i0 - pre), i1, np.arange(i0 + end, i1 + 1)))
     return wins, notes
 
 
@@ -73,12 +98,19 @@ def secant(residual: Callable[[float], float], x0: float, slope0: float, lo: flo
 def _pooled_mean(model: Model, wins: list[Window], mu_s: float, mu_k: float,
                  cells: int) -> tuple[float, np.ndarray]:
     """Whole-cycle mean model torque over the used samples of all windows [N·m], and the
-    bits' speeds there [rad/s]."""
+    bits' speeds there [rad/s]; samples within the model's own start-up (its highest torque
+    may wind the string further than the data's, :func:`start_up_end`) are left out."""
     taus, bits = [], []
+    rad_per_Nm, round_trip_s = model.wind_up(cells)
     for w in wins:
         tau, bit = model.simulate(w, mu_s, mu_k, cells)
-        taus.append(tau[w.used - w.sim0])
-        bits.append(bit[w.used - w.sim0])
+        own = start_up_end(tau, model.data.turned_rad(w.sim0, w.end), model.data.dt,
+                           rad_per_Nm, round_trip_s)
+        keep = w.used - w.sim0
+        if own is not None and np.any(keep >= own):
+            keep = keep[keep >= own]
+        taus.append(tau[keep])
+        bits.append(bit[keep])
     return cycle_mean(taus, model.data.dt), np.concatenate(bits)
 
 

@@ -1,9 +1,10 @@
 """A lower bound on μ_s from the stick-slip onset (docs/theory.md §6.2, §6.4).
 
-Where stick-slip data hold no creep that identifies μ_s, the model is run on the first
-:data:`SCAN_ROTATION_S` of rotation of one run for μ_s on a grid above μ_k: the highest μ_s
-below which the model's bit never sticks bounds the truth from below. None is given where
-sticking is not monotone in μ_s (bistable) or never happens below ``observer.mu_max``.
+Where stick-slip data hold no creep that identifies μ_s, the model is run on the start-up
+and the next :data:`SCAN_COMPARED_S` of rotation of one run for μ_s on a grid above μ_k:
+the highest μ_s below which the model's bit never sticks bounds the truth from below. None
+is given where sticking is not monotone in μ_s (bistable) or never happens below
+``observer.mu_max``.
 """
 
 from __future__ import annotations
@@ -12,9 +13,8 @@ from dataclasses import dataclass
 
 from drillfric.estimation.batch.harness import Model, Window, sticks
 from drillfric.estimation.batch.settings import (
-    MU_K_SKIP_S,
+    SCAN_COMPARED_S,
     SCAN_CONFIRM,
-    SCAN_ROTATION_S,
     SCAN_STEP,
 )
 from drillfric.friction import CASED_STATIC
@@ -71,11 +71,12 @@ class BoundOutcome:
 
 def onset_bound(model: Model, wins: list[Window], mu_k: float, cells: int,
                 had_creep: bool = False) -> BoundOutcome:
-    """Stick-slip-onset lower bound on μ_s over the first 90 s of rotation of the longest
-    run. With a cased zone of unknown static friction the scan runs under both hypotheses
-    and the lower bound is kept (a bound above the truth is a false claim)."""
+    """Stick-slip-onset lower bound on μ_s over the start-up and the first
+    :data:`SCAN_COMPARED_S` after it of the longest run. With a cased zone of unknown
+    static friction the scan runs under both hypotheses and the lower bound is kept (a
+    bound above the truth is a false claim)."""
     w = max(wins, key=lambda w: w.used.size)
-    last = min(w.end, w.used[0] + int(round((SCAN_ROTATION_S - MU_K_SKIP_S) / model.data.dt)))
+    last = min(w.end, w.used[0] + int(round(SCAN_COMPARED_S / model.data.dt)))
     scan_win = Window(w.sim0, last, w.used[w.used <= last])
     bound, bistable, scan = onset_scan(model, scan_win, mu_k, cells)
     if not model.profile.static_known and bound is not None and not bistable:

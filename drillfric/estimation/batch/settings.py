@@ -67,7 +67,9 @@ TORQUE_SMOOTH_S = 1.0  #: smoothing of torques compared in the creep misfit [s]
 CREEP_DRIVE_SMOOTH_S = 4.0  #: smoothing of the speed driving a creep (keeps its angle) [s]
 
 # --- the μ_k fit by mean-torque matching (docs/theory.md §6.4) -----------------------------
-MU_K_SKIP_S = 30.0  #: rotating samples left out after the top drive first exceeds ω_c [s]
+#: Whole torque cycles a rotating run must hold after its start-up to be compared: fewer
+#: give no standard error of the mean torque, so no stated uncertainty of μ_k (§6.4).
+MIN_CYCLES = 3
 STICK_SLIP_FLUCTUATION = 0.1  #: data stick-slip when std/mean of the smoothed torque exceeds
 PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
 MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
@@ -82,7 +84,7 @@ STUCK_FRACTION = 0.01  #: the model's bit sticks when this share of samples is n
 REST_BIT = 0.1  #: the bit is near rest below this fraction of ω_c
 SCAN_STEP = 0.02  #: μ_s grid step of the onset scan
 SCAN_CONFIRM = 3  #: grid points above the first sticking one that must stick too
-SCAN_ROTATION_S = 90.0  #: rotation simulated per onset-scan point (30 s skipped + 60 s) [s]
+SCAN_COMPARED_S = 60.0  #: rotation compared after the start-up per onset-scan point [s]
 
 # --- the creep fit of μ_s (docs/theory.md §6.3–§6.4) ---------------------------------------
 CREEP_CELLS_PER_MD = 1000  #: creep fits at Δx ≤ MD/1000
