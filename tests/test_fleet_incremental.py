@@ -199,3 +199,73 @@ def test_folder_of_hourly_files_continues_with_the_grown_and_the_new_files(stand
         well / "hourly" / "h01.csv", index=False)
     run_many([WellSpec(well)], out, workers=1)
     assert _summary(out)["resumed"]["reason"].startswith("h01.csv: earlier rows changed")
+
+
+#: Units a WITSML export of the simulated well states (its columns are SI, named so).
+_WITSML_UNITS = {"time_s": "s", "surface_rpm": "rpm", "surface_torque_Nm": "N.m",
+                 "hookload_N": "N", "bit_depth_m": "m", "hole_depth_m": "m", "bit_rpm": "rpm",
+                 "string_torque_Nm": "N.m"}
+
+
+def _witsml_part(frame: pd.DataFrame) -> str:
+    """``frame`` as one numbered part of a WITSML log indexed by elapsed time."""
+    from tests.io.test_witsml import _curve, _doc, _log
+
+    names = list(frame.columns)
+    units = [_WITSML_UNITS[n] for n in names]
+    curves = "".join(_curve(n, u) for n, u in zip(names, units, strict=True))
+    rows = frame.to_csv(header=False, index=False, lineterminator="\n").splitlines()
+    return _doc(_log(rows, mnemonics=",".join(names), units=",".join(units), curves=curves,
+                     index="elapsed time", index_curve="time_s"))
+
+
+def _witsml_well(stands, tmp_path):
+    """A folder ``three/`` for WITSML numbered parts, its sidecars beside it; the well's
+    rows and where each of its six parts ends."""
+    path, _ = stands
+    frame = pd.read_csv(path)
+    folder = tmp_path / "wells" / "three"
+    folder.mkdir(parents=True)
+    shutil.copy(path.with_suffix(".survey.csv"), folder.parent / "three.survey.csv")
+    (folder.parent / "three.toml").write_text(
+        path.with_suffix(".toml").read_text().replace('data = "three.csv"\n', ""))
+    return folder, frame, np.linspace(0, len(frame), 7).astype(int)
+
+
+def test_witsml_log_in_numbered_parts_continues_with_the_new_parts(stands, tmp_path):
+    """A WITSML log exported as numbered files (00001.xml …): the parts read before are
+    recognised by their rows' content; the new parts' rows only are read, the results are
+    those of a run over all the parts. An earlier part edited: redone whole, the part
+    named."""
+    folder, frame, bounds = _witsml_well(stands, tmp_path)
+    parts = [frame.iloc[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    for i, part in enumerate(parts[:3]):
+        (folder / f"{i + 1:05d}.xml").write_text(_witsml_part(part))
+    out = tmp_path / "out"
+    assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
+    for i, part in enumerate(parts[3:], start=3):
+        (folder / f"{i + 1:05d}.xml").write_text(_witsml_part(part))
+    assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": bounds[3], "reason": ""}
+    whole = run_well(open_well(folder))
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    edited = parts[1].assign(surface_rpm=parts[1]["surface_rpm"] + 0.5)
+    (folder / "00002.xml").write_text(_witsml_part(edited))
+    run_many([WellSpec(folder)], out, workers=1)
+    assert _summary(out)["resumed"]["reason"].startswith("00002.xml: earlier rows changed")
+
+
+def test_witsml_last_part_rewritten_with_more_rows_continues(stands, tmp_path):
+    """The store rewrote its last, still filling part with more rows (its header changed
+    too): continued from the row where the last run stopped."""
+    folder, frame, bounds = _witsml_well(stands, tmp_path)
+    (folder / "00001.xml").write_text(_witsml_part(frame.iloc[:bounds[2]]))
+    (folder / "00002.xml").write_text(_witsml_part(frame.iloc[bounds[2]:bounds[4]]))
+    out = tmp_path / "out"
+    run_many([WellSpec(folder)], out, workers=1)
+    (folder / "00002.xml").write_text(_witsml_part(frame.iloc[bounds[2]:]).replace(
+        "<name>Surface</name>", "<name>Surface</name><objectGrowing>false</objectGrowing>"))
+    assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": bounds[4], "reason": ""}

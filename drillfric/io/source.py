@@ -44,7 +44,14 @@ class RawSource:
         source, in reading order; else empty.
     seek : str or None
         How :meth:`window` addresses rows: ``"byte"`` (a delimited text file: byte
-        offsets), ``"row"`` (Parquet: row numbers); None: the source is read whole.
+        offsets), ``"row"`` (Parquet, WITSML, HDF5, LAS: row numbers); None: the source is
+        read whole.
+    digest : callable or None
+        ``digest(n)``: a SHA-256 (hex) of what gives the values of the first ``n`` rows (None:
+        of all :attr:`rows`) — their stated columns, units and contents — for a source whose
+        growth is recognised by its rows' content rather than its bytes (a WITSML log
+        rewritten with more rows, an HDF5 table, a LAS file: docs/fleet.md "Only what is
+        new"); None for the others.
     """
 
     path: Path
@@ -56,6 +63,8 @@ class RawSource:
     depth_index: str | None = None
     seek: str | None = None
     parts: tuple = ()
+    digest: Callable[[int | None], str] | None = field(default=None, repr=False,
+                                                       compare=False)
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
