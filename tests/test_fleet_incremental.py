@@ -269,3 +269,25 @@ def test_witsml_last_part_rewritten_with_more_rows_continues(stands, tmp_path):
         "<name>Surface</name>", "<name>Surface</name><objectGrowing>false</objectGrowing>"))
     assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
     assert _summary(out)["resumed"] == {"from_row": bounds[4], "reason": ""}
+
+
+def test_csv_cut_mid_line_continues_from_its_last_complete_line(stands, tmp_path):
+    """The rig logger was writing a line at the nightly cut: that night's results count the
+    part-written row, the state stops before it; the next night reads it again, complete,
+    and continues (not redone whole): the whole file's results."""
+    path, whole = stands
+    data = tmp_path / "wells" / path.name
+    lines = _grow(path, data, 0.5)
+    half = len(lines) // 2
+    cut = lines[half][: len(lines[half]) // 2]  # "12.34,5" of "12.34,56.7,…\n"
+    with open(data, "ab") as fh:
+        fh.write(cut)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["inputs"]["rows"] == half  # header line 0: half - 1 rows, the cut
+    with open(data, "ab") as fh:
+        fh.write(lines[half][len(cut):] + b"".join(lines[half + 1:]))
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": half - 1, "reason": ""}
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)

@@ -4,8 +4,10 @@
 A data file that grew is recognised by its content, not its name or date (:func:`mark`,
 :func:`changed`):
 
-- a delimited text file: the byte length read, a SHA-256 of those bytes and whether they
-  ended with a complete line; it continues when its first bytes hash the same;
+- a delimited text file: the bytes up to its last complete line, a SHA-256 of them; it
+  continues when its first bytes hash the same (a last line not ended yet — the logger
+  writing it at the nightly cut — is read for tonight's results, but not continued from:
+  :func:`tail`, read again complete the next night);
 - a Parquet file rewritten with more rows: a SHA-256 of each row group's bytes, and of the
   last group's values; it continues when the same groups come first — the last one may
   have been rewritten larger, then its first rows must hold the same values;
@@ -37,14 +39,17 @@ from .finish import DirectorySink
 from .state import read_state
 
 _BLOCK = 1 << 22
+_TAIL_BLOCK = 1 << 16
 
 
 def mark(well: Well) -> dict:
     """What a run reads of the well's data now (for a folder of files: of each file)."""
     source = well.source
     if source.parts:
+        last = len(source.parts) - 1
         return {"format": "parts", "columns": list(source.columns), "units": _units(source),
-                "parts": [{"name": p.path.name} | source_mark(p) for p in source.parts]}
+                "parts": [{"name": p.path.name} | source_mark(p, whole=i < last)
+                          for i, p in enumerate(source.parts)]}
     return source_mark(source)
 
 
@@ -53,11 +58,14 @@ def _units(source) -> dict:
     return {k: v for k, v in sorted(source.units.items(), key=str) if isinstance(k, str)}
 
 
-def source_mark(source) -> dict:
-    """What a run reads of one file now."""
+def source_mark(source, *, whole: bool = False) -> dict:
+    """What a run reads of one file now (a delimited text file: up to its last complete
+    line, unless ``whole`` — a part of a log followed by others)."""
     kind = _kind(source)
     if kind == "csv":
-        return csv_mark(source.path, source.path.stat().st_size)
+        size = source.path.stat().st_size
+        return csv_mark(source.path, size if whole else lines_end(source.path, size)) \
+            | {"end": size}
     if kind == "rows":
         return {"format": "rows", "rows": source.rows, "sha256": source.digest(None)}
     return parquet_mark(source.path, source)
@@ -87,6 +95,31 @@ def unread(well: Well, before: dict | None, now: dict, chunk_rows: int):
         if i >= k:
             start = _end(before["parts"][i]) if before and i == k else 0
             yield from part.window(start, _end(found), chunk_rows)
+
+
+def tail(well: Well, now: dict, chunk_rows: int):
+    """The raw rows past the mark ``now`` up to the end of the data: a last line not ended
+    yet (fed to :meth:`~drillfric.runner.engine.Engine.close`, not to the state)."""
+    source, found = (well.source.parts[-1], now["parts"][-1]) if well.source.parts \
+        else (well.source, now)
+    if found["format"] == "csv" and found["end"] > found["bytes"]:
+        yield from source.window(found["bytes"], found["end"], chunk_rows)
+
+
+def lines_end(path: Path, size: int) -> int:
+    """Where the last complete line (ended by LF or CR) of a file's first ``size`` bytes
+    ends (0: none), read backwards from ``size``."""
+    with open(path, "rb") as fh:
+        end = size
+        while end > 0:
+            begin = max(end - _TAIL_BLOCK, 0)
+            fh.seek(begin)
+            block = fh.read(end - begin)
+            at = max(block.rfind(b"\n"), block.rfind(b"\r"))
+            if at >= 0:
+                return begin + at + 1
+            end = begin
+    return 0
 
 
 def csv_mark(path: Path, size: int) -> dict:
@@ -183,7 +216,7 @@ def _source_changed(found: dict | None, source) -> str:
     size = path.stat().st_size
     if size < found["bytes"]:
         return f"the file is shorter than the {found['bytes']} bytes read before"
-    if not found.get("ends_line"):
+    if not found.get("ends_line") and size > found["bytes"]:
         return "the earlier rows did not end with a complete line"
     if csv_mark(path, found["bytes"])["sha256"] != found["sha256"]:
         return "earlier rows changed (the first bytes differ from those read before)"
