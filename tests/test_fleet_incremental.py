@@ -291,3 +291,58 @@ def test_csv_cut_mid_line_continues_from_its_last_complete_line(stands, tmp_path
     assert _summary(out)["resumed"] == {"from_row": half - 1, "reason": ""}
     written = pd.read_parquet(out / "three" / "segments.parquet")
     _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+
+def _hdf5(frame: pd.DataFrame, path) -> None:
+    """``frame`` as a group of 1-D datasets with unit attributes (a rig recorder's HDF5)."""
+    import h5py
+
+    with h5py.File(path, "w") as h5:
+        group = h5.create_group("surface")
+        for name in frame.columns:
+            group[name] = frame[name].to_numpy()
+            group[name].attrs["unit"] = _WITSML_UNITS[name]
+
+
+#: LAS mnemonics of the simulated well's surface channels (lasio reads names upper case).
+_LAS_NAMES = {"time_s": "TIME", "surface_rpm": "SURF_RPM", "surface_torque_Nm": "TORQUE",
+              "hookload_N": "HKLD", "bit_depth_m": "BITDEP", "hole_depth_m": "HDTH"}
+
+
+def _las(frame: pd.DataFrame, path) -> None:
+    import lasio
+
+    las = lasio.LASFile()
+    for name, mnemonic in _LAS_NAMES.items():
+        las.append_curve(mnemonic, frame[name].to_numpy(), unit=_WITSML_UNITS[name])
+    las.write(str(path), version=2.0, fmt="%.10g")
+
+
+@pytest.mark.parametrize("suffix, write", [(".h5", _hdf5), (".las", _las)])
+def test_hdf5_and_las_rewritten_with_more_rows_continue(stands, tmp_path, suffix, write):
+    """An HDF5 table or a LAS file written again with more rows: its earlier rows are
+    recognised by their values (and the columns and units stated), only the new rows are
+    read, the results are those of a run over the whole file. An earlier value changed:
+    redone whole with the reason."""
+    path, _ = stands
+    frame = pd.read_csv(path)
+    data = tmp_path / "wells" / f"three{suffix}"
+    _grow(path, data.with_suffix(".csv"), 0.0)
+    data.with_suffix(".csv").unlink()
+    toml = data.with_suffix(".toml")
+    toml.write_text(toml.read_text().replace('data = "three.csv"', f'data = "{data.name}"'))
+    first = int(len(frame) * 0.55)
+    write(frame.iloc[:first], data)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    write(frame, data)
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": first, "reason": ""}
+    whole = run_well(open_well(data))
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    write(frame.assign(surface_rpm=frame["surface_rpm"].where(frame.index != 10, 99.0)), data)
+    run_many([WellSpec(data)], out, workers=1)
+    reason = _summary(out)["resumed"]["reason"]
+    assert reason.startswith(f"earlier rows changed (the first {len(frame)} rows"), reason
