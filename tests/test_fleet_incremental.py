@@ -346,3 +346,27 @@ def test_hdf5_and_las_rewritten_with_more_rows_continue(stands, tmp_path, suffix
     run_many([WellSpec(data)], out, workers=1)
     reason = _summary(out)["resumed"]["reason"]
     assert reason.startswith(f"earlier rows changed (the first {len(frame)} rows"), reason
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_stick_slip_well_fed_by_appends_at_random_bytes_ends_as_the_whole(stick_slip, tmp_path,
+                                                                          seed):
+    """The second plant (a soft drive that stick-slips: many short segments): a fleet re-run
+    after each of three appends cut at random bytes (mostly mid-line, as a logger writing
+    at the nightly cut leaves it) ends with the whole file's segments, kinds, statuses and
+    friction numbers, each re-run continuing from the last."""
+    path, whole = stick_slip
+    data = tmp_path / "wells" / path.name
+    _grow(path, data, 0.0)
+    text = path.read_bytes()
+    cuts = np.sort(np.random.default_rng(seed).integers(len(text) // 10, len(text), size=3))
+    out = tmp_path / "out"
+    for a, b in zip([0, *cuts], [*cuts, len(text)], strict=True):
+        with open(data, "ab") as fh:
+            fh.write(text[a:b])
+        assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+        if a:
+            resumed = _summary(out, "soft")["resumed"]
+            assert resumed["reason"] == "" and resumed["from_row"] == text[:a].count(b"\n") - 1
+    written = pd.read_parquet(out / "soft" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out, "soft"), written), whole)
