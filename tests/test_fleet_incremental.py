@@ -270,6 +270,18 @@ def test_witsml_last_part_rewritten_with_more_rows_continues(stands, tmp_path):
     assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
     assert _summary(out)["resumed"] == {"from_row": bounds[4], "reason": ""}
 
+    single = folder.parent / "one.xml"  # one WITSML file, rewritten with more rows alike
+    shutil.copy(folder.parent / "three.toml", single.with_suffix(".toml"))
+    shutil.copy(folder.parent / "three.survey.csv", single.with_suffix(".survey.csv"))
+    single.with_suffix(".toml").write_text(single.with_suffix(".toml").read_text().replace(
+        'file = "three.survey.csv"', 'file = "one.survey.csv"').replace('name = "three"',
+                                                                        'name = "one"'))
+    single.write_text(_witsml_part(frame.iloc[:bounds[5]]))
+    run_many([WellSpec(single)], out, workers=1)
+    single.write_text(_witsml_part(frame))
+    assert run_many([WellSpec(single)], out, workers=1).count("ok") == 1
+    assert _summary(out, "one")["resumed"] == {"from_row": bounds[5], "reason": ""}
+
 
 def test_csv_cut_mid_line_continues_from_its_last_complete_line(stands, tmp_path):
     """The rig logger was writing a line at the nightly cut: that night's results count the
