@@ -23,6 +23,7 @@ import hashlib
 import json
 import os
 import socket
+import sys
 import time
 import uuid
 import warnings
@@ -143,7 +144,11 @@ def _claim(task: WellTask, dir_name: str) -> None:
 
 def _one_kernel_thread() -> None:
     """On a Dask worker (one task per core) the compiled kernels run on this thread only:
-    numba's parallel observer members (docs/performance.md) would oversubscribe the cores."""
+    numba's parallel observer members (docs/performance.md) would oversubscribe the cores.
+    A process that has not imported distributed is no Dask worker (the check then costs
+    nothing: importing distributed takes 0.2 s, docs/performance.md)."""
+    if "distributed" not in sys.modules:
+        return
     try:
         from distributed import get_worker
 

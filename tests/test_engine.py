@@ -29,21 +29,27 @@ def _same_results(result, whole) -> None:
         x, y = a[name].to_numpy(float), b[name].to_numpy(float)
         assert (np.isnan(x) == np.isnan(y)).all(), name
         np.testing.assert_allclose(x[~np.isnan(x)], y[~np.isnan(y)], rtol=AGREE, err_msg=name)
-    assert result.summary["mu_k"] == pytest.approx(whole.summary["mu_k"], rel=AGREE)
+    if whole.summary["mu_k"] is None:  # withheld for the well: withheld alike
+        assert result.summary["mu_k"] is None
+    else:
+        assert result.summary["mu_k"] == pytest.approx(whole.summary["mu_k"], rel=AGREE)
 
 
-@pytest.mark.parametrize("seed", [1, 2, 3])
-def test_chunks_of_random_size_and_a_saved_state_give_the_whole_run(stands, tmp_path, seed):
-    """Chunks of 1 … 20 000 rows (boundaries inside stands, pre-rolls and connections), a
-    peek at the results half-way and the state written to disk and read back between
-    chunks: the same segments, kinds, statuses and friction numbers as the whole file."""
-    path, whole = stands
+@pytest.mark.parametrize("plant, seed", [("stands", s) for s in range(1, 11)]
+                         + [("stick_slip", s) for s in range(1, 11)])
+def test_chunks_of_random_size_and_a_saved_state_give_the_whole_run(request, tmp_path, plant,
+                                                                    seed):
+    """Chunks of 1 … 20 000 rows (boundaries inside stands, pre-rolls, connections and
+    stick-slip stalls), a peek at the results half-way and the state written to disk and
+    read back between chunks: the same segments, kinds, statuses and friction numbers as
+    the whole file — for a stiff drive turning smoothly and a soft one that stick-slips."""
+    path, whole = request.getfixturevalue(plant)
     frame = pd.read_csv(path)
     rng = np.random.default_rng(seed)
     cuts = np.cumsum(rng.integers(1, 20_000, size=40))
     cuts = np.unique(np.r_[0, cuts[cuts < len(frame)], len(frame)])
     well = open_well(frame=frame.iloc[:cuts[1]], config=path.with_suffix(".toml"),
-                     survey=path.with_suffix(".survey.csv"), name="three")
+                     survey=path.with_suffix(".survey.csv"), name=path.stem)
     engine = Engine(well)
     for k, (a, b) in enumerate(zip(cuts[:-1], cuts[1:], strict=True)):
         engine.feed(frame.iloc[a:b])

@@ -199,3 +199,186 @@ def test_folder_of_hourly_files_continues_with_the_grown_and_the_new_files(stand
         well / "hourly" / "h01.csv", index=False)
     run_many([WellSpec(well)], out, workers=1)
     assert _summary(out)["resumed"]["reason"].startswith("h01.csv: earlier rows changed")
+
+
+#: Units a WITSML export of the simulated well states (its columns are SI, named so).
+_WITSML_UNITS = {"time_s": "s", "surface_rpm": "rpm", "surface_torque_Nm": "N.m",
+                 "hookload_N": "N", "bit_depth_m": "m", "hole_depth_m": "m", "bit_rpm": "rpm",
+                 "string_torque_Nm": "N.m"}
+
+
+def _witsml_part(frame: pd.DataFrame) -> str:
+    """``frame`` as one numbered part of a WITSML log indexed by elapsed time."""
+    from tests.io.test_witsml import _curve, _doc, _log
+
+    names = list(frame.columns)
+    units = [_WITSML_UNITS[n] for n in names]
+    curves = "".join(_curve(n, u) for n, u in zip(names, units, strict=True))
+    rows = frame.to_csv(header=False, index=False, lineterminator="\n").splitlines()
+    return _doc(_log(rows, mnemonics=",".join(names), units=",".join(units), curves=curves,
+                     index="elapsed time", index_curve="time_s"))
+
+
+def _witsml_well(stands, tmp_path):
+    """A folder ``three/`` for WITSML numbered parts, its sidecars beside it; the well's
+    rows and where each of its six parts ends."""
+    path, _ = stands
+    frame = pd.read_csv(path)
+    folder = tmp_path / "wells" / "three"
+    folder.mkdir(parents=True)
+    shutil.copy(path.with_suffix(".survey.csv"), folder.parent / "three.survey.csv")
+    (folder.parent / "three.toml").write_text(
+        path.with_suffix(".toml").read_text().replace('data = "three.csv"\n', ""))
+    return folder, frame, np.linspace(0, len(frame), 7).astype(int)
+
+
+def test_witsml_log_in_numbered_parts_continues_with_the_new_parts(stands, tmp_path):
+    """A WITSML log exported as numbered files (00001.xml …): the parts read before are
+    recognised by their rows' content; the new parts' rows only are read, the results are
+    those of a run over all the parts. An earlier part edited: redone whole, the part
+    named."""
+    folder, frame, bounds = _witsml_well(stands, tmp_path)
+    parts = [frame.iloc[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    for i, part in enumerate(parts[:3]):
+        (folder / f"{i + 1:05d}.xml").write_text(_witsml_part(part))
+    out = tmp_path / "out"
+    assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
+    for i, part in enumerate(parts[3:], start=3):
+        (folder / f"{i + 1:05d}.xml").write_text(_witsml_part(part))
+    assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": bounds[3], "reason": ""}
+    whole = run_well(open_well(folder))
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    edited = parts[1].assign(surface_rpm=parts[1]["surface_rpm"] + 0.5)
+    (folder / "00002.xml").write_text(_witsml_part(edited))
+    run_many([WellSpec(folder)], out, workers=1)
+    assert _summary(out)["resumed"]["reason"].startswith("00002.xml: earlier rows changed")
+
+
+def test_witsml_last_part_rewritten_with_more_rows_continues(stands, tmp_path):
+    """The store rewrote its last, still filling part with more rows (its header changed
+    too): continued from the row where the last run stopped."""
+    folder, frame, bounds = _witsml_well(stands, tmp_path)
+    (folder / "00001.xml").write_text(_witsml_part(frame.iloc[:bounds[2]]))
+    (folder / "00002.xml").write_text(_witsml_part(frame.iloc[bounds[2]:bounds[4]]))
+    out = tmp_path / "out"
+    run_many([WellSpec(folder)], out, workers=1)
+    (folder / "00002.xml").write_text(_witsml_part(frame.iloc[bounds[2]:]).replace(
+        "<name>Surface</name>", "<name>Surface</name><objectGrowing>false</objectGrowing>"))
+    assert run_many([WellSpec(folder)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": bounds[4], "reason": ""}
+
+    single = folder.parent / "one.xml"  # one WITSML file, rewritten with more rows alike
+    shutil.copy(folder.parent / "three.toml", single.with_suffix(".toml"))
+    shutil.copy(folder.parent / "three.survey.csv", single.with_suffix(".survey.csv"))
+    single.with_suffix(".toml").write_text(single.with_suffix(".toml").read_text().replace(
+        'file = "three.survey.csv"', 'file = "one.survey.csv"').replace('name = "three"',
+                                                                        'name = "one"'))
+    single.write_text(_witsml_part(frame.iloc[:bounds[5]]))
+    run_many([WellSpec(single)], out, workers=1)
+    single.write_text(_witsml_part(frame))
+    assert run_many([WellSpec(single)], out, workers=1).count("ok") == 1
+    assert _summary(out, "one")["resumed"] == {"from_row": bounds[5], "reason": ""}
+
+
+def test_csv_cut_mid_line_continues_from_its_last_complete_line(stands, tmp_path):
+    """The rig logger was writing a line at the nightly cut: that night's results count the
+    part-written row, the state stops before it; the next night reads it again, complete,
+    and continues (not redone whole): the whole file's results."""
+    path, whole = stands
+    data = tmp_path / "wells" / path.name
+    lines = _grow(path, data, 0.5)
+    half = len(lines) // 2
+    cut = lines[half][: len(lines[half]) // 2]  # "12.34,5" of "12.34,56.7,…\n"
+    with open(data, "ab") as fh:
+        fh.write(cut)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["inputs"]["rows"] == half  # header line 0: half - 1 rows, the cut
+    with open(data, "ab") as fh:
+        fh.write(lines[half][len(cut):] + b"".join(lines[half + 1:]))
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": half - 1, "reason": ""}
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+
+def _hdf5(frame: pd.DataFrame, path) -> None:
+    """``frame`` as a group of 1-D datasets with unit attributes (a rig recorder's HDF5)."""
+    import h5py
+
+    with h5py.File(path, "w") as h5:
+        group = h5.create_group("surface")
+        for name in frame.columns:
+            group[name] = frame[name].to_numpy()
+            group[name].attrs["unit"] = _WITSML_UNITS[name]
+
+
+#: LAS mnemonics of the simulated well's surface channels (lasio reads names upper case).
+_LAS_NAMES = {"time_s": "TIME", "surface_rpm": "SURF_RPM", "surface_torque_Nm": "TORQUE",
+              "hookload_N": "HKLD", "bit_depth_m": "BITDEP", "hole_depth_m": "HDTH"}
+
+
+def _las(frame: pd.DataFrame, path) -> None:
+    import lasio
+
+    las = lasio.LASFile()
+    for name, mnemonic in _LAS_NAMES.items():
+        las.append_curve(mnemonic, frame[name].to_numpy(), unit=_WITSML_UNITS[name])
+    las.write(str(path), version=2.0, fmt="%.10g")
+
+
+@pytest.mark.parametrize("suffix, write", [(".h5", _hdf5), (".las", _las)])
+def test_hdf5_and_las_rewritten_with_more_rows_continue(stands, tmp_path, suffix, write):
+    """An HDF5 table or a LAS file written again with more rows: its earlier rows are
+    recognised by their values (and the columns and units stated), only the new rows are
+    read, the results are those of a run over the whole file. An earlier value changed:
+    redone whole with the reason."""
+    path, _ = stands
+    frame = pd.read_csv(path)
+    data = tmp_path / "wells" / f"three{suffix}"
+    _grow(path, data.with_suffix(".csv"), 0.0)
+    data.with_suffix(".csv").unlink()
+    toml = data.with_suffix(".toml")
+    toml.write_text(toml.read_text().replace('data = "three.csv"', f'data = "{data.name}"'))
+    first = int(len(frame) * 0.55)
+    write(frame.iloc[:first], data)
+    out = tmp_path / "out"
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    write(frame, data)
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    assert _summary(out)["resumed"] == {"from_row": first, "reason": ""}
+    whole = run_well(open_well(data))
+    written = pd.read_parquet(out / "three" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out), written), whole)
+
+    write(frame.assign(surface_rpm=frame["surface_rpm"].where(frame.index != 10, 99.0)), data)
+    run_many([WellSpec(data)], out, workers=1)
+    reason = _summary(out)["resumed"]["reason"]
+    assert reason.startswith(f"earlier rows changed (the first {len(frame)} rows"), reason
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_stick_slip_well_fed_by_appends_at_random_bytes_ends_as_the_whole(stick_slip, tmp_path,
+                                                                          seed):
+    """The second plant (a soft drive that stick-slips: many short segments): a fleet re-run
+    after each of three appends cut at random bytes (mostly mid-line, as a logger writing
+    at the nightly cut leaves it) ends with the whole file's segments, kinds, statuses and
+    friction numbers, each re-run continuing from the last."""
+    path, whole = stick_slip
+    data = tmp_path / "wells" / path.name
+    _grow(path, data, 0.0)
+    text = path.read_bytes()
+    cuts = np.sort(np.random.default_rng(seed).integers(len(text) // 10, len(text), size=3))
+    out = tmp_path / "out"
+    for a, b in zip([0, *cuts], [*cuts, len(text)], strict=True):
+        with open(data, "ab") as fh:
+            fh.write(text[a:b])
+        assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+        if a:
+            resumed = _summary(out, "soft")["resumed"]
+            assert resumed["reason"] == "" and resumed["from_row"] == text[:a].count(b"\n") - 1
+    written = pd.read_parquet(out / "soft" / "segments.parquet")
+    _same_results(type(whole)(whole.well, _summary(out, "soft"), written), whole)

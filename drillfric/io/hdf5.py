@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
-from drillfric.io.source import RawSource
+from drillfric.io.source import RawSource, RowsDigest
 
 _CORRUPT_FIX = "re-export or re-copy the file"
 _PICKLED = "refused: the file stores data as Python pickles, which can run code when read"
@@ -222,19 +222,23 @@ def _source(path: Path, name: str, columns, units, rows, reader):
     units = dict(units)
     units.update({("source", c): "header" for c in list(units)})
 
-    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+    def read(chunk_rows: int, start: int = 0, stop: int | None = None
+             ) -> Iterator[pd.DataFrame]:
+        """Rows [start, stop) (None: to the end)."""
         import h5py
 
+        end = rows if stop is None else min(stop, rows)
         try:
             with h5py.File(path, "r") as h5:
                 node = node_at(h5, name, path)
-                for start in range(0, rows, chunk_rows):
-                    yield reader(node, start, min(start + chunk_rows, rows))
+                for first in range(start, end, chunk_rows):
+                    yield reader(node, first, min(first + chunk_rows, end))
         except (OSError, KeyError) as exc:
             raise InputError("not a readable HDF5 file (truncated or corrupt)", file=path,
                              fix=_CORRUPT_FIX) from exc
 
-    return RawSource(path, "hdf5", columns, units, rows, read)
+    digest = RowsDigest(columns, units, lambda a, b: read(200_000, a, b), rows)
+    return RawSource(path, "hdf5", columns, units, rows, read, seek="row", digest=digest)
 
 
 def _surface_name(h5, key: str, path: Path) -> str:

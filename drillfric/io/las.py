@@ -24,7 +24,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.delimited import MAX_LINE_CHARS
-from drillfric.io.source import RawSource
+from drillfric.io.source import RawSource, RowsDigest
 from drillfric.io.text import printable
 
 #: Most items (curves, parameters, well lines) a LAS header section may hold: rig and
@@ -72,12 +72,17 @@ def open_las(path: Path) -> RawSource:
     units = {c.mnemonic: c.unit for c in las.curves if c.unit}
     units.update({("source", c): "header" for c in list(units)})
 
-    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
-        for start in range(0, len(frame), chunk_rows):
-            yield frame.iloc[start:start + chunk_rows].reset_index(drop=True)
+    def read(chunk_rows: int, start: int = 0, stop: int | None = None
+             ) -> Iterator[pd.DataFrame]:
+        """Rows [start, stop) (None: to the end)."""
+        end = len(frame) if stop is None else min(stop, len(frame))
+        for first in range(start, end, chunk_rows):
+            yield frame.iloc[first:min(first + chunk_rows, end)].reset_index(drop=True)
 
+    digest = RowsDigest(columns, units, lambda a, b: read(200_000, a, b), len(frame))
     return RawSource(path, "las", columns, units, len(frame), read,
-                     depth_index=_depth_index(las.curves[0]) if las.curves else None)
+                     depth_index=_depth_index(las.curves[0]) if las.curves else None,
+                     seek="row", digest=digest)
 
 
 def header_items(path: Path) -> dict[str, int]:

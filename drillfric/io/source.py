@@ -9,6 +9,8 @@ Every format reader (:mod:`drillfric.io.readers`, :mod:`drillfric.io.delimited`,
 
 from __future__ import annotations
 
+import hashlib
+import json
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,7 +46,14 @@ class RawSource:
         source, in reading order; else empty.
     seek : str or None
         How :meth:`window` addresses rows: ``"byte"`` (a delimited text file: byte
-        offsets), ``"row"`` (Parquet: row numbers); None: the source is read whole.
+        offsets), ``"row"`` (Parquet, WITSML, HDF5, LAS: row numbers); None: the source is
+        read whole.
+    digest : callable or None
+        ``digest(n)``: a SHA-256 (hex) of what gives the values of the first ``n`` rows (None:
+        of all :attr:`rows`) — their stated columns, units and contents — for a source whose
+        growth is recognised by its rows' content rather than its bytes (a WITSML log
+        rewritten with more rows, an HDF5 table, a LAS file: docs/fleet.md "Only what is
+        new"); None for the others.
     """
 
     path: Path
@@ -56,6 +65,8 @@ class RawSource:
     depth_index: str | None = None
     seek: str | None = None
     parts: tuple = ()
+    digest: Callable[[int | None], str] | None = field(default=None, repr=False,
+                                                       compare=False)
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""
@@ -71,6 +82,41 @@ class RawSource:
         if self.seek is None:
             raise ValueError(f"a {self.format} source is read whole")
         yield from self._read(chunk_rows, start, stop)
+
+class RowsDigest:
+    """:attr:`RawSource.digest` of a source read by row number (HDF5, LAS): a SHA-256 of
+    the columns and units it states and of its first ``n`` rows' values (pandas' per-row
+    hashes, the same whatever the blocks read). The hash goes on from the rows it last
+    covered, so the check of a grown file (its earlier rows) and its mark (all its rows)
+    read its rows once.
+
+    Parameters
+    ----------
+    columns, units
+        What the source states (``units``: column → unit).
+    window : callable
+        ``window(start, stop)``: the rows [start, stop) in blocks.
+    rows : int
+        The source's rows now.
+    """
+
+    def __init__(self, columns: list[str], units: dict,
+                 window: Callable[[int, int], Iterator[pd.DataFrame]], rows: int):
+        stated = {str(k): v for k, v in units.items() if isinstance(k, str)}
+        self._described = json.dumps([list(columns), stated], sort_keys=True).encode()
+        self._window, self._rows = window, rows
+        self._at, self._hash = 0, hashlib.sha256(self._described)
+
+    def __call__(self, n: int | None = None) -> str:
+        n = self._rows if n is None else min(n, self._rows)
+        if n < self._at:
+            self._at, self._hash = 0, hashlib.sha256(self._described)
+        for chunk in self._window(self._at, n):
+            self._hash.update(pd.util.hash_pandas_object(chunk, index=False).to_numpy()
+                              .tobytes())
+        self._at = n
+        return self._hash.hexdigest()
+
 
 #: Extensions of surface data files, by format.
 FORMATS = {".parquet": "parquet", ".pq": "parquet", ".csv": "csv", ".txt": "csv",

@@ -23,10 +23,14 @@ large log is held one chunk at a time. Every failure is an InputError naming the
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import io
+import json
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from itertools import islice
 from pathlib import Path
 from xml.etree.ElementTree import ParseError
 
@@ -224,6 +228,8 @@ class LogHeader:
         Index value of the first and last data row.
     wellbore : str
         ``nameWellbore`` of the log, else its ``nameWell`` (``""`` when neither).
+    rows_sha256 : str
+        SHA-256 (hex) of the ``data`` rows' texts (each stripped, followed by a newline).
     """
 
     position: int
@@ -240,6 +246,7 @@ class LogHeader:
     first_index: str | None
     last_index: str | None
     wellbore: str = ""
+    rows_sha256: str = ""
 
     @property
     def depth_indexed(self) -> bool:
@@ -267,6 +274,7 @@ class _LogScan:
         self.rows = 0
         self.first_row: str | None = None
         self.last_row: str | None = None
+        self.rows_sha256 = hashlib.sha256()
 
     def end(self, name: str, parent: str, elem) -> None:
         text = (elem.text or "").strip()
@@ -282,6 +290,7 @@ class _LogScan:
             self.rows += 1
             self.first_row = text if self.first_row is None else self.first_row
             self.last_row = text
+            self.rows_sha256.update(text.encode() + b"\n")
 
     def header(self, path: Path) -> LogHeader:
         names, units = self._columns(path)
@@ -302,7 +311,8 @@ class _LogScan:
                          index_curve, self.fields.get("direction", "increasing").lower(),
                          tuple(names), tuple(units), nulls, text, self.rows,
                          _field(self.first_row, at), _field(self.last_row, at),
-                         self.fields.get("nameWellbore") or self.fields.get("nameWell", ""))
+                         self.fields.get("nameWellbore") or self.fields.get("nameWell", ""),
+                         self.rows_sha256.hexdigest())
 
     def _columns(self, path: Path) -> tuple[list[str], list[str]]:
         """Column names in data order and their units (mnemonicList, else logCurveInfo)."""
@@ -460,9 +470,11 @@ def _without_null(values: pd.Series, null: str) -> pd.Series:
     return values.mask(values.astype("string").str.strip() == null.strip())
 
 
-def _chunks(path: Path, header: LogHeader, chunk_rows: int) -> Iterator[pd.DataFrame]:
+def _chunks(path: Path, header: LogHeader, chunk_rows: int, start: int = 0,
+            stop: int | None = None) -> Iterator[pd.DataFrame]:
+    """The log's data rows [start, stop) (None: to the end) in frames of ``chunk_rows``."""
     rows: list[str] = []
-    for text in _row_texts(path, header.position):
+    for text in islice(_row_texts(path, header.position), start, stop):
         rows.append(text)
         if len(rows) == chunk_rows:
             yield _frame(rows, header, path)
@@ -480,13 +492,40 @@ def _units(header: LogHeader) -> dict:
     return units
 
 
+def _depth_index(header: LogHeader) -> str | None:
+    """The depth index column with its unit (``"DEPT [m]"``), None for a time log."""
+    if not header.depth_indexed:
+        return None
+    unit = header.index_unit
+    return f"{header.index_curve} [{unit}]" if unit else header.index_curve
+
+
 def _source(path: Path, header: LogHeader) -> RawSource:
-    depth = None
-    if header.depth_indexed:
-        unit = header.index_unit
-        depth = f"{header.index_curve} [{unit}]" if unit else header.index_curve
+    def read(chunk_rows: int, start: int = 0, stop: int | None = None):
+        return _chunks(path, header, chunk_rows, start, stop)
+
     return RawSource(path, "witsml", list(header.mnemonics), _units(header), header.rows,
-                     lambda n: _chunks(path, header, n), depth_index=depth)
+                     read, depth_index=_depth_index(header), seek="row",
+                     digest=_digest(path, header))
+
+
+def _digest(path: Path, header: LogHeader) -> Callable[[int | None], str]:
+    """:attr:`RawSource.digest` of a log: what the header says of its columns and the rows'
+    texts (the first ``n``: read again up to there; all: hashed by the header scan)."""
+    described = json.dumps([header.index_type, header.index_curve, header.direction,
+                            header.mnemonics, header.units, header.nulls,
+                            header.text_columns]).encode()
+
+    def digest(n: int | None = None) -> str:
+        rows = header.rows_sha256
+        if n is not None and n != header.rows:
+            texts = hashlib.sha256()
+            for text in islice(_row_texts(path, header.position), n):
+                texts.update(text.strip().encode() + b"\n")
+            rows = texts.hexdigest()
+        return hashlib.sha256(described + rows.encode()).hexdigest()
+
+    return digest
 
 
 def open_witsml(path, *, log: str | None = None) -> RawSource:
@@ -592,9 +631,31 @@ def _index_keys(values: pd.Series, header: LogHeader) -> np.ndarray:
     return pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
 
 
+def _key(header: LogHeader, text: str | None) -> float:
+    """One index value as :func:`_index_keys` gives it (NaN: none)."""
+    return float(_index_keys(pd.Series([text], dtype=object), header)[0])
+
+
 def _first_key(header: LogHeader) -> float:
-    key = _index_keys(pd.Series([header.first_index], dtype=object), header)[0]
-    return float(key) if np.isfinite(key) else np.inf
+    key = _key(header, header.first_index)
+    return key if np.isfinite(key) else np.inf
+
+
+def _reaches(paths: list[Path], headers: list[LogHeader], sign: float
+             ) -> Callable[[int], float]:
+    """``before(i)``: the furthest index (× ``sign``) of the parts before part ``i``, past
+    which part ``i``'s rows are kept. A part reaches its last row's index (WITSML orders a
+    log's rows by ``direction``); a part whose last row has none is read for it."""
+    @functools.cache
+    def reach(j: int) -> float:
+        key = sign * _key(headers[j], headers[j].last_index)
+        if np.isfinite(key):
+            return key
+        return max((float(np.nanmax(sign * _index_keys(c[headers[j].index_curve],
+                                                        headers[j]), initial=-np.inf))
+                    for c in _chunks(paths[j], headers[j], 100_000)), default=-np.inf)
+
+    return lambda i: max((reach(j) for j in range(i)), default=-np.inf)
 
 
 def _same_log(headers: list[LogHeader], paths: list[Path]) -> None:
@@ -629,7 +690,9 @@ def open_witsml_parts(paths, *, log: str | None = None) -> RawSource:
     Parts are read in index order (by their first index value, reversed for a decreasing
     log), whatever the order of ``paths``; a part's rows whose index does not go past the
     last index of the parts before it (an overlap) are dropped. Columns are the union of
-    the parts' columns (NaN where a part lacks one).
+    the parts' columns (NaN where a part lacks one). The source's ``parts`` are the parts
+    in that order, each read by row number (its ``data`` rows, overlap dropped), so that a
+    fleet re-run reads only a new part's rows (docs/fleet.md "Only what is new").
 
     Parameters
     ----------
@@ -653,19 +716,29 @@ def open_witsml_parts(paths, *, log: str | None = None) -> RawSource:
     paths, headers = [paths[i] for i in order], [headers[i] for i in order]
     columns, units = _merged_units(headers, paths)
     sign = -1.0 if headers[0].direction == "decreasing" else 1.0
+    before = _reaches(paths, headers, sign)
+    depth = _depth_index(headers[0])
 
-    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
-        last = -np.inf
-        for path, header in zip(paths, headers, strict=True):
-            reached = last
-            for chunk in _chunks(path, header, chunk_rows):
+    def part(i: int) -> RawSource:
+        path, header = paths[i], headers[i]
+
+        def read(chunk_rows: int, start: int = 0, stop: int | None = None
+                 ) -> Iterator[pd.DataFrame]:
+            last = before(i)
+            for chunk in _chunks(path, header, chunk_rows, start, stop):
                 keys = sign * _index_keys(chunk[header.index_curve], header)
                 kept = chunk[~(keys <= last)].reindex(columns=columns)
-                reached = max(reached, float(np.nanmax(keys, initial=-np.inf)))
                 if len(kept):
                     yield kept.reset_index(drop=True)
-            last = reached
 
-    first = headers[0]
-    depth = f"{first.index_curve} [{first.index_unit}]" if first.depth_indexed else None
-    return RawSource(paths[0], "witsml", columns, units, None, read, depth_index=depth)
+        return RawSource(path, "witsml", columns, units, header.rows, read, depth_index=depth,
+                         seek="row", digest=_digest(path, header))
+
+    parts = tuple(part(i) for i in range(len(paths)))
+
+    def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
+        for source in parts:
+            yield from source.chunks(chunk_rows)
+
+    return RawSource(paths[0], "witsml", columns, units, None, read, depth_index=depth,
+                     parts=parts)

@@ -24,6 +24,7 @@ continue after its results were written.
 
 from __future__ import annotations
 
+import copy
 import json
 import time
 from collections.abc import Callable
@@ -187,13 +188,20 @@ class Engine:
                 self._before_close = None  # fed further, the engine's state is its own
         return result
 
-    def close(self) -> WellResult:
+    def close(self, tail=()) -> WellResult:
         """End of the data: the open segment, revisions, the summary and the result files
         (with a directory sink). :meth:`state` afterwards is the state before the end (to be
-        saved and continued)."""
-        self._before_close = self.state()
+        saved and continued).
+
+        ``tail``: raw chunks that end the data but not the state — a last line of a CSV
+        still being written (docs/fleet.md "Only what is new"): its rows count in these
+        results and are read again, complete, by the run that continues."""
+        tail = list(tail)
+        # the tail moves the accumulators on: the state before it, copied (not views of them)
+        self._before_close = copy.deepcopy(self.state()) if tail else self.state()
+        ended = {r.id for raw in tail for r in self.feed_raw(raw)}
         done = self.stream.close()
-        open_ids = {seg.id for seg, _ in done}
+        open_ids = {seg.id for seg, _ in done} | ended
         self._take(done)
         if self.check.rows == 0:
             raise InputError("no data rows", file=self.well.files.data,

@@ -4,11 +4,19 @@
 A data file that grew is recognised by its content, not its name or date (:func:`mark`,
 :func:`changed`):
 
-- a delimited text file: the byte length read, a SHA-256 of those bytes and whether they
-  ended with a complete line; it continues when its first bytes hash the same;
+- a delimited text file: the bytes up to its last complete line, a SHA-256 of them; it
+  continues when its first bytes hash the same (a last line not ended yet — the logger
+  writing it at the nightly cut — is read for tonight's results, but not continued from:
+  :func:`tail`, read again complete the next night);
 - a Parquet file rewritten with more rows: a SHA-256 of each row group's bytes, and of the
   last group's values; it continues when the same groups come first — the last one may
-  have been rewritten larger, then its first rows must hold the same values.
+  have been rewritten larger, then its first rows must hold the same values;
+- a source that states its rows' content (:attr:`~drillfric.io.source.RawSource.digest`:
+  a WITSML log, each numbered part of one): the rows read and their digest; it continues
+  when its first rows have the same digest;
+- a log in parts (a folder of hourly files, a WITSML log in numbered files): each part's
+  mark, and the columns and units of the whole; the parts read come first, unchanged but
+  the last, which may have grown.
 
 Anything else — no state, another drillfric, configuration or rate, earlier rows changed, a
 format read only whole — is run from the start, and the summary says why (summary.json
@@ -31,21 +39,44 @@ from .finish import DirectorySink
 from .state import read_state
 
 _BLOCK = 1 << 22
+_TAIL_BLOCK = 1 << 16
 
 
 def mark(well: Well) -> dict:
     """What a run reads of the well's data now (for a folder of files: of each file)."""
-    if well.source.parts:
-        return {"format": "parts", "parts": [{"name": p.path.name} | source_mark(p)
-                                             for p in well.source.parts]}
-    return source_mark(well.source)
+    source = well.source
+    if source.parts:
+        last = len(source.parts) - 1
+        return {"format": "parts", "columns": list(source.columns), "units": _units(source),
+                "parts": [{"name": p.path.name} | source_mark(p, whole=i < last)
+                          for i, p in enumerate(source.parts)]}
+    return source_mark(source)
 
 
-def source_mark(source) -> dict:
-    """What a run reads of one delimited text or Parquet file now."""
-    if source.seek == "byte":
-        return csv_mark(source.path, source.path.stat().st_size)
+def _units(source) -> dict:
+    """The units a source states, by column (JSON-comparable)."""
+    return {k: v for k, v in sorted(source.units.items(), key=str) if isinstance(k, str)}
+
+
+def source_mark(source, *, whole: bool = False) -> dict:
+    """What a run reads of one file now (a delimited text file: up to its last complete
+    line, unless ``whole`` — a part of a log followed by others)."""
+    kind = _kind(source)
+    if kind == "csv":
+        size = source.path.stat().st_size
+        return csv_mark(source.path, size if whole else lines_end(source.path, size)) \
+            | {"end": size}
+    if kind == "rows":
+        return {"format": "rows", "rows": source.rows, "sha256": source.digest(None)}
     return parquet_mark(source.path, source)
+
+
+def _kind(source) -> str:
+    """How a file's growth is recognised: ``"csv"`` (its bytes), ``"rows"`` (its rows'
+    digest), ``"parquet"`` (its row groups)."""
+    if source.seek == "byte":
+        return "csv"
+    return "rows" if source.digest is not None else "parquet"
 
 
 def _end(found: dict) -> int:
@@ -64,6 +95,31 @@ def unread(well: Well, before: dict | None, now: dict, chunk_rows: int):
         if i >= k:
             start = _end(before["parts"][i]) if before and i == k else 0
             yield from part.window(start, _end(found), chunk_rows)
+
+
+def tail(well: Well, now: dict, chunk_rows: int):
+    """The raw rows past the mark ``now`` up to the end of the data: a last line not ended
+    yet (fed to :meth:`~drillfric.runner.engine.Engine.close`, not to the state)."""
+    source, found = (well.source.parts[-1], now["parts"][-1]) if well.source.parts \
+        else (well.source, now)
+    if found["format"] == "csv" and found["end"] > found["bytes"]:
+        yield from source.window(found["bytes"], found["end"], chunk_rows)
+
+
+def lines_end(path: Path, size: int) -> int:
+    """Where the last complete line (ended by LF or CR) of a file's first ``size`` bytes
+    ends (0: none), read backwards from ``size``."""
+    with open(path, "rb") as fh:
+        end = size
+        while end > 0:
+            begin = max(end - _TAIL_BLOCK, 0)
+            fh.seek(begin)
+            block = fh.read(end - begin)
+            at = max(block.rfind(b"\n"), block.rfind(b"\r"))
+            if at >= 0:
+                return begin + at + 1
+            end = begin
+    return 0
 
 
 def csv_mark(path: Path, size: int) -> dict:
@@ -125,6 +181,9 @@ def changed(found: dict | None, well: Well) -> str:
         return _source_changed(found, well.source)
     if not found or found.get("format") != "parts":
         return "the earlier run read another kind of data"
+    source = well.source
+    if found.get("columns") != list(source.columns) or found.get("units") != _units(source):
+        return "the log's columns or units changed (a new part brings other curves)"
     names = [p.path.name for p in well.source.parts]
     earlier = [p["name"] for p in found["parts"]]
     if names[:len(earlier)] != earlier:
@@ -142,23 +201,35 @@ def _size_now(source) -> int:
     """A file's length now, as a mark counts it (bytes or rows)."""
     if source.seek == "byte":
         return source.path.stat().st_size
-    return pq.ParquetFile(source.path).metadata.num_rows
+    return source.rows
 
 
 def _source_changed(found: dict | None, source) -> str:
     """Why one file does not continue what ``found`` recorded ("" when it does)."""
     path = source.path
-    if not found or found.get("format") != {"byte": "csv", "row": "parquet"}.get(source.seek):
+    if not found or found.get("format") != _kind(source):
         return "the earlier run read another kind of file"
     if found["format"] == "parquet":
         return _parquet_changed(found, path, source)
+    if found["format"] == "rows":
+        return _rows_changed(found, source)
     size = path.stat().st_size
     if size < found["bytes"]:
         return f"the file is shorter than the {found['bytes']} bytes read before"
-    if not found.get("ends_line"):
+    if not found.get("ends_line") and size > found["bytes"]:
         return "the earlier rows did not end with a complete line"
     if csv_mark(path, found["bytes"])["sha256"] != found["sha256"]:
         return "earlier rows changed (the first bytes differ from those read before)"
+    return ""
+
+
+def _rows_changed(found: dict, source) -> str:
+    """Why a source marked by its rows' digest does not continue ``found`` ("" if it does)."""
+    if source.rows < found["rows"]:
+        return f"the data hold fewer rows than the {found['rows']} read before"
+    if source.digest(found["rows"]) != found["sha256"]:
+        return (f"earlier rows changed (the first {found['rows']} rows or their columns "
+                "differ from those read before)")
     return ""
 
 
@@ -183,18 +254,30 @@ def _parquet_changed(found: dict, path: Path, source) -> str:
 
 def resumable(well: Well) -> bool:
     """Whether the well's data can be continued where a run stopped (a delimited text file
-    in a byte-seekable encoding, a Parquet file, or a folder of them)."""
+    in a byte-seekable encoding, a Parquet or WITSML file, or a log in parts of them)."""
     source = well.source
     if well.files.in_memory or source is None:
         return False
     return all(p.seek is not None for p in source.parts or (source,))
 
 
+def _read_whole(well: Well) -> str:
+    """Why a well's data cannot be continued (:func:`resumable` is False)."""
+    if well.files.in_memory or well.source is None:
+        return "data given in memory"
+    fmt = well.source.format
+    if fmt == "csv":
+        return "a delimited text file in an encoding read from its start (UTF-16, …)"
+    return {"dlis": "DLIS is read whole, in an isolated process",
+            "excel": "Excel is read whole, in an isolated process"}.get(
+                fmt, f"{fmt} is read whole")
+
+
 def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engine | None, str]:
     """An engine continuing the run of ``previous`` (a result directory), its output rows
     seeded into ``sink``; or None and why it cannot."""
     if not resumable(well):
-        return None, "its data file is read whole (not delimited text or Parquet)"
+        return None, f"its data file is read whole ({_read_whole(well)})"
     folder = previous / "state"
     if not (folder / "engine.json").is_file():
         return None, "no saved state"

@@ -27,7 +27,7 @@ from drillfric.result import RunProgress, WellResult
 
 from .engine import Engine
 from .finish import DirectorySink, ReportWriter, Sink, deliver
-from .resume import mark, resumable, unread
+from .resume import mark, resumable, tail, unread
 from .resume import resume as continued
 
 #: Folder of a result directory holding the engine's state (docs/outputs.md).
@@ -52,7 +52,8 @@ def run_time_log(well: Well, out_root=None, *, rate_hz: float | None = None,
             engine.resumed = {"from_row": 0, "reason": why} if resume else None
         for raw in _rows(well, engine, chunk_rows):
             engine.feed_raw(raw)
-        return finish_engine(engine, sink)
+        ending = tail(well, engine.source, chunk_rows) if resumable(well) else ()
+        return finish_engine(engine, sink, ending)
 
     return deliver(well, out_root, run, report)
 
@@ -66,9 +67,10 @@ def _rows(well: Well, engine: Engine, chunk_rows: int):
     return unread(well, before, engine.source, chunk_rows)
 
 
-def finish_engine(engine: Engine, sink: Sink) -> WellResult:
-    """Close ``engine`` into ``sink``; a result directory keeps the state to continue from."""
-    result = engine.close()
+def finish_engine(engine: Engine, sink: Sink, tail=()) -> WellResult:
+    """Close ``engine`` into ``sink`` (``tail`` as :meth:`Engine.close`); a result directory
+    keeps the state to continue from."""
+    result = engine.close(tail)
     if isinstance(sink, DirectorySink):
         engine.save(sink.folder / STATE_DIR)
     return result
