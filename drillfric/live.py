@@ -6,13 +6,16 @@ Three pieces:
 - :class:`Tail` — where the complete lines of a growing text file end (a write may stop
   mid-line: a partial last line waits for its newline), with the SHA-256 of the bytes up to
   there (the mark :mod:`drillfric.runner.resume` checks a continued file against);
-- :class:`LiveRun` — a worker thread feeds the new complete lines to an
-  :class:`~drillfric.runner.engine.Engine` (kept in memory) and, when a segment closes (and
-  every :attr:`LiveRun.publish_every_s` with new data), *publishes*: a copy of the engine is
-  closed into ``OUT/NAME`` exactly as ``drillfric run`` writes it (atomically, with the state
-  to continue from), which also estimates the open segment;
-- :func:`status` — live.json, rewritten atomically by the calling thread every
-  :data:`POLL_S` while the worker estimates (the worker never blocks it).
+- :class:`LiveRun` — a *feed thread* reads the new complete lines into the cheap half of an
+  :class:`~drillfric.runner.engine.Engine` (kept in memory: log check, rig states, segment
+  cuts; :meth:`~drillfric.runner.engine.Engine.segment_raw`) and hands the segments that
+  closed to a *fit thread*, which estimates them in order and *publishes*: a copy of the
+  engine is closed into ``OUT/NAME`` exactly as ``drillfric run`` writes it (atomically, with
+  the state to continue from), which also estimates the open segment. A publication follows
+  each segment's close, and one of an open segment with new rows comes every
+  :attr:`LiveRun.publish_every_s` (or later: :meth:`LiveRun.open_every_s`);
+- :func:`status` — live.json, rewritten atomically by the calling thread as soon as rows were
+  fed and at least every :data:`POLL_S` (neither a fit nor a publication holds it back).
 
 A restarted live run continues from ``OUT/NAME/state`` (the last publication) when the file
 still starts with the bytes it had read, so no row is lost or read twice.
@@ -45,8 +48,13 @@ from drillfric.runner.state import read_state
 from drillfric.runner.time_log import STATE_DIR, finish_engine
 from drillfric.segmentation import RIG_STATES
 
-#: Seconds between polls of the file and rewrites of live.json (INTERFACE: at least every 0.5 s).
+#: Longest wait between two rewrites of live.json [s] (INTERFACE: at least every 0.5 s).
 POLL_S = 0.2
+#: Seconds between polls of the file when it did not grow.
+FEED_POLL_S = 0.1
+#: Shortest wait between two rewrites of live.json [s] (it is rewritten as soon as rows were
+#: fed, but not more often).
+MIN_WRITE_S = 0.05
 #: Complete data lines wanted before the file's layout is sniffed (header + rows).
 FIRST_LINES = 20
 #: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
@@ -134,7 +142,8 @@ class LiveRun:
     report : callable, optional
         Writes the report of the final results (none for the intermediate ones).
     publish_every_s : float
-        Wall seconds between publications of an open segment with new data.
+        Wall seconds between publications of an open segment with new data (at least:
+        :meth:`open_every_s`).
     stale_s, stopped_s : float
         Wall seconds without new data before a ``data_stale`` / ``data_stopped`` alert.
     clock : callable
@@ -154,6 +163,7 @@ class LiveRun:
         self.engine: Engine | None = None
         self.stop = threading.Event()
         self.done = threading.Event()  # the worker ended (final results written or error)
+        self.fed = threading.Event()  # rows fed since live.json was last written
         self.error: BaseException | None = None
         self.result = None
         self.last_data = clock()  # when the file last grew (wall clock)
@@ -183,7 +193,7 @@ class LiveRun:
         try:
             while not self.stop.is_set():
                 if not self._step():
-                    self.stop.wait(POLL_S)
+                    self.stop.wait(FEED_POLL_S)
             if self.error is None:
                 if self.engine is None and self.tail.poll() and self.tail.lines() >= 2:
                     self._start()  # a header and a few rows: enough to finish with
@@ -252,6 +262,7 @@ class LiveRun:
                 closed = True
         self.tail_fed, self.engine.source, self.dirty = end, self.tail.mark(), True
         self._note_rows()
+        self.fed.set()
         return closed
 
     def _note_rows(self) -> None:
@@ -513,14 +524,17 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
 
 
 def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None) -> None:
-    """live.json every :data:`POLL_S` while the worker runs; stop it when idle. (The
+    """live.json as soon as rows were fed (at most every :data:`MIN_WRITE_S`, at least
+    every :data:`POLL_S`) while the worker runs; stop it when idle. (The
     worker's ``done`` event is waited on, not ``Thread.join``: a join interrupted by a signal
     can leave ``is_alive()`` False while the thread still runs, CPython gh-90882.)"""
     while not live.done.is_set():
         live.watch()
+        live.fed.clear()
         live.write_status(live.target)
         if until_idle_s is not None and live.clock() - live.last_data >= until_idle_s:
             live.stop.set()
-        time.sleep(POLL_S)
+        time.sleep(MIN_WRITE_S)  # then at once when rows are fed, at the latest after POLL_S
+        live.fed.wait(POLL_S - MIN_WRITE_S)
     worker.join()
     live.write_status(live.target)
