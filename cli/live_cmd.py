@@ -16,7 +16,8 @@ from .common import UserError, compile_kernels_once, echo
 @click.argument("source")
 @click.option("--out", "out", type=click.Path(path_type=Path), required=True,
               help="Output directory: OUT/NAME as 'drillfric run' writes it (updated as "
-                   "segments close) and OUT/live.json (rewritten every 0.2 s).")
+                   "segments close) and OUT/live.json (rewritten as rows arrive, at least "
+                   "every 0.2 s).")
 @click.option("--config", type=click.Path(path_type=Path), help="Well configuration (TOML), "
               "overrides the NAME.toml sidecar.")
 @click.option("--name", help="The well's name (OUT/NAME), overriding [well] name.")

@@ -6,13 +6,16 @@ Three pieces:
 - :class:`Tail` — where the complete lines of a growing text file end (a write may stop
   mid-line: a partial last line waits for its newline), with the SHA-256 of the bytes up to
   there (the mark :mod:`drillfric.runner.resume` checks a continued file against);
-- :class:`LiveRun` — a worker thread feeds the new complete lines to an
-  :class:`~drillfric.runner.engine.Engine` (kept in memory) and, when a segment closes (and
-  every :attr:`LiveRun.publish_every_s` with new data), *publishes*: a copy of the engine is
-  closed into ``OUT/NAME`` exactly as ``drillfric run`` writes it (atomically, with the state
-  to continue from), which also estimates the open segment;
-- :func:`status` — live.json, rewritten atomically by the calling thread every
-  :data:`POLL_S` while the worker estimates (the worker never blocks it).
+- :class:`LiveRun` — a *feed thread* reads the new complete lines into the cheap half of an
+  :class:`~drillfric.runner.engine.Engine` (kept in memory: log check, rig states, segment
+  cuts; :meth:`~drillfric.runner.engine.Engine.segment_raw`) and hands the segments that
+  closed to a *fit thread*, which estimates them in order and *publishes*: a copy of the
+  engine is closed into ``OUT/NAME`` exactly as ``drillfric run`` writes it (atomically, with
+  the state to continue from), which also estimates the open segment. A publication follows
+  each segment's close, and one of an open segment with new rows comes every
+  :attr:`LiveRun.publish_every_s` (or later: :meth:`LiveRun.open_every_s`);
+- :func:`status` — live.json, rewritten atomically by the calling thread as soon as rows were
+  fed and at least every :data:`POLL_S` (neither a fit nor a publication holds it back).
 
 A restarted live run continues from ``OUT/NAME/state`` (the last publication) when the file
 still starts with the bytes it had read, so no row is lost or read twice.
@@ -24,6 +27,7 @@ import copy
 import hashlib
 import math
 import os
+import queue
 import threading
 import time
 from collections import deque
@@ -46,12 +50,20 @@ from drillfric.runner.state import read_state
 from drillfric.runner.time_log import STATE_DIR, finish_engine
 from drillfric.segmentation import RIG_STATES
 
-#: Seconds between polls of the file and rewrites of live.json (INTERFACE: at least every 0.5 s).
+#: Longest wait between two rewrites of live.json [s] (INTERFACE: at least every 0.5 s).
 POLL_S = 0.2
+#: Seconds between polls of the file when it did not grow.
+FEED_POLL_S = 0.1
+#: Shortest wait between two rewrites of live.json [s] (it is rewritten as soon as rows were
+#: fed, but not more often).
+MIN_WRITE_S = 0.05
 #: Complete data lines wanted before the file's layout is sniffed (header + rows).
 FIRST_LINES = 20
 #: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
 SEVERE_STICK_SLIP = 1.0
+#: Share of a core that publications of an open segment may take on average (they come
+#: less often than every ``publish_every_s`` when one costs more).
+OPEN_SHARE = 0.1
 #: Relative change of a converged μ_k against the median of the previous five that raises a
 #: friction-trend alert.
 TREND_CHANGE = 0.25
@@ -178,7 +190,8 @@ class LiveRun:
     report : callable, optional
         Writes the report of the final results (none for the intermediate ones).
     publish_every_s : float
-        Wall seconds between publications of an open segment with new data.
+        Wall seconds between publications of an open segment with new data (at least:
+        :meth:`open_every_s`).
     stale_s, stopped_s : float
         Wall seconds without new data before a ``data_stale`` / ``data_stopped`` alert.
     clock : callable
@@ -198,10 +211,17 @@ class LiveRun:
         self.engine: Engine | None = None
         self.stop = threading.Event()
         self.done = threading.Event()  # the worker ended (final results written or error)
+        self.fed = threading.Event()  # rows fed since live.json was last written
         self.error: BaseException | None = None
         self.result = None
         self.last_data = clock()  # when the file last grew (wall clock)
         self.tail_fed, self.published_at, self.dirty = 0, clock(), False
+        #: Work for the fit thread, in order: ("fit", segments, plateaus), ("publish" or
+        #: "final", the engine's feed state, None); None ends it.
+        self.jobs: queue.Queue = queue.Queue()
+        self.pending = threading.Event()  # a publication handed and not yet begun
+        self.fitted = threading.Event()  # the fit thread ended
+        self.publish_cpu_s = 0.0  # CPU seconds of the last publication
         self.max_gap_s = 0.0  # the longest wait between two live.json writes
         self._size, self._written = -1, None
         self.lock = threading.Lock()
@@ -211,43 +231,57 @@ class LiveRun:
                            "trend_alert": None, "rows": 0, "segments_closed": 0,
                            "resumed": None}
 
-    # ------------------------------------------------------------------ worker
+    # ------------------------------------------------------------------ feed thread
     def work(self) -> None:
-        """The worker thread: feed, publish, and the final results when :attr:`stop` is set
-        (after data came)."""
+        """The feed thread: rows into the engine's cheap half, segments and publications
+        handed to the fit thread (:meth:`_fit_loop`), and the final results when
+        :attr:`stop` is set (after data came); :attr:`done` once both threads ended."""
+        fitter = threading.Thread(target=self._fit_loop, name="drillfric-live-fit",
+                                  daemon=True)
+        fitter.start()
         try:
             while not self.stop.is_set():
                 if not self._step():
-                    self.stop.wait(POLL_S)
-            if self.engine is None and self.tail.poll() and self.tail.lines() >= 2:
-                self._start()  # a header and a few rows: enough to finish with
-            if self.engine is not None:
-                self._feed(self.tail.poll())
-                self.result = self._publish(final=True)
-                with self.lock:  # the end of the data closed every segment
-                    self.view["open_segment"] = None
+                    self.stop.wait(FEED_POLL_S)
+            if self.error is None:
+                if self.engine is None and self.tail.poll() and self.tail.lines() >= 2:
+                    self._start()  # a header and a few rows: enough to finish with
+                if self.engine is not None:
+                    self._feed(self.tail.poll())
+                    self._hand_publication(final=True)
         except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
-            self.error = exc
-            self.stop.set()
+            self._fail(exc)
         finally:
+            self.jobs.put(None)  # the fit thread ends after what it was handed
+            self.fitted.wait()
             self.done.set()
 
+    def _fail(self, exc: BaseException) -> None:
+        if self.error is None:
+            self.error = exc
+        self.stop.set()
+
     def _step(self) -> bool:
-        """One poll; True when rows were fed or results published."""
+        """One poll; True when rows were fed."""
         end = self.tail.poll()
         if self.engine is None:
             if end == 0 or self.tail.lines() < FIRST_LINES:
                 return False
             self._start()
             end = self.tail.poll()
-        if end > self.tail_fed:
-            if self._feed(end) or self.clock() - self.published_at > self.publish_every_s:
-                self._publish()
-            return True
-        if self.dirty and self.clock() - self.published_at > self.publish_every_s:
-            self._publish()
-            return True
-        return False
+        fed = end > self.tail_fed
+        if fed and self._feed(end):
+            self._hand_publication()
+        elif self.dirty and not self.pending.is_set() and \
+                self.clock() - self.published_at > self.open_every_s():
+            self._hand_publication()
+        return fed
+
+    def open_every_s(self) -> float:
+        """Wall seconds between publications of an open segment: :attr:`publish_every_s`,
+        longer when one costs more than :data:`OPEN_SHARE` of a core over that time (its
+        cost grows with the open segment's rows: each re-estimates it from its first row)."""
+        return max(self.publish_every_s, self.publish_cpu_s / OPEN_SHARE)
 
     def _start(self) -> None:
         """Open the well and its engine: continued from OUT/NAME/state when it fits."""
@@ -264,15 +298,21 @@ class LiveRun:
             self.view["resumed"] = self.engine.resumed
 
     def _feed(self, end: int) -> bool:
-        """Feed bytes [fed, end); True when segments closed."""
+        """Feed bytes [fed, end) to the engine's cheap half; the segments they closed are
+        handed to the fit thread (with the hook-load plateaus found up to their close, as
+        a run over the whole file estimates them). True when segments closed."""
         closed = False
         if self.engine is None or end <= self.tail_fed:
             return False
         for raw in self.well.source.window(self.tail_fed, end, CHUNK_ROWS):
-            closed |= bool(self.engine.feed_raw(raw))
+            done = self.engine.segment_raw(raw)
             self.recent.add(self.engine.last_chunk)
+            if done:
+                self.jobs.put(("fit", done, list(self.engine.hook.plateaus)))
+                closed = True
         self.tail_fed, self.engine.source, self.dirty = end, self.tail.mark(), True
         self._note_rows()
+        self.fed.set()
         return closed
 
     def _note_rows(self) -> None:
@@ -287,10 +327,49 @@ class LiveRun:
                 rig_state=RIG_STATES[int(states[-1])] if states is not None and len(states)
                 else self.view["rig_state"])
 
-    def _publish(self, final: bool = False):
-        """Close a copy of the engine into OUT/NAME as ``drillfric run`` would (the final
-        results with the report)."""
-        state = copy.deepcopy(self.engine.state())
+    def _hand_publication(self, final: bool = False) -> None:
+        """Hand the fit thread a publication of the rows fed so far (a copy of the engine's
+        cheap half: the fit thread adds its own, consistent once it estimated the segments
+        handed before)."""
+        snapshot = copy.deepcopy(self.engine.feed_state())
+        self.pending.set()
+        self.jobs.put(("final" if final else "publish", snapshot, None))
+        self.published_at, self.dirty = self.clock(), False
+
+    # ------------------------------------------------------------------ fit thread
+    def _fit_loop(self) -> None:
+        """The fit thread: estimate the segments handed, in order, and publish; of several
+        publications waiting, only the newest is made (none is restarted)."""
+        try:
+            while True:
+                jobs = [self.jobs.get()]
+                while True:
+                    try:
+                        jobs.append(self.jobs.get_nowait())
+                    except queue.Empty:
+                        break
+                newest = max((i for i, job in enumerate(jobs) if job and job[0] != "fit"),
+                             default=-1)
+                for i, job in enumerate(jobs):
+                    if job is None:
+                        return
+                    if self.error is not None:
+                        continue
+                    if job[0] == "fit":
+                        self.engine.estimate(job[1], job[2])
+                    elif i == newest:
+                        self.pending.clear()
+                        self._publish(job[1], final=job[0] == "final")
+        except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
+            self._fail(exc)
+        finally:
+            self.fitted.set()
+
+    def _publish(self, feed_state: dict, final: bool = False) -> None:
+        """Close a copy of the engine (``feed_state`` and the fit thread's half) into OUT/NAME
+        as ``drillfric run`` would (the final results with the report)."""
+        cpu = time.thread_time()
+        state = feed_state | copy.deepcopy(self.engine.fit_state())
         memory = self.engine.sink
 
         def run(sink: DirectorySink):
@@ -305,8 +384,11 @@ class LiveRun:
             return result
 
         result = deliver(self.well, self.out_root, run, self.report if final else None)
-        self.published_at, self.dirty = self.clock(), False
-        return result
+        self.publish_cpu_s = time.thread_time() - cpu
+        if final:
+            self.result = result
+            with self.lock:  # the end of the data closed every segment
+                self.view["open_segment"] = None
 
     def _note_result(self, result, open_ids: set[int], folder: Path) -> None:
         records = [SegmentRecord.from_json(r) for r in result.summary["segments"]]
@@ -495,14 +577,17 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
 
 
 def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None) -> None:
-    """live.json every :data:`POLL_S` while the worker runs; stop it when idle. (The
+    """live.json as soon as rows were fed (at most every :data:`MIN_WRITE_S`, at least
+    every :data:`POLL_S`) while the worker runs; stop it when idle. (The
     worker's ``done`` event is waited on, not ``Thread.join``: a join interrupted by a signal
     can leave ``is_alive()`` False while the thread still runs, CPython gh-90882.)"""
     while not live.done.is_set():
         live.watch()
+        live.fed.clear()
         live.write_status(live.target)
         if until_idle_s is not None and live.clock() - live.last_data >= until_idle_s:
             live.stop.set()
-        time.sleep(POLL_S)
+        time.sleep(MIN_WRITE_S)  # then at once when rows are fed, at the latest after POLL_S
+        live.fed.wait(POLL_S - MIN_WRITE_S)
     worker.join()
     live.write_status(live.target)

@@ -179,3 +179,46 @@ def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_tren
     assert _trend(done(0.25, 0.26, 0.25, 0.27)) is None  # within 25 % of the median
     alert = _trend(done(0.25, 0.26, 0.25, 0.34))
     assert alert["kind"] == "friction_trend" and alert["time_s"] == 400.0
+
+
+def test_a_slow_segment_fit_does_not_hold_back_the_newest_sample(recorded, tmp_path,
+                                                                 monkeypatch):
+    """Regression (issue 24, lag): the fits ran in the thread that feeds the rows, so
+    live.json's newest sample stood still for as long as a segment was estimated."""
+    import threading
+
+    from drillfric.live import LiveRun
+    from drillfric.runner.engine import Engine
+
+    started, finished = threading.Event(), threading.Event()
+    estimate = Engine.estimate
+
+    def slow(self, done, plateaus=None):
+        if not done:
+            return estimate(self, done, plateaus)
+        started.set()
+        time.sleep(4.0)
+        records = estimate(self, done, plateaus)
+        finished.set()
+        return records
+
+    monkeypatch.setattr(Engine, "estimate", slow)
+    target = _feed_folder(recorded, tmp_path)
+    header, *lines = recorded[0].read_bytes().splitlines(keepends=True)
+    first_close = 16_000  # rows: past the first stand's stop (about 150 s at 100 Hz)
+    target.write_bytes(header + b"".join(lines[:first_close]))
+    live = LiveRun(target, tmp_path / "out", publish_every_s=1e9)
+    worker = threading.Thread(target=live.work, daemon=True)
+    worker.start()
+    try:
+        assert started.wait(30), "no segment closed"
+        with open(target, "ab") as fh:
+            fh.write(b"".join(lines[first_close:first_close + 2000]))
+        newest = float(lines[first_close + 1999].split(b",", 1)[0])
+        _wait_for(lambda: live.view["last_sample_time_s"] == newest, 2.0)
+        assert not finished.is_set(), "the fit was not slow: the test shows nothing"
+    finally:
+        live.stop.set()
+        assert live.done.wait(60)
+    assert live.error is None
+    assert live.result.summary["inputs"]["rows"] == first_close + 2000

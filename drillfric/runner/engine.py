@@ -132,6 +132,13 @@ class Engine:
 
     def feed_raw(self, raw: pd.DataFrame) -> list[SegmentRecord]:
         """:meth:`feed` for a raw chunk of the well's own source (labels already text)."""
+        return self.estimate(self.segment_raw(raw))
+
+    def segment_raw(self, raw: pd.DataFrame) -> list[tuple[Segment, pd.DataFrame]]:
+        """The cheap half of :meth:`feed_raw` (steps 1–3): the rows checked, classified and
+        accumulated; returns the segments they closed, with their rows, to be handed to
+        :meth:`estimate` in order (``drillfric live`` estimates them in another thread:
+        this half touches only :meth:`feed_state`, that one only :meth:`fit_state`)."""
         self.raw_rows += len(raw)
         chunk = self.last_chunk = self.well.canonical(raw, self.tracker)
         if self.check.rows == 0 and len(chunk):
@@ -143,16 +150,24 @@ class Engine:
         self.hook.feed(chunk, states)
         self.tracks.feed(chunk, states)
         self.moves.feed(chunk, states, self.stream.last_bit_depth_m)
-        records = self._take(done)
+        return done
+
+    def estimate(self, done: list[tuple[Segment, pd.DataFrame]],
+                 plateaus: list | None = None) -> list[SegmentRecord]:
+        """Step 4 of :meth:`feed_raw`: estimate the segments :meth:`segment_raw` closed;
+        ``plateaus`` are the hook-load plateaus found up to their close (default: now)."""
+        records = self._take(done, plateaus)
         self._report()
         return records
 
-    def _take(self, done: list[tuple[Segment, pd.DataFrame]]) -> list[SegmentRecord]:
+    def _take(self, done: list[tuple[Segment, pd.DataFrame]],
+              plateaus: list | None = None) -> list[SegmentRecord]:
         """Estimate closed segments (with the calibration the rows so far support)."""
         scale = None
         if self.calibration is not None and done:
             self.calibration.add(done)
-            self.estimator.well, calib = self.calibration.current(self.hook.plateaus)
+            self.estimator.well, calib = self.calibration.current(
+                self.hook.plateaus if plateaus is None else plateaus)
             scale = calib.scale
         out = []
         for seg, rows in done:
@@ -276,12 +291,20 @@ class Engine:
     def state(self) -> dict:
         """Everything that continues the run (plain values, arrays, DataFrames: the format of
         :func:`~drillfric.runner.state.write_state`)."""
+        return self.feed_state() | self.fit_state()
+
+    def feed_state(self) -> dict:
+        """The part of :meth:`state` that :meth:`segment_raw` changes."""
         return {"drillfric_version": __version__, "config": self.well.config.to_dict(),
                 "rate_hz": self.rate_hz, "raw_rows": self.raw_rows, "source": self.source,
                 "tracker": self.tracker.state(), "stream": self.stream.state(),
                 "check": self.check.state(),
                 "accumulators": {k: a.state() for k, a in self.accumulators.items()},
-                "estimator": self.estimator.state(), "warnings": list(self.warnings),
+                "warnings": list(self.warnings)}
+
+    def fit_state(self) -> dict:
+        """The part of :meth:`state` that :meth:`estimate` changes."""
+        return {"estimator": self.estimator.state(),
                 "calibration": None if self.calibration is None else self.calibration.state(),
                 "sink": self.sink.state() if isinstance(self.sink, MemorySink) else None,
                 **self._records_state()}
