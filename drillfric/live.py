@@ -43,6 +43,7 @@ from drillfric.errors import InputError
 from drillfric.io.results import write_json
 from drillfric.io.well import CHUNK_ROWS, Well, open_well
 from drillfric.result import SegmentRecord, Status
+from drillfric.runner import warmup
 from drillfric.runner.engine import Engine, mismatch
 from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
 from drillfric.runner.resume import changed
@@ -556,6 +557,7 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
     KeyboardInterrupt
         Interrupted (Ctrl-C, SIGTERM): the final results were written first.
     """
+    warmup.load()  # the kernels loaded now: loading them mid-stream held live.json ~0.5 s
     live = LiveRun(path, out_root, **kw)
     if started is not None:
         started(live)

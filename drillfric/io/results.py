@@ -37,6 +37,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from drillfric.errors import OutputError
+from drillfric.io.digest import sha256_prefix
 from drillfric.io.locks import lock_directory
 from drillfric.result import ESTIMATE_COLUMNS, segment_table
 
@@ -49,13 +50,10 @@ _TMP, _OLD = ".tmp-", ".old-"
 _HOST = hashlib.sha256(socket.gethostname().encode()).hexdigest()[:6]
 
 
-def file_sha256(path: str | Path, block: int = 1 << 20) -> str:
-    """SHA-256 of a file, read in blocks (constant memory)."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while chunk := fh.read(block):
-            digest.update(chunk)
-    return digest.hexdigest()
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 of a file, read in blocks (constant memory; a file already hashed in this
+    process, or a prefix of it, is not read again: :mod:`drillfric.io.digest`)."""
+    return sha256_prefix(path)
 
 
 def jsonable(value):

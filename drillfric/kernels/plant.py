@@ -371,9 +371,10 @@ def plant_kernel(law: int, fixed: bool):
     loop of :func:`pass_cells` is branch-free and vectorised, and no reference counting
     happens inside the time loop (a run-time dispatch there cost ~30 atomic reference-count
     updates per step: half the time of a 65-cell step). Compiled on first use, cached on
-    disk per variant.
+    disk per variant. It runs without the GIL (``nogil``: arrays only), so a long fit in one
+    thread does not stall another (``drillfric live`` writes live.json while fits run).
     """
-    @njit(cache=True)
+    @njit(cache=True, nogil=True)
     def kernel(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
                fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
                inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):

@@ -32,6 +32,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
+from drillfric.io.digest import sha256_prefix
 from drillfric.io.well import Well
 
 from .engine import Engine, mismatch
@@ -124,15 +125,12 @@ def lines_end(path: Path, size: int) -> int:
 
 def csv_mark(path: Path, size: int) -> dict:
     """What a run read of a delimited text file: its first ``size`` bytes."""
-    digest = hashlib.sha256()
     last = b""
-    with open(path, "rb") as fh:
-        left = size
-        while left > 0 and (block := fh.read(min(_BLOCK, left))):
-            digest.update(block)
-            left -= len(block)
-            last = block[-1:]
-    return {"format": "csv", "bytes": size, "sha256": digest.hexdigest(),
+    if size > 0:
+        with open(path, "rb") as fh:
+            fh.seek(size - 1)
+            last = fh.read(1)
+    return {"format": "csv", "bytes": size, "sha256": sha256_prefix(path, size),
             "ends_line": last in (b"\n", b"\r")}
 
 

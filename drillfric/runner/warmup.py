@@ -63,6 +63,14 @@ def warm_up(tick: Callable[[float], None] | None = None, *, timeout_s: float = 6
     return False
 
 
+def load() -> None:
+    """Load the compiled kernels into this process now (from the per-user cache; compiling
+    what is missing), for a process that must not pause later: numba loads a kernel on its
+    first call, holding the GIL ~0.5 s (``drillfric live`` writes live.json every 0.2 s)."""
+    for part in PARTS:
+        _compile(part)
+
+
 def _ticking(tick, t0: float, poll_s: float, done: threading.Event) -> None:
     while tick is not None and not done.wait(poll_s):
         tick(time.monotonic() - t0)
