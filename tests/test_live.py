@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from drillfric.live import Tail
+from drillfric.live_source import Tail
 from drillfric.runner.resume import csv_mark
 from tests.test_engine import AGREE
 
