@@ -435,12 +435,29 @@ def _seed(sink: MemorySink, folder: Path, ids: set[int]) -> None:
 
 
 def _open_view(record: SegmentRecord, folder: Path) -> dict:
-    """live.json ``open_segment``: the open segment's numbers as estimated so far."""
+    """live.json ``open_segment``: the open segment's numbers as estimated so far; its bit
+    speed null with ``bit_rpm_reason`` where the run withholds it (:func:`bit_speed_withheld`)."""
+    why = bit_speed_withheld(record.to_json())
+    bit_rpm = None if why else _last_bit_rpm(folder, record.id)
+    if bit_rpm is None and not why:
+        why = "no estimated bit speed in this publication"
     return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
             "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
             "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
-            "bit_rpm": _last_bit_rpm(folder, record.id),
+            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None,
             "stick_slip_severity": record.stick_slip_severity}
+
+
+def bit_speed_withheld(record: dict) -> str:
+    """Why a segment's estimated bit speed is not shown ("" when it is): the segment was not
+    estimated (status not ``ok``), or its bit trace is not resolved (``bit_speed_resolved``
+    false: docs/bit_speed.md) — the one rule of live.json and the live page. ``record``:
+    the segment as in summary.json."""
+    if record.get("status") != "ok":
+        return f"segment {record.get('status', 'not published')}: {record.get('message', '')}"
+    if record.get("bit_speed_resolved") is False:
+        return record.get("bit_speed_reason") or "bit speed not resolved"
+    return ""
 
 
 def _last_bit_rpm(folder: Path, seg_id: int) -> float | None:
