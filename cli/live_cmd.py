@@ -33,9 +33,12 @@ from .common import UserError, compile_kernels_once, echo
                    "The address is printed (docs/live.md, 'Live page').")
 def command(source: str, out: Path, config: Path | None, name: str | None,
             until_idle: float | None, report: bool, serve: str | None) -> None:
-    """Follow SOURCE — a CSV file a rig logger appends to, or wits0://HOST:PORT (a WITS
-    level 0 stream, recorded into OUT/NAME.wits0.csv) — and estimate its segments as they
-    close. A restarted live run on the same SOURCE and --out continues where it stopped."""
+    """Follow SOURCE — a CSV file a rig logger appends to, a well directory into which the
+    well's CSV or Parquet files arrive (its well.toml names them: [well] data = "." or a
+    sub-folder; read in name order, as 'drillfric run' reads the folder), or
+    wits0://HOST:PORT (a WITS level 0 stream, recorded into OUT/NAME.wits0.csv) — and
+    estimate its segments as they close. A restarted live run on the same SOURCE and --out
+    continues where it stopped."""
     from drillfric.live import run_live
     from drillfric.report import write_well_report
 
@@ -43,10 +46,11 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
         raise UserError(f"--until-idle must be positive seconds, got {until_idle:g}")
     kw = {"config": config} if config else {}
     kw |= {"name": name} if name else {}
-    if not source.startswith("wits0:") and \
+    if not source.startswith("wits0:") and not Path(source).is_dir() and \
             Path(source).suffix.lower() not in (".csv", ".txt", ".tsv"):
-        raise UserError(f"{source}: live follows a delimited text file (.csv, .txt, .tsv) or "
-                        "wits0://HOST:PORT; folder sources are not done yet (docs/live.md)")
+        raise UserError(f"{source}: live follows a delimited text file (.csv, .txt, .tsv), a "
+                        "well directory into which the files arrive, or wits0://HOST:PORT "
+                        "(docs/live.md)")
     server = _server(serve) if serve is not None else None
     receiver, path = None, Path(source)
     try:

@@ -1,11 +1,12 @@
-"""A well estimated while it is drilled: ``drillfric live`` on a CSV file being appended to
-(docs/live.md, issue 24).
+"""A well estimated while it is drilled: ``drillfric live`` on a CSV file being appended to,
+or on a well directory into which its files arrive (docs/live.md, issue 24).
 
 Three pieces:
 
-- :class:`Tail` — where the complete lines of a growing text file end (a write may stop
-  mid-line: a partial last line waits for its newline), with the SHA-256 of the bytes up to
-  there (the mark :mod:`drillfric.runner.resume` checks a continued file against);
+- the source's tail (:mod:`drillfric.live_source`: :class:`~drillfric.live_source.Tail`,
+  :class:`~drillfric.live_source.PartsTail`) — how far the data arrived complete (a write
+  may stop mid-line: a partial last line waits for its line end), with the mark
+  :mod:`drillfric.runner.resume` checks a continued run against;
 - :class:`LiveRun` — a *feed thread* reads the new complete lines into the cheap half of an
   :class:`~drillfric.runner.engine.Engine` (kept in memory: log check, rig states, segment
   cuts; :meth:`~drillfric.runner.engine.Engine.segment_raw`) and hands the segments that
@@ -17,14 +18,13 @@ Three pieces:
 - :func:`status` — live.json, rewritten atomically by the calling thread as soon as rows were
   fed and at least every :data:`POLL_S` (neither a fit nor a publication holds it back).
 
-A restarted live run continues from ``OUT/NAME/state`` (the last publication) when the file
-still starts with the bytes it had read, so no row is lost or read twice.
+A restarted live run continues from ``OUT/NAME/state`` (the last publication) when the data
+still start with what it had read, so no row is lost or read twice.
 """
 
 from __future__ import annotations
 
 import copy
-import hashlib
 import math
 import os
 import queue
@@ -41,12 +41,13 @@ import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
 from drillfric.io.results import write_json
-from drillfric.io.well import CHUNK_ROWS, Well, open_well
+from drillfric.io.well import CHUNK_ROWS, Well
+from drillfric.live_source import PartsTail, Tail, follow
 from drillfric.result import SegmentRecord, Status
 from drillfric.runner import warmup
 from drillfric.runner.engine import Engine, mismatch
 from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
-from drillfric.runner.resume import changed
+from drillfric.runner.resume import changed, unread
 from drillfric.runner.state import read_state
 from drillfric.runner.time_log import STATE_DIR, finish_engine
 from drillfric.segmentation import RIG_STATES
@@ -58,8 +59,6 @@ FEED_POLL_S = 0.1
 #: Shortest wait between two rewrites of live.json [s] (it is rewritten as soon as rows were
 #: fed, but not more often).
 MIN_WRITE_S = 0.05
-#: Complete data lines wanted before the file's layout is sniffed (header + rows).
-FIRST_LINES = 20
 #: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
 SEVERE_STICK_SLIP = 1.0
 #: Share of a core that publications of an open segment may take on average (they come
@@ -116,74 +115,14 @@ def _newest(parts) -> float:
     return max(np.nanmax(p["time_s"], initial=-np.inf) for p in parts)
 
 
-class Tail:
-    """The complete lines of a growing text file.
-
-    Parameters
-    ----------
-    path : Path
-        The file.
-    start : int
-        Bytes already read (a line's end), hashed again on creation.
-    """
-
-    def __init__(self, path: Path, start: int = 0):
-        self.path, self.end = Path(path), 0
-        self._digest = hashlib.sha256()
-        if start:
-            self._take(start)
-
-    def poll(self) -> int:
-        """Where the complete lines end now [bytes] (a partial last line is not counted).
-
-        Raises
-        ------
-        InputError
-            The file became shorter than what was read (rewritten, not appended to).
-        """
-        try:
-            size = self.path.stat().st_size
-        except FileNotFoundError:
-            size = 0
-        if size < self.end:
-            raise InputError(f"the file shrank to {size} bytes after {self.end} were read",
-                             file=self.path, fix="append to the file; restart live on a new "
-                                                 "--out for a rewritten file")
-        if size > self.end:  # the partial last line is read again: it may have ended
-            with open(self.path, "rb") as fh:
-                fh.seek(self.end)
-                block = fh.read(size - self.end)
-            cut = block.rfind(b"\n")
-            if cut >= 0:
-                self._take(self.end + cut + 1, block[:cut + 1])
-        return self.end
-
-    def lines(self) -> int:
-        """How many complete lines there are up to :attr:`end` (for the first sniff)."""
-        with open(self.path, "rb") as fh:
-            return fh.read(self.end).count(b"\n")
-
-    def _take(self, end: int, block: bytes | None = None) -> None:
-        if block is None:
-            with open(self.path, "rb") as fh:
-                fh.seek(self.end)
-                block = fh.read(end - self.end)
-        self._digest.update(block)
-        self.end = end
-
-    def mark(self) -> dict:
-        """The mark of the bytes read (:func:`drillfric.runner.resume.csv_mark`'s format)."""
-        return {"format": "csv", "bytes": self.end, "sha256": self._digest.hexdigest(),
-                "ends_line": True}
-
-
 class LiveRun:
-    """A live run of one CSV file being appended to, into ``out_root/NAME``.
+    """A live run of one CSV file being appended to (or of a well directory into which its
+    files arrive), into ``out_root/NAME``.
 
     Parameters
     ----------
     path : Path
-        The growing CSV file.
+        The growing CSV file, or the well directory (:func:`drillfric.live_source.follow`).
     out_root : Path
         Output root (``--out``).
     open_kw : dict
@@ -207,7 +146,7 @@ class LiveRun:
         self.target = self.out_root / "live.json"
         self.report, self.publish_every_s = report, publish_every_s
         self.stale_s, self.stopped_s, self.clock = stale_s, stopped_s, clock
-        self.tail = Tail(self.path)
+        self.tail: Tail | PartsTail = follow(self.path)
         self.well: Well | None = None
         self.engine: Engine | None = None
         self.stop = threading.Event()
@@ -218,7 +157,7 @@ class LiveRun:
         self.last_data = clock()  # when the file last grew (wall clock)
         self.tail_fed, self.published_at, self.dirty = 0, clock(), False
         #: Work for the fit thread, in order: ("fit", segments, plateaus), ("publish" or
-        #: "final", the engine's feed state, None); None ends it.
+        #: "final", the engine's feed state, the well read); None ends it.
         self.jobs: queue.Queue = queue.Queue()
         self.pending = threading.Event()  # a publication handed and not yet begun
         self.fitted = threading.Event()  # the fit thread ended
@@ -245,10 +184,11 @@ class LiveRun:
                 if not self._step():
                     self.stop.wait(FEED_POLL_S)
             if self.error is None:
-                if self.engine is None and self.tail.poll() and self.tail.lines() >= 2:
+                self.tail.poll(final=True)
+                if self.engine is None and self.tail.ready(final=True):
                     self._start()  # a header and a few rows: enough to finish with
                 if self.engine is not None:
-                    self._feed(self.tail.poll())
+                    self._feed(self.tail.poll(final=True))
                     self._hand_publication(final=True)
         except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
             self._fail(exc)
@@ -266,7 +206,7 @@ class LiveRun:
         """One poll; True when rows were fed."""
         end = self.tail.poll()
         if self.engine is None:
-            if end == 0 or self.tail.lines() < FIRST_LINES:
+            if not self.tail.ready():
                 return False
             self._start()
             end = self.tail.poll()
@@ -286,32 +226,33 @@ class LiveRun:
 
     def _start(self) -> None:
         """Open the well and its engine: continued from OUT/NAME/state when it fits."""
-        self.well = open_well(self.path, **self.open_kw)
+        self.well = self.tail.open(self.path, self.open_kw)
         self.folder = self.out_root / self.well.dir_name
         self.engine, why = _continued(self.well, self.folder)
-        fed = 0 if self.engine is None else self.engine.source["bytes"]
         if self.engine is None:
             self.engine = Engine(self.well, sink=MemorySink())
             self.engine.resumed = {"from_row": 0, "reason": why}
-        self.tail = Tail(self.path, fed)
-        self.tail_fed, self.published_at, self.dirty = fed, self.clock(), False
+        self.tail.restart(self.engine.source)
+        self.tail_fed, self.published_at, self.dirty = self.tail.end, self.clock(), False
         with self.lock:
             self.view["resumed"] = self.engine.resumed
 
     def _feed(self, end: int) -> bool:
-        """Feed bytes [fed, end) to the engine's cheap half; the segments they closed are
-        handed to the fit thread (with the hook-load plateaus found up to their close, as
-        a run over the whole file estimates them). True when segments closed."""
+        """Feed the rows read since the engine's source mark up to the tail's (``end``: how
+        far it read) to the engine's cheap half; the segments they closed are handed to the
+        fit thread (with the hook-load plateaus found up to their close, as a run over the
+        whole file estimates them). True when segments closed."""
         closed = False
         if self.engine is None or end <= self.tail_fed:
             return False
-        for raw in self.well.source.window(self.tail_fed, end, CHUNK_ROWS):
+        self.well, now = self.tail.well_for(self.well), self.tail.mark()
+        for raw in unread(self.well, self.engine.source, now, CHUNK_ROWS):
             done = self.engine.segment_raw(raw)
             self.recent.add(self.engine.last_chunk)
             if done:
                 self.jobs.put(("fit", done, list(self.engine.hook.plateaus)))
                 closed = True
-        self.tail_fed, self.engine.source, self.dirty = end, self.tail.mark(), True
+        self.tail_fed, self.engine.source, self.dirty = end, now, True
         self._note_rows()
         self.fed.set()
         return closed
@@ -334,7 +275,7 @@ class LiveRun:
         handed before)."""
         snapshot = copy.deepcopy(self.engine.feed_state())
         self.pending.set()
-        self.jobs.put(("final" if final else "publish", snapshot, None))
+        self.jobs.put(("final" if final else "publish", snapshot, self.well))
         self.published_at, self.dirty = self.clock(), False
 
     # ------------------------------------------------------------------ fit thread
@@ -360,21 +301,22 @@ class LiveRun:
                         self.engine.estimate(job[1], job[2])
                     elif i == newest:
                         self.pending.clear()
-                        self._publish(job[1], final=job[0] == "final")
+                        self._publish(job[1], job[2], final=job[0] == "final")
         except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
             self._fail(exc)
         finally:
             self.fitted.set()
 
-    def _publish(self, feed_state: dict, final: bool = False) -> None:
-        """Close a copy of the engine (``feed_state`` and the fit thread's half) into OUT/NAME
-        as ``drillfric run`` would (the final results with the report)."""
+    def _publish(self, feed_state: dict, well: Well, final: bool = False) -> None:
+        """Close a copy of the engine (``feed_state`` and the fit thread's half; ``well`` as
+        the feed thread read it then) into OUT/NAME as ``drillfric run`` would (the final
+        results with the report)."""
         cpu = time.thread_time()
         state = feed_state | copy.deepcopy(self.engine.fit_state())
         memory = self.engine.sink
 
         def run(sink: DirectorySink):
-            twin = Engine(self.well, sink=sink, rate_hz=self.engine.rate_hz)
+            twin = Engine(well, sink=sink, rate_hz=self.engine.rate_hz)
             twin.restore(state)
             twin.resumed = self.engine.resumed
             for key, parts in memory.frames.items():
@@ -384,7 +326,7 @@ class LiveRun:
             self._note_result(result, twin._open_ids, sink.folder)
             return result
 
-        result = deliver(self.well, self.out_root, run, self.report if final else None)
+        result = deliver(well, self.out_root, run, self.report if final else None)
         self.publish_cpu_s = time.thread_time() - cpu
         if final:
             self.result = result
@@ -434,12 +376,9 @@ class LiveRun:
                 "idle_s": round(idle, 3), "max_update_gap_s": round(self.max_gap_s, 3)}
 
     def watch(self) -> None:
-        """Note whether the file grew (the caller's thread: a busy worker does not make the
-        data look idle)."""
-        try:
-            size = self.path.stat().st_size
-        except OSError:
-            size = -1
+        """Note whether the source grew (the caller's thread: a busy worker does not make
+        the data look idle)."""
+        size = self.tail.growth()
         if size != self._size:
             self._size, self.last_data = size, self.clock()
 
@@ -464,8 +403,9 @@ def _continued(well: Well, folder: Path) -> tuple[Engine | None, str]:
     except InputError as exc:
         return None, exc.message
     source = state.get("source") or {}
+    kind = "parts" if well.source.parts else "csv"
     why = mismatch(state, well, None) or changed(source, well) or \
-        ("" if source.get("format") == "csv" else "the earlier run read another kind of file")
+        ("" if source.get("format") == kind else "the earlier run read another kind of file")
     if why:
         return None, why
     sink = MemorySink()
@@ -496,12 +436,29 @@ def _seed(sink: MemorySink, folder: Path, ids: set[int]) -> None:
 
 
 def _open_view(record: SegmentRecord, folder: Path) -> dict:
-    """live.json ``open_segment``: the open segment's numbers as estimated so far."""
+    """live.json ``open_segment``: the open segment's numbers as estimated so far; its bit
+    speed null with ``bit_rpm_reason`` where the run withholds it (:func:`bit_speed_withheld`)."""
+    why = bit_speed_withheld(record.to_json())
+    bit_rpm = None if why else _last_bit_rpm(folder, record.id)
+    if bit_rpm is None and not why:
+        why = "no estimated bit speed in this publication"
     return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
             "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
             "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
-            "bit_rpm": _last_bit_rpm(folder, record.id),
+            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None,
             "stick_slip_severity": record.stick_slip_severity}
+
+
+def bit_speed_withheld(record: dict) -> str:
+    """Why a segment's estimated bit speed is not shown ("" when it is): the segment was not
+    estimated (status not ``ok``), or its bit trace is not resolved (``bit_speed_resolved``
+    false: docs/bit_speed.md) — the one rule of live.json and the live page. ``record``:
+    the segment as in summary.json."""
+    if record.get("status") != "ok":
+        return f"segment {record.get('status', 'not published')}: {record.get('message', '')}"
+    if record.get("bit_speed_resolved") is False:
+        return record.get("bit_speed_reason") or "bit speed not resolved"
+    return ""
 
 
 def _last_bit_rpm(folder: Path, seg_id: int) -> float | None:

@@ -42,7 +42,7 @@ import pyarrow.parquet as pq
 from markupsafe import Markup
 
 from drillfric.io.results import jsonable
-from drillfric.live import SEVERE_STICK_SLIP, LiveRun
+from drillfric.live import SEVERE_STICK_SLIP, LiveRun, bit_speed_withheld
 from drillfric.report.data import FINAL_START_ID, extreme_rows
 from drillfric.report.interactive import bokeh_js, json_in_script, script_hash, time_figure
 from drillfric.report.render import environment, is_apparent, mu_k_cell, mu_s_text, status_word
@@ -222,9 +222,9 @@ class LivePage:
         parts, withheld = [], []
         groups = list(window.groupby("segment_id", sort=True))
         for seg_id, rows in groups:
-            record = records.get(int(seg_id), {})
-            if record.get("status") != "ok" or record.get("bit_speed_resolved") is False:
-                withheld.append({"segment": int(seg_id), "reason": _bit_reason(record)})
+            why = bit_speed_withheld(records.get(int(seg_id), {}))
+            if why:
+                withheld.append({"segment": int(seg_id), "reason": why})
                 continue
             rows = rows.iloc[extreme_rows(rows, BIT_POINTS // len(groups),
                                           ("bit_rpm_est",))]
@@ -247,12 +247,6 @@ def _final_bit_rows(path: Path, ids: tuple[int, ...]) -> pd.DataFrame:
         if column not in frame:
             frame[column] = np.nan
     return frame.sort_values(["segment_id", "time_s"], kind="stable")
-
-
-def _bit_reason(record: dict) -> str:
-    if record.get("status") != "ok":
-        return f"segment {record.get('status', 'not published')}: {record.get('message', '')}"
-    return record.get("bit_speed_reason") or "bit speed not resolved"
 
 
 def segment_view(record: dict, is_open: bool) -> dict:

@@ -40,7 +40,8 @@
         : withheld(ok ? "not identifiable from these data" : why));
     put("open-bit-rpm", row && row.bit_speed_resolved === false
       ? withheld(row.bit_speed_reason || "bit speed not resolved")
-      : ok && known(open.bit_rpm) ? fixed(open.bit_rpm, 1) + " rpm" : withheld(why));
+      : ok && known(open.bit_rpm) ? fixed(open.bit_rpm, 1) + " rpm"
+        : withheld(open.bit_rpm_reason || why));
     put("open-severity", ok && known(open.stick_slip_severity)
       ? fixed(open.stick_slip_severity, 2) : withheld(why));
   }

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from drillfric.live import Tail
+from drillfric.live_source import Tail
 from drillfric.runner.resume import csv_mark
 from tests.test_engine import AGREE
 
@@ -222,3 +222,26 @@ def test_a_slow_segment_fit_does_not_hold_back_the_newest_sample(recorded, tmp_p
         assert live.done.wait(60)
     assert live.error is None
     assert live.result.summary["inputs"]["rows"] == first_close + 2000
+
+
+def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it(tmp_path):
+    """Regression (issue 24): live.json ``open_segment.bit_rpm`` showed the last estimated bit
+    speed of a segment whose bit trace the run withholds (not resolved, or the segment not
+    estimated); it is null with ``bit_rpm_reason``, by the live page's rule."""
+    from drillfric.live import _open_view
+    from drillfric.result import SegmentRecord, Status
+
+    pd.DataFrame({"segment_id": np.int32([3, 3]), "bit_rpm_est": [44.0, 45.0]}).to_parquet(
+        tmp_path / "estimates.parquet", index=False)
+    resolved = SegmentRecord(id=3, status=Status.OK, bit_speed_resolved=True)
+    view = _open_view(resolved, tmp_path)
+    assert view["bit_rpm"] == 45.0 and view["bit_rpm_reason"] is None
+    reason = "the 1-s log does not resolve the stick-slip cycle"
+    view = _open_view(SegmentRecord(id=3, status=Status.OK, bit_speed_resolved=False,
+                                    bit_speed_reason=reason), tmp_path)
+    assert view["bit_rpm"] is None and view["bit_rpm_reason"] == reason
+    view = _open_view(SegmentRecord(id=3, status=Status.SKIPPED, message="too short"),
+                      tmp_path)
+    assert view["bit_rpm"] is None and view["bit_rpm_reason"] == "segment skipped: too short"
+    view = _open_view(SegmentRecord(id=4, status=Status.OK, bit_speed_resolved=True), tmp_path)
+    assert view["bit_rpm"] is None and "no estimated bit speed" in view["bit_rpm_reason"]

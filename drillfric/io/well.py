@@ -302,6 +302,21 @@ def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, surv
                 files=files, config=cfg, survey=path_m, source=source, mappings=mappings)
 
 
+def with_parts(well: Well, parts: tuple[Path, ...]) -> Well:
+    """``well`` with its log read from ``parts`` — the files of its data folder that have
+    arrived so far (``drillfric live`` on a folder, docs/live.md) — its channels mapped from
+    their header (every part must have the first part's columns).
+
+    Raises
+    ------
+    InputError
+        A part not readable as the first part is (other columns, not a data file).
+    """
+    files = replace(well.files, parts=tuple(parts))
+    source, mappings = _open(files, well.config)
+    return replace(well, files=files, source=source, mappings=mappings)
+
+
 def find_well(path, *, config=None, survey=None, name: str | None = None
               ) -> tuple[WellFiles, str | None]:
     """A well's files and name from its paths and sidecars alone: no data file is opened

@@ -190,6 +190,32 @@ def resolve_files(path, config, survey, peek: bool = True) -> tuple[WellFiles, d
                      find_string(data_path, raw, peek)), raw
 
 
+def arriving_data(path: Path) -> Path:
+    """Where the data of a well directory ``path`` arrive (``drillfric live`` on a folder):
+    the file or folder its ``well.toml`` names (``[well] data``; ``"."`` for the directory's
+    own files).
+
+    Raises
+    ------
+    InputError, ConfigError
+        No well.toml, no ``[well] data``, or data named outside the directory.
+    """
+    path = Path(path)
+    well_toml = path / "well.toml"
+    if special(well_toml):
+        require_file(well_toml, "well.toml")
+    if not well_toml.is_file():
+        raise InputError("well directory has no well.toml", file=path,
+                         fix='add well.toml with [well] data = "." (the files arriving in '
+                             'this folder) or the sub-folder they arrive in')
+    data = read_toml(well_toml).get("well", {}).get("data")
+    if not isinstance(data, str):
+        raise ConfigError("well.toml does not name its data", file=well_toml,
+                          fix='add [well] data = "." (the files arriving in this folder)')
+    return require_inside(path / data, path, "data named by well.toml",
+                          fix="let the files arrive inside the well directory")
+
+
 def frame_files(config, survey) -> tuple[WellFiles, dict]:
     """The files of a well whose data is a DataFrame: only those given (a configuration
     file's ``[survey] file`` too), never a sidecar."""

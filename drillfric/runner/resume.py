@@ -48,10 +48,16 @@ def mark(well: Well) -> dict:
     source = well.source
     if source.parts:
         last = len(source.parts) - 1
-        return {"format": "parts", "columns": list(source.columns), "units": _units(source),
-                "parts": [{"name": p.path.name} | source_mark(p, whole=i < last)
-                          for i, p in enumerate(source.parts)]}
+        return parts_mark(source, [{"name": p.path.name} | source_mark(p, whole=i < last)
+                                   for i, p in enumerate(source.parts)])
     return source_mark(source)
+
+
+def parts_mark(source, parts: list[dict]) -> dict:
+    """The mark of a log in parts (``source``): its columns and units, and ``parts``, each
+    part's mark with its ``name``."""
+    return {"format": "parts", "columns": list(source.columns), "units": _units(source),
+            "parts": parts}
 
 
 def _units(source) -> dict:
