@@ -67,6 +67,12 @@ OPEN_SHARE = 0.1
 #: Relative change of a converged μ_k against the median of the previous five that raises a
 #: friction-trend alert.
 TREND_CHANGE = 0.25
+#: Log seconds the estimated bit must have stayed stuck, at the end of the open segment while
+#: the top drive turns, for a ``bit_stalled`` alert: longer than the stick phase of ordinary
+#: stick-slip (1–3 s at 60–120 RPM: docs/live.md).
+BIT_STALL_S = 5.0
+#: Surface speed above which the top drive counts as turning for a stall [RPM].
+STALL_SURFACE_RPM = 5.0
 #: Log seconds of surface rows kept for the live page's time tracks (:class:`RecentRows`).
 RECENT_S = 600.0
 #: The channels of :class:`RecentRows` (SI; NaN where the log lacks one).
@@ -364,6 +370,11 @@ class LiveRun:
             alerts.append(_alert("severe_stick_slip", f"stick-slip severity {ssi:.2f} in the "
                                  f"open segment (≥ {SEVERE_STICK_SLIP:g})",
                                  view["last_sample_time_s"]))
+        stalled = (view["open_segment"] or {}).get("bit_stalled_s")
+        if stalled is not None and stalled >= BIT_STALL_S:
+            alerts.append(_alert("bit_stalled", f"estimated bit speed at rest for the last "
+                                 f"{stalled:.0f} s of the open segment while the top drive "
+                                 "turns", (view["open_segment"] or {}).get("t_end_s")))
         if view["trend_alert"] is not None:
             alerts.append(view["trend_alert"])
         return {"source": str(self.path), "well": None if self.well is None else self.well.name,
@@ -439,13 +450,13 @@ def _open_view(record: SegmentRecord, folder: Path) -> dict:
     """live.json ``open_segment``: the open segment's numbers as estimated so far; its bit
     speed null with ``bit_rpm_reason`` where the run withholds it (:func:`bit_speed_withheld`)."""
     why = bit_speed_withheld(record.to_json())
-    bit_rpm = None if why else _last_bit_rpm(folder, record.id)
+    bit_rpm, stalled_s = (None, None) if why else _bit_tail(folder, record.id)
     if bit_rpm is None and not why:
         why = "no estimated bit speed in this publication"
     return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
             "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
             "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
-            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None,
+            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
             "stick_slip_severity": record.stick_slip_severity}
 
 
@@ -461,18 +472,34 @@ def bit_speed_withheld(record: dict) -> str:
     return ""
 
 
-def _last_bit_rpm(folder: Path, seg_id: int) -> float | None:
-    """The last estimated bit speed [RPM] of segment ``seg_id`` (its last row group)."""
+def _bit_tail(folder: Path, seg_id: int) -> tuple[float | None, float | None]:
+    """The last estimated bit speed [RPM] of segment ``seg_id`` (its last row group) and how
+    long [s] the estimated bit has been stuck (``bit_stuck``) at its end while the top drive
+    turned (above :data:`STALL_SURFACE_RPM`); (None, None) without estimates."""
     path = folder / "estimates.parquet"
     if not path.is_file():
-        return None
+        return None, None
     source = pq.ParquetFile(path)
     for i in reversed(range(source.num_row_groups)):
-        table = source.read_row_group(i, columns=["segment_id", "bit_rpm_est"])
+        table = source.read_row_group(i, columns=["segment_id", "time_s", "surface_rpm",
+                                                  "bit_rpm_est", "bit_stuck"])
         if table.num_rows and int(table["segment_id"][0].as_py()) == seg_id:
             value = table["bit_rpm_est"][-1].as_py()
-            return None if value is None or not math.isfinite(value) else float(value)
-    return None
+            last = None if value is None or not math.isfinite(value) else float(value)
+            return last, _stalled_s(table.to_pandas())
+    return None, None
+
+
+def _stalled_s(rows: pd.DataFrame) -> float:
+    """Log seconds of the trailing rows whose bit is stuck while the top drive turns."""
+    stalled = rows["bit_stuck"].fillna(False).to_numpy(bool) & \
+        (rows["surface_rpm"].to_numpy(float) > STALL_SURFACE_RPM)
+    if not stalled.size or not stalled[-1]:
+        return 0.0
+    moving = np.flatnonzero(~stalled)
+    first = moving[-1] + 1 if moving.size else 0
+    t = rows["time_s"].to_numpy(float)
+    return float(t[-1] - t[first])
 
 
 def _trend(done: list[SegmentRecord]) -> dict | None:

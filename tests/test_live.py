@@ -231,8 +231,10 @@ def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it
     from drillfric.live import _open_view
     from drillfric.result import SegmentRecord, Status
 
-    pd.DataFrame({"segment_id": np.int32([3, 3]), "bit_rpm_est": [44.0, 45.0]}).to_parquet(
-        tmp_path / "estimates.parquet", index=False)
+    pd.DataFrame({"segment_id": np.int32([3, 3]), "time_s": [0.0, 0.01],
+                  "surface_rpm": [60.0, 60.0], "bit_rpm_est": [44.0, 45.0],
+                  "bit_stuck": [False, False]}).to_parquet(tmp_path / "estimates.parquet",
+                                                           index=False)
     resolved = SegmentRecord(id=3, status=Status.OK, bit_speed_resolved=True)
     view = _open_view(resolved, tmp_path)
     assert view["bit_rpm"] == 45.0 and view["bit_rpm_reason"] is None
@@ -245,3 +247,38 @@ def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it
     assert view["bit_rpm"] is None and view["bit_rpm_reason"] == "segment skipped: too short"
     view = _open_view(SegmentRecord(id=4, status=Status.OK, bit_speed_resolved=True), tmp_path)
     assert view["bit_rpm"] is None and "no estimated bit speed" in view["bit_rpm_reason"]
+
+
+def test_bit_stalled_alert_after_the_bit_stays_stuck_while_the_top_drive_turns(tmp_path):
+    """Issue 24 names a "bit stalled" alert: the estimated bit at rest (``bit_stuck``) for the
+    last BIT_STALL_S of the open segment while the top drive turns — not a stick phase of
+    ordinary stick-slip (1–3 s), not a stop of the top drive, not a withheld bit trace."""
+    from drillfric.live import BIT_STALL_S, LiveRun, _open_view
+    from drillfric.result import SegmentRecord, Status
+
+    t = np.arange(0.0, 20.0, 0.01)
+    stuck = t >= 20.0 - (BIT_STALL_S + 1.0)  # the last 6 s at rest
+    surface = np.full(t.size, 80.0)
+
+    def view(surface_rpm, stuck, resolved=True):
+        pd.DataFrame({"segment_id": np.int32(np.full(t.size, 7)), "time_s": t,
+                      "surface_rpm": surface_rpm, "bit_rpm_est": np.where(stuck, 0.0, 80.0),
+                      "bit_stuck": stuck}).to_parquet(tmp_path / "estimates.parquet",
+                                                      index=False)
+        return _open_view(SegmentRecord(id=7, status=Status.OK, bit_speed_resolved=resolved,
+                                        t_end_s=20.0), tmp_path)
+
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: 0.0)
+    live.view["open_segment"] = view(surface, stuck)
+    assert live.view["open_segment"]["bit_stalled_s"] == pytest.approx(BIT_STALL_S + 1.0,
+                                                                       abs=0.02)
+    alerts = live.status()["alerts"]
+    assert [a["kind"] for a in alerts] == ["bit_stalled"] and alerts[0]["time_s"] == 20.0
+    cycles = (t % 4.0) >= 2.5  # stick-slip: 1.5-s stick phases
+    live.view["open_segment"] = view(surface, cycles)
+    assert live.status()["alerts"] == []
+    live.view["open_segment"] = view(np.where(stuck, 0.0, 80.0), stuck)  # top drive stopped
+    assert live.status()["alerts"] == []
+    live.view["open_segment"] = view(surface, stuck, resolved=False)  # trace withheld
+    assert live.view["open_segment"]["bit_stalled_s"] is None
+    assert live.status()["alerts"] == []
