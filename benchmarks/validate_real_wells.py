@@ -84,7 +84,7 @@ def statuses(summary: dict, rate: str, truth_mu_k: float = MU_K) -> list[dict]:
     out = []
     rows = [(f"seg {g['id']} {g['kind']}", g) for g in summary["segments"]]
     rows.append(("well", {"mu_k": summary["mu_k"], "converged": summary["mu_k"] is not None,
-                          "status": "ok", "flags": [],
+                          "status": "ok", "quality_flags": [],
                           "message": summary.get("mu_k_reason") or "no converged segment"}))
     for name, g in rows:
         if g["status"] != "ok":
@@ -95,9 +95,9 @@ def statuses(summary: dict, rate: str, truth_mu_k: float = MU_K) -> list[dict]:
         if mu is not None and g["converged"]:
             ok = abs(mu / truth_mu_k - 1.0) <= tol
             out.append({"what": name, "status": "ok" if ok else "FALSE", "mu_k": mu,
-                        "reason": ", ".join(g["flags"])})
+                        "reason": ", ".join(g["quality_flags"])})
         else:
-            why = [f for f in g["flags"] if f not in ("observer_not_converged",
+            why = [f for f in g["quality_flags"] if f not in ("observer_not_converged",
                                                       "observer_deadlock_averted")]
             out.append({"what": name, "status": "withheld", "mu_k": mu,
                         "reason": ", ".join(why) or (g["message"] or "not converged")[:90]})

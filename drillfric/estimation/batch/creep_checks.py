@@ -94,14 +94,16 @@ def measure(model: Model, wins: list[Window], mu_s: float, mu_k: float, cells: i
     noise = smoothed_noise_Nm(d, np.concatenate([w.used for w in wins]))
     level = max(float(np.max(np.abs(data))), 1e-9)
     independent = np.sqrt(max(1.0, base.size * d.dt / TORQUE_SMOOTH_S))
+    sensitivity = float(np.sqrt(np.mean((moved - base) ** 2))) / noise * independent
+    twist_noise = float(np.sqrt(sum(walks))) / max(jacobian_sq, 1e-30) / mu_s
+    spread = float(np.hypot(CREEP_SENSITIVITY_STEP / max(sensitivity, 1e-9), twist_noise))
     return CreepChecks(engaged=float(np.max(base)) / max(capacity, 1e-9),
                        misfit=float(np.sqrt(np.mean((base - data) ** 2))) / level,
-                       sensitivity=float(np.sqrt(np.mean((moved - base) ** 2))) / noise
-                       * independent, noise_Nm=noise,
-                       swing_ratio=_swing_ratio(model, rotating, mu_s, mu_k, rotating_cells)
-                       if stick_slip and rotating else None,
+                       sensitivity=sensitivity, noise_Nm=noise,
+                       swing_ratio=swing_ratio(model, rotating, mu_s, mu_k, rotating_cells,
+                                               spread) if stick_slip and rotating else None,
                        halves=_split_half(model, wins, mu_s, mu_k, cells),
-                       twist_noise=float(np.sqrt(sum(walks))) / max(jacobian_sq, 1e-30) / mu_s)
+                       twist_noise=twist_noise)
 
 
 def _twist_walk(d: FitData, w: Window, base: np.ndarray, moved: np.ndarray,
@@ -248,12 +250,26 @@ def smoothed_noise_Nm(d: FitData, samples: np.ndarray) -> float:
     return max(sigma / np.sqrt(max(1.0, TORQUE_SMOOTH_S / d.dt)), 1e-6)
 
 
-def _swing_ratio(model: Model, rotating: list[Window], mu_s: float, mu_k: float,
-                 cells: int) -> float:
-    """Torque fluctuation of the model at (μ_s, μ_k) over the used samples of the longest
-    rotating run, relative to the data's there [-]."""
+def swing_ratio(model: Model, rotating: list[Window], mu_s: float, mu_k: float, cells: int,
+                spread: float = 0.0) -> float:
+    """Torque fluctuation of the model over the used samples of the longest rotating run,
+    relative to the data's there [-]: the median over μ_s·(1 − s), μ_s, μ_s·(1 + s) with
+    s = ``spread``, the fit's own relative 1-σ of μ_s (one point where that is not finite).
+
+    Stick-slip near its onset is bistable and chaotic: the model at one (μ_s, μ_k) may
+    settle into steady rotation where its neighbours within the fit's uncertainty
+    stick-slip like the data (the step-law stand at 5 Hz: 0.46 at μ_s = 0.614, μ_k =
+    0.2507, against 0.86–1.08 at μ_s 0.600 and 0.620 or μ_k 0.2489–0.2500;
+    docs/validation.md). The median of the three asks whether the law explains the slips,
+    not whether one chaotic run happened to; a law that does not (Stribeck friction: the
+    model's stick-slip 0.05–0.2 of the data's) fails at its neighbours as well."""
     w = max(rotating, key=lambda w: w.used.size)
-    tau, _ = model.simulate(w, mu_s, mu_k, cells)
     d = model.data
-    model_fluct = fluctuation(smooth(tau, d.dt, TORQUE_SMOOTH_S)[w.used - w.sim0])
-    return model_fluct / max(fluctuation(d.tau_bar[w.used]), 1e-9)
+    data_fluct = max(fluctuation(d.tau_bar[w.used]), 1e-9)
+    factors = (1.0 - spread, 1.0, 1.0 + spread) if 0.0 < spread < 1.0 else (1.0,)
+    ratios = []
+    for f in factors:
+        tau, _ = model.simulate(w, f * mu_s, min(mu_k, f * mu_s), cells)
+        ratios.append(fluctuation(smooth(tau, d.dt, TORQUE_SMOOTH_S)[w.used - w.sim0])
+                      / data_fluct)
+    return float(np.median(ratios))
