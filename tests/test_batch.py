@@ -552,3 +552,22 @@ def test_swing_check_one_chaotic_steady_run_does_not_withhold_a_right_mu_s():
     assert creep_checks.swing_ratio(law_fails, [w], 0.614, 0.25, 500, spread=0.023) < 0.1
     # an unpinned fit (infinite spread) is judged at its own point
     assert creep_checks.swing_ratio(one_off, [w], 0.614, 0.25, 500, spread=np.inf) < 0.1
+
+
+def test_cased_effective_5_hz_seed_8_halves_blind_to_the_cased_top():
+    """Regression (issue 22; docs/validation.md seed probe): the cased-effective plant of
+    validate_trust.py (μ_s 0.35 above the 1500-m shoe, 0.6 below, no casing keys; effective
+    0.500) logged at 5 Hz with noise seed 8 claimed μ_s = 0.412 (−17.5 %). Its creep checks
+    as measured: misfit 0.8 %, sensitivity 22, twist noise ±2.1 %, halves 0.404 / 0.419
+    (−3.6 %, inside the −6 % line) — but each half's twist noise (≈ ±2.4 %, the walk over
+    that half) makes the halves' 2σ ±7.0 %, more than the 6 % split a cased top must show:
+    the check cannot see it, and μ_s is withheld with that reason. The same creep logged
+    with quiet speed (each half ±1 %: 2σ ≈ 3.3 %) is judged by the line and passes."""
+    seed_8 = creep_checks.CreepChecks(engaged=1.0, misfit=0.008, sensitivity=22.0,
+                                      noise_Nm=20.0, halves=(0.404, 0.419), twist_noise=0.021,
+                                      halves_twist_noise=(0.024, 0.024), swing_ratio=0.85)
+    assert creep_checks.halves_noise(seed_8) == pytest.approx(0.070, abs=0.002)
+    problems = creep_checks.problems(0.412, seed_8)
+    assert len(problems) == 1
+    assert "halves cannot be compared: noise ±7.0 % (2σ) at this rate > 6 %" in problems[0]
+    assert creep_checks.problems(0.412, replace(seed_8, halves_twist_noise=(0.01, 0.01))) == []
