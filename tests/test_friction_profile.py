@@ -119,13 +119,21 @@ def test_halves_allow_a_slowly_logged_onset_but_not_a_low_top():
     assert creep_checks.problems(0.6, replace(PASSING, halves=(0.555, 0.60)))
 
 
-def test_halves_allow_for_their_own_noise():
-    """A quiet creep (sensitivity 4: each half's μ_s uncertain by ≈ 3.5 %) may split by
-    2σ of the difference, 2 × 2 × 10 %/4 = 10 %; a well-measured one (sensitivity 25) not."""
-    quiet = replace(PASSING, sensitivity=4.0, halves=(0.416, 0.443))  # −6.1 %
-    assert creep_checks.problems(0.43, quiet) == []
-    assert creep_checks.problems(0.43, replace(quiet, sensitivity=25.0))
-    assert creep_checks.problems(0.43, replace(quiet, halves=(0.38, 0.443)))  # −14 %
+def test_halves_too_noisy_to_see_a_cased_top_withhold_mu_s():
+    """The halves check states its own noise: 2σ of the halves' difference, the torque noise
+    (2 × 10 %/sensitivity) and each half's twist noise in quadrature. Where that exceeds the
+    6 % line a cased top must cross, the check is blind and μ_s is withheld however close
+    the halves are: a quiet creep (sensitivity 4: 2σ = 10 %) or a slow one (each half's
+    twist noise 3 %: 2σ ≈ 8.6 %); a well-measured one is judged by the line."""
+    quiet = replace(PASSING, sensitivity=4.0, halves=(0.43, 0.43))
+    slow = replace(PASSING, halves=(0.60, 0.60), halves_twist_noise=(0.03, 0.03))
+    for blind in (quiet, slow):
+        problems = creep_checks.problems(0.43, blind)
+        assert len(problems) == 1 and "halves cannot be compared" in problems[0]
+    assert creep_checks.problems(0.6, replace(slow, halves_twist_noise=(0.015, 0.015))) == []
+    assert creep_checks.problems(0.43, replace(quiet, sensitivity=25.0)) == []
+    assert creep_checks.halves_noise(replace(slow, sensitivity=1e9)) == pytest.approx(
+        2.0 * np.hypot(0.03, 0.03))
 
 
 def test_smoothed_noise_of_white_noise_on_a_smooth_torque():
@@ -143,11 +151,15 @@ def test_smoothed_noise_of_white_noise_on_a_smooth_torque():
 
 def test_twist_and_torque_noise_add_in_quadrature():
     """Each 1-σ alone within 10 %/3 = 3.33 % passes; 2.5 % and 2.5 % together are 3.54 %:
-    withheld (docs/theory.md §6.3, check 2)."""
+    withheld (docs/theory.md §6.3, check 2). (Sensitivity 4 leaves the halves blind, 2σ =
+    10 % > 6 %: that check is left out here.)"""
+    def twist_check(c):
+        return [p for p in creep_checks.problems(0.6, c) if "halves" not in p]
+
     torque_only = replace(PASSING, sensitivity=4.0)  # 10 %/4 = 2.5 %
-    assert creep_checks.problems(0.6, torque_only) == []
-    assert creep_checks.problems(0.6, replace(PASSING, twist_noise=0.025)) == []
-    assert creep_checks.problems(0.6, replace(torque_only, twist_noise=0.025))
+    assert twist_check(torque_only) == []
+    assert twist_check(replace(PASSING, twist_noise=0.025)) == []
+    assert twist_check(replace(torque_only, twist_noise=0.025))
 
 
 def test_twist_walk_variance_of_a_constant_weight():

@@ -51,6 +51,9 @@ class CreepChecks:
         Standard deviation of the smoothed measured torque's noise [N·m].
     halves : tuple of float
         μ_s fitted on the first and on the second half of the creep alone [-].
+    halves_twist_noise : tuple of float
+        Relative 1-σ of each half's μ_s due to the twist noise, as ``twist_noise`` but over
+        that half alone (the walk accumulated before it included) [-] (docs/theory.md §6.3).
     twist_noise : float
         Relative 1-σ of μ_s due to the speed noise the model integrates into its twist
         (a random walk, σ_ω·√(Δt·t)) [-] (docs/theory.md §6.3).
@@ -68,6 +71,7 @@ class CreepChecks:
     noise_Nm: float
     halves: tuple[float, float]
     twist_noise: float = 0.0
+    halves_twist_noise: tuple[float, float] = (0.0, 0.0)
     swing_ratio: float | None = None
     other_hypothesis: float | None = None
 
@@ -81,11 +85,14 @@ def measure(model: Model, wins: list[Window], mu_s: float, mu_k: float, cells: i
     g, fc = model.grid(cells)
     est, _, fix_s = model.profile.parts(g.x_m, g.dx_true_m, fc, mu_s, mu_k, model.cased_static)
     capacity = float(np.sum((mu_s * est + fix_s) * g.dx_true_m))
-    base, moved, data, walks = [], [], [], []
+    base, moved, data = [], [], []
+    walks, jacobians = np.zeros(3), np.zeros(3)  # the whole creep, its first and second half
     for w in wins:
         at, up = (smooth(model.simulate(w, f * mu_s, min(mu_k, f * mu_s), cells)[0], d.dt,
                          TORQUE_SMOOTH_S) for f in (1.0, 1.0 + CREEP_SENSITIVITY_STEP))
-        walks.append(_twist_walk(d, w, at, up, mu_s))
+        walk, jacobian = _twist_walk(d, w, at, up, mu_s)
+        walks += walk
+        jacobians += jacobian
         base.append(at[w.used - w.sim0])
         moved.append(up[w.used - w.sim0])
         data.append(d.tau_bar[w.used])
@@ -95,7 +102,9 @@ def measure(model: Model, wins: list[Window], mu_s: float, mu_k: float, cells: i
     level = max(float(np.max(np.abs(data))), 1e-9)
     independent = np.sqrt(max(1.0, base.size * d.dt / TORQUE_SMOOTH_S))
     sensitivity = float(np.sqrt(np.mean((moved - base) ** 2))) / noise * independent
-    twist_noise = float(np.sqrt(sum(walks))) / max(jacobian_sq, 1e-30) / mu_s
+    twist_noise = float(np.sqrt(walks[0])) / max(jacobian_sq, 1e-30) / mu_s
+    halves_twist = tuple(float(np.sqrt(v)) / max(j, 1e-30) / mu_s
+                         for v, j in zip(walks[1:], jacobians[1:], strict=True))
     spread = float(np.hypot(CREEP_SENSITIVITY_STEP / max(sensitivity, 1e-9), twist_noise))
     return CreepChecks(engaged=float(np.max(base)) / max(capacity, 1e-9),
                        misfit=float(np.sqrt(np.mean((base - data) ** 2))) / level,
@@ -103,29 +112,44 @@ def measure(model: Model, wins: list[Window], mu_s: float, mu_k: float, cells: i
                        swing_ratio=swing_ratio(model, rotating, mu_s, mu_k, rotating_cells,
                                                spread) if stick_slip and rotating else None,
                        halves=_split_half(model, wins, mu_s, mu_k, cells),
-                       twist_noise=twist_noise)
+                       twist_noise=twist_noise, halves_twist_noise=halves_twist)
 
 
 def _twist_walk(d: FitData, w: Window, base: np.ndarray, moved: np.ndarray,
-                mu_s: float) -> float:
-    """One creep window's share of Var(Σ J_i τ'_i W_i): the speed noise the model integrates
+                mu_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """One creep window's shares of Var(Σ J_i τ'_i W_i) and of Σ J_i² over the whole creep,
+    its first and its second half (:func:`half_rows`): the speed noise the model integrates
     into its twist (docs/theory.md §6.3, check 2). W is the random walk of the twist error,
-    Var W(t) = q·t with q its rate (:func:`walk_rate`); J = ∂τ/∂μ_s the fit's sensitivity
+    Var W(t) = q·t with q its rate (:func:`walk_rate`), from the start of the window — a
+    half's sum carries the walk accumulated before it; J = ∂τ/∂μ_s the fit's sensitivity
     [N·m per unit μ] and τ' = dτ/dθ the slope of the quasi-static creep torque against the
-    top angle [N·m/rad]. Divided by (Σ J²)² it is the variance of μ_s [-]; the caller adds
-    the windows and takes the root. A window too short to tell gives inf (not claimed)."""
+    top angle [N·m/rad]. The caller adds the windows; variance over (Σ J²)² is the variance
+    of μ_s [-]. A window too short to tell gives inf (not claimed)."""
     span = slice(w.sim0, w.end + 1)
     drive = d.creep_drive[span]
     if drive.size < 5:
-        return np.inf
+        return np.full(3, np.inf), np.ones(3)
     rows = w.used - w.sim0
     floor = 0.5 * float(np.median(np.abs(drive[rows])))
     slope = np.gradient(base, d.dt) / np.maximum(np.abs(drive), max(floor, 1e-6))
-    a = np.zeros(drive.size)
-    a[rows] = (moved[rows] - base[rows]) / (CREEP_SENSITIVITY_STEP * mu_s) * slope[rows]
+    jacobian = (moved[rows] - base[rows]) / (CREEP_SENSITIVITY_STEP * mu_s)
     creep = slice(w.sim0 + int(rows.min()), w.sim0 + int(rows.max()) + 1)
     rate = walk_rate(d.speed[creep] - d.creep_drive[creep], d.dt)
-    return twist_walk_variance(a, rate, d.dt)
+    walks, jacobians = np.zeros(3), np.zeros(3)
+    for k, part in enumerate((slice(None), *half_rows(rows.size))):
+        a = np.zeros(drive.size)
+        a[rows[part]] = jacobian[part] * slope[rows[part]]
+        walks[k] = twist_walk_variance(a, rate, d.dt)
+        jacobians[k] = float(np.sum(jacobian[part] ** 2))
+    return walks, jacobians
+
+
+def half_rows(n: int) -> tuple[slice, slice]:
+    """The first and second half of a creep's ``n`` used samples that the halves check
+    compares, its first :data:`SPLIT_SKIP` left out (the smoothed drive blurs the onset)."""
+    start = int(SPLIT_SKIP * n)
+    mid = (start + n) // 2
+    return slice(start, mid), slice(mid, n)
 
 
 def twist_walk_variance(a, walk_rate: float, dt_s: float) -> float:
@@ -189,16 +213,15 @@ def _split_half(model: Model, wins: list[Window], mu_s: float, mu_k: float,
         for w in wins:
             tau, _ = model.simulate(w, mu, min(mu_k, mu), cells)
             err = (smooth(tau, d.dt, TORQUE_SMOOTH_S)[w.used - w.sim0] - d.tau_bar[w.used])**2
-            a, b = int(SPLIT_SKIP * err.size), err.size
-            mid = (a + b) // 2
-            halves[0, j] += float(np.mean(err[a:mid]))
-            halves[1, j] += float(np.mean(err[mid:b]))
+            for k, part in enumerate(half_rows(err.size)):
+                halves[k, j] += float(np.mean(err[part]))
     return tuple(float(parabola_vertex(x, h)[0]) for h in halves)
 
 
 def problems(mu_s: float, c: CreepChecks) -> list[str]:
     """Why a grid-converged creep fit does not identify μ_s (empty: it does)."""
     found = []
+    pinned = False  # by the torque and twist noise: a fit that is not is not compared again
     if c.misfit > MAX_CREEP_MISFIT:
         found.append(f"the fitted model misses the creep torque by {100 * c.misfit:.0f} % "
                      "RMS: the friction law does not explain the break-over")
@@ -211,17 +234,13 @@ def problems(mu_s: float, c: CreepChecks) -> list[str]:
                      f"±{100 * c.twist_noise:.1f} % (1σ; torque noise "
                      f"±{100 * CREEP_SENSITIVITY_STEP / c.sensitivity:.1f} %): a creep "
                      "logged faster or with a quieter speed sensor would pin it")
+    else:
+        pinned = True
     if c.swing_ratio is not None and c.swing_ratio < MIN_SWING_RATIO:
         found.append(f"with this μ_s the model's stick-slip after the creep is "
                      f"{c.swing_ratio:.2f}× the data's: the law that fits the creep does "
                      "not explain the slips (friction falling with speed?)")
-    first, second = c.halves
-    change = first / max(second, 1e-9) - 1.0
-    noise = HALVES_SIGMAS * 2.0 * CREEP_SENSITIVITY_STEP / max(c.sensitivity, 1e-9)
-    if change < -max(MAX_HALVES_BELOW, noise) or abs(change) > max(MAX_HALVES_SPLIT, noise):
-        found.append(f"the first and second half of the creep give μ_s = "
-                     f"{c.halves[0]:.3f} and {c.halves[1]:.3f}: friction is not the same "
-                     "along the string the creep wound up (cased and open hole?)")
+    found += _halves_problems(c, pinned)
     if c.other_hypothesis is not None and \
             abs(c.other_hypothesis / mu_s - 1.0) > MAX_HYPOTHESIS_SPLIT:
         found.append(f"it depends on the unknown static friction in the casing "
@@ -230,13 +249,42 @@ def problems(mu_s: float, c: CreepChecks) -> list[str]:
     return found
 
 
+def _halves_problems(c: CreepChecks, pinned: bool) -> list[str]:
+    """The halves check (docs/theory.md §6.3, check 4): blind where its own noise exceeds
+    the −6 % split a cased top must show (said only of a fit the noise checks ``pinned``),
+    else the split itself."""
+    change = c.halves[0] / max(c.halves[1], 1e-9) - 1.0
+    noise = halves_noise(c)
+    if not noise <= MAX_HALVES_BELOW:  # NaN or inf too: blind to the split it must catch
+        return [f"the creep's halves cannot be compared: noise ±{100 * noise:.1f} % "
+                f"({HALVES_SIGMAS:.0f}σ) at this rate > {100 * MAX_HALVES_BELOW:.0f} %, the "
+                "lower friction of a cased top would not show: a creep logged faster or "
+                "with a quieter speed sensor would"] if pinned else []
+    if change < -MAX_HALVES_BELOW or abs(change) > MAX_HALVES_SPLIT:
+        return [f"the first and second half of the creep give μ_s = {c.halves[0]:.3f} and "
+                f"{c.halves[1]:.3f}: friction is not the same along the string the creep "
+                "wound up (cased and open hole?)"]
+    return []
+
+
+def halves_noise(c: CreepChecks) -> float:
+    """:data:`HALVES_SIGMAS` standard deviations of the relative difference of the halves'
+    μ_s due to noise alone [-] (docs/theory.md §6.3, check 4): the torque noise (each half
+    holds about half the creep's information, so the difference's 1-σ is ≈ 2 × 10 % /
+    sensitivity) and each half's twist noise, in quadrature."""
+    torque = 2.0 * CREEP_SENSITIVITY_STEP / max(c.sensitivity, 1e-9)
+    return HALVES_SIGMAS * float(np.sqrt(torque ** 2 + sum(s ** 2 for s in
+                                                           c.halves_twist_noise)))
+
+
 def checks_text(c: CreepChecks) -> str:
     """The checks as one message (the evidence beside a μ_s)."""
     swing = "—" if c.swing_ratio is None else f"{c.swing_ratio:.2f}"
     return (f"creep checks: misfit {100 * c.misfit:.1f} %, sensitivity {c.sensitivity:.0f}, "
             f"twist noise ±{100 * c.twist_noise:.1f} %, "
             f"string engaged {100 * min(c.engaged, 1.0):.0f} %, halves {c.halves[0]:.3f} / "
-            f"{c.halves[1]:.3f}, model/data stick-slip {swing}")
+            f"{c.halves[1]:.3f} (noise ±{100 * halves_noise(c):.1f} %), "
+            f"model/data stick-slip {swing}")
 
 
 def smoothed_noise_Nm(d: FitData, samples: np.ndarray) -> float:

@@ -115,8 +115,9 @@ MIN_SWING_RATIO = 0.5  #: model/data stick-slip fluctuation after the creep
 #: the second (a top of lower friction, e.g. casing, the creep wound up first) and this much
 #: either way (the onset of a slowly logged creep fits high: +4…+13 % at 5 Hz on the plants).
 MAX_HALVES_BELOW, MAX_HALVES_SPLIT = 0.06, 0.15
-#: Both limits widen to this many standard deviations of the halves' difference due to
-#: noise alone: each half holds about half the creep's information, so the relative 1-σ of
-#: their difference is ≈ 2 × CREEP_SENSITIVITY_STEP / sensitivity (4.9 % at sensitivity 4).
+#: Standard deviations of the halves' difference due to noise alone that must stay within
+#: MAX_HALVES_BELOW, else the check is blind to a cased top and μ_s is withheld: the torque
+#: noise (each half holds about half the creep's information: ≈ 2 × CREEP_SENSITIVITY_STEP /
+#: sensitivity, 1-σ) and each half's twist noise in quadrature (creep_checks.halves_noise).
 HALVES_SIGMAS = 2.0
 MAX_HYPOTHESIS_SPLIT = 0.05  #: the two hypotheses for an unknown cased static factor
