@@ -87,7 +87,13 @@ def test_mu_s_honest(demo_run, truth):
             if seg["mu_s_lower_bound"] is not None:
                 assert seg["mu_s_lower_bound"] < truth["mu_s"], seg
     identified = {s["bit_depth_m"] for s in summary["segments"] if s["mu_s_identifiable"]}
-    assert identified == creeps
+    # μ_s only from creep stands; a creep may be withheld by its checks, with the reason
+    # (2210 m engages 52 % of the string: its halves' noise ±15 % cannot see a 6 % split,
+    # docs/theory.md §6.3 check 4), but the demo's well keeps a claimed μ_s
+    assert identified and identified <= creeps
+    for seg in summary["segments"]:
+        if seg["bit_depth_m"] in creeps - identified:
+            assert "creep checks" in seg["message"], seg
 
 
 def test_bit_speed_in_severe_stick_slip(demo_run):
