@@ -207,10 +207,16 @@ class Recording:
             end = size - len(tail) + tail.rfind(b"\n") + 1
             fh.truncate(end)
             lines = tail[:tail.rfind(b"\n")].split(b"\n")
-        last = lines[-1].split(b",")[0].decode() if lines else ""
+        last = lines[-1].split(b",")[0].decode("utf-8", "replace") if lines else ""
         if not last or last == "time":
             return None
-        stamp = datetime.fromisoformat(last)
+        try:
+            stamp = datetime.fromisoformat(last)
+        except ValueError:
+            raise InputError(f"this recording of a WITS0 stream ends with a line without a "
+                             f"time ('{printable(last, 40)}'): not written by live",
+                             file=self.path, fix="give another --out (or remove the file)") \
+                from None
         return stamp.replace(tzinfo=UTC).timestamp() if stamp.tzinfo is None else \
             stamp.timestamp()
 

@@ -54,6 +54,14 @@ def test_wits0_frame_dated_2099_is_dropped_and_does_not_silence_the_stream(tmp_p
     assert len(warnings) == 1 and "2099-12-31" in warnings[0] and "not recorded" in warnings[0]
 
 
+def test_wits0_recording_edited_to_end_without_a_time_is_one_error(tmp_path):
+    names = Row(item_map({})).names
+    path = tmp_path / "t.wits0.csv"
+    path.write_bytes(("time," + ",".join(names) + "\n").encode() + b"not-a-time\xff,1\n")
+    with pytest.raises(InputError, match="without a time"):
+        Recording(path, names, False)
+
+
 def test_wits0_value_1e308_kdn_overflowing_si_is_missing_not_inf():
     row = Row(item_map({}))
     values = row.update({"0114": "1e308", "0120": "41.0"})  # 1e308 KDN = 1e312 N
