@@ -31,6 +31,12 @@ from drillfric.runner.resume import csv_mark, parquet_mark, parts_mark
 FIRST_LINES = 20
 #: A line end: LF, CR LF or a bare CR (as ``drillfric run`` reads them, io/delimited.py).
 _LINE_END = re.compile(rb"\r\n|\r|\n")
+#: Most bytes read from a growing file in one poll (the rest at the next poll): a file
+#: that jumps by gigabytes (a sparse file, a copy) cannot fill the memory.
+MAX_BLOCK = 64 * 2**20
+#: Longest line a rig log may hold [bytes]: a longer one (a never-ending line, a run of NUL
+#: bytes) is no text log, not a line to wait for.
+MAX_LINE_BYTES = 2**20
 
 
 def follow(path: Path) -> Tail | PartsTail:
@@ -88,19 +94,34 @@ class Tail:
             raise InputError(f"the file shrank to {size} bytes after {self.end} were read",
                              file=self.path, fix="append to the file; restart live on a new "
                                                  "--out for a rewritten file")
-        if size > self.end:  # the partial last line is read again: it may have ended
-            with open(self.path, "rb") as fh:
+        while size > self.end:  # the partial last line is read again: it may have ended
+            with open(self.path, "rb") as fh:  # in blocks: memory bounded by MAX_BLOCK
                 fh.seek(self.end)
-                block = fh.read(size - self.end)
-            cut = lines_end(block, final)
-            if cut:
-                self._take(self.end + cut, block[:cut])
+                block = fh.read(min(size - self.end, MAX_BLOCK))
+            cut = lines_end(block, final and self.end + len(block) >= size)
+            if not cut and len(block) > MAX_LINE_BYTES:
+                raise InputError(f"a line of more than {MAX_LINE_BYTES} bytes after byte "
+                                 f"{self.end}: this is no text log", file=self.path,
+                                 fix="follow the rig log's CSV file (lines end with a line end)")
+            if not cut:
+                break
+            self._take(self.end + cut, block[:cut])
         return self.end
 
     def lines(self) -> int:
-        """How many complete lines there are up to :attr:`end` (for the first sniff)."""
-        with open(self.path, "rb") as fh:
-            return len(_LINE_END.findall(fh.read(self.end)))
+        """How many complete lines there are up to :attr:`end`, counted up to
+        :data:`FIRST_LINES` (for the first sniff)."""
+        count, done = 0, 0
+        with open(self.path, "rb") as fh:  # in blocks: a file of gigabytes is not held
+            while done < self.end and count < FIRST_LINES:
+                block = fh.read(min(self.end - done, MAX_BLOCK))
+                if not block:
+                    break
+                if block.endswith(b"\r") and done + len(block) < self.end:
+                    block += fh.read(1)  # a CR LF cut by the block is one line end
+                count += len(_LINE_END.findall(block))
+                done += len(block)
+        return count
 
     def ready(self, final: bool = False) -> bool:
         """Whether enough lines arrived to read the file's layout: a header and

@@ -357,7 +357,9 @@ class _Handler(BaseHTTPRequestHandler):
 
     def _respond(self, body: bool) -> None:
         url = urlsplit(self.path)
-        if not self.server.host_allowed(self.headers.get("Host", "")):
+        hosts = self.headers.get_all("Host") or []  # one, and an absolute URI's host too
+        if len(hosts) != 1 or not self.server.host_allowed(hosts[0]) or \
+                (url.netloc and not self.server.host_allowed(url.netloc)):
             answer = _error(421, "this page answers only to a loopback host name")
         else:
             try:

@@ -37,6 +37,10 @@ NOT_WITS_BYTES = 65536
 #: spaced by their arrival, kept inside that second.
 WITHIN_SECOND_S = 0.999
 _MIN_STEP_S = 0.001
+#: Furthest a frame's date and time may lie ahead of the wall clock [s] (time zones span
+#: UTC-12 to UTC+14): a frame dated later is a wrong clock, not recorded — it would make
+#: every true frame after it look "before the previous one" and be dropped for good.
+MAX_AHEAD_S = 86400.0
 
 
 @dataclass(frozen=True)
@@ -132,6 +136,13 @@ class FrameClock:
         self._first_arrival = 0.0
         self.out_of_order = 0
 
+    def ahead(self, clock: datetime | None, wall_s: float) -> bool:
+        """Whether the date/time ``clock`` lies more than :data:`MAX_AHEAD_S` after the wall
+        time ``wall_s`` (UTC, [s] since 1970)."""
+        if clock is None:
+            return False
+        return clock.replace(tzinfo=UTC).timestamp() - self.offset_s > wall_s + MAX_AHEAD_S
+
     def time_s(self, clock: datetime | None, arrival_s: float, wall_s: float) -> float | None:
         """The time of a frame with date/time ``clock`` arriving at ``arrival_s`` (monotonic
         [s]) and wall time ``wall_s`` (UTC, [s] since 1970); None when it lies before the
@@ -196,10 +207,16 @@ class Recording:
             end = size - len(tail) + tail.rfind(b"\n") + 1
             fh.truncate(end)
             lines = tail[:tail.rfind(b"\n")].split(b"\n")
-        last = lines[-1].split(b",")[0].decode() if lines else ""
+        last = lines[-1].split(b",")[0].decode("utf-8", "replace") if lines else ""
         if not last or last == "time":
             return None
-        stamp = datetime.fromisoformat(last)
+        try:
+            stamp = datetime.fromisoformat(last)
+        except ValueError:
+            raise InputError(f"this recording of a WITS0 stream ends with a line without a "
+                             f"time ('{printable(last, 40)}'): not written by live",
+                             file=self.path, fix="give another --out (or remove the file)") \
+                from None
         return stamp.replace(tzinfo=UTC).timestamp() if stamp.tzinfo is None else \
             stamp.timestamp()
 
@@ -302,8 +319,13 @@ class Receiver:
         arrival, wall = time.monotonic(), time.time()
         self._received += len(data)
         for frame in self.decoder.feed(data):
-            values = self.setup.row.update(frame)
-            t = self.clock.time_s(frame_clock(frame), arrival, wall)
+            values, stamp = self.setup.row.update(frame), frame_clock(frame)
+            if self.clock.ahead(stamp, wall):
+                self._once("future", f"{self.address}: a frame dated {stamp:%Y-%m-%d %H:%M:%S}"
+                                     ", more than a day after this computer's clock: not "
+                                     "recorded (see the rig clock)")
+                continue
+            t = self.clock.time_s(stamp, arrival, wall)
             if t is None:
                 self._once("order", f"{self.address}: a frame's date and time lie before the "
                                     "previous frame's: not recorded (see the rig clock)")

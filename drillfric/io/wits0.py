@@ -71,6 +71,7 @@ MAX_ITEMS = 1000
 NULL_TEXT = "-999.25"
 
 _CODE = re.compile(r"^\d{4}$")
+_STAMP = re.compile(r"^\d{1,6}(\.0*)?$")
 
 
 @dataclass(frozen=True)
@@ -246,10 +247,10 @@ def frame_clock(frame: dict[str, str]) -> datetime | None:
     (True, True)
     """
     date, time = frame.get(DATE_CODE), frame.get(TIME_CODE)
-    if date is None or time is None:
-        return None
+    if date is None or time is None or not _STAMP.match(date) or not _STAMP.match(time):
+        return None  # digits only: "-9899" or "2.6e5" would give a date the rig never sent
     try:
-        day, clock = int(float(date)), int(float(time))
+        day, clock = int(date.split(".")[0]), int(time.split(".")[0])
         return datetime(2000 + day // 10000, day // 100 % 100, day % 100,
                         clock // 10000, clock // 100 % 100, clock % 100)
     except (ValueError, OverflowError):
@@ -273,8 +274,9 @@ class Row:
         """The values after ``frame`` (unreadable values and null markers are NaN)."""
         for code, text in frame.items():
             slot = self.slots.get(code)
-            if slot is not None:
-                self.values[slot.channel.name] = number(text) * slot.factor
+            if slot is not None:  # a finite text can overflow in SI (1e308 KDN): missing
+                value = number(text) * slot.factor
+                self.values[slot.channel.name] = value if math.isfinite(value) else math.nan
         return {name: self.values.get(name, math.nan) for name in self.names}
 
 
