@@ -53,7 +53,7 @@ def _wits0(file: Path, target: str, speed: float, drop_after: int | None) -> Non
     from drillfric.wits0_receiver import parse_address
     from drillfric.wits0_server import frames_of, serve, start_clock
 
-    address = parse_address(target)
+    address = parse_address(target, "--to")
     _, canonical, origin = recorded_frame(file)
     start = start_clock()
     frames = frames_of(canonical, origin, start)

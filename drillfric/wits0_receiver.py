@@ -54,8 +54,9 @@ class Address:
         return f"{SCHEME}{self.host}:{self.port}"
 
 
-def parse_address(text: str) -> Address:
-    """``wits0://HOST:PORT`` (an IPv6 host in brackets).
+def parse_address(text: str, what: str = "SOURCE") -> Address:
+    """``wits0://HOST:PORT`` (an IPv6 host in brackets); ``what`` names the argument in the
+    error (``SOURCE`` of live, ``--to`` of replay).
 
     Raises
     ------
@@ -70,7 +71,7 @@ def parse_address(text: str) -> Address:
     match = re.fullmatch(r"wits0://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9.-]{1,253}):(\d{1,5})", text)
     port = int(match[2]) if match else 0
     if not match or not 0 < port < 65536:
-        raise InputError(f"'{printable(text, 80)}' is no WITS0 address", file="SOURCE",
+        raise InputError(f"'{printable(text, 80)}' is no WITS0 address", file=what,
                          fix="write wits0://HOST:PORT with a port 1–65535, e.g. "
                              "wits0://127.0.0.1:5000")
     return Address(match[1].strip("[]"), port)
