@@ -70,6 +70,18 @@ def _same_segments(folder: Path, whole: pd.DataFrame) -> None:
         np.testing.assert_allclose(x[~np.isnan(x)], y[~np.isnan(y)], rtol=AGREE, err_msg=name)
 
 
+def _resumed_as_the_whole_run(folder: Path, whole: pd.DataFrame) -> None:
+    """A restarted live run continued its saved state (not from the first row), read each of
+    the three-stand well's 44 001 rows once and ended with the whole-file run's segments,
+    none written twice."""
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["resumed"]["reason"] == "" and summary["resumed"]["from_row"] > 0
+    assert summary["inputs"]["rows"] == 44001
+    _same_segments(folder, whole)
+    estimates = pd.read_parquet(folder / "estimates.parquet")
+    assert estimates["segment_id"].is_monotonic_increasing  # no segment written twice
+
+
 def _wait_for(predicate, seconds: float) -> None:
     deadline = time.monotonic() + seconds
     while not predicate():
@@ -123,12 +135,7 @@ def test_kill_9_and_restart_continue_without_losing_or_repeating_a_row(recorded,
     assert _finish(replay)[0] == 0
     code, err = _finish(again)
     assert code == 0, err
-    summary = json.loads((out / "three" / "summary.json").read_text())
-    assert summary["resumed"]["reason"] == "" and summary["resumed"]["from_row"] > 0
-    assert summary["inputs"]["rows"] == 44001
-    _same_segments(out / "three", recorded[1])
-    estimates = pd.read_parquet(out / "three" / "estimates.parquet")
-    assert estimates["segment_id"].is_monotonic_increasing  # no segment written twice
+    _resumed_as_the_whole_run(out / "three", recorded[1])
 
 
 def test_sigterm_writes_the_final_results_and_exits_143(recorded, tmp_path):

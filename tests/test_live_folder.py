@@ -20,7 +20,13 @@ import pytest
 from drillfric.errors import InputError
 from drillfric.live_source import PartsTail, Tail, follow
 from drillfric.runner.resume import changed, csv_mark
-from tests.test_live import _drillfric, _finish, _same_segments, _wait_for
+from tests.test_live import (
+    _drillfric,
+    _finish,
+    _resumed_as_the_whole_run,
+    _same_segments,
+    _wait_for,
+)
 
 #: Rows of the three-stand well at which its parts are cut (44001 rows: four parts).
 CUTS = (0, 9000, 21000, 33000, 44001)
@@ -126,12 +132,7 @@ def test_parquet_parts_written_slowly_and_a_kill_9_continue_to_the_run_of_the_fo
     finally:
         code, err = _finish(again)
     assert code == 0, err
-    summary = json.loads((out / "three" / "summary.json").read_text())
-    assert summary["resumed"]["reason"] == "" and summary["resumed"]["from_row"] > 0
-    assert summary["inputs"]["rows"] == 44001
-    _same_segments(out / "three", recorded[1])
-    estimates = pd.read_parquet(out / "three" / "estimates.parquet")
-    assert estimates["segment_id"].is_monotonic_increasing  # no segment written twice
+    _resumed_as_the_whole_run(out / "three", recorded[1])
 
 
 def _csv(path: Path, rows: range) -> None:
