@@ -113,6 +113,9 @@ def _config(folder: Path, plant: str, spec: tuple | None = None,
     else:
         est["model"].update(model)
     est.pop("simulate")
+    # the simulated hook load is the string alone: the plant's block weight is 0, which the
+    # rig's configuration states (without it the log cannot weigh the string, theory §2.1)
+    est["hookload"] = dict(raw.get("hookload") or {}, block_weight_N=0.0)
     est_cfg = folder / "estimate.toml"
     est_cfg.write_text(dumps_toml(_clean(est)), encoding="utf-8")
     return sim_cfg, est_cfg

@@ -119,7 +119,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
              f"{cfg.survey.tortuosity_deg_30m:g}°/30 m (survey.tortuosity_deg_30m), "
              "written as the output's survey")
     keep = tuple(p for p in (config, survey_path) if p is not None)
-    written = write_well(out, pd.DataFrame(result.columns), config=cfg.to_dict(),
+    written = write_well(out, pd.DataFrame(result.columns), config=sim.written_config(cfg),
                          survey=well_path, truth=result.truth(), keep=keep)
     rows = len(result.columns["time_s"])
     echo(f"wrote {out}: {rows} rows, {plan.total_s:.0f} s at {result.rate_hz:g} Hz, "

@@ -338,8 +338,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("block_weight_N", float, None, "N", "Weight of the travelling block, hook and "
             "top drive on the hook (rig specification; 0 for a hook load zeroed on the empty "
             "block), used when the log holds no in-slips plateau to weigh it: without either "
-            "the string weight is only checked for gross mismatch and the hook-load verdict "
-            "is 'unverified' (docs/theory.md §2.1).", min=0.0, max=5e6),
+            "the log cannot weigh the string, the hook-load verdict is 'unverified' and the "
+            "friction factors are withheld (docs/theory.md §2.1).", min=0.0, max=5e6),
         Key("calibrate_string_weight", bool, False, "", "When the hook load contradicts the "
             "configured string, scale the string's buoyed weight to the measured one (a "
             "first pass over the log; needs the block weight, from the slips or "

@@ -434,11 +434,19 @@ _WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
              "mu_k_observer", "mu_s_observer", "mu_td")
 
 
-def _withhold(record: SegmentRecord, why: str) -> SegmentRecord:
+def _withhold(record: SegmentRecord, why: str,
+              flag: Flag = Flag.HOOKLOAD_CONTRADICTS_STRING) -> SegmentRecord:
     nulls = {name: None for name in _WITHHELD}
     message = "; ".join(filter(None, [record.message, f"friction factors withheld: {why}"]))
     return replace(record, **nulls, converged=False, message=message,
-                   quality_flags=record.quality_flags + (Flag.HOOKLOAD_CONTRADICTS_STRING,))
+                   quality_flags=record.quality_flags + (flag,))
+
+
+def _unverified(block: BlockWeight) -> str:
+    """Why friction factors resting on a string weight the log cannot measure are withheld."""
+    return (f"the string weight is unverified: no block weight ({block.reason}), so the hook "
+            "load (block + string) cannot weigh the string, and μ scales as 1/(string "
+            "weight) — a string 40 % off the configured one would pass")
 
 
 def judge(records: list, plateaus: list[Plateau], cfg,
@@ -449,8 +457,10 @@ def judge(records: list, plateaus: list[Plateau], cfg,
     string weight over the modelled one (needs the block weight); outside
     ``1 ± hookload.tolerance`` every segment's friction factors are withheld (all segments
     share the string). A segment whose own hook load contradicts the model is withheld
-    too. With a ``calibration`` every estimated segment is flagged
-    ``string_weight_calibrated``.
+    too. Without a block weight (no in-slips plateau, no ``hookload.block_weight_N``) the
+    log cannot weigh the string: every estimated segment's friction factors are withheld
+    (flag ``string_weight_unverified``). With a ``calibration`` every estimated segment is
+    flagged ``string_weight_calibrated``.
     """
     tol = cfg.hookload.tolerance
     points = off_bottom_points(records)
@@ -460,7 +470,7 @@ def judge(records: list, plateaus: list[Plateau], cfg,
     if not len(points):
         summary.update(verdict="not_checked", reason="no estimated off-bottom rotating "
                        "segment with a hook load")
-        return Outcome(list(records), summary)
+        return Outcome(list(records), summary, _unchecked(records))
     problems = {int(p.id): point_problem(p.hookload_N, p.hookload_model_N, block.weight_N, tol)
                 for p in points.itertuples()}
     well_problem = ""
@@ -479,11 +489,15 @@ def judge(records: list, plateaus: list[Plateau], cfg,
         if len(bad) > len(points) / 2:
             well_problem = (f"the hook load contradicts the configured string in {len(bad)} of "
                             f"{len(points)} off-bottom segments ({problems[bad[0]]})")
+    unverified = _unverified(block) if block.weight_N is None and not well_problem else ""
     out, withheld = [], []
     for r in records:
         why = well_problem or problems.get(r.id, "")
         if why and r.status is Status.OK:
             out.append(_withhold(r, why))
+            withheld.append(r.id)
+        elif unverified and r.status is Status.OK:
+            out.append(_withhold(r, unverified, Flag.STRING_WEIGHT_UNVERIFIED))
             withheld.append(r.id)
         elif calibration is not None and calibration.scale is not None \
                 and r.status is Status.OK:
@@ -491,16 +505,28 @@ def judge(records: list, plateaus: list[Plateau], cfg,
         else:
             out.append(r)
     summary.update(verdict=_verdict(well_problem, block, calibration),
-                   withheld_segments=withheld, reason=well_problem or None)
-    warnings = _warnings(well_problem, withheld, problems, block, calibration, cfg)
+                   withheld_segments=withheld, reason=well_problem or unverified or None)
+    contradicted = [i for i in withheld if well_problem or problems.get(i)]
+    warnings = _warnings(well_problem, contradicted, problems, block, calibration, cfg)
     return Outcome(out, summary, warnings)
+
+
+def _unchecked(records) -> list[str]:
+    """The warning of estimated off-bottom rotating segments without a hook load: their
+    friction factors rest on the configured string's weight, which nothing checked."""
+    ids = [str(r.id) for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM]
+    if not ids:
+        return []
+    return [f"string weight not checked: the off-bottom segment(s) {', '.join(ids)} have no "
+            "hook load, so their friction factors rest on the configured string's weight "
+            "(μ scales as 1/W; docs/theory.md §2.1): log the hook load to check it"]
 
 
 def _verdict(well_problem: str, block: BlockWeight, calibration: Calibration | None) -> str:
     """summary.json ``hookload.verdict`` of a checked well: ``contradicted``, ``calibrated``,
     ``consistent`` (the string weight measured and within the tolerance) or ``unverified``
-    (no block weight: only a gross mismatch could be seen, the friction factors rest on the
-    configured string weight)."""
+    (no block weight: the log cannot weigh the string, and the friction factors, which
+    scale as 1/(string weight), are withheld)."""
     if well_problem:
         return "contradicted"
     if calibration is not None and calibration.scale is not None:
@@ -540,10 +566,9 @@ def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWei
                    f"{calibration.scale:.3f} (block weight {block.weight_N / 1e3:.0f} kN from "
                    f"{block.source}, {calibration.segments} off-bottom segments)")
     if block.weight_N is None and not well_problem:
-        out.append(f"block weight unknown ({block.reason}): the string weight was only "
-                   "checked for gross mismatch, and the friction factors scale as 1/(string "
-                   "weight): they are as right as the configured string's weight (give "
-                   "hookload.block_weight_N, or a log with the string in the slips)")
+        out.append(f"friction factors withheld: {_unverified(block)}; give "
+                   "hookload.block_weight_N (the rig's block, hook and top drive; 0 for a hook "
+                   "load zeroed on the empty block), or a log with the string in the slips")
     return out
 
 

@@ -67,6 +67,7 @@ class Flag(StrEnum):
     POOLED = "pooled"
     BIT_SPEED_DRIFT = "bit_speed_drift"
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
+    STRING_WEIGHT_UNVERIFIED = "string_weight_unverified"
     STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
     RELAXATION_CYCLES = "relaxation_cycles"
     MU_K_UNCERTAIN = "mu_k_uncertain"
@@ -117,6 +118,10 @@ FLAG_MEANINGS = {
     Flag.HOOKLOAD_CONTRADICTS_STRING: "the hook load contradicts the configured string's "
                                       "weight beyond hookload.tolerance (docs/theory.md "
                                       "§2.1): friction factors withheld (null)",
+    Flag.STRING_WEIGHT_UNVERIFIED: "the log holds no in-slips period and no [hookload] "
+                                   "block_weight_N is given, so the string weight μ scales "
+                                   "with (1/W) cannot be measured (docs/theory.md §2.1): "
+                                   "friction factors withheld (null)",
     Flag.STRING_WEIGHT_CALIBRATED: "the string's buoyed weight was scaled to the hook load "
                                    "before estimation (hookload.calibrate_string_weight; "
                                    "summary.json hookload)",
@@ -134,6 +139,7 @@ class WellFlag(StrEnum):
     STRING_WEIGHT_INCONSISTENT = "string_weight_inconsistent"
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
     STRING_WEIGHT_UNVERIFIED = "string_weight_unverified"
+    STRING_WEIGHT_NOT_CHECKED = "string_weight_not_checked"
     SEGMENTS_FAILED = "segments_failed"
 
 
@@ -155,8 +161,11 @@ WELL_FLAG_MEANINGS = {
                                           "factors (hookload, docs/theory.md §2.1)",
     WellFlag.STRING_WEIGHT_UNVERIFIED: "the log holds no in-slips period and no "
                                        "[hookload] block_weight_N is given: the string "
-                                       "weight, which μ scales with (1/W), is checked for "
-                                       "gross mismatch only",
+                                       "weight, which μ scales with (1/W), cannot be "
+                                       "measured, and the friction factors are withheld",
+    WellFlag.STRING_WEIGHT_NOT_CHECKED: "the well μ_k rests on off-bottom segments without "
+                                        "a hook load: the configured string's weight, which "
+                                        "μ scales with (1/W), was not checked",
     WellFlag.SEGMENTS_FAILED: "segments whose estimation failed (counts.failed)",
 }
 

@@ -7,7 +7,9 @@ load come from soft-string torque and drag (:mod:`drillfric.torque_drag`, docs/t
 the plant of docs/theory.md §3 (:mod:`drillfric.torsional`) is run from rest under a PI
 top-drive speed controller following the stand's set-point schedule (or a prescribed motor
 torque). Between stands the rotation is stopped, the trapped torque released and the bit
-moved to the next depth (a connection: speed, torque and hook load recorded as zero).
+moved to the next depth (a connection: speed and torque recorded as zero, the hook load
+as the block weight ``hookload.block_weight_N``, 0 when not given — the string is in the
+slips). The block weight is on the hook load throughout.
 Measurement noise and quantisation are added last, seeded.
 
 A scenario file (TOML, see docs/simulator.md)::
@@ -602,6 +604,8 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     columns = {k: v[keep] for k, v in columns.items()}
     if not any(s.on_bottom for s in scenario.stands):
         columns.pop("wob_N")
+    block = cfg.hookload.block_weight_N
+    columns["hookload_N"] = columns["hookload_N"] + (block or 0.0)
     noise.apply(columns)
     notes = _notes(stands)
     return Simulation(columns, tuple(stands), settings, noise, rate, notes)
@@ -765,6 +769,17 @@ def simulate_config(config, *, out=None, overrides: dict | None = None, survey=N
             well_path = no_survey_path(max(s.bit_depth_m for s in stands.stands),
                                        cfg.tortuosity_rad_m)
         keep = tuple(p for p in (Path(config), survey_path) if p is not None)
-        write_well(out, pd.DataFrame(result.columns), config=cfg.to_dict(), survey=well_path,
-                   truth=result.truth(), keep=keep)
+        write_well(out, pd.DataFrame(result.columns), config=written_config(cfg),
+                   survey=well_path, truth=result.truth(), keep=keep)
     return result
+
+
+def written_config(cfg: Config) -> dict:
+    """The simulated well's configuration as written beside it (``Config.to_dict()``), stating
+    the block weight its hook load carries — the configured one, else 0 (the simulated hook
+    load is then the string alone) — so that ``run`` can weigh the string without a
+    connection in the record (docs/theory.md §2.1)."""
+    config = cfg.to_dict()
+    hook = dict(config.get("hookload") or {})
+    hook["block_weight_N"] = hook.get("block_weight_N") or 0.0
+    return config | {"hookload": hook}

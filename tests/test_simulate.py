@@ -438,3 +438,28 @@ def test_duration_with_a_scenario_says_what_it_did(well, tmp_path):
     assert result.exit_code == 0, result.output
     line = next(ln for ln in result.output.splitlines() if "--duration 1800 s" in ln)
     assert "the record lasts 180 s" in line and "0 of 2" in line and "--bit-depth" in line
+
+
+def test_written_well_states_the_block_its_hook_load_carries(well, tmp_path):
+    """The simulated hook load is the string alone (block 0) unless the configuration gives
+    hookload.block_weight_N, which is then on the hook throughout and alone in the slips. The
+    written NAME.toml states it, so `run` can weigh the string of a record without a
+    connection (docs/theory.md §2.1: without a block weight friction factors are withheld)."""
+    out = tmp_path / "bare" / "sim.csv"
+    assert invoke(well, "--out", out, "--duration", 15, "--bit-depth", 1500).exit_code == 0
+    assert load_config(out.with_suffix(".toml")).hookload.block_weight_N == 0.0
+    bare = pd.read_csv(out)
+    heavy_cfg = tmp_path / "heavy.toml"
+    heavy_cfg.write_text(well.read_text() + "\n[hookload]\nblock_weight_N = 150000.0\n")
+    (tmp_path / "heavy.survey.csv").write_text(SURVEY)
+    out = tmp_path / "heavy" / "sim.csv"
+    assert invoke(heavy_cfg, "--out", out, "--scenario", well.parent / "s.toml").exit_code == 0
+    assert load_config(out.with_suffix(".toml")).hookload.block_weight_N == 150e3
+    heavy = pd.read_csv(out)
+    slips = heavy["string_torque_Nm"].eq(0) & heavy["bit_rpm"].eq(0)  # noise-free truth:
+    assert slips.sum() > 100  # the connection between the two stands
+    # 2 kN hook-load noise (the default): the slips read the block, the first stand block +
+    # the same string as the bare record at the same depth
+    assert heavy.loc[slips, "hookload_N"].median() == pytest.approx(150e3, abs=1e3)
+    assert heavy["hookload_N"].iloc[:200].median() - bare["hookload_N"].iloc[:200].median() \
+        == pytest.approx(150e3, abs=2e3)

@@ -31,7 +31,8 @@ STRING_WEIGHT_WARNING = "string weight inconsistent with the hook load"
 #: The flags that make a well μ_k low-confidence (the others are told, not judged).
 LOWERING = (WellFlag.LOW_SUPPORT, WellFlag.WIDE_SPREAD, WellFlag.INDICATIVE,
              WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE, WellFlag.STRING_WEIGHT_INCONSISTENT,
-             WellFlag.HOOKLOAD_CONTRADICTS_STRING, WellFlag.STRING_WEIGHT_UNVERIFIED)
+             WellFlag.HOOKLOAD_CONTRADICTS_STRING, WellFlag.STRING_WEIGHT_UNVERIFIED,
+             WellFlag.STRING_WEIGHT_NOT_CHECKED)
 
 
 def judge(summary: dict) -> dict:
@@ -116,10 +117,12 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
                       f"{STRING_WEIGHT_TOLERANCE:.0%}; check the string's linear masses and "
                       "lengths, the mud density and the hook-load channel"))
     hook = summary.get("hookload") or {}
-    if hook.get("verdict") == "contradicted" or hook.get("withheld_segments"):
-        found.append((WellFlag.HOOKLOAD_CONTRADICTS_STRING, ""))  # the check's own warning
-    elif hook.get("verdict") == "unverified" and mu_k is not None:
+    if hook.get("verdict") == "not_checked" and mu_k is not None:
+        found.append((WellFlag.STRING_WEIGHT_NOT_CHECKED, ""))  # the check's own warning
+    elif hook.get("verdict") == "unverified":
         found.append((WellFlag.STRING_WEIGHT_UNVERIFIED, ""))  # the check's own warning
+    elif hook.get("verdict") == "contradicted" or hook.get("withheld_segments"):
+        found.append((WellFlag.HOOKLOAD_CONTRADICTS_STRING, ""))  # the check's own warning
     failed = [s["id"] for s in segments if s.get("status") == "failed"]
     if failed:
         found.append((WellFlag.SEGMENTS_FAILED, f"{len(failed)} segment(s) failed "
