@@ -174,8 +174,8 @@ def line(s: dict, t_bit_true: float) -> str:
     log = "; ".join(f"{n} st {mu:.3f} {st}" for (n, mu), st in zip(s["log"], s["log_status"],
                                                                      strict=True)) or "—"
     well = "—" if s["well_mu_k"] is None else f"{s['well_mu_k']:.3f} {s['well']}"
-    bits = ", ".join("—" if t is None else f"{t / 1e3:.2f}±{u / 1e3:.2f} {st}"
-                     for t, u, st, *_ in s["t_bit"])
+    bits = ", ".join("—" if t is None else f"{t / 1e3:.2f}±{u / 1e3:.2f} "
+                     f"({true / 1e3:.2f}) {st}" for t, u, st, _, _, true in s["t_bit"])
     mu_mse = ", ".join(f"{m}/{e}" for _, _, _, m, e, _ in s["t_bit"])
     why = "; ".join(sorted(s["reasons"])) or "—"
     law = f"{s['wob_t']:g} t, {s['bit_mu']:g}"
@@ -198,8 +198,8 @@ def main() -> None:
     print(f"truth μ_s {MU_S}, μ_k {MU_K}; {STANDS} stands from {FIRST_M:g} m, {RPM:g} RPM, "
           f"{ON_BOTTOM_S:g} s on bottom per stand\n")
     print("| off-bottom rotation [s] | bit law | rate | friction log (stands, μ_k) | well "
-          "μ_k | T_k [kN·m] | true mean T_bit [kN·m] | T_bit ± 95 % [kN·m] per on-bottom "
-          "segment | μ_bit/MSE | why withheld | run [s] |")
+          "μ_k | T_k [kN·m] | true mean T_bit [kN·m] | T_bit ± 95 % (truth) [kN·m] per "
+          "on-bottom segment | μ_bit/MSE | why withheld | run [s] |")
     print("|" + "---|" * 11)
     rows = []
     laws = [tuple(float(x) for x in law.split(":")) for law in args.laws.split(",")]
