@@ -414,6 +414,12 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "T_bit = μ_bit·WOB·D_bit/3.", min=0.0, max=2.0),
         _positive("bit_diameter_m", 0.2159, "m", "Bit diameter D_bit (bit-torque model and "
                   "hole size).", max=1.5),
+        Key("bit_weakening_ratio", float, 1.0, "", "Rate-weakening bit (docs/simulator.md, "
+            "Bit): ratio r of the break-away to the high-speed bit torque, "
+            "T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)) with T_k = μ_bit·WOB·D_bit/3; 1 is "
+            "the Coulomb bit.", min=1.0, max=10.0),
+        _positive("bit_weakening_rpm", 10.0, "RPM", "Decay speed ω_b of the rate-weakening "
+                  "bit torque (used when bit_weakening_ratio > 1).", max=1000.0),
         Key("off_bottom_m", float, 5.0, "m", "Distance of the bit above hole bottom in "
             "off-bottom stands (recorded hole depth = bit depth + this).", min=0.0),
         Key("friction_law", str, "step", "", "Friction law of the truth (docs/theory.md §3.2): "

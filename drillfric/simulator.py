@@ -72,6 +72,9 @@ class Stand:
         Rate of penetration of an on-bottom stand [m/h]: the recorded bit and hole depth
         advance at it while the set-point is held (the plant stays at ``bit_depth_m``, a few
         decimetres per stand; docs/simulator.md).
+    bit_weakening_ratio, bit_weakening_rpm : float
+        Rate-weakening bit of an on-bottom stand, T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)):
+        r [-] (1: the Coulomb bit) and ω_b [RPM] (docs/simulator.md, Bit).
     setpoint_rpm : tuple of (t_s, rpm), optional
         Explicit piecewise-linear set-point from the start of the stand (replaces the
         start-up/hold/stop shape; a repeated time makes a step).
@@ -94,6 +97,8 @@ class Stand:
     stop_hold_s: float = 10.0
     wob_N: float = 0.0
     rop_m_h: float = 0.0
+    bit_weakening_ratio: float = 1.0
+    bit_weakening_rpm: float = 10.0
     setpoint_rpm: tuple | None = None
     motor_torque_Nm: tuple | None = None
     stop: bool = True
@@ -204,7 +209,8 @@ def _series(value, where: str, file) -> tuple:
 
 
 def _check_stand(stand: Stand, where: str, file) -> None:
-    positive = ("bit_depth_m", "duration_s", "ramp_s", "creep_ramp_s", "creep_hold_s")
+    positive = ("bit_depth_m", "duration_s", "ramp_s", "creep_ramp_s", "creep_hold_s",
+                "bit_weakening_rpm")
     for key in positive:
         if not getattr(stand, key) > 0:
             raise ConfigError(f"{where}.{key} must be > 0, got {getattr(stand, key)}",
@@ -213,6 +219,10 @@ def _check_stand(stand: Stand, where: str, file) -> None:
         if getattr(stand, key) < 0:
             raise ConfigError(f"{where}.{key} must be ≥ 0, got {getattr(stand, key)}",
                               file=file)
+    if not 1.0 <= stand.bit_weakening_ratio <= 10.0:
+        raise ConfigError(f"{where}.bit_weakening_ratio must be in [1, 10], got "
+                          f"{stand.bit_weakening_ratio}", file=file,
+                          fix="1 is the Coulomb bit; r > 1 a bit that is stronger at rest")
     if stand.setpoint_rpm is None and stand.start_up_s > stand.duration_s:
         raise ConfigError(f"{where}: the start-up ({stand.start_up_s:g} s) is longer than "
                           f"duration_s ({stand.duration_s:g} s)", file=file,
@@ -257,7 +267,9 @@ def base_stand(cfg: Config) -> Stand:
     """Stand defaults from the ``[simulate]`` table (bit depth filled in by the caller)."""
     return Stand(bit_depth_m=cfg.simulate.bit_depth_m or float("nan"),
                  duration_s=cfg.simulate.duration_s, rpm=cfg.simulate.rpm,
-                 ramp_s=cfg.simulate.ramp_s, wob_N=cfg.simulate.wob_N)
+                 ramp_s=cfg.simulate.ramp_s, wob_N=cfg.simulate.wob_N,
+                 bit_weakening_ratio=cfg.simulate.bit_weakening_ratio,
+                 bit_weakening_rpm=cfg.simulate.bit_weakening_rpm)
 
 
 def single_stand(cfg: Config, bit_depth_m: float) -> Scenario:
@@ -409,9 +421,11 @@ class PlantSettings:
         top = grid.x_m - 0.5 * grid.dx_true_m
         return np.clip((self.casing_shoe_md_m - top) / grid.dx_true_m, 0.0, 1.0)
 
-    def plant(self, grid: torsional.Grid, fc_Nm_m: np.ndarray,
-              bit_torque_cap_Nm: float) -> torsional.Plant:
-        """The true plant on ``grid`` with the capacity profile F_c at the cell centres.
+    def plant(self, grid: torsional.Grid, fc_Nm_m: np.ndarray, bit_torque_cap_Nm: float,
+              bit_weakening_ratio: float = 1.0,
+              bit_weakening_rpm: float = 10.0) -> torsional.Plant:
+        """The true plant on ``grid`` with the capacity profile F_c at the cell centres and
+        the bit T_k = ``bit_torque_cap_Nm`` [N·m], r, ω_b [RPM] (:class:`Stand`).
 
         With a cased truth, each cell's F_c is split by the share of its true length above
         the shoe: that share times μ_k_cased, μ_s_cased is the fixed part of the profile,
@@ -428,7 +442,8 @@ class PlantSettings:
                                self.k_t_per_s, self.top_drive_inertia_kg_m2, bit_torque_cap_Nm,
                                fixed_k, fixed_s,
                                self.stribeck_speed_rad_s if stribeck else None,
-                               self.stribeck_exponent)
+                               self.stribeck_exponent, bit_weakening_ratio,
+                               bit_weakening_rpm * RPM_TO_RAD_S)
 
 
 @dataclass(frozen=True)
@@ -438,6 +453,9 @@ class StandResult:
     ``T_N_Nm`` is ∫F_c dx over the part of the string whose truth is ``mu_s``, ``mu_k``
     (the open hole with a cased truth, else the whole string), ``T_N_cased_Nm`` over the
     cased part (0 without a cased truth) [N·m per unit friction factor].
+    ``bit_torque_Nm`` is the time-mean of the torque the bit applied from the end of the
+    start-up to the start of the stop [N·m] (0 off bottom): with a rate-weakening bit in
+    stick-slip it differs from ``bit_torque_k_Nm`` = T_k = μ_bit·WOB·D_bit/3.
     """
 
     index: int
@@ -456,6 +474,10 @@ class StandResult:
     bit_stuck_fraction: float
     creep_end_s: float | None = None
     T_N_cased_Nm: float = 0.0
+    bit_torque_Nm: float = 0.0
+    bit_torque_k_Nm: float = 0.0
+    bit_weakening_ratio: float = 1.0
+    bit_weakening_rpm: float = 10.0
 
 
 @dataclass(frozen=True)
@@ -551,7 +573,9 @@ def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None,
     grid = torsional.make_grid(string, settings.cells)
     td = fc_profile(cfg, path, stand.bit_depth_m, stand.wob_N)
     cap = torsional.bit_torque_cap(settings.bit_mu, stand.wob_N, settings.bit_diameter_m)
-    return settings.plant(grid, td.fc_at(grid.x_m), cap), td
+    plant = settings.plant(grid, td.fc_at(grid.x_m), cap, stand.bit_weakening_ratio,
+                           stand.bit_weakening_rpm)
+    return plant, td
 
 
 def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
@@ -638,8 +662,22 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
                          hookload_N=float(td.hookload_N),
                          cells=plant.grid.n_cells, dt_s=plant.grid.dt_s,
                          max_rounding_m=float(np.max(np.abs(plant.grid.rounding_m))),
-                         bit_stuck_fraction=stuck, creep_end_s=creep_end)
+                         bit_stuck_fraction=stuck, creep_end_s=creep_end,
+                         bit_torque_Nm=_mean_bit_torque_Nm(stand, rec),
+                         bit_torque_k_Nm=plant.bit_torque_cap_Nm,
+                         bit_weakening_ratio=stand.bit_weakening_ratio,
+                         bit_weakening_rpm=stand.bit_weakening_rpm)
     return cols, result
+
+
+def _mean_bit_torque_Nm(stand: Stand, rec: torsional.Record) -> float:
+    """Time-mean of the bit torque the plant applied over the stand's rotation after its
+    start-up, up to the stop [N·m] (0 off bottom or without such a span)."""
+    held = (rec.time_s >= stand.idle_s + stand.start_up_s) & (
+        rec.time_s <= stand.idle_s + stand.duration_s)
+    if not stand.on_bottom or not held.any():
+        return 0.0
+    return float(np.mean(rec.bit_torque_Nm[held]))
 
 
 def _drilled_m(stand: Stand, time_s: np.ndarray) -> np.ndarray:

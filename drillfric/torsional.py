@@ -29,7 +29,8 @@ from drillfric.errors import ModelError
 #: motor-torque series, or a prescribed top-drive speed (the speed-driven model of §6.4).
 DRIVE_MODES = {"pi": 0, "torque": 1, "speed": 2, "fed": 3}
 #: Columns of the record array returned by the kernels.
-RECORD_COLUMNS = ("surface_rad_s", "motor_torque_Nm", "string_torque_Nm", "bit_rad_s")
+RECORD_COLUMNS = ("surface_rad_s", "motor_torque_Nm", "string_torque_Nm", "bit_rad_s",
+                  "bit_torque_Nm")
 _CANDIDATE_SPREAD = 0.05  # the cell count may move ±5 % from the request to reduce rounding
 
 
@@ -201,8 +202,15 @@ class Plant:
     top_drive_inertia_kg_m2 : float
         I_TD [kg·m²].
     bit_torque_cap_Nm : float
-        Coulomb bit torque magnitude T_bit = μ_bit·WOB·r_bit [N·m]; 0 is a free bit (off
-        bottom). See :func:`bit_torque_cap`.
+        Bit torque magnitude at high speed T_k = μ_bit·WOB·D_bit/3 [N·m]; 0 is a free bit
+        (off bottom). See :func:`bit_torque_cap`.
+    bit_weakening_ratio : float
+        r ≥ 1, static (break-away) over high-speed bit torque of the rate-weakening bit
+        T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)) (docs/theory.md §3, bit) [-]; 1
+        (default) is the Coulomb bit.
+    bit_weakening_speed_rad_s : float
+        ω_b, the bit speed over which the bit torque decays from r·T_k towards T_k [rad/s]
+        (used when r > 1).
     fc_fixed_k_Nm_m, fc_fixed_s_Nm_m : ndarray, optional
         Fixed part of the friction profile (docs/theory.md §3.2): kinetic and static friction
         torque per metre of a zone whose friction factor is known (e.g. cased hole above the
@@ -227,6 +235,8 @@ class Plant:
     fc_fixed_s_Nm_m: np.ndarray | None = None
     stribeck_speed_rad_s: float | None = None
     stribeck_exponent: float = 1.0
+    bit_weakening_ratio: float = 1.0
+    bit_weakening_speed_rad_s: float = 1.0
 
     def __post_init__(self):
         if self.top_drive_inertia_kg_m2 <= 0:
@@ -253,6 +263,13 @@ class Plant:
             raise ModelError(f"the Stribeck speed must be ≥ 0 (0: step law), got "
                              f"{self.stribeck_speed_rad_s} rad/s",
                              fix="set simulate.stribeck_speed_rad_s > 0")
+        if not (self.bit_weakening_ratio >= 1.0 and self.bit_weakening_speed_rad_s > 0
+                and np.isfinite(self.bit_weakening_ratio * self.bit_weakening_speed_rad_s)):
+            raise ModelError(f"the rate-weakening bit needs r ≥ 1 and ω_b > 0, got r = "
+                             f"{self.bit_weakening_ratio}, ω_b = "
+                             f"{self.bit_weakening_speed_rad_s} rad/s",
+                             fix="set simulate.bit_weakening_ratio ≥ 1 and "
+                             "simulate.bit_weakening_rpm > 0")
         if not 1.0 <= self.stribeck_exponent <= 2.0:
             raise ModelError(f"the Stribeck exponent must be in [1, 2], got "
                              f"{self.stribeck_exponent}", fix="set simulate.stribeck_exponent")
@@ -340,6 +357,13 @@ class Plant:
                                 ** self.stribeck_exponent))
         return float(abs(omega_rad_s) <= self.omega_c_rad_s)
 
+    def bit_torque_Nm(self, omega_rad_s: float) -> float:
+        """Sliding bit torque T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)) of a bit turning
+        at ω [N·m] (docs/theory.md §3, bit); at ω = 0 the break-away capacity r·T_k."""
+        weak = (self.bit_weakening_ratio - 1.0) * np.exp(
+            -abs(omega_rad_s) / self.bit_weakening_speed_rad_s)
+        return float(self.bit_torque_cap_Nm * (1.0 + weak))
+
     def friction_torque_Nm(self, omega_rad_s: float) -> float:
         """Coulomb torque of the whole string turning uniformly at ω, Σ friction·Δx [N·m]
         (docs/theory.md §3.2; the steady rotating surface torque without viscous part)."""
@@ -351,7 +375,8 @@ def bit_torque_cap(bit_mu: float, wob_N: float, bit_diameter_m: float) -> float:
 
     The bit is a Coulomb element at x = L: |τ_bit| ≤ T_bit while the bit is stuck,
     τ_bit = T_bit·sign(ω_bit) while it turns. With a rigid-face PDC assumption of uniform
-    pressure the mean friction radius is D/3.
+    pressure the mean friction radius is D/3. A rate-weakening bit
+    (:attr:`Plant.bit_weakening_ratio`) takes this as its high-speed torque T_k.
 
     Examples
     --------
@@ -486,6 +511,9 @@ class Record:
         String torque at the top τ(0) = ζ(ω₀ − β(0)) [N·m] (= τ_m − I_TD dω₀/dt).
     bit_rad_s : ndarray
         Bit speed: ω of the last cell [rad/s].
+    bit_torque_Nm : ndarray
+        Torque the bit applies to the string τ_bit = ζ·clamp(α(L), ±T_bit/ζ) [N·m] (0 for a
+        free bit), the value held over each model step.
     """
 
     time_s: np.ndarray
@@ -493,6 +521,7 @@ class Record:
     motor_torque_Nm: np.ndarray
     string_torque_Nm: np.ndarray
     bit_rad_s: np.ndarray
+    bit_torque_Nm: np.ndarray
 
 
 def energy(grid: Grid, state: State, top_drive_inertia_kg_m2: float = 0.0) -> float:
@@ -517,7 +546,9 @@ def kernel_args(plant: Plant, drive: Drive) -> tuple:
     return (g.section_start, g.junction_z, g.zeta_Nms, plant.fcap_rad_s, plant.fix_k_rad_s,
             plant.fix_s_rad_s, g.dt_s, plant.k_t_per_s * g.dt_s, plant.mu_s, plant.mu_k,
             plant.omega_c_rad_s, plant.law_speed_rad_s, float(plant.stribeck_exponent),
-            plant.bit_torque_cap_Nm / g.zeta_Nms[-1], 1.0 / plant.top_drive_inertia_kg_m2,
+            plant.bit_torque_cap_Nm / g.zeta_Nms[-1],
+            (plant.bit_weakening_ratio - 1.0) * plant.bit_torque_cap_Nm / g.zeta_Nms[-1],
+            1.0 / plant.bit_weakening_speed_rad_s, 1.0 / plant.top_drive_inertia_kg_m2,
             DRIVE_MODES[drive.kind], np.ascontiguousarray(drive.values, dtype=float).ravel(),
             drive.t0_s, drive.dt_s, drive.kp_Nms_rad, drive.ki_Nm_rad)
 

@@ -205,6 +205,73 @@ def test_coulomb_bit_holds_below_its_cap_and_slips_above():
                                                                    rel=1e-15)
 
 
+def test_rate_weakening_bit_at_rest_holds_r_times_T_k_then_slips_at_it():
+    """docs/theory.md §3 bit, rate-weakening: a bit at rest (face speed 0 at the step before)
+    has the break-away capacity r·T_k. A wave arriving at a resting bit with ζα between T_k
+    and r·T_k reflects as from a clamped end (β = −α), where the Coulomb bit would slip; a
+    stronger one slips it with τ(L) = r·T_k exactly (the capacity at ω = 0)."""
+    g = T.make_grid(DrillString((section("dp", 0.146529, 0.123024, 1000.0),)), 100)
+    n, zeta = g.n_cells, g.zeta_Nms[-1]
+    t_k, r = 2.0 * zeta, 2.5  # T_k/ζ = 2 rad/s, r·T_k/ζ = 5 rad/s
+    plant = T.Plant(g, np.zeros(n), 0.0, 0.0, 1.0, 0.0, bit_torque_cap_Nm=t_k,
+                    bit_weakening_ratio=r, bit_weakening_speed_rad_s=1.0)
+    for a_in, b_out in ((4.0, -4.0), (6.0, 6.0 - 10.0)):
+        state = T.State.rest(g)
+        state.alpha[-2] = a_in  # reaches the bit cell after one step, the bit at rest
+        out = steps(plant, clamp_top(), 2, state)
+        assert out.beta[-1] == pytest.approx(b_out, rel=1e-15)
+
+
+@pytest.mark.parametrize("ratio", [1.0, 2.5])
+def test_stuck_bit_breaks_away_at_r_times_T_k(ratio):
+    """A frictionless string wound up by a slowly rising motor torque (150 N·m/s) against a
+    stuck bit: the recorded bit torque follows the twist up to r·T_k (within 1e-3; the
+    ramp moves 0.6 N·m per model step) while the bit stays put (|ω_bit| < 1e-3 rad/s), then
+    the bit slips and the torque falls to the sliding T_bit(ω) → T_k at speed (ω ≫ ω_b).
+    The Coulomb bit (r = 1) lets go at T_k, (r − 1)·T_k/150 s = 15 s earlier for r = 2.5."""
+    from drillfric.simulator import well_b_plant
+
+    t_k = 1500.0
+    p = well_b_plant(cells=200, k_t_per_s=0.1, mu_s=0.0, mu_k=0.0)
+    plant = T.Plant(p.grid, p.fc_Nm_m, 0.0, 0.0, p.omega_c_rad_s, p.k_t_per_s,
+                    bit_torque_cap_Nm=t_k, bit_weakening_ratio=ratio,
+                    bit_weakening_speed_rad_s=1.0)
+    rec, _ = T.run(plant, T.Drive("torque", np.array([0.0, 4 * t_k]), 40.0), 40.0, 100.0)
+    assert rec.bit_torque_Nm.max() == pytest.approx(ratio * t_k, rel=1e-3)
+    broke = int(np.argmax(rec.bit_torque_Nm >= 0.99 * ratio * t_k))
+    assert np.abs(rec.bit_rad_s[:broke]).max() < 1e-3
+    assert rec.time_s[broke] == pytest.approx(ratio * t_k / 150.0, abs=2.0)
+    assert rec.bit_rad_s[-1] > 10.0
+    assert rec.bit_torque_Nm[-1] == pytest.approx(plant.bit_torque_Nm(rec.bit_rad_s[-1]),
+                                                  rel=1e-3)
+
+
+@pytest.mark.parametrize("ratio, speed_rad_s, rpm", [(3.0, 5.0, 100.0), (2.0, 3.0, 60.0)])
+def test_steady_rotation_on_a_rate_weakening_bit_adds_T_bit_of_omega(ratio, speed_rad_s, rpm):
+    """docs/theory.md §3 bit: turning steadily at ω (Well B, μ_s = μ_k, k_t = 0.5 1/s: stable
+    sliding, the law's slope (r − 1)·T_k/ω_b·e^(−ω/ω_b) ≤ 75 N·m·s against ζ_BHA ≈ 7900),
+    the mean motor torque on bottom exceeds the off-bottom one by
+    T_bit(ω) = T_k·(1 + (r − 1)·exp(−ω/ω_b)) — 12–25 % above T_k here — within 1e-4
+    (measured 3e-6 and 4e-6 over the last 20 s of 80), and the recorded bit torque is
+    the same."""
+    from drillfric.simulator import well_b_plant
+
+    off = well_b_plant(cells=200, k_t_per_s=0.5, mu_s=0.2, mu_k=0.2)
+    on = T.Plant(off.grid, off.fc_Nm_m, off.mu_s, off.mu_k, off.omega_c_rad_s,
+                 off.k_t_per_s, bit_torque_cap_Nm=1500.0, bit_weakening_ratio=ratio,
+                 bit_weakening_speed_rad_s=speed_rad_s)
+    drive = T.Drive("pi", np.array([0.0, rpm * RPM]), 10.0)
+    off_rec, _ = T.run(off, drive, 80.0, 5.0)
+    on_rec, _ = T.run(on, drive, 80.0, 5.0)
+    last = on_rec.time_s > 60.0
+    gained = float(np.mean(on_rec.motor_torque_Nm[last] - off_rec.motor_torque_Nm[last]))
+    want = 1500.0 * (1.0 + (ratio - 1.0) * np.exp(-rpm * RPM / speed_rad_s))
+    assert want == pytest.approx(on.bit_torque_Nm(rpm * RPM), rel=1e-12)
+    assert want > 1.1 * 1500.0
+    assert gained == pytest.approx(want, rel=1e-4)
+    assert float(np.mean(on_rec.bit_torque_Nm[last])) == pytest.approx(want, rel=1e-4)
+
+
 def test_unit_impedance_junction_is_transparent():
     """Z = 1: the junction formulas reduce to α_b = α_a, β_a = β_b (bit-identical states).
 
@@ -620,7 +687,9 @@ def test_bad_plant_settings_raise(kw, word):
     ({"fc_fixed_k_Nm_m": 2.0, "fc_fixed_s_Nm_m": 1.0}, "exceeds"),
     ({"fc_fixed_k_Nm_m": -1.0}, "non-negative"),
     ({"stribeck_speed_rad_s": -1.0}, "Stribeck speed"),
-    ({"stribeck_exponent": 2.5}, "exponent")])
+    ({"stribeck_exponent": 2.5}, "exponent"),
+    ({"bit_weakening_ratio": 0.5}, "rate-weakening"),
+    ({"bit_weakening_speed_rad_s": 0.0}, "rate-weakening")])
 def test_bad_friction_profile_and_law_raise(kw, word):
     g, fc = _string_and_fc(cells=50)
     kw = {k: np.full(g.n_cells, v) if k.startswith("fc_") else v for k, v in kw.items()}

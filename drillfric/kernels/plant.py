@@ -363,6 +363,19 @@ def top_drive_step(omega0, beta0, q, accel_dt):
     return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
 
 
+@njit(cache=True, inline="always")
+def bit_cap(cap_k_rel, weak_rel, inv_speed, w_bit):
+    """Bit capacity T_bit(ω)/ζ_bit of a rate-weakening bit [rad/s] (docs/theory.md §3, bit).
+
+    T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)): ``cap_k_rel`` = T_k/ζ_bit (the high-speed
+    sliding torque), ``weak_rel`` = (r − 1)·T_k/ζ_bit, ``inv_speed`` = 1/ω_b [s/rad], taken
+    at ``w_bit``, the bit speed of the step before (explicit, as the friction caps of
+    :func:`friction_cap` at ω^k). A bit at rest (``w_bit`` = 0) holds up to r·T_k; with
+    ``weak_rel`` = 0 the result is ``cap_k_rel`` exactly (the Coulomb bit).
+    """
+    return cap_k_rel + weak_rel * exp_neg(abs(w_bit) * inv_speed)
+
+
 def plant_kernel(law: int, fixed: bool):
     """The compiled plant kernel for one friction-law variant (``law``, :func:`law_code`) with
     or without a fixed friction part: :func:`run_plant` without the variant dispatch.
@@ -377,7 +390,8 @@ def plant_kernel(law: int, fixed: bool):
     @njit(cache=True, nogil=True)
     def kernel(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
                fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
-               inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
+               bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times,
+               out):
         last = alpha.size + 2 * section_start.size - 4  # the bit cell in the ghost layout
         X = work_buffer(alpha, beta, section_start, (fcap, fix_s, fix_k))
         A, B, W, fcap_p, fix_s_p, fix_k_p = X[0:2], X[2:4], X[4:6], X[6], X[7], X[8]
@@ -391,7 +405,9 @@ def plant_kernel(law: int, fixed: bool):
         n_rec = times.size
         r = 0
         eps = 1e-9 * dt
-        p0 = p1 = p2 = p3 = 0.0
+        p0 = p1 = p2 = p3 = p4 = 0.0
+        zeta_bit = zeta[zeta.size - 1]
+        w_face = W[0, last]  # bit speed of the step before (the bit cell's at the start)
         for k in range(n_steps + 1):
             t = t0 + k * dt
             if mode == _MODE_FED:
@@ -408,14 +424,17 @@ def plant_kernel(law: int, fixed: bool):
             tau_m = motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt,
                                  inv_itd)
             w_bit = W[cur, last]
+            cap = bit_cap(bit_cap_rel, bit_weak_rel, bit_inv_speed, w_face)
+            tau_bit = zeta_bit * min(max(A[cur, last], -cap), cap)
             while r < n_rec and times[r] <= t + eps:
                 f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
                 out[r, 0] = p0 + f * (omega0 - p0)
                 out[r, 1] = p1 + f * (tau_m - p1)
                 out[r, 2] = p2 + f * (tau0 - p2)
                 out[r, 3] = p3 + f * (w_bit - p3)
+                out[r, 4] = p4 + f * (tau_bit - p4)
                 r += 1
-            p0, p1, p2, p3 = omega0, tau_m, tau0, w_bit
+            p0, p1, p2, p3, p4 = omega0, tau_m, tau0, w_bit, tau_bit
             if k == n_steps:
                 break
             omega_next = omega0
@@ -423,7 +442,8 @@ def plant_kernel(law: int, fixed: bool):
                 omega_next = top_drive_step(omega0, beta0, q_td, dt * inv_itd * tau_m)
             omega_bar = 0.5 * (omega0 + omega_next)
             inflows(A, B, W, cur, section_start, junction_z, 2.0 * omega_bar - beta0,
-                    omega_bar, bit_cap_rel)
+                    omega_bar, cap)
+            w_face = W[cur, last + 1]
             pass_cells(A, B, W, cur, end, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k,
                        omega_c, inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
             if mode == _MODE_PI:
@@ -449,8 +469,8 @@ def variant(law_speed: float, law_exp: float, fix_k, fix_s) -> tuple[int, bool]:
 
 
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
-              fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd,
-              mode, u, u_t0, u_dt, kp, ki, times, out):
+              fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
+              bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
     """Advance ``n_steps`` steps from time ``t0`` and record at ``times`` (docs/theory.md §3.1).
 
     ``alpha``, ``beta`` (cells) and ``top`` = [ω₀, PI integral] are updated in place.
@@ -459,8 +479,12 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     δ = ``law_exp``. Per step: τ_m from the state at step k (held over the step), ω₀^(k+1)
     by the trapezoidal :func:`top_drive_step` (except for a prescribed speed), then steps
     1–3 with the top inflow α(0) = 2ω̄₀ − β(0) (erratum E11).
-    ``out[r]`` receives (ω₀, τ_m, τ(0) = ζ(ω₀ − β(0)), ω_bit) at ``times[r]`` (step values,
-    τ(0) from ω₀ and β(0) at the step), linearly interpolated
+    Bit (docs/theory.md §3, rate-weakening bit): capacity T_bit(ω)/ζ_bit =
+    ``bit_cap_rel`` + ``bit_weak_rel``·exp(−|ω|·``bit_inv_speed``) [rad/s] at the bit speed
+    of the step before (:func:`bit_cap`); ``bit_weak_rel`` = 0 is the Coulomb bit.
+    ``out[r]`` receives (ω₀, τ_m, τ(0) = ζ(ω₀ − β(0)), ω_bit, τ_bit) at ``times[r]`` (step
+    values, τ(0) from ω₀ and β(0) at the step, τ_bit the bit torque applied over the step),
+    linearly interpolated
     between the bracketing steps; ``times`` must lie in [t0, t0 + n_steps·dt].
     Argument order: see :func:`drillfric.torsional.kernel_args`. Runs the compiled
     :func:`plant_kernel` of the call's variant (:func:`variant`).
@@ -470,4 +494,4 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
         _KERNELS[key] = plant_kernel(*key)
     _KERNELS[key](alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
                   fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
-                  inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out)
+                  bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out)

@@ -123,9 +123,15 @@ def top_drive_step(omega0, beta0, q, accel_dt):
     return ((1.0 - q) * omega0 + 2.0 * q * beta0 + accel_dt) / (1.0 + q)
 
 
+def bit_cap(cap_k_rel, weak_rel, inv_speed, w_bit):
+    """Rate-weakening bit capacity T_bit(ω)/ζ_bit [rad/s]; see
+    :func:`drillfric.kernels.plant.bit_cap` (the same arithmetic)."""
+    return cap_k_rel + weak_rel * float(exp_neg(np.array([abs(w_bit) * inv_speed]))[0])
+
+
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
-              fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel, inv_itd,
-              mode, u, u_t0, u_dt, kp, ki, times, out):
+              fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
+              bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
     """NumPy twin of :func:`drillfric.kernels.plant.run_plant` (same arguments and effects)."""
     law = law_code(law_speed, law_exp)
     inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
@@ -135,7 +141,8 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     omega0, integral = float(top[0]), float(top[1])
     q_td = 0.5 * zeta[0] * dt * inv_itd
     r, eps = 0, 1e-9 * dt
-    prev = np.zeros(4)
+    prev = np.zeros(5)
+    w_face = 0.5 * (a[-1] + b[-1])  # bit speed of the step before (the bit cell's at start)
     for k in range(n_steps + 1):
         t = t0 + k * dt
         if mode == _MODE_FED:
@@ -150,7 +157,9 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
             u_aux = drive_value(u, u_t0, u_dt, t + dt)
         tau0 = zeta[0] * (omega0 - b[0])
         tau_m = motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt, inv_itd)
-        cur = np.array([omega0, tau_m, tau0, 0.5 * (a[-1] + b[-1])])
+        cap = bit_cap(bit_cap_rel, bit_weak_rel, bit_inv_speed, w_face)
+        tau_bit = zeta[-1] * min(max(a[-1], -cap), cap)
+        cur = np.array([omega0, tau_m, tau0, 0.5 * (a[-1] + b[-1]), tau_bit])
         while r < times.size and times[r] <= t + eps:
             f = 1.0 if k == 0 else (times[r] - (t - dt)) / dt
             out[r] = prev + f * (cur - prev)
@@ -163,7 +172,8 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
             omega_next = top_drive_step(omega0, b[0], q_td, dt * inv_itd * tau_m)
         omega_bar = 0.5 * (omega0 + omega_next)
         transport(a, b, a2, b2, w_a, w_b, section_start, junction_z, 2.0 * omega_bar - b[0],
-                  omega_bar, bit_cap_rel)
+                  omega_bar, cap)
+        w_face = 0.5 * (a[-1] + b2[-1])
         damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k,
                           omega_c, inv_vs, law_exp, law)
         if mode == _MODE_PI:
