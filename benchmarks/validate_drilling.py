@@ -11,9 +11,11 @@ laws (WOB 5, 12, 20 t with μ_bit 0.3, 0.6, 0.15), each logged at 100 Hz, 5 Hz, 
 as 1-s means and run through the whole pipeline (:func:`drillfric.run`). A law
 ``WOB:μ_bit:r:ω_b`` makes the bit rate-weakening (docs/simulator.md, Bit:
 T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)), T_k = μ_bit·WOB·D_bit/3, ω_b in RPM). The
-truth of each on-bottom segment is the mean bit torque the plant applied over its stand
-after the start-up (the truth file's ``bit_torque_Nm``; with stick-slip on a
-rate-weakening bit it is not T_k). Scored:
+truth of each on-bottom segment is the bit's mean power over its mean speed over its stand
+after the start-up, ⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ (the truth file's ``bit_power_torque_Nm``;
+docs/theory.md §2.3: the torque Teale's MSE and μ_bit describe; with stick-slip on a
+rate-weakening bit it is not T_k, and not the time-mean ``bit_torque_Nm``, which holds the
+stuck bit's reaction torque). Scored:
 
 - every off-bottom μ_k claimed (converged segments, pools = the friction log entries, the
   well's consensus): within 5 % (10 % at 1 Hz / 1-s means) or FALSE;
@@ -106,10 +108,11 @@ def covered(value, half_width, truth, tol) -> str:
 
 
 def stand_truth(stands, t_s: float) -> float:
-    """Mean applied bit torque [N·m] of the on-bottom stand holding time ``t_s``."""
+    """The bit torque [N·m] of the on-bottom stand holding time ``t_s``: its mean power over
+    its mean speed, ⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ (docs/theory.md §2.3; the torque MSE describes)."""
     for s in stands:
         if s.wob_N > 0 and s.t_start_s <= t_s <= s.t_end_s:
-            return s.bit_torque_Nm
+            return s.bit_power_torque_Nm
     raise ValueError(f"no on-bottom stand at {t_s:g} s")
 
 
@@ -152,7 +155,7 @@ def run_case(rotation_s: float, law: tuple, rates, work: Path) -> list[dict]:
     simulation = drillfric.simulate(sim_cfg)
     stands = simulation.stands
     on_bottom = [s for s in stands if s.wob_N > 0]
-    t_bit_true = float(np.mean([s.bit_torque_Nm for s in on_bottom]))
+    t_bit_true = float(np.mean([s.bit_power_torque_Nm for s in on_bottom]))
     stuck = float(np.mean([s.bit_stuck_fraction for s in on_bottom]))
     frame = pd.DataFrame(simulation.columns)
     rows = []
@@ -198,7 +201,7 @@ def main() -> None:
     print(f"truth μ_s {MU_S}, μ_k {MU_K}; {STANDS} stands from {FIRST_M:g} m, {RPM:g} RPM, "
           f"{ON_BOTTOM_S:g} s on bottom per stand\n")
     print("| off-bottom rotation [s] | bit law | rate | friction log (stands, μ_k) | well "
-          "μ_k | T_k [kN·m] | true mean T_bit [kN·m] | T_bit ± 95 % (truth) [kN·m] per "
+          "μ_k | T_k [kN·m] | true T_bit ⟨τω⟩/⟨ω⟩ [kN·m] | T_bit ± 95 % (truth) [kN·m] per "
           "on-bottom segment | μ_bit/MSE | why withheld | run [s] |")
     print("|" + "---|" * 11)
     rows = []

@@ -265,8 +265,10 @@ class SegmentRecord:
                                               "start-up)")
     bit_torque_Nm: float | None = _f("N·m", "torque on bit T_bit = T_on − (μ_k·"
                                             "torque_per_mu_Nm + torque_fixed_Nm), "
-                                            "μ_k from off-bottom rotation nearby "
-                                            "(docs/theory.md §2.3; null: bit_torque_reason)")
+                                            "μ_k from off-bottom rotation nearby: the "
+                                            "bit's dissipative torque, its mean power over "
+                                            "its mean speed (docs/theory.md §2.3 eq. 2.2d; "
+                                            "null: bit_torque_reason)")
     bit_torque_uncertainty_Nm: float | None = _f("N·m", "95 % half-width of bit_torque_Nm "
                                                         "(μ_k's uncertainty and the torque "
                                                         "noise)")

@@ -456,6 +456,9 @@ class StandResult:
     ``bit_torque_Nm`` is the time-mean of the torque the bit applied from the end of the
     start-up to the start of the stop [N·m] (0 off bottom): with a rate-weakening bit in
     stick-slip it differs from ``bit_torque_k_Nm`` = T_k = μ_bit·WOB·D_bit/3.
+    ``bit_power_torque_Nm`` is the bit's mean power over its mean speed over the same span,
+    ⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ [N·m] (docs/theory.md §2.3): the torque Teale's MSE and μ_bit
+    describe — a stuck bit's holding torque does no work and is not in it.
     """
 
     index: int
@@ -478,6 +481,7 @@ class StandResult:
     bit_torque_k_Nm: float = 0.0
     bit_weakening_ratio: float = 1.0
     bit_weakening_rpm: float = 10.0
+    bit_power_torque_Nm: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -664,6 +668,7 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
                          max_rounding_m=float(np.max(np.abs(plant.grid.rounding_m))),
                          bit_stuck_fraction=stuck, creep_end_s=creep_end,
                          bit_torque_Nm=_mean_bit_torque_Nm(stand, rec),
+                         bit_power_torque_Nm=_power_bit_torque_Nm(stand, rec),
                          bit_torque_k_Nm=plant.bit_torque_cap_Nm,
                          bit_weakening_ratio=stand.bit_weakening_ratio,
                          bit_weakening_rpm=stand.bit_weakening_rpm)
@@ -678,6 +683,17 @@ def _mean_bit_torque_Nm(stand: Stand, rec: torsional.Record) -> float:
     if not stand.on_bottom or not held.any():
         return 0.0
     return float(np.mean(rec.bit_torque_Nm[held]))
+
+
+def _power_bit_torque_Nm(stand: Stand, rec: torsional.Record) -> float:
+    """⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ over the span of :func:`_mean_bit_torque_Nm` [N·m] (0 off
+    bottom, without such a span or with the bit at rest throughout)."""
+    held = (rec.time_s >= stand.idle_s + stand.start_up_s) & (
+        rec.time_s <= stand.idle_s + stand.duration_s)
+    if not stand.on_bottom or not held.any() or np.mean(rec.bit_rad_s[held]) <= 0:
+        return 0.0
+    power = np.mean(rec.bit_torque_Nm[held] * rec.bit_rad_s[held])
+    return float(power / np.mean(rec.bit_rad_s[held]))
 
 
 def _drilled_m(stand: Stand, time_s: np.ndarray) -> np.ndarray:

@@ -489,3 +489,23 @@ def test_written_well_states_the_block_its_hook_load_carries(well, tmp_path):
     assert heavy.loc[slips, "hookload_N"].median() == pytest.approx(150e3, abs=1e3)
     assert heavy["hookload_N"].iloc[:200].median() - bare["hookload_N"].iloc[:200].median() \
         == pytest.approx(150e3, abs=2e3)
+
+
+def test_truth_power_bit_torque_of_a_stick_slipping_coulomb_bit_is_its_sliding_torque(
+        tmp_path):
+    """⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ (docs/theory.md §2.3) of a Coulomb bit is T_k whatever the
+    stick-slip: it slides at T_k and does no work while stuck (the bit does not turn
+    backwards here). The plant of the test above at k_t = 0.5 1/s, sticky
+    string (μ_s 0.6, μ_k 0.25), 40 RPM: the bit is stuck 12 % of the time."""
+    cfg = config_from_dict({"model": {"cells": 100, "k_t_per_s": 0.5},
+                            "simulate": {"rate_hz": 10.0, "mu_s": 0.6, "mu_k": 0.25,
+                                         "bit_mu": 0.3}})
+    path = tmp_path / "s.toml"
+    path.write_text("[[stand]]\nbit_depth_m = 1200.0\nduration_s = 90.0\nrpm = 40.0\n"
+                    "wob_N = 80e3\n")
+    run = sim.simulate(cfg, None, sim.load_scenario(path, sim.base_stand(cfg)))
+    truth = run.truth()["stands"][0]
+    assert truth["bit_stuck_fraction"] > 0.1  # it sticks and slips (0.12)
+    assert np.min(run.columns["bit_rpm"]) > -0.5  # and never turns backwards
+    t_k = T.bit_torque_cap(0.3, 80e3, 0.2159)
+    assert truth["bit_power_torque_Nm"] == pytest.approx(t_k, rel=1e-3)
