@@ -50,9 +50,15 @@ CASES = [
      dict(mu_k=0.21, method=Method.OBSERVER, converged=False, adapt=True),
      "without a fit the observer consensus is reported, converged only as the observer "
      "says, and the seeded pass keeps adapting"),
-    ("no_batch_mu_k_observer_converged", dict(batch_mu_k=None, turning_s=10.0),
+    ("no_batch_mu_k_observer_converged", dict(batch_mu_k=None),
      dict(mu_k=0.21, method=Method.OBSERVER, converged=True, flags=()),
-     "the rotation rule is the batch fit's: the observer's own convergence stands"),
+     "without a fit the observer's own convergence stands on a long rotation"),
+    ("no_batch_mu_k_observer_converged_too_short", dict(batch_mu_k=None, turning_s=20.0),
+     dict(mu_k=0.21, method=Method.OBSERVER, converged=False,
+          flags=(Flag.TOO_SHORT_TO_CONVERGE,)),
+     "regression (docs/validation.md 'Drilling records', 20-s rotations at 1-s means): the "
+     "observer's convergence was let stand on 20 s of rotation; the rotation rule is now "
+     "either estimator's"),
     ("low_mu_k", dict(batch_mu_k=0.04, observer_mu_k=0.04, mu_s_model=None,
                       mu_s_lower_bound=None),
      dict(mu_k=0.04, flags=(Flag.OUTSIDE_TYPICAL_RANGE,), seed=0.04, bound=None),

@@ -110,7 +110,8 @@ def decide(ev: Evidence) -> Verdict:
     """Apply the rules to one segment's :class:`Evidence`.
 
     1. μ_k is the batch fit's when it has one (``batch``), else the observer consensus
-       (``observer``, converged only if the observer says so);
+       (``observer``, converged only if the observer says so and the segment turned at
+       least :data:`MIN_CONVERGED_ROTATION_S`);
     2. a batch μ_k is not converged when the fit flags ``mu_k_not_converged`` or
        ``relaxation_cycles`` (:data:`NOT_CONVERGED`), when batch and
        observer differ by more than :data:`DISAGREEMENT`, with less than
@@ -138,6 +139,7 @@ def decide(ev: Evidence) -> Verdict:
     else:
         mu_k, method, converged = ev.observer_mu_k, Method.OBSERVER, ev.observer_converged
         messages.append("batch refinement gave no μ_k: observer consensus reported")
+        converged = _long_enough(ev, flags, messages) and converged
     if not TYPICAL_MU[0] <= mu_k <= TYPICAL_MU[1]:
         flags.append(Flag.OUTSIDE_TYPICAL_RANGE)
         messages.append(f"μ_k = {mu_k:.3f} is outside the range usually seen ({TYPICAL_MU[0]}–"
@@ -183,9 +185,15 @@ def _batch_converged(ev: Evidence, flags: list, messages: list) -> bool:
         messages.append(f"μ_k = {ev.batch_mu_k:.3f} ± {2.0 * ev.batch_mu_k_sigma:.3f} (2σ) is "
                         f"not known within {100 * MU_K_CLAIM:.0f} %: not converged (a longer "
                         "record of the same rotation narrows it as 1/√time)")
-    if ev.turning_s < MIN_CONVERGED_ROTATION_S:
-        converged = False
-        flags.append(Flag.TOO_SHORT_TO_CONVERGE)
-        messages.append(f"only {ev.turning_s:.0f} s of rotation (< "
-                        f"{MIN_CONVERGED_ROTATION_S:.0f} s): not converged")
-    return converged
+    return _long_enough(ev, flags, messages) and converged
+
+
+def _long_enough(ev: Evidence, flags: list, messages: list) -> bool:
+    """The rotation rule of either estimator's μ_k: :data:`MIN_CONVERGED_ROTATION_S` of
+    turning, else not converged (shorter pieces count through pooling)."""
+    if ev.turning_s >= MIN_CONVERGED_ROTATION_S:
+        return True
+    flags.append(Flag.TOO_SHORT_TO_CONVERGE)
+    messages.append(f"only {ev.turning_s:.0f} s of rotation (< "
+                    f"{MIN_CONVERGED_ROTATION_S:.0f} s): not converged")
+    return False
