@@ -91,7 +91,8 @@ def score(summary: dict, frame: pd.DataFrame, omega_c: float, name: str,
         row = {"plant": name, "rate": rate, "segment": seg["id"], "stuck_true": stuck_true,
                "severity_true": sev_true, "stuck": stuck, "severity": sev,
                "reason": seg.get("bit_speed_reason") or "",
-               "stats_reason": seg.get("bit_statistics_reason") or ""}
+               "stats_reason": next((m for m in (seg.get("message") or "").split("; ")
+                                     if m.startswith("stuck fraction and severity")), "")}
         row["stuck_err"] = None if stuck is None else stuck - stuck_true
         row["severity_err"] = None if sev is None else sev / sev_true - 1.0
         row["ok"] = ((row["stuck_err"] is None or abs(row["stuck_err"]) <= STUCK_TOL)
@@ -102,17 +103,17 @@ def score(summary: dict, frame: pd.DataFrame, omega_c: float, name: str,
 
 
 def _fmt(v, spec: str) -> str:
-    return "null" if v is None else format(v, spec)
+    return "—" if v is None else format(v, spec)
 
 
 def line(r: dict) -> str:
     verdict = "ok" if r["ok"] else "FALSE"
     if r["stuck"] is None and r["severity"] is None:
         verdict = "withheld"
-    sev_err = None if r["severity_err"] is None else 100.0 * r["severity_err"]
+    sev_err = "—" if r["severity_err"] is None else f"{100.0 * r['severity_err']:+.1f} %"
     return (f"| {r['plant']} | {r['rate']} | {r['stuck_true']:.3f} / {r['severity_true']:.2f} "
             f"| {_fmt(r['stuck'], '.3f')} / {_fmt(r['severity'], '.2f')} | "
-            f"{_fmt(r['stuck_err'], '+.3f')} / {_fmt(sev_err, '+.1f')} % | {verdict} |")
+            f"{_fmt(r['stuck_err'], '+.3f')} / {sev_err} | {verdict} |")
 
 
 def run_plant(name: str, rates, work: Path) -> list[dict]:
@@ -130,7 +131,7 @@ def run_plant(name: str, rates, work: Path) -> list[dict]:
         summary = drillfric.run(well).summary
         for r in score(summary, frame, omega_c, name, rate):
             print(line(r) + f" {time.perf_counter() - t0:.0f} s", flush=True)
-            if r["stats_reason"]:
+            if r["stats_reason"] and rate == rates[0]:
                 print("    ", r["stats_reason"], flush=True)
             rows.append(r)
     return rows
