@@ -58,7 +58,8 @@ def changes(summary: dict | None, history: list[dict], *, ran: bool,
     notes += _moved(summary.get("mu_k"), [h["mu_k"] for h in history[-HISTORY_NIGHTS:]
                                           if h.get("mu_k") is not None])
     severe = [s["id"] for s in segments[before:] if (s.get("stick_slip_severity") or 0.0)
-              > SEVERE_STICK_SLIP]
+              > SEVERE_STICK_SLIP
+              or "stick_slip_beyond_validated" in (s.get("quality_flags") or ())]
     if severe:
         notes.append(f"severe stick-slip (the bit stops) in segment(s) "
                      f"{', '.join(map(str, severe))}")

@@ -66,6 +66,7 @@ class Flag(StrEnum):
     BIT_TORQUE_IN_FRICTION = "bit_torque_in_friction"
     POOLED = "pooled"
     BIT_SPEED_DRIFT = "bit_speed_drift"
+    STICK_SLIP_BEYOND_VALIDATED = "stick_slip_beyond_validated"
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
     STRING_WEIGHT_UNVERIFIED = "string_weight_unverified"
     STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
@@ -101,6 +102,9 @@ FLAG_MEANINGS = {
     Flag.BIT_SPEED_DRIFT: "the bit-speed trace drifts from the top drive by more than the "
                           "string's twist allows, by under a third of its stick-slip swing: "
                           "shown, its phase approximate",
+    Flag.STICK_SLIP_BEYOND_VALIDATED: "stick-slip more severe than the stuck fraction and the "
+                                      "severity are validated for (estimated severity ≥ 2.1): "
+                                      "both withheld",
     Flag.RELAXATION_CYCLES: "the string stalls while a soft top drive crawls below ω_c, "
                             "then bursts free (a relaxation cycle): the mean torque is "
                             "mostly static wind-up, μ_k not converged",

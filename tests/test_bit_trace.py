@@ -8,17 +8,21 @@ import pytest
 
 from drillfric.drillstring import build_string
 from drillfric.estimation.bit_trace import (
+    SEVERITY_VALIDATED_BELOW,
     bit_speed_claim,
     check_trace,
     compliance_rad_Nm,
     drift_note,
     mixture_severity,
+    statistics_note,
     stuck_share,
     twist_bound_rad,
 )
+from drillfric.estimation.chain import SegmentData, estimate_segment
 from drillfric.estimation.diagnostics import stick_slip_severity
 from drillfric.estimation.sampling import Resolution
-from tests.synthetic import RPM, build_and_hold, config, simulate
+from drillfric.result import Flag
+from tests.synthetic import RPM, build_and_hold, config, noisy, simulate
 
 NOISE = 0.5 * RPM
 
@@ -159,3 +163,30 @@ def test_stick_slip_trace_drifting_under_a_third_of_its_swing_is_shown_flagged()
     steady = check_trace(t[::10], surface[::10] + 6 * RPM, t, surface, bound, NOISE)
     assert not steady.passed and not steady.approximate
     assert not bit_speed_claim(Resolution(True, 20.0), steady, on_bottom=False).resolved
+
+
+def test_severe_stick_slip_statistics_withheld_not_printed_low():
+    """Issue 22 (benchmarks/validate_severity.py): in severe off-bottom stick-slip (sticky
+    0.8/0.25 at 2000 m, 30 RPM: the truth's severity 3.9, stuck 0.73) the ensemble read the
+    severity up to 26 % and the stuck fraction up to 0.13 low — beyond the stated ±12 % /
+    ±0.05. Such a segment's estimated severity is ≥ 2.1: both statistics are withheld, with
+    the flag and the reason, not printed."""
+    path = build_and_hold(800.0, 45.0, 2000.0)
+    cfg = config(cells=200)
+    case = simulate(path, 2000.0, 0.8, 0.25, 30.0, 150.0, cells=400, rate_hz=10.0, cfg=cfg)
+    rec = case.record
+    late = rec.time_s > 30.0
+    assert stick_slip_severity(rec.bit_rad_s[late]) > 2.9  # beyond the validated 1.9–2.9
+    w, q = noisy(rec)
+    est = estimate_segment(cfg, path, SegmentData(rec.time_s, w / RPM, q, 2000.0))
+    assert est.stick_slip_severity >= SEVERITY_VALIDATED_BELOW
+    assert not est.bit_statistics
+    assert Flag.STICK_SLIP_BEYOND_VALIDATED in est.flags
+    assert any(m.startswith("stuck fraction and severity withheld") for m in est.messages)
+
+
+def test_statistics_note_only_beyond_the_validated_severity():
+    assert statistics_note(SEVERITY_VALIDATED_BELOW - 0.01) == ""
+    assert statistics_note(float("nan")) == ""
+    note = statistics_note(3.2)
+    assert "3.2" in note and "docs/bit_speed.md" in note

@@ -32,3 +32,12 @@ def test_mu_k_moved_beyond_its_own_spread_needs_three_nights():
 def test_a_well_whose_data_did_not_change_says_since_when():
     out = changes(_summary(0.25, [0.2]), [], ran=False, data_changed_utc="2026-11-20T02:00:00")
     assert out == {"new_segments": 0, "notes": ["no new data since 2026-11-20T02:00:00"]}
+
+
+def test_severe_stick_slip_with_statistics_withheld_is_still_noted():
+    """Issue 22: beyond the validated severity the number is null, the flag says why; the
+    night's note still names the segment."""
+    summary = _summary(0.25, [0.2, None])
+    summary["segments"][1]["quality_flags"] = ["stick_slip_beyond_validated"]
+    out = changes(summary, [], ran=True, data_changed_utc=None)
+    assert "severe stick-slip (the bit stops) in segment(s) 2" in out["notes"]

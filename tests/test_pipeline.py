@@ -103,7 +103,9 @@ def test_bit_speed_in_severe_stick_slip(demo_run):
     reason: on the demo the ensemble runs 4–7 RPM ahead of or behind the top drive for
     minutes), and then within 35 RPM RMS. The stuck fraction (|ω_bit| ≤ ω_c) and the severity
     are reported within their stated tolerance, ±0.05 and ±12 % (docs/bit_speed.md), against
-    the truth over the same rows. Where a trace is reported it lies inside its band."""
+    the truth over the same rows, or withheld with the reason where the estimated severity
+    is ≥ 2.1 (issue 22: severer stick-slip read up to 26 % low). Where a trace is reported
+    it lies inside its band."""
     out = demo_run[0]
     summary = json.loads((out / "summary.json").read_text())
     est = pd.read_parquet(out / "estimates.parquet")
@@ -119,6 +121,11 @@ def test_bit_speed_in_severe_stick_slip(demo_run):
         else:
             assert "kinematic check" in seg["bit_speed_reason"], seg
             assert rows["bit_rpm_est"].isna().all() and seg["bit_rms_error_rpm"] is None
+        if "stick_slip_beyond_validated" in seg["quality_flags"]:  # issue 22: severity ≥ 2.1
+            assert seg["stuck_fraction"] is None and seg["stick_slip_severity"] is None
+            assert "stuck fraction and severity withheld" in seg["message"]
+            assert stick_slip_severity(truth) > 1.9
+            continue
         assert seg["stuck_fraction"] == pytest.approx(np.mean(np.abs(truth) <= omega_c_rpm),
                                                       abs=0.05)
         assert seg["stick_slip_severity"] == pytest.approx(stick_slip_severity(truth),

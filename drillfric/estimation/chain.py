@@ -137,8 +137,10 @@ class SegmentEstimate:
         The trace's kinematic check (docs/bit_speed.md).
     bit_statistics : bool
         Whether the stuck fraction and the severity may be reported: the logging resolves
-        the cycle and the bit is off bottom (they are validated within their tolerance also
-        where the kinematic check withholds the trace, docs/bit_speed.md).
+        the cycle, the bit is off bottom and the estimated severity is below
+        :data:`~drillfric.estimation.bit_trace.SEVERITY_VALIDATED_BELOW` (they are validated
+        within their tolerance also where the kinematic check withholds the trace,
+        docs/bit_speed.md).
     logged : LoggingInterval
         The log's effective interval and, with min/max channels, the torque swing within it.
     torque_terms : TorqueTerms or None
@@ -567,16 +569,20 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     logging = bit_speed_resolution(models)
     claim = bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom)
     drift = claim.resolved and kinematics.approximate
+    severe = bit_trace.statistics_note(estimate.stick_slip_severity)
+    statistics = logging.resolved and not models.on_bottom
     fitted = fit_evidence(cfg, models, verdict, refined.mu_s)
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(cfg, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
     return replace(estimate, evidence=fitted, torque_terms=terms,
                    bit_speed=claim, kinematics=kinematics,
-                   bit_statistics=logging.resolved and not models.on_bottom,
-                   flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ()),
+                   bit_statistics=statistics and not severe,
+                   flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ())
+                   + ((Flag.STICK_SLIP_BEYOND_VALIDATED,) if statistics and severe else ()),
                    messages=estimate.messages + ((bit_trace.drift_note(kinematics),)
-                                                 if drift else ()),
+                                                 if drift else ())
+                   + ((severe,) if statistics and severe else ()),
                    logged=models.logged)
 
 

@@ -61,17 +61,17 @@ def _evidence_fields(est: SegmentEstimate) -> dict:
 
 def _bit_fields(est: SegmentEstimate) -> dict:
     """The bit-speed statistics, or null with the reason where the trace is withheld (the
-    stuck fraction and severity stay where only the kinematic check withheld it)."""
+    stuck fraction and severity stay where only the kinematic check withheld it; they are
+    null where the stick-slip is beyond their validated range, the reason in the message)."""
     logged = dict(sample_interval_s=est.logged.interval_s,
                   interval_torque_swing=est.logged.torque_swing)
+    kept = dict(stick_slip_severity=est.stick_slip_severity,
+                stuck_fraction=est.stuck_fraction) if est.bit_statistics else {}
     if not est.bit_speed.resolved:
-        kept = dict(stick_slip_severity=est.stick_slip_severity,
-                    stuck_fraction=est.stuck_fraction) if est.bit_statistics else {}
         return logged | kept | dict(bit_speed_resolved=False,
                                     bit_speed_reason=est.bit_speed.reason)
-    return logged | dict(bit_speed_resolved=True, stick_slip_severity=est.stick_slip_severity,
-                         stuck_fraction=est.stuck_fraction,
-                         bit_rms_error_rpm=est.bit_rms_error_rpm)
+    return logged | kept | dict(bit_speed_resolved=True,
+                                bit_rms_error_rpm=est.bit_rms_error_rpm)
 
 
 def _median(rows: pd.DataFrame, column: str) -> float | None:
