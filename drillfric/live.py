@@ -43,7 +43,7 @@ from drillfric.errors import InputError
 from drillfric.io.results import write_json
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live_source import PartsTail, Tail, follow
-from drillfric.result import SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord, Status
 from drillfric.runner import warmup
 from drillfric.runner.engine import Engine, mismatch
 from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
@@ -365,11 +365,9 @@ class LiveRun:
         elif idle >= self.stale_s:
             alerts.append(_alert("data_stale", f"no new data for {idle:.0f} s",
                                  view["last_sample_time_s"]))
-        ssi = (view["open_segment"] or {}).get("stick_slip_severity")
-        if ssi is not None and ssi >= SEVERE_STICK_SLIP:
-            alerts.append(_alert("severe_stick_slip", f"stick-slip severity {ssi:.2f} in the "
-                                 f"open segment (≥ {SEVERE_STICK_SLIP:g})",
-                                 view["last_sample_time_s"]))
+        severe = _severe_stick_slip(view["open_segment"] or {})
+        if severe:
+            alerts.append(_alert("severe_stick_slip", severe, view["last_sample_time_s"]))
         stalled = (view["open_segment"] or {}).get("bit_stalled_s")
         if stalled is not None and stalled >= BIT_STALL_S:
             alerts.append(_alert("bit_stalled", f"estimated bit speed at rest for the last "
@@ -457,7 +455,22 @@ def _open_view(record: SegmentRecord, folder: Path) -> dict:
             "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
             "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
             "bit_rpm": bit_rpm, "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
-            "stick_slip_severity": record.stick_slip_severity}
+            "stick_slip_severity": record.stick_slip_severity,
+            "stick_slip_beyond_validated":
+                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
+
+
+def _severe_stick_slip(open_segment: dict) -> str:
+    """The ``severe_stick_slip`` alert's message ("" when none): the open segment's severity
+    at least :data:`SEVERE_STICK_SLIP`, or withheld as beyond its validated range (an
+    estimated severity ≥ 2.1, docs/bit_speed.md: severe by far)."""
+    ssi = open_segment.get("stick_slip_severity")
+    if ssi is not None and ssi >= SEVERE_STICK_SLIP:
+        return f"stick-slip severity {ssi:.2f} in the open segment (≥ {SEVERE_STICK_SLIP:g})"
+    if open_segment.get("stick_slip_beyond_validated"):
+        return ("severe stick-slip in the open segment: severity beyond its validated range "
+                "(estimated ≥ 2.1; the number is withheld, docs/bit_speed.md)")
+    return ""
 
 
 def bit_speed_withheld(record: dict) -> str:

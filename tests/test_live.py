@@ -178,6 +178,16 @@ def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_tren
     live.last_data = now[0]
     live.view["open_segment"] = {"stick_slip_severity": 1.3}
     assert [a["kind"] for a in live.status()["alerts"]] == ["severe_stick_slip"]
+    # regression: a severity withheld as beyond its validated range (≥ 2.1) silenced the
+    # alert exactly where the stick-slip is worst
+    live.view["open_segment"] = {"stick_slip_severity": None,
+                                 "stick_slip_beyond_validated": True}
+    alerts = live.status()["alerts"]
+    assert [a["kind"] for a in alerts] == ["severe_stick_slip"]
+    assert "beyond its validated range" in alerts[0]["message"]
+    live.view["open_segment"] = {"stick_slip_severity": 0.6,
+                                 "stick_slip_beyond_validated": False}
+    assert live.status()["alerts"] == []
 
     def done(*mu_k):
         return [SegmentRecord(id=i + 1, mu_k=m, converged=True, t_end_s=100.0 * (i + 1))

@@ -276,12 +276,11 @@ def statistics_note(severity: float) -> str:
     --------
     >>> statistics_note(1.5)
     ''
-    >>> statistics_note(2.6)[:40]
-    'stuck fraction and severity withheld: th'
+    >>> statistics_note(2.6)[:60]
+    'severe stick-slip: stuck fraction and severity withheld, the'
     """
     if not severity >= SEVERITY_VALIDATED_BELOW:
         return ""
-    return (f"stuck fraction and severity withheld: the estimated severity {severity:.1f} "
-            f"shows stick-slip beyond where they are validated (below "
-            f"{SEVERITY_VALIDATED_BELOW:g}); in severer stick-slip they read up to 26 % and "
-            "0.13 low (docs/bit_speed.md)")
+    return (f"severe stick-slip: stuck fraction and severity withheld, the estimated "
+            f"severity is {SEVERITY_VALIDATED_BELOW:g} or more, beyond where they are "
+            "validated; there they read up to 26 % and 0.13 low (docs/bit_speed.md)")

@@ -28,7 +28,7 @@ from .figures import (
     drag_rows,
 )
 from .interactive import MIN_WIDTH_PX
-from .render import is_apparent, mu_k_cell, mu_s_text, zone_text
+from .render import is_apparent, mu_k_cell, mu_s_text, severity_text, zone_text
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
@@ -55,7 +55,7 @@ def _source_frame(seg: pd.DataFrame, units: Units) -> pd.DataFrame:
                          zip(rows["mu_s"], rows["mu_s_identifiable"], rows["mu_s_lower_bound"],
                              strict=True)]
     rows["mu_td_text"] = [fmt(v) for v in rows["mu_td"]]
-    rows["severity_text"] = [fmt(v, ".2f") for v in rows["stick_slip_severity"]]
+    rows["severity_text"] = [severity_text(r) for r in records]
     rows["zone"] = rows["friction_zone"].fillna("—").astype(str).str.replace("_", " ")
     rows["status"] = rows["status"].astype(str)
     rows["identified"] = rows["mu_s_identifiable"].astype(bool) & rows["mu_s"].notna()

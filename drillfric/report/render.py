@@ -90,6 +90,17 @@ def mu_s_text(mu_s, identifiable: bool, lower_bound) -> str:
     return "not identifiable"
 
 
+def severity_text(row: dict) -> str:
+    """The stick-slip severity as shown: its value, or "severe (withheld)" where it is
+    withheld as beyond its validated range (flag ``stick_slip_beyond_validated``,
+    docs/bit_speed.md), never a bare "—" that reads as "no stick-slip"."""
+    flags = row.get("quality_flags")
+    flags = [] if flags is None or isinstance(flags, float) else list(map(str, flags))
+    if fmt(row.get("stick_slip_severity")) == "—" and "stick_slip_beyond_validated" in flags:
+        return "severe (withheld)"
+    return fmt(row.get("stick_slip_severity"), ".2f")
+
+
 def observability(row: dict) -> str:
     """Whether the segment identifies μ_s, bounds it, or says nothing about it."""
     if row.get("status") != "ok":
@@ -324,7 +335,7 @@ def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None,
                  fmt(row["mu_td"]), str(row.get("friction_zone") or "—").replace("_", " "),
                  pair(row["mu_s_spread"], row["mu_k_spread"]),
                  fmt(row["settling_time_s"], ".1f"), fmt(row["residual_rms_rpm"], ".2f"),
-                 _torque_fit(row, units, quality), fmt(row["stick_slip_severity"], ".2f"),
+                 _torque_fit(row, units, quality), severity_text(row),
                  fmt(row["stuck_fraction"], ".0%"),
                  units.pair(row.get("hookload_N"), row.get("hookload_model_N"), "force"),
                  _bit_speed_cell(row), observability(row), status_text(row), message]

@@ -55,6 +55,7 @@ from .render import (
     non_default_rows,
     note_flags,
     now_utc,
+    severity_text,
     status_word,
     string_table,
     written_at,
@@ -324,6 +325,7 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
     row["interval_swing"] = fmt(row.get("interval_torque_swing"), ".0%")
     row["zone"] = str(row.get("friction_zone") or "—").replace("_", " ")
     row["starts_text"] = starts_text(row)
+    row["severity_text"] = severity_text(row)
     row["notes"] = message_parts(str(row.get("message") or ""))
     row["flag_items"] = flag_items(row)
     return row
