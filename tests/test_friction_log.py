@@ -205,6 +205,11 @@ def test_run_writes_the_result_files_of_a_time_log(depth_log, tmp_path):
     assert summary["friction_log"]["mu_apparent"] == pytest.approx(MU, abs=ROOT_TOL)
     assert summary["friction_log"]["mu_k_reason"] is None
     assert any("no observer" in w for w in summary["warnings"])
+    # its μ rests on the configured string: told, not hidden (docs/theory.md §2.1)
+    assert summary["hookload"]["verdict"] == "not_checked"
+    assert "string_weight_not_checked" in summary["quality_flags"]
+    assert summary["mu_k_confidence"] == "low"
+    assert any("string weight not checked" in w for w in summary["warnings"])
     segments = pd.read_parquet(folder / "segments.parquet")
     assert list(segments["method"]) == ["td_backcalc"] * WINDOWS
     assert segments["mu_s"].isna().all()

@@ -91,13 +91,13 @@ def mu_s_text(mu_s, identifiable: bool, lower_bound) -> str:
 
 
 def severity_text(row: dict) -> str:
-    """The stick-slip severity as shown: its value, or "severe (withheld)" where it is
+    """The stick-slip severity as shown: its value, or "severe" where it is
     withheld as beyond its validated range (flag ``stick_slip_beyond_validated``,
     docs/bit_speed.md), never a bare "—" that reads as "no stick-slip"."""
     flags = row.get("quality_flags")
     flags = [] if flags is None or isinstance(flags, float) else list(map(str, flags))
     if fmt(row.get("stick_slip_severity")) == "—" and "stick_slip_beyond_validated" in flags:
-        return "severe (withheld)"
+        return "severe"
     return fmt(row.get("stick_slip_severity"), ".2f")
 
 

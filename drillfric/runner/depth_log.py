@@ -28,6 +28,13 @@ from drillfric.torque_drag import TDResult
 
 from .finish import ReportWriter, Sink, deliver, finish, summarise
 
+#: summary.json ``hookload`` of a depth-indexed log: the string-weight check of
+#: docs/theory.md §2.1 needs the time log's in-slips rows and off-bottom rotating segments.
+UNCHECKED = {"verdict": "not_checked", "reason": "a depth-indexed log: the hook-load check "
+             "of the string weight runs on time-indexed logs (docs/theory.md §2.1)"}
+UNCHECKED_WARNING = ("string weight not checked: a depth-indexed log's friction factors rest "
+                     "on the configured string's weight (μ scales as 1/W; docs/theory.md "
+                     "§2.1): run the time-indexed log to check it against the hook load")
 #: Spacing of the torque-and-drag profile rows written per window [m].
 PROFILE_STEP_M = 10.0
 
@@ -61,7 +68,10 @@ def _friction_log(well: Well, sink: Sink, rate_hz, progress, chunk_rows,
     summary = summarise(well, records, [], rows=len(log),
                         assumed=assumed + _assumptions(well, results, notes),
                         warnings=warnings, wall_s=time.perf_counter() - t_wall)
-    summary.update(index="depth", friction_log=_log_summary(well, log, results))
+    summary.update(index="depth", friction_log=_log_summary(well, log, results),
+                   hookload=UNCHECKED)
+    if summary.get("mu_k") is not None:
+        summary["warnings"].append(UNCHECKED_WARNING)
     return finish(sink, well, summary, records,
                   tables={"friction_log.parquet": log_table(results)})
 
