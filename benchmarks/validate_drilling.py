@@ -14,7 +14,7 @@ T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)), T_k = μ_bit·WOB·D_bit/3,
 truth of each on-bottom segment is the bit's mean power over its mean speed over its stand
 after the start-up, ⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ (the truth file's ``bit_power_torque_Nm``;
 docs/theory.md §2.3: the torque Teale's MSE and μ_bit describe; with stick-slip on a
-rate-weakening bit it is not T_k, and not the time-mean ``bit_torque_Nm``, which holds the
+rate-weakening bit it is not T_k, and not the time-mean ``bit_torque_time_mean_Nm``, which holds the
 stuck bit's reaction torque). Scored:
 
 - every off-bottom μ_k claimed (converged segments, pools = the friction log entries, the

@@ -467,7 +467,7 @@ def judge(records: list, plateaus: list[Plateau], cfg,
     block = calibration.block if calibration is not None and calibration.scale is not None \
         else block_weight_of(plateaus, points, cfg)
     summary = _summary_base(cfg, block, calibration, len(points))
-    if not len(points):
+    if not len(points) and (block.weight_N is not None or not _hooked(records)):
         summary.update(verdict="not_checked", reason="no estimated off-bottom rotating "
                        "segment with a hook load")
         return Outcome(list(records), summary, _unchecked(records))
@@ -511,15 +511,23 @@ def judge(records: list, plateaus: list[Plateau], cfg,
     return Outcome(out, summary, warnings)
 
 
+def _hooked(records) -> bool:
+    """Whether any estimated segment has a measured hook load."""
+    return any(r.status is Status.OK and r.hookload_N is not None
+               and np.isfinite(r.hookload_N) for r in records)
+
+
 def _unchecked(records) -> list[str]:
-    """The warning of estimated off-bottom rotating segments without a hook load: their
-    friction factors rest on the configured string's weight, which nothing checked."""
-    ids = [str(r.id) for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM]
+    """The warning of estimated segments whose string weight nothing checked (no off-bottom
+    rotating segment with a hook load to weigh it against): their friction factors rest on
+    the configured string's weight."""
+    ids = [str(r.id) for r in records if r.status is Status.OK]
     if not ids:
         return []
-    return [f"string weight not checked: the off-bottom segment(s) {', '.join(ids)} have no "
-            "hook load, so their friction factors rest on the configured string's weight "
-            "(μ scales as 1/W; docs/theory.md §2.1): log the hook load to check it"]
+    return [f"string weight not checked: no off-bottom rotating segment with a hook load to "
+            f"weigh it against, so the friction factors of segment(s) {', '.join(ids)} rest "
+            "on the configured string's weight (μ scales as 1/W; docs/theory.md §2.1): log "
+            "the hook load, and rotate off bottom"]
 
 
 def _verdict(well_problem: str, block: BlockWeight, calibration: Calibration | None) -> str:

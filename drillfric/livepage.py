@@ -45,7 +45,14 @@ from drillfric.io.results import jsonable
 from drillfric.live import SEVERE_STICK_SLIP, LiveRun, bit_speed_withheld
 from drillfric.report.data import FINAL_START_ID, extreme_rows
 from drillfric.report.interactive import bokeh_js, json_in_script, script_hash, time_figure
-from drillfric.report.render import environment, is_apparent, mu_k_cell, mu_s_text, status_word
+from drillfric.report.render import (
+    environment,
+    is_apparent,
+    mu_k_cell,
+    mu_s_text,
+    severity_text,
+    status_word,
+)
 
 #: Host the page binds when ``--serve`` names only a port (never all interfaces unasked).
 DEFAULT_HOST = "127.0.0.1"
@@ -263,6 +270,7 @@ def segment_view(record: dict, is_open: bool) -> dict:
         "mu_k_text": mu_k_cell(record) if ok and mu_k is not None else "withheld",
         "mu_s_text": mu_s_text(record.get("mu_s"), bool(record.get("mu_s_identifiable")),
                                record.get("mu_s_lower_bound")) if ok else "withheld",
+        "severity_text": severity_text(record) if ok else "—",
         "plot_mu_k": None if apparent else mu_k, "plot_mu_app": mu_k if apparent else None,
         "plot_mu_s": record.get("mu_s") if ok and record.get("mu_s_identifiable") else None,
         "plot_mu_s_lb": record.get("mu_s_lower_bound") if ok else None,

@@ -167,9 +167,10 @@ WELL_FLAG_MEANINGS = {
                                        "[hookload] block_weight_N is given: the string "
                                        "weight, which μ scales with (1/W), cannot be "
                                        "measured, and the friction factors are withheld",
-    WellFlag.STRING_WEIGHT_NOT_CHECKED: "the well μ_k rests on off-bottom segments without "
-                                        "a hook load: the configured string's weight, which "
-                                        "μ scales with (1/W), was not checked",
+    WellFlag.STRING_WEIGHT_NOT_CHECKED: "nothing in the log could check the configured "
+                                        "string's weight, which μ scales with (1/W): no hook "
+                                        "load, no off-bottom rotating segment with one, or a "
+                                        "depth-indexed log",
     WellFlag.SEGMENTS_FAILED: "segments whose estimation failed (counts.failed)",
 }
 
@@ -207,12 +208,15 @@ class SegmentRecord:
     settling_time_s: float | None = _f("s", "time the observer starts took to settle")
     residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
     stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated bit "
-                                                "speed (ensemble members pooled; ±12 %)")
+                                                "speed (ensemble members pooled; ±12 %); null "
+                                                "where beyond its validated range (flag "
+                                                "stick_slip_beyond_validated)")
     status: Status = _f("", "ok, skipped or failed", Status.OK)
     message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
     duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
     stuck_fraction: float | None = _f("-", "share of the time the bit is stuck, |ω_bit| ≤ ω_c "
-                                           "(ensemble members pooled; ±0.05)")
+                                           "(ensemble members pooled; ±0.05); null where "
+                                           "beyond its validated range")
     mu_k_observer: float | None = _f("-", "observer consensus μ_k (first pass)")
     mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass)")
     mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")

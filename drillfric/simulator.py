@@ -453,7 +453,7 @@ class StandResult:
     ``T_N_Nm`` is ∫F_c dx over the part of the string whose truth is ``mu_s``, ``mu_k``
     (the open hole with a cased truth, else the whole string), ``T_N_cased_Nm`` over the
     cased part (0 without a cased truth) [N·m per unit friction factor].
-    ``bit_torque_Nm`` is the time-mean of the torque the bit applied from the end of the
+    ``bit_torque_time_mean_Nm`` is the time-mean of the torque the bit applied from the end of the
     start-up to the start of the stop [N·m] (0 off bottom): with a rate-weakening bit in
     stick-slip it differs from ``bit_torque_k_Nm`` = T_k = μ_bit·WOB·D_bit/3.
     ``bit_power_torque_Nm`` is the bit's mean power over its mean speed over the same span,
@@ -477,7 +477,7 @@ class StandResult:
     bit_stuck_fraction: float
     creep_end_s: float | None = None
     T_N_cased_Nm: float = 0.0
-    bit_torque_Nm: float = 0.0
+    bit_torque_time_mean_Nm: float = 0.0
     bit_torque_k_Nm: float = 0.0
     bit_weakening_ratio: float = 1.0
     bit_weakening_rpm: float = 10.0
@@ -667,7 +667,7 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
                          cells=plant.grid.n_cells, dt_s=plant.grid.dt_s,
                          max_rounding_m=float(np.max(np.abs(plant.grid.rounding_m))),
                          bit_stuck_fraction=stuck, creep_end_s=creep_end,
-                         bit_torque_Nm=_mean_bit_torque_Nm(stand, rec),
+                         bit_torque_time_mean_Nm=_mean_bit_torque_Nm(stand, rec),
                          bit_power_torque_Nm=_power_bit_torque_Nm(stand, rec),
                          bit_torque_k_Nm=plant.bit_torque_cap_Nm,
                          bit_weakening_ratio=stand.bit_weakening_ratio,

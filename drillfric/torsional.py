@@ -210,7 +210,7 @@ class Plant:
         (default) is the Coulomb bit.
     bit_weakening_speed_rad_s : float
         ω_b, the bit speed over which the bit torque decays from r·T_k towards T_k [rad/s]
-        (used when r > 1).
+        (used when r > 1; default 10 RPM as ``simulate.bit_weakening_rpm``).
     fc_fixed_k_Nm_m, fc_fixed_s_Nm_m : ndarray, optional
         Fixed part of the friction profile (docs/theory.md §3.2): kinetic and static friction
         torque per metre of a zone whose friction factor is known (e.g. cased hole above the
@@ -236,7 +236,7 @@ class Plant:
     stribeck_speed_rad_s: float | None = None
     stribeck_exponent: float = 1.0
     bit_weakening_ratio: float = 1.0
-    bit_weakening_speed_rad_s: float = 1.0
+    bit_weakening_speed_rad_s: float = 10.0 * np.pi / 30.0  # 10 RPM, the config's default
 
     def __post_init__(self):
         if self.top_drive_inertia_kg_m2 <= 0:
@@ -359,7 +359,8 @@ class Plant:
 
     def bit_torque_Nm(self, omega_rad_s: float) -> float:
         """Sliding bit torque T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)) of a bit turning
-        at ω [N·m] (docs/theory.md §3, bit); at ω = 0 the break-away capacity r·T_k."""
+        at ω [N·m] (docs/theory.md §3, bit); at ω = 0 the break-away capacity r·T_k. The
+        law in closed form: the tests' reference for the kernel's bit."""
         weak = (self.bit_weakening_ratio - 1.0) * np.exp(
             -abs(omega_rad_s) / self.bit_weakening_speed_rad_s)
         return float(self.bit_torque_cap_Nm * (1.0 + weak))

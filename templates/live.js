@@ -43,7 +43,9 @@
       : ok && known(open.bit_rpm) ? fixed(open.bit_rpm, 1) + " rpm"
         : withheld(open.bit_rpm_reason || why));
     put("open-severity", ok && known(open.stick_slip_severity)
-      ? fixed(open.stick_slip_severity, 2) : withheld(why));
+      ? fixed(open.stick_slip_severity, 2)
+      : ok && open.stick_slip_beyond_validated
+        ? withheld("severe, beyond the validated range (estimated ≥ 2.1)") : withheld(why));
   }
 
   function showStatus(s, segs) {
@@ -110,7 +112,7 @@
       cell(tr, fixed(r.t_start_s, 0) + "–" + fixed(r.t_end_s, 0));
       cell(tr, r.mu_k_text, "num");
       cell(tr, r.mu_s_text, "num");
-      cell(tr, known(r.stick_slip_severity) && r.status === "ok" ? fixed(r.stick_slip_severity, 2) : "—", "num");
+      cell(tr, r.severity_text || "—", "num");
       cell(tr, r.status_text);
       cell(tr, r.message || "");
       body.appendChild(tr);

@@ -377,3 +377,27 @@ def test_no_hookload_channel_is_told_not_hidden(hanging_stand, tmp_path):
     assert "string_weight_not_checked" in summary["quality_flags"]
     assert any("string weight not checked" in w and "log the hook load" in w
                for w in summary["warnings"])
+
+
+def test_drilling_only_log_without_block_weight_withholds_its_apparent_friction():
+    """Regression (second reader, issue 22): a log with a hook load but only on-bottom
+    rotation, no slips and no block weight fell into `not_checked` and printed its apparent μ
+    with no flag — the same unweighable string weight the off-bottom case withholds. Now
+    withheld as `string_weight_unverified`; with a block weight known it is `not_checked`
+    (no off-bottom rotating hook load to weigh the string against) and says so."""
+    from drillfric import hookload
+    from drillfric.config import config_from_dict
+    from drillfric.result import Kind, SegmentRecord, Status
+
+    records = [SegmentRecord(id=i, status=Status.OK, kind=Kind.ON_BOTTOM, mu_k=0.3,
+                             bit_depth_m=2000.0, hookload_N=900e3, hookload_model_N=600e3)
+               for i in (1, 2)]
+    out = hookload.judge(records, [], config_from_dict({}))
+    assert out.summary["verdict"] == "unverified"
+    assert all(r.mu_k is None and "string_weight_unverified" in r.quality_flags
+               for r in out.records)
+    assert any("hookload.block_weight_N" in w for w in out.warnings)
+    known = hookload.judge(records, [], config_from_dict({"hookload": {"block_weight_N": 3e5}}))
+    assert known.summary["verdict"] == "not_checked"
+    assert [r.mu_k for r in known.records] == [0.3, 0.3]
+    assert any("string weight not checked" in w for w in known.warnings)

@@ -809,3 +809,16 @@ def test_report_command_default_segments_is_the_library_default():
 
     option = next(p for p in cli.commands["report"].params if p.name == "segments")
     assert option.default == str(MAX_SEGMENT_FIGURES)
+
+
+def test_fleet_worst_severity_is_severe_where_one_is_withheld():
+    """Regression (second reader): the fleet table's largest severity skipped a segment whose
+    severity was withheld as beyond its validated range (≥ 2.1) and showed the mild 0.90 of
+    another — a false "worst". docs/bit_speed.md."""
+    from drillfric.report.fleet import _worst
+
+    mild = {"status": "ok", "stick_slip_severity": 0.9, "quality_flags": []}
+    severe = {"status": "ok", "stick_slip_severity": None,
+              "quality_flags": ["stick_slip_beyond_validated"]}
+    assert _worst([mild])["severity"] == "0.90"
+    assert _worst([mild, severe])["severity"] == "severe"

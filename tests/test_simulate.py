@@ -388,7 +388,7 @@ def test_truth_bit_torque_is_the_mean_the_bit_applied(tmp_path, ratio):
     want = t_k * (1.0 + (ratio - 1.0) * np.exp(-60.0 / 20.0))
     assert truth["bit_torque_k_Nm"] == pytest.approx(t_k, rel=1e-12)
     assert truth["bit_weakening_ratio"] == ratio and truth["bit_weakening_rpm"] == 20.0
-    assert truth["bit_torque_Nm"] == pytest.approx(want, rel=1e-3)
+    assert truth["bit_torque_time_mean_Nm"] == pytest.approx(want, rel=1e-3)
 
 
 def test_cli_without_survey_simulates_the_path_run_assumes(tmp_path):

@@ -20,7 +20,8 @@ from .well import _write_text
 
 
 def _worst(segments: list[dict]) -> dict:
-    """Worst diagnostics of a well's segments (largest residual, spread, severity; counts)."""
+    """Worst diagnostics of a well's segments (largest residual, spread, severity — "severe"
+    where any is withheld as beyond its validated range, docs/bit_speed.md; counts)."""
     ok = [s for s in segments if s.get("status") == "ok"]
 
     def largest(key: str) -> float | None:
@@ -30,7 +31,9 @@ def _worst(segments: list[dict]) -> dict:
 
     return {"residual": fmt(largest("residual_rms_rpm"), ".2f"),
             "spread": fmt(largest("mu_k_spread")),
-            "severity": fmt(largest("stick_slip_severity"), ".2f"),
+            "severity": ("severe" if any("stick_slip_beyond_validated"
+                                         in (s.get("quality_flags") or ()) for s in ok)
+                         else fmt(largest("stick_slip_severity"), ".2f")),
             "unconverged": sum(not s.get("converged") for s in ok),
             "failed": sum(s.get("status") == "failed" for s in segments)}
 

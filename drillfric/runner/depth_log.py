@@ -69,8 +69,8 @@ def _friction_log(well: Well, sink: Sink, rate_hz, progress, chunk_rows,
                         assumed=assumed + _assumptions(well, results, notes),
                         warnings=warnings, wall_s=time.perf_counter() - t_wall)
     summary.update(index="depth", friction_log=_log_summary(well, log, results),
-                   hookload=UNCHECKED)
-    if summary.get("mu_k") is not None:
+                   hookload=dict(UNCHECKED))
+    if any(r.record.status is Status.OK for r in results):
         summary["warnings"].append(UNCHECKED_WARNING)
     return finish(sink, well, summary, records,
                   tables={"friction_log.parquet": log_table(results)})
