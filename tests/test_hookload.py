@@ -401,3 +401,22 @@ def test_drilling_only_log_without_block_weight_withholds_its_apparent_friction(
     assert known.summary["verdict"] == "not_checked"
     assert [r.mu_k for r in known.records] == [0.3, 0.3]
     assert any("string weight not checked" in w for w in known.warnings)
+
+
+def test_report_titles_the_mu_traces_of_a_withheld_segment(hanging_stand):
+    """Second reader: the report's evidence panel drew each observer start's μ̂ traces for a
+    segment whose friction factors the check withheld, and the final pass ends at the
+    withheld μ_k. The panel is now titled as withheld (HTML and PDF share mu_withheld)."""
+    from drillfric.report.evidence import mu_withheld
+
+    assert mu_withheld({"quality_flags": ["string_weight_unverified"]}).startswith(
+        "friction factors withheld (string weight unverified)")
+    assert mu_withheld({"quality_flags": ["pooled"]}) == ""
+    folder, base = hanging_stand
+    (folder / "report.toml").write_text(base)
+    result = CliRunner().invoke(cli, ["-q", "run", str(folder / "well.csv"), "--config",
+                                      str(folder / "report.toml"), "--out",
+                                      str(folder / "with_report")])
+    assert result.exit_code == 0, result.output
+    html = (folder / "with_report" / "demo" / "report.html").read_text(encoding="utf-8")
+    assert "friction factors withheld (string weight unverified)" in html

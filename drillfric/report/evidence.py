@@ -153,16 +153,35 @@ def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | TimeAxis | None,
     return out
 
 
-def signature(sources: dict[str, dict], axis: TimeAxis, units: Units = SI) -> tuple:
+#: Segment flags under which the segment's friction factors are withheld although the
+#: observer's μ̂ traces are drawn (docs/outputs.md, the hook-load check).
+WITHHELD_MU_FLAGS = ("hookload_contradicts_string", "string_weight_unverified")
+
+
+def mu_withheld(segment: dict) -> str:
+    """The μ̂ panel's title where the segment's friction factors are withheld ("" else): the
+    traces are the observer's adaptation on the configured string, not a result."""
+    flags = segment.get("quality_flags")
+    flags = [] if flags is None or isinstance(flags, float) else list(map(str, flags))
+    flag = next((f for f in WITHHELD_MU_FLAGS if f in flags), None)
+    if flag is None:
+        return ""
+    return (f"friction factors withheld ({flag.replace('_', ' ')}): μ̂ of the observer on "
+            "the configured string, not a result")
+
+
+def signature(sources: dict[str, dict], axis: TimeAxis, units: Units = SI,
+              mu_note: str = "") -> tuple:
     """What the layout of :func:`evidence_plot` depends on besides the sources' data."""
-    return ("evidence", axis.kind, units.system,
+    return ("evidence", axis.kind, units.system, mu_note,
             tuple((name, tuple(cols)) for name, cols in sources.items()))
 
 
-def evidence_plot(sources: dict[str, dict], axis: TimeAxis, units: Units = SI):
+def evidence_plot(sources: dict[str, dict], axis: TimeAxis, units: Units = SI,
+                  mu_note: str = ""):
     """A segment's evidence as a Bokeh layout (panels share the time axis), from
     :func:`evidence_sources` in display ``units``; each ColumnDataSource is named like its
-    key there."""
+    key there. ``mu_note``: the μ̂ panel's title (:func:`mu_withheld`)."""
     from bokeh.layouts import gridplot
     from bokeh.models import ColumnDataSource, HoverTool
 
@@ -193,7 +212,7 @@ def evidence_plot(sources: dict[str, dict], axis: TimeAxis, units: Units = SI):
                                 formatters=formatters))
         _legend(fig)
         figs.append(fig)
-    figs.append(_mu_plot(sources, axis, x_range))
+    figs.append(_mu_plot(sources, axis, x_range, mu_note))
     return gridplot([[f] for f in figs], merge_tools=True, toolbar_location="right",
                     sizing_mode="stretch_width")
 
@@ -214,11 +233,14 @@ def _legend(fig) -> None:
     fig.legend.margin = 2
 
 
-def _mu_plot(sources: dict[str, dict], axis: TimeAxis, x_range):
+def _mu_plot(sources: dict[str, dict], axis: TimeAxis, x_range, note: str = ""):
     from bokeh.models import ColumnDataSource, HoverTool
     from bokeh.palettes import Category10
 
     fig = time_figure(_PX, _label("mu", SI), x_range=x_range, axis=axis, x_label=axis.label)
+    if note:
+        fig.title.text = note
+        fig.title.text_color = "#c9302c"
     lines = []
     for name, columns in sources.items():
         if not name.startswith("start:"):
@@ -309,6 +331,9 @@ def _series_axes(ax, key: str, series: dict, x, t, est, origin) -> None:
 
 
 def _mu_axes(ax, est: pd.DataFrame, segment: dict, origin) -> None:
+    note = mu_withheld(segment)
+    if note:
+        ax.set_title(note, fontsize=8, color="#c9302c", loc="left")
     for start_id, rows in est.groupby("start_id", sort=True):
         final = start_id == FINAL_START_ID
         kw = {"color": "black", "linewidth": 1.4} if final else {"linewidth": 0.8}

@@ -28,6 +28,7 @@ from .evidence import (
     evidence_plot,
     evidence_sources,
     has_column,
+    mu_withheld,
     signature,
     starts_text,
 )
@@ -446,8 +447,10 @@ def _html(report: Report) -> str:
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
         sources = evidence_sources(est, axis, units, not row["bit_unresolved"])
-        div = embed.add_like(signature(sources, axis, units),
-                             lambda sources=sources: evidence_plot(sources, axis, units),
+        note = mu_withheld(row)
+        div = embed.add_like(signature(sources, axis, units, note),
+                             lambda sources=sources, note=note: evidence_plot(
+                                 sources, axis, units, note),
                              sources, f"segment-{row['id']}")
         segments.append((row, div, _missing_evidence(est)))
     sections = [(k, t, figure_uri(f) if f is not None else None, n)
