@@ -160,11 +160,9 @@ def run_case(rotation_s: float, law: tuple, rates, work: Path) -> list[dict]:
     frame = pd.DataFrame(simulation.columns)
     rows = []
     for rate in rates:
-        data = folder / f"{rate.replace(' ', '_')}.parquet"
-        trust.record(frame, rate, name).to_parquet(data, index=False)
         t0 = time.perf_counter()
-        well = drillfric.open_well(data, config=est_cfg, survey=folder / "path.survey.csv")
-        s = score(drillfric.run(well).summary, rate, stands, wob_N)
+        s = score(trust.run_logged(frame, rate, name, folder, est_cfg).summary, rate, stands,
+                  wob_N)
         s |= {"rotation_s": rotation_s, "wob_t": wob_t, "bit_mu": bit_mu, "rate": rate,
               "ratio": ratio, "weakening_rpm": weakening_rpm, "t_k": t_k, "stuck": stuck,
               "s": time.perf_counter() - t0, "t_bit_true": t_bit_true}

@@ -124,11 +124,8 @@ def run_plant(name: str, rates, work: Path) -> list[dict]:
     omega_c = load_config(est_cfg).omega_c_rad_s
     rows = []
     for rate in rates:
-        data = folder / f"{rate.replace(' ', '_')}.parquet"
-        trust.record(frame, rate, name).to_parquet(data, index=False)
         t0 = time.perf_counter()
-        well = drillfric.open_well(data, config=est_cfg, survey=folder / "path.survey.csv")
-        summary = drillfric.run(well).summary
+        summary = trust.run_logged(frame, rate, name, folder, est_cfg).summary
         for r in score(summary, frame, omega_c, name, rate):
             print(line(r) + f" {time.perf_counter() - t0:.0f} s", flush=True)
             if r["stats_reason"] and rate == rates[0]:

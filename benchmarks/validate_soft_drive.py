@@ -91,11 +91,8 @@ def run_case(kp: float, ki: float, rates, work: Path, zeta: float) -> list[dict]
     cycles = cycle_text(frame)
     rows = []
     for rate in rates:
-        data = folder / f"{rate.replace(' ', '_')}.parquet"
-        trust.record(frame, rate, name).to_parquet(data, index=False)
         t0 = time.perf_counter()
-        well = drillfric.open_well(data, config=est_cfg, survey=folder / "path.survey.csv")
-        summary = drillfric.run(well).summary
+        summary = trust.run_logged(frame, rate, name, folder, est_cfg).summary
         segs = [g for g in summary["segments"] if g["status"] == "ok"]
         pooled = [p["mu_k"] for p in summary["pooled"]]
         well_row = {"mu_k": summary["mu_k"], "converged": summary["mu_k"] is not None,

@@ -145,6 +145,16 @@ def truth(plant: str, est_cfg: Path) -> dict:
             "cased_share": share}
 
 
+def run_logged(frame: pd.DataFrame, rate: str, name: str, folder: Path, est_cfg: Path):
+    """The simulation ``frame`` logged at ``rate`` (:func:`record`, written to ``folder``)
+    and run through the whole pipeline with ``est_cfg`` and the folder's survey: the
+    :class:`~drillfric.result.WellResult`."""
+    data = folder / f"{rate.replace(' ', '_')}.parquet"
+    record(frame, rate, name).to_parquet(data, index=False)
+    return drillfric.run(drillfric.open_well(data, config=est_cfg,
+                                             survey=folder / "path.survey.csv"))
+
+
 def record(frame: pd.DataFrame, rate: str, plant: str, seed: int = 3) -> pd.DataFrame:
     """The 100 Hz simulation as logged at ``rate`` (and by the plant's sensors)."""
     cols = {c: frame[c].to_numpy(float) for c in frame.columns}
