@@ -678,22 +678,27 @@ def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: f
 def _mean_bit_torque_Nm(stand: Stand, rec: torsional.Record) -> float:
     """Time-mean of the bit torque the plant applied over the stand's rotation after its
     start-up, up to the stop [N·m] (0 off bottom or without such a span)."""
-    held = (rec.time_s >= stand.idle_s + stand.start_up_s) & (
-        rec.time_s <= stand.idle_s + stand.duration_s)
-    if not stand.on_bottom or not held.any():
-        return 0.0
-    return float(np.mean(rec.bit_torque_Nm[held]))
+    held = _drilling_rows(stand, rec)
+    return float(np.mean(rec.bit_torque_Nm[held])) if held.any() else 0.0
 
 
 def _power_bit_torque_Nm(stand: Stand, rec: torsional.Record) -> float:
-    """⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ over the span of :func:`_mean_bit_torque_Nm` [N·m] (0 off
-    bottom, without such a span or with the bit at rest throughout)."""
-    held = (rec.time_s >= stand.idle_s + stand.start_up_s) & (
-        rec.time_s <= stand.idle_s + stand.duration_s)
-    if not stand.on_bottom or not held.any() or np.mean(rec.bit_rad_s[held]) <= 0:
+    """⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ over the rows of :func:`_drilling_rows` [N·m] (0 off bottom,
+    without such rows or with the bit at rest throughout)."""
+    held = _drilling_rows(stand, rec)
+    speed = float(np.mean(rec.bit_rad_s[held])) if held.any() else 0.0
+    if speed <= 0:
         return 0.0
-    power = np.mean(rec.bit_torque_Nm[held] * rec.bit_rad_s[held])
-    return float(power / np.mean(rec.bit_rad_s[held]))
+    return float(np.mean(rec.bit_torque_Nm[held] * rec.bit_rad_s[held]) / speed)
+
+
+def _drilling_rows(stand: Stand, rec: torsional.Record) -> np.ndarray:
+    """The rows of an on-bottom stand from the end of its start-up to its stop (none off
+    bottom)."""
+    if not stand.on_bottom:
+        return np.zeros(rec.time_s.size, dtype=bool)
+    return (rec.time_s >= stand.idle_s + stand.start_up_s) & (
+        rec.time_s <= stand.idle_s + stand.duration_s)
 
 
 def _drilled_m(stand: Stand, time_s: np.ndarray) -> np.ndarray:

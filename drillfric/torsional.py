@@ -24,6 +24,7 @@ import numpy as np
 from drillfric.config import default
 from drillfric.drillstring import G_ACCEL, DrillString
 from drillfric.errors import ModelError
+from drillfric.units import RPM_TO_RAD_S
 
 #: Top-drive modes of the kernel: PI speed control on a set-point series, a prescribed
 #: motor-torque series, or a prescribed top-drive speed (the speed-driven model of §6.4).
@@ -236,7 +237,7 @@ class Plant:
     stribeck_speed_rad_s: float | None = None
     stribeck_exponent: float = 1.0
     bit_weakening_ratio: float = 1.0
-    bit_weakening_speed_rad_s: float = 10.0 * np.pi / 30.0  # 10 RPM, the config's default
+    bit_weakening_speed_rad_s: float = 10.0 * RPM_TO_RAD_S  # the config's default, 10 RPM
 
     def __post_init__(self):
         if self.top_drive_inertia_kg_m2 <= 0:

@@ -23,6 +23,15 @@ _EXTRA = {
 }
 
 
+def row_flags(row: dict) -> list[str]:
+    """A segment's ``quality_flags`` as strings, whether a list, a tuple or an array (from
+    parquet), and none where missing or null."""
+    flags = row.get("quality_flags")
+    if flags is None or isinstance(flags, float | str):
+        return []
+    return [str(f) for f in flags]
+
+
 def fmt(value, spec: str = ".3f") -> str:
     """``value`` formatted with ``spec``, or "—" for None / NaN / non-numbers."""
     if value is None or isinstance(value, bool):

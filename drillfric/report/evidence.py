@@ -27,7 +27,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from .data import FINAL_START_ID
-from .display import SI, Units
+from .display import SI, Units, row_flags
 from .interactive import TimeAxis, float32, time_figure, time_label, time_values
 
 MEASURED = "#555555"
@@ -161,8 +161,7 @@ WITHHELD_MU_FLAGS = ("hookload_contradicts_string", "string_weight_unverified")
 def mu_withheld(segment: dict) -> str:
     """The μ̂ panel's title where the segment's friction factors are withheld ("" else): the
     traces are the observer's adaptation on the configured string, not a result."""
-    flags = segment.get("quality_flags")
-    flags = [] if flags is None or isinstance(flags, float) else list(map(str, flags))
+    flags = row_flags(segment)
     flag = next((f for f in WITHHELD_MU_FLAGS if f in flags), None)
     if flag is None:
         return ""

@@ -12,7 +12,7 @@ from urllib.parse import quote
 from drillfric._version import __version__
 
 from .data import segments_frame
-from .display import fmt, report_units
+from .display import fmt, report_units, row_flags
 from .friction import fleet_plot
 from .interactive import Embedder
 from .render import environment, mu_s_text, now_utc
@@ -31,8 +31,8 @@ def _worst(segments: list[dict]) -> dict:
 
     return {"residual": fmt(largest("residual_rms_rpm"), ".2f"),
             "spread": fmt(largest("mu_k_spread")),
-            "severity": ("severe" if any("stick_slip_beyond_validated"
-                                         in (s.get("quality_flags") or ()) for s in ok)
+            "severity": ("severe" if any("stick_slip_beyond_validated" in row_flags(s)
+                                         for s in ok)
                          else fmt(largest("stick_slip_severity"), ".2f")),
             "unconverged": sum(not s.get("converged") for s in ok),
             "failed": sum(s.get("status") == "failed" for s in segments)}

@@ -20,7 +20,7 @@ import pandas as pd
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
-from .display import Units, fmt
+from .display import Units, fmt, row_flags
 
 #: Resolution of the figures embedded in HTML [dots per inch].
 HTML_DPI = 90
@@ -94,9 +94,8 @@ def severity_text(row: dict) -> str:
     """The stick-slip severity as shown: its value, or "severe" where it is
     withheld as beyond its validated range (flag ``stick_slip_beyond_validated``,
     docs/bit_speed.md), never a bare "—" that reads as "no stick-slip"."""
-    flags = row.get("quality_flags")
-    flags = [] if flags is None or isinstance(flags, float) else list(map(str, flags))
-    if fmt(row.get("stick_slip_severity")) == "—" and "stick_slip_beyond_validated" in flags:
+    if fmt(row.get("stick_slip_severity")) == "—" and \
+            "stick_slip_beyond_validated" in row_flags(row):
         return "severe"
     return fmt(row.get("stick_slip_severity"), ".2f")
 
