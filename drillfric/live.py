@@ -32,7 +32,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from datetime import UTC, datetime, timedelta
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +41,7 @@ import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
 from drillfric.io.results import write_json
+from drillfric.io.timebase import clock_at
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live_source import PartsTail, Tail, follow
 from drillfric.result import Flag, SegmentRecord, Status
@@ -537,7 +538,7 @@ def _alert(kind: str, message: str, time_s: float | None) -> dict:
 def _utc(origin, time_s: float) -> str | None:
     if origin is None:
         return None
-    return (pd.Timestamp(origin).to_pydatetime() + timedelta(seconds=time_s)).isoformat()
+    return clock_at(pd.Timestamp(origin), time_s).isoformat()
 
 
 def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,

@@ -8,6 +8,12 @@ backwards is an error naming the row; a row repeating the previous timestamp is 
 
 :class:`TimeTracker` carries the state across chunks so that a file read in several
 chunks gives exactly the same ``time_s`` as the file read at once.
+
+Clock times stay in integer nanoseconds: the rows keep the timestamps as parsed, and a clock
+time drillfric derives from a ``time_s`` (an estimate on the model's grid, a segment's end)
+is the origin plus a whole number of nanoseconds, rounded to the microsecond of the
+outputs (:func:`clock_at`) — never a float turned back into a timestamp, which leaves stray
+nanoseconds that a microsecond column cannot hold.
 """
 
 from __future__ import annotations
@@ -119,6 +125,47 @@ def summarize(time_s: np.ndarray, *, max_gap_s: float, duplicates_dropped: int =
                     untimed_dropped=untimed_dropped, source_start_s=source_start_s)
 
 
+OUTPUT_CLOCK_UNIT = "us"
+"""Resolution of the clock times drillfric writes (estimates.parquet ``timestamp``)."""
+
+
+def clock_at(origin: pd.Timestamp, seconds):
+    """Clock time ``seconds`` [s] after ``origin``, in whole microseconds.
+
+    ``seconds`` is a float or an array of floats (NaN gives NaT); the offset is rounded to
+    the nanosecond and the sum to the microsecond, so the result fits the outputs'
+    ``timestamp[us]`` column exactly, whatever the origin's resolution.
+
+    Examples
+    --------
+    >>> origin = pd.Timestamp("2026-03-01T06:00:00.000000001Z")
+    >>> clock_at(origin, 2.3116699999)
+    Timestamp('2026-03-01 06:00:02.311670+0000', tz='UTC')
+    """
+    offset = np.round(np.asarray(seconds, dtype=float) * 1e9)
+    if offset.ndim == 0:
+        if not np.isfinite(offset):
+            return pd.NaT
+        return (origin + pd.Timedelta(int(offset), unit="ns")).round(OUTPUT_CLOCK_UNIT)
+    delta = pd.to_timedelta(np.where(np.isfinite(offset), offset, np.nan), unit="ns")
+    return (origin + delta).round(OUTPUT_CLOCK_UNIT)
+
+
+def origin_of(stamp: pd.Timestamp, seconds: float) -> pd.Timestamp:
+    """Clock time of ``time_s = 0`` from one row's ``stamp`` and its ``seconds`` [s].
+
+    The offset is rounded to the nanosecond, so the origin a reader computed is found again
+    exactly (``seconds`` was an integer number of nanoseconds divided by 10⁹; a float holds
+    it to the nanosecond for 52 days of log).
+
+    Examples
+    --------
+    >>> origin_of(pd.Timestamp("2026-03-01T06:00:02.311670Z"), 2.31167)
+    Timestamp('2026-03-01 06:00:00+0000', tz='UTC')
+    """
+    return pd.Timestamp(stamp) - pd.Timedelta(int(np.round(float(seconds) * 1e9)), unit="ns")
+
+
 class TimeTracker:
     """Turns the time column of successive chunks into checked ``time_s`` [s].
 
@@ -157,7 +204,7 @@ class TimeTracker:
         self._rows_seen, self._last = int(state["rows_seen"]), state["last"]
         self._absolute = state["absolute"]
 
-    def step(self, values: pd.Series) -> tuple[np.ndarray, np.ndarray]:
+    def step(self, values: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series | None]:
         """Check one chunk's time column.
 
         Returns
@@ -166,13 +213,16 @@ class TimeTracker:
             Seconds from the first sample for the rows kept.
         keep : ndarray of bool
             Which rows of the chunk are kept (time present, not a repeat).
+        stamps : pandas.Series or None
+            The kept rows' timestamps (UTC, nanoseconds, as parsed) when the column holds
+            clock time; None for a numeric time.
 
         Raises
         ------
         InputError
             A time that goes backwards (naming its data row) or cannot be read.
         """
-        seconds = self._seconds(values)
+        seconds, stamps = self._seconds(values)
         valid = np.isfinite(seconds)
         self.untimed += int((~valid).sum())
         rows = np.flatnonzero(valid)
@@ -192,15 +242,17 @@ class TimeTracker:
         if t.size:
             self._last = float(t[-1])
         self._rows_seen += len(seconds)
-        return seconds[keep], keep
+        kept = None if stamps is None else stamps[keep].reset_index(drop=True)
+        return seconds[keep], keep, kept
 
     def _show(self, t: float) -> str:
         if self.origin is not None:
-            return str(self.origin + pd.Timedelta(seconds=float(t)))
+            return str(clock_at(self.origin, t))
         return f"{t + (self.source_start_s or 0.0):g} s"
 
-    def _seconds(self, values: pd.Series) -> np.ndarray:
-        """Seconds from the first sample (the origin is set by the first valid value)."""
+    def _seconds(self, values: pd.Series) -> tuple[np.ndarray, pd.Series | None]:
+        """Seconds from the first sample (the origin is set by the first valid value), and
+        the timestamps they come from (None for a numeric time)."""
         try:
             numeric = _as_number(values)
         except UnreadNumber as bad:
@@ -221,9 +273,9 @@ class TimeTracker:
             if self.origin is None and stamps.notna().any():
                 self.origin = stamps[stamps.notna()].iloc[0]
             if self.origin is None:
-                return np.full(len(values), np.nan)
+                return np.full(len(values), np.nan), stamps
             return ((stamps - self.origin) / pd.Timedelta(seconds=1)).to_numpy(
-                dtype=float, na_value=np.nan)
+                dtype=float, na_value=np.nan), stamps
         if not np.isfinite(self.factor):
             raise InputError(f"time column '{printable(self.column)}' holds numbers but its "
                              "unit is not a time unit", file=self.file,
@@ -231,7 +283,7 @@ class TimeTracker:
         seconds = numeric * self.factor
         if self.source_start_s is None and np.isfinite(seconds).any():
             self.source_start_s = float(seconds[np.isfinite(seconds)][0])
-        return seconds - (self.source_start_s or 0.0)
+        return seconds - (self.source_start_s or 0.0), None
 
     def _timestamps(self, values: pd.Series) -> pd.Series:
         if pd.api.types.is_datetime64_any_dtype(values):

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from drillfric.io.timebase import clock_at, origin_of
 from drillfric.segmentation import RIG_STATES, UNKNOWN
 
 #: Channels kept in tracks.parquet when the log has them (canonical names, SI units).
@@ -167,7 +168,7 @@ class TrackAccumulator:
         have = np.flatnonzero(stamps.notna().to_numpy() & np.isfinite(t))
         if have.size:
             i = have[0]
-            self.origin = stamps.iloc[i] - pd.Timedelta(seconds=float(t[i]))
+            self.origin = origin_of(stamps.iloc[i], t[i])
 
     def _add_channel(self, name: str) -> None:
         self.channels.append(name)
@@ -239,7 +240,7 @@ class TrackAccumulator:
         used = self._time_count[:n] > 0
         out = {"time_s": self._time_sum[:n][used] / self._time_count[:n][used]}
         if self.origin is not None:
-            out["timestamp"] = self.origin + pd.to_timedelta(out["time_s"], unit="s")
+            out["timestamp"] = clock_at(self.origin, out["time_s"])
         for name in self.channels:
             count = self._count[name][:n][used]
             with np.errstate(invalid="ignore", divide="ignore"):

@@ -551,10 +551,10 @@ def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
     out: dict = {}
     keep = slice(None)
     if tracker is not None:
-        time_s, keep = tracker.step(chunk[mappings["time"].column])
+        time_s, keep, stamps = tracker.step(chunk[mappings["time"].column])
         out["time_s"] = time_s
-        if tracker.origin is not None:
-            out["timestamp"] = tracker.origin + pd.to_timedelta(time_s, unit="s")
+        if stamps is not None:
+            out["timestamp"] = stamps.array
     for key, m in mappings.items():
         if key != "time":
             out[m.channel.name] = _numeric(chunk[m.column])[keep] * m.factor

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.timebase import origin_of
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_FIELDS, SEGMENT_NUMBER_FIELDS
 
 from .interactive import TimeAxis, time_axis
@@ -106,7 +107,7 @@ class ResultData:
         tracks = self.tracks
         if tracks is not None and "timestamp" in tracks and len(tracks):
             first = pd.to_datetime(tracks["timestamp"].iloc[:1], utc=True).iloc[0]
-            return first - pd.Timedelta(seconds=float(tracks["time_s"].iloc[0]))
+            return origin_of(first, float(tracks["time_s"].iloc[0]))
         return None
 
 

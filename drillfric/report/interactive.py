@@ -25,6 +25,8 @@ import numpy as np
 import pandas as pd
 from markupsafe import Markup
 
+from drillfric.io.timebase import clock_at
+
 #: Width of the interactive figures when the page is wider than this [px] (they stretch).
 MIN_WIDTH_PX = 600
 #: Tools of every time-axis figure: zoom and pan along time, box zoom, reset, hover, save.
@@ -179,8 +181,7 @@ class TimeAxis:
         """Log time [s] as plotted: naive-UTC datetimes, hours or seconds."""
         seconds = np.asarray(time_s, dtype=float)
         if self.origin is not None:
-            return (self.origin.tz_convert("UTC").tz_localize(None)
-                    + pd.to_timedelta(seconds, unit="s")).to_numpy()
+            return clock_at(self.origin.tz_convert("UTC").tz_localize(None), seconds).to_numpy()
         return seconds / 3600.0 if self.hours else seconds
 
     @property

@@ -20,6 +20,8 @@ import pandas as pd
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
+from drillfric.io.timebase import clock_at
+
 from .display import Units, fmt, row_flags
 
 #: Resolution of the figures embedded in HTML [dots per inch].
@@ -122,8 +124,8 @@ def clock_span(row: dict, origin) -> str:
     """A segment's time span: UTC clock times when known, else log seconds."""
     start, end = row.get("clock_start_utc"), row.get("clock_end_utc")
     if origin is not None and math.isfinite(row.get("t_start_s", math.nan)):
-        start = (origin + pd.Timedelta(seconds=float(row["t_start_s"]))).isoformat()
-        end = (origin + pd.Timedelta(seconds=float(row["t_end_s"]))).isoformat()
+        start = clock_at(origin, row["t_start_s"]).isoformat()
+        end = clock_at(origin, row["t_end_s"]).isoformat()
     if isinstance(start, str) and isinstance(end, str):
         a, b = pd.Timestamp(start), pd.Timestamp(end)
         return f"{a:%H:%M:%S}–{b:%H:%M:%S}"

@@ -18,6 +18,7 @@ import pandas as pd
 
 from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
+from drillfric.io.timebase import clock_at
 
 from . import broomstick as broom
 from . import figures
@@ -204,7 +205,7 @@ def _log_span(data: ResultData, units: Units) -> tuple[str, str] | None:
     if origin is None:
         return what, f"{clock(span[0])} – {clock(span[1])} (log time h:mm:ss)"
     spec = "%Y-%m-%d %H:%M" if span[1] - span[0] > LONG_LOG_S else "%Y-%m-%d %H:%M:%S"
-    a, b = (origin + pd.Timedelta(seconds=t) for t in span)
+    a, b = (clock_at(origin, t) for t in span)
     return what, f"{a:{spec}} – {b:{spec}} UTC"
 
 
@@ -403,7 +404,7 @@ def _when(time_s: float, origin) -> str:
     """A log time as shown in a sentence: clock time when known, else h:mm:ss log time."""
     if origin is None:
         return f"{clock(time_s)} log time"
-    return f"{origin + pd.Timedelta(seconds=time_s):%H:%M:%S} UTC"
+    return f"{clock_at(origin, time_s):%H:%M:%S} UTC"
 
 
 def _static_sections(report: Report, size=None) -> list[tuple[str, str, object, str | None]]:

@@ -10,6 +10,7 @@ import pandas as pd
 from drillfric.estimation.bit_torque import rate_of_penetration_m_h
 from drillfric.estimation.chain import SegmentData, SegmentEstimate
 from drillfric.estimation.observer import ObserverRecord
+from drillfric.io.timebase import clock_at, origin_of
 from drillfric.result import SEEDED_START_ID, Kind, SegmentRecord, Status
 from drillfric.segmentation import Segment
 from drillfric.units import RPM_TO_RAD_S
@@ -85,7 +86,7 @@ def _origin(rows: pd.DataFrame) -> pd.Timestamp | None:
     if "timestamp" not in rows or rows.empty:
         return None
     first = pd.to_datetime(rows["timestamp"].iloc[:1], utc=True).iloc[0]
-    return first - pd.to_timedelta(float(rows["time_s"].iloc[0]), unit="s")
+    return origin_of(first, float(rows["time_s"].iloc[0]))
 
 
 def _clock(rows: pd.DataFrame, seg: Segment) -> dict:
@@ -93,8 +94,8 @@ def _clock(rows: pd.DataFrame, seg: Segment) -> dict:
     origin = _origin(rows)
     if origin is None:
         return {}
-    return {"clock_start_utc": iso(origin + pd.to_timedelta(seg.t_start_s, unit="s")),
-            "clock_end_utc": iso(origin + pd.to_timedelta(seg.t_end_s, unit="s"))}
+    return {"clock_start_utc": iso(clock_at(origin, seg.t_start_s)),
+            "clock_end_utc": iso(clock_at(origin, seg.t_end_s))}
 
 
 def _with_clock(frame: pd.DataFrame, rows: pd.DataFrame) -> pd.DataFrame:
@@ -102,7 +103,7 @@ def _with_clock(frame: pd.DataFrame, rows: pd.DataFrame) -> pd.DataFrame:
     log has absolute time."""
     origin = _origin(rows)
     if origin is not None:
-        frame.insert(1, "timestamp", origin + pd.to_timedelta(frame["time_s"], unit="s"))
+        frame.insert(1, "timestamp", clock_at(origin, frame["time_s"].to_numpy(float)))
     return frame
 
 

@@ -11,6 +11,8 @@ from hypothesis import strategies as st
 from drillfric.errors import InputError
 from drillfric.io.timebase import (
     TimeTracker,
+    clock_at,
+    origin_of,
     find_gaps,
     nominal_rate_hz,
     spacing_summary,
@@ -56,8 +58,8 @@ def test_backwards_time_names_the_row():
 
 def test_repeated_timestamps_are_dropped_and_counted_across_chunks():
     tracker = TimeTracker(1.0)
-    t1, k1 = tracker.step(pd.Series([5.0, 6.0, 6.0, 7.0]))
-    t2, k2 = tracker.step(pd.Series([7.0, 8.0]))
+    t1, k1, _ = tracker.step(pd.Series([5.0, 6.0, 6.0, 7.0]))
+    t2, k2, _ = tracker.step(pd.Series([7.0, 8.0]))
     assert t1.tolist() == [0.0, 1.0, 2.0] and k1.tolist() == [True, True, False, True]
     assert t2.tolist() == [3.0] and tracker.duplicates == 2
     assert tracker.source_start_s == 5.0
@@ -65,7 +67,7 @@ def test_repeated_timestamps_are_dropped_and_counted_across_chunks():
 
 def test_iso_timestamps_give_seconds_from_origin():
     tracker = TimeTracker(1.0)
-    t, _ = tracker.step(pd.Series(["2024-05-01T12:00:00", "2024-05-01T12:00:00.5",
+    t, _, _ = tracker.step(pd.Series(["2024-05-01T12:00:00", "2024-05-01T12:00:00.5",
                                    "2024-05-01 12:00:01.25"]))
     assert t.tolist() == [0.0, 0.5, 1.25]
     assert tracker.origin == pd.Timestamp("2024-05-01T12:00:00")
@@ -79,7 +81,7 @@ def test_unreadable_time_names_the_row():
 
 def test_null_times_are_dropped():
     tracker = TimeTracker(1.0)
-    t, keep = tracker.step(pd.Series([0.0, -999.25, 2.0, np.nan]))
+    t, keep, _ = tracker.step(pd.Series([0.0, -999.25, 2.0, np.nan]))
     assert t.tolist() == [0.0, 2.0] and tracker.untimed == 2 and keep.sum() == 2
 
 
@@ -94,9 +96,52 @@ def test_chunking_does_not_change_time(steps, chunk):
     # Property: any split of the time column into chunks gives the same time_s and counts.
     t = pd.Series(np.round(np.cumsum(steps), 3) + 100.0)
     whole = TimeTracker(1.0)
-    expected, _ = whole.step(t)
+    expected, _, _ = whole.step(t)
     tracker = TimeTracker(1.0)
     parts = [tracker.step(t.iloc[i:i + chunk].reset_index(drop=True))[0]
              for i in range(0, len(t), chunk)]
     np.testing.assert_array_equal(np.concatenate(parts), expected)
     assert tracker.duplicates == whole.duplicates
+
+
+# ------------------------------------------------------------ clock times in integer ns
+_ORIGINS = st.integers(0, 2**62).map(lambda ns: pd.Timestamp(ns, unit="ns", tz="UTC"))
+
+
+@settings(max_examples=200, deadline=None)
+@given(origin=_ORIGINS, seconds=st.floats(0.0, 4.0e6, allow_nan=False))
+def test_clock_at_fits_a_microsecond_column_whatever_the_origin(origin, seconds):
+    """Issue 30 (1): origin + a float time turned into a timedelta left stray nanoseconds
+    that estimates.parquet's timestamp[us] column refused ("would lose data"). clock_at is
+    whole microseconds, and within half a microsecond (+ the float's own ulp) of the sum."""
+    stamp = clock_at(origin, seconds)
+    assert stamp.value % 1000 == 0
+    exact = origin.value + seconds * 1e9
+    assert abs(stamp.value - exact) <= 500 + abs(exact) * 2.0**-52
+
+
+@settings(max_examples=200, deadline=None)
+@given(origin=_ORIGINS, offset_ns=st.integers(0, 52 * 86_400 * 10**9))
+def test_origin_of_finds_the_readers_origin_again_exactly(origin, offset_ns):
+    """A row's stamp minus its time_s (the stamp's offset from the origin / 10⁹ as a
+    float) gives the origin back to the nanosecond within 52 days of log."""
+    stamp = origin + pd.Timedelta(offset_ns, unit="ns")
+    seconds = (stamp - origin) / pd.Timedelta(seconds=1)
+    assert origin_of(stamp, seconds) == origin
+
+
+def test_clock_at_of_arrays_keeps_missing_times_missing():
+    origin = pd.Timestamp("2026-03-01T06:00:00.123456789Z")
+    out = clock_at(origin, np.array([0.0, np.nan, 1.5]))
+    assert out[0] == pd.Timestamp("2026-03-01T06:00:00.123457Z") and pd.isna(out[1])
+    assert out[2] == pd.Timestamp("2026-03-01T06:00:01.623457Z")
+
+
+def test_tracker_hands_back_the_parsed_stamps_not_a_float_round_trip():
+    """The rows keep the timestamps as parsed (nanoseconds), not origin + float seconds."""
+    text = pd.Series(["2026-03-01T06:00:00.000000001Z", "2026-03-01T06:00:00.049788999Z",
+                      "2026-03-01T06:00:00.049788999Z", "2026-03-01T06:00:00.100241003Z"])
+    time_s, keep, stamps = TimeTracker(1.0).step(text)
+    assert keep.tolist() == [True, True, False, True]
+    assert [s.value % 10**9 for s in stamps] == [1, 49_788_999, 100_241_003]
+    assert time_s[1] == pytest.approx(0.049788998)
