@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 import pytest
 from click.testing import CliRunner
-
 from drillfric.cli.main import cli
+
 from drillfric.wits0_receiver import FrameClock, Recording
 from tests.conftest import DEMO
 

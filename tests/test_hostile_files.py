@@ -5,15 +5,15 @@ Each case builds its files in a sandbox and runs the CLI through the checks of t
 corpus (:func:`tests.test_hostile_inputs._check`: exit code, no traceback, nothing written
 outside ``--out``, one error line with the file and the fix, no secret and no escape
 sequence printed), and in addition: no control character but newline in anything printed,
-the secret in no file under ``--out``, and every command done within
-:data:`SECONDS`. Cases are named after the attack or accident they reproduce.
+the secret in no file under ``--out``, and no command hung
+(:data:`tests.test_hostile_inputs.HANG_S`; how long a case takes is timed by no test). Cases
+are named after the attack or accident they reproduce.
 """
 
 from __future__ import annotations
 
 import os
 import re
-import time
 from pathlib import Path
 
 import h5py
@@ -22,8 +22,6 @@ import pytest
 
 from tests.test_hostile_inputs import ESC, SECRET, Case, _check, _config, _log
 
-#: Longest a hostile case may take [s] (the corpus's bound for "bounded time").
-SECONDS = 30.0
 #: Any control character but newline (ESC, BEL, CR, DEL …) in a printed line.
 _CONTROL = re.compile(r"[\x00-\x09\x0b-\x1f\x7f]")
 
@@ -308,13 +306,10 @@ CASES = {name[5:]: fn for name, fn in sorted(globals().items()) if name.startswi
 
 
 def _strict_check(case: Case, root: Path, capsys) -> None:
-    """:func:`_check`, then: no control characters printed, no secret in --out, in time."""
-    started = time.monotonic()
+    """:func:`_check`, then: no control characters printed, no secret in --out."""
     text = _check(case, root)
-    took = time.monotonic() - started
     printed = capsys.readouterr()
-    label = f"{case.args}: took {took:.1f} s: {text[-600:]!r}"
-    assert took < SECONDS, label
+    label = f"{case.args}: {text[-600:]!r}"
     assert not _CONTROL.search(text + printed.out + printed.err), label
     out = root / "out"
     for path in out.rglob("*") if out.is_dir() else ():

@@ -17,6 +17,7 @@ import signal
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -444,6 +445,25 @@ def _tree(root: Path, out: Path) -> dict:
     return seen
 
 
+#: A command still running after this long [s] is taken as hung (a guard against a hang,
+#: not a speed target: how long a case takes is no test's business, benchmarks/ time them).
+HANG_S = 300
+
+
+@contextmanager
+def hang_guard(seconds: float = HANG_S):
+    """Raise TimeoutError in this (main) thread after ``seconds`` [s] of one command."""
+    def _hung(signum, frame):
+        raise TimeoutError(f"still running after {seconds:.0f} s: hung")
+    previous = signal.signal(signal.SIGALRM, _hung)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def _check(case: Case, root: Path) -> str:
     out = root / "out"
     cwd = root / case.cwd
@@ -452,9 +472,8 @@ def _check(case: Case, root: Path) -> str:
     old = Path.cwd()
     os.chdir(cwd)
     try:
-        started = time.monotonic()
-        result = CliRunner().invoke(cli, [str(a) for a in case.args])
-        took = time.monotonic() - started
+        with hang_guard():
+            result = CliRunner().invoke(cli, [str(a) for a in case.args])
     finally:
         os.chdir(old)
     text = result.output
@@ -488,7 +507,6 @@ def _check(case: Case, root: Path) -> str:
         assert summaries, "exit 0 but no result: " + label
         summary = json.loads(summaries[0].read_text())
         assert summary["segments"] or summary["warnings"], "silent empty result: " + label
-    assert took < 60, f"took {took:.0f} s: {label}"
     return text
 
 

@@ -14,7 +14,6 @@ import struct
 import subprocess
 import sys
 import threading
-import time
 import zipfile
 from pathlib import Path
 
@@ -95,9 +94,7 @@ def test_native_reader_crash_is_one_line_exit_2(tmp_path, build, says, command):
     path = build(tmp_path)
     out = tmp_path / "out"
     args = [command, path] + (["--out", out] if command == "run" else [])
-    t0 = time.monotonic()
-    done = _drillfric(*args)
-    assert time.monotonic() - t0 < 30
+    done = _drillfric(*args)  # a hang ends in its TimeoutExpired
     assert done.returncode == 2, (done.returncode, done.stderr)
     (line,) = _one_line(done.stderr)
     assert line.startswith(f"Error: {path}: {says}") and "fix:" in line, line
@@ -174,10 +171,8 @@ class _Listener:
 def test_scheduler_that_is_not_dask_is_one_line(hostile_fleet, tmp_path, greeting, says):
     listener = _Listener(greeting)
     try:
-        t0 = time.monotonic()
         result = fleet(hostile_fleet, "--out", tmp_path / "out", "--scheduler",
-                       listener.address)
-        assert time.monotonic() - t0 < 30
+                       listener.address)  # bounded by drillfric's own greeting timeout
     finally:
         listener.close()
     assert result.exit_code == 2

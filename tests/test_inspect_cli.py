@@ -52,7 +52,6 @@ def test_json_keys(good):
 
 
 def test_json_survey_summary(good, tmp_path):
-    pytest.importorskip("drillfric.io.survey")
     (tmp_path / "w.survey.csv").write_text("md_m,inc_deg,azi_deg\n0,0,0\n800,10,0\n1200,20,0\n")
     doc = json.loads(_inspect(good, "--json").output)
     assert doc["survey"]["stations"] == 3 and doc["survey"]["md_max_m"] == 1200.0
@@ -164,7 +163,6 @@ def test_every_bad_input_is_one_line_exit_2(tmp_path):
 
 
 def test_bad_survey_through_inspect(good, tmp_path):
-    pytest.importorskip("drillfric.io.survey")
     (tmp_path / "s.csv").write_text("md_m,inc_deg,azi_deg\n0,0,0\n500,200,0\n")
     result = _inspect(good, "--survey", tmp_path / "s.csv")
     assert result.exit_code == 2 and "s.csv" in result.output

@@ -12,9 +12,9 @@ from drillfric.errors import InputError
 from drillfric.io.timebase import (
     TimeTracker,
     clock_at,
-    origin_of,
     find_gaps,
     nominal_rate_hz,
+    origin_of,
     spacing_summary,
     summarize,
 )

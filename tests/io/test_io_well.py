@@ -41,7 +41,6 @@ def test_sidecars_found_by_name(csv_well):
     (csv_well.parent / "A-12.survey.csv").write_text(SURVEY_CSV)
     data, cfg, survey = astuple(resolve_well(csv_well))[:3]
     assert (cfg.name, survey.name) == ("A-12.toml", "A-12.survey.csv")
-    pytest.importorskip("drillfric.io.survey")
     w = load_well(csv_well)
     assert w.name == "Alpha" and w.config.segmentation.max_gap_s == 2.0
     assert w.survey.md_max_m == 1500.0 and set(w.files) == {"data", "config", "survey"}
@@ -77,7 +76,6 @@ def test_directory_well(tmp_path, frame):
     (well / "dev.csv").write_text(SURVEY_CSV)
     (well / "well.toml").write_text('[well]\ndata = "surface.parquet"\n'
                                     '[survey]\nfile = "dev.csv"\n')
-    pytest.importorskip("drillfric.io.survey")
     w = load_well(well)
     assert w.name == "B-7" and w.files["config"] == well / "well.toml"
     assert w.survey is not None and len(w.surface) == len(frame)
@@ -102,7 +100,6 @@ def test_hdf5_bundle(tmp_path, frame):
                   "azi_deg": [0.0, 90.0, 90.0]}).to_hdf(path, key="survey", format="table")
     with h5py.File(path, "a") as h5:
         h5["config"] = '[well]\nname = "Charlie"\n[fluid]\nmud_density_kg_m3 = 1500.0\n'
-    pytest.importorskip("drillfric.io.survey")
     w = load_well(path)
     assert w.name == "Charlie" and w.config.fluid.mud_density_kg_m3 == 1500.0
     assert w.survey.md_max_m == 2000.0 and w.files["survey"] == path
