@@ -3,7 +3,10 @@ live, replay."""
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
+from contextlib import contextmanager
 
 import click
 
@@ -26,12 +29,24 @@ class _Group(click.Group):
     def invoke(self, ctx: click.Context):
         catch_sigterm()
         try:
-            with user_errors(), library_output():
+            with user_errors(), library_output(), _reader_gone():
                 return super().invoke(ctx)
         except KeyboardInterrupt:
             click.secho("interrupted: nothing half-written was left; run the command again "
                         "to complete it", err=True, fg="yellow")
             ctx.exit(interrupted_exit_code())
+
+
+@contextmanager
+def _reader_gone():
+    """The reader of standard output went away (``drillfric td … | head``): stop quietly
+    with the shell's exit code for SIGPIPE, as a command-line tool does, not an internal
+    error."""
+    try:
+        yield
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error
+        raise click.exceptions.Exit(128 + signal.SIGPIPE) from None
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

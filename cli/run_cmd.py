@@ -72,7 +72,8 @@ def _describe(result, units: str = "si") -> str:
     mu_s = _fmt(s["mu_s"]) if s["mu_s"] is not None else (
         f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
         else "not identifiable")
-    return (f"{result.well}: {c['segments']} segments ({c['estimated']} estimated, "
+    return (f"{result.well}: {c['segments']} segment{'s' * (c['segments'] != 1)} "
+            f"({c['estimated']} estimated, "
             f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed"
             f"{_depths(s['segments'], units)}); {_mu_k_text(s)}, μ_s = {mu_s}")
 

@@ -86,8 +86,9 @@ def _write_table(frame, out: Path) -> None:
 
 @click.command("td")
 @click.argument("well_or_config", type=click.Path(path_type=Path))
-@click.option("--bit-depth", type=Quantity("m"), help="Bit measured depth [m] (default: end "
-              "of survey); a number with a unit is converted, e.g. \"8200 ft\".")
+@click.option("--bit-depth", type=Quantity("m"), help="Bit measured depth [m] (default: the "
+              "config's [well] bit_depth_m, else the end of the survey); a number with a unit "
+              "is converted, e.g. \"8200 ft\".")
 @click.option("--friction", type=float, help="Friction factor μ (default: from the config, "
               "per hole section when casing_shoe_md_m is set).")
 @click.option("--load-case", default="rotating_off_bottom", show_default=True,
@@ -137,8 +138,11 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
     else:
         cfg, path = _load(well_or_config, config, survey, overrides)
     if bit_depth is None:
+        bit_depth = cfg.well.bit_depth_m
+    if bit_depth is None:
         if path is None:
-            raise UserError("no survey: give --bit-depth (the hole is taken as vertical, with "
+            raise UserError("no survey: give --bit-depth or [well] bit_depth_m (the hole is "
+                            "taken as vertical, with "
                             "the nominal tortuosity survey.tortuosity_deg_30m)")
         bit_depth = path.md_max_m
     for note in cfg.assumed_with(path):

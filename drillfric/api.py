@@ -99,7 +99,8 @@ def torque_and_drag(well, bit_depth_m: float | None = None, *, friction: float |
     well : Well, str or Path
         A well (its string, survey and mud are used) or a path to one.
     bit_depth_m : float, optional
-        Bit depth [m] (default: the survey's last station).
+        Bit depth [m] (default: the configuration's ``[well] bit_depth_m``, else the
+        survey's last station).
     friction : float, optional
         Friction factor (default: the configuration's, per hole section).
     load_case : str
@@ -117,6 +118,8 @@ def torque_and_drag(well, bit_depth_m: float | None = None, *, friction: float |
 
     if not isinstance(well, Well):
         well = open_well(well, header=False)
+    if bit_depth_m is None:
+        bit_depth_m = well.config.well.bit_depth_m
     if bit_depth_m is None:
         if well.survey is None:
             raise InputError("no survey: give bit_depth_m", file=well.files.data)

@@ -571,5 +571,6 @@ class WellResult:
         return (f"<WellResult {self.well!r}: {self.status}, μ_k {mu_k}, μ_s {mu_s}; "
                 f"{c.get('segments', 0)} segment{'s' * (c.get('segments') != 1)} "
                 f"({c.get('converged', 0)} converged, "
-                f"{c.get('failed', 0)} failed); {len(self.warnings)} warnings"
+                f"{c.get('failed', 0)} failed); {len(self.warnings)} "
+                f"warning{'s' * (len(self.warnings) != 1)}"
                 f"{' (indicative)' * self.indicative}{where}>")

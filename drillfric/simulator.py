@@ -506,6 +506,12 @@ class Simulation:
     rate_hz: float
     notes: tuple = field(default_factory=tuple)
 
+    def __repr__(self) -> str:
+        n = len(next(iter(self.columns.values()), ()))
+        return (f"<Simulation μ_s {self.settings.mu_s:g}, μ_k {self.settings.mu_k:g}: "
+                f"{len(self.stands)} stand{'s' * (len(self.stands) != 1)}, {n} rows at "
+                f"{self.rate_hz:g} Hz; columns {', '.join(self.columns)}>")
+
     def truth(self) -> dict:
         """Ground truth as plain data (NAME.truth.json, file metadata)."""
         from drillfric._version import __version__

@@ -91,6 +91,12 @@ class TDResult:
         """Bit measured depth [m]."""
         return float(self.md_m[-1])
 
+    def __repr__(self) -> str:
+        friction = "varies" if self.friction is None else f"{self.friction:g}"
+        return (f"<TDResult {self.load_case} at {self.bit_depth_m:.1f} m, friction {friction}: "
+                f"hook load {self.hookload_N:.4g} N, surface torque "
+                f"{self.surface_torque_Nm:.4g} N·m, {self.md_m.size} nodes>")
+
     def fc_at(self, md_m) -> np.ndarray:
         """F_c [N·m/m] of the element containing each measured depth (bit → last element)."""
         md = np.atleast_1d(np.asarray(md_m, dtype=float))

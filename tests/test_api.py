@@ -165,6 +165,24 @@ def test_well_result_headline_numbers_are_typed_and_shown_short():
     assert none.status == "not_estimated" and "μ_k —" in repr(none)
     empty = WellResult("C", {"mu_k": None, "counts": {"segments": 0}}, pd.DataFrame())
     assert empty.status == "no_segments"
+    one = WellResult("D", {"mu_k": None, "counts": {"segments": 1}}, pd.DataFrame(),
+                     warnings=["w"])
+    assert "; 1 segment (" in repr(one) and "; 1 warning>" in repr(one)  # not "1 segments"
+
+
+def test_notebook_reprs_are_one_line_not_the_arrays():
+    """Issue 35 (15): a Well, a Simulation and a TDResult printed ~1000 lines of arrays in a
+    notebook; each is one line naming what it holds."""
+    import drillfric
+
+    demo = REPO / "examples" / "demo"
+    well = drillfric.open_well(demo / "demo.csv")
+    shown = {"Well": repr(well),
+             "TDResult": repr(drillfric.torque_and_drag(well, 2300.0, friction=0.25)),
+             "Simulation": repr(drillfric.simulate(demo / "demo.toml", duration_s=60.0))}
+    for name, text in shown.items():
+        assert text.startswith(f"<{name} ") and "\n" not in text and len(text) < 300, text
+    assert "2300.0 m" in shown["TDResult"] and "'demo'" in shown["Well"]
 
 
 def test_dir_lists_the_public_api():

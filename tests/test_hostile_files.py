@@ -242,7 +242,7 @@ def case_infinite_values_give_no_library_warning(root):
     text[101] = "10.0,-inf,inf"
     path.write_text("\n".join(text) + "\n", encoding="utf-8")
     return [Case(["inspect", path], (0,), ("2 (0.5%)",)),
-            Case(["run", path, "--out", "out"], (0,), ("1 segments",))]
+            Case(["run", path, "--out", "out"], (0,), ("1 segment (",))]
 
 
 # --------------------------------------------------------------------------- true messages

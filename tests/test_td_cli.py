@@ -60,6 +60,35 @@ def test_default_bit_depth_is_end_of_survey_and_on_bottom_case(well):
     assert out["wob_N"] == 1e5 and out["surface_torque_Nm"] > 3e3
 
 
+def test_config_bit_depth_is_the_default_of_td_and_the_api(well):
+    """Issue 35 (17): `drillfric td WELL.toml` ignored [well] bit_depth_m (used the survey's
+    end); --bit-depth still wins."""
+    well.write_text(well.read_text() + "[well]\nbit_depth_m = 2000.0\n")
+    assert json.loads(invoke(well, "--json").stdout)["bit_depth_m"] == 2000.0
+    assert json.loads(invoke(well, "--json", "--bit-depth", 2100).stdout)["bit_depth_m"] == 2100
+    import drillfric
+
+    demo = drillfric.open_well(Path(__file__).parents[1] / "examples/demo/demo.csv",
+                               overrides={"well.bit_depth_m": 2000.0})
+    assert drillfric.torque_and_drag(demo).bit_depth_m == 2000.0
+
+
+def test_output_piped_into_a_reader_that_stops_early_is_no_internal_error(well):
+    """`drillfric td … --json | head -1`: the reader closes the pipe first; drillfric stops
+    with the shell's SIGPIPE code (141) and prints no error, not "internal error:
+    BrokenPipeError"."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "drillfric.cli.main", "td", str(well),
+                             "--broomstick", "--json"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    proc.stdout.close()  # before drillfric writes a byte
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141, err
+    assert "Error" not in err and "Traceback" not in err, err
+
+
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_profile_file_columns(well, tmp_path, suffix):
     out = tmp_path / f"profile{suffix}"

@@ -184,6 +184,14 @@ class Well:
     source: RawSource | None = field(default=None, repr=False)
     mappings: dict[str, Mapping] = field(default_factory=dict, repr=False)
 
+    def __repr__(self) -> str:
+        survey = "no survey" if self.survey is None else \
+            f"survey of {self.survey.md_m.size} stations to {self.survey.md_m[-1]:.0f} m"
+        index = "depth-indexed" if self.depth_indexed else "time-indexed"
+        return (f"<Well {self.name!r}: {self.files.data.name}, {index}, "
+                f"{len(self.mappings)} channels ({', '.join(self.channels) or 'not read'}), "
+                f"{survey}>")
+
     @property
     def channels(self) -> dict[str, Mapping]:
         """The channel mappings keyed by canonical column name (``surface_torque_Nm``)."""
