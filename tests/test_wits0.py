@@ -209,6 +209,7 @@ def test_receiver_sends_handshakes_reconnects_and_records_each_frame_once(tmp_pa
         conn.sendall(frames[1] + frames[2])
         heard.append(conn.recv(100))
         _wait_for(lambda: receiver.frames == 3, 10)
+        receiver.stop.set()  # before the close: a drop would be reconnected (a 3rd connection)
         conn.close()
     finally:
         receiver.stop.set()
