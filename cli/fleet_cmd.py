@@ -83,8 +83,21 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
     for note in result.notes:
         click.secho(f"note: {note}", err=True)
+    empty = result.nothing_estimated
+    if empty:
+        click.secho(f"warning: nothing estimated in {len(empty)} of {len(result.wells)} "
+                    f"well(s) (every segment skipped: too short, no rotation …): "
+                    f"{_some(empty)} — see {result.out_root}/NAME/summary.json", err=True,
+                    fg="yellow")
     echo(_closing_line(result))
     if result.count("failed") == len(result.wells):
         raise UserError("no well could be processed — fix: see each well's error above")
-    if result.count("failed") or result.failed_segments:
+    if result.count("failed") or result.failed_segments or \
+            len(empty) == len(result.wells) - result.count("failed"):
         sys.exit(1)
+
+
+def _some(names: tuple[str, ...], shown: int = 5) -> str:
+    """The first ``shown`` names, and how many more."""
+    more = len(names) - shown
+    return ", ".join(names[:shown]) + (f" and {more} more" if more > 0 else "")

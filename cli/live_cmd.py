@@ -59,7 +59,8 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
         compile_kernels_once()
         live = run_live(path, out, until_idle_s=until_idle, open_kw=kw,
                         report=partial(write_well_report, pdf=False) if report else None,
-                        started=None if server is None else server.start)
+                        started=None if server is None else server.start,
+                        upstream=None if receiver is None else lambda: receiver.error)
     except InputError as exc:
         if receiver is None or receiver.frames:
             raise

@@ -13,13 +13,13 @@ same layers.
 
 from __future__ import annotations
 
-import json
 from functools import partial
 from pathlib import Path
 
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.results import read_json
 from drillfric.io.well import Well, open_well
 from drillfric.result import RunProgress, WellResult, segments_from_json
 from drillfric.runner import run_well
@@ -77,11 +77,10 @@ def load_result(result_dir) -> WellResult:
         Not a result directory (no readable summary.json).
     """
     folder = Path(result_dir)
-    try:
-        summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise InputError("not a drillfric result directory (no readable summary.json)",
-                         file=folder, fix="give OUT/NAME of a 'drillfric run'") from exc
+    if not (folder / "summary.json").is_file():
+        raise InputError("not a drillfric result directory (no summary.json)", file=folder,
+                         fix="give OUT/NAME of a 'drillfric run'")
+    summary = read_json(folder / "summary.json", fix="give OUT/NAME of a 'drillfric run'")
     segments = pd.read_parquet(folder / "segments.parquet") if (
         folder / "segments.parquet").is_file() else segments_from_json(
         summary.get("segments", []))

@@ -249,7 +249,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("interpolation", str, "linear", "", "Measurements between samples: 'linear' "
             "(default, one sample of lag) or 'hold' (the paper's zero-order hold).",
             choices=("linear", "hold")),
-        _positive("output_rate_hz", 10.0, "Hz", "Rate of estimates.parquet rows."),
+        _positive("output_rate_hz", 10.0, "Hz", "Rate of estimates.parquet rows (at most "
+                  "1000 Hz: ten times the fastest rig logs; rows cost memory per segment).",
+                  max=1000.0),
         _positive("speed_noise_rpm", 0.5, "RPM", "Standard deviation of the logged top-drive "
                   "speed's noise per sample; with the logging interval it sets the Kalman "
                   "design's measurement noise."),

@@ -16,6 +16,7 @@ from pathlib import Path
 
 from drillfric.errors import InputError
 from drillfric.io import witsml
+from drillfric.io.wellfiles import OUT_FILES
 
 _DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las", ".xml", ".dlis",
              ".xlsx")
@@ -99,7 +100,8 @@ def _discover_dir(folder: Path) -> list[WellSpec]:
 def _is_data_file(path: Path) -> bool:
     """A data file of a well: a data extension, not a sidecar, not a WITSML object that
     only accompanies a log (a file that does not parse is kept: it fails as its well)."""
-    if path.suffix.lower() not in _DATA_EXT or path.stem.endswith(_SIDECAR_TAGS):
+    if path.suffix.lower() not in _DATA_EXT or path.stem.endswith(_SIDECAR_TAGS) or \
+            path.name.casefold() in OUT_FILES:  # a fleet's own output (--out = the wells)
         return False
     if path.suffix.lower() != ".xml":
         return True

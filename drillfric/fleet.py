@@ -37,7 +37,8 @@ import pandas as pd
 
 from drillfric import __version__, overnight
 from drillfric.discovery import WellSpec
-from drillfric.errors import DrillfricError, InputError
+from drillfric.errors import DrillfricError, InputError, OutputError
+from drillfric.io.atomic import refuse_link, replacing
 from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
     check_distinct,
@@ -45,6 +46,7 @@ from drillfric.io.results import (
     jsonable,
     mark_stale,
     missing_dirs,
+    read_json,
     remove_empty,
     remove_stale,
     write_json,
@@ -247,6 +249,7 @@ def _same(fingerprint: dict, entry: dict | None, known: dict) -> bool:
         return False
     outputs = entry.get("outputs", {}).get("summary")
     if (outputs is None or not Path(outputs).is_file()
+            or _summary_sha256(Path(outputs)) != entry.get("summary_sha256")
             or fingerprint["config_sha256"] != entry.get("config_sha256")
             or fingerprint["drillfric_version"] != entry.get("drillfric_version")):
         return False
@@ -259,6 +262,15 @@ def _same(fingerprint: dict, entry: dict | None, known: dict) -> bool:
                    for role, f in recorded.items() if role not in fingerprint["inputs"])
     except (OSError, KeyError, TypeError):
         return False
+
+
+def _summary_sha256(path: Path) -> str | None:
+    """The digest of a well's summary.json as it is now (None: unreadable): one the fleet
+    did not write (a manual ``run`` into OUT/NAME) differs from the manifest's."""
+    try:
+        return file_sha256(path)
+    except OSError:
+        return None
 
 
 def _entry(manifest: _Manifest, job: _Job) -> tuple[str, dict | None]:
@@ -339,6 +351,13 @@ class FleetResult:
         """Failed segments over the wells that ran or were skipped."""
         return sum(w.failed_segments for w in self.wells)
 
+    @property
+    def nothing_estimated(self) -> tuple[str, ...]:
+        """Wells that ran (or were unchanged) with not one segment estimated: every
+        segment skipped, or none found."""
+        return tuple(w.well for w in self.wells if w.status != "failed" and w.summary
+                     and not (w.summary.get("counts") or {}).get("estimated"))
+
 
 class _Manifest:
     """OUT/manifest.json: one entry per well, saved atomically (throttled while running).
@@ -349,10 +368,10 @@ class _Manifest:
     def __init__(self, out_root: Path | None):
         self.path = None if out_root is None else out_root / MANIFEST
         try:
-            self.data = json.loads(self.path.read_text(encoding="utf-8")) if self.path else {}
-        except (OSError, json.JSONDecodeError):
+            self.data = read_json(self.path) if self.path and self.path.exists() else {}
+        except InputError:
             self.data = {}
-        if not isinstance(self.data, dict) or not isinstance(self.data.get("wells"), dict):
+        if not isinstance(self.data.get("wells"), dict):
             self.data = {"wells": {}}  # unreadable: every well runs again
         self._saved = 0.0
 
@@ -369,9 +388,8 @@ class _Manifest:
         if self.path is None or (not now and time.monotonic() - self._saved < SAVE_EVERY_S):
             return
         self.data.update(drillfric_version=__version__, updated_utc=_now())
-        tmp = self.path.with_name(f".{MANIFEST}.tmp-{os.getpid()}")
-        write_json(tmp, self.data)
-        os.replace(tmp, self.path)
+        with replacing(self.path) as tmp:
+            write_json(tmp, self.data)
         self._saved = time.monotonic()
 
 
@@ -515,7 +533,9 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
                             "estimates": str(out / "estimates.parquet"),
                             "segments": str(out / "segments.parquet"),
                             "report": str(out / "report.html")}
-        if not (out / "summary.json").is_file():
+        if (out / "summary.json").is_file():  # a run into OUT/NAME by another hand shows
+            entry["summary_sha256"] = file_sha256(out / "summary.json")  # next night
+        else:
             entry.update(status="failed", message=f"{out}: the worker wrote its result where "
                          "this machine cannot see it — fix: put OUT on storage shared by the "
                          "client and every worker")
@@ -560,7 +580,7 @@ def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
 
 def _skipped(name: str, entry: dict) -> WellOutcome:
     out = Path(entry["outputs"]["dir"])
-    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    summary = read_json(out / "summary.json")
     changed = overnight.changes(summary, entry.get("history", []), ran=False,
                                 data_changed_utc=entry.get("data_changed_utc"))
     return WellOutcome(name, "skipped", "unchanged since the last run", out, summary,
@@ -670,6 +690,8 @@ def _locked(out_root: Path):
     lock = ExitStack()
     try:
         out_root.mkdir(parents=True, exist_ok=True)
+        for name in (_LOCK, MANIFEST, SUMMARY, REPORT):  # refused before any well runs
+            refuse_link(out_root / name)
         lock.enter_context(lock_file(out_root / _LOCK))
     except Busy:
         raise InputError("another fleet run is writing to this directory", file=out_root,
@@ -718,9 +740,8 @@ def _changed_first(outcomes) -> list:
 
 def _write_summary(out_root: Path, outcomes) -> Path:
     path = out_root / SUMMARY
-    tmp = out_root / f".{SUMMARY}.tmp-{os.getpid()}"
-    summary_frame(outcomes).to_parquet(tmp, index=False)
-    os.replace(tmp, path)
+    with replacing(path) as tmp:
+        summary_frame(outcomes).to_parquet(tmp, index=False)
     return path
 
 
@@ -736,5 +757,7 @@ def _write_report(out_root: Path, outcomes) -> tuple[Path | None, tuple[str, ...
              for o in _changed_first(outcomes)]
     try:
         return report.write_fleet_report(out_root, items), ()
+    except OutputError:  # a full disk, a link planted meanwhile: one line, exit 2
+        raise
     except Exception as exc:  # noqa: BLE001 — the night's results are already written
         return None, (f"fleet.html not written: {type(exc).__name__}: {exc}",)

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import queue
 import threading
 import time
@@ -39,17 +38,17 @@ import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 
-from drillfric.errors import InputError
+from drillfric.errors import DrillfricError, InputError
+from drillfric.io.atomic import replacing
 from drillfric.io.results import write_json
 from drillfric.io.timebase import clock_at
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live_source import PartsTail, Tail, follow
 from drillfric.result import Flag, SegmentRecord, Status
 from drillfric.runner import warmup
-from drillfric.runner.engine import Engine, mismatch
+from drillfric.runner.engine import Engine
 from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
-from drillfric.runner.resume import changed, unread
-from drillfric.runner.state import read_state
+from drillfric.runner.resume import restored, unread
 from drillfric.runner.time_log import STATE_DIR, finish_engine
 from drillfric.segmentation import RIG_STATES
 
@@ -60,6 +59,8 @@ FEED_POLL_S = 0.1
 #: Shortest wait between two rewrites of live.json [s] (it is rewritten as soon as rows were
 #: fed, but not more often).
 MIN_WRITE_S = 0.05
+#: Longest wait for the worker to end after live.json could not be written [s].
+STOP_WAIT_S = 30.0
 #: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
 SEVERE_STICK_SLIP = 1.0
 #: Share of a core that publications of an open segment may take on average (they come
@@ -399,31 +400,24 @@ class LiveRun:
             self.max_gap_s = max(self.max_gap_s, now - self._written)
         self._written = now
         target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
-        write_json(tmp, self.status())
-        os.replace(tmp, target)
+        with replacing(target) as tmp:
+            write_json(tmp, self.status())
 
 
 def _continued(well: Well, folder: Path) -> tuple[Engine | None, str]:
     """An in-memory engine continuing the state published in ``folder``, or None and why."""
-    if not (folder / STATE_DIR / "engine.json").is_file():
-        return None, "no saved state"
-    try:
-        state = read_state(folder / STATE_DIR)
-    except InputError as exc:
-        return None, exc.message
-    source = state.get("source") or {}
     kind = "parts" if well.source.parts else "csv"
-    why = mismatch(state, well, None) or changed(source, well) or \
-        ("" if source.get("format") == kind else "the earlier run read another kind of file")
-    if why:
-        return None, why
+
+    def same_kind(state: dict) -> str:
+        source = state.get("source") or {}
+        return "" if source.get("format") == kind else \
+            "the earlier run read another kind of file"
+
     sink = MemorySink()
-    engine = Engine(well, sink=sink)
-    try:
-        engine.restore(state)
-    except (KeyError, TypeError, ValueError, IndexError) as exc:  # not a state we wrote
-        return None, f"engine state not readable ({type(exc).__name__}: {exc})"
+    engine, why = restored(well, folder / STATE_DIR, lambda: Engine(well, sink=sink),
+                           also=same_kind)
+    if engine is None:
+        return None, why
     _seed(sink, folder, {r.id for r in engine.records})
     engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
     return engine, ""
@@ -542,16 +536,21 @@ def _utc(origin, time_s: float) -> str | None:
 
 
 def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
-             started: Callable[[LiveRun], None] | None = None, **kw) -> LiveRun:
+             started: Callable[[LiveRun], None] | None = None,
+             upstream: Callable[[], BaseException | None] | None = None, **kw) -> LiveRun:
     """Run :class:`LiveRun` (``kw``) until ``until_idle_s`` wall seconds without new data
     (None: until interrupted), writing ``out_root/live.json`` every :data:`POLL_S` from this
     thread while the worker feeds and estimates; ``started`` is given the run before its
-    worker starts (the live page serves it).
+    worker starts (the live page serves it); ``upstream`` returns the error that ended
+    whatever writes ``path`` (the WITS0 receiver: a full disk), which ends the run.
 
     Raises
     ------
     InputError
         No data ever arrived, or the file cannot be read as it grows.
+    DrillfricError
+        ``upstream``'s error, or live.json cannot be written (after the final results were
+        attempted).
     KeyboardInterrupt
         Interrupted (Ctrl-C, SIGTERM): the final results were written first.
     """
@@ -562,10 +561,14 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
     worker = threading.Thread(target=live.work, name="drillfric-live", daemon=True)
     worker.start()
     try:
-        _tend(live, worker, until_idle_s)
+        _tend(live, worker, until_idle_s, upstream or (lambda: None))
     except KeyboardInterrupt:
         live.stop.set()
-        _tend(live, worker, None)
+        _tend(live, worker, None, lambda: None)
+        raise
+    except DrillfricError:  # live.json cannot be written: the worker ends, then the line
+        live.stop.set()
+        live.done.wait(STOP_WAIT_S)
         raise
     if live.error is not None:
         raise live.error
@@ -576,9 +579,11 @@ def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,
     return live
 
 
-def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None) -> None:
+def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None,
+          upstream: Callable[[], BaseException | None]) -> None:
     """live.json as soon as rows were fed (at most every :data:`MIN_WRITE_S`, at least
-    every :data:`POLL_S`) while the worker runs; stop it when idle. (The
+    every :data:`POLL_S`) while the worker runs; stop it when idle or when ``upstream``
+    failed (its error becomes the run's). (The
     worker's ``done`` event is waited on, not ``Thread.join``: a join interrupted by a signal
     can leave ``is_alive()`` False while the thread still runs, CPython gh-90882.)"""
     while not live.done.is_set():
@@ -587,6 +592,8 @@ def _tend(live: LiveRun, worker: threading.Thread, until_idle_s: float | None) -
         live.write_status(live.target)
         if until_idle_s is not None and live.clock() - live.last_data >= until_idle_s:
             live.stop.set()
+        if (failed := upstream()) is not None:
+            live._fail(failed)
         time.sleep(MIN_WRITE_S)  # then at once when rows are fed, at the latest after POLL_S
         live.fed.wait(POLL_S - MIN_WRITE_S)
     worker.join()

@@ -41,7 +41,8 @@ import pandas as pd
 import pyarrow.parquet as pq
 from markupsafe import Markup
 
-from drillfric.io.results import jsonable
+from drillfric.errors import DrillfricError
+from drillfric.io.results import jsonable, read_json
 from drillfric.live import SEVERE_STICK_SLIP, LiveRun, bit_speed_withheld
 from drillfric.report.data import FINAL_START_ID, extreme_rows
 from drillfric.report.interactive import bokeh_js, json_in_script, script_hash, time_figure
@@ -177,7 +178,7 @@ class LivePage:
             return None if held is None else held[1]
         try:
             value = read(path)
-        except (OSError, ValueError):  # replaced while read: the next poll reads it
+        except (OSError, ValueError, DrillfricError):  # replaced while read: next poll
             return None if held is None else held[1]
         with self._lock:
             self._cache[name] = (key, value)
@@ -185,8 +186,7 @@ class LivePage:
 
     def records(self) -> list[dict]:
         """The segments of the last publication (summary.json), as written."""
-        summary = self._published("summary.json",
-                                  lambda p: json.loads(p.read_text(encoding="utf-8")))
+        summary = self._published("summary.json", read_json)
         return [] if summary is None else list(summary.get("segments", []))
 
     def segments(self) -> dict:

@@ -43,6 +43,11 @@ from drillfric.wellpath import WellPath, no_survey_path
 
 _SERIES_DT_S = 0.01  # [s] sampling of the set-point series handed to the kernel
 _STARTS = ("ramp", "creep")
+#: CPU time of one plant cell-step [s] (0.52–0.55 ns measured, docs/performance.md;
+#: rounded up so the work estimate errs high).
+SIM_CELL_STEP_S = 1.0e-9
+#: Budget of one simulation [CPU s] (a 24-h well at 500 cells takes ≈ 20 s).
+MAX_SIM_CPU_S = 3600.0
 
 
 @dataclass(frozen=True)
@@ -618,6 +623,7 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     settings = PlantSettings.from_config(cfg)
     noise = Noise.from_config(cfg) if noise is None else noise
     check_depths(scenario, path, cfg.source)
+    check_work(cfg, settings, scenario)
     if path is None:
         path = no_survey_path(max(s.bit_depth_m for s in scenario.stands),
                               cfg.tortuosity_rad_m)
@@ -643,6 +649,31 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     noise.apply(columns)
     notes = _notes(stands)
     return Simulation(columns, tuple(stands), settings, noise, rate, notes)
+
+
+def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario) -> float:
+    """The plant's CPU time for ``scenario`` [s], estimated as cells²/t_w cell-steps per
+    simulated second (t_w: the wave's travel time along the stand's string; the Courant-1
+    grid, docs/theory.md §3.1) at :data:`SIM_CELL_STEP_S` each.
+
+    Raises
+    ------
+    ConfigError
+        Beyond :data:`MAX_SIM_CPU_S` (``[simulate] cells`` enters squared).
+    """
+    cell_steps = 0.0
+    for stand in scenario.stands:
+        string = build_string(cfg.sections, stand.bit_depth_m)
+        travel = sum(sec.length_m / sec.wave_speed_m_s for sec in string.sections)
+        cell_steps += stand.total_s * settings.cells ** 2 / travel
+    cpu_s = cell_steps * SIM_CELL_STEP_S
+    if cpu_s > MAX_SIM_CPU_S:
+        raise ConfigError(f"[simulate] cells = {settings.cells} over the scenario's "
+                          f"{sum(st.total_s for st in scenario.stands):.0f} s would take ≈ "
+                          f"{cpu_s / 3600:.3g} CPU-hours (cost ∝ cells²); the budget is "
+                          f"{MAX_SIM_CPU_S / 3600:g}", file=cfg.source,
+                          fix="fewer cells (default 2500) or shorter stands")
+    return cpu_s
 
 
 def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: float):

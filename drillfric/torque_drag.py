@@ -37,6 +37,10 @@ LOAD_CASES = ("rotating_off_bottom", "rotating_on_bottom", "pick_up", "slack_off
 #: weight on bit and no rotation (motor drilling); its bit torque is not modelled (M = 0).
 ON_BOTTOM_CASES = ("rotating_on_bottom", "sliding")
 _MIN_ELEMENT_M = 1e-6  # [m] nodes closer than this are merged
+#: Most elements of one string's mesh (each a few hundred bytes and a step of every sweep;
+#: the default 2-m elements give 3000 at 6 km): a budget on the work ``element_length_m``
+#: implies (docs/security.md, "Work budget").
+MAX_ELEMENTS = 200_000
 _FRICTION_BRACKET = (0.0, 2.0)
 
 Friction = float | Callable[[np.ndarray], np.ndarray]
@@ -230,6 +234,11 @@ def _mesh(path: WellPath, string: DrillString, element_length_m: float, mud_out:
     """Nodes every ``element_length_m`` plus section boundaries, survey stations and extras."""
     bit = string.bit_depth_m
     n_reg = max(1, int(np.ceil(bit / element_length_m - 1e-9)))
+    if n_reg > MAX_ELEMENTS:
+        raise ModelError(f"element length {element_length_m:g} m gives {n_reg:.3g} "
+                         f"torque-and-drag elements to {bit:.0f} m; at most {MAX_ELEMENTS:.0e}",
+                         fix=f"[model] element_length_m ≥ {bit / MAX_ELEMENTS:.2g} m "
+                             "(default 2 m)")
     stations = path.md_m[(path.md_m > 0) & (path.md_m < bit)]
     extra = np.asarray(extra_nodes_m, dtype=float)
     nodes = np.concatenate([np.linspace(0.0, bit, n_reg + 1), string.boundaries_m, stations,

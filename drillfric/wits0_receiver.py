@@ -21,7 +21,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from drillfric.config import read_toml
-from drillfric.errors import InputError
+from drillfric.errors import DrillfricError, InputError
+from drillfric.io.atomic import open_appending, output_error, refuse_link
 from drillfric.io.text import printable
 from drillfric.io.wellfiles import safe_name
 from drillfric.io.wits0 import Decoder, Row, frame_clock, item_map
@@ -184,21 +185,26 @@ class Recording:
     ------
     InputError
         An existing file with another header (another configuration).
+    OutputError
+        The path is a symbolic link (dangling or not): drillfric writes through no link.
     """
 
     def __init__(self, path: Path, names: list[str], utc: bool):
         self.path, self.utc = Path(path), utc
         self.header = ",".join(["time", *names]) + "\n"
+        refuse_link(self.path)
         self.last_s = self._continue() if self.path.exists() else None
         self._fh = None
 
     def _continue(self) -> float | None:
-        """Check the header, cut a partial last line; the last recorded time."""
+        """Check the header, cut a partial last line; the last recorded time. (No message
+        quotes the file: it may not be drillfric's.)"""
         with open(self.path, "rb") as fh:
             head = fh.readline(len(self.header) + 1).decode("utf-8", "replace")
         if head != self.header:
-            raise InputError("this recording of a WITS0 stream has other columns "
-                             f"({printable(head.strip(), 120)})", file=self.path,
+            raise InputError("this recording of a WITS0 stream has other columns than this "
+                             f"configuration's ({printable(self.header.strip(), 120)})",
+                             file=self.path,
                              fix="give another --out (or remove the file) when the "
                                  "configuration's items changed")
         with open(self.path, "r+b") as fh:
@@ -214,32 +220,45 @@ class Recording:
         try:
             stamp = datetime.fromisoformat(last)
         except ValueError:
-            raise InputError(f"this recording of a WITS0 stream ends with a line without a "
-                             f"time ('{printable(last, 40)}'): not written by live",
+            raise InputError("this recording of a WITS0 stream ends with a line without a "
+                             "time: not written by live",
                              file=self.path, fix="give another --out (or remove the file)") \
                 from None
         return stamp.replace(tzinfo=UTC).timestamp() if stamp.tzinfo is None else \
             stamp.timestamp()
 
     def write(self, time_s: float, values: dict[str, float]) -> None:
-        """One line: the time (ISO 8601, µs) and the values (empty when NaN)."""
-        if self._fh is None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            fresh = not self.path.exists() or self.path.stat().st_size == 0
-            self._fh = open(self.path, "ab")
-            if fresh:
-                self._fh.write(self.header.encode())
+        """One line: the time (ISO 8601, µs) and the values (empty when NaN).
+
+        Raises
+        ------
+        OutputError
+            The line cannot be written (disk full …, named by path) or the path became a link.
+        """
         stamp = datetime.fromtimestamp(time_s, UTC)
         text = stamp.isoformat(timespec="microseconds") if self.utc else \
             stamp.replace(tzinfo=None).isoformat(timespec="microseconds")
         cells = ["" if math.isnan(v) else repr(v) for v in values.values()]
-        self._fh.write((",".join([text, *cells]) + "\n").encode())
-        self._fh.flush()
+        line = (",".join([text, *cells]) + "\n").encode()
+        try:
+            if self._fh is None:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                self._fh = open_appending(self.path)
+                if self._fh.tell() == 0:
+                    self._fh.write(self.header.encode())
+            self._fh.write(line)
+            self._fh.flush()
+        except OSError as exc:
+            raise output_error(exc, self.path) from None
 
     def close(self) -> None:
+        """Close the file (a write that failed was said by :meth:`write`: not again)."""
         if self._fh is not None:
-            self._fh.close()
-            self._fh = None
+            fh, self._fh = self._fh, None
+            try:
+                fh.close()
+            except OSError:
+                pass
 
 
 class Receiver:
@@ -264,33 +283,42 @@ class Receiver:
         self.decoder = Decoder()
         self.stop = threading.Event()
         self.frames = self.connections = 0
+        #: What ended the receiver for good (a recording that cannot be written), else None.
+        self.error: DrillfricError | None = None
         self.warn = warn or (lambda text: print(f"warning: {text}", file=sys.stderr))
         self._received = 0
         self._warned: set[str] = set()
 
     def run(self) -> None:
         """Connect, record, reconnect (waiting 0.2 s, doubling to ``reconnect_max_s``)
-        until :attr:`stop`."""
-        wait = RECONNECT_MIN_S
+        until :attr:`stop`, or until the recording cannot be written (:attr:`error`: the
+        caller says it in one line; no thread traceback)."""
         try:
-            while not self.stop.is_set():
-                try:
-                    conn = socket.create_connection((self.address.host, self.address.port),
-                                                    timeout=2.0)
-                except OSError as exc:
-                    why = exc.strerror or exc
-                    self._once("connect", f"{self.address}: cannot connect ({why}); retrying")
-                    self.stop.wait(wait)
-                    wait = min(2 * wait, self.setup.reconnect_max_s)
-                    continue
-                self.connections += 1
-                if self._session(conn):
-                    wait = RECONNECT_MIN_S
-                else:
-                    self.stop.wait(wait)
-                    wait = min(2 * wait, self.setup.reconnect_max_s)
+            self._connect_loop()
+        except DrillfricError as exc:
+            self.error = exc
+            self.stop.set()
         finally:
             self.recording.close()
+
+    def _connect_loop(self) -> None:
+        wait = RECONNECT_MIN_S
+        while not self.stop.is_set():
+            try:
+                conn = socket.create_connection((self.address.host, self.address.port),
+                                                timeout=2.0)
+            except OSError as exc:
+                why = exc.strerror or exc
+                self._once("connect", f"{self.address}: cannot connect ({why}); retrying")
+                self.stop.wait(wait)
+                wait = min(2 * wait, self.setup.reconnect_max_s)
+                continue
+            self.connections += 1
+            if self._session(conn):
+                wait = RECONNECT_MIN_S
+            else:
+                self.stop.wait(wait)
+                wait = min(2 * wait, self.setup.reconnect_max_s)
 
     def _session(self, conn: socket.socket) -> bool:
         """Record frames until the connection drops; True when a frame came."""

@@ -328,7 +328,13 @@ def kalman_filter_gain(params: LumpedParams, n_cells: int,
     a_r, c_r = basis.T @ a @ basis, c @ basis
     q_r = reduce @ _process_noise(params, n_cells, noise) @ reduce.T
     r = np.array([[noise.speed_psd / lumped.time_step_s(params, n_cells)]])
-    p = scipy.linalg.solve_discrete_are(a_r.T, c_r.T, q_r, r)
+    try:
+        p = scipy.linalg.solve_discrete_are(a_r.T, c_r.T, q_r, r)
+    except (np.linalg.LinAlgError, ValueError) as exc:  # e.g. k_t so high no wave survives
+        raise ModelError(f"the observer's Kalman gains have no finite solution ({exc}) for "
+                         f"this string and damping (k_t = {params.k_t_per_s:g} 1/s)",
+                         fix="check [model] k_t_per_s (typical 0.01–10 1/s) and the string "
+                             "sections") from None
     gain = basis @ (a_r @ p @ c_r.T / (c_r @ p @ c_r.T + r))
     return gain[:, 0] / scale
 

@@ -20,7 +20,6 @@ docs/security.md describes the rules; the column schema is :mod:`drillfric.resul
 
 from __future__ import annotations
 
-import errno
 import hashlib
 import json
 import math
@@ -36,7 +35,8 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from drillfric.errors import OutputError
+from drillfric.errors import InputError, OutputError
+from drillfric.io.atomic import is_write_problem, output_error, replacing
 from drillfric.io.digest import sha256_prefix
 from drillfric.io.locks import lock_directory
 from drillfric.result import ESTIMATE_COLUMNS, segment_table
@@ -73,31 +73,6 @@ def jsonable(value):
     return value
 
 
-# --------------------------------------------------------------------------- errors
-_FIXES = {
-    errno.ENOSPC: ("no space left on the device", "free disk space or choose another --out"),
-    errno.EDQUOT: ("disk quota exceeded", "free space in your quota or choose another --out"),
-    errno.EFBIG: ("file too large for the file system or a size limit",
-                  "choose another --out (or raise the file-size limit)"),
-    errno.EROFS: ("read-only file system", "choose a writable --out"),
-    errno.EACCES: ("permission denied", "choose a writable --out"),
-    errno.EPERM: ("operation not permitted", "choose a writable --out"),
-    errno.ENAMETOOLONG: ("path too long", "use a shorter --out or well name"),
-    errno.ENOTDIR: ("a file stands where a directory must go",
-                    "remove or rename that file, or choose another --out"),
-    errno.EEXIST: ("a file stands where a directory must go",
-                   "remove or rename that file, or choose another --out"),
-}
-
-
-def output_error(exc: OSError, where: Path) -> OutputError:
-    """One-line :class:`OutputError` for an OSError met while writing results."""
-    problem, fix = _FIXES.get(exc.errno, (f"cannot write ({exc.strerror or exc})",
-                                          "check --out and the disk"))
-    path = exc.filename or where
-    return OutputError(f"cannot write results: {problem}", file=path, fix=fix)
-
-
 # --------------------------------------------------------------------------- directories
 def _marker(path: Path, well: str, state: str) -> None:
     from drillfric._version import __version__
@@ -114,10 +89,10 @@ def is_result_dir(path: Path) -> bool:
     if (path / MARKER).is_file():
         return True
     try:
-        summary = json.loads((path / "summary.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        summary = read_json(path / "summary.json")
+    except InputError:
         return False
-    return isinstance(summary, dict) and {"drillfric_version", "segments"} <= set(summary)
+    return {"drillfric_version", "segments"} <= set(summary)
 
 
 def _pid_alive(pid: int) -> bool:
@@ -265,7 +240,7 @@ def _is_output_problem(exc: OSError, out_root: Path) -> bool:
             return True
         except ValueError:
             return False
-    return exc.errno in _FIXES
+    return is_write_problem(exc)
 
 
 def missing_dirs(path: Path) -> list[Path]:
@@ -333,14 +308,14 @@ def mark_stale(folder: Path, reason: str, when_utc: str) -> bool:
             return False
         summary_path = folder / "summary.json"
         try:
-            summary = json.loads(summary_path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            summary = read_json(summary_path)
+        except InputError:
             summary = None
-        if isinstance(summary, dict):
-            tmp = folder / f".summary.json{_TMP}{_token()}"
-            write_json(tmp, summary | {"stale": stale})
-            os.replace(tmp, summary_path)
-        write_json(folder / STALE, stale)
+        if summary is not None:
+            with replacing(summary_path) as tmp:
+                write_json(tmp, summary | {"stale": stale})
+        with replacing(folder / STALE) as tmp:
+            write_json(tmp, stale)
     return True
 
 
@@ -384,6 +359,28 @@ class EstimatesWriter:
     def close(self) -> None:
         """Finish the file."""
         self._writer.close()
+
+
+def read_json(path: Path, *, fix: str = "rerun 'drillfric run' to rewrite the results") -> dict:
+    """A JSON object drillfric wrote (summary.json, manifest.json …), read as untrusted: any
+    unreadable, undecodable, too deeply nested or non-object file is one InputError naming
+    it (never its content).
+
+    Raises
+    ------
+    InputError
+    """
+    try:
+        value = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError) as exc:
+        why = "too deeply nested" if isinstance(exc, RecursionError) else \
+            "not UTF-8" if isinstance(exc, UnicodeDecodeError) else \
+            f"not JSON ({exc.msg})" if isinstance(exc, json.JSONDecodeError) else \
+            (exc.strerror or type(exc).__name__) if isinstance(exc, OSError) else "not JSON"
+        raise InputError(f"unreadable {Path(path).name}: {why}", file=path, fix=fix) from None
+    if not isinstance(value, dict):
+        raise InputError(f"{Path(path).name} is not a JSON object", file=path, fix=fix)
+    return value
 
 
 def write_json(path: Path, payload: dict) -> None:

@@ -481,11 +481,15 @@ def frame_source(frame: pd.DataFrame) -> RawSource:
     Raises
     ------
     InputError
-        Not a DataFrame, or two columns of one label.
+        Not a DataFrame, columns of several levels, or two columns of one label.
     """
     if not isinstance(frame, pd.DataFrame):
         raise InputError(f"frame is a {type(frame).__name__}, not a pandas DataFrame",
                          file=FRAME_LABEL, fix="give the surface data as a DataFrame")
+    if frame.columns.nlevels > 1:
+        raise InputError(f"the columns have {frame.columns.nlevels} levels (a MultiIndex)",
+                         file=FRAME_LABEL, fix="give one label per column, e.g. "
+                         "frame.columns = ['_'.join(map(str, c)) for c in frame.columns]")
     if not isinstance(frame.index, pd.RangeIndex):
         frame = frame.reset_index()
     frame = frame.set_axis([str(c) for c in frame.columns], axis=1)

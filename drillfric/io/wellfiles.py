@@ -31,6 +31,11 @@ from drillfric.io.text import printable
 
 #: Longest output directory name [bytes of UTF-8]; longer names are cut and given a hash.
 MAX_NAME_BYTES = 100
+#: Files drillfric itself writes in OUT beside the wells' directories (the fleet's and
+#: live's, docs/outputs.md): no well may be named so. Compared case-folded.
+OUT_FILES = frozenset({"manifest.json", "fleet_summary.parquet", "fleet.html", "live.json"})
+#: Suffix of live's WITS0 recordings in OUT (``OUT/NAME.wits0.csv``).
+RECORDING_SUFFIX = ".wits0.csv"
 #: Extensions of HDF5 files (a bundle may hold /config and /survey beside /surface).
 HDF5_EXT = (".h5", ".hdf5")
 #: Extensions of survey sidecars (NAME.survey.EXT), in the order they are looked for.
@@ -111,7 +116,8 @@ def safe_name(raw, where=None) -> str:
     Raises
     ------
     ConfigError
-        Nothing usable is left (e.g. ``"."`` or ``"///"``).
+        Nothing usable is left (e.g. ``"."`` or ``"///"``), or the name is one of drillfric's
+        own files in OUT (:data:`OUT_FILES`, ``*.wits0.csv``).
 
     Examples
     --------
@@ -127,6 +133,11 @@ def safe_name(raw, where=None) -> str:
     if len(text.encode()) > MAX_NAME_BYTES:
         digest = hashlib.sha256(str(raw).encode()).hexdigest()[:10]
         text = text.encode()[:MAX_NAME_BYTES - 11].decode("utf-8", "ignore") + "-" + digest
+    if text.casefold() in OUT_FILES or text.casefold().endswith(RECORDING_SUFFIX):
+        raise ConfigError(f"well name '{printable(raw)}' is the name of a file drillfric "
+                          "writes in OUT beside the wells", file=where,
+                          fix='name the well otherwise, e.g. [well] name = "A-12" (or rename '
+                              'its file or folder)')
     return text
 
 

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.results import read_json
 from drillfric.io.timebase import origin_of
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_FIELDS, SEGMENT_NUMBER_FIELDS
 
@@ -156,12 +157,8 @@ def load_result(result_dir: Path) -> ResultData:
     if not path.is_file():
         raise InputError("no summary.json: not a drillfric result directory", file=result_dir,
                          fix="give the OUT/NAME directory written by 'drillfric run'")
-    try:
-        summary = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"unreadable summary.json ({exc})", file=path,
-                         fix="rerun 'drillfric run' to rewrite the results") from None
-    if not isinstance(summary, dict) or not isinstance(summary.get("segments", []), list):
+    summary = read_json(path)
+    if not isinstance(summary.get("segments", []), list):
         raise InputError("summary.json is not a drillfric summary", file=path,
                          fix="rerun 'drillfric run' to rewrite the results")
     return ResultData(result_dir, summary, segments_frame(summary.get("segments", [])),

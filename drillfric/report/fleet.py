@@ -10,13 +10,13 @@ from pathlib import Path
 from urllib.parse import quote
 
 from drillfric._version import __version__
+from drillfric.io.atomic import write_text_replacing
 
 from .data import segments_frame
 from .display import fmt, report_units, row_flags
 from .friction import fleet_plot
 from .interactive import Embedder
 from .render import environment, mu_s_text, now_utc
-from .well import _write_text
 
 
 def _worst(segments: list[dict]) -> dict:
@@ -123,7 +123,7 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
         news=news,
         plot_id=plot_id, bokeh=embed.head, version=__version__, built=now_utc())
     out = out_dir / "fleet.html"
-    _write_text(out, html)
+    write_text_replacing(out, html)
     return out
 
 

@@ -10,11 +10,12 @@ the well's name and "page n of N" in its footer, below every axis and its tick l
 
 from __future__ import annotations
 
-import os
 import textwrap
 from pathlib import Path
 
 from matplotlib.figure import Figure
+
+from drillfric.io.atomic import replacing
 
 from .render import quiet_glyphs
 
@@ -203,9 +204,9 @@ def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str,
     from matplotlib.backends.backend_pdf import PdfPages  # ~0.2 s: only when a PDF is asked
 
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
     count = len(pages)
-    with PdfPages(tmp, metadata={"Title": title, "Creator": "drillfric"}) as pdf:
+    with replacing(path) as tmp, PdfPages(tmp, metadata={"Title": title,
+                                                          "Creator": "drillfric"}) as pdf:
         for number, (page_title, fig) in enumerate(pages, start=1):
             fig.set_size_inches(*PAGE_IN)
             if page_title:
@@ -218,7 +219,6 @@ def write_pdf(path: Path, pages: list[tuple[str, Figure]], *, title: str,
                      f"page {number} of {count}", fontsize=7, color="#555555", ha="right")
             with quiet_glyphs():
                 pdf.savefig(fig)
-    os.replace(tmp, path)
     return path
 
 

@@ -10,7 +10,6 @@ or columns a result directory lacks (older results) are left out with a one-line
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import pandas as pd
 
 from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
+from drillfric.io.atomic import write_text_replacing
 from drillfric.io.timebase import clock_at
 
 from . import broomstick as broom
@@ -530,7 +530,7 @@ def write_well_report(result_dir: Path, *, pdf: bool = False,
     """
     report = build_report(result_dir, segments, units)
     out = report.data.result_dir / "report.html"
-    _write_text(out, _html(report))
+    write_text_replacing(out, _html(report))  # undecodable file names: replaced
     if pdf:
         from .pdf import PAGE_IN
 
@@ -709,10 +709,4 @@ def _header_lines(report: Report) -> list[list[str]]:
         lines.append(["WARNING" if report.broomstick.check["warning"] else "string weight",
                       check])
     return lines
-
-
-def _write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8", errors="replace")  # undecodable file names
-    os.replace(tmp, path)
 

@@ -382,7 +382,7 @@ class Engine:
         engine = cls(well, **kw)
         try:
             engine.restore(state)
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise InputError(f"engine state not readable ({type(exc).__name__}: {exc})",
                              file=Path(folder), fix="run the well from its start") from exc
         return engine

@@ -15,6 +15,7 @@ from drillfric.io.well import Well
 from drillfric.result import Kind, SegmentRecord, Status
 from drillfric.segmentation import Segment
 
+from .budget import check_work
 from .segment_output import output_frames, segment_record
 
 #: Bit depth assumed when neither the log, the config nor a survey gives one [m].
@@ -25,8 +26,20 @@ RATE_MARGIN = 0.01
 
 
 def first_chunk(well: Well, chunk: pd.DataFrame, rate_hz, warnings: list) -> float | None:
-    """Checks of the first chunk; the rate the estimation resamples to."""
+    """Checks of the first chunk (the rate; the work the configuration implies at the
+    log's first bit depth, :mod:`drillfric.runner.budget`); the rate the estimation
+    resamples to.
+
+    Raises
+    ------
+    InputError, ConfigError
+        An implausible rate; a configuration beyond the work budget.
+    """
     check_plausible_rate(chunk["time_s"].to_numpy(), file=well.files.data)
+    depth = chunk["bit_depth_m"].to_numpy(float) if "bit_depth_m" in chunk else np.empty(0)
+    depth = depth[np.isfinite(depth)]
+    check_work(well.config, float(np.median(depth)) if depth.size else
+               _bit_depth_default(well, []), file=well.files.config or well.files.data)
     rate_used, note = effective_rate(rate_hz, chunk["time_s"].to_numpy())
     warnings += [note] * bool(note)
     return rate_used

@@ -21,6 +21,7 @@ from drillfric._version import __version__
 from drillfric.estimation.consensus import consensus
 from drillfric.estimation.headline import judge as judge_headline
 from drillfric.friction import FrictionProfile
+from drillfric.io.atomic import replacing
 from drillfric.io.results import (
     EstimatesWriter,
     ResultDirectory,
@@ -202,21 +203,20 @@ class DirectorySink:
         row group per segment, in segment order)."""
         path = self.folder / "estimates.parquet"
         old = pq.ParquetFile(path)
-        fresh = self.folder / ".estimates.revised.parquet"
-        writer = EstimatesWriter(fresh, "bit_rpm" in old.schema_arrow.names,
-                                 "timestamp" in old.schema_arrow.names)
-        pending = sorted((i, f) for i, f in self.revised.items() if f is not None)
-        for g in range(old.num_row_groups):
-            table = old.read_row_group(g)
-            seg_id = int(table["segment_id"][0].as_py()) if table.num_rows else 0
-            while pending and pending[0][0] < seg_id:
-                writer.write(pending.pop(0)[1])
-            if seg_id not in self.revised:
-                writer.write_table(table)
-        for _, frame in pending:
-            writer.write(frame)
-        writer.close()
-        fresh.replace(path)
+        with replacing(path) as fresh:
+            writer = EstimatesWriter(fresh, "bit_rpm" in old.schema_arrow.names,
+                                     "timestamp" in old.schema_arrow.names)
+            pending = sorted((i, f) for i, f in self.revised.items() if f is not None)
+            for g in range(old.num_row_groups):
+                table = old.read_row_group(g)
+                seg_id = int(table["segment_id"][0].as_py()) if table.num_rows else 0
+                while pending and pending[0][0] < seg_id:
+                    writer.write(pending.pop(0)[1])
+                if seg_id not in self.revised:
+                    writer.write_table(table)
+            for _, frame in pending:
+                writer.write(frame)
+            writer.close()
 
 
 Sink = MemorySink | DirectorySink

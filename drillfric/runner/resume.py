@@ -26,6 +26,7 @@ format read only whole — is run from the start, and the summary says why (summ
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
@@ -282,21 +283,37 @@ def resume(well: Well, previous: Path, sink: DirectorySink, **kw) -> tuple[Engin
     seeded into ``sink``; or None and why it cannot."""
     if not resumable(well):
         return None, f"its data file is read whole ({_read_whole(well)})"
-    folder = previous / "state"
+    engine, why = restored(well, previous / "state", lambda: Engine(well, sink=sink, **kw),
+                           rate_hz=kw.get("rate_hz"))
+    if engine is None:
+        return None, why
+    sink.seed(previous, {r.id for r in engine.records})
+    engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
+    return engine, ""
+
+
+def restored(well: Well, folder: Path, make: Callable[[], Engine], *,
+             rate_hz: float | None = None,
+             also: Callable[[dict], str] | None = None) -> tuple[Engine | None, str]:
+    """An engine (``make()``) continuing the state saved in ``folder`` (OUT/NAME/state), or
+    None and why not: no state, another drillfric, configuration, rate or data (``also``
+    adds a check of the state's source), or a state that cannot be read. The state lies in
+    OUT, where anyone may have written it (docs/security.md): whatever is wrong with it,
+    the well runs from its start and the summary's ``resumed`` says why — never an error.
+    """
     if not (folder / "engine.json").is_file():
         return None, "no saved state"
     try:
         state = read_state(folder)
+        why = mismatch(state, well, rate_hz) or changed(state.get("source"), well) or \
+            (also(state) if also is not None else "")
+        if why:
+            return None, why
+        engine = make()
+        engine.restore(state)
     except InputError as exc:
         return None, exc.message
-    why = mismatch(state, well, kw.get("rate_hz")) or changed(state.get("source"), well)
-    if why:
-        return None, why
-    engine = Engine(well, sink=sink, **kw)
-    try:
-        engine.restore(state)
-    except (KeyError, TypeError, ValueError, IndexError) as exc:  # not a state we wrote
-        return None, f"engine state not readable ({type(exc).__name__}: {exc})"
-    sink.seed(previous, {r.id for r in engine.records})
-    engine.resumed = {"from_row": engine.raw_rows, "reason": ""}
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError,
+            RecursionError) as exc:  # a well-formed file, but not a state we wrote
+        return None, f"engine state not readable ({type(exc).__name__})"
     return engine, ""

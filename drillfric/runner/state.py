@@ -14,10 +14,12 @@ from __future__ import annotations
 import json
 import math
 import re
+import zipfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
 
@@ -27,6 +29,13 @@ STATE_VERSION = 1
 _DOC, _ARRAYS = "engine.json", "arrays.npz"
 _FRAME_NAME = re.compile(r"^frame-\d{1,6}\.parquet$")
 _FIX = "run the well again from its start (drillfric fleet --force)"
+#: Largest engine.json read [bytes] (a state is a few MB; the rows live in arrays and tables).
+MAX_DOC_BYTES = 64 << 20
+#: Deepest nesting of engine.json (the engine's state is a few levels deep).
+MAX_DEPTH = 64
+#: Decoded bytes a state table may hold per byte of its file, and the floor below which any
+#: table is read (floats compress ~1–3×; a 2-MB file declaring 2×10⁸ rows is refused).
+MAX_TABLE_RATIO, MIN_TABLE_BYTES = 50, 64 << 20
 
 
 def write_state(folder: Path, state: dict) -> None:
@@ -69,17 +78,69 @@ def read_state(folder: Path) -> dict:
         No state there, another format or version, or unreadable parts.
     """
     try:
+        if (folder / _DOC).stat().st_size > MAX_DOC_BYTES:
+            raise ValueError(f"{_DOC} is larger than {MAX_DOC_BYTES >> 20} MB")
         doc = json.loads((folder / _DOC).read_text(encoding="utf-8"))
         if not isinstance(doc, dict) or doc.get("format") != STATE_FORMAT:
             raise ValueError("not an engine state")
         if doc.get("version") != STATE_VERSION:
             raise ValueError(f"state version {doc.get('version')!r}, this drillfric reads "
                              f"{STATE_VERSION}")
+        _check_depth(doc["state"])
+        _check_arrays(folder / _ARRAYS)
         with np.load(folder / _ARRAYS, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
         return _decode(doc["state"], arrays, folder)
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise InputError(f"engine state not readable ({exc})", file=folder, fix=_FIX) from exc
+    except (OSError, ValueError, KeyError, TypeError, RecursionError, EOFError,
+            zipfile.BadZipFile) as exc:
+        why = str(exc) if isinstance(exc, ValueError | KeyError) else type(exc).__name__
+        raise InputError(f"engine state not readable ({why})", file=folder, fix=_FIX) \
+            from exc
+
+
+def _check_depth(value) -> None:
+    """ValueError when ``value`` nests deeper than :data:`MAX_DEPTH` (iterative: a deep
+    document cannot exhaust the stack here)."""
+    stack = [(value, 1)]
+    while stack:
+        item, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ValueError(f"nested deeper than {MAX_DEPTH} levels")
+        children = item.values() if isinstance(item, dict) else item if \
+            isinstance(item, list) else ()
+        stack += [(child, depth + 1) for child in children]
+
+
+def _check_arrays(path: Path) -> None:
+    """ValueError unless every member of ``path`` is a stored (uncompressed: np.savez)
+    .npy whose header declares no more bytes than it holds — read before any array, so a
+    small archive cannot expand into gigabytes."""
+    from numpy.lib import format as npy
+
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            if info.compress_type != zipfile.ZIP_STORED:
+                raise ValueError(f"{info.filename}: compressed (drillfric stores arrays "
+                                 "uncompressed)")
+            with archive.open(info) as stream:
+                read = {(1, 0): npy.read_array_header_1_0,
+                        (2, 0): npy.read_array_header_2_0}.get(npy.read_magic(stream))
+                if read is None:
+                    raise ValueError(f"{info.filename}: not an .npy of version 1 or 2")
+                shape, _, dtype = read(stream)
+            if dtype.hasobject or math.prod(shape) * dtype.itemsize > info.file_size:
+                raise ValueError(f"{info.filename}: declares more than it holds")
+
+
+def _read_table(path: Path) -> pd.DataFrame:
+    """A state table, refused before reading when its declared rows would decode to more
+    than :data:`MAX_TABLE_RATIO` × its size (and :data:`MIN_TABLE_BYTES`)."""
+    meta = pq.ParquetFile(path).metadata
+    decoded = meta.num_rows * max(1, meta.num_columns) * 8
+    if decoded > max(MIN_TABLE_BYTES, MAX_TABLE_RATIO * path.stat().st_size):
+        raise ValueError(f"{path.name}: declares {meta.num_rows:.3g} rows in "
+                         f"{path.stat().st_size:.3g} bytes")
+    return pd.read_parquet(path)
 
 
 def _decode(value, arrays: dict, folder: Path):
@@ -97,5 +158,5 @@ def _decode(value, arrays: dict, folder: Path):
         name = value["$frame"]
         if not isinstance(name, str) or not _FRAME_NAME.match(name):
             raise ValueError("bad table name")
-        return pd.read_parquet(folder / name)
+        return _read_table(folder / name)
     return {k: _decode(v, arrays, folder) for k, v in value.items()}

@@ -1,0 +1,387 @@
+"""Hostile inputs, round four (issue 30): the output folder, the saved state, live
+recordings, fleet names and the work a config implies. Each case goes through the CLI with
+the strict checks of :func:`tests.test_hostile_files._strict_check` (exit code, one error
+line naming the file and the fix, no traceback, nothing written outside ``--out``, no secret
+echoed). Cases are named after the attack (lasio's practice).
+"""
+
+from __future__ import annotations
+
+import shutil
+import socket
+import subprocess
+import threading
+from datetime import datetime, timedelta
+
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric.errors import OutputError
+from tests.test_hostile_files import _strict_check
+from tests.test_hostile_inputs import SECRET, Case, _config, _log
+
+
+def _secret(root):
+    """A file outside OUT that a planted link points at (its content must stay as it is)."""
+    folder = root / "secret"
+    folder.mkdir(exist_ok=True)
+    target = folder / "credentials.txt"
+    target.write_text(SECRET + "\n", encoding="utf-8")
+    return target
+
+
+def _well(root, name="w"):
+    """A wells folder holding one small well (one segment, skipped: fast)."""
+    path = _log(root / "wells" / f"{name}.csv")
+    _config(path.with_suffix(".toml"))
+    return path
+
+
+def _planted(root, name, target=None):
+    """OUT/NAME as a link to ``target`` (the secret; None: a dangling link)."""
+    out = root / "out"
+    (out / name).parent.mkdir(parents=True, exist_ok=True)
+    (out / name).symlink_to(target if target is not None else root / "secret" / "gone.txt")
+    return out / name
+
+
+# --------------------------------------------------------------- links planted in OUT (3)
+@pytest.mark.parametrize("name", ["fleet.html", "fleet_summary.parquet", "manifest.json",
+                                  ".fleet.lock"])
+def test_fleet_output_planted_as_a_link_is_refused(name, tmp_path, capsys):
+    """The fleet's files were written through a link planted in OUT: a file outside OUT
+    overwritten (fleet.html.tmp, .manifest.json.tmp-PID … had predictable names)."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _well(root)
+    _planted(root, name, _secret(root))
+    _strict_check(Case(["fleet", "wells", "--out", "out"], (2,), ("symbolic link",)), root,
+                  capsys)
+    assert (root / "secret" / "credentials.txt").read_text() == SECRET + "\n"
+
+
+def test_report_html_planted_as_a_link_is_refused(tmp_path, capsys):
+    """`drillfric report OUT/NAME` wrote NAME/report.html.tmp and renamed it: through a link
+    planted as report.html the link was replaced, and as report.html.tmp a file elsewhere
+    was overwritten."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"))
+    _strict_check(Case(["run", "w.csv", "--out", "out"], (0,)), root, capsys)
+    (root / "out" / "w" / "report.html").unlink()
+    _planted(root, "w/report.html", _secret(root))
+    _strict_check(Case(["report", "out/w"], (2,), ("symbolic link",)), root, capsys)
+
+
+def test_live_json_planted_as_a_link_is_refused(tmp_path, capsys):
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"))
+    _planted(root, "live.json", _secret(root))
+    _strict_check(Case(["live", "w.csv", "--out", "out", "--until-idle", "1"], (2,),
+                       ("symbolic link",)), root, capsys)
+
+
+def test_wits0_recording_planted_as_a_dangling_link_is_refused(tmp_path, capsys):
+    """A dangling link at OUT/NAME.wits0.csv made live write the whole recording outside
+    OUT (exit 0); pointing at a secrets file, the error printed its first line."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _config(root / "w.toml", '[well]\nname = "rig"\n')
+    for target in (None, _secret(root)):
+        link = _planted(root, "rig.wits0.csv", target)
+        _strict_check(Case(["live", "wits0://127.0.0.1:9", "--config", "w.toml", "--out",
+                            "out", "--until-idle", "1"], (2,), ("symbolic link",)), root,
+                      capsys)
+        assert not (root / "secret" / "gone.txt").exists()
+        link.unlink()
+
+
+# --------------------------------------------------------------- a full disk (7)
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 256-KiB tmpfs at tmp_path/disk (a real ENOSPC); skipped where it cannot be mounted
+    (not root)."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(disk)],
+                          capture_output=True, check=False)
+    if done.returncode:
+        pytest.skip("cannot mount a small tmpfs here (needs root)")
+    try:
+        yield disk
+    finally:
+        subprocess.run(["umount", "-l", str(disk)], capture_output=True, check=False)
+
+
+def _fill(disk, leave_bytes: int) -> None:
+    """Fill ``disk`` until about ``leave_bytes`` are free."""
+    free = shutil.disk_usage(disk).free
+    (disk / "filler").write_bytes(b"\0" * max(0, free - leave_bytes))
+
+
+def test_fleet_on_a_full_disk_fails_each_well_in_one_line_and_leaves_no_temporary(
+        tmp_path, small_disk, capsys):
+    """A fleet on a full disk left a half-written fleet.html.tmp."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    for name in "ab":
+        _well(root, name)
+    _fill(small_disk, 8192)
+    out = small_disk / "out"
+    result = CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out", str(out)])
+    text = result.output
+    assert result.exit_code == 2 and "Traceback" not in text, text
+    assert text.count("no space left on the device") >= 1 and "fix" in text, text
+    left = [p.name for p in small_disk.rglob("*") if ".tmp" in p.name]
+    assert not left, left
+
+
+def test_wits0_stream_filling_the_disk_ends_the_receiver_with_one_error_naming_the_path(
+        small_disk):
+    """A fast WITS0 stream filling the disk gave `internal error: OSError: [Errno 28]` with no
+    path and a traceback from the receiver thread."""
+    from drillfric.io.wits0 import Row, encode, item_map
+    from drillfric.wits0_receiver import Receiver, Recording, parse_address, setup
+
+    _fill(small_disk, 4096)
+    listener = socket.create_server(("127.0.0.1", 0))
+    listener.settimeout(10)
+    address = parse_address(f"wits0://127.0.0.1:{listener.getsockname()[1]}")
+    recording = Recording(small_disk / "t.wits0.csv", Row(item_map({})).names, False)
+    receiver = Receiver(address, setup(address, None, "t"), recording)
+    hooked = []
+    previous, threading.excepthook = threading.excepthook, hooked.append
+    thread = threading.Thread(target=receiver.run, daemon=True)
+    thread.start()
+    try:
+        conn, _ = listener.accept()
+        start = datetime(2026, 11, 27, 14, 0, 0)
+        for k in range(2000):  # ≈ 60 bytes a line: the 4 KiB left are full after ~70
+            if receiver.error is not None:
+                break
+            frame = encode({"surface_rpm": float(k)}, item_map({}),
+                           start + timedelta(seconds=k))
+            try:
+                conn.sendall(frame)
+            except OSError:
+                break
+        thread.join(10)
+        conn.close()
+    finally:
+        receiver.stop.set()
+        thread.join(5)
+        listener.close()
+        threading.excepthook = previous
+    assert not thread.is_alive() and not hooked
+    assert isinstance(receiver.error, OutputError)
+    assert "no space left" in str(receiver.error) and "t.wits0.csv" in str(receiver.error)
+
+
+# --------------------------------------------------------------- fleet and live names (5)
+@pytest.mark.parametrize("name", ["fleet_summary.parquet", "fleet.html", "manifest.json",
+                                  "Live.json", "rig.wits0.csv"])
+def test_a_well_named_as_a_file_drillfric_writes_in_out_fails_alone(name, tmp_path, capsys):
+    """A well named fleet_summary.parquet, fleet.html or manifest.json broke the whole fleet
+    every night (IsADirectoryError, no fleet summary); a live well named live.json could
+    never run. Now that well fails in one line and the others run."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _well(root, "good")
+    odd = _log(root / "wells" / "odd.csv")
+    _config(odd.with_suffix(".toml"), f'[well]\nname = "{name}"\n')
+    _strict_check(Case(["fleet", "wells", "--out", "out", "--workers", "1"], (1,),
+                       ("drillfric writes in OUT", "1 failed")), root, capsys)
+    assert (root / "out" / "fleet_summary.parquet").is_file()
+    assert (root / "out" / "good" / "summary.json").is_file()
+
+
+def test_fleet_writing_into_its_own_wells_folder_does_not_take_its_outputs_for_wells(
+        tmp_path, capsys):
+    """With --out equal to the wells folder, night 2 read its own fleet_summary.parquet as a
+    well and exited 1 every night."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _well(root)
+    for night in (1, 2):
+        result = CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out",
+                                          str(root / "wells"), "--workers", "1"])
+        assert "fleet_summary" not in result.output and "1 wells" in result.output, \
+            (night, result.output)
+
+
+# --------------------------------------------------------------- silently nothing (6)
+def test_a_fleet_in_which_nothing_was_estimated_says_so_and_exits_1(tmp_path):
+    """300 wells with nothing estimated: the fleet said "300 ok" and exited 0."""
+    root = tmp_path / "sandbox"
+    for name in ("a", "b"):
+        _well(root, name)
+    result = CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out",
+                                      str(root / "out"), "--workers", "1"])
+    assert result.exit_code == 1, result.output
+    assert "nothing estimated in 2 of 2 well(s)" in result.output and "a, b" in result.output
+
+
+def test_a_manual_run_into_a_fleets_out_is_redone_next_night_not_unchanged(tmp_path):
+    """`run` with another config into a fleet's OUT was reported next night as "ok
+    (unchanged)" with the old results, contradicting OUT/NAME/summary.json."""
+    root = tmp_path / "sandbox"
+    path = _well(root)
+    out = root / "out"
+    fleet = ["fleet", str(root / "wells"), "--out", str(out), "--workers", "1"]
+    first = CliRunner().invoke(cli, fleet)
+    assert "1 processed" in first.output, first.output
+    again = CliRunner().invoke(cli, fleet)
+    assert "all 1 wells ok (unchanged" in again.output, again.output
+    other = _config(root / "other.toml", "[well]\nbit_depth_m = 1800.0\n")
+    manual = CliRunner().invoke(cli, ["run", str(path), "--config", str(other), "--out",
+                                      str(out)])
+    assert manual.exit_code == 0, manual.output
+    night = CliRunner().invoke(cli, fleet)
+    assert "1 processed" in night.output, night.output
+
+
+# --------------------------------------------------------------- the saved state (4)
+def _zip_bomb(path):
+    """arrays.npz holding one deflated .npy that expands ~1000×."""
+    import io
+    import zipfile
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.save(buf, np.zeros(2_000_000))  # 16 MB of zeros: a few kB deflated
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("a0.npy", buf.getvalue())
+
+
+def _lying_npy(path):
+    """arrays.npz whose stored .npy header declares 10¹⁰ floats in a few bytes."""
+    import zipfile
+
+    header = b"{'descr': '<f8', 'fortran_order': False, 'shape': (10000000000,), }"
+    header += b" " * (117 - len(header)) + b"\n"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as archive:
+        archive.writestr("a0.npy", b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little")
+                         + header + b"\0" * 64)
+
+
+def _many_rows(folder):
+    """frame-0.parquet declaring 2×10⁸ rows of one run (a few kB)."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    column = pa.array(np.zeros(1_000_000))
+    writer = pq.ParquetWriter(folder / "frame-0.parquet", pa.schema([("x", pa.float64())]))
+    for _ in range(200):
+        writer.write_table(pa.table({"x": column}))
+    writer.close()
+
+
+def _deep_json(folder):
+    doc = folder / "engine.json"
+    doc.write_text('{"format": "drillfric-engine-state", "version": 1, "state": '
+                   + "[" * 100_000 + "]" * 100_000 + "}", encoding="utf-8")
+
+
+def _wrong_type(folder):
+    doc = folder / "engine.json"
+    doc.write_text('{"format": "drillfric-engine-state", "version": 1, "state": [1, 2]}',
+                   encoding="utf-8")
+
+
+def _truncated_arrays(folder):
+    path = folder / "arrays.npz"
+    path.write_bytes(path.read_bytes()[: max(1, path.stat().st_size // 2)])
+
+
+@pytest.mark.parametrize("damage", [_truncated_arrays, _deep_json, _wrong_type, _many_rows,
+                                    lambda f: _zip_bomb(f / "arrays.npz"),
+                                    lambda f: _lying_npy(f / "arrays.npz")],
+                         ids=["truncated_npz", "deep_json", "wrong_type", "frame_of_2e8_rows",
+                              "npz_zip_bomb", "npy_header_lying"])
+def test_a_damaged_saved_state_reruns_the_well_from_its_start(damage, tmp_path, capsys):
+    """A truncated arrays.npz, a deep engine.json or a wrong type ended in `internal error`
+    naming no file (and the well failed every night until --force); a 2-MB frame declaring
+    2×10⁸ rows or a 9.5-MB npz expanding to > 1.8 GB exhausted memory at resume."""
+    import json
+
+    import pandas as pd
+
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _well(root)
+    fleet = Case(["fleet", "wells", "--out", "out", "--workers", "1"], (1,))
+    _strict_check(fleet, root, capsys)
+    state = root / "out" / "w" / "state"
+    assert (state / "engine.json").is_file()
+    damage(state)
+    frame = pd.read_csv(path)
+    later = frame.assign(time_s=frame["time_s"] + frame["time_s"].iloc[-1] + 0.1)
+    later.to_csv(path, mode="a", header=False, index=False)  # the log grew: resume is tried
+    _strict_check(fleet, root, capsys)
+    summary = json.loads((root / "out" / "w" / "summary.json").read_text())
+    assert summary["resumed"]["from_row"] == 0, summary["resumed"]
+    assert "not readable" in summary["resumed"]["reason"], summary["resumed"]
+
+
+# --------------------------------------------------------------- configs that ask for hours (2)
+@pytest.mark.parametrize(("table", "text", "says"), [
+    ("model", "element_length_m = 1e-6", "element_length_m"),
+    ("model", "cells = 200000", "cells = 200000"),
+    ("observer", "starts = " + repr([[0.5, 0.3]] * 20000), "20000 observer.starts"),
+    ("observer", "output_rate_hz = 100000", "output_rate_hz"),
+])
+def test_a_config_implying_hours_of_work_is_refused_up_front(table, text, says, tmp_path,
+                                                             capsys):
+    """Inside each key's range: element_length_m = 1e-6 reached 22.7 GB, output_rate_hz =
+    100000 5 GB in 52 s, 20 000 starts > 120 s at 2.8 GB, cells = 200000 unfinished after
+    120 s. Now one line naming the key and the budget, before any work."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"), f"[well]\nbit_depth_m = 2000.0\n[{table}]\n{text}\n")
+    _strict_check(Case(["run", "w.csv", "--out", "out"], (2,), (says,)), root, capsys)
+    assert not (root / "out").exists()
+
+
+def test_damping_without_a_finite_kalman_design_is_a_model_error_naming_k_t():
+    """k_t_per_s = 10000 (in range) gave `internal error: LinAlgError` (no finite solution of
+    the Riccati equation): now a ModelError naming the key, which fails the segment in one
+    line while the others go on."""
+    from drillfric.errors import ModelError
+    from drillfric.estimation.gains import kalman_filter_gain
+    from tests.test_gains import as_params
+
+    with pytest.raises(ModelError, match="k_t_per_s"):
+        kalman_filter_gain(as_params(k_t_per_s=1e4), 40)
+
+
+def test_units_pint_cannot_tokenize_are_unknown_units_and_multiindex_frames_are_refused():
+    """open_well(frame=…) with MultiIndex columns gave tokenize.TokenError (its labels were
+    read as units); any text pint's parser chokes on is an unknown unit."""
+    import numpy as np
+    import pandas as pd
+
+    import drillfric
+    from drillfric.errors import InputError
+    from drillfric.units import parse_unit
+
+    with pytest.raises(InputError, match="unknown unit"):
+        parse_unit("('a', 'b'")
+    frame = pd.DataFrame(np.ones((10, 3)), columns=pd.MultiIndex.from_tuples(
+        [("time_s", "s"), ("surface_rpm", "rpm"), ("surface_torque_Nm", "Nm")]))
+    with pytest.raises(InputError, match="MultiIndex"):
+        drillfric.open_well(frame=frame)
+
+
+def test_report_on_a_summary_nested_100000_deep_is_one_line(tmp_path, capsys):
+    """`drillfric report` on a 100 000-deep summary.json: RecursionError."""
+    root = tmp_path / "sandbox"
+    (root / "out" / "w").mkdir(parents=True)
+    (root / "out" / "w" / "summary.json").write_text("[" * 100_000 + "]" * 100_000)
+    _strict_check(Case(["report", "out/w"], (2,), ("too deeply nested",)), root, capsys)
