@@ -38,7 +38,7 @@ import pandas as pd
 from drillfric import __version__, overnight
 from drillfric.discovery import WellSpec
 from drillfric.errors import DrillfricError, InputError, OutputError
-from drillfric.io.atomic import refuse_link, replacing
+from drillfric.io.atomic import own_file, refuse_link, replacing
 from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
     check_distinct,
@@ -231,6 +231,10 @@ def _abs(path) -> str | None:
 
 
 def _file_stamp(path: Path, known: dict) -> dict:
+    """Size, modification time and SHA-256 of an input file (hashed again only when size or
+    time changed). OSError for anything but a regular file: a FIFO would hang the hash."""
+    if not path.is_file():
+        raise FileNotFoundError(f"not a regular file: {path}")
     stat = path.stat()
     key = str(path.resolve())
     stamp = {"path": key, "size": stat.st_size, "mtime_ns": stat.st_mtime_ns}
@@ -257,9 +261,13 @@ def _same(fingerprint: dict, entry: dict | None, known: dict) -> bool:
     if any(recorded.get(role, {}).get("sha256") != f["sha256"]
            for role, f in fingerprint["inputs"].items()):
         return False
+    extra = [f for role, f in recorded.items() if role not in fingerprint["inputs"]]
+    near = [Path(f["path"]).parent for f in fingerprint["inputs"].values()]
+    if not all(any(Path(f["path"]).is_relative_to(d) for d in near) for f in extra):
+        return False  # a file away from the well's own: not one its worker read
     try:
         return all(_file_stamp(Path(f["path"]), known)["sha256"] == f["sha256"]
-                   for role, f in recorded.items() if role not in fingerprint["inputs"])
+                   for f in extra)
     except (OSError, KeyError, TypeError):
         return False
 
@@ -268,8 +276,8 @@ def _summary_sha256(path: Path) -> str | None:
     """The digest of a well's summary.json as it is now (None: unreadable): one the fleet
     did not write (a manual ``run`` into OUT/NAME) differs from the manifest's."""
     try:
-        return file_sha256(path)
-    except OSError:
+        return file_sha256(own_file(path))
+    except (OSError, ValueError):
         return None
 
 
@@ -359,6 +367,31 @@ class FleetResult:
                      and not (w.summary.get("counts") or {}).get("estimated"))
 
 
+def _sound(entry, out_root: Path | None) -> bool:
+    """Whether a manifest entry has the shape drillfric writes, with its outputs in OUT/NAME
+    (the manifest lies in OUT, where anyone may write: an entry naming files elsewhere would
+    make the fleet hash them, hang on a FIFO there, or publish results that are not this
+    well's as "unchanged")."""
+    if not isinstance(entry, dict) or not isinstance(entry.get("status"), str):
+        return False
+    inputs, outputs = entry.get("inputs", {}), entry.get("outputs", {})
+    history = entry.get("history", [])
+    if not (isinstance(inputs, dict) and isinstance(outputs, dict) and
+            isinstance(history, list) and all(isinstance(h, dict) for h in history)):
+        return False
+    if not all(isinstance(f, dict) and isinstance(f.get("path"), str) and
+               isinstance(f.get("sha256"), str) for f in inputs.values()):
+        return False
+    if not outputs:
+        return True
+    folder = outputs.get("dir")
+    if not isinstance(folder, str) or out_root is None or \
+            Path(folder).resolve().parent != Path(out_root).resolve():
+        return False
+    return all(isinstance(v, str) and Path(v).parent == Path(folder)
+               for k, v in outputs.items() if k != "dir")
+
+
 class _Manifest:
     """OUT/manifest.json: one entry per well, saved atomically (throttled while running).
 
@@ -373,6 +406,8 @@ class _Manifest:
             self.data = {}
         if not isinstance(self.data.get("wells"), dict):
             self.data = {"wells": {}}  # unreadable: every well runs again
+        self.data["wells"] = {name: entry for name, entry in self.data["wells"].items()
+                              if _sound(entry, out_root)}  # a bad entry: that well runs again
         self._saved = 0.0
 
     @property

@@ -48,6 +48,8 @@ _STARTS = ("ramp", "creep")
 SIM_CELL_STEP_S = 1.0e-9
 #: Budget of one simulation [CPU s] (a 24-h well at 500 cells takes ≈ 20 s).
 MAX_SIM_CPU_S = 3600.0
+#: Most rows one simulation records (each ~15 channels of 8 bytes, held in memory).
+MAX_SIM_ROWS = 5e7
 
 
 @dataclass(frozen=True)
@@ -623,7 +625,7 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     settings = PlantSettings.from_config(cfg)
     noise = Noise.from_config(cfg) if noise is None else noise
     check_depths(scenario, path, cfg.source)
-    check_work(cfg, settings, scenario)
+    check_work(cfg, settings, scenario, rate)
     if path is None:
         path = no_survey_path(max(s.bit_depth_m for s in scenario.stands),
                               cfg.tortuosity_rad_m)
@@ -651,16 +653,25 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     return Simulation(columns, tuple(stands), settings, noise, rate, notes)
 
 
-def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario) -> float:
+def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario,
+               rate_hz: float) -> float:
     """The plant's CPU time for ``scenario`` [s], estimated as cells²/t_w cell-steps per
     simulated second (t_w: the wave's travel time along the stand's string; the Courant-1
-    grid, docs/theory.md §3.1) at :data:`SIM_CELL_STEP_S` each.
+    grid, docs/theory.md §3.1) at :data:`SIM_CELL_STEP_S` each; and its recorded rows.
 
     Raises
     ------
     ConfigError
-        Beyond :data:`MAX_SIM_CPU_S` (``[simulate] cells`` enters squared).
+        Beyond :data:`MAX_SIM_CPU_S` (``[simulate] cells`` enters squared), or more than
+        :data:`MAX_SIM_ROWS` rows at ``rate_hz``.
     """
+    seconds = sum(st.total_s for st in scenario.stands) + \
+        scenario.connection_s * max(0, len(scenario.stands) - 1)
+    if seconds * rate_hz > MAX_SIM_ROWS:
+        raise ConfigError(f"{seconds:.4g} s recorded at {rate_hz:g} Hz is {seconds * rate_hz:.3g} "
+                          f"rows; the budget is {MAX_SIM_ROWS:.0e} (≈ 6 days at 100 Hz)",
+                          file=cfg.source, fix="a lower [simulate] rate_hz (--rate) or "
+                                               "shorter stands")
     cell_steps = 0.0
     for stand in scenario.stands:
         string = build_string(cfg.sections, stand.bit_depth_m)

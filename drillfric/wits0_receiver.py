@@ -21,8 +21,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from drillfric.config import read_toml
-from drillfric.errors import DrillfricError, InputError
-from drillfric.io.atomic import open_appending, output_error, refuse_link
+from drillfric.errors import DrillfricError, InputError, OutputError
+from drillfric.io.atomic import open_appending, output_error, own_file, refuse_link
 from drillfric.io.text import printable
 from drillfric.io.wellfiles import safe_name
 from drillfric.io.wits0 import Decoder, Row, frame_clock, item_map
@@ -193,6 +193,12 @@ class Recording:
         self.path, self.utc = Path(path), utc
         self.header = ",".join(["time", *names]) + "\n"
         refuse_link(self.path)
+        if self.path.exists():
+            try:
+                own_file(self.path)  # a FIFO there would hang the open
+            except ValueError as exc:
+                raise OutputError(f"cannot record the stream: {exc}", file=self.path,
+                                  fix="remove it, or choose another --out") from None
         self.last_s = self._continue() if self.path.exists() else None
         self._fh = None
 

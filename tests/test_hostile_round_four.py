@@ -7,11 +7,13 @@ echoed). Cases are named after the attack (lasio's practice).
 
 from __future__ import annotations
 
+import os
 import shutil
 import socket
 import subprocess
 import threading
 from datetime import datetime, timedelta
+from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -19,7 +21,7 @@ from drillfric.cli.main import cli
 
 from drillfric.errors import OutputError
 from tests.test_hostile_files import _strict_check
-from tests.test_hostile_inputs import SECRET, Case, _config, _log
+from tests.test_hostile_inputs import SECRET, Case, _check, _config, _log, hang_guard
 
 
 def _secret(root):
@@ -299,11 +301,65 @@ def _truncated_arrays(folder):
     path.write_bytes(path.read_bytes()[: max(1, path.stat().st_size // 2)])
 
 
+def _tracks_asking_for_gigabytes(folder):
+    """engine.json's track accumulator with max_bins 10⁹ and 10-µs bins (1.8 GB at resume)."""
+    import json
+
+    doc = json.loads((folder / "engine.json").read_text())
+
+    def edit(node):
+        if isinstance(node, dict):
+            if "max_bins" in node:
+                node.update(max_bins=1_000_000_000, width_s=1e-5)
+            for value in node.values():
+                edit(value)
+        elif isinstance(node, list):
+            for value in node:
+                edit(value)
+
+    edit(doc)
+    (folder / "engine.json").write_text(json.dumps(doc))
+
+
+def _text_array(folder):
+    """Every array of arrays.npz replaced by one of text (the time buffer's arithmetic then
+    failed with UFuncTypeError on every night)."""
+    import numpy as np
+
+    with np.load(folder / "arrays.npz") as npz:
+        keys = list(npz.files)
+    np.savez(folder / "arrays.npz", **{k: np.array(["x"] * 400) for k in keys})
+
+
+def _fifo(name):
+    def plant(folder):
+        (folder / name).unlink()
+        os.mkfifo(folder / name)
+    return plant
+
+
+def _outside_table(folder):
+    """frame-0.parquet a link to a table elsewhere: its rows were read into the results."""
+    import pandas as pd
+
+    elsewhere = folder.parents[3] / "secret" / "private.parquet"
+    elsewhere.parent.mkdir(exist_ok=True)
+    pd.DataFrame({"time_s": [0.0], "surface_rpm": [60.0],
+                  "surface_torque_Nm": [31337.0]}).to_parquet(elsewhere)
+    for old in folder.glob("frame-*.parquet"):
+        old.unlink()
+        old.symlink_to(elsewhere)
+
+
 @pytest.mark.parametrize("damage", [_truncated_arrays, _deep_json, _wrong_type, _many_rows,
                                     lambda f: _zip_bomb(f / "arrays.npz"),
-                                    lambda f: _lying_npy(f / "arrays.npz")],
+                                    lambda f: _lying_npy(f / "arrays.npz"),
+                                    _tracks_asking_for_gigabytes, _text_array,
+                                    _fifo("arrays.npz"), _fifo("engine.json"), _outside_table],
                          ids=["truncated_npz", "deep_json", "wrong_type", "frame_of_2e8_rows",
-                              "npz_zip_bomb", "npy_header_lying"])
+                              "npz_zip_bomb", "npy_header_lying", "tracks_of_1e9_bins",
+                              "text_arrays", "fifo_npz", "fifo_engine_json",
+                              "table_linked_from_elsewhere"])
 def test_a_damaged_saved_state_reruns_the_well_from_its_start(damage, tmp_path, capsys):
     """A truncated arrays.npz, a deep engine.json or a wrong type ended in `internal error`
     naming no file (and the well failed every night until --force); a 2-MB frame declaring
@@ -326,7 +382,8 @@ def test_a_damaged_saved_state_reruns_the_well_from_its_start(damage, tmp_path, 
     _strict_check(fleet, root, capsys)
     summary = json.loads((root / "out" / "w" / "summary.json").read_text())
     assert summary["resumed"]["from_row"] == 0, summary["resumed"]
-    assert "not readable" in summary["resumed"]["reason"], summary["resumed"]
+    assert "not readable" in summary["resumed"]["reason"] or \
+        summary["resumed"]["reason"] == "no saved state", summary["resumed"]  # not a file
 
 
 # --------------------------------------------------------------- configs that ask for hours (2)
@@ -385,3 +442,86 @@ def test_report_on_a_summary_nested_100000_deep_is_one_line(tmp_path, capsys):
     (root / "out" / "w").mkdir(parents=True)
     (root / "out" / "w" / "summary.json").write_text("[" * 100_000 + "]" * 100_000)
     _strict_check(Case(["report", "out/w"], (2,), ("too deeply nested",)), root, capsys)
+
+
+# ------------------------------------------------ a manifest lying (issue 30, the attack)
+def _night(root):
+    return CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out", str(root / "out"),
+                                    "--workers", "1"])
+
+
+@pytest.mark.parametrize("lie", ["entry_a_number", "inputs_a_list", "outputs_a_text",
+                                 "input_without_path", "outputs_elsewhere", "extra_input_fifo"])
+def test_a_manifest_entry_that_is_not_drillfrics_makes_the_well_run_again(lie, tmp_path):
+    """manifest.json's entries were trusted: a number or a list where a table goes was an
+    internal error every night (--force too); a FIFO named as an input hung the fleet; an
+    entry whose outputs lay elsewhere published another folder's results as "unchanged"."""
+    import json
+
+    import pandas as pd
+
+    root = tmp_path / "sandbox"
+    _well(root)
+    assert "1 processed" in _night(root).output
+    path = root / "out" / "manifest.json"
+    manifest = json.loads(path.read_text())
+    entry = manifest["wells"]["w"]
+    if lie == "entry_a_number":
+        manifest["wells"]["w"] = 5
+    elif lie == "inputs_a_list":
+        entry["inputs"] = []
+    elif lie == "outputs_a_text":
+        entry["outputs"] = "x"
+    elif lie == "input_without_path":
+        entry["inputs"]["data"] = {"sha256": "x"}
+    elif lie == "outputs_elsewhere":
+        elsewhere = root / "elsewhere"
+        shutil.copytree(root / "out" / "w", elsewhere)
+        entry["outputs"] = {k: v.replace(str(root / "out" / "w"), str(elsewhere))
+                            for k, v in entry["outputs"].items()}
+    else:
+        os.mkfifo(root / "fifo")
+        entry["inputs"]["extra"] = {"path": str(root / "fifo"), "size": 0, "mtime_ns": 0,
+                                    "sha256": "00"}
+    path.write_text(json.dumps(manifest))
+    with hang_guard(120):
+        night = _night(root)
+    assert "Traceback" not in night.output and "internal error" not in night.output, \
+        night.output
+    assert "1 processed" in night.output, night.output
+    table = pd.read_parquet(root / "out" / "fleet_summary.parquet")
+    assert {str(Path(d).resolve()) for d in table["result_dir"]} == \
+        {str((root / "out" / "w").resolve())}
+
+
+def test_a_fifo_at_the_wits0_recording_is_refused_not_waited_on(tmp_path, capsys):
+    """A FIFO at OUT/NAME.wits0.csv hung live in open() (O_NOFOLLOW only)."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _config(root / "rig.toml", '[well]\nname = "rig"\n')
+    (root / "out").mkdir()
+    os.mkfifo(root / "out" / "rig.wits0.csv")
+    _strict_check(Case(["live", "wits0://127.0.0.1:9", "--config", "rig.toml", "--out", "out",
+                        "--until-idle", "1"], (2,), ("FIFO",)), root, capsys)
+
+
+def test_simulate_recording_more_rows_than_memory_holds_is_refused(tmp_path, capsys):
+    """rate_hz = 100000 over 100 000 s asked for 74.5 GiB: internal MemoryError."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    (root / "s.toml").write_text("[simulate]\nbit_depth_m = 1000.0\ncells = 20\n"
+                                 "duration_s = 100000.0\nrate_hz = 100000.0\n")
+    _strict_check(Case(["simulate", "s.toml", "--out", "out/o.csv"], (2,), ("rows",)), root,
+                  capsys)
+
+
+def test_a_directory_where_the_fleet_writes_a_file_is_named_not_its_temporary(tmp_path,
+                                                                             capsys):
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _well(root)
+    (root / "out" / "fleet.html").mkdir(parents=True)
+    text = _check(Case(["fleet", "wells", "--out", "out", "--workers", "1"], (2,),
+                       ("a directory stands where drillfric writes",)), root)
+    assert "out/fleet.html:" in text and ".tmp" not in text, text
+

@@ -15,6 +15,7 @@ from __future__ import annotations
 import errno
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -37,22 +38,46 @@ _FIXES = {
                    "remove or rename that file, or choose another --out"),
     errno.ELOOP: ("a symbolic link stands where drillfric writes (it writes through no link)",
                   "remove the link, or choose another --out"),
+    errno.EISDIR: ("a directory stands where drillfric writes a file",
+                   "remove or rename that directory, or choose another --out"),
 }
 LINK_FIX = _FIXES[errno.ELOOP][1]
 
 
-def output_error(exc: OSError, where: Path) -> OutputError:
+def output_error(exc: OSError, where: Path, *, named: bool = False) -> OutputError:
     """One-line :class:`OutputError` for an OSError met while writing results (the path
-    the error names, else ``where``; never the content of a file)."""
+    the error names, else ``where``; ``where`` always when ``named``: a temporary's path
+    means nothing to the reader; never the content of a file)."""
     problem, fix = _FIXES.get(exc.errno, (f"cannot write ({exc.strerror or exc})",
                                           "check --out and the disk"))
-    path = exc.filename or where
+    path = where if named else exc.filename or where
     return OutputError(f"cannot write results: {problem}", file=path, fix=fix)
 
 
 def is_write_problem(exc: OSError) -> bool:
     """Whether an OSError is one of a full, read-only or forbidden output (not an input's)."""
     return exc.errno in _FIXES
+
+
+def own_file(path: Path) -> Path:
+    """``path`` when it is a regular file itself — not a link, a FIFO, a device or a
+    directory: a file drillfric wrote in OUT and reads back (summary.json, manifest.json,
+    the saved state, a recording). Anyone may plant something else there: a link would be
+    read outside OUT, a FIFO would hang the open.
+
+    Raises
+    ------
+    FileNotFoundError
+        Nothing there.
+    ValueError
+        Something there that drillfric does not write (the caller names it in its error).
+    """
+    mode = os.lstat(path).st_mode
+    if not stat.S_ISREG(mode):
+        kind = "a symbolic link" if stat.S_ISLNK(mode) else "a directory" if \
+            stat.S_ISDIR(mode) else "a FIFO, device or socket"
+        raise ValueError(f"{Path(path).name} is {kind}, not a file drillfric wrote")
+    return Path(path)
 
 
 def refuse_link(path: Path) -> None:
@@ -85,7 +110,7 @@ def replacing(path: Path) -> Iterator[Path]:
         refuse_link(path)  # planted while the file was written
         os.replace(private / path.name, path)
     except OSError as exc:
-        raise output_error(exc, path) from None
+        raise output_error(exc, path, named=True) from None
     finally:
         shutil.rmtree(private, ignore_errors=True)
 

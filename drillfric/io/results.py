@@ -36,7 +36,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from drillfric.errors import InputError, OutputError
-from drillfric.io.atomic import is_write_problem, output_error, replacing
+from drillfric.io.atomic import is_write_problem, output_error, own_file, replacing
 from drillfric.io.digest import sha256_prefix
 from drillfric.io.locks import lock_directory
 from drillfric.result import ESTIMATE_COLUMNS, segment_table
@@ -362,21 +362,22 @@ class EstimatesWriter:
 
 
 def read_json(path: Path, *, fix: str = "rerun 'drillfric run' to rewrite the results") -> dict:
-    """A JSON object drillfric wrote (summary.json, manifest.json …), read as untrusted: any
-    unreadable, undecodable, too deeply nested or non-object file is one InputError naming
-    it (never its content).
+    """A JSON object drillfric wrote (summary.json, manifest.json …), read as untrusted: a
+    link, FIFO or directory there (:func:`~drillfric.io.atomic.own_file`), or an unreadable,
+    undecodable, too deeply nested or non-object file is one InputError naming it (never
+    its content).
 
     Raises
     ------
     InputError
     """
     try:
-        value = json.loads(Path(path).read_text(encoding="utf-8"))
+        value = json.loads(own_file(Path(path)).read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError) as exc:
         why = "too deeply nested" if isinstance(exc, RecursionError) else \
             "not UTF-8" if isinstance(exc, UnicodeDecodeError) else \
             f"not JSON ({exc.msg})" if isinstance(exc, json.JSONDecodeError) else \
-            (exc.strerror or type(exc).__name__) if isinstance(exc, OSError) else "not JSON"
+            (exc.strerror or type(exc).__name__) if isinstance(exc, OSError) else str(exc)
         raise InputError(f"unreadable {Path(path).name}: {why}", file=path, fix=fix) from None
     if not isinstance(value, dict):
         raise InputError(f"{Path(path).name} is not a JSON object", file=path, fix=fix)

@@ -32,6 +32,9 @@ TRACK_CHANNELS = ("hookload_N", "surface_torque_Nm", "surface_rpm", "bit_depth_m
 TARGET_BINS = 4000
 #: Bin width when the log's duration is not known in advance [s].
 INITIAL_BIN_S = 0.1
+#: Narrowest bin a saved state may give [s] (a known duration sets duration / max_bins:
+#: 1 ms is a 4-s log's).
+MIN_BIN_S = 1e-3
 _N_STATES = len(RIG_STATES)
 
 
@@ -148,7 +151,14 @@ class TrackAccumulator:
                    for stat in ("min", "max", "sum", "count") for name in self.channels}}
 
     def restore(self, state: dict) -> None:
-        """Continue from a :meth:`state`."""
+        """Continue from a :meth:`state` (read from OUT, so checked: ValueError unless it has
+        this accumulator's ``max_bins``, a finite bin width of at least :data:`MIN_BIN_S`
+        and no more bins than ``max_bins`` — a tampered width or count asked for gigabytes).
+        """
+        if int(state["max_bins"]) != self.max_bins or not \
+                MIN_BIN_S <= float(state["width_s"]) < np.inf or \
+                not 0 <= int(state["n"]) <= self.max_bins:
+            raise ValueError("tracks state outside its bounds")
         self.max_bins, self.width_s = int(state["max_bins"]), float(state["width_s"])
         self._expected_s, self.t0_s = float(state["expected_s"]), state["t0_s"]
         self.origin = None if state["origin"] is None else pd.Timestamp(state["origin"])

@@ -22,6 +22,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
+from drillfric.io.atomic import own_file
 
 #: ``engine.json`` ``format`` and ``version`` of the state this drillfric writes and reads.
 STATE_FORMAT = "drillfric-engine-state"
@@ -36,6 +37,8 @@ MAX_DEPTH = 64
 #: Decoded bytes a state table may hold per byte of its file, and the floor below which any
 #: table is read (floats compress ~1–3×; a 2-MB file declaring 2×10⁸ rows is refused).
 MAX_TABLE_RATIO, MIN_TABLE_BYTES = 50, 64 << 20
+#: dtype kinds of the arrays a state holds (bool, integers, floats, datetimes).
+_ARRAY_KINDS = "biufMm"
 
 
 def write_state(folder: Path, state: dict) -> None:
@@ -78,6 +81,8 @@ def read_state(folder: Path) -> dict:
         No state there, another format or version, or unreadable parts.
     """
     try:
+        for part in (folder / _DOC, folder / _ARRAYS):
+            own_file(part)  # a link would be read outside OUT, a FIFO would hang
         if (folder / _DOC).stat().st_size > MAX_DOC_BYTES:
             raise ValueError(f"{_DOC} is larger than {MAX_DOC_BYTES >> 20} MB")
         doc = json.loads((folder / _DOC).read_text(encoding="utf-8"))
@@ -128,14 +133,16 @@ def _check_arrays(path: Path) -> None:
                 if read is None:
                     raise ValueError(f"{info.filename}: not an .npy of version 1 or 2")
                 shape, _, dtype = read(stream)
-            if dtype.hasobject or math.prod(shape) * dtype.itemsize > info.file_size:
+            if dtype.kind not in _ARRAY_KINDS:
+                raise ValueError(f"{info.filename}: {dtype} is not a number array")
+            if math.prod(shape) * dtype.itemsize > info.file_size:
                 raise ValueError(f"{info.filename}: declares more than it holds")
 
 
 def _read_table(path: Path) -> pd.DataFrame:
     """A state table, refused before reading when its declared rows would decode to more
     than :data:`MAX_TABLE_RATIO` × its size (and :data:`MIN_TABLE_BYTES`)."""
-    meta = pq.ParquetFile(path).metadata
+    meta = pq.ParquetFile(own_file(path)).metadata
     decoded = meta.num_rows * max(1, meta.num_columns) * 8
     if decoded > max(MIN_TABLE_BYTES, MAX_TABLE_RATIO * path.stat().st_size):
         raise ValueError(f"{path.name}: declares {meta.num_rows:.3g} rows in "
