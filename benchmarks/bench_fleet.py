@@ -20,8 +20,8 @@ from pathlib import Path
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.discovery import WellSpec
-from drillfric.fleet import _client, run_many
+from drillfric.fleet.discovery import WellSpec
+from drillfric.fleet.run import _client, run_many
 
 REPO = Path(__file__).resolve().parents[1]
 #: Off-bottom rotating segments per day of rig data: 49 segments in the 50 000 s of the
@@ -79,7 +79,7 @@ def trivial_overhead(folder: Path, count: int, workers: int) -> tuple[float, flo
 
 COLD_START = """
 import os, sys, time
-from drillfric.fleet import _client
+from drillfric.fleet.run import _client
 t0 = time.perf_counter()
 with _client(2, None) as client:
     client.gather([client.submit(os.getpid, pure=False) for _ in range(2)])

@@ -26,7 +26,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from drillfric import torsional as T  # noqa: E402
-from drillfric.simulator import well_b_plant  # noqa: E402
+from drillfric.sim.well_b import well_b_plant  # noqa: E402
 from drillfric.units import RPM_TO_RAD_S as RPM  # noqa: E402
 
 

@@ -36,10 +36,10 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import drillfric  # noqa: E402
-from drillfric import recorder  # noqa: E402
 from drillfric.config import load_config  # noqa: E402
 from drillfric.io.survey import read_survey  # noqa: E402
 from drillfric.io.writers import dumps_toml  # noqa: E402
+from drillfric.sim import recorder  # noqa: E402
 from drillfric.torque_drag import solve_config  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]

@@ -1,6 +1,6 @@
 """`drillfric fleet` (docs/cli.md, docs/fleet.md): every well of a directory or manifest.
 
-Thin layer over :func:`drillfric.fleet.run_many`: a progress bar over wells, one line per
+Thin layer over :func:`drillfric.fleet.run.run_many`: a progress bar over wells, one line per
 failed well, a closing summary line. SIGTERM (and Ctrl-C) stop the run cleanly: finished
 wells stay recorded in OUT/manifest.json, no half-written well directory is left, and the
 next run completes the rest. Exit codes: 0 all ok, 1 some wells or segments failed, 2 bad
@@ -58,8 +58,8 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
     """Run every well of DIR_OR_MANIFEST (a directory of wells, or a .csv/.json manifest
     with columns well, data, config, survey), skipping wells unchanged since their last run.
     """
-    from drillfric.discovery import discover
-    from drillfric.fleet import run_many
+    from drillfric.fleet.discovery import discover
+    from drillfric.fleet.run import run_many
 
     if workers is not None and workers < 1:
         raise UserError(f"--workers must be at least 1, got {workers}")

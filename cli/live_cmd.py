@@ -39,7 +39,7 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
     wits0://HOST:PORT (a WITS level 0 stream, recorded into OUT/NAME.wits0.csv) — and
     estimate its segments as they close. A restarted live run on the same SOURCE and --out
     continues where it stopped."""
-    from drillfric.live import run_live
+    from drillfric.live.run import run_live
     from drillfric.report import write_well_report
 
     if until_idle is not None and not until_idle > 0:
@@ -82,7 +82,7 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
 def _wits0(source: str, out: Path, config: Path | None, name: str | None):
     """The recording a WITS0 source fills, the keywords to open it, and its receiver
     (running)."""
-    from drillfric import wits0_receiver as wits0
+    from drillfric.live import wits0_receiver as wits0
 
     address = wits0.parse_address(source)
     setup = wits0.setup(address, config, name)
@@ -92,7 +92,7 @@ def _wits0(source: str, out: Path, config: Path | None, name: str | None):
 
 def _server(address: str):
     """The live page's server bound at ``address`` (one line and exit 2 when it cannot be)."""
-    from drillfric.livepage import serve
+    from drillfric.live.page import serve
 
     try:
         server = serve(address)

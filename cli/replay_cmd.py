@@ -34,7 +34,7 @@ def command(file: Path, target: str, speed: float, tick: float, seed: int,
     if target.startswith("wits0:"):
         _wits0(file, target, speed, drop_after)
         return
-    from drillfric.replay import recorded_text, replay
+    from drillfric.live.replay import recorded_text, replay
 
     path = Path(target)
     if path.exists() and path.stat().st_size:
@@ -49,9 +49,9 @@ def _wits0(file: Path, target: str, speed: float, drop_after: int | None) -> Non
     """Serve FILE at ``target`` until every frame was sent whole."""
     import time
 
-    from drillfric.replay import recorded_frame
-    from drillfric.wits0_receiver import parse_address
-    from drillfric.wits0_server import frames_of, serve, start_clock
+    from drillfric.live.replay import recorded_frame
+    from drillfric.live.wits0_receiver import parse_address
+    from drillfric.live.wits0_server import frames_of, serve, start_clock
 
     address = parse_address(target, "--to")
     _, canonical, origin = recorded_frame(file)

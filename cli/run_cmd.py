@@ -216,8 +216,8 @@ def _print(result, units: str | None = None) -> None:
 def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers) -> None:
     """Several wells on local worker processes, through the fleet executor (always redone;
     OUT gets the wells' directories only, none of the fleet files)."""
-    from drillfric.discovery import WellSpec
-    from drillfric.fleet import run_many
+    from drillfric.fleet.discovery import WellSpec
+    from drillfric.fleet.run import run_many
 
     from .common import progress
 

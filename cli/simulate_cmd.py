@@ -1,8 +1,8 @@
 """`drillfric simulate` (docs/cli.md): synthetic surface data with ground truth.
 
 Thin layer: options become configuration overrides (command line > file > defaults), the
-survey is resolved, :func:`drillfric.simulator.plan` picks the stands (the scenario, else one
-stand), :func:`drillfric.simulator.simulate` runs the plant stand
+survey is resolved, :func:`drillfric.sim.run.plan` picks the stands (the scenario, else one
+stand), :func:`drillfric.sim.run.simulate` runs the plant stand
 by stand, :func:`drillfric.io.writers.write_well` writes the data file and its sidecars.
 """
 
@@ -94,8 +94,8 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     """
     import pandas as pd
 
-    from drillfric import simulator as sim
     from drillfric.io.writers import data_format, write_well
+    from drillfric.sim import run as sim
     from drillfric.wellpath import no_survey_path
 
     data_format(out)

@@ -143,10 +143,10 @@ def simulate(config, *, out=None, **settings):
 
     Returns
     -------
-    drillfric.simulator.Simulation
+    drillfric.sim.run.Simulation
         ``.frame()`` the surface channels, ``.truth()`` the ground truth.
     """
-    from drillfric.simulator import simulate_config
+    from drillfric.sim.run import simulate_config
 
     return simulate_config(config, out=out, overrides={f"simulate.{k}": v
                                                        for k, v in settings.items()})

@@ -13,8 +13,8 @@ from tests.conftest import REPO
 CONTRACT = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["importlinter"]
 
 
-def _layered_modules() -> set[str]:
-    (layers,) = [c["layers"] for c in CONTRACT["contracts"] if c["type"] == "layers"]
+def _layered_modules(contract: str = "layers") -> set[str]:
+    (layers,) = [c["layers"] for c in CONTRACT["contracts"] if c["id"] == contract]
     return {name.strip() for layer in layers for name in layer.replace("|", ":").split(":")}
 
 
@@ -34,3 +34,13 @@ def test_every_module_has_a_layer(path):
     """A new module outside every layer would be unchecked: each must be placed."""
     assert f"drillfric.{path.stem}" in _layered_modules(), (
         f"drillfric/{path.name} is in no layer of [tool.importlinter] in pyproject.toml")
+
+
+@pytest.mark.parametrize("path", sorted(
+    p for family in ("fleet", "live", "sim") for p in (REPO / "drillfric" / family).glob("*.py")
+    if p.name != "__init__.py"), ids=lambda p: f"{p.parent.name}.{p.stem}")
+def test_every_module_of_a_family_has_a_layer_in_it(path):
+    """The families (issue 31) keep their own order: the entry module above its parts."""
+    family = path.parent.name
+    assert f"drillfric.{family}.{path.stem}" in _layered_modules(family), (
+        f"drillfric/{family}/{path.name} is in no layer of the '{family}' contract")

@@ -16,7 +16,7 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.wits0_receiver import FrameClock, Recording
+from drillfric.live.wits0_receiver import FrameClock, Recording
 from tests.conftest import DEMO
 
 START = pd.Timestamp("2026-03-01T06:00:00Z")

@@ -18,9 +18,9 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.discovery import WellSpec, discover
 from drillfric.errors import InputError
-from drillfric.fleet import run_many
+from drillfric.fleet.discovery import WellSpec, discover
+from drillfric.fleet.run import run_many
 
 REPO = Path(__file__).resolve().parents[1]
 #: Files of a complete well directory (docs/outputs.md).

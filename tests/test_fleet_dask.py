@@ -118,7 +118,7 @@ def test_scheduler_fleet_matches_local_fleet(scheduler, wells, tmp_path):
 
 
 def test_unreachable_scheduler_is_exit_2(wells, tmp_path, monkeypatch):
-    monkeypatch.setattr("drillfric.fleet.CONNECT_TIMEOUT_S", 2)
+    monkeypatch.setattr("drillfric.fleet.run.CONNECT_TIMEOUT_S", 2)
     result = fleet(wells, "--out", tmp_path / "out", "--scheduler",
                    f"tcp://127.0.0.1:{_free_port()}")
     assert result.exit_code == 2

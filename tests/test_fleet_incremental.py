@@ -15,8 +15,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from drillfric.discovery import WellSpec
-from drillfric.fleet import run_many
+from drillfric.fleet.discovery import WellSpec
+from drillfric.fleet.run import run_many
 from drillfric.io.well import open_well
 from drillfric.runner import run_well
 from tests.test_engine import _same_results

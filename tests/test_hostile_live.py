@@ -18,9 +18,9 @@ import pytest
 
 from drillfric.errors import InputError
 from drillfric.io.wits0 import Row, encode, frame_clock, item_map
-from drillfric.live_source import MAX_LINE_BYTES, Tail
-from drillfric.livepage import LiveServer
-from drillfric.wits0_receiver import Receiver, Recording, parse_address, setup
+from drillfric.live.page import LiveServer
+from drillfric.live.source import MAX_LINE_BYTES, Tail
+from drillfric.live.wits0_receiver import Receiver, Recording, parse_address, setup
 from tests.test_live import _wait_for
 
 
@@ -108,7 +108,7 @@ def test_never_ending_line_is_one_error_not_waited_for(tmp_path):
 
 def test_a_log_larger_than_one_block_is_read_whole_and_its_lines_counted_once(
         tmp_path, monkeypatch):
-    import drillfric.live_source as live_source
+    import drillfric.live.source as live_source
 
     monkeypatch.setattr(live_source, "MAX_BLOCK", 19)  # > a line; the third block cuts a CR LF
     rows = b"time,surface_rpm\r\n" + b"".join(b"%d,%d\r\n" % (k, k) for k in range(10))

@@ -147,7 +147,7 @@ def test_wits0_stream_filling_the_disk_ends_the_receiver_with_one_error_naming_t
     """A fast WITS0 stream filling the disk gave `internal error: OSError: [Errno 28]` with no
     path and a traceback from the receiver thread."""
     from drillfric.io.wits0 import Row, encode, item_map
-    from drillfric.wits0_receiver import Receiver, Recording, parse_address, setup
+    from drillfric.live.wits0_receiver import Receiver, Recording, parse_address, setup
 
     _fill(small_disk, 4096)
     listener = socket.create_server(("127.0.0.1", 0))

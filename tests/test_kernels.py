@@ -17,7 +17,7 @@ from drillfric import torsional as T
 from drillfric.drillstring import DrillString, Section
 from drillfric.kernels import plant as kernels
 from drillfric.kernels import plant_numpy as kernels_numpy
-from drillfric.simulator import well_b_plant
+from drillfric.sim.well_b import well_b_plant
 
 RPM = np.pi / 30.0
 

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from drillfric.live_source import Tail
+from drillfric.live.source import Tail
 from drillfric.runner.resume import csv_mark
 from tests.test_engine import AGREE
 
@@ -167,7 +167,7 @@ def test_no_data_ever_exits_2_with_one_line(tmp_path):
 
 
 def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_trend(tmp_path):
-    from drillfric.live import LiveRun, _trend
+    from drillfric.live.run import LiveRun, _trend
     from drillfric.result import SegmentRecord
 
     now = [0.0]
@@ -206,7 +206,7 @@ def test_a_slow_segment_fit_does_not_hold_back_the_newest_sample(recorded, tmp_p
     live.json's newest sample stood still for as long as a segment was estimated."""
     import threading
 
-    from drillfric.live import LiveRun
+    from drillfric.live.run import LiveRun
     from drillfric.runner.engine import Engine
 
     started, finished = threading.Event(), threading.Event()
@@ -247,7 +247,7 @@ def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it
     """Regression (issue 24): live.json ``open_segment.bit_rpm`` showed the last estimated bit
     speed of a segment whose bit trace the run withholds (not resolved, or the segment not
     estimated); it is null with ``bit_rpm_reason``, by the live page's rule."""
-    from drillfric.live import _open_view
+    from drillfric.live.run import _open_view
     from drillfric.result import SegmentRecord, Status
 
     pd.DataFrame({"segment_id": np.int32([3, 3]), "time_s": [0.0, 0.01],
@@ -272,7 +272,7 @@ def test_bit_stalled_alert_after_the_bit_stays_stuck_while_the_top_drive_turns(t
     """Issue 24 names a "bit stalled" alert: the estimated bit at rest (``bit_stuck``) for the
     last BIT_STALL_S of the open segment while the top drive turns — not a stick phase of
     ordinary stick-slip (1–3 s), not a stop of the top drive, not a withheld bit trace."""
-    from drillfric.live import BIT_STALL_S, LiveRun, _open_view
+    from drillfric.live.run import BIT_STALL_S, LiveRun, _open_view
     from drillfric.result import SegmentRecord, Status
 
     t = np.arange(0.0, 20.0, 0.01)

@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 
 from drillfric.errors import InputError
-from drillfric.live_source import PartsTail, Tail, follow
+from drillfric.live.source import PartsTail, Tail, follow
 from drillfric.runner.resume import changed, csv_mark
 from tests.test_live import (
     _drillfric,

@@ -18,8 +18,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from drillfric.live import LiveRun, RecentRows
-from drillfric.livepage import LivePage, LiveServer, parse_address, segment_view
+from drillfric.live.page import LivePage, LiveServer, parse_address, segment_view
+from drillfric.live.run import LiveRun, RecentRows
 from tests.test_live import LIVE_KEYS, _drillfric, _feed_folder, _finish, _wait_for
 from tests.test_report_browser import Browser, PageVisit, _chromium, _record
 

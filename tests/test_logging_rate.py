@@ -20,8 +20,8 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric import recorder
 from drillfric.estimation import sampling
+from drillfric.sim import recorder
 from tests.conftest import REPO
 
 DEMO = REPO / "examples" / "demo"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from drillfric.overnight import changes, night
+from drillfric.fleet.overnight import changes, night
 
 
 def _summary(mu_k, severities):

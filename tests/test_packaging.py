@@ -47,7 +47,7 @@ def test_wheel_installs_and_runs_outside_repo(tmp_path: Path):
     _run([str(py), "-c", f"import importlib\nfor m in {names!r}: importlib.import_module(m)"],
          cwd=outside)
     # the live page's template and script are package data (templates/live.*)
-    _run([str(py), "-c", "from drillfric.livepage import page; assert b'bk-live' in page()[0]"],
+    _run([str(py), "-c", "from drillfric.live.page import page; assert b'bk-live' in page()[0]"],
          cwd=outside)
     bare = subprocess.run([str(py), "-c", "import cli"], cwd=outside, capture_output=True)
     assert bare.returncode != 0, "a bare top-level package 'cli' must not be installed"

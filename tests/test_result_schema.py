@@ -10,7 +10,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from drillfric.drag import DRAG_NAMES
-from drillfric.fleet import WellOutcome, summary_frame
+from drillfric.fleet.run import WellOutcome, summary_frame
 from drillfric.io.results import arrow_schema, write_segments
 from drillfric.io.tracks import TRACK_CHANNELS
 from drillfric.result import (

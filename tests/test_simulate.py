@@ -13,12 +13,13 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric import simulator as sim
 from drillfric import torsional as T
 from drillfric.config import config_from_dict, load_config
 from drillfric.errors import ConfigError, ModelError
 from drillfric.io.readers import open_source
 from drillfric.io.writers import dumps_toml
+from drillfric.sim import run as sim
+from drillfric.sim import scenario, settings, well_b
 from drillfric.wellpath import minimum_curvature
 
 RPM = np.pi / 30.0
@@ -79,7 +80,7 @@ def invoke(*args):
 
 def test_creep_start_shape(tmp_path):
     """docs/theory.md §6.3 creep: 0 → 5 RPM in 5 s, hold 30 s, then ramp to the set-point."""
-    stand = sim.Stand(2000.0, duration_s=100.0, rpm=40.0, start="creep", idle_s=5.0)
+    stand = scenario.Stand(2000.0, duration_s=100.0, rpm=40.0, start="creep", idle_s=5.0)
     k = stand.knots()
     np.testing.assert_allclose(k[:6], [[0, 0], [5, 0], [10, 5], [40, 5], [50, 40], [105, 40]])
     assert k[-1, 0] == stand.total_s == 5 + 100 + 5 + 10
@@ -87,7 +88,7 @@ def test_creep_start_shape(tmp_path):
 
 def test_scenario_file_defaults_and_overrides(well):
     cfg = load_config(well)
-    scen = sim.load_scenario(well.parent / "s.toml", sim.base_stand(cfg))
+    scen = scenario.load_scenario(well.parent / "s.toml", scenario.base_stand(cfg))
     assert [s.bit_depth_m for s in scen.stands] == [1500.0, 1530.0]
     assert [s.rpm for s in scen.stands] == [40.0, 60.0]
     assert scen.stands[0].start == "creep" and scen.stands[1].start == "ramp"
@@ -109,7 +110,7 @@ def test_bad_scenarios_name_the_problem(tmp_path, text, word):
     path = tmp_path / "bad.toml"
     path.write_text(text)
     with pytest.raises(ConfigError, match=word):
-        sim.load_scenario(path, sim.Stand(float("nan")))
+        scenario.load_scenario(path, scenario.Stand(float("nan")))
 
 
 def test_explicit_setpoint_with_a_step():
@@ -128,8 +129,8 @@ def two_stands():
                                          "cells": 120}})
     path = minimum_curvature([0.0, 500.0, 1000.0, 2000.0], np.radians([0, 0, 30, 30]),
                              np.radians([0, 0, 20, 20]))
-    scen = sim.Scenario((sim.Stand(1500.0, duration_s=60.0, rpm=40.0, start="creep"),
-                         sim.Stand(1530.0, duration_s=60.0, rpm=60.0)), 20.0)
+    scen = scenario.Scenario((scenario.Stand(1500.0, duration_s=60.0, rpm=40.0, start="creep"),
+                         scenario.Stand(1530.0, duration_s=60.0, rpm=60.0)), 20.0)
     return cfg, path, scen, sim.simulate(cfg, path, scen)
 
 
@@ -181,7 +182,7 @@ def test_cased_open_truth_torque_from_the_truth_file(law):
                      **law}})
     path = minimum_curvature([0.0, 300.0, 900.0, 2000.0], np.radians([0, 0, 45, 45]),
                              np.zeros(4))
-    result = sim.simulate(cfg, path, sim.single_stand(cfg, 1500.0))
+    result = sim.simulate(cfg, path, scenario.single_stand(cfg, 1500.0))
     truth = json.loads(json.dumps(result.truth()))
     cased, open_ = truth["zones"]
     assert (cased["zone"], cased["md_to_m"], open_["zone"]) == ("cased", 1000.0, "open")
@@ -193,7 +194,7 @@ def test_cased_open_truth_torque_from_the_truth_file(law):
         w = np.exp(-(omega / truth["stribeck_speed_rad_s"]) ** truth["stribeck_exponent"])
     friction = sum(z["mu_k"] * t_zone[z["zone"]] + (z["mu_s"] - z["mu_k"]) * w
                    * t_zone[z["zone"]] for z in truth["zones"])
-    plant, _ = sim.plant_for(cfg, result.settings, path, sim.Stand(1500.0))
+    plant, _ = sim.plant_for(cfg, result.settings, path, scenario.Stand(1500.0))
     viscous = 1.0 * omega * float(np.sum(plant.grid.rho_j_kg_m * plant.grid.dx_model_m))
     kinetic = sum(z["mu_k"] * t_zone[z["zone"]] for z in truth["zones"])
     assert cased["mu_k"] * t_zone["cased"] > 0.1 * (friction + viscous)
@@ -211,16 +212,16 @@ def test_bad_cased_truth(simulate, word):
     model = {"casing_shoe_md_m": 800.0} if simulate.pop("casing", False) else {}
     cfg = config_from_dict({"model": model, "simulate": simulate})
     with pytest.raises((ConfigError, ModelError), match=word):
-        sim.PlantSettings.from_config(cfg)
+        settings.PlantSettings.from_config(cfg)
 
 
 def test_noise_is_seeded_and_quantised():
     cols = {"surface_rpm": np.full(20000, 40.0), "surface_torque_Nm": np.full(20000, 1e4),
             "hookload_N": np.full(20000, 5e5)}
     a, b, c = (dict(cols) for _ in range(3))
-    sim.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=1).apply(a)
-    sim.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=1).apply(b)
-    sim.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=2).apply(c)
+    settings.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=1).apply(a)
+    settings.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=1).apply(b)
+    settings.Noise(0.5, 200.0, 0.0, 0.1, 10.0, seed=2).apply(c)
     np.testing.assert_array_equal(a["surface_rpm"], b["surface_rpm"])
     assert not np.array_equal(a["surface_rpm"], c["surface_rpm"])
     # standard error of a 20 000-sample sd is 0.5 %; quantisation adds step²/12
@@ -232,7 +233,7 @@ def test_noise_is_seeded_and_quantised():
 
 def test_bit_on_bottom_adds_bit_torque():
     """Coulomb bit (docs/simulator.md): steady torque gains T_bit = μ_bit·WOB·D/3."""
-    p = sim.well_b_plant(cells=200, k_t_per_s=0.5, mu_s=0.2, mu_k=0.2)
+    p = well_b.well_b_plant(cells=200, k_t_per_s=0.5, mu_s=0.2, mu_k=0.2)
     cap = T.bit_torque_cap(0.3, 80e3, 0.2159)
     on = T.Plant(p.grid, p.fc_Nm_m, p.mu_s, p.mu_k, p.omega_c_rad_s, p.k_t_per_s,
                  bit_torque_cap_Nm=cap)
@@ -357,9 +358,9 @@ def test_cli_bit_depth_overrides_configured_scenario(well, tmp_path):
 def test_on_bottom_stand_records_wob_and_hole_depth():
     """A stand with WOB: T&D on-bottom load case, Coulomb bit, wob_N column, bit at bottom."""
     cfg = config_from_dict({"model": {"cells": 100}, "simulate": {"rate_hz": 10.0}})
-    scen = sim.Scenario((sim.Stand(1200.0, duration_s=30.0, rpm=60.0, wob_N=50e3),), 0.0)
-    off = sim.simulate(cfg, None, sim.Scenario((sim.Stand(1200.0, duration_s=30.0, rpm=60.0),),
-                                               0.0))
+    scen = scenario.Scenario((scenario.Stand(1200.0, duration_s=30.0, rpm=60.0, wob_N=50e3),), 0.0)
+    bare = scenario.Stand(1200.0, duration_s=30.0, rpm=60.0)
+    off = sim.simulate(cfg, None, scenario.Scenario((bare,), 0.0))
     on = sim.simulate(cfg, None, scen)
     c = on.columns
     assert "wob_N" in c and "wob_N" not in off.columns
@@ -382,7 +383,7 @@ def test_truth_bit_torque_is_the_mean_the_bit_applied(tmp_path, ratio):
     path = tmp_path / "s.toml"
     path.write_text(f"[[stand]]\nbit_depth_m = 1200.0\nduration_s = 60.0\nrpm = 60.0\n"
                     f"wob_N = 80e3\nbit_weakening_ratio = {ratio}\n")
-    scen = sim.load_scenario(path, sim.base_stand(cfg))
+    scen = scenario.load_scenario(path, scenario.base_stand(cfg))
     truth = sim.simulate(cfg, None, scen).truth()["stands"][0]
     t_k = T.bit_torque_cap(0.3, 80e3, 0.2159)
     want = t_k * (1.0 + (ratio - 1.0) * np.exp(-60.0 / 20.0))
@@ -503,7 +504,7 @@ def test_truth_power_bit_torque_of_a_stick_slipping_coulomb_bit_is_its_sliding_t
     path = tmp_path / "s.toml"
     path.write_text("[[stand]]\nbit_depth_m = 1200.0\nduration_s = 90.0\nrpm = 40.0\n"
                     "wob_N = 80e3\n")
-    run = sim.simulate(cfg, None, sim.load_scenario(path, sim.base_stand(cfg)))
+    run = sim.simulate(cfg, None, scenario.load_scenario(path, scenario.base_stand(cfg)))
     truth = run.truth()["stands"][0]
     assert truth["bit_stuck_fraction"] > 0.1  # it sticks and slips (0.12)
     assert np.min(run.columns["bit_rpm"]) > -0.5  # and never turns backwards

@@ -229,7 +229,7 @@ def test_stuck_bit_breaks_away_at_r_times_T_k(ratio):
     ramp moves 0.6 N·m per model step) while the bit stays put (|ω_bit| < 1e-3 rad/s), then
     the bit slips and the torque falls to the sliding T_bit(ω) → T_k at speed (ω ≫ ω_b).
     The Coulomb bit (r = 1) lets go at T_k, (r − 1)·T_k/150 s = 15 s earlier for r = 2.5."""
-    from drillfric.simulator import well_b_plant
+    from drillfric.sim.well_b import well_b_plant
 
     t_k = 1500.0
     p = well_b_plant(cells=200, k_t_per_s=0.1, mu_s=0.0, mu_k=0.0)
@@ -254,7 +254,7 @@ def test_steady_rotation_on_a_rate_weakening_bit_adds_T_bit_of_omega(ratio, spee
     T_bit(ω) = T_k·(1 + (r − 1)·exp(−ω/ω_b)) — 12–25 % above T_k here — within 1e-4
     (measured 3e-6 and 4e-6 over the last 20 s of 80), and the recorded bit torque is
     the same."""
-    from drillfric.simulator import well_b_plant
+    from drillfric.sim.well_b import well_b_plant
 
     off = well_b_plant(cells=200, k_t_per_s=0.5, mu_s=0.2, mu_k=0.2)
     on = T.Plant(off.grid, off.fc_Nm_m, off.mu_s, off.mu_k, off.omega_c_rad_s,
@@ -508,7 +508,7 @@ def test_fed_drive_replays_its_own_pi_run_exactly():
     sync the correction is zero and the replay is the run itself. Stick-slip amplifies
     round-off (the logged series carry 1e-16 relative error), so 20 s are compared — the
     top-drive speed within 1e-6 rad/s and the string torque within 1e-3 N·m."""
-    from drillfric.simulator import well_b_plant
+    from drillfric.sim.well_b import well_b_plant
 
     plant = well_b_plant(cells=200)
     dt = plant.grid.dt_s
@@ -630,7 +630,7 @@ def test_friction_split_into_fixed_part_is_the_same_plant():
     Stick-slip on Well B for 30 s: μ·fcap and the fixed cap differ by round-off (8e-17
     relative), which the chaotic stick-slip may amplify; records within 1e-9 of their scale
     (measured 1.6e-15 here, 2.4e-15 over 120 s)."""
-    from drillfric.simulator import well_b_plant
+    from drillfric.sim.well_b import well_b_plant
 
     p = well_b_plant(cells=200)
     moved = T.Plant(p.grid, np.zeros(p.grid.n_cells), p.mu_s, p.mu_k, p.omega_c_rad_s,
@@ -664,7 +664,7 @@ def test_energy_conserved_without_friction_under_the_stribeck_law(seed, delta):
 @pytest.fixture(scope="module")
 def well_b():
     """A&S 2018 Well B (docs/reference_cases.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""
-    from drillfric.simulator import well_b_plant
+    from drillfric.sim.well_b import well_b_plant
 
     plant = well_b_plant()
     rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0), 300.0, 100.0)

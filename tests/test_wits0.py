@@ -19,7 +19,7 @@ import pytest
 
 from drillfric.errors import ConfigError, InputError
 from drillfric.io.wits0 import MAX_LINE, Decoder, Row, encode, frame_clock, item_map
-from drillfric.wits0_receiver import (
+from drillfric.live.wits0_receiver import (
     HANDSHAKE,
     FrameClock,
     Receiver,
@@ -270,8 +270,8 @@ def test_replay_over_wits0_dropping_once_gives_live_the_run_of_the_whole_file(on
 
 
 def test_kill_9_during_a_wits0_stream_and_restart_lose_and_repeat_no_row(one_hz, tmp_path):
-    from drillfric.replay import recorded_frame
-    from drillfric.wits0_server import frames_of
+    from drillfric.live.replay import recorded_frame
+    from drillfric.live.wits0_server import frames_of
 
     path, whole = one_hz
     _, canonical, _ = recorded_frame(path)

@@ -18,8 +18,8 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
-from drillfric.discovery import discover
 from drillfric.errors import InputError
+from drillfric.fleet.discovery import discover
 from drillfric.io.well import open_well
 from drillfric.io.witsml_objects import tubular_sections
 from tests.io.test_witsml import _component, _curve, _doc, _log, _station

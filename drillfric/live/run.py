@@ -3,8 +3,8 @@ or on a well directory into which its files arrive (docs/live.md, issue 24).
 
 Three pieces:
 
-- the source's tail (:mod:`drillfric.live_source`: :class:`~drillfric.live_source.Tail`,
-  :class:`~drillfric.live_source.PartsTail`) — how far the data arrived complete (a write
+- the source's tail (:mod:`drillfric.live.source`: :class:`~drillfric.live.source.Tail`,
+  :class:`~drillfric.live.source.PartsTail`) — how far the data arrived complete (a write
   may stop mid-line: a partial last line waits for its line end), with the mark
   :mod:`drillfric.runner.resume` checks a continued run against;
 - :class:`LiveRun` — a *feed thread* reads the new complete lines into the cheap half of an
@@ -43,7 +43,7 @@ from drillfric.io.atomic import replacing
 from drillfric.io.results import write_json
 from drillfric.io.timebase import clock_at
 from drillfric.io.well import CHUNK_ROWS, Well
-from drillfric.live_source import PartsTail, Tail, follow
+from drillfric.live.source import PartsTail, Tail, follow
 from drillfric.result import Flag, SegmentRecord, Status
 from drillfric.runner import warmup
 from drillfric.runner.engine import Engine
@@ -130,7 +130,7 @@ class LiveRun:
     Parameters
     ----------
     path : Path
-        The growing CSV file, or the well directory (:func:`drillfric.live_source.follow`).
+        The growing CSV file, or the well directory (:func:`drillfric.live.source.follow`).
     out_root : Path
         Output root (``--out``).
     open_kw : dict

@@ -4,9 +4,9 @@ The simulator's surface channels are spot values at the model's rate. Real logs 
 an electronic drilling recorder (EDR) stores each channel as the mean over 1 s or 5 s
 (often with the interval's minimum and maximum), sensors lag, and links drop samples. These
 functions turn a simulated record into what a recorder would have written, so that the
-estimator is validated on data that depart from its own model the way rig data do
-(``[simulate] record_interval_s``, ``rpm_lag_s``, ``torque_lag_s``, ``dropouts_per_hour``;
-docs/simulator.md "Recording").
+estimator is validated on data that depart from its own model the way rig data do (the
+validation sweeps use them: benchmarks/validate_trust.py, docs/validation.md; `drillfric
+simulate` itself records spot values).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ The unit of work is a well: :func:`process_well` runs :func:`drillfric.runner.ru
 on a worker, which writes OUT/NAME itself (temporary directory + rename, so a well directory
 is either complete or absent). The client only prepares tasks (input hashes, effective
 configuration hash), collects small result records and keeps ``OUT/manifest.json``; the
-wells come from :func:`drillfric.discovery.discover` (a folder or a manifest).
+wells come from :func:`drillfric.fleet.discovery.discover` (a folder or a manifest).
 
 Execution: one code path through :class:`dask.distributed.Client` — a ``LocalCluster`` of
 worker processes by default, an existing cluster with ``scheduler``; ``workers=1`` without
@@ -35,9 +35,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from drillfric import __version__, overnight
-from drillfric.discovery import WellSpec
+from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError, OutputError
+from drillfric.fleet import overnight
+from drillfric.fleet.discovery import WellSpec
 from drillfric.io.atomic import own_file, refuse_link, replacing
 from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
@@ -321,7 +322,7 @@ class WellOutcome:
     new_segments : int or None
         Segments new since the last night (None: the well failed).
     changes : tuple of str
-        What changed since the last night (:func:`drillfric.overnight.changes`).
+        What changed since the last night (:func:`drillfric.fleet.overnight.changes`).
     """
 
     well: str
@@ -703,7 +704,7 @@ def _connect(address: str):
     one InputError naming the address)."""
     from distributed import Client
 
-    from drillfric.scheduler import probe, shown
+    from drillfric.fleet.scheduler import probe, shown
 
     probe(address)
     try:

@@ -6,8 +6,8 @@ connection) serves five fixed paths:
 - ``/`` — the page: Bokeh figures (BokehJS inlined as in the reports,
   :mod:`drillfric.report.interactive`) and a script that polls the JSON below every
   :data:`POLL_MS` and redraws;
-- ``/live.json`` — :meth:`drillfric.live.LiveRun.status`, the object of OUT/live.json;
-- ``/tracks.json`` — the last minutes of surface rows (:class:`drillfric.live.RecentRows`,
+- ``/live.json`` — :meth:`drillfric.live.run.LiveRun.status`, the object of OUT/live.json;
+- ``/tracks.json`` — the last minutes of surface rows (:class:`drillfric.live.run.RecentRows`,
   ≤ :data:`TRACK_POINTS`, extremes kept) and the estimated bit speed with its band from
   OUT/NAME/estimates.parquet (``?since=T``: rows after log time T [s] only);
 - ``/segments.json`` — the segments of the last publication (OUT/NAME/summary.json) with the
@@ -43,7 +43,7 @@ from markupsafe import Markup
 
 from drillfric.errors import DrillfricError
 from drillfric.io.results import jsonable, read_json
-from drillfric.live import SEVERE_STICK_SLIP, LiveRun, bit_speed_withheld
+from drillfric.live.run import SEVERE_STICK_SLIP, LiveRun, bit_speed_withheld
 from drillfric.report.data import FINAL_START_ID, extreme_rows
 from drillfric.report.interactive import bokeh_js, json_in_script, script_hash, time_figure
 from drillfric.report.render import (
@@ -121,7 +121,7 @@ def _error(status: int, message: str) -> Answer:
 
 
 class LivePage:
-    """The answers of the live page's server for one :class:`~drillfric.live.LiveRun`.
+    """The answers of the live page's server for one :class:`~drillfric.live.run.LiveRun`.
 
     Reading the well's result files and decimating the rows is done once per change (a
     publication, new rows), whatever the number of pages polling.

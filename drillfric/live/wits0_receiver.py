@@ -3,7 +3,7 @@
 :class:`Receiver` connects to the recorder, reconnects with a doubling wait when the stream
 drops, sends a handshake frame every ``[wits0] handshake_s`` and writes every complete frame
 as one line of :class:`Recording` — ``OUT/NAME.wits0.csv``, absolute time plus the SI
-channels, flushed per frame. :class:`~drillfric.live.LiveRun` then follows that file as it
+channels, flushed per frame. :class:`~drillfric.live.run.LiveRun` then follows that file as it
 follows any growing CSV, so a restarted live run continues the recording and resumes from
 its saved state, no row lost or read twice.
 """

@@ -1,0 +1,249 @@
+"""A simulation's scenario: its stands and their set-point schedules, from the
+configuration's ``[simulate]`` table or a scenario file (docs/simulator.md)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from drillfric.config import Config, read_toml
+from drillfric.errors import ConfigError
+
+_STARTS = ("ramp", "creep")
+
+
+@dataclass(frozen=True)
+class Stand:
+    """One stand: the bit at a fixed depth, rotation started from rest and stopped.
+
+    Attributes
+    ----------
+    bit_depth_m : float
+        Bit measured depth during the stand [m].
+    duration_s : float
+        Rotating time from the start of the set-point to the start of the stop [s].
+    rpm : float
+        Set-point after the start-up [RPM].
+    start : str
+        "ramp" (0 → rpm in ``ramp_s``) or "creep" (0 → ``creep_rpm`` in ``creep_ramp_s``,
+        hold ``creep_hold_s``, then ramp to rpm in ``ramp_s``), docs/theory.md §6.3.
+    ramp_s, creep_rpm, creep_ramp_s, creep_hold_s : float
+        Start-up shape [s], [RPM].
+    idle_s : float
+        Rest before the start [s].
+    stop_s, stop_hold_s : float
+        Ramp of the set-point down to 0 and the time held at 0 (torque trapped) [s].
+    wob_N : float
+        Weight on bit [N]; > 0 puts the bit on bottom.
+    rop_m_h : float
+        Rate of penetration of an on-bottom stand [m/h]: the recorded bit and hole depth
+        advance at it while the set-point is held (the plant stays at ``bit_depth_m``, a few
+        decimetres per stand; docs/simulator.md).
+    bit_weakening_ratio, bit_weakening_rpm : float
+        Rate-weakening bit of an on-bottom stand, T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)):
+        r [-] (1: the Coulomb bit) and ω_b [RPM] (docs/simulator.md, Bit).
+    setpoint_rpm : tuple of (t_s, rpm), optional
+        Explicit piecewise-linear set-point from the start of the stand (replaces the
+        start-up/hold/stop shape; a repeated time makes a step).
+    motor_torque_Nm : tuple of (t_s, N·m), optional
+        Prescribed motor torque instead of the PI controller.
+    stop : bool
+        Stop rotation at the end (False for a single-stand run).
+    """
+
+    bit_depth_m: float
+    duration_s: float = 120.0
+    rpm: float = 60.0
+    start: str = "ramp"
+    ramp_s: float = 10.0
+    creep_rpm: float = 5.0
+    creep_ramp_s: float = 5.0
+    creep_hold_s: float = 30.0
+    idle_s: float = 5.0
+    stop_s: float = 5.0
+    stop_hold_s: float = 10.0
+    wob_N: float = 0.0
+    rop_m_h: float = 0.0
+    bit_weakening_ratio: float = 1.0
+    bit_weakening_rpm: float = 10.0
+    setpoint_rpm: tuple | None = None
+    motor_torque_Nm: tuple | None = None
+    stop: bool = True
+
+    @property
+    def start_up_s(self) -> float:
+        """Time from the start of the set-point to the end of its start-up [s]."""
+        creep = self.creep_ramp_s + self.creep_hold_s if self.start == "creep" else 0.0
+        return creep + self.ramp_s
+
+    @property
+    def total_s(self) -> float:
+        """Recorded length of the stand, rest to rest [s]."""
+        if self.setpoint_rpm is not None or self.motor_torque_Nm is not None:
+            series = self.setpoint_rpm or self.motor_torque_Nm
+            return self.idle_s + float(series[-1][0])
+        stop = self.stop_s + self.stop_hold_s if self.stop else 0.0
+        return self.idle_s + self.duration_s + stop
+
+    def knots(self) -> np.ndarray:
+        """Set-point (t [s] from stand start, ω_ref [RPM]) knots of the piecewise-linear shape."""
+        if self.setpoint_rpm is not None:
+            pts = np.asarray(self.setpoint_rpm, dtype=float)
+            return np.column_stack([pts[:, 0] + self.idle_s, pts[:, 1]])
+        t = self.idle_s
+        pts = [(0.0, 0.0), (t, 0.0)]
+        if self.start == "creep":
+            pts += [(t + self.creep_ramp_s, self.creep_rpm),
+                    (t + self.creep_ramp_s + self.creep_hold_s, self.creep_rpm)]
+        pts.append((t + self.start_up_s, self.rpm))
+        pts.append((t + self.duration_s, self.rpm))
+        if self.stop:
+            pts += [(t + self.duration_s + self.stop_s, 0.0), (self.total_s, 0.0)]
+        return np.asarray(pts, dtype=float)
+
+    @property
+    def end_depth_m(self) -> float:
+        """Recorded bit depth at the end of the stand [m] (after drilling ``rop_m_h``)."""
+        drilled = self.rop_m_h / 3600.0 * self.duration_s if self.on_bottom else 0.0
+        return self.bit_depth_m + drilled
+
+    @property
+    def on_bottom(self) -> bool:
+        """Bit on bottom (WOB > 0)."""
+        return self.wob_N > 0
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Stands separated by connections.
+
+    Attributes
+    ----------
+    stands : tuple of Stand
+    connection_s : float
+        Time between the end of one stand and the start of the next [s] (rotation 0,
+        torque released, string in slips, bit moved to the next depth).
+    """
+
+    stands: tuple[Stand, ...]
+    connection_s: float = 60.0
+
+    @property
+    def total_s(self) -> float:
+        """Recorded length of the whole scenario [s]."""
+        return sum(s.total_s for s in self.stands) + self.connection_s * (len(self.stands) - 1)
+
+
+_STAND_FIELDS = {f for f in Stand.__dataclass_fields__ if f != "stop"}
+
+
+def _stand_from_dict(raw: dict, defaults: dict, where: str, file) -> Stand:
+    merged = defaults | raw
+    unknown = set(merged) - _STAND_FIELDS
+    if unknown:
+        raise ConfigError(f"unknown key '{sorted(unknown)[0]}' in {where}", file=file,
+                          fix=f"use one of: {', '.join(sorted(_STAND_FIELDS))}")
+    if "bit_depth_m" not in merged:
+        raise ConfigError(f"{where} needs bit_depth_m", file=file)
+    values = {}
+    for key, value in merged.items():
+        if key in ("setpoint_rpm", "motor_torque_Nm"):
+            values[key] = _series(value, f"{where}.{key}", file)
+        elif key == "start":
+            if value not in _STARTS:
+                raise ConfigError(f"{where}.start must be 'ramp' or 'creep', got {value!r}",
+                                  file=file)
+            values[key] = value
+        else:
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ConfigError(f"{where}.{key} must be a number, got {value!r}", file=file)
+            values[key] = float(value)
+    stand = Stand(**values)
+    _check_stand(stand, where, file)
+    return stand
+
+
+def _series(value, where: str, file) -> tuple:
+    try:
+        pts = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        pts = np.empty((0, 0))
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 2 or np.any(np.diff(pts[:, 0]) < 0) \
+            or pts[0, 0] != 0.0 or not np.all(np.isfinite(pts)):
+        raise ConfigError(f"{where} must be [[t_s, value], ...] from t = 0, times "
+                          "non-decreasing, at least two points", file=file)
+    return tuple(map(tuple, pts.tolist()))
+
+
+def _check_stand(stand: Stand, where: str, file) -> None:
+    positive = ("bit_depth_m", "duration_s", "ramp_s", "creep_ramp_s", "creep_hold_s",
+                "bit_weakening_rpm")
+    for key in positive:
+        if not getattr(stand, key) > 0:
+            raise ConfigError(f"{where}.{key} must be > 0, got {getattr(stand, key)}",
+                              file=file)
+    for key in ("rpm", "creep_rpm", "idle_s", "stop_s", "stop_hold_s", "wob_N", "rop_m_h"):
+        if getattr(stand, key) < 0:
+            raise ConfigError(f"{where}.{key} must be ≥ 0, got {getattr(stand, key)}",
+                              file=file)
+    if not 1.0 <= stand.bit_weakening_ratio <= 10.0:
+        raise ConfigError(f"{where}.bit_weakening_ratio must be in [1, 10], got "
+                          f"{stand.bit_weakening_ratio}", file=file,
+                          fix="1 is the Coulomb bit; r > 1 a bit that is stronger at rest")
+    if stand.setpoint_rpm is None and stand.start_up_s > stand.duration_s:
+        raise ConfigError(f"{where}: the start-up ({stand.start_up_s:g} s) is longer than "
+                          f"duration_s ({stand.duration_s:g} s)", file=file,
+                          fix="increase duration_s or shorten the ramp/creep")
+
+
+def load_scenario(path: str | Path, base: Stand) -> Scenario:
+    """Read a scenario TOML file (format: module docstring and docs/simulator.md).
+
+    Parameters
+    ----------
+    path : str or Path
+    base : Stand
+        Defaults for every stand (from the ``[simulate]`` configuration); the file's
+        ``[defaults]`` table and each ``[[stand]]`` override them.
+    """
+    raw = read_toml(path)
+    allowed = {"connection_s", "defaults", "stand"}
+    for key in raw:
+        if key not in allowed:
+            raise ConfigError(f"unknown key '{key}' in scenario", file=path,
+                              fix="use connection_s, [defaults] and [[stand]]")
+    stands_raw = raw.get("stand")
+    if not isinstance(stands_raw, list) or not stands_raw:
+        raise ConfigError("a scenario needs at least one [[stand]] with bit_depth_m",
+                          file=path)
+    defaults = raw.get("defaults", {})
+    if not isinstance(defaults, dict):
+        raise ConfigError("[defaults] must be a table", file=path)
+    base_dict = {k: v for k, v in asdict(base).items()
+                 if k in _STAND_FIELDS - {"bit_depth_m"} and v is not None}
+    stands = tuple(_stand_from_dict(s, base_dict | defaults, f"stand[{i}]", path)
+                   for i, s in enumerate(stands_raw, start=1))
+    connection = raw.get("connection_s", 60.0)
+    if isinstance(connection, bool) or not isinstance(connection, int | float) \
+            or connection < 0:
+        raise ConfigError(f"connection_s must be a number ≥ 0, got {connection!r}", file=path)
+    return Scenario(stands, float(connection))
+
+
+def base_stand(cfg: Config) -> Stand:
+    """Stand defaults from the ``[simulate]`` table (bit depth filled in by the caller)."""
+    return Stand(bit_depth_m=cfg.simulate.bit_depth_m or float("nan"),
+                 duration_s=cfg.simulate.duration_s, rpm=cfg.simulate.rpm,
+                 ramp_s=cfg.simulate.ramp_s, wob_N=cfg.simulate.wob_N,
+                 bit_weakening_ratio=cfg.simulate.bit_weakening_ratio,
+                 bit_weakening_rpm=cfg.simulate.bit_weakening_rpm)
+
+
+def single_stand(cfg: Config, bit_depth_m: float) -> Scenario:
+    """A single stand (no stop): rest, ramp to ``simulate.rpm``, hold to ``duration_s``."""
+    stand = replace(base_stand(cfg), bit_depth_m=bit_depth_m, idle_s=0.0, stop=False)
+    if stand.ramp_s > stand.duration_s:
+        stand = replace(stand, ramp_s=stand.duration_s)
+    return Scenario((stand,), 0.0)
