@@ -15,6 +15,8 @@ from pathlib import Path
 
 import click
 
+from drillfric.result import WellStatus
+
 from .common import UserError, compile_kernels_once, echo, interrupted_exit_code, progress
 
 
@@ -79,7 +81,7 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
                     fg="yellow")
         sys.exit(interrupted_exit_code())
     for well in result.wells:
-        if well.status == "failed":
+        if well.status == WellStatus.FAILED:
             click.secho(f"error: {well.well}: {well.message}", err=True, fg="red")
     for note in result.notes:
         click.secho(f"note: {note}", err=True)

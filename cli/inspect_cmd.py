@@ -8,6 +8,7 @@ import click
 import numpy as np
 
 from drillfric.io.text import terminal_text
+from drillfric.result import Status
 
 from .common import unit_system, units_option
 
@@ -231,7 +232,7 @@ def render(s: dict, units: str = "si") -> str:
 
 
 def _segments_line(segments: list[dict]) -> str:
-    ok = [g for g in segments if g["status"] == "ok"]
+    ok = [g for g in segments if g["status"] == Status.OK]
     kinds = {k: sum(g["kind"] == k for g in ok) for k in sorted({g["kind"] for g in ok})}
     detail = ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in kinds.items())
     seconds = sum(g["duration_s"] or 0.0 for g in ok)
@@ -256,7 +257,7 @@ def render_depth_log(s: dict, units: str = "si") -> str:
     lines.append(f"depth      {format_value(s['md_start_m'], 'length', units)} … "
                  f"{format_value(s['md_end_m'], 'length', units)} MD{step}")
     lines.append(_survey_line(s["survey"], units))
-    ok = [w for w in s["segments"] if w["status"] == "ok"]
+    ok = [w for w in s["segments"] if w["status"] == Status.OK]
     kinds = {k: sum(w["kind"] == k for w in ok) for k in sorted({w["kind"] for w in ok})}
     detail = ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in kinds.items())
     lines.append(f"windows    {len(s['segments'])} of "

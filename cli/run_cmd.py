@@ -8,6 +8,7 @@ import click
 
 from drillfric.errors import DrillfricError
 from drillfric.io.text import terminal_text
+from drillfric.result import WellStatus
 
 from .common import (
     Quantity,
@@ -227,7 +228,7 @@ def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, work
                           overrides=overrides, rate_hz=rate, pdf=pdf, report=report,
                           fleet_files=False)
     for well in result.wells:
-        if well.status == "failed":
+        if well.status == WellStatus.FAILED:
             error(f"{well.well}: {well.message}")
         elif well.result_dir is not None:
             for note in (well.summary or {}).get("warnings", []):

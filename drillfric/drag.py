@@ -68,6 +68,8 @@ MAX_UNCERTAINTY = 0.1
 MU_GRID = np.linspace(0.0, 2.0, 201)
 
 PICK_UP, SLACK_OFF = "pick_up", "slack_off"
+#: A connection's drag_log.parquet ``status``: its μ stated, or withheld with the reason.
+_OK, _WITHHELD = "ok", "withheld"
 
 
 @dataclass(frozen=True)
@@ -465,9 +467,9 @@ def _verdict(found: dict[str, Estimate], why: str) -> dict:
         source = min(good, key=lambda k: good[k].uncertainty)
     else:
         return out | {"mu_drag": None, "mu_drag_uncertainty": None, "source": None,
-                      "status": "withheld", "reason": why or "; ".join(reasons)}
+                      "status": _WITHHELD, "reason": why or "; ".join(reasons)}
     return out | {"mu_drag": good[source].mu, "mu_drag_uncertainty": good[source].uncertainty,
-                  "source": source, "status": "ok", "reason": "; ".join(reasons) or None}
+                  "source": source, "status": _OK, "reason": "; ".join(reasons) or None}
 
 
 def drag_log(moves: list[Move], too_short: int, cfg, path,
@@ -495,7 +497,7 @@ def drag_log(moves: list[Move], too_short: int, cfg, path,
 
     rows = [connection_row(up, down, hook, curves) for up, down in pair_moves(moves)]
     table = pd.DataFrame(rows, columns=list(DRAG_NAMES))
-    ok = table[table["status"] == "ok"]
+    ok = table[table["status"] == _OK]
     if not moves:
         reason = ("no axial movement: no pick-up or slack-off without rotation of at least "
                   f"{MIN_WINDOW_S + 2 * SETTLE_S:g} s in the log")

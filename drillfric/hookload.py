@@ -642,7 +642,7 @@ def _points(done, cfg, path) -> list[tuple]:
     segments."""
     out = []
     for seg, rows in done:
-        if seg.kind != Kind.OFF_BOTTOM.value or seg.status != "ok" or \
+        if seg.kind != Kind.OFF_BOTTOM or seg.status != Status.OK or \
                 not np.isfinite(seg.bit_depth_m) or "hookload_N" not in rows:
             continue
         hook = rows["hookload_N"].to_numpy(float)

@@ -26,26 +26,25 @@ import pandas as pd
 from drillfric.config import Config
 from drillfric.errors import InputError
 from drillfric.kernels.lazy import lazy_jit
+from drillfric.result import STATE_KINDS, Kind, RigState
 
 #: Rig states, coded by their position (``np.int8``; new states are appended, codes never
 #: move). ``sliding_on_bottom`` (on bottom with the pumps on but no surface rotation: motor
 #: drilling), ``reaming`` and ``back_reaming`` (rotating off bottom while the pipe runs in
 #: or pulls out faster than ``ream_speed_m_s``) are drillfric's additions.
-RIG_STATES = ("rotating_off_bottom", "rotating_on_bottom", "in_slips", "tripping", "idle",
-              "unknown", "sliding_on_bottom", "reaming", "back_reaming")
+RIG_STATES = tuple(state.text for state in RigState)
 (ROTATING_OFF_BOTTOM, ROTATING_ON_BOTTOM, IN_SLIPS, TRIPPING, IDLE, UNKNOWN,
- SLIDING_ON_BOTTOM, REAMING, BACK_REAMING) = range(len(RIG_STATES))
+ SLIDING_ON_BOTTOM, REAMING, BACK_REAMING) = map(int, RigState)  # plain ints in the kernel
 #: States that make hole ("drilling"): on bottom, rotating or sliding.
 DRILLING_STATES = (ROTATING_ON_BOTTOM, SLIDING_ON_BOTTOM)
 #: States in which the string turns (a segment is a run of them).
 TURNING_STATES = (ROTATING_OFF_BOTTOM, ROTATING_ON_BOTTOM, REAMING, BACK_REAMING)
 #: Segment kind of each turning state (docs/outputs.md ``kind`` values).
-KINDS = {ROTATING_OFF_BOTTOM: "off_bottom_rotating", ROTATING_ON_BOTTOM: "on_bottom_rotating",
-         REAMING: "reaming", BACK_REAMING: "back_reaming"}
+KINDS = STATE_KINDS
 #: Kinds whose friction factors and bit speed are withheld: the pipe moves along the hole
 #: while it turns, so the wall friction splits between axial and tangential, and the
 #: estimators model pure rotation (docs/segmentation.md "Reaming").
-COMBINED_MOTION_KINDS = ("reaming", "back_reaming")
+COMBINED_MOTION_KINDS = (Kind.REAMING, Kind.BACK_REAMING)
 
 #: How the bit depth is known: measured channel, reckoned from the block, or not at all.
 _DEPTH_CHANNEL, _DEPTH_BLOCK, _DEPTH_NONE = 0, 1, 2
@@ -61,9 +60,9 @@ class Segment:
     ----------
     id : int
         Running number, 1-based, in time order.
-    kind : str
-        ``"off_bottom_rotating"``, ``"on_bottom_rotating"``, ``"reaming"`` or
-        ``"back_reaming"`` (always skipped: :data:`COMBINED_MOTION_KINDS`).
+    kind : Kind
+        Off or on bottom, reaming or back-reaming (the last two always skipped:
+        :data:`COMBINED_MOTION_KINDS`).
     t_start_s, t_end_s : float
         Times of the first and the last sample of the segment [s].
     i_start, i_end : int
@@ -81,7 +80,7 @@ class Segment:
     """
 
     id: int
-    kind: str
+    kind: Kind
     t_start_s: float
     t_end_s: float
     i_start: int
@@ -440,7 +439,7 @@ def _combined_motion(kind: str, depth_m: np.ndarray, duration_s: float) -> str:
     """Why a reaming / back-reaming segment is not estimated."""
     speed = abs(depth_m[-1] - depth_m[0]) / duration_s if depth_m.size > 1 and \
         duration_s > 0 else float("nan")
-    way = "running in" if kind == "reaming" else "pulling out"
+    way = "running in" if kind == Kind.REAMING else "pulling out"
     return (f"{kind.replace('_', '-')}: the pipe is {way} at {speed:.2g} m/s while it turns, "
             "so the wall friction splits between axial and tangential and the rotating model "
             "(all friction tangential) does not hold: μ and the bit speed are withheld "

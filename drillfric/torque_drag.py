@@ -26,16 +26,16 @@ from numba import njit
 
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import ModelError
+from drillfric.result import LoadCase
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
 
 #: Load cases (docs/theory.md §2 step 3): σ is the axial share of the friction (+1 pulling out,
 #: −1 running in, 0 rotating), the torque share is the tangential one.
-LOAD_CASES = ("rotating_off_bottom", "rotating_on_bottom", "pick_up", "slack_off",
-              "rotating_pick_up", "rotating_slack_off", "sliding")
+LOAD_CASES = tuple(LoadCase)
 #: Load cases with the bit on bottom (bit boundary F = −WOB). ``sliding`` is slack-off with
 #: weight on bit and no rotation (motor drilling); its bit torque is not modelled (M = 0).
-ON_BOTTOM_CASES = ("rotating_on_bottom", "sliding")
+ON_BOTTOM_CASES = (LoadCase.ROTATING_ON_BOTTOM, LoadCase.SLIDING)
 _MIN_ELEMENT_M = 1e-6  # [m] nodes closer than this are merged
 #: Most elements of one string's mesh (each a few hundred bytes and a step of every sweep;
 #: the default 2-m elements give 3000 at 6 km): a budget on the work ``element_length_m``
@@ -271,11 +271,11 @@ def _shares(load_case: str, rc_m: np.ndarray, axial_speed_m_s: float,
         raise ModelError(f"unknown load case '{load_case}'",
                          fix=f"use one of: {', '.join(LOAD_CASES)}")
     one, zero = np.ones_like(rc_m), np.zeros_like(rc_m)
-    if load_case in ("rotating_off_bottom", "rotating_on_bottom"):
+    if load_case in (LoadCase.ROTATING_OFF_BOTTOM, LoadCase.ROTATING_ON_BOTTOM):
         return zero, one
-    if load_case == "pick_up":
+    if load_case == LoadCase.PICK_UP:
         return one, zero
-    if load_case in ("slack_off", "sliding"):
+    if load_case in (LoadCase.SLACK_OFF, LoadCase.SLIDING):
         return -one, zero
     v, omega = abs(axial_speed_m_s), abs(rpm) * RPM_TO_RAD_S
     if v <= 0 or omega <= 0:
@@ -283,7 +283,7 @@ def _shares(load_case: str, rc_m: np.ndarray, axial_speed_m_s: float,
                          f"{axial_speed_m_s} m/s and {rpm} RPM",
                          fix="give axial_speed_m_s and rpm (e.g. 0.3 m/s and 60 RPM)")
     speed = np.hypot(v, omega * rc_m)
-    sign = 1.0 if load_case == "rotating_pick_up" else -1.0
+    sign = 1.0 if load_case == LoadCase.ROTATING_PICK_UP else -1.0
     return sign * v / speed, omega * rc_m / speed
 
 
@@ -293,7 +293,7 @@ def _bit_boundary(load_case: str, wob_N: float, bit_torque_Nm: float) -> tuple[f
         return 0.0, 0.0
     if not np.isfinite(wob_N) or wob_N < 0:
         raise ModelError(f"WOB must be ≥ 0, got {wob_N} N")
-    torque = float(bit_torque_Nm) if load_case == "rotating_on_bottom" else 0.0
+    torque = float(bit_torque_Nm) if load_case == LoadCase.ROTATING_ON_BOTTOM else 0.0
     return -float(wob_N), torque
 
 

@@ -382,8 +382,32 @@ def test_a_damaged_saved_state_reruns_the_well_from_its_start(damage, tmp_path, 
     _strict_check(fleet, root, capsys)
     summary = json.loads((root / "out" / "w" / "summary.json").read_text())
     assert summary["resumed"]["from_row"] == 0, summary["resumed"]
-    assert "not readable" in summary["resumed"]["reason"] or \
+    assert "changed since the state was sealed" in summary["resumed"]["reason"] or \
         summary["resumed"]["reason"] == "no saved state", summary["resumed"]  # not a file
+
+
+@pytest.mark.parametrize("damage", [_truncated_arrays, _deep_json, _many_rows,
+                                    lambda f: _zip_bomb(f / "arrays.npz"),
+                                    lambda f: _lying_npy(f / "arrays.npz"), _text_array,
+                                    _fifo("arrays.npz"), _fifo("engine.json"), _outside_table],
+                         ids=["truncated_npz", "deep_json", "frame_of_2e8_rows", "npz_zip_bomb",
+                              "npy_header_lying", "text_arrays", "fifo_npz", "fifo_engine_json",
+                              "table_linked_from_elsewhere"])
+def test_the_state_reader_refuses_damage_before_reading_it(damage, tmp_path):
+    """Under the seal, the reader keeps its own limits (a state sealed under a shared
+    DRILLFRIC_STATE_KEY is only as safe as the key): each damage is one InputError before
+    any array, table or document is loaded whole."""
+    import numpy as np
+    import pandas as pd
+
+    from drillfric.errors import InputError
+    from drillfric.runner.state import read_state, write_state
+
+    state = tmp_path / "state"
+    write_state(state, {"a": np.arange(400.0), "t": pd.DataFrame({"x": np.arange(10.0)})})
+    damage(state)
+    with hang_guard(60), pytest.raises(InputError, match="engine state not readable"):
+        read_state(state)
 
 
 # --------------------------------------------------------------- configs that ask for hours (2)
@@ -525,3 +549,138 @@ def test_a_directory_where_the_fleet_writes_a_file_is_named_not_its_temporary(tm
                        ("a directory stands where drillfric writes",)), root)
     assert "out/fleet.html:" in text and ".tmp" not in text, text
 
+
+
+# ------------------------------------------------ the second attack (issue 30)
+def test_a_light_stiff_string_cannot_slip_past_the_work_budget(tmp_path, capsys):
+    """The budget took steel's wave speed; G = 1e12 Pa and ρ = 2 kg/m³ (each in range) made
+    the grid's step 700× shorter and `run` was still going at 120 s."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"), """[well]
+bit_depth_m = 2000.0
+[model]
+cells = 2000
+[fluid]
+mud_density_kg_m3 = 0.0
+[[string.sections]]
+name = "dp"
+od_m = 0.127
+id_m = 0.1086
+shear_modulus_Pa = 1e12
+steel_density_kg_m3 = 2.0
+linear_mass_kg_m = 29.0
+[[string.sections]]
+name = "bha"
+od_m = 0.2032
+id_m = 0.0714
+length_m = 200
+shear_modulus_Pa = 1e12
+steel_density_kg_m3 = 2.0
+linear_mass_kg_m = 220.0
+""")
+    _strict_check(Case(["run", "w.csv", "--out", "out"], (2,), ("cells = 2000",)), root,
+                  capsys)
+
+
+def test_a_simulation_that_diverges_is_one_line_and_no_file(tmp_path, capsys):
+    """kp_Nms_rad = 1e7 (in range): the explicit PI drive diverged and simulate wrote inf and
+    1e305 with exit 0."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    (root / "sk.toml").write_text("[simulate]\nbit_depth_m = 2000.0\nkp_Nms_rad = 1e7\n"
+                                  "duration_s = 20\ncells = 200\n")
+    _strict_check(Case(["simulate", "sk.toml", "--out", "out/sk.csv"], (2,), ("diverged",)),
+                  root, capsys)
+    assert not (root / "out" / "sk.csv").exists()
+
+
+@pytest.mark.parametrize("edit", ["text_time", "huge_id", "negative_rows", "carried_rows"])
+def test_a_state_changed_by_anyone_but_drillfric_is_not_continued(edit, tmp_path, capsys):
+    """Values of a tampered engine.json got past every check into the feed: `internal
+    error` every night (a text time, a 10²⁰ id), a fault blamed on the user's log, a silently
+    shorter segment (raw_rows = -5); an estimates.parquet changed in OUT was carried into
+    the next night's results. The state is sealed: any change means a run from the start."""
+    import json
+
+    import pandas as pd
+
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _well(root)
+    fleet = Case(["fleet", "wells", "--out", "out", "--workers", "1"], (1,))
+    _strict_check(fleet, root, capsys)
+    folder = root / "out" / "w"
+    doc = json.loads((folder / "state" / "engine.json").read_text())
+    if edit == "carried_rows":
+        frame = pd.read_parquet(folder / "estimates.parquet")
+        frame.assign(**{c: 31337.0 for c in frame.columns if c.endswith("_Nm")}).to_parquet(
+            folder / "estimates.parquet")
+    else:
+        state = doc["state"]
+        key, value = {"text_time": ("raw_rows", "x"), "huge_id": ("raw_rows", 10 ** 20),
+                      "negative_rows": ("raw_rows", -5)}[edit]
+        state[key] = value
+        (folder / "state" / "engine.json").write_text(json.dumps(doc))
+    frame = pd.read_csv(path)
+    frame.assign(time_s=frame["time_s"] + 40.0).to_csv(path, mode="a", header=False,
+                                                      index=False)
+    _strict_check(fleet, root, capsys)
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["resumed"]["from_row"] == 0 and "seal" in summary["resumed"]["reason"] \
+        or "changed since" in summary["resumed"]["reason"], summary["resumed"]
+
+
+def test_an_untouched_state_is_continued(tmp_path, capsys):
+    """The seal's other half: a state nobody changed is continued from where it stopped."""
+    import json
+
+    import pandas as pd
+
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _well(root)
+    fleet = Case(["fleet", "wells", "--out", "out", "--workers", "1"], (1,))
+    _strict_check(fleet, root, capsys)
+    assert (root / "out" / "w" / "state" / "seal.json").is_file()
+    frame = pd.read_csv(path)
+    frame.assign(time_s=frame["time_s"] + 40.0).to_csv(path, mode="a", header=False,
+                                                      index=False)
+    _strict_check(fleet, root, capsys)
+    summary = json.loads((root / "out" / "w" / "summary.json").read_text())
+    assert summary["resumed"]["from_row"] == len(frame), summary["resumed"]
+
+
+@pytest.fixture(scope="module")
+def result_dir(stands, tmp_path_factory):
+    """OUT/NAME of the three-stand well's run (estimates, tracks, profiles), once."""
+    out = tmp_path_factory.mktemp("result")
+    done = CliRunner().invoke(cli, ["run", str(stands[0]), "--out", str(out), "--no-report"])
+    assert done.exit_code == 0, done.output
+    return out / stands[0].stem
+
+
+@pytest.mark.parametrize(("table", "how"), [("estimates", "text"), ("tracks", "text"),
+                                            ("estimates", "list"), ("profiles", "list"),
+                                            ("tracks", "codes")])
+def test_report_on_crafted_result_tables_is_one_line(table, how, result_dir, tmp_path,
+                                                     capsys):
+    """`drillfric report` on its own tables made wrong: columns of text or of lists, rig
+    states no state has — ArrowTypeError, TypeError, IndexError as internal errors."""
+    import numpy as np
+    import pandas as pd
+
+    root = tmp_path / "sandbox"
+    shutil.copytree(result_dir, root / "out" / "demo")
+    path = root / "out" / "demo" / f"{table}.parquet"
+    frame = pd.read_parquet(path)
+    if how == "text":
+        frame = frame.astype(str)
+    elif how == "list":
+        frame = frame.assign(**{c: [[1.0, 2.0]] * len(frame) for c in frame.columns
+                                if c not in ("segment_id", "start_id")})
+    else:
+        frame = frame.assign(rig_state=np.int64(2 ** 62))
+    frame.to_parquet(path)
+    _strict_check(Case(["report", "out/demo"], (2,), (f"{table}.parquet",)), root, capsys)

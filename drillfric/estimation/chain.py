@@ -45,7 +45,7 @@ from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_i
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import Evidence, Verdict, decide
 from drillfric.friction import FrictionProfile
-from drillfric.result import Flag, Method
+from drillfric.result import Flag, Kind, Method
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
 
@@ -66,8 +66,8 @@ class SegmentData:
     time_s, surface_rpm, surface_torque_Nm : ndarray
     bit_depth_m : float
         Bit depth of the segment [m].
-    kind : str
-        Segment kind ("off_bottom_rotating", "on_bottom_rotating").
+    kind : Kind
+        Segment kind (off or on bottom).
     wob_N : float
         Median weight on bit [N] (0 off bottom).
     bit_rpm : ndarray or None
@@ -80,7 +80,7 @@ class SegmentData:
     surface_rpm: np.ndarray
     surface_torque_Nm: np.ndarray
     bit_depth_m: float
-    kind: str = "off_bottom_rotating"
+    kind: Kind = Kind.OFF_BOTTOM
     wob_N: float = 0.0
     bit_rpm: np.ndarray | None = None
     torque_min_Nm: np.ndarray | None = None
@@ -395,7 +395,7 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
     fix = "give the well's survey" + (
         "" if path is not None else " (or a nominal survey.tortuosity_deg_30m > 0)")
     path = _path_for(cfg, path, data.bit_depth_m)
-    on_bottom = data.kind == "on_bottom_rotating"
+    on_bottom = data.kind == Kind.ON_BOTTOM
     td = torque_drag.solve_config(cfg, path, data.bit_depth_m,
                                   load_case="rotating_on_bottom" if on_bottom
                                   else "rotating_off_bottom", wob_N=data.wob_N)

@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.stats import t as student_t
 
-from drillfric.result import Flag, Kind, SegmentRecord, Status
+from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
 
 #: Flags a short segment may carry and still be pooled (it is only too short: a few torque
 #: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``
@@ -101,7 +101,7 @@ def pool_short_segments(records: list[SegmentRecord]) -> tuple[list, list[dict]]
     """
 
     short = [r for r in records if r.status is Status.OK and r.kind is Kind.OFF_BOTTOM
-             and not r.converged and r.method.value == "batch" and r.mu_k is not None
+             and not r.converged and r.method == Method.BATCH and r.mu_k is not None
              and set(r.quality_flags) <= _POOLABLE]
     groups: list[list[SegmentRecord]] = []
     for r in sorted(short, key=lambda r: r.bit_depth_m):
@@ -182,7 +182,7 @@ MU_K_MATCH = 0.02
 def _own_mu_k(record: SegmentRecord) -> float:
     """A segment's own μ_k uncertainty [-]: half its observer starts' spread where the
     observer gave the number, never below the fit's torque match (:data:`MU_K_MATCH`)."""
-    spread = record.mu_k_spread if record.method.value == "observer" else None
+    spread = record.mu_k_spread if record.method == Method.OBSERVER else None
     return max((spread or 0.0) / 2.0, MU_K_MATCH * record.mu_k)
 
 

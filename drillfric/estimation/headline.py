@@ -11,7 +11,7 @@ changes them.
 from __future__ import annotations
 
 from drillfric.estimation.verdict import TYPICAL_MU
-from drillfric.result import WellFlag
+from drillfric.result import Flag, Kind, Status, WellFlag
 
 #: A well μ_k resting on fewer segments than this is low-confidence: two segments cannot
 #: show which of them is the odd one out.
@@ -73,8 +73,8 @@ def _no_mu_k(summary: dict) -> str:
     if log_reason:
         return str(log_reason)
     segments = summary.get("segments") or []
-    off = [s for s in segments if s.get("kind") == "off_bottom_rotating"]
-    done = [s for s in off if s.get("status") == "ok"]
+    off = [s for s in segments if s.get("kind") == Kind.OFF_BOTTOM]
+    done = [s for s in off if s.get("status") == Status.OK]
     if not segments:
         return "no rotating segment in the log"
     if not off:
@@ -103,7 +103,7 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
         found.append((WellFlag.INDICATIVE, f"{INDICATIVE_WARNING} {len(summary['assumed'])} "
                       "default(s) assumed (summary.json assumed), e.g. "
                       f"{summary['assumed'][0]}"))
-    outside = [s["id"] for s in segments if "outside_typical_range" in
+    outside = [s["id"] for s in segments if Flag.OUTSIDE_TYPICAL_RANGE in
                (s.get("quality_flags") or ())]
     if outside:
         found.append((WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE, f"{len(outside)} segment(s) "
@@ -123,7 +123,7 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
         found.append((WellFlag.STRING_WEIGHT_UNVERIFIED, ""))  # the check's own warning
     elif hook.get("verdict") == "contradicted" or hook.get("withheld_segments"):
         found.append((WellFlag.HOOKLOAD_CONTRADICTS_STRING, ""))  # the check's own warning
-    failed = [s["id"] for s in segments if s.get("status") == "failed"]
+    failed = [s["id"] for s in segments if s.get("status") == Status.FAILED]
     if failed:
         found.append((WellFlag.SEGMENTS_FAILED, f"{len(failed)} segment(s) failed "
                       f"({_ids(failed)}): their messages say why"))
@@ -137,7 +137,7 @@ def _heavier_than_measured(segments: list[dict]) -> list[int]:
     out = []
     for s in segments:
         hook, model = s.get("hookload_N"), s.get("hookload_model_N")
-        if s.get("kind") == "off_bottom_rotating" and hook and model and hook > 0 \
+        if s.get("kind") == Kind.OFF_BOTTOM and hook and model and hook > 0 \
                 and model > (1.0 + STRING_WEIGHT_TOLERANCE) * hook:
             out.append(s["id"])
     return out

@@ -13,6 +13,7 @@ import numpy as np
 
 from drillfric.errors import DrillfricError
 from drillfric.io.channels import factor
+from drillfric.result import Kind
 from drillfric.units import RPM_TO_RAD_S
 
 #: Friction factors bounding any physical rotating torque (generous): off bottom the soft
@@ -53,7 +54,7 @@ def plausible_torque_range(T_N_Nm: float, kind: str, wob_N: float = 0.0) -> tupl
     (200.0, 40000.0)
     """
     lo, hi = PLAUSIBLE_MU[0] * T_N_Nm, PLAUSIBLE_MU[1] * T_N_Nm
-    if kind == "on_bottom_rotating":
+    if kind == Kind.ON_BOTTOM:
         hi += BIT_TORQUE_PER_WOB_M * wob_N if wob_N > 0 else BIT_TORQUE_UNKNOWN_WOB_NM
     return lo, hi
 
@@ -87,7 +88,7 @@ def check_torque_scale(data, T_N_Nm: float, omega_c_rad_s: float, *,
         return
     mean = float(np.mean(data.surface_torque_Nm[rotating]))
     lo, hi = plausible_torque_range(T_N_Nm, data.kind, data.wob_N)
-    bit = " plus bit torque" if data.kind == "on_bottom_rotating" else ""
+    bit = " plus bit torque" if data.kind == Kind.ON_BOTTOM else ""
     where = (f"the torque-and-drag range at {data.bit_depth_m:.0f} m (mean {_kNm(mean)} kN·m "
              f"while rotating; range {_kNm(lo)}–{_kNm(hi)} kN·m for μ {PLAUSIBLE_MU[0]}–"
              f"{PLAUSIBLE_MU[1]}{bit})")

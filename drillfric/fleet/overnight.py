@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from drillfric.result import Flag
+
 #: Nights of history kept per well.
 HISTORY_NIGHTS = 7
 #: Nights of history a μ_k must have before a move is judged against them.
@@ -59,7 +61,7 @@ def changes(summary: dict | None, history: list[dict], *, ran: bool,
                                           if h.get("mu_k") is not None])
     severe = [s["id"] for s in segments[before:] if (s.get("stick_slip_severity") or 0.0)
               > SEVERE_STICK_SLIP
-              or "stick_slip_beyond_validated" in (s.get("quality_flags") or ())]
+              or Flag.STICK_SLIP_BEYOND_VALIDATED in (s.get("quality_flags") or ())]
     if severe:
         notes.append(f"severe stick-slip (the bit stops) in segment(s) "
                      f"{', '.join(map(str, severe))}")

@@ -52,7 +52,7 @@ from drillfric.io.results import (
     remove_stale,
     write_json,
 )
-from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS
+from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS, WellStatus
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"
@@ -250,7 +250,7 @@ def _same(fingerprint: dict, entry: dict | None, known: dict) -> bool:
     """True when ``entry`` (manifest) was an ok run of the same inputs, config, version:
     the files found now are the ones recorded, and every file the worker read (some are
     only found inside a data file) is unchanged."""
-    if not entry or entry.get("status") != "ok":
+    if not entry or entry.get("status") != WellStatus.OK:
         return False
     outputs = entry.get("outputs", {}).get("summary")
     if (outputs is None or not Path(outputs).is_file()
@@ -364,7 +364,7 @@ class FleetResult:
     def nothing_estimated(self) -> tuple[str, ...]:
         """Wells that ran (or were unchanged) with not one segment estimated: every
         segment skipped, or none found."""
-        return tuple(w.well for w in self.wells if w.status != "failed" and w.summary
+        return tuple(w.well for w in self.wells if w.status != WellStatus.FAILED and w.summary
                      and not (w.summary.get("counts") or {}).get("estimated"))
 
 
@@ -575,11 +575,11 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
             entry.update(status="failed", message=f"{out}: the worker wrote its result where "
                          "this machine cannot see it — fix: put OUT on storage shared by the "
                          "client and every worker")
-    stale = _mark_stale(manifest, name, job, rec, entry) if entry["status"] == "failed" \
+    stale = _mark_stale(manifest, name, job, rec, entry) if entry["status"] == WellStatus.FAILED \
         else None
     before = manifest.wells.get(name) or {}
     history = list(before.get("history", [])) if isinstance(before, dict) else []
-    summary = rec.get("summary") if entry["status"] == "ok" else None
+    summary = rec.get("summary") if entry["status"] == WellStatus.OK else None
     changed = overnight.changes(summary, history, ran=True, data_changed_utc=None)
     if summary is not None:
         entry["history"] = (history + [overnight.night(summary, _now())])[
@@ -589,7 +589,7 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
     entry["data_changed_utc"] = _now()
     manifest.wells[name] = entry
     return WellOutcome(name, entry["status"], entry["message"],
-                       Path(rec["out_dir"]) if entry["status"] == "ok" else None,
+                       Path(rec["out_dir"]) if entry["status"] == WellStatus.OK else None,
                        summary, entry["failed_segments"], rec.get("task_s", 0.0), attempts,
                        stale_dir=stale, new_segments=changed["new_segments"],
                        changes=tuple(changed["notes"]))
@@ -771,7 +771,7 @@ def summary_frame(outcomes) -> pd.DataFrame:
 def _changed_first(outcomes) -> list:
     """Outcomes with news tonight first (new segments, moves, stick-slip), the others after
     (no new data, failed, nothing new); input order within each."""
-    return sorted(outcomes, key=lambda o: not (o.changes and o.status == "ok"))
+    return sorted(outcomes, key=lambda o: not (o.changes and o.status == WellStatus.OK))
 
 
 def _write_summary(out_root: Path, outcomes) -> Path:

@@ -54,6 +54,7 @@ from drillfric.report.render import (
     severity_text,
     status_word,
 )
+from drillfric.result import Status
 
 #: Host the page binds when ``--serve`` names only a port (never all interfaces unasked).
 DEFAULT_HOST = "127.0.0.1"
@@ -259,7 +260,7 @@ def _final_bit_rows(path: Path, ids: tuple[int, ...]) -> pd.DataFrame:
 def segment_view(record: dict, is_open: bool) -> dict:
     """One segment of /segments.json: its numbers, the report's texts, and the values the
     friction figure plots (null where withheld; μ_k and the apparent μ on bottom apart)."""
-    ok = record.get("status") == "ok"
+    ok = record.get("status") == Status.OK
     apparent = is_apparent(record)
     mu_k = record.get("mu_k") if ok else None
     return {key: record.get(key) for key in (

@@ -473,7 +473,7 @@ def bit_speed_withheld(record: dict) -> str:
     estimated (status not ``ok``), or its bit trace is not resolved (``bit_speed_resolved``
     false: docs/bit_speed.md) — the one rule of live.json and the live page. ``record``:
     the segment as in summary.json."""
-    if record.get("status") != "ok":
+    if record.get("status") != Status.OK:
         return f"segment {record.get('status', 'not published')}: {record.get('message', '')}"
     if record.get("bit_speed_resolved") is False:
         return record.get("bit_speed_reason") or "bit speed not resolved"

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.estimation.headline import STRING_WEIGHT_TOLERANCE
+from drillfric.result import Kind, LoadCase
 
 from .display import SI, Units
 
@@ -126,7 +127,7 @@ def default_depths(cfg, deepest_m: float, count: int = 40) -> np.ndarray:
 def rotating_hookload(table: pd.DataFrame, depths_m) -> np.ndarray:
     """Modelled rotating off-bottom hook load at ``depths_m``, interpolated in the table
     (it does not depend on μ: no axial friction when rotating) [N]."""
-    rot = table[table["load_case"] == "rotating_off_bottom"]
+    rot = table[table["load_case"] == LoadCase.ROTATING_OFF_BOTTOM]
     rot = rot[rot["friction_factor"] == rot["friction_factor"].min()].sort_values(
         "bit_depth_m")
     return np.interp(np.asarray(depths_m, dtype=float), rot["bit_depth_m"], rot["hookload_N"])
@@ -146,7 +147,7 @@ def weight_check(points: pd.DataFrame, table: pd.DataFrame | None = None,
         modelled: the implied travelling-block weight, NaN when none compared) and
         ``warning`` (a sentence, or None).
     """
-    off = points[(points["kind"] == "off_bottom_rotating") & points["hookload_N"].notna()]
+    off = points[(points["kind"] == Kind.OFF_BOTTOM) & points["hookload_N"].notna()]
     model = off["hookload_model_N"].to_numpy(float) if "hookload_model_N" in off else \
         np.full(len(off), np.nan)
     if table is not None and len(off):

@@ -15,9 +15,12 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.atomic import own_file
 from drillfric.io.results import read_json
+from drillfric.io.text import printable
 from drillfric.io.timebase import origin_of
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_FIELDS, SEGMENT_NUMBER_FIELDS
+from drillfric.segmentation import RIG_STATES
 
 from .interactive import TimeAxis, time_axis
 
@@ -169,14 +172,45 @@ def load_result(result_dir: Path) -> ResultData:
                       _optional_parquet(result_dir / "drag_log.parquet"))
 
 
+#: Text columns of the result tables (every other column holds numbers or timestamps).
+_TEXT_COLUMNS = frozenset({"kind", "status", "source", "reason"})
+
+
+def _numbers_schema(path: Path) -> list[str]:
+    """The column names of a result table whose every column but :data:`_TEXT_COLUMNS`
+    holds numbers, booleans or timestamps; ValueError otherwise (or for a link, a FIFO:
+    :func:`~drillfric.io.atomic.own_file`)."""
+    import pyarrow.parquet as pq
+    import pyarrow.types as pt
+
+    schema = pq.read_schema(own_file(path))
+    for fld in schema:
+        if fld.name in _TEXT_COLUMNS and not pt.is_nested(fld.type):
+            continue
+        if not (pt.is_integer(fld.type) or pt.is_floating(fld.type) or
+                pt.is_boolean(fld.type) or pt.is_timestamp(fld.type) or pt.is_null(fld.type)):
+            raise ValueError(f"column '{printable(fld.name, 40)}' holds {fld.type}, not numbers")
+    return schema.names
+
+
 def _optional_parquet(path: Path) -> pd.DataFrame | None:
+    """A result table drillfric wrote, read as untrusted (it lies in OUT): a regular file,
+    flat columns, numbers where numbers go, and rig-state codes among the known states —
+    else one InputError naming it (a crafted table was an internal error in the report)."""
     if not path.is_file():
         return None
     try:
-        return pd.read_parquet(path)
+        _numbers_schema(path)
+        frame = pd.read_parquet(path)
     except (OSError, ValueError) as exc:
         raise InputError(f"unreadable Parquet file ({exc})", file=path,
                          fix="rerun 'drillfric run' to rewrite the results") from None
+    if "rig_state" in frame:
+        codes = frame["rig_state"].dropna()
+        if len(codes) and not codes.isin(range(-1, len(RIG_STATES))).all():
+            raise InputError("rig_state holds codes that are no rig state", file=path,
+                             fix="rerun 'drillfric run' to rewrite the results")
+    return frame
 
 
 #: The final (seeded) observer pass in estimates.parquet (drillfric.result.SEEDED_START_ID).
@@ -233,11 +267,11 @@ def segment_estimates(result_dir: Path, ids: list[int],
     import pyarrow.parquet as pq
 
     try:
-        names = pq.read_schema(path).names
+        names = _numbers_schema(path)
         columns = [c for c in ESTIMATE_NAMES if c in names]  # older results lack some
         table = pq.read_table(path, columns=columns,
                               filters=[("segment_id", "in", [int(i) for i in ids])])
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, TypeError, NotImplementedError) as exc:  # pyarrow's too
         raise InputError(f"unreadable estimates ({exc})", file=path,
                          fix="rerun 'drillfric run' to rewrite the results") from None
     frame = table.to_pandas()
@@ -269,12 +303,12 @@ def final_torques(result_dir: Path, ids: list[int]) -> dict[int, pd.DataFrame]:
     import pyarrow.parquet as pq
 
     try:
-        if "surface_torque_fit_Nm" not in pq.read_schema(path).names:
+        if "surface_torque_fit_Nm" not in _numbers_schema(path):
             return {}
         table = pq.read_table(path, columns=list(_FIT_COLUMNS),
                               filters=[("segment_id", "in", [int(i) for i in ids]),
                                        ("start_id", "=", FINAL_START_ID)])
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, TypeError, NotImplementedError) as exc:
         raise InputError(f"unreadable estimates ({exc})", file=path,
                          fix="rerun 'drillfric run' to rewrite the results") from None
     frame = table.to_pandas()

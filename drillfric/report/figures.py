@@ -17,6 +17,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from drillfric.result import Status
+
 from .display import SI, Units
 from .render import is_apparent, zone_text
 
@@ -185,7 +187,7 @@ def friction_log_figure(segments: pd.DataFrame,
     fig = _new(size[1], size[0], left_in=0.9, wspace=0.08, top_in=top_in)
     ax, ax_sev = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [2.2, 1]})
     seg = segments.assign(depth=segments["bit_depth_m"] * units.factor("length"))
-    ok = seg[seg["status"] == "ok"]
+    ok = seg[seg["status"] == Status.OK]
     apparent = np.array([is_apparent(r) for r in ok.to_dict("records")], dtype=bool)
     for rows, color, marker, name in (
             (ok[~apparent], MU_K_COLOR, "o", "μ_k (off bottom)"),
@@ -205,7 +207,7 @@ def friction_log_figure(segments: pd.DataFrame,
     if len(td):
         ax.plot(td["mu_td"], td["depth"], "x", color=TD_COLOR,
                 label="μ from torque and drag", clip_on=False)
-    none = seg[(seg["status"] != "ok") & seg["depth"].notna()]
+    none = seg[(seg["status"] != Status.OK) & seg["depth"].notna()]
     if len(none):
         ax.plot(np.zeros(len(none)), none["depth"], "d", color="#888888",
                 markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")

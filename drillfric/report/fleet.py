@@ -11,6 +11,7 @@ from urllib.parse import quote
 
 from drillfric._version import __version__
 from drillfric.io.atomic import write_text_replacing
+from drillfric.result import Flag, Status, WellStatus
 
 from .data import segments_frame
 from .display import fmt, report_units, row_flags
@@ -22,7 +23,7 @@ from .render import environment, mu_s_text, now_utc
 def _worst(segments: list[dict]) -> dict:
     """Worst diagnostics of a well's segments (largest residual, spread, severity — "severe"
     where any is withheld as beyond its validated range, docs/bit_speed.md; counts)."""
-    ok = [s for s in segments if s.get("status") == "ok"]
+    ok = [s for s in segments if s.get("status") == Status.OK]
 
     def largest(key: str) -> float | None:
         values = [float(s[key]) for s in ok if isinstance(s.get(key), int | float)
@@ -31,11 +32,11 @@ def _worst(segments: list[dict]) -> dict:
 
     return {"residual": fmt(largest("residual_rms_rpm"), ".2f"),
             "spread": fmt(largest("mu_k_spread")),
-            "severity": ("severe" if any("stick_slip_beyond_validated" in row_flags(s)
+            "severity": ("severe" if any(Flag.STICK_SLIP_BEYOND_VALIDATED in row_flags(s)
                                          for s in ok)
                          else fmt(largest("stick_slip_severity"), ".2f")),
             "unconverged": sum(not s.get("converged") for s in ok),
-            "failed": sum(s.get("status") == "failed" for s in segments)}
+            "failed": sum(s.get("status") == Status.FAILED for s in segments)}
 
 
 def _link(out_dir: Path, result_dir) -> str | None:
@@ -72,7 +73,7 @@ def _row(out_dir: Path, well: dict) -> dict:
                     "stale (STALE.json, summary.json stale)")
     return {"well": str(well.get("well", "?")), "status": status,
             "status_text": STATUS_TEXT.get(status, status),
-            "badge": "ok" if status == "skipped" else status,
+            "badge": WellStatus.OK if status == WellStatus.SKIPPED else status,
             "message": message,
             "stale_link": _link(out_dir, stale) if stale is not None else None,
             "segments": counts.get("segments", "—"), "estimated": counts.get("estimated", "—"),
@@ -115,11 +116,11 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
     shown = report_units({}, units or _common_units(wells))
     embed = Embedder()
     plot_id = embed.add(fleet_plot(logs, shown), "fleet") if any(
-        ((seg["status"] == "ok") & seg["mu_k"].notna()).any() for _, seg in logs) else None
+        ((seg["status"] == Status.OK) & seg["mu_k"].notna()).any() for _, seg in logs) else None
     counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
     news = [(str(w.get("well", "?")), w["changes"]) for w in wells if w.get("changes")]
     html = environment().get_template("fleet_report.html.j2").render(
-        rows=rows, failed=[r for r in rows if r["status"] == "failed"], counts=counts,
+        rows=rows, failed=[r for r in rows if r["status"] == WellStatus.FAILED], counts=counts,
         news=news,
         plot_id=plot_id, bokeh=embed.head, version=__version__, built=now_utc())
     out = out_dir / "fleet.html"

@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from drillfric.result import Status
+
 from .display import SI, Units, fmt
 from .figures import (
     APPARENT_COLOR,
@@ -150,7 +152,7 @@ def friction_sources(segments: pd.DataFrame, units: Units = SI,
     drag_log.parquet), ``none`` (segments without an estimate) and ``severity``. Depths in
     display ``units``."""
     frame = _source_frame(segments[segments["bit_depth_m"].notna()], units)
-    ok = frame[frame["status"] == "ok"]
+    ok = frame[frame["status"] == Status.OK]
     off = ok[~ok["apparent"]]
     out = {}
     for rows, col, half in ((off, "mu_k", "half_k"), (ok, "mu_app", "half_k"),
@@ -177,7 +179,7 @@ def friction_sources(segments: pd.DataFrame, units: Units = SI,
             out["whisker:mu_drag"] = _span(whisk["mu_drag"] - whisk["half"],
                                            whisk["mu_drag"] + whisk["half"], whisk["depth"])
         out["points:mu_drag:converged"] = _columns(dragged)
-    none = frame[frame["status"] != "ok"].assign(zero=0.0)
+    none = frame[frame["status"] != Status.OK].assign(zero=0.0)
     if len(none):
         out["none"] = _columns(none)
     severity = ok[ok["stick_slip_severity"].notna()]
@@ -214,11 +216,11 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
     cds = {name: ColumnDataSource(columns, name=name) for name, columns in sources.items()}
     renderers, drag_renderers = [], []
     for name, source in cds.items():
-        kind, _, col = name.partition(":")
-        if kind == "whisker":
+        mark, _, col = name.partition(":")
+        if mark == "whisker":
             mu.segment("x0", "y0", "x1", "y1", source=source, line_width=1,
                        color=_MARKS[col][1])
-        elif kind == "points":
+        elif mark == "points":
             col, _, part = col.partition(":")
             marker, color, label = _MARKS[col]
             conv = part == "converged"
@@ -226,15 +228,15 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
                 col, "depth", source=source, marker=marker, size=9, line_color=color,
                 fill_color=color if conv else "white", line_width=2 if col == "mu_drag" else 1,
                 legend_label=label + ("" if conv else " (not converged)")))
-        elif kind == "bound_tail":
+        elif mark == "bound_tail":
             mu.segment("x0", "y0", "x1", "y1", source=source, color=MU_S_COLOR,
                        line_dash="dotted")
-        elif kind == "bound":
+        elif mark == "bound":
             renderers.append(mu.scatter("mu_s_lower_bound", "depth", source=source,
                                         marker="triangle", angle=-np.pi / 2, size=10,
                                         line_color=MU_S_COLOR, fill_color="white",
                                         legend_label="μ_s ≥ lower bound"))
-        elif kind == "none":
+        elif mark == "none":
             renderers.append(mu.scatter("zero", "depth", source=source, marker="diamond",
                                         size=10, color="#888888", fill_color="white",
                                         legend_label="no estimate"))
@@ -270,7 +272,7 @@ def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
     palette = Category10[10] if len(logs) <= 10 else Category20[20]
     items, renderers = [], []
     for index, (name, seg) in enumerate(logs):
-        ok = seg[(seg["status"] == "ok") & seg["mu_k"].notna() & seg["bit_depth_m"].notna()]
+        ok = seg[(seg["status"] == Status.OK) & seg["mu_k"].notna() & seg["bit_depth_m"].notna()]
         if not len(ok):
             continue
         color = palette[index % len(palette)]

@@ -21,6 +21,7 @@ from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
 from drillfric.io.timebase import clock_at
+from drillfric.result import Flag, Kind, Method, Status
 
 from .display import Units, fmt, row_flags
 
@@ -97,14 +98,14 @@ def severity_text(row: dict) -> str:
     withheld as beyond its validated range (flag ``stick_slip_beyond_validated``,
     docs/bit_speed.md), never a bare "—" that reads as "no stick-slip"."""
     if fmt(row.get("stick_slip_severity")) == "—" and \
-            "stick_slip_beyond_validated" in row_flags(row):
+            Flag.STICK_SLIP_BEYOND_VALIDATED in row_flags(row):
         return "severe"
     return fmt(row.get("stick_slip_severity"), ".2f")
 
 
 def observability(row: dict) -> str:
     """Whether the segment identifies μ_s, bounds it, or says nothing about it."""
-    if row.get("status") != "ok":
+    if row.get("status") != Status.OK:
         return "—"
     if row.get("mu_s_identifiable"):
         return "μ_s identified"
@@ -115,7 +116,7 @@ def observability(row: dict) -> str:
 
 def row_class(row: dict) -> str:
     """CSS class of a segment: failed, skipped, unconverged or ok."""
-    if row.get("status") in ("failed", "skipped"):
+    if row.get("status") in (Status.FAILED, Status.SKIPPED):
         return str(row["status"])
     return "ok" if row.get("converged") else "unconverged"
 
@@ -159,7 +160,7 @@ _REASON_PREFIX = "bit speed not resolved:"
 def bit_speed_text(row: dict, reason: bool = True) -> str:
     """Whether the segment's bit speed is resolved (and, with ``reason``, why not)."""
     resolved = row.get("bit_speed_resolved")
-    if row.get("status") != "ok" or resolved is None or pd.isna(resolved):
+    if row.get("status") != Status.OK or resolved is None or pd.isna(resolved):
         return "—"
     if not bit_speed_unresolved(row):
         return "resolved"
@@ -180,7 +181,7 @@ def zone_text(segments: pd.DataFrame) -> str:
     "" when they differ or the results do not say (older results)."""
     if "friction_zone" not in segments:
         return ""
-    zones = set(segments.loc[segments["status"] == "ok", "friction_zone"].dropna())
+    zones = set(segments.loc[segments["status"] == Status.OK, "friction_zone"].dropna())
     return zones.pop().replace("_", " ") if len(zones) == 1 else ""
 
 
@@ -247,7 +248,7 @@ def is_note_flag(row: dict, flag: str) -> bool:
     """Whether ``flag`` says nothing against the segment's reported numbers: the observer's
     flags where μ_k is the batch fit's (the observer is then a cross-check, and a
     disagreement beyond ×1.5 is its own flag, ``estimators_disagree``)."""
-    return flag in _NOTE_FLAGS and row.get("method") == "batch"
+    return flag in _NOTE_FLAGS and row.get("method") == Method.BATCH
 
 
 #: What "converged" means for a segment; the header, the status cell and the badges say it.
@@ -260,8 +261,8 @@ CONVERGED_MEANING = (
 def is_apparent(row: dict) -> bool:
     """Whether the segment's μ is apparent: on bottom, the bit torque is in it."""
     flags = row.get("quality_flags")
-    return row.get("kind") == "on_bottom_rotating" or (
-        isinstance(flags, list | tuple) and "bit_torque_in_friction" in flags)
+    return row.get("kind") == Kind.ON_BOTTOM or (
+        isinstance(flags, list | tuple) and Flag.BIT_TORQUE_IN_FRICTION in flags)
 
 
 def mu_name(row: dict) -> str:
@@ -278,9 +279,9 @@ def mu_k_cell(row: dict) -> str:
 def status_word(row: dict) -> str:
     """The segment's status in the words of its badge: "converged", "not converged",
     "static" (a depth log's torque-and-drag back-calculation), or skipped / failed."""
-    if row.get("status") != "ok":
+    if row.get("status") != Status.OK:
         return str(row.get("status"))
-    if row.get("method") == "td_backcalc":
+    if row.get("method") == Method.TD_BACKCALC:
         return "static"
     return "converged" if row.get("converged") else "not converged"
 
@@ -288,7 +289,7 @@ def status_word(row: dict) -> str:
 def status_text(row: dict) -> str:
     """Status, convergence (:data:`CONVERGED_MEANING`) and method in one cell."""
     word = status_word(row)
-    if row.get("status") != "ok":
+    if row.get("status") != Status.OK:
         return word
     if word == "static":
         return "ok, static torque-and-drag back-calculation"
@@ -322,7 +323,7 @@ def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None,
     out = []
     for row in segments.to_dict("records"):
         quality, unreproduced = (fits or {}).get(int(row["id"]), (None, ""))
-        ok = row["status"] == "ok"
+        ok = row["status"] == Status.OK
         mu_s = mu_s_text(row["mu_s"], row["mu_s_identifiable"], row["mu_s_lower_bound"])
         flags = ", ".join([flag for flag, _, _ in flag_items(row)]
                           + [f"{flag} (a note: μ_k is the batch fit's)"

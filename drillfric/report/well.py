@@ -19,6 +19,7 @@ from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
 from drillfric.io.atomic import write_text_replacing
 from drillfric.io.timebase import clock_at
+from drillfric.result import Status
 
 from . import broomstick as broom
 from . import figures
@@ -110,7 +111,7 @@ def select_segments(segments: pd.DataFrame, limit: int | None = MAX_SEGMENT_FIGU
     places go to the worst (not converged first, then the largest residual RMS) and the
     rest to the latest.
     """
-    ok = segments[segments["status"] == "ok"]
+    ok = segments[segments["status"] == Status.OK]
     if limit is None or len(ok) <= limit:
         return [int(i) for i in ok["id"]]
     ranked = ok.assign(_bad=~ok["converged"], _res=ok["residual_rms_rpm"].fillna(float("inf")))
@@ -218,7 +219,7 @@ def _no_mu_k_reason(data: ResultData) -> str:
         "mu_k_reason")
     if reason:
         return str(reason)
-    ok = data.segments[data.segments["status"] == "ok"]
+    ok = data.segments[data.segments["status"] == Status.OK]
     if not len(ok):
         return "no segment was estimated"
     off = ok[~ok.apply(lambda r: is_apparent(r.to_dict()), axis=1)]
@@ -231,7 +232,7 @@ def _apparent(data: ResultData) -> dict | None:
     """The headline's apparent (on-bottom) friction factor: a depth log's ``mu_apparent``,
     else the median over the converged on-bottom stands; None when there is none."""
     seg = data.segments
-    on = seg[(seg["status"] == "ok") & seg["converged"] & seg["mu_k"].notna()]
+    on = seg[(seg["status"] == Status.OK) & seg["converged"] & seg["mu_k"].notna()]
     on = on[[is_apparent(r) for r in on.to_dict("records")]]
     value = (data.summary.get("friction_log") or {}).get("mu_apparent")
     if value is None and not len(on):
@@ -370,7 +371,7 @@ def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
     shown = report_units(data.summary, units)
     drawn = select_segments(data.segments, limit)
     estimates = segment_estimates(data.result_dir, drawn)
-    ok = [int(i) for i in data.segments.loc[data.segments["status"] == "ok", "id"]]
+    ok = [int(i) for i in data.segments.loc[data.segments["status"] == Status.OK, "id"]]
     fits = {i: found for i, rows in final_torques(data.result_dir, ok).items()
             if (found := reproduction(rows)) is not None}
     rows = data.segments.set_index("id", drop=False)
@@ -463,7 +464,7 @@ def _html(report: Report) -> str:
         sections=sections, segments=segments,
         broomstick_check=_broomstick_note(report.broomstick.check, units),
         broomstick_warning=bool(report.broomstick.check["warning"]),
-        n_estimated=int((data.segments["status"] == "ok").sum()),
+        n_estimated=int((data.segments["status"] == Status.OK).sum()),
         columns=diagnostic_columns(units), fold=MESSAGE_FOLD_CHARS,
         diagnostics=report.diagnostics,
         u={q: units.label(q) for q in ("length", "force", "torque")})
@@ -472,7 +473,7 @@ def _html(report: Report) -> str:
 def has_friction(segments: pd.DataFrame) -> bool:
     """Whether the friction log has a friction factor to draw (an estimated segment with a
     bit depth and a μ)."""
-    return bool(((segments["status"] == "ok") & segments["bit_depth_m"].notna()
+    return bool(((segments["status"] == Status.OK) & segments["bit_depth_m"].notna()
                  & segments["mu_k"].notna()).any())
 
 

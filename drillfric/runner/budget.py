@@ -9,8 +9,8 @@ module estimates that work from the configuration and the first rows of the data
 refuses, in one line naming the key and the budget, a run that would exceed it.
 
 The estimate is physical, not a measurement: one observer pass costs cells²/t_w cell-steps
-per second of data (t_w = bit depth / :data:`WAVE_SPEED_M_S`, the wave's travel time along
-the string), at :data:`CELL_STEP_S` each — on the 24 h benchmark (docs/performance.md) the
+per second of data (t_w, the torsional wave's travel time along the configured string:
+:func:`travel_s`), at :data:`CELL_STEP_S` each — on the 24 h benchmark (docs/performance.md) the
 estimate of the whole run is within 20 % of the measured CPU time.
 """
 
@@ -19,7 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from drillfric.config import Config
-from drillfric.errors import ConfigError
+from drillfric.drillstring import build_string
+from drillfric.errors import ConfigError, DrillfricError
 from drillfric.torque_drag import MAX_ELEMENTS as MAX_TD_ELEMENTS
 
 #: Torsional wave speed of steel, √(G/ρ) = √(79.3 GPa / 7850 kg/m³) [m/s].
@@ -69,11 +70,23 @@ def work(cfg: Config, bit_depth_m: float) -> Work:
     """
     depth = _clamped(bit_depth_m)
     cells = float(cfg.model.cells)
-    per_pass_s = cells * cells / (depth / WAVE_SPEED_M_S) * CELL_STEP_S  # per data second
+    per_pass_s = cells * cells / travel_s(cfg, depth) * CELL_STEP_S  # per data second
     passes = cfg.observer.ensemble_members + 1
     starts = len(cfg.observer.starts) * cfg.observer.starts_window_s * per_pass_s
     return Work(3600.0 * passes * per_pass_s, starts,
                 int(depth / cfg.model.element_length_m) + 1)
+
+
+def travel_s(cfg: Config, depth_m: float) -> float:
+    """The torsional wave's travel time down the configured string to ``depth_m`` [s]:
+    Σ L_i / √(G_i/ρ_i) over its sections (docs/theory.md §3.1) — the materials are the
+    configuration's, so a light, stiff one cannot slip past the budget; steel's
+    :data:`WAVE_SPEED_M_S` where the string cannot be built to that depth."""
+    try:
+        string = build_string(cfg.sections, depth_m)
+    except DrillfricError:
+        return depth_m / WAVE_SPEED_M_S
+    return sum(sec.length_m / sec.wave_speed_m_s for sec in string.sections)
 
 
 def _clamped(bit_depth_m: float) -> float:

@@ -42,7 +42,7 @@ from drillfric.hookload import PlateauFinder, StringWeightCalibration, judge
 from drillfric.io.logcheck import LogCheck
 from drillfric.io.tracks import TrackAccumulator
 from drillfric.io.well import Well, frame_source
-from drillfric.result import RunProgress, SegmentRecord, Status, WellResult
+from drillfric.result import Kind, RunProgress, SegmentRecord, Status, WellResult
 from drillfric.segmentation import Segment, SegmentStream
 
 from .estimator import SegmentEstimator, first_chunk
@@ -175,7 +175,7 @@ class Engine:
             self.records.append(record)
             out.append(record)
             self.sink.add(frames, self.estimator.has_truth)
-            if self.calibration is not None and seg.status == "ok":
+            if self.calibration is not None and seg.status == Status.OK:
                 self._kept[seg.id] = (seg, rows, scale, self._warm_set(record))
             self._report(seg.i_end)
         return out
@@ -183,7 +183,7 @@ class Engine:
     def _warm_set(self, record: SegmentRecord):
         """The warm start a segment passed on (None: it passed on the one it got)."""
         return self.estimator.warm if record.status is Status.OK and record.converged \
-            and record.kind.value == "off_bottom_rotating" else None
+            and record.kind == Kind.OFF_BOTTOM else None
 
     def _report(self, row: int | None = None) -> None:
         if self.progress:

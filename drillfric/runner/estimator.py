@@ -61,7 +61,7 @@ class SegmentEstimator:
         """The record and output rows (estimates, profile; none when not estimated) of one
         segment."""
         depth = self._depth(seg)
-        if seg.status != "ok":
+        if seg.status != Status.OK:
             return segment_record(seg, depth, Status.SKIPPED, seg.message, rows), {}
         data = _segment_data(rows, seg, depth)
         cfg = self.well.config

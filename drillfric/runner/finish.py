@@ -18,6 +18,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 
 from drillfric._version import __version__
+from drillfric.errors import OutputError
 from drillfric.estimation.consensus import consensus
 from drillfric.estimation.headline import judge as judge_headline
 from drillfric.friction import FrictionProfile
@@ -240,10 +241,15 @@ def deliver(well: Well, out_root, run: Callable[[Sink], WellResult],
     written atomically with the report (``report``) before it is committed."""
     if out_root is None:
         return run(MemorySink())
+    final = Path(out_root) / well.dir_name
     with ResultDirectory(out_root, well.dir_name, well.name) as tmp:
         result = run(DirectorySink(tmp))
         if report is not None:
-            write_report(tmp, report, result)
+            try:
+                write_report(tmp, report, result)
+            except OutputError as exc:  # named by the final path, not the temporary's
+                raise OutputError(exc.problem, file=final / Path(exc.file or "").name,
+                                  fix=exc.fix) from None
     result.out_dir = Path(out_root) / well.dir_name
     return result
 
@@ -253,7 +259,7 @@ def write_report(result_dir: Path, report: ReportWriter, result: WellResult) -> 
     stand), and leaves no partial report file; a failure to write (disk) fails the run."""
     try:
         report(result_dir)
-    except OSError:
+    except (OSError, OutputError):  # the disk, not the drawing: the run fails (exit 2)
         raise
     except Exception as exc:  # noqa: BLE001 — the estimates are written; say what failed
         for partial in result_dir.glob("report.*"):

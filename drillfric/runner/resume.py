@@ -34,6 +34,7 @@ import pyarrow.parquet as pq
 
 from drillfric.errors import InputError
 from drillfric.io.digest import sha256_prefix
+from drillfric.io.seal import broken
 from drillfric.io.well import Well
 
 from .engine import Engine, mismatch
@@ -303,6 +304,8 @@ def restored(well: Well, folder: Path, make: Callable[[], Engine], *,
     """
     if not (folder / "engine.json").is_file():
         return None, "no saved state"
+    if why := broken(folder):  # not the state this user's drillfric wrote: not trusted
+        return None, why
     try:
         state = read_state(folder)
         why = mismatch(state, well, rate_hz) or changed(state.get("source"), well) or \

@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from drillfric.io.seal import seal
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import RunProgress, WellResult
 
@@ -73,6 +74,7 @@ def finish_engine(engine: Engine, sink: Sink, tail=()) -> WellResult:
     result = engine.close(tail)
     if isinstance(sink, DirectorySink):
         engine.save(sink.folder / STATE_DIR)
+        seal(sink.folder / STATE_DIR)  # over the state and the result files it carries over
     return result
 
 

@@ -244,6 +244,7 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     columns = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     keep = np.concatenate([[True], np.diff(columns["time_s"]) > 0.5 / rate])
     columns = {k: v[keep] for k, v in columns.items()}
+    _check_bounded(columns, cfg)
     if not any(s.on_bottom for s in scenario.stands):
         columns.pop("wob_N")
     block = cfg.hookload.block_weight_N
@@ -251,6 +252,25 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     noise.apply(columns)
     notes = _notes(stands)
     return Simulation(columns, tuple(stands), settings, noise, rate, notes)
+
+
+#: Largest |speed| [RPM] and |torque| [N·m] a simulated top drive may show: beyond, the
+#: plant has diverged (a controller too stiff for the time step), not drilled.
+_DIVERGED_RPM, _DIVERGED_NM = 1e5, 1e10
+
+
+def _check_bounded(columns: dict, cfg: Config) -> None:
+    """ModelError when the recorded surface channels are not finite or beyond any drive's
+    (a top-drive controller gain that makes the explicit scheme diverge: written out, the
+    file held inf and 1e305 with exit 0)."""
+    rpm, torque = columns["surface_rpm"], columns["surface_torque_Nm"]
+    if not (np.all(np.isfinite(rpm)) and np.all(np.isfinite(torque)) and
+            np.max(np.abs(rpm), initial=0.0) < _DIVERGED_RPM and
+            np.max(np.abs(torque), initial=0.0) < _DIVERGED_NM):
+        raise ModelError("the simulated plant diverged (the top drive's speed or torque ran "
+                         "to infinity): its controller is too stiff for the time step",
+                         file=cfg.source, fix="lower [simulate] kp_Nms_rad and ki_Nm_rad "
+                                              "(or raise cells)")
 
 
 def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario,
