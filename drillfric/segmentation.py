@@ -509,7 +509,7 @@ class Segmenter:
     ...                       "surface_torque_Nm": 100.0 * rpm})
     >>> seg = Segmenter(load_config())
     >>> done = seg.feed(frame.iloc[:50]) + seg.feed(frame.iloc[50:]) + seg.close()
-    >>> [(s.kind, s.i_start, s.i_end, s.duration_s, s.status) for s in done]
+    >>> [(s.kind.value, s.i_start, s.i_end, s.duration_s, s.status) for s in done]
     [('off_bottom_rotating', 20, 80, 59.0, 'ok')]
     """
 

@@ -286,41 +286,6 @@ def test_no_survey_and_no_tortuosity_skips_as_before(first_stand_alone, tmp_path
     assert summary["mu_k"] is None and summary["counts"]["estimated"] == 0
 
 
-def test_dsats_runs_end_to_end(real_data, tmp_path):
-    """Issue 6 acceptance on real data (../shared/data/real/dsats_1hz, 13.9 h at 1 Hz, no
-    truth) with the documented config: segments found and estimated, nothing fails, μ_s
-    null (no creep start-up in this log, so not identifiable), a report written
-    (docs/validation.md). Issue #22 regression (hook-load check, docs/theory.md §2.1): the
-    assumed default string is ~3× heavier than the string the log's own hook load weighs
-    (rotating hook load − in-slips block weight), so no friction factor is published — per
-    segment nor well-wide — and summary.json warnings and mu_k_reason say why."""
-    data = real_data / "dsats_1hz" / "SampleData1.csv"
-    result = CliRunner().invoke(cli, ["-q", "run", str(data), "--config",
-                                      str(REPO / "examples" / "dsats_1hz.toml"),
-                                      "--out", str(tmp_path)])
-    assert result.exit_code == 0, result.output
-    (out,) = [p for p in tmp_path.iterdir() if p.is_dir()]
-    summary = json.loads((out / "summary.json").read_text())
-    status = [s["status"] for s in summary["segments"]]
-    assert status.count("failed") == 0 and status.count("ok") >= 20
-    check = summary["hookload"]
-    assert check["verdict"] == "contradicted" and check["string_weight_ratio"] < 0.5
-    assert check["block_weight_source"] == "slips_hookload_N"
-    assert check["block_weight_evidence"]["rows"] > 100
-    for seg in summary["segments"]:
-        assert seg["mu_k"] is None and seg["mu_s_lower_bound"] is None, seg
-        if seg["status"] == "ok":
-            assert "hookload_contradicts_string" in seg["quality_flags"]
-    assert summary["mu_k"] is None and summary["mu_s"] is None
-    assert "hook-load check" in summary["mu_k_reason"]
-    assert any("contradicts the configured string" in w for w in summary["warnings"])
-    # nor a drag-based one (issue #22 item 4): the connections are found, all withheld
-    assert summary["drag"]["connections"] >= 10 and summary["drag"]["estimated"] == 0
-    drag_log = pd.read_parquet(out / "drag_log.parquet")
-    assert drag_log["reason"].str.contains("contradicts the configured string").all()
-    assert (out / "report.html").stat().st_size > 0
-
-
 def test_bit_depth_from_the_well_config(tmp_path):
     """A log without bit depth takes ``[well] bit_depth_m`` for its segments, and that is a
     given, not an assumption: nothing about bit depth in ``assumed``. Without it the survey's
