@@ -15,7 +15,7 @@ from pathlib import Path
 
 import click
 
-from drillfric.result import WellStatus
+from drillfric.vocabulary import WellStatus
 
 from .common import UserError, compile_kernels_once, echo, interrupted_exit_code, progress
 

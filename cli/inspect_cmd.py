@@ -8,7 +8,7 @@ import click
 import numpy as np
 
 from drillfric.io.text import terminal_text
-from drillfric.result import Status
+from drillfric.vocabulary import Status
 
 from .common import unit_system, units_option
 

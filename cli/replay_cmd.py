@@ -9,6 +9,12 @@ import click
 
 from .common import UserError, echo
 
+#: Fastest replay (times real time): a day of log in under a second; beyond, the pace is
+#: meaningless (and infinity cannot be paced at all).
+MAX_SPEED = 1e6
+#: Longest wall pause between two writes [s].
+MAX_TICK_S = 3600.0
+
 
 @click.command("replay")
 @click.argument("file", type=click.Path(path_type=Path))
@@ -29,14 +35,19 @@ def command(file: Path, target: str, speed: float, tick: float, seed: int,
             drop_after: int | None) -> None:
     """Append FILE (a CSV's own bytes; any other readable well file as CSV of its canonical
     channels) to TARGET at SPEED times real time, or serve it over WITS level 0."""
-    if not speed > 0 or not tick > 0:
-        raise UserError(f"--speed and --tick must be positive, got {speed:g} and {tick:g}")
+    if not 0 < speed < MAX_SPEED or not 0 < tick <= MAX_TICK_S:
+        raise UserError(f"--speed must lie in (0, {MAX_SPEED:g}) and --tick in (0, "
+                        f"{MAX_TICK_S:g}] s, got {speed:.4g} and {tick:.4g} — fix: e.g. "
+                        "--speed 20 --tick 0.1")
     if target.startswith("wits0:"):
         _wits0(file, target, speed, drop_after)
         return
     from drillfric.live.replay import recorded_text, replay
 
     path = Path(target)
+    if path.is_symlink() or path.exists() and not path.is_file():
+        raise UserError(f"{target}: not a regular file (a directory, a FIFO, a device or a "
+                        "link) — fix: give a new or empty file to replay into")
     if path.exists() and path.stat().st_size:
         raise UserError(f"{target}: already holds data; give a new or empty file to replay "
                         "into")

@@ -8,7 +8,7 @@ import click
 
 from drillfric.errors import DrillfricError
 from drillfric.io.text import terminal_text
-from drillfric.result import WellStatus
+from drillfric.vocabulary import WellStatus
 
 from .common import (
     Quantity,

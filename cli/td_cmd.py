@@ -16,6 +16,7 @@ import click
 import numpy as np
 
 from drillfric.files import require_file
+from drillfric.io.text import printable
 
 from .common import Quantity, UserError, echo, unit_system, units_option, warn
 
@@ -55,19 +56,48 @@ def _load_with_log(target: Path, config, survey, overrides):
     return well.config, well.survey, measured_points_from_log(well.surface, well.config)
 
 
+#: Most values of one --depths or --frictions list (a range's count is checked before it is
+#: made: 0:1e15:1 asked for 7 PiB).
+MAX_LIST = 10_000
+#: Deepest bit [m] (the configuration's plausible maximum for depths, docs/configuration.md).
+MAX_BIT_DEPTH_M = 15_000.0
+#: Budget of a broomstick: depths × friction factors × load cases × elements of the deepest
+#: string (≈ 20 ns each: 2×10⁹ is about 40 s).
+MAX_BROOMSTICK_WORK = 2e9
+
+
 def _floats(text: str | None, what: str) -> list[float] | None:
+    """The finite numbers of a comma list or START:STOP:STEP (None: not given)."""
     if text is None:
         return None
+    bad = UserError(f"--{what}: expected comma-separated finite numbers or START:STOP:STEP, "
+                    f"got '{printable(text, 60)}' — fix: e.g. --{what} 0.1,0.2,0.3 or "
+                    "500:2500:100")
     try:
         if ":" in text:
             start, stop, step = (float(v) for v in text.split(":"))
-            if step <= 0 or stop < start:
-                raise ValueError
-            return list(np.arange(start, stop + 0.5 * step, step))
-        return [float(v) for v in text.split(",") if v.strip()]
+            if not (np.isfinite([start, stop, step]).all() and step > 0 and stop >= start):
+                raise bad
+            if (stop - start) / step + 1 > MAX_LIST:
+                raise UserError(f"--{what}: {start:.4g}:{stop:.4g}:{step:.4g} gives "
+                                f"{(stop - start) / step + 1:.3g} values; at most {MAX_LIST} "
+                                "— fix: a larger STEP")
+            values = list(np.arange(start, stop + 0.5 * step, step))
+        else:
+            values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
-        raise UserError(f"--{what}: expected comma-separated numbers or START:STOP:STEP, got "
-                        f"'{text}'") from None
+        raise bad from None
+    if not values or len(values) > MAX_LIST or not np.isfinite(values).all():
+        raise bad
+    return values
+
+
+def _check_depth(depth_m: float, what: str) -> None:
+    """UserError unless ``depth_m`` is a bit depth a well can have (0 < d ≤ 15 km)."""
+    if not 0 < depth_m <= MAX_BIT_DEPTH_M:
+        raise UserError(f"{what} {depth_m:.4g} m is not a well's: at most "
+                        f"{MAX_BIT_DEPTH_M:.0f} m — fix: a bit depth in metres (or with its "
+                        "unit, e.g. \"8200 ft\")")
 
 
 def _check_out(out: Path | None, suffixes: tuple[str, ...]) -> None:
@@ -145,6 +175,7 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
                             "taken as vertical, with "
                             "the nominal tortuosity survey.tortuosity_deg_30m)")
         bit_depth = path.md_max_m
+    _check_depth(bit_depth, "the bit depth")
     for note in cfg.assumed_with(path):
         if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
             warn(f"assumed {note}")
@@ -200,6 +231,7 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
                 units, measured=None) -> None:
     from drillfric.drillstring import build_string
     from drillfric.torque_drag import broomstick, broomstick_figure, config_friction
+    from drillfric.vocabulary import LoadCase
     from drillfric.wellpath import no_survey_path
 
     _check_out(out, _TABLE_SUFFIXES)
@@ -207,17 +239,25 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
         plot = out.with_suffix(".png")
     _check_out(plot, _PLOT_SUFFIXES)
     mus = _floats(frictions, "frictions") or list(_DEFAULT_FRICTIONS)
-    if any(m < 0 or m > 2 for m in mus):
-        raise UserError(f"--frictions must lie in [0, 2], got {mus}")
+    if not all(0 <= m <= 2 for m in mus):
+        raise UserError(f"--frictions must lie in [0, 2], got {printable(str(mus), 80)} — "
+                        "fix: friction factors such as 0.1,0.2,0.3")
     string = build_string(cfg.sections, bit_depth)
     bha_m = string.bit_depth_m - string.bha_top_m
     grid = _floats(depths, "depths")
     if grid is None:
         grid = list(np.linspace(max(bha_m + 1.0, bit_depth / 50), bit_depth, 50))
-    path = no_survey_path(max(grid), cfg.tortuosity_rad_m) if path is None else path
-    cases = ["rotating_off_bottom", "pick_up", "slack_off"]
+    _check_depth(max(grid), "--depths")
+    cases = [LoadCase.ROTATING_OFF_BOTTOM, LoadCase.PICK_UP, LoadCase.SLACK_OFF]
     if kw["wob_N"] > 0 or kw["bit_torque_Nm"] != 0:
-        cases.append("rotating_on_bottom")
+        cases.append(LoadCase.ROTATING_ON_BOTTOM)
+    work = len(grid) * len(mus) * len(cases) * max(grid) / cfg.model.element_length_m
+    if work > MAX_BROOMSTICK_WORK:
+        raise UserError(f"the broomstick of {len(grid)} depths × {len(mus)} friction factors "
+                        f"× {len(cases)} load cases at {cfg.model.element_length_m:g}-m elements "
+                        f"is {work:.3g} element solves; the budget is {MAX_BROOMSTICK_WORK:.0e} "
+                        "— fix: fewer --depths or --frictions, or a longer --element-length")
+    path = no_survey_path(max(grid), cfg.tortuosity_rad_m) if path is None else path
     if callable(config_friction(cfg)):
         warn("broomstick uses one friction factor per curve; cased/open-hole values ignored")
     table = broomstick(path, cfg.sections, grid, mus, cases,

@@ -30,7 +30,8 @@ import pandas as pd
 from drillfric import torque_drag
 from drillfric.drillstring import section_from_config
 from drillfric.kernels.lazy import lazy_jit
-from drillfric.result import Flag, Kind, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
+from drillfric.vocabulary import Kind, Status
 
 #: Heaviest plausible travelling equipment (block, hook, top drive, elevators) [N]: about
 #: 70 t, above the heaviest offshore top-drive systems. Without an in-slips plateau a hook

@@ -11,98 +11,14 @@ every column of ``estimates.parquet`` from :data:`ESTIMATE_COLUMNS`. Units are i
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
-from enum import IntEnum, StrEnum
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pyarrow as pa
 
-
-class Status(StrEnum):
-    """What became of a segment."""
-
-    OK = "ok"  #: estimated (the numbers may still be flagged or not converged)
-    SKIPPED = "skipped"  #: nothing to estimate (too short, nulls, no side force)
-    FAILED = "failed"  #: the estimation could not be done (e.g. torque in the wrong unit)
-
-
-class WellStatus(StrEnum):
-    """What became of a well in a fleet run (manifest.json, fleet_summary.parquet
-    ``well_status``)."""
-
-    OK = "ok"  #: processed now
-    SKIPPED = "skipped"  #: unchanged since an ok run: its results stand
-    FAILED = "failed"  #: could not be processed (its message says why)
-
-
-class Kind(StrEnum):
-    """The load case of a rotating segment (docs/theory.md §2 item 5)."""
-
-    OFF_BOTTOM = "off_bottom_rotating"
-    ON_BOTTOM = "on_bottom_rotating"
-    REAMING = "reaming"  #: turning while running in faster than segmentation.ream_speed_m_s
-    BACK_REAMING = "back_reaming"  #: turning while pulling out (μ, bit speed withheld)
-
-
-class LoadCase(StrEnum):
-    """A torque-and-drag load case (docs/theory.md §2 step 3; docs/torque_drag.md): σ, the
-    axial share of the wall friction, is +1 pulling out, −1 running in, 0 rotating; the
-    rotating pick-up and slack-off split it between axial and tangential."""
-
-    ROTATING_OFF_BOTTOM = "rotating_off_bottom"
-    ROTATING_ON_BOTTOM = "rotating_on_bottom"
-    PICK_UP = "pick_up"
-    SLACK_OFF = "slack_off"
-    ROTATING_PICK_UP = "rotating_pick_up"
-    ROTATING_SLACK_OFF = "rotating_slack_off"
-    SLIDING = "sliding"  #: slack-off with weight on bit and no rotation (motor drilling)
-
-
-class RigState(IntEnum):
-    """What the rig does at a sample (docs/segmentation.md): the codes stored per row
-    (tracks, the segmenter's state); :attr:`text` is the public name (live.json
-    ``rig_state``, tracks.parquet)."""
-
-    ROTATING_OFF_BOTTOM = 0
-    ROTATING_ON_BOTTOM = 1
-    IN_SLIPS = 2
-    TRIPPING = 3
-    IDLE = 4
-    UNKNOWN = 5
-    SLIDING_ON_BOTTOM = 6
-    REAMING = 7
-    BACK_REAMING = 8
-
-    @property
-    def text(self) -> str:
-        """The public name, e.g. ``"rotating_off_bottom"``."""
-        return self.name.lower()
-
-    @property
-    def kind(self) -> Kind | None:
-        """The kind of segment a run of this state makes (None: the string does not turn)."""
-        return STATE_KINDS.get(self)
-
-
-class Method(StrEnum):
-    """Which estimator produced a segment's friction factors."""
-
-    BATCH = "batch"  #: the speed-driven fit (docs/theory.md §6.4)
-    OBSERVER = "observer"  #: the adaptive observer's consensus (§5), the fit gave no μ_k
-    TD_BACKCALC = "td_backcalc"  #: static torque-and-drag back-calculation of a depth log
-    NONE = "none"  #: no estimate (skipped or failed)
-
-
-#: The segment kind of each turning rig state (the one mapping between the two vocabularies).
-STATE_KINDS = {RigState.ROTATING_OFF_BOTTOM: Kind.OFF_BOTTOM,
-               RigState.ROTATING_ON_BOTTOM: Kind.ON_BOTTOM,
-               RigState.REAMING: Kind.REAMING, RigState.BACK_REAMING: Kind.BACK_REAMING}
-#: The load case each segment kind is modelled with (reaming: running in while turning).
-KIND_LOAD_CASES = {Kind.OFF_BOTTOM: LoadCase.ROTATING_OFF_BOTTOM,
-                   Kind.ON_BOTTOM: LoadCase.ROTATING_ON_BOTTOM,
-                   Kind.REAMING: LoadCase.ROTATING_SLACK_OFF,
-                   Kind.BACK_REAMING: LoadCase.ROTATING_PICK_UP}
+from drillfric.vocabulary import Kind, Method, Status
 
 
 class Flag(StrEnum):

@@ -26,7 +26,7 @@ import pandas as pd
 from drillfric.config import Config
 from drillfric.errors import InputError
 from drillfric.kernels.lazy import lazy_jit
-from drillfric.result import STATE_KINDS, Kind, RigState
+from drillfric.vocabulary import STATE_KINDS, Kind, RigState
 
 #: Rig states, coded by their position (``np.int8``; new states are appended, codes never
 #: move). ``sliding_on_bottom`` (on bottom with the pumps on but no surface rotation: motor

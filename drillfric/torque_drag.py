@@ -26,8 +26,8 @@ from numba import njit
 
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import ModelError
-from drillfric.result import LoadCase
 from drillfric.units import RPM_TO_RAD_S
+from drillfric.vocabulary import LoadCase
 from drillfric.wellpath import WellPath, no_survey_path
 
 #: Load cases (docs/theory.md §2 step 3): σ is the axial share of the friction (+1 pulling out,

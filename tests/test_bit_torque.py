@@ -10,8 +10,9 @@ import pytest
 
 from drillfric.estimation.bit_torque import assess, mu_bit, teale_mse_Pa
 from drillfric.estimation.consensus import mean_half_width, pool_short_segments
-from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
 from drillfric.torsional import bit_torque_cap
+from drillfric.vocabulary import Kind, Method, Status
 
 REPO = __import__("pathlib").Path(__file__).resolve().parents[1]
 

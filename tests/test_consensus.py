@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from drillfric.estimation.consensus import consensus, pool_short_segments
-from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
+from drillfric.vocabulary import Kind, Method, Status
 
 
 def _seg(i, mu_k, depth=2000.0, duration=40.0, converged=False, flags=(Flag.TOO_SHORT_TO_CONVERGE,),

@@ -27,9 +27,10 @@ from drillfric.errors import InputError
 from drillfric.estimation.friction_log import bit_torque_Nm, friction_log
 from drillfric.io.survey import read_survey
 from drillfric.io.well import open_well
-from drillfric.result import Flag, Kind, Method, Status
+from drillfric.result import Flag
 from drillfric.runner.depth_log import run_depth_log
 from drillfric.torque_drag import solve
+from drillfric.vocabulary import Kind, Method, Status
 from tests.conftest import REPO
 
 MU = 0.27  # the synthetic log's friction factor

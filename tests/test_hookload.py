@@ -25,7 +25,8 @@ from drillfric import hookload
 from drillfric.config import config_from_dict, load_config
 from drillfric.drillstring import G_ACCEL
 from drillfric.estimation.consensus import consensus
-from drillfric.result import Flag, Kind, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
+from drillfric.vocabulary import Kind, Status
 from tests.conftest import REPO
 
 DEMO = REPO / "examples" / "demo"
@@ -387,7 +388,8 @@ def test_drilling_only_log_without_block_weight_withholds_its_apparent_friction(
     (no off-bottom rotating hook load to weigh the string against) and says so."""
     from drillfric import hookload
     from drillfric.config import config_from_dict
-    from drillfric.result import Kind, SegmentRecord, Status
+    from drillfric.result import SegmentRecord
+    from drillfric.vocabulary import Kind, Status
 
     records = [SegmentRecord(id=i, status=Status.OK, kind=Kind.ON_BOTTOM, mu_k=0.3,
                              bit_depth_m=2000.0, hookload_N=900e3, hookload_model_N=600e3)

@@ -684,3 +684,107 @@ def test_report_on_crafted_result_tables_is_one_line(table, how, result_dir, tmp
         frame = frame.assign(rig_state=np.int64(2 ** 62))
     frame.to_parquet(path)
     _strict_check(Case(["report", "out/demo"], (2,), (f"{table}.parquet",)), root, capsys)
+
+
+# ------------------------------------------------ the third attack (issue 30)
+@pytest.mark.parametrize("plant", ["fifo", "empty", "readable_by_others", "link_to_zero"])
+def test_a_state_key_that_is_not_a_key_seals_and_resumes_nothing(plant, tmp_path,
+                                                                 monkeypatch):
+    """A FIFO as the key hung the run; a link to /dev/zero read 20 GB; an empty or
+    world-readable key let anyone forge a seal. None of them is a key."""
+    from drillfric.io import seal
+
+    home = tmp_path / "config"
+    folder = home / "drillfric"
+    folder.mkdir(parents=True)
+    path = folder / "state.key"
+    if plant == "fifo":
+        os.mkfifo(path)
+    elif plant == "empty":
+        path.write_bytes(b"")
+        path.chmod(0o600)
+    elif plant == "readable_by_others":
+        path.write_bytes(b"k" * 32)
+        path.chmod(0o644)
+    else:
+        path.symlink_to("/dev/zero")
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(home))
+    monkeypatch.delenv(seal.KEY_ENV, raising=False)
+    with hang_guard(30):
+        assert seal.key() is None
+        state = tmp_path / "state"
+        state.mkdir()
+        (state / "engine.json").write_text("{}")
+        assert not seal.seal(state) and "no key" in seal.broken(state)
+
+
+def test_a_key_made_on_first_use_is_private_and_kept(tmp_path, monkeypatch):
+    from drillfric.io import seal
+
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
+    monkeypatch.delenv(seal.KEY_ENV, raising=False)
+    first = seal.key()
+    path = tmp_path / "drillfric" / "state.key"
+    assert len(first) == 32 and path.stat().st_mode & 0o777 == 0o600
+    assert seal.key() == first
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    (["--depths="], "finite numbers"), (["--depths=,"], "finite numbers"),
+    (["--depths", "0:1e15:1"], "at most 10000"), (["--frictions", "nan,0.2"], "finite"),
+    (["--bit-depth", "1e9"], "not a well's"),
+    (["--depths", "300:2400:2.1", "--element-length", "0.0121"], "budget")])
+def test_td_broomstick_asking_for_petabytes_or_hours_is_one_line(args, says, tmp_path,
+                                                                  capsys):
+    """--depths 0:1e15:1 asked for 7 PiB; 1000 depths at 1.2-cm elements took 89 s; an
+    empty list was an IndexError; NaN frictions drew NaN curves with exit 0; --bit-depth 1e9
+    took 13 GB before the element budget said no."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    (root / "w.toml").write_text("[well]\nbit_depth_m = 2400.0\n")
+    _strict_check(Case(["td", "w.toml", "--broomstick", *args], (2,), (says,)), root, capsys)
+
+
+@pytest.mark.parametrize(("args", "says"), [(["--speed", "inf"], "--speed"),
+                                            (["--tick", "inf"], "--tick"),
+                                            (["--to", "fifo"], "not a regular file")])
+def test_replay_at_infinite_pace_or_into_a_fifo_is_one_line(args, says, tmp_path, capsys):
+    """--speed inf was an OverflowError leaving an empty target; --to a FIFO blocked."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _log(root / "w.csv")
+    os.mkfifo(root / "fifo")
+    target = [] if "--to" in args else ["--to", "out/t.csv"]
+    _strict_check(Case(["replay", "w.csv", *target, *args], (2,), (says,)), root, capsys)
+    assert not (root / "out" / "t.csv").exists()
+
+
+def test_a_followed_file_replaced_by_another_is_one_line_not_spliced(tmp_path):
+    """A file renamed over the followed one, as long as it, was spliced silently into one
+    log (the old rows, then the new file's); a file rewritten whole with the same first
+    bytes (a logger that renames its rewrite over the old file) is followed on."""
+    from drillfric.errors import InputError
+    from drillfric.live.source import Tail
+
+    path = tmp_path / "g.csv"
+    path.write_text("time_s,x\n0,1\n1,2\n")
+    tail = Tail(path)
+    assert tail.poll() == len(path.read_bytes())
+    grown = tmp_path / "new.csv"
+    grown.write_text("time_s,x\n0,1\n1,2\n2,3\n")
+    os.replace(grown, path)  # the same first bytes, renamed over: followed on
+    assert tail.poll() == len(path.read_bytes())
+    other = tmp_path / "other.csv"
+    other.write_text("time_s,x\n0,9\n1,9\n2,9\n3,9\n")
+    os.replace(other, path)
+    with pytest.raises(InputError, match="replaced by another"):
+        tail.poll()
+
+
+def test_pdf_tables_draw_at_most_their_cap_of_rows():
+    """A summary.json of a million 'assumed' lines grew report --pdf past 5 GB."""
+    from drillfric.report.pdf import MAX_TABLE_ROWS, table_pages
+
+    few = table_pages("t", ["a", "b"], [["x", "y"]] * 100)
+    many = table_pages("t", ["a", "b"], [["x", "y"]] * 100_000)
+    assert len(many) <= len(few) * (MAX_TABLE_ROWS // 100 + 1)

@@ -248,7 +248,8 @@ def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it
     speed of a segment whose bit trace the run withholds (not resolved, or the segment not
     estimated); it is null with ``bit_rpm_reason``, by the live page's rule."""
     from drillfric.live.run import _open_view
-    from drillfric.result import SegmentRecord, Status
+    from drillfric.result import SegmentRecord
+    from drillfric.vocabulary import Status
 
     pd.DataFrame({"segment_id": np.int32([3, 3]), "time_s": [0.0, 0.01],
                   "surface_rpm": [60.0, 60.0], "bit_rpm_est": [44.0, 45.0],
@@ -273,7 +274,8 @@ def test_bit_stalled_alert_after_the_bit_stays_stuck_while_the_top_drive_turns(t
     last BIT_STALL_S of the open segment while the top drive turns — not a stick phase of
     ordinary stick-slip (1–3 s), not a stop of the top drive, not a withheld bit trace."""
     from drillfric.live.run import BIT_STALL_S, LiveRun, _open_view
-    from drillfric.result import SegmentRecord, Status
+    from drillfric.result import SegmentRecord
+    from drillfric.vocabulary import Status
 
     t = np.arange(0.0, 20.0, 0.01)
     stuck = t >= 20.0 - (BIT_STALL_S + 1.0)  # the last 6 s at rest

@@ -17,12 +17,11 @@ from drillfric.result import (
     ESTIMATE_NAMES,
     FLEET_WELL_COLUMNS,
     SEGMENT_FIELDS,
-    Kind,
     SegmentRecord,
-    Status,
     outputs_markdown,
     segment_arrow_types,
 )
+from drillfric.vocabulary import Kind, Status
 from tests.conftest import REPO
 
 #: Columns of the other result tables (profiles.parquet, wellpath.parquet, tracks.parquet).

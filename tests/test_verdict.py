@@ -18,7 +18,8 @@ from drillfric.estimation.verdict import (
     Evidence,
     decide,
 )
-from drillfric.result import Flag, Method
+from drillfric.result import Flag
+from drillfric.vocabulary import Method
 
 #: Off bottom, batch μ_k 0.2 agreeing with the observer's 0.21, 120 s of rotation, a bound
 #: 0.3, the model's regime μ_s 0.5, no creep μ_s.

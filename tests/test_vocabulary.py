@@ -1,4 +1,4 @@
-"""One vocabulary (issue 31 item 2): each idea has one enum (drillfric.result: Status, Kind,
+"""One vocabulary (issue 31 item 2): each idea has one enum (drillfric.vocabulary: Status, Kind,
 Method, Flag, LoadCase, RigState, WellStatus), the public strings are their values, and no
 code compares an enum's value with a string literal — a misspelt literal would compare
 false silently, a misspelt member fails at import."""
@@ -9,10 +9,12 @@ import ast
 
 import pytest
 
-from drillfric.result import (
+from drillfric.result import Flag
+from drillfric.segmentation import KINDS, RIG_STATES
+from drillfric.torque_drag import LOAD_CASES
+from drillfric.vocabulary import (
     KIND_LOAD_CASES,
     STATE_KINDS,
-    Flag,
     Kind,
     LoadCase,
     Method,
@@ -20,8 +22,6 @@ from drillfric.result import (
     Status,
     WellStatus,
 )
-from drillfric.segmentation import KINDS, RIG_STATES
-from drillfric.torque_drag import LOAD_CASES
 from tests.conftest import REPO
 
 #: Values no other vocabulary shares: a literal of one is a comparison with the enum.

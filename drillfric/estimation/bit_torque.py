@@ -27,8 +27,9 @@ import numpy as np
 import pandas as pd
 
 from drillfric.estimation.consensus import POOL_TORQUE_SHARE, mean_half_width, mu_k_tolerance
-from drillfric.result import Kind, SegmentRecord, Status
+from drillfric.result import SegmentRecord
 from drillfric.units import RPM_TO_RAD_S
+from drillfric.vocabulary import Kind, Status
 
 #: Block length of the standard error of a mean torque [s]: longer than a stick-slip
 #: period (4 × the wave travel time, 2–10 s), so block means are nearly independent.

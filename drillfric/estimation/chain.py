@@ -45,8 +45,9 @@ from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_i
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import Evidence, Verdict, decide
 from drillfric.friction import FrictionProfile
-from drillfric.result import Flag, Kind, Method
+from drillfric.result import Flag
 from drillfric.units import RPM_TO_RAD_S
+from drillfric.vocabulary import Kind, Method
 from drillfric.wellpath import WellPath, no_survey_path
 
 #: Largest cell of the batch fit's model [m] (docs/theory.md §6.4).

@@ -13,7 +13,8 @@ from dataclasses import replace
 import numpy as np
 from scipy.stats import t as student_t
 
-from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
+from drillfric.vocabulary import Kind, Method, Status
 
 #: Flags a short segment may carry and still be pooled (it is only too short: a few torque
 #: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``

@@ -44,8 +44,9 @@ from drillfric.drillstring import build_string
 from drillfric.errors import InputError, ModelError
 from drillfric.estimation.verdict import TYPICAL_MU
 from drillfric.io.well import CHUNK_ROWS, Well
-from drillfric.result import Flag, Kind, Method, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
 from drillfric.torque_drag import TDResult, back_calculate_friction, solve
+from drillfric.vocabulary import Kind, Method, Status
 from drillfric.wellpath import no_survey_path
 
 #: What a depth log cannot give, said in every summary and segment message.

@@ -11,7 +11,8 @@ changes them.
 from __future__ import annotations
 
 from drillfric.estimation.verdict import TYPICAL_MU
-from drillfric.result import Flag, Kind, Status, WellFlag
+from drillfric.result import Flag, WellFlag
+from drillfric.vocabulary import Kind, Status
 
 #: A well μ_k resting on fewer segments than this is low-confidence: two segments cannot
 #: show which of them is the odd one out.

@@ -13,8 +13,8 @@ import numpy as np
 
 from drillfric.errors import DrillfricError
 from drillfric.io.channels import factor
-from drillfric.result import Kind
 from drillfric.units import RPM_TO_RAD_S
+from drillfric.vocabulary import Kind
 
 #: Friction factors bounding any physical rotating torque (generous): off bottom the soft
 #: string gives a surface torque μ·T_N (docs/theory.md §2, §5.1), so μ ∈ this range bounds it.

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from drillfric.estimation.batch.settings import MU_K_CLAIM
-from drillfric.result import Flag, Method
+from drillfric.result import Flag
+from drillfric.vocabulary import Method
 
 #: Batch flags under which a stick-slip-onset bound on μ_s is not reported (docs/theory.md
 #: §6.4: a bound above the truth is a false claim; prefer none).

@@ -52,7 +52,8 @@ from drillfric.io.results import (
     remove_stale,
     write_json,
 )
-from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS, WellStatus
+from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS
+from drillfric.vocabulary import WellStatus
 
 MANIFEST = "manifest.json"
 SUMMARY = "fleet_summary.parquet"

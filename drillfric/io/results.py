@@ -361,6 +361,10 @@ class EstimatesWriter:
         self._writer.close()
 
 
+#: Largest JSON file of drillfric's read back (a 24 h well's summary.json is a few MB).
+MAX_JSON_BYTES = 256 << 20
+
+
 def read_json(path: Path, *, fix: str = "rerun 'drillfric run' to rewrite the results") -> dict:
     """A JSON object drillfric wrote (summary.json, manifest.json …), read as untrusted: a
     link, FIFO or directory there (:func:`~drillfric.io.atomic.own_file`), or an unreadable,
@@ -372,7 +376,9 @@ def read_json(path: Path, *, fix: str = "rerun 'drillfric run' to rewrite the re
     InputError
     """
     try:
-        value = json.loads(own_file(Path(path)).read_text(encoding="utf-8"))
+        if own_file(Path(path)).stat().st_size > MAX_JSON_BYTES:
+            raise ValueError(f"larger than {MAX_JSON_BYTES >> 20} MiB")
+        value = json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError) as exc:
         why = "too deeply nested" if isinstance(exc, RecursionError) else \
             "not UTF-8" if isinstance(exc, UnicodeDecodeError) else \

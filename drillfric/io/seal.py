@@ -14,8 +14,9 @@ Such a state is never an error: the well runs from its start, and summary.json
 
 The key: ``DRILLFRIC_STATE_KEY`` (text; give every machine of a cluster the same one), else
 ``$XDG_CONFIG_HOME/drillfric/state.key`` (``~/.config``), 32 random bytes made on first use,
-mode 0600. Without a key (a home that cannot be written) nothing is sealed and nothing
-resumed.
+mode 0600. Without a key — a home that cannot be written, or a key file that is not one
+(a link, a FIFO, a device, another length, readable by others, another user's: a weak key
+would let anyone forge a seal) — nothing is sealed and nothing resumed.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import hmac
 import json
 import os
 import secrets
+import stat
 from pathlib import Path
 
 from drillfric.io.atomic import own_file
@@ -36,27 +38,48 @@ KEY_ENV = "DRILLFRIC_STATE_KEY"
 CARRIED = ("estimates.parquet", "profiles.parquet")
 
 
+#: Bytes of a key file (what :func:`_make` writes; anything else is not a key).
+KEY_BYTES = 32
+
+
 def key() -> bytes | None:
-    """The sealing key (see the module's text), or None when none can be had."""
+    """The sealing key (see the module's text), or None when none can be had: no key file
+    can be made, or the one there is not a key (a link, a FIFO, a device, not 32 bytes,
+    readable by others, another user's) — then nothing is sealed or resumed."""
     given = os.environ.get(KEY_ENV)
     if given:
         return hashlib.sha256(given.encode("utf-8", "surrogateescape")).digest()
     base = Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config")
     path = base / "drillfric" / "state.key"
     try:
-        return path.read_bytes() if path.is_file() else _make(path)
+        return _read(path) if os.path.lexists(path) else _make(path)
     except OSError:
         return None
 
 
-def _make(path: Path) -> bytes:
+def _read(path: Path) -> bytes | None:
+    """The key in ``path``, opened without following a link or blocking on a FIFO, and
+    only a regular file of :data:`KEY_BYTES` bytes, mode 0600 or stricter, this user's."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode) or info.st_size != KEY_BYTES or \
+                info.st_mode & 0o077 or info.st_uid != os.geteuid():
+            return None
+        data = os.read(fd, KEY_BYTES + 1)
+    finally:
+        os.close(fd)
+    return data if len(data) == KEY_BYTES else None
+
+
+def _make(path: Path) -> bytes | None:
     """A new key at ``path`` (0600; a concurrent maker's key wins: O_EXCL)."""
     path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
-    fresh = secrets.token_bytes(32)
+    fresh = secrets.token_bytes(KEY_BYTES)
     try:
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
     except FileExistsError:
-        return path.read_bytes()
+        return _read(path)
     with os.fdopen(fd, "wb") as fh:
         fh.write(fresh)
     return fresh

@@ -54,7 +54,7 @@ from drillfric.report.render import (
     severity_text,
     status_word,
 )
-from drillfric.result import Status
+from drillfric.vocabulary import Status
 
 #: Host the page binds when ``--serve`` names only a port (never all interfaces unasked).
 DEFAULT_HOST = "127.0.0.1"

@@ -44,13 +44,14 @@ from drillfric.io.results import write_json
 from drillfric.io.timebase import clock_at
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live.source import PartsTail, Tail, follow
-from drillfric.result import Flag, SegmentRecord, Status
+from drillfric.result import Flag, SegmentRecord
 from drillfric.runner import warmup
 from drillfric.runner.engine import Engine
 from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
 from drillfric.runner.resume import restored, unread
 from drillfric.runner.time_log import STATE_DIR, finish_engine
 from drillfric.segmentation import RIG_STATES
+from drillfric.vocabulary import Status
 
 #: Longest wait between two rewrites of live.json [s] (INTERFACE: at least every 0.5 s).
 POLL_S = 0.2

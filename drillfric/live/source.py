@@ -19,6 +19,7 @@ import pyarrow as pa
 
 from drillfric.errors import InputError
 from drillfric.files import require_inside
+from drillfric.io.digest import sha256_prefix
 from drillfric.io.parts import folder_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import FORMATS
@@ -74,6 +75,7 @@ class Tail:
     def __init__(self, path: Path, start: int = 0):
         self.path, self.end = Path(path), 0
         self._digest = hashlib.sha256()
+        self._identity: tuple[int, int] | None = None  # (device, inode) of what was read
         if start:
             self._take(start)
 
@@ -87,13 +89,21 @@ class Tail:
             The file became shorter than what was read (rewritten, not appended to).
         """
         try:
-            size = self.path.stat().st_size
+            info = self.path.stat()
+            size, identity = info.st_size, (info.st_dev, info.st_ino)
         except FileNotFoundError:
-            size = 0
+            size, identity = 0, self._identity
         if size < self.end:
             raise InputError(f"the file shrank to {size} bytes after {self.end} were read",
                              file=self.path, fix="append to the file; restart live on a new "
                                                  "--out for a rewritten file")
+        if self.end and self._identity not in (None, identity) and not self._same_start():
+            raise InputError("the file was replaced by another (renamed over it) whose first "
+                             f"{self.end} bytes are not the ones read: its rows cannot "
+                             "continue them", file=self.path,
+                             fix="append to the file; restart live on a new --out for a "
+                                 "rewritten file")
+        self._identity = identity
         while size > self.end:  # the partial last line is read again: it may have ended
             with open(self.path, "rb") as fh:  # in blocks: memory bounded by MAX_BLOCK
                 fh.seek(self.end)
@@ -107,6 +117,14 @@ class Tail:
                 break
             self._take(self.end + cut, block[:cut])
         return self.end
+
+    def _same_start(self) -> bool:
+        """Whether the file now starts with the bytes read so far (a logger that rewrites
+        its file whole and renames it over the old one keeps them; another file does not)."""
+        try:
+            return sha256_prefix(self.path, self.end) == self._digest.hexdigest()
+        except (OSError, ValueError):
+            return False
 
     def lines(self) -> int:
         """How many complete lines there are up to :attr:`end`, counted up to

@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.estimation.headline import STRING_WEIGHT_TOLERANCE
-from drillfric.result import Kind, LoadCase
+from drillfric.vocabulary import Kind, LoadCase
 
 from .display import SI, Units
 

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from drillfric.result import Status
+from drillfric.vocabulary import Status
 
 from .display import SI, Units
 from .render import is_apparent, zone_text

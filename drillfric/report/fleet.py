@@ -11,7 +11,8 @@ from urllib.parse import quote
 
 from drillfric._version import __version__
 from drillfric.io.atomic import write_text_replacing
-from drillfric.result import Flag, Status, WellStatus
+from drillfric.result import Flag
+from drillfric.vocabulary import Status, WellStatus
 
 from .data import segments_frame
 from .display import fmt, report_units, row_flags

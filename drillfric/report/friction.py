@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from drillfric.result import Status
+from drillfric.vocabulary import Status
 
 from .display import SI, Units, fmt
 from .figures import (

@@ -75,6 +75,10 @@ def column_chars(columns: list[str], rows: list[list[str]], budget: int) -> list
     return [n + min(share, 1.0) * gap for n, gap in zip(need, lack, strict=True)]
 
 
+#: Most rows of one table in the PDF (about 20 pages of a diagnostics table).
+MAX_TABLE_ROWS = 500
+
+
 def table_pages(title: str, columns: list[str], rows: list[list[str]],
                 widths: list[float] | None = None, *, font_pt: float = TABLE_FONT_PT,
                 notes: list[str] | None = None, lead: str = "") -> list[Figure]:
@@ -97,7 +101,16 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
         to the next page when it must); "" for none.
     lead : str
         A paragraph above the table on its first page (wrapped).
+
+    At most :data:`MAX_TABLE_ROWS` rows are drawn (a summary.json of a million rows asked
+    for gigabytes of pages); a last row says how many more there are and where they are.
     """
+    if len(rows) > MAX_TABLE_ROWS:
+        more = len(rows) - MAX_TABLE_ROWS
+        rows = [*rows[:MAX_TABLE_ROWS],
+                [f"… and {more} more rows (summary.json and report.html hold them all)",
+                 *[""] * (len(columns) - 1)]]
+        notes = None if notes is None else [*notes[:MAX_TABLE_ROWS], ""]
     width_in = PAGE_IN[0] - 2 * _MARGIN_IN
     if widths is None:
         widths = column_chars(columns, rows, int(width_in * 72.0 / (_CHAR_EM * font_pt)))

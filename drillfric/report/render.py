@@ -21,7 +21,8 @@ from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
 from drillfric.io.timebase import clock_at
-from drillfric.result import Flag, Kind, Method, Status
+from drillfric.result import Flag
+from drillfric.vocabulary import Kind, Method, Status
 
 from .display import Units, fmt, row_flags
 

@@ -19,7 +19,7 @@ from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
 from drillfric.io.atomic import write_text_replacing
 from drillfric.io.timebase import clock_at
-from drillfric.result import Status
+from drillfric.vocabulary import Status
 
 from . import broomstick as broom
 from . import figures

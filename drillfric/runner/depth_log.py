@@ -23,8 +23,9 @@ from drillfric.estimation.friction_log import (
     read_depth_log,
 )
 from drillfric.io.well import CHUNK_ROWS, Well
-from drillfric.result import Kind, RunProgress, Status, WellResult
+from drillfric.result import RunProgress, WellResult
 from drillfric.torque_drag import TDResult
+from drillfric.vocabulary import Kind, Status
 
 from .finish import ReportWriter, Sink, deliver, finish, summarise
 

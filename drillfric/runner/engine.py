@@ -42,8 +42,9 @@ from drillfric.hookload import PlateauFinder, StringWeightCalibration, judge
 from drillfric.io.logcheck import LogCheck
 from drillfric.io.tracks import TrackAccumulator
 from drillfric.io.well import Well, frame_source
-from drillfric.result import Kind, RunProgress, SegmentRecord, Status, WellResult
+from drillfric.result import RunProgress, SegmentRecord, WellResult
 from drillfric.segmentation import Segment, SegmentStream
+from drillfric.vocabulary import Kind, Status
 
 from .estimator import SegmentEstimator, first_chunk
 from .finish import MemorySink, Sink, finish, summarise

@@ -12,8 +12,9 @@ from drillfric.errors import DrillfricError
 from drillfric.estimation.chain import SegmentData, SkipSegment, check_segment, estimate_segment
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
 from drillfric.io.well import Well
-from drillfric.result import Kind, SegmentRecord, Status
+from drillfric.result import SegmentRecord
 from drillfric.segmentation import Segment
+from drillfric.vocabulary import Kind, Status
 
 from .budget import check_work
 from .segment_output import output_frames, segment_record

@@ -32,7 +32,8 @@ from drillfric.io.results import (
 )
 from drillfric.io.tracks import write_tracks
 from drillfric.io.well import Well
-from drillfric.result import SegmentRecord, Status, WellResult, segments_frame
+from drillfric.result import SegmentRecord, WellResult, segments_frame
+from drillfric.vocabulary import Status
 
 #: Writes the report of a result directory into it (``drillfric.report.write_well_report``
 #: with the options asked for); the run layer calls it and never imports the report.

@@ -11,9 +11,10 @@ from drillfric.estimation.bit_torque import rate_of_penetration_m_h
 from drillfric.estimation.chain import SegmentData, SegmentEstimate
 from drillfric.estimation.observer import ObserverRecord
 from drillfric.io.timebase import clock_at, origin_of
-from drillfric.result import SEEDED_START_ID, Kind, SegmentRecord, Status
+from drillfric.result import SEEDED_START_ID, SegmentRecord
 from drillfric.segmentation import Segment
 from drillfric.units import RPM_TO_RAD_S
+from drillfric.vocabulary import Kind, Status
 
 
 def segment_record(seg: Segment, depth: float, status: Status, message: str, rows: pd.DataFrame,
