@@ -107,11 +107,15 @@ def _check_out(out: Path | None, suffixes: tuple[str, ...]) -> None:
 
 
 def _write_table(frame, out: Path) -> None:
+    """The table at ``out``, whole or not at all, never through a link (io/atomic)."""
+    from drillfric.io.atomic import replacing
+
     out.parent.mkdir(parents=True, exist_ok=True)
-    if out.suffix.lower() == ".parquet":
-        frame.to_parquet(out, index=False)
-    else:
-        frame.to_csv(out, index=False)
+    with replacing(out) as tmp:
+        if out.suffix.lower() == ".parquet":
+            frame.to_parquet(tmp, index=False)
+        else:
+            frame.to_csv(tmp, index=False)
 
 
 @click.command("td")
@@ -275,7 +279,10 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
             warn(check["warning"])
     if plot is not None:
         plot.parent.mkdir(parents=True, exist_ok=True)
-        broomstick_figure(table, measured).savefig(plot, dpi=120)
+        from drillfric.io.atomic import replacing
+
+        with replacing(plot) as tmp:  # a path derived from --out: never through a link
+            broomstick_figure(table, measured).savefig(tmp, dpi=120)
     if as_json:
         click.echo(table.to_json(orient="records", indent=2))
         return

@@ -180,8 +180,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "(default: same as mud_density_kg_m3).", min=0.0, max=7849.0),
     ),
     "rig": (
-        _positive("top_drive_inertia_kg_m2", 2900.0, "kg·m²", "Top-drive rotating inertia "
-                  "I_TD (A&S 2018 measured 2900)."),
+        Key("top_drive_inertia_kg_m2", float, 2900.0, "kg·m²", "Top-drive rotating inertia "
+            "I_TD (A&S 2018 measured 2900; real drives 300–10 000: below 10 the observer's "
+            "inertia correction diverges).", min=10.0),
         Key("torque_kind", str, "motor", "", "What the logged surface torque is: 'motor' "
             "(drive torque τ_m) or 'string' (already inertia-corrected, τ(0) = τ_m − I_TD "
             "dω₀/dt).", choices=("motor", "string")),
@@ -236,8 +237,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "'backstepping' of docs/theory.md §5.1.", choices=("backstepping", "kalman")),
         Key("law", str, "corrected", "", "Adaptation law: 'corrected' (drillfric) or 'paper' "
             "(eqs. 42–43 exactly as printed, for comparison).", choices=("corrected", "paper")),
-        Key("kappa1", float, 1.0, "", "Fraction κ₁ of the top-side reflection cancelled.",
-            min=0.0, max=2.0, min_exclusive=True),
+        Key("kappa1", float, 1.0, "", "Fraction κ₁ of the top-side reflection cancelled "
+            "(0 < κ₁ < 2: the design needs it strictly below 2).",
+            min=0.0, max=1.99, min_exclusive=True),
         _positive("lambda0_per_s", 10.0, "1/s", "Bandwidth λ₀ of the top-drive injection."),
         Key("poles_per_s", list, [1.0, 1.5], "1/s", "The two poles z, p placed for the "
             "downhole error (ω_L, d)."),
@@ -391,7 +393,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("ki_Nm_rad", float, 100e3, "N·m/rad", "PI speed controller integral gain.",
             min=0.0),
         Key("rpm_noise", float, 0.0, "RPM", "Gaussian noise on the recorded surface speed.",
-            min=0.0),
+            min=0.0, max=100.0),
         Key("torque_noise_Nm", float, 0.0, "N·m", "Gaussian noise on the recorded torque.",
             min=0.0),
         Key("cells", int, 2500, "", "Cells of the simulated (true) string: finer than the "
@@ -405,7 +407,7 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         Key("scenario", str, None, "", "Scenario file of several stands (TOML, relative to the "
             "config; see docs/simulator.md). Without it: one stand."),
         Key("rpm_resolution", float, 0.0, "RPM", "Quantisation step of the recorded surface "
-            "speed (0: none).", min=0.0),
+            "speed (0: none).", min=0.0, max=100.0),
         Key("torque_resolution_Nm", float, 0.0, "N·m", "Quantisation step of the recorded "
             "torque (0: none).", min=0.0),
         Key("hookload_noise_N", float, 0.0, "N", "Gaussian noise on the recorded hook load.",

@@ -788,3 +788,94 @@ def test_pdf_tables_draw_at_most_their_cap_of_rows():
     few = table_pages("t", ["a", "b"], [["x", "y"]] * 100)
     many = table_pages("t", ["a", "b"], [["x", "y"]] * 100_000)
     assert len(many) <= len(few) * (MAX_TABLE_ROWS // 100 + 1)
+
+
+# ------------------------------------------------ the fourth attack (issue 30)
+@pytest.mark.parametrize("side", ["ok.toml", "ok.survey.csv", "ok.truth.json"])
+def test_simulate_never_writes_its_sidecars_through_a_link(side, tmp_path, capsys):
+    """A link planted as NAME.toml, NAME.survey.csv or NAME.truth.json beside simulate's
+    --out was written through: a file elsewhere overwritten with exit 0."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    (root / "ok.toml").write_text("[simulate]\nbit_depth_m = 1000.0\ncells = 50\n"
+                                  "duration_s = 20\nrate_hz = 10\n")
+    target = _secret(root)
+    (root / "out").mkdir()
+    (root / "out" / side).symlink_to(target)
+    _strict_check(Case(["simulate", "ok.toml", "--out", "out/ok.csv"], (2,),
+                       ("symbolic link",)), root, capsys)
+    assert not (root / "out" / "ok.csv").exists()
+    assert target.read_text() == SECRET + "\n"
+
+
+def test_a_tiny_top_drive_inertia_is_refused_and_a_diverging_observer_prints_no_mu(
+        tmp_path, capsys):
+    """top_drive_inertia_kg_m2 = 1e-6 (in range then): the observer ran to 10¹² RPM and a μ_k
+    of 0.74 was printed with "severe stick-slip" on a steady log. The key's range now starts
+    at 10 kg·m², and an observer that runs away fails its segment in one line."""
+    import numpy as np
+
+    from drillfric.errors import ModelError
+    from drillfric.estimation.chain import check_bounded
+    from drillfric.estimation.observer import Measurements
+
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"), "[rig]\ntop_drive_inertia_kg_m2 = 1e-6\n")
+    _strict_check(Case(["run", "w.csv", "--out", "out"], (2,), ("top_drive_inertia",)), root,
+                  capsys)
+    meas = Measurements.__new__(Measurements)
+    object.__setattr__(meas, "surface_rad_s", np.full(10, 6.0))
+    record = type("R", (), {"surface_rad_s_est": np.full((10, 1), 6.0),
+                            "bit_rad_s_est": np.full((10, 1), 7e11)})()
+    with pytest.raises(ModelError, match="observer diverged"):
+        check_bounded(record, meas)
+    record.bit_rad_s_est = np.full((10, 1), 12.0)
+    check_bounded(record, meas)  # a bit at twice the surface speed: stick-slip, not a runaway
+
+
+@pytest.mark.parametrize("lie", ["history_without_segments", "summary_with_text_mu",
+                                 "summary_segments_a_number"])
+def test_a_fleets_unchanged_well_is_rerun_when_its_records_were_made_up(lie, tmp_path):
+    """A manifest history entry without its fields, or a summary.json crafted with its
+    digest stored in the manifest, was an internal error every night (--force too), or
+    published text as the well's μ_k in fleet_summary.parquet."""
+    import hashlib
+    import json
+
+    root = tmp_path / "sandbox"
+    _well(root)
+    assert "1 processed" in _night(root).output
+    manifest_path = root / "out" / "manifest.json"
+    manifest = json.loads(manifest_path.read_text())
+    entry = manifest["wells"]["w"]
+    if lie == "history_without_segments":
+        entry["history"] = [{"utc": "x"}]
+    else:
+        summary_path = root / "out" / "w" / "summary.json"
+        summary = json.loads(summary_path.read_text())
+        summary.update({"mu_k": "abc"} if lie == "summary_with_text_mu" else {"segments": 5})
+        summary_path.write_text(json.dumps(summary))
+        entry["summary_sha256"] = hashlib.sha256(summary_path.read_bytes()).hexdigest()
+    manifest_path.write_text(json.dumps(manifest))
+    night = _night(root)
+    assert "internal error" not in night.output and "1 processed" in night.output, \
+        night.output
+
+
+def test_a_wits0_recording_dated_in_the_future_is_named_not_obeyed(tmp_path, capsys):
+    """A last line dated 9999 made every frame 'older' and dropped, ending in 'no WITS0
+    frame arrived' — the wrong cause and fix, on every restart."""
+    from drillfric.io.wits0 import Row, item_map
+
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    _config(root / "rig.toml", '[well]\nname = "rig"\n')
+    names = Row(item_map({})).names
+    (root / "out").mkdir()
+    (root / "out" / "rig.wits0.csv").write_text(
+        ",".join(["time", *names]) + "\n9999-12-31T00:00:00.000000" + "," * len(names) + "\n")
+    _strict_check(Case(["live", "wits0://127.0.0.1:9", "--config", "rig.toml", "--out", "out",
+                        "--until-idle", "1"], (2,), ("dated more than a day after",)), root,
+                  capsys)

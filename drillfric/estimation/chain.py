@@ -26,7 +26,7 @@ import numpy as np
 
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
-from drillfric.errors import DrillfricError
+from drillfric.errors import DrillfricError, ModelError
 from drillfric.estimation import batch, bit_torque, bit_trace
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
@@ -266,6 +266,7 @@ def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: 
     state = ObserverState.from_starts(observer, members, omega0_rad_s=meas.surface_rad_s[0],
                                       t_s=meas.t0_s, torque_top_Nm=_initial_torque(meas))
     final, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz)
+    check_bounded(final, meas)
     return final
 
 
@@ -432,7 +433,28 @@ def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
     window_end = min(meas.t_end_s, meas.t0_s + cfg.observer.starts_window_s)
     first, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz,
                        t_end_s=window_end)
+    check_bounded(first, meas)
     return starts, first, diagnose(first, cfg.omega_c_rad_s)
+
+
+#: How far the observer's surface-speed estimate may stray beyond the logged speed before
+#: it is taken as diverged: the innovation e = ω̂₀ − ω₀ is driven to 0 (docs/theory.md §5),
+#: so a bounded, tracking observer stays within a few times the speed it is fed.
+DIVERGED_FACTOR, DIVERGED_FLOOR_RAD_S = 10.0, 50.0
+
+
+def check_bounded(record: ObserverRecord, meas: Measurements) -> None:
+    """ModelError when the observer diverged: its estimates not finite, or its surface speed
+    beyond :data:`DIVERGED_FACTOR` × the largest logged speed (a top-drive inertia of 10⁻⁶
+    kg·m², inside the key's range, drove ω̂₀ to 10¹² and still printed a μ_k)."""
+    bound = DIVERGED_FACTOR * float(np.nanmax(np.abs(meas.surface_rad_s))) + \
+        DIVERGED_FLOOR_RAD_S
+    speeds = (record.surface_rad_s_est, record.bit_rad_s_est)
+    if not all(np.isfinite(x).all() and np.abs(x).max(initial=0.0) <= bound for x in speeds):
+        raise ModelError("the observer diverged (its speed estimates ran past ten times the "
+                         "logged speed): its model of this rig cannot follow the log",
+                         fix="check [rig] top_drive_inertia_kg_m2 and [model] k_t_per_s, and "
+                             "that the torque and speed channels are the top drive's")
 
 
 def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import socket
 import sys
@@ -256,6 +257,7 @@ def _same(fingerprint: dict, entry: dict | None, known: dict) -> bool:
     outputs = entry.get("outputs", {}).get("summary")
     if (outputs is None or not Path(outputs).is_file()
             or _summary_sha256(Path(outputs)) != entry.get("summary_sha256")
+            or not _plausible_summary(Path(outputs))
             or fingerprint["config_sha256"] != entry.get("config_sha256")
             or fingerprint["drillfric_version"] != entry.get("drillfric_version")):
         return False
@@ -369,6 +371,33 @@ class FleetResult:
                      and not (w.summary.get("counts") or {}).get("estimated"))
 
 
+def _number_or_none(value) -> bool:
+    return value is None or isinstance(value, int | float) and not isinstance(value, bool) \
+        and math.isfinite(value)
+
+
+def _sound_night(night) -> bool:
+    """A history entry as :func:`drillfric.fleet.overnight.night` writes it."""
+    return isinstance(night, dict) and isinstance(night.get("utc"), str) and \
+        isinstance(night.get("segments"), int) and _number_or_none(night.get("mu_k"))
+
+
+def _plausible_summary(path: Path) -> bool:
+    """Whether an unchanged well's summary.json has the shape drillfric writes (the fleet
+    republishes it: a crafted one with a matching digest in the manifest made internal
+    errors, and published text as well_mu_k)."""
+    try:
+        summary = read_json(path)
+    except InputError:
+        return False
+    segments, counts = summary.get("segments"), summary.get("counts")
+    return (isinstance(segments, list) and all(isinstance(g, dict) for g in segments)
+            and isinstance(counts, dict)
+            and all(isinstance(v, int) for v in counts.values())
+            and all(_number_or_none(summary.get(k))
+                    for k in ("mu_k", "mu_s", "mu_s_lower_bound", "mu_k_uncertainty")))
+
+
 def _sound(entry, out_root: Path | None) -> bool:
     """Whether a manifest entry has the shape drillfric writes, with its outputs in OUT/NAME
     (the manifest lies in OUT, where anyone may write: an entry naming files elsewhere would
@@ -379,7 +408,7 @@ def _sound(entry, out_root: Path | None) -> bool:
     inputs, outputs = entry.get("inputs", {}), entry.get("outputs", {})
     history = entry.get("history", [])
     if not (isinstance(inputs, dict) and isinstance(outputs, dict) and
-            isinstance(history, list) and all(isinstance(h, dict) for h in history)):
+            isinstance(history, list) and all(_sound_night(h) for h in history)):
         return False
     if not all(isinstance(f, dict) and isinstance(f.get("path"), str) and
                isinstance(f.get("sha256"), str) for f in inputs.values()):

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.atomic import refuse_link, replacing, write_text_replacing
 from drillfric.wellpath import WellPath
 
 FORMATS = {".parquet": "parquet", ".csv": "csv", ".h5": "hdf5", ".hdf5": "hdf5"}
@@ -126,17 +127,23 @@ def write_well(path: str | Path, frame: pd.DataFrame, *, config: dict, survey: W
     side = sidecar_paths(path)
     config = _sidecar_config(config, path, side["survey"])
     toml_text = dumps_toml(config)
-    written = {"data": write_table(path, frame, truth, survey=survey, config_toml=toml_text)}
     kept = {Path(k).resolve() for k in keep}
+    for target in (path, *side.values()):  # before anything is written: no half a set
+        if target.resolve() not in kept:
+            refuse_link(target)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with replacing(path) as tmp:  # every file whole or not at all, never through a link
+        write_table(tmp, frame, truth, survey=survey, config_toml=toml_text)
+    written = {"data": path}
     if side["config"].resolve() not in kept:
-        side["config"].write_text(toml_text, encoding="utf-8")
+        write_text_replacing(side["config"], toml_text)
         written["config"] = side["config"]
     if side["survey"].resolve() not in kept:
-        survey_frame(survey).to_csv(side["survey"], index=False, float_format="%.10g")
+        with replacing(side["survey"]) as tmp:
+            survey_frame(survey).to_csv(tmp, index=False, float_format="%.10g")
         written["survey"] = side["survey"]
     if truth is not None:
-        side["truth"].write_text(json.dumps(truth, indent=2, default=_plain) + "\n",
-                                 encoding="utf-8")
+        write_text_replacing(side["truth"], json.dumps(truth, indent=2, default=_plain) + "\n")
         written["truth"] = side["truth"]
     return written
 

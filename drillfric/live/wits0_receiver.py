@@ -200,6 +200,11 @@ class Recording:
                 raise OutputError(f"cannot record the stream: {exc}", file=self.path,
                                   fix="remove it, or choose another --out") from None
         self.last_s = self._continue() if self.path.exists() else None
+        if self.last_s is not None and self.last_s > time.time() + MAX_AHEAD_S:
+            raise InputError("this recording of a WITS0 stream ends with a line dated more "
+                             "than a day after this computer's clock: every frame would be "
+                             "taken as older and dropped", file=self.path,
+                             fix="give another --out (or remove the file)")
         self._fh = None
 
     def _continue(self) -> float | None:
