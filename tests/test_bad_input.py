@@ -14,6 +14,10 @@ from drillfric.cli.main import cli
 
 from tests.conftest import REPO
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 DEMO = REPO / "examples" / "demo"
 
 

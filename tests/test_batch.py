@@ -29,6 +29,10 @@ from drillfric.estimation import batch
 from drillfric.estimation.batch import creep_checks, harness, kinetic
 from drillfric.estimation.creep import find_creeps, rotating_runs, smooth
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 RPM = np.pi / 30.0
 OMEGA_C = 1.0  # [rad/s] docs/theory.md §6 prototypes
 K_T = 0.1  # [1/s]

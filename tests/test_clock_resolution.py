@@ -19,6 +19,10 @@ from drillfric.cli.main import cli
 from drillfric.live.wits0_receiver import FrameClock, Recording
 from tests.conftest import DEMO
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 START = pd.Timestamp("2026-03-01T06:00:00Z")
 CHANNELS = ["surface_rpm", "surface_torque_Nm", "hookload_N", "bit_depth_m", "hole_depth_m"]
 

@@ -16,6 +16,10 @@ from drillfric.runner.engine import Engine
 from drillfric.runner.state import read_state, write_state
 from tests.conftest import DEMO
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 #: Relative agreement of the friction numbers with the whole-file run (issue 23).
 AGREE = 0.005
 

@@ -23,6 +23,10 @@ from drillfric.io.writers import dumps_toml
 from drillfric.runner import run_well
 from tests.conftest import REPO
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 DEMO = REPO / "examples" / "demo"
 IN = Fraction("0.0254")
 FT = 12 * IN

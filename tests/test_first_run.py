@@ -13,6 +13,10 @@ import pytest
 
 from drillfric.kernels.cache import cache_dir
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[1]
 DEMO = REPO / "examples" / "demo" / "demo.csv"
 

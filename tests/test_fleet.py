@@ -22,6 +22,10 @@ from drillfric.errors import InputError
 from drillfric.fleet.discovery import WellSpec, discover
 from drillfric.fleet.run import run_many
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[1]
 #: Files of a complete well directory (docs/outputs.md).
 WELL_FILES = ("summary.json", "estimates.parquet", "segments.parquet", "report.html")

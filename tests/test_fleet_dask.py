@@ -19,7 +19,8 @@ import pytest
 from tests.test_fleet import TRUTH, assert_complete, fleet, make_wells, manifest
 
 DASK = Path(sys.executable).with_name("dask")
-pytestmark = pytest.mark.skipif(not DASK.is_file(), reason="dask CLI not installed")
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(not DASK.is_file(), reason="dask CLI not installed")]
 
 
 def _free_port() -> int:

@@ -22,6 +22,10 @@ from drillfric.io.well import open_well
 from drillfric.runner import run_well
 from tests.test_engine import _same_results
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 
 def _grow(src, dst, fraction: float):
     """``dst`` (with ``src``'s sidecars) holding the first ``fraction`` of ``src``'s lines."""

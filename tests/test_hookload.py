@@ -29,6 +29,10 @@ from drillfric.result import Flag, SegmentRecord
 from drillfric.vocabulary import Kind, Status
 from tests.conftest import REPO
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 DEMO = REPO / "examples" / "demo"
 PIPE = {"name": "pipe", "od_m": 0.127, "id_m": 0.1086}
 

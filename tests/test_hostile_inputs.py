@@ -28,6 +28,10 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 PAYLOAD = b"cos\nsystem\n(S'touch PWNED'\ntR."  # protocol-0 pickle that runs a shell command
 SECRET = "API_KEY=sk-live-0123456789"
 ESC = "\x1b[2J"

@@ -23,6 +23,10 @@ from drillfric.errors import OutputError
 from tests.test_hostile_files import _strict_check
 from tests.test_hostile_inputs import SECRET, Case, _check, _config, _log, hang_guard
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 
 def _secret(root):
     """A file outside OUT that a planted link points at (its content must stay as it is)."""

@@ -21,6 +21,10 @@ import pytest
 
 from tests.test_fleet import fleet, make_wells, manifest
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[1]
 _SHEET_NS = "http://schemas.openxmlformats.org/spreadsheetml/2006/main"
 _REL_NS = "http://schemas.openxmlformats.org/package/2006/relationships"

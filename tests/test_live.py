@@ -22,6 +22,10 @@ from drillfric.live.source import Tail
 from drillfric.runner.resume import csv_mark
 from tests.test_engine import AGREE
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[1]
 LIVE_KEYS = {"last_sample_time_s", "last_sample_utc", "updated_utc", "rig_state",
              "open_segment", "latest", "alerts"}

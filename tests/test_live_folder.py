@@ -28,6 +28,10 @@ from tests.test_live import (
     _wait_for,
 )
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 #: Rows of the three-stand well at which its parts are cut (44001 rows: four parts).
 CUTS = (0, 9000, 21000, 33000, 44001)
 

@@ -23,6 +23,10 @@ from drillfric.live.run import LiveRun, RecentRows
 from tests.test_live import LIVE_KEYS, _drillfric, _feed_folder, _finish, _wait_for
 from tests.test_report_browser import Browser, PageVisit, _chromium, _record
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 #: Replay speed: the three-stand well's 440 s pass in ~30 s, long enough for the checks.
 SPEED = 15
 

@@ -22,6 +22,10 @@ from drillfric.io.well import open_well
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_KEYS
 from tests.conftest import REPO
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 DEMO = REPO / "examples" / "demo"
 SUMMARY_KEYS = ("well", "drillfric_version", "mu_s", "mu_k", "mu_s_lower_bound", "segments",
                 "inputs", "config")

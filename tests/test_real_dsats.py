@@ -6,10 +6,15 @@ from __future__ import annotations
 import json
 
 import pandas as pd
+import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
 from tests.conftest import REPO
+
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
 
 
 def test_dsats_runs_end_to_end(real_data, tmp_path):

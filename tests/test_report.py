@@ -40,6 +40,10 @@ from tests.synthetic_results import (
     older_result,
 )
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[1]
 DEMO = REPO / "examples" / "demo" / "demo.csv"
 XSS_NAME = "<script>alert(1)</script>"

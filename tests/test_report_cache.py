@@ -21,6 +21,10 @@ from drillfric.report import write_well_report
 from drillfric.report.interactive import _LAYOUTS, forget_layouts
 from tests.test_report import bokeh_items, copy_result, evidence_dir, sources
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 #: Factor applied to the other well's tracks and torques (any change of the data will do).
 _SCALE = 1.1
 

@@ -32,6 +32,10 @@ from tests.test_report import (
     sources,
 )
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def evidence(tmp_path_factory):

@@ -38,6 +38,10 @@ from tests.test_report import (
     sources,
 )
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 FT_M = 0.3048  # exact, by definition
 LBF_N = 0.45359237 * 9.80665  # exact, by definition
 KLBF_N = 1e3 * LBF_N

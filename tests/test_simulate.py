@@ -22,6 +22,10 @@ from drillfric.sim import run as sim
 from drillfric.sim import scenario, settings, well_b
 from drillfric.wellpath import minimum_curvature
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 RPM = np.pi / 30.0
 
 CONFIG = """

@@ -30,6 +30,10 @@ from drillfric.live.wits0_receiver import (
 from tests.conftest import DEMO, SCENARIO
 from tests.test_live import _drillfric, _finish, _same_segments, _wait_for
 
+#: Several seconds a test, or a costly shared fixture: not in the fast lane
+#: (`pytest -m "not slow"`, docs/performance.md "The test suite").
+pytestmark = pytest.mark.slow
+
 FRAME = (b"&&\r\n0105261127\r\n0106143015\r\n01082450.5\r\n01102455.0\r\n"
          b"0114150.0\r\n011818.42\r\n012041.0\r\n!!\r\n")
 
