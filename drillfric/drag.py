@@ -66,6 +66,10 @@ MAX_UNCERTAINTY = 0.1
 #: Friction factors on which the model's hook loads are tabulated (inverted by
 #: interpolation; the curves are smooth and monotone).
 MU_GRID = np.linspace(0.0, 2.0, 201)
+#: Least share of the string's free-hanging weight a pick-up's or slack-off's hook load
+#: (less the block) must carry to count as drag: friction lightens a slack-off (to ~60 % of
+#: the hanging weight at μ = 0.4 in a 60° well), the slips take it all.
+HANGING_SHARE = 0.25
 
 PICK_UP, SLACK_OFF = "pick_up", "slack_off"
 #: A connection's drag_log.parquet ``status``: its μ stated, or withheld with the reason.
@@ -421,6 +425,8 @@ def connection_row(up: Move | None, down: Move | None, hook: HookEvidence, curve
         models = {m.direction: curves(m.bit_depth_m) for m in present}
     except ModelError as exc:
         return row | _verdict({}, exc.message)
+    if why := _not_hanging(present, models, hook):
+        return row | _verdict({}, why)
     found = {}
     if up is not None and down is not None:
         found["pair"] = _pair(up, down, models, hook)
@@ -430,6 +436,23 @@ def connection_row(up: Move | None, down: Move | None, hook: HookEvidence, curve
     return row | _verdict(found, "" if found or hook.block_N is not None else
                           "no block weight and no pick-up/slack-off pair: a single hook load "
                           "gives no μ without the block weight")
+
+
+def _not_hanging(moves: list[Move], models: dict, hook: HookEvidence) -> str:
+    """Why a move's hook load is no drag evidence ("" when every move's string hangs): less
+    the block (0 where unknown: the hook load itself bounds the string's share) it must carry
+    at least :data:`HANGING_SHARE` of the string's free-hanging weight (the model at μ = 0).
+    A string in the slips while the bit depth moves (the block alone on the hook) looked
+    like a slack-off against μ ≈ 1.2 and printed it (the demo's connections)."""
+    for move in moves:
+        hanging = float(models[move.direction][0][0])  # μ = 0: the buoyed string's weight
+        carried = move.hookload_N - (hook.block_N or 0.0)
+        if not carried >= HANGING_SHARE * hanging:
+            return (f"the string was not hanging during the {move.direction.replace('_', '-')}"
+                    f" (hook load less the block {carried / 1e3:.0f} kN, below "
+                    f"{HANGING_SHARE:.0%} of its free-hanging {hanging / 1e3:.0f} kN): in the "
+                    "slips or set down, not dragging")
+    return ""
 
 
 def _pair(up: Move, down: Move, models: dict, hook: HookEvidence) -> Estimate:

@@ -310,3 +310,14 @@ def test_report_draws_the_drag_based_log(tmp_path, demo_cfg):
     fig = figures.friction_log_figure(data.segments, drag=data.drag_log)
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert figures.DRAG_LABEL in labels
+
+
+def test_a_string_in_the_slips_while_the_bit_depth_moves_is_no_drag(stands):
+    """Issue 33 item 6, the demo's false drag μ of 1.24 (truth 0.28): its simulated
+    connections move the bit depth with the string in the slips (hook load ≈ the block, 0
+    here). A slack-off against that looked like μ ≈ 1.2; drag counts only with the string
+    hanging (≥ 25 % of its free-hanging weight on the hook), else withheld with the reason."""
+    _, whole = stands
+    info = whole.summary["drag"]
+    assert info["connections"] >= 2 and info["estimated"] == 0, info
+    assert all("not hanging" in row["reason"] for row in info["log"]), info["log"]
