@@ -101,9 +101,16 @@ def _check_depth(depth_m: float, what: str) -> None:
 
 
 def _check_out(out: Path | None, suffixes: tuple[str, ...]) -> None:
+    """UserError for an output path of another type, or where a link, a directory or a
+    special file stands — checked for every output before any is written (the table was
+    left written when the plot beside it could not be)."""
     if out is not None and out.suffix.lower() not in suffixes:
         raise UserError(f"{out}: unsupported output type '{out.suffix}' — use "
                         f"{' or '.join(suffixes)}")
+    if out is not None and (out.is_symlink() or out.exists() and not out.is_file()):
+        raise UserError(f"{out}: a link, a directory or a special file stands where the "
+                        "output goes (drillfric writes through no link) — fix: remove it or "
+                        "give another path")
 
 
 def _write_table(frame, out: Path) -> None:

@@ -883,3 +883,41 @@ def test_a_wits0_recording_dated_in_the_future_is_named_not_obeyed(tmp_path, cap
     _strict_check(Case(["live", "wits0://127.0.0.1:9", "--config", "rig.toml", "--out", "out",
                         "--until-idle", "1"], (2,), ("dated more than a day after",)), root,
                   capsys)
+
+
+# ------------------------------------------------ the fifth attack (issue 30)
+def test_out_equal_to_a_directory_wells_data_folder_runs_every_night(tmp_path, capsys):
+    """--out equal to a directory well's data folder ([well] data = "."): night 2 read its
+    own fleet.html, fleet_summary.parquet and manifest.json as parts of the log and failed
+    every night after."""
+    root = tmp_path / "sandbox"
+    folder = root / "wells" / "b"
+    for k in (1, 2):
+        _log(folder / f"p{k}.csv", t0=40.0 * (k - 1))
+    (folder / "well.toml").write_text('[well]\ndata = "."\n[segmentation]\n'
+                                      "min_segment_s = 60.0\n")
+    for _ in range(2):
+        night = CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out", str(folder),
+                                         "--workers", "1", "--no-report"])
+        assert "data folder holds files" not in night.output, night.output
+        assert "error" not in night.output.lower() and ("0 failed" in night.output or
+                                                       "all 1 wells ok" in night.output), \
+            night.output
+
+
+@pytest.mark.parametrize("plant", ["link", "directory"])
+def test_td_checks_every_output_before_writing_any(plant, tmp_path, capsys):
+    """A link or a directory at the broomstick's plot path: one error line — but the table
+    beside it had been written already."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    (root / "w.toml").write_text("[well]\nbit_depth_m = 2400.0\n")
+    (root / "out").mkdir()
+    if plant == "link":
+        (root / "out" / "b.png").symlink_to(_secret(root))
+    else:
+        (root / "out" / "b.png").mkdir()
+    _strict_check(Case(["td", "w.toml", "--broomstick", "--depths", "1000:2400:700",
+                        "--out", "out/b.parquet"], (2,), ("stands where the output goes",)),
+                  root, capsys)
+    assert not (root / "out" / "b.parquet").exists()

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from drillfric.errors import InputError
 from drillfric.io import witsml
-from drillfric.io.wellfiles import OUT_FILES
+from drillfric.io.atomic import OUT_FILES
 
 _DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las", ".xml", ".dlis",
              ".xlsx")

@@ -42,6 +42,12 @@ _FIXES = {
                    "remove or rename that directory, or choose another --out"),
 }
 LINK_FIX = _FIXES[errno.ELOOP][1]
+#: Files drillfric itself writes in OUT beside the wells' directories (the fleet's and
+#: live's, docs/outputs.md): no well may be named so, no data folder holds them as parts of
+#: a log, discovery takes none for a well. Compared case-folded.
+OUT_FILES = frozenset({"manifest.json", "fleet_summary.parquet", "fleet.html", "live.json"})
+#: Suffix of live's WITS0 recordings in OUT (``OUT/NAME.wits0.csv``).
+RECORDING_SUFFIX = ".wits0.csv"
 
 
 def output_error(exc: OSError, where: Path, *, named: bool = False) -> OutputError:

@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.atomic import OUT_FILES, RECORDING_SUFFIX
 from drillfric.io.readers import data_format, open_source
 from drillfric.io.source import RawSource
 from drillfric.io.text import printable
@@ -35,7 +36,8 @@ def folder_parts(folder: Path) -> tuple[Path, ...] | None:
         return None
     files = sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")
                    and not any(tag in p.name for tag in _SIDECAR_TAGS)
-                   and p.suffix.lower() not in (".toml", ".json", ".md"))
+                   and p.suffix.lower() not in (".toml", ".json", ".md")
+                   and not _drillfrics(p.name))
     if not files:
         return None
     formats = {_format(p) for p in files}
@@ -44,6 +46,12 @@ def folder_parts(folder: Path) -> tuple[Path, ...] | None:
                          "files must be parts of one log of one format", file=folder,
                          fix="keep only the log's CSV or Parquet files in the folder")
     return tuple(files)
+
+
+def _drillfrics(name: str) -> bool:
+    """A file drillfric writes in OUT (--out may be the data folder itself: the next night
+    read its own fleet.html and fleet_summary.parquet as parts of the log)."""
+    return name.casefold() in OUT_FILES or name.casefold().endswith(RECORDING_SUFFIX)
 
 
 def _format(path: Path) -> str:

@@ -24,6 +24,7 @@ from drillfric.config import Config, parse_toml, read_toml
 from drillfric.errors import ConfigError, InputError
 from drillfric.files import require_file, require_inside, special
 from drillfric.io import witsml
+from drillfric.io.atomic import OUT_FILES, RECORDING_SUFFIX
 from drillfric.io.hdf5 import members, node_at
 from drillfric.io.parts import folder_parts
 from drillfric.io.source import FORMATS, data_format
@@ -31,11 +32,6 @@ from drillfric.io.text import printable
 
 #: Longest output directory name [bytes of UTF-8]; longer names are cut and given a hash.
 MAX_NAME_BYTES = 100
-#: Files drillfric itself writes in OUT beside the wells' directories (the fleet's and
-#: live's, docs/outputs.md): no well may be named so. Compared case-folded.
-OUT_FILES = frozenset({"manifest.json", "fleet_summary.parquet", "fleet.html", "live.json"})
-#: Suffix of live's WITS0 recordings in OUT (``OUT/NAME.wits0.csv``).
-RECORDING_SUFFIX = ".wits0.csv"
 #: Extensions of HDF5 files (a bundle may hold /config and /survey beside /surface).
 HDF5_EXT = (".h5", ".hdf5")
 #: Extensions of survey sidecars (NAME.survey.EXT), in the order they are looked for.
