@@ -479,11 +479,16 @@ def _night(root):
 
 
 @pytest.mark.parametrize("lie", ["entry_a_number", "inputs_a_list", "outputs_a_text",
-                                 "input_without_path", "outputs_elsewhere", "extra_input_fifo"])
+                                 "input_without_path", "outputs_elsewhere", "extra_input_fifo",
+                                 "history_without_segments", "summary_with_text_mu",
+                                 "summary_segments_a_number"])
 def test_a_manifest_entry_that_is_not_drillfrics_makes_the_well_run_again(lie, tmp_path):
     """manifest.json's entries were trusted: a number or a list where a table goes was an
     internal error every night (--force too); a FIFO named as an input hung the fleet; an
-    entry whose outputs lay elsewhere published another folder's results as "unchanged"."""
+    entry whose outputs lay elsewhere published another folder's results as "unchanged"; a
+    history entry without its fields, or a summary.json made up with its digest stored in the
+    manifest, was an internal error every night or published text as the well's μ_k."""
+    import hashlib
     import json
 
     import pandas as pd
@@ -507,10 +512,18 @@ def test_a_manifest_entry_that_is_not_drillfrics_makes_the_well_run_again(lie, t
         shutil.copytree(root / "out" / "w", elsewhere)
         entry["outputs"] = {k: v.replace(str(root / "out" / "w"), str(elsewhere))
                             for k, v in entry["outputs"].items()}
-    else:
+    elif lie == "extra_input_fifo":
         os.mkfifo(root / "fifo")
         entry["inputs"]["extra"] = {"path": str(root / "fifo"), "size": 0, "mtime_ns": 0,
                                     "sha256": "00"}
+    elif lie == "history_without_segments":
+        entry["history"] = [{"utc": "x"}]
+    else:  # a summary.json made up, its digest stored in the manifest to match
+        summary_path = root / "out" / "w" / "summary.json"
+        summary = json.loads(summary_path.read_text())
+        summary.update({"mu_k": "abc"} if lie == "summary_with_text_mu" else {"segments": 5})
+        summary_path.write_text(json.dumps(summary))
+        entry["summary_sha256"] = hashlib.sha256(summary_path.read_bytes()).hexdigest()
     path.write_text(json.dumps(manifest))
     with hang_guard(120):
         night = _night(root)
@@ -837,35 +850,6 @@ def test_a_tiny_top_drive_inertia_is_refused_and_a_diverging_observer_prints_no_
         check_bounded(record, meas)
     record.bit_rad_s_est = np.full((10, 1), 12.0)
     check_bounded(record, meas)  # a bit at twice the surface speed: stick-slip, not a runaway
-
-
-@pytest.mark.parametrize("lie", ["history_without_segments", "summary_with_text_mu",
-                                 "summary_segments_a_number"])
-def test_a_fleets_unchanged_well_is_rerun_when_its_records_were_made_up(lie, tmp_path):
-    """A manifest history entry without its fields, or a summary.json crafted with its
-    digest stored in the manifest, was an internal error every night (--force too), or
-    published text as the well's μ_k in fleet_summary.parquet."""
-    import hashlib
-    import json
-
-    root = tmp_path / "sandbox"
-    _well(root)
-    assert "1 processed" in _night(root).output
-    manifest_path = root / "out" / "manifest.json"
-    manifest = json.loads(manifest_path.read_text())
-    entry = manifest["wells"]["w"]
-    if lie == "history_without_segments":
-        entry["history"] = [{"utc": "x"}]
-    else:
-        summary_path = root / "out" / "w" / "summary.json"
-        summary = json.loads(summary_path.read_text())
-        summary.update({"mu_k": "abc"} if lie == "summary_with_text_mu" else {"segments": 5})
-        summary_path.write_text(json.dumps(summary))
-        entry["summary_sha256"] = hashlib.sha256(summary_path.read_bytes()).hexdigest()
-    manifest_path.write_text(json.dumps(manifest))
-    night = _night(root)
-    assert "internal error" not in night.output and "1 processed" in night.output, \
-        night.output
 
 
 def test_a_wits0_recording_dated_in_the_future_is_named_not_obeyed(tmp_path, capsys):

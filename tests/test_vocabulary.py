@@ -45,7 +45,8 @@ def _literal_comparisons(path) -> list[str]:
             for item in items:
                 if isinstance(item, ast.Constant) and isinstance(item.value, str) and (
                         item.value in _DISTINCT or named and item.value in _SHARED):
-                    found.append(f"{path.relative_to(REPO)}:{node.lineno}: {text}")
+                    where = path.relative_to(REPO) if path.is_relative_to(REPO) else path
+                    found.append(f"{where}:{node.lineno}: {text}")
     return found
 
 
@@ -76,13 +77,9 @@ def test_one_mapping_between_rig_states_kinds_and_load_cases():
     assert KIND_LOAD_CASES[RigState.BACK_REAMING.kind] == LoadCase.ROTATING_PICK_UP
 
 
-def test_the_scan_catches_a_literal():
+def test_the_scan_catches_a_literal(tmp_path):
     """The scan itself: a comparison with a kind's literal is found."""
-    import tempfile
-    from pathlib import Path
-
-    with tempfile.TemporaryDirectory(dir=REPO) as folder:
-        path = Path(folder) / "x.py"
-        path.write_text('def f(seg):\n    return seg.kind == "off_bottom_rotating" or '
-                        'seg["status"] in ("ok", "failed")\n')
-        assert len(_literal_comparisons(path)) == 3
+    path = tmp_path / "x.py"
+    path.write_text('def f(seg):\n    return seg.kind == "off_bottom_rotating" or '
+                    'seg["status"] in ("ok", "failed")\n')
+    assert len(_literal_comparisons(path)) == 3
