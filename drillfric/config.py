@@ -277,9 +277,10 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "μ_s."),
     ),
     "batch": (
-        _positive("window_s", 600.0, "s", "The batch refinement (docs/theory.md §6.4) fits "
-                  "the first this-many seconds of each segment (the mean-torque match needs "
-                  "minutes; creep start-ups are at the start)."),
+        Key("window_s", float, 600.0, "s", "The batch refinement (docs/theory.md §6.4) fits "
+            "the first this-many seconds of each segment (the mean-torque match needs "
+            "minutes; creep start-ups are at the start). At least 10 s: a shorter window "
+            "holds less than one stick-slip cycle.", min=10.0),
     ),
     "segmentation": (
         _positive("rotating_rpm", 2.0, "RPM", "Surface speed above which the string starts "
@@ -385,8 +386,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
     "simulate": (
         Key("bit_depth_m", float, None, "m", "Bit depth of a single-stand simulation "
             "(default: the survey's last station).", min=0.0, min_exclusive=True),
-        Key("rpm", float, 60.0, "RPM", "Constant surface speed set-point after the ramp.",
-            min=0.0),
+        Key("rpm", float, 60.0, "RPM", "Constant surface speed set-point after the ramp "
+            "(at most 600 RPM: no top drive turns faster).", min=0.0, max=600.0),
         Key("mu_s", float, 0.6, "", "True static friction factor.", min=0.0, max=2.0),
         Key("mu_k", float, 0.3, "", "True kinetic friction factor.", min=0.0, max=2.0),
         _positive("kp_Nms_rad", 38e3, "N·m·s/rad", "PI speed controller proportional gain."),
@@ -401,7 +402,9 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "grids (docs/theory.md §6.4: dx ≤ MD/1000).", min=20, max=200000),
         _positive("duration_s", 120.0, "s", "Simulated time of a single-stand run; with a "
                   "scenario, the rotating time of stands that do not give their own."),
-        _positive("rate_hz", 100.0, "Hz", "Recording rate of the simulated surface data."),
+        Key("rate_hz", float, 100.0, "Hz", "Recording rate of the simulated surface data "
+            "(0.01–10000 Hz: from 100-s recorder blocks to ten times the fastest rig logs).",
+            min=0.01, max=1e4),
         _positive("ramp_s", 10.0, "s", "Time of the set-point ramp from rest to `rpm`."),
         Key("seed", int, 0, "", "Seed of the measurement noise.", min=0),
         Key("scenario", str, None, "", "Scenario file of several stands (TOML, relative to the "

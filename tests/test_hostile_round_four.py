@@ -905,3 +905,75 @@ def test_td_checks_every_output_before_writing_any(plant, tmp_path, capsys):
                         "--out", "out/b.parquet"], (2,), ("stands where the output goes",)),
                   root, capsys)
     assert not (root / "out" / "b.parquet").exists()
+
+
+# ------------------------------------------------ the fifth attack's leftovers (issue 30)
+@pytest.mark.parametrize(("table", "key", "value"), [
+    ("batch", "window_s", "0.15"),  # the segment failed, blaming the log's time order
+    ("simulate", "rpm", "1e6"),  # blamed the controller ("diverged")
+    ("simulate", "rate_hz", "1e-300"),  # a one-row simulation, exit 0
+])
+def test_an_in_range_setting_that_makes_no_sense_names_its_key(table, key, value, tmp_path,
+                                                              capsys):
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"), f"[well]\nbit_depth_m = 1000.0\n[{table}]\n"
+                                       f"{key} = {value}\n[simulate]\ncells = 20\n"
+                                       if table == "batch" else
+                                       f"[{table}]\n{key} = {value}\nbit_depth_m = 1000.0\n"
+                                       "cells = 20\nduration_s = 20\n")
+    args = ["run", "w.csv", "--out", "out"] if table == "batch" else \
+        ["simulate", "w.toml", "--out", "out/s.csv"]
+    _strict_check(Case(args, (2,), (f"{table}.{key}",)), root, capsys)
+
+
+def test_a_simulated_stand_of_fewer_rows_than_a_record_is_refused(tmp_path, capsys):
+    """0.05 Hz over a 20-s stand recorded one row and exited 0."""
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    (root / "s.toml").write_text("[simulate]\nbit_depth_m = 1000.0\ncells = 20\n"
+                                 "duration_s = 20\nrate_hz = 0.05\n")
+    _strict_check(Case(["simulate", "s.toml", "--out", "out/s.csv"], (2,), ("rate_hz",)),
+                  root, capsys)
+    assert not (root / "out" / "s.csv").exists()
+
+
+def test_live_json_of_a_failed_run_says_so_not_stale_numbers(tmp_path):
+    """A live run that stopped on an error left live.json as at its last write: a page
+    polling it showed the open segment's numbers as current. The last live.json now says
+    the run is not running and why, first in its alerts."""
+    import json
+    import sys
+    import time
+
+    path = _log(tmp_path / "w.csv", seconds=400.0)
+    _config(path.with_suffix(".toml"))
+    proc = subprocess.Popen([sys.executable, "-m", "drillfric.cli.main", "live", "w.csv",
+                             "--out", "out", "--until-idle", "20", "--no-report"],
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    status = tmp_path / "out" / "live.json"
+    deadline = time.monotonic() + 60.0
+    while time.monotonic() < deadline and not (
+            status.exists() and json.loads(status.read_text() or "{}").get("rows")):
+        time.sleep(0.1)
+    other = _log(tmp_path / "other.csv", seconds=500.0, rpm=90.0)
+    os.replace(other, path)  # another file renamed over the followed one: the run fails
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 2, err
+    final = json.loads(status.read_text())
+    assert final["running"] is False
+    assert final["alerts"][0]["kind"] == "run_failed", final["alerts"]
+    assert "replaced by another" in final["alerts"][0]["message"]
+
+
+def test_live_json_of_a_run_that_ended_says_so(tmp_path):
+    import json
+
+    path = _log(tmp_path / "w.csv")
+    _config(path.with_suffix(".toml"))
+    result = CliRunner().invoke(cli, ["live", str(path), "--out", str(tmp_path / "out"),
+                                      "--until-idle", "1", "--no-report"])
+    assert result.exit_code == 0, result.output
+    final = json.loads((tmp_path / "out" / "live.json").read_text())
+    assert final["running"] is False and final["alerts"][0]["kind"] == "run_ended"

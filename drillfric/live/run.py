@@ -361,7 +361,7 @@ class LiveRun:
         with self.lock:
             view = dict(self.view)
         idle = self.clock() - self.last_data
-        alerts = []
+        alerts = _ended(self.error, self.done.is_set(), view["last_sample_time_s"])
         if self.engine is not None and idle >= self.stopped_s:
             alerts.append(_alert("data_stopped", f"no new data for {idle:.0f} s",
                                  view["last_sample_time_s"]))
@@ -384,6 +384,7 @@ class LiveRun:
                 "updated_utc": datetime.now(UTC).isoformat(timespec="milliseconds"),
                 "rig_state": view["rig_state"], "open_segment": view["open_segment"],
                 "latest": view["latest"], "alerts": alerts, "rows": view["rows"],
+                "running": not self.done.is_set(),
                 "segments_closed": view["segments_closed"], "resumed": view["resumed"],
                 "idle_s": round(idle, 3), "max_update_gap_s": round(self.max_gap_s, 3)}
 
@@ -524,6 +525,18 @@ def _trend(done: list[SegmentRecord]) -> dict | None:
         return _alert("friction_trend", f"μ_k {done[-1].mu_k:.3f} in segment {done[-1].id} "
                       f"against {median:.3f} before", done[-1].t_end_s)
     return None
+
+
+def _ended(error: BaseException | None, done: bool, time_s: float | None) -> list[dict]:
+    """The alert of a run that ended: ``run_failed`` with its one-line reason (the numbers
+    shown are the last published, not current), or ``run_ended``; none while it runs."""
+    if error is not None:
+        reason = error.message if isinstance(error, DrillfricError) else type(error).__name__
+        return [_alert("run_failed", f"the live run stopped, the numbers shown are its last: "
+                                     f"{reason}", time_s)]
+    if done:
+        return [_alert("run_ended", "the live run ended; the numbers shown are final", time_s)]
+    return []
 
 
 def _alert(kind: str, message: str, time_s: float | None) -> dict:

@@ -49,6 +49,8 @@ _SERIES_DT_S = 0.01  # [s] sampling of the set-point series handed to the kernel
 SIM_CELL_STEP_S = 1.0e-9
 #: Budget of one simulation [CPU s] (a 24-h well at 500 cells takes ≈ 20 s).
 MAX_SIM_CPU_S = 3600.0
+#: Fewest rows a simulated stand records (fewer is no record to estimate from).
+MIN_STAND_ROWS = 10
 #: Most rows one simulation records (each ~15 channels of 8 bytes, held in memory).
 MAX_SIM_ROWS = 5e7
 
@@ -292,6 +294,12 @@ def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario,
                           f"rows; the budget is {MAX_SIM_ROWS:.0e} (≈ 6 days at 100 Hz)",
                           file=cfg.source, fix="a lower [simulate] rate_hz (--rate) or "
                                                "shorter stands")
+    short = min(st.total_s for st in scenario.stands) * rate_hz
+    if short < MIN_STAND_ROWS:
+        raise ConfigError(f"a stand of {min(st.total_s for st in scenario.stands):.4g} s at "
+                          f"{rate_hz:g} Hz records {short:.3g} rows; a record needs at least "
+                          f"{MIN_STAND_ROWS} per stand", file=cfg.source,
+                          fix="a higher [simulate] rate_hz (--rate) or longer stands")
     cell_steps = 0.0
     for stand in scenario.stands:
         string = build_string(cfg.sections, stand.bit_depth_m)

@@ -111,8 +111,11 @@ def prepare(time_s, surface_rad_s, torque_Nm, torque_kind: str,
         raise InputError("batch refinement needs equal-length time, speed and torque series")
     ok = np.isfinite(t) & np.isfinite(w) & np.isfinite(tau)
     t, w, tau = t[ok], w[ok], tau[ok]
-    if t.size < 3 or np.any(np.diff(t) <= 0):
-        raise InputError("batch refinement needs at least 3 samples at increasing times",
+    if t.size < 3:
+        raise InputError(f"batch refinement needs at least 3 samples; its window holds "
+                         f"{t.size}", fix="a longer [batch] window_s, or a faster log")
+    if np.any(np.diff(t) <= 0):
+        raise InputError("batch refinement needs samples at increasing times",
                          fix="sort the record by time and drop duplicate samples")
     notes = [] if ok.all() else [f"{int((~ok).sum())} samples with missing values dropped"]
     dt = float(np.median(np.diff(t)))
