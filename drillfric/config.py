@@ -329,7 +329,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "on (used when flow in is not recorded)."),
         _positive("pumps_on_m3_s", 0.002, "m³/s", "Flow in above which the pumps count as on."),
         Key("start_bit_depth_m", float, None, "m", "Bit depth at the first sample when bit "
-            "depth is reckoned from block position (without it segment depths are unknown).",
+            "depth is reckoned from block position (without it segment depths are unknown). "
+            "Needs slips_hookload_N: the string moves with the block only off the slips.",
             min=0.0),
     ),
     "hookload": (

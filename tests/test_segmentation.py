@@ -487,3 +487,37 @@ def test_a_stop_with_the_torque_released_ends_the_rotation():
 def test_a_loaded_stop_longer_than_the_dip_limit_ends_the_rotation():
     segs = segment(_soft_torque_log(dip_torque=11e3, dip_s=15.0), cfg(min_segment_s=1.0))
     assert len(segs) == 30
+
+
+def test_block_reckoning_without_a_slips_threshold_is_refused_not_silently_wrong(tmp_path):
+    """Issue 33 item 7: the DSATS log run with only a start depth put the bit at 896–926 m
+    (it drilled 934–1120 m): every connection's block travel in the slips moved the bit too.
+    Reckoning from the block without ``slips_hookload_N`` is now one line naming it; with it,
+    the depths follow the string only off the slips."""
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    t = np.arange(0.0, 400.0, 1.0)
+    in_slips = (t >= 150.0) & (t < 250.0)  # a connection: the block goes up 28 m empty
+    block = np.where(t < 150.0, 30.0 - 0.1 * t, np.where(in_slips, 15.0 + 0.28 * (t - 150.0),
+                                                          43.0 - 0.1 * (t - 250.0)))
+    frame = pd.DataFrame({"time_s": t, "surface_rpm": np.where(in_slips, 0.0, 60.0),
+                          "surface_torque_Nm": np.where(in_slips, 0.0, 8e3),
+                          "hookload_N": np.where(in_slips, 3e5, 1.2e6),
+                          "block_position_m": block})
+    frame.to_csv(tmp_path / "w.csv", index=False)
+    base = "[segmentation]\nstart_bit_depth_m = 1000.0\nmin_segment_s = 600.0\n"
+    (tmp_path / "w.toml").write_text(base)
+    runner = CliRunner()
+    refused = runner.invoke(cli, ["run", str(tmp_path / "w.csv"), "--out", str(tmp_path / "a"),
+                                  "--no-report"])
+    assert refused.exit_code == 2 and "slips_hookload_N" in refused.output, refused.output
+    assert not (tmp_path / "a" / "w").exists()
+    (tmp_path / "w.toml").write_text(base + "slips_hookload_N = 6e5\n")
+    ran = runner.invoke(cli, ["run", str(tmp_path / "w.csv"), "--out", str(tmp_path / "b"),
+                              "--no-report"])
+    assert ran.exit_code == 0, ran.output
+    segments = pd.read_parquet(tmp_path / "b" / "w" / "segments.parquet")
+    # 15 m lowered before the connection and 15 m after it: the second stand's median bit
+    # depth is 1022.5 m (the empty block's 28-m climb in the slips moved the bit to 994.5 m)
+    assert segments["bit_depth_m"].max() == pytest.approx(1022.5, abs=0.5)

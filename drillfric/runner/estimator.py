@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from drillfric.errors import DrillfricError
+from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.chain import SegmentData, SkipSegment, check_segment, estimate_segment
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
 from drillfric.io.well import Well
@@ -37,6 +37,7 @@ def first_chunk(well: Well, chunk: pd.DataFrame, rate_hz, warnings: list) -> flo
         An implausible rate; a configuration beyond the work budget.
     """
     check_plausible_rate(chunk["time_s"].to_numpy(), file=well.files.data)
+    check_depth_reckoning(well, chunk)
     depth = chunk["bit_depth_m"].to_numpy(float) if "bit_depth_m" in chunk else np.empty(0)
     depth = depth[np.isfinite(depth)]
     check_work(well.config, float(np.median(depth)) if depth.size else
@@ -44,6 +45,32 @@ def first_chunk(well: Well, chunk: pd.DataFrame, rate_hz, warnings: list) -> flo
     rate_used, note = effective_rate(rate_hz, chunk["time_s"].to_numpy())
     warnings += [note] * bool(note)
     return rate_used
+
+
+def check_depth_reckoning(well: Well, chunk: pd.DataFrame) -> None:
+    """Refuse bit depths reckoned from the block position (docs/segmentation.md) that
+    cannot tell when the string moves with the block: without
+    ``segmentation.slips_hookload_N`` every block movement in the slips (each connection)
+    moved the bit too — the DSATS log run so put the bit at 896–926 m where it drilled
+    934–1120 m, with nothing said.
+
+    Raises
+    ------
+    ConfigError
+        Depth from block position and a start depth, but no slips threshold.
+    """
+    seg = well.config.segmentation
+    if "bit_depth_m" in chunk or "block_position_m" not in chunk or \
+            seg.start_bit_depth_m is None or seg.slips_hookload_N is not None:
+        return
+    hook = "hookload_N" in chunk
+    raise ConfigError(
+        "the bit depth is reckoned from the block position (start_bit_depth_m), but nothing "
+        "tells when the string is in the slips: every connection's block travel would move "
+        "the bit", file=well.files.config or well.files.data,
+        fix="set [segmentation] slips_hookload_N to a hook load between the block's weight "
+            "and the string's (drillfric inspect shows the hook load)" if hook else
+            "log a bit-depth channel, or the hook load with [segmentation] slips_hookload_N")
 
 
 class SegmentEstimator:
