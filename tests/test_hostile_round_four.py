@@ -547,11 +547,12 @@ def test_a_fifo_at_the_wits0_recording_is_refused_not_waited_on(tmp_path, capsys
 
 
 def test_simulate_recording_more_rows_than_memory_holds_is_refused(tmp_path, capsys):
-    """rate_hz = 100000 over 100 000 s asked for 74.5 GiB: internal MemoryError."""
+    """rate_hz = 100000 over 100 000 s asked for 74.5 GiB: internal MemoryError (the rate
+    is now at most 10 kHz; 10 kHz over 1 000 000 s asks as much)."""
     root = tmp_path / "sandbox"
     root.mkdir()
     (root / "s.toml").write_text("[simulate]\nbit_depth_m = 1000.0\ncells = 20\n"
-                                 "duration_s = 100000.0\nrate_hz = 100000.0\n")
+                                 "duration_s = 1000000.0\nrate_hz = 10000.0\n")
     _strict_check(Case(["simulate", "s.toml", "--out", "out/o.csv"], (2,), ("rows",)), root,
                   capsys)
 

@@ -36,6 +36,7 @@ from drillfric.estimation.batch.onset import BoundOutcome, onset_bound
 from drillfric.estimation.batch.settings import (
     MIN_CREEP_RATE_HZ,
     MU_K_REFIT_MOVE,
+    STEADY_BLOCK_S,
     STICK_SLIP_FLUCTUATION,
     TORQUE_SMOOTH_S,
     BatchSettings,
@@ -364,8 +365,9 @@ def _uncertainty_note(model: Model, rotation: _Rotation, mu_k: float, cells: int
     two_sigma = 2.0 * _mu_k_sigma(model, rotation, cells)
     err, n = rotation.target_error
     return (f"μ_k = {mu_k:.3f} ± {two_sigma:.3f} (2σ, ±{100 * two_sigma / mu_k:.1f} %): the "
-            f"mean torque of {n} whole cycles is known to ±{err:.0f} N·m (1σ), the model's "
-            "as well")
+            f"mean torque of {n} whole cycles (or {STEADY_BLOCK_S:g}-s blocks of steady "
+            f"rotation) is known to "
+            f"±{err:.0f} N·m (1σ), the model's as well")
 
 
 def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Static,

@@ -21,6 +21,8 @@ from drillfric.estimation.batch.settings import (
     DRIVE_SMOOTH_S,
     MIN_CYCLES,
     REST_BIT,
+    STEADY_BLOCK_S,
+    STICK_SLIP_FLUCTUATION,
     STUCK_FRACTION,
     TORQUE_SMOOTH_S,
     WOUND_SPAN_S,
@@ -352,6 +354,33 @@ def up_crossings(tau_Nm, dt_s: float) -> np.ndarray:
     return np.flatnonzero((xb[:-1] < xb.mean()) & (xb[1:] >= xb.mean())) + 1
 
 
+def torque_pieces(tau_Nm, dt_s: float) -> tuple[list[tuple[int, int]], bool]:
+    """The pieces whose means scatter like the mean torque's error, and whether they are
+    steady blocks: the whole torque
+    cycles (:func:`up_crossings`), or — for a steady rotation (1-s smoothed torque
+    fluctuating by at most ``STICK_SLIP_FLUCTUATION``) with fewer than :data:`MIN_CYCLES`
+    of them — blocks of :data:`STEADY_BLOCK_S` (docs/theory.md §6.4 "Uncertainty of μ_k":
+    a steady torque has no cycles, its mean's error is the scatter of its block means,
+    drift included).
+
+    Examples
+    --------
+    >>> pieces, steady = torque_pieces(np.full(200, 8e3) + np.linspace(0.0, 1.0, 200), 0.2)
+    >>> len(pieces), steady
+    (8, True)
+    >>> torque_pieces(np.sin(np.linspace(0.0, 5.5 * np.pi, 100)), 1.0)
+    ([(1, 37), (37, 73)], False)
+    """
+    x = np.asarray(tau_Nm, dtype=float)
+    up = up_crossings(x, dt_s)
+    cycles = [(int(a), int(b)) for a, b in zip(up[:-1], up[1:], strict=True)]
+    if len(cycles) >= MIN_CYCLES or \
+            fluctuation(smooth(x, dt_s, TORQUE_SMOOTH_S)) > STICK_SLIP_FLUCTUATION:
+        return cycles, False
+    n = max(int(round(STEADY_BLOCK_S / dt_s)), 2)
+    return [(i * n, (i + 1) * n) for i in range(x.size // n)], True
+
+
 def cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
     """Mean over the whole cycles of each window, pooled [N·m]."""
     return float(np.mean(np.concatenate([x[whole_cycles(x, dt_s)] for x in series])))
@@ -364,7 +393,9 @@ def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int]
 
     Each whole torque cycle (between upward crossings of the 1-s smoothed torque through its
     mean) gives one mean; the pooled mean is their length-weighted average, and its standard
-    error the ratio estimator's, √Σ(Lᵢ(mᵢ − m))² / ΣLᵢ.
+    error the ratio estimator's, √Σ(Lᵢ(mᵢ − m))² / ΣLᵢ. A steady series cut in blocks
+    (:func:`torque_pieces`) adds its drift in quadrature — the difference of its halves'
+    means: blocks of a torque still settling are not independent samples of its level.
 
     Examples
     --------
@@ -374,14 +405,18 @@ def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int]
     >>> err < 1.0, n
     (True, 18)
     """
-    means, lengths = [], []
+    means, lengths, drift = [], [], 0.0
     for x in series:
         x = np.asarray(x, dtype=float)
-        up = up_crossings(x, dt_s)
-        means += [float(np.mean(x[a:b])) for a, b in zip(up[:-1], up[1:], strict=True)]
-        lengths += [float(b - a) for a, b in zip(up[:-1], up[1:], strict=True)]
+        pieces, steady = torque_pieces(x, dt_s)
+        means += [float(np.mean(x[a:b])) for a, b in pieces]
+        lengths += [float(b - a) for a, b in pieces]
+        if steady:
+            half = x.size // 2
+            drift = max(drift, abs(float(np.mean(x[:half]) - np.mean(x[half:]))))
     if len(means) < MIN_CYCLES:
         return None
     m, w = np.asarray(means), np.asarray(lengths)
     mean = float(np.sum(w * m) / np.sum(w))
-    return float(np.sqrt(np.sum((w * (m - mean)) ** 2)) / np.sum(w)), len(means)
+    scatter = float(np.sqrt(np.sum((w * (m - mean)) ** 2)) / np.sum(w))
+    return float(np.hypot(scatter, drift)), len(means)

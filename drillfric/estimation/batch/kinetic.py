@@ -22,7 +22,7 @@ from drillfric.estimation.batch.harness import (
     cycle_mean,
     start_up_end,
     sticks,
-    up_crossings,
+    torque_pieces,
 )
 from drillfric.estimation.batch.settings import (
     MIN_CYCLES,
@@ -30,6 +30,7 @@ from drillfric.estimation.batch.settings import (
     MU_K_TOLERANCE,
     PRE_ROLL_S,
     PROVISIONAL_RATIO,
+    STEADY_BLOCK_S,
     BatchSettings,
 )
 from drillfric.estimation.creep import bridge_loaded_dips, rotating_runs
@@ -62,12 +63,13 @@ def rotating_windows(data: FitData, settings: BatchSettings, rad_per_Nm: float,
                          f"{round_trip_s:.1f}-s wave round trip, the run turned "
                          f"{turned[-1]:.0f} rad: not used for μ_k")
             continue
-        cycles = up_crossings(data.tau[i0 + end:i1 + 1], data.dt).size - 1
+        cycles = len(torque_pieces(data.tau[i0 + end:i1 + 1], data.dt)[0])
         if cycles < MIN_CYCLES:
             notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s holds "
                          f"{max(cycles, 0)} whole torque cycles after its start-up (ended "
                          f"{data.t[i0 + end] - data.t[i0]:.0f} s in), fewer than "
-                         f"{MIN_CYCLES}: its mean torque has no stated uncertainty, not used "
+                         f"{MIN_CYCLES} (or {MIN_CYCLES} {STEADY_BLOCK_S:g}-s blocks of steady "
+                         "rotation): its mean torque has no stated uncertainty, not used "
                          "for μ_k")
             continue
         wins.append(Window(max(0, i0 - pre), i1, np.arange(i0 + end, i1 + 1)))

@@ -70,6 +70,9 @@ CREEP_DRIVE_SMOOTH_S = 4.0  #: smoothing of the speed driving a creep (keeps its
 #: Whole torque cycles a rotating run must hold after its start-up to be compared: fewer
 #: give no standard error of the mean torque, so no stated uncertainty of μ_k (§6.4).
 MIN_CYCLES = 3
+#: A steady rotation (no stick-slip) has no torque cycles: its mean torque's error comes from
+#: the scatter of blocks this long instead, MIN_CYCLES of them at least (§6.4) [s].
+STEADY_BLOCK_S = 5.0
 STICK_SLIP_FLUCTUATION = 0.1  #: data stick-slip when std/mean of the smoothed torque exceeds
 PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
 MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
