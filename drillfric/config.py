@@ -619,6 +619,13 @@ def _sections(raw: Any, file: str | None) -> tuple[dict, ...]:
         if sec["id_m"] >= sec["od_m"]:
             raise ConfigError(f"{where}: id_m ({sec['id_m']}) must be smaller than od_m "
                               f"({sec['od_m']})", file=file, fix="check the pipe dimensions")
+        joint = sec["tool_joint_od_m"]
+        if joint is not None and joint < sec["od_m"]:
+            raise ConfigError(f"{where}: tool_joint_od_m ({joint}) is smaller than od_m "
+                              f"({sec['od_m']}): a tool joint is at least as wide as its "
+                              "pipe, and its radius is where the string touches the hole",
+                              file=file, fix="give the joint's outside diameter, or leave "
+                                             "tool_joint_od_m out (the pipe's OD is used)")
         if i > 1 and sec["length_m"] is None:
             raise ConfigError(f"{where} needs length_m (only the top section may omit it)",
                               file=file)
@@ -651,6 +658,22 @@ def _channels(raw: Any, file: str | None) -> dict:
                                   file=file, fix="e.g. scale = -1 for a log of opposite sign")
         out[name] = dict(spec)
     return out
+
+
+def _check_hole(sections: tuple[dict, ...], bit_diameter_m: float | None,
+                file: str | None) -> None:
+    """ConfigError when a section's widest part (tool joint, else pipe) does not pass
+    through the hole the bit drilled (``well.bit_diameter_m``)."""
+    if bit_diameter_m is None:
+        return
+    for i, sec in enumerate(sections, start=1):
+        widest = max(sec["od_m"], sec["tool_joint_od_m"] or 0.0)
+        if widest >= bit_diameter_m:
+            raise ConfigError(f"string.sections[{i}] is {widest} m wide (od_m / "
+                              f"tool_joint_od_m), not less than well.bit_diameter_m "
+                              f"({bit_diameter_m}): it does not fit in the hole",
+                              file=file, fix="check the section's diameters (in metres) and "
+                                             "the bit diameter")
 
 
 def _is_number(value) -> bool:
@@ -773,6 +796,7 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
                           "(rotation starts above rotating_rpm and ends below the stop speed)",
                           file=fname, fix="e.g. rotating_rpm = 2.0, rotating_stop_rpm = 1.0")
     _check_friction(values["model"], fname)
+    _check_hole(sections, values["well"]["bit_diameter_m"], fname)
     if values["model"]["omega_c_rad_s"] is not None and values["model"]["omega_c_rpm"] is not None:
         raise ConfigError("give either model.omega_c_rad_s or model.omega_c_rpm, not both",
                           file=fname)

@@ -435,8 +435,9 @@ _WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
              "mu_k_observer", "mu_s_observer", "mu_td")
 
 
-def _withhold(record: SegmentRecord, why: str,
-              flag: Flag = Flag.HOOKLOAD_CONTRADICTS_STRING) -> SegmentRecord:
+def withhold_friction(record: SegmentRecord, why: str,
+                      flag: Flag = Flag.HOOKLOAD_CONTRADICTS_STRING) -> SegmentRecord:
+    """``record`` with its friction numbers null, ``why`` in its message and ``flag``."""
     nulls = {name: None for name in _WITHHELD}
     message = "; ".join(filter(None, [record.message, f"friction factors withheld: {why}"]))
     return replace(record, **nulls, converged=False, message=message,
@@ -495,10 +496,10 @@ def judge(records: list, plateaus: list[Plateau], cfg,
     for r in records:
         why = well_problem or problems.get(r.id, "")
         if why and r.status is Status.OK:
-            out.append(_withhold(r, why))
+            out.append(withhold_friction(r, why))
             withheld.append(r.id)
         elif unverified and r.status is Status.OK:
-            out.append(_withhold(r, unverified, Flag.STRING_WEIGHT_UNVERIFIED))
+            out.append(withhold_friction(r, unverified, Flag.STRING_WEIGHT_UNVERIFIED))
             withheld.append(r.id)
         elif calibration is not None and calibration.scale is not None \
                 and r.status is Status.OK:

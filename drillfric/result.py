@@ -46,6 +46,7 @@ class Flag(StrEnum):
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
     STRING_WEIGHT_UNVERIFIED = "string_weight_unverified"
     STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
+    TORQUE_ZERO_OFFSET = "torque_zero_offset"
     RELAXATION_CYCLES = "relaxation_cycles"
     MU_K_UNCERTAIN = "mu_k_uncertain"
 
@@ -105,6 +106,10 @@ FLAG_MEANINGS = {
     Flag.STRING_WEIGHT_CALIBRATED: "the string's buoyed weight was scaled to the hook load "
                                    "before estimation (hookload.calibrate_string_weight; "
                                    "summary.json hookload)",
+    Flag.TORQUE_ZERO_OFFSET: "the torque reads more than 3 % of the rotating torque with "
+                             "the string in the slips, where it should read zero: a zero "
+                             "offset that moves μ by as much (summary.json torque_zero, "
+                             "docs/theory.md §2.1): friction factors withheld (null)",
 }
 
 

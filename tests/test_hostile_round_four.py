@@ -20,6 +20,7 @@ from click.testing import CliRunner
 from drillfric.cli.main import cli
 
 from drillfric.errors import OutputError
+from drillfric.runner.state import STATE_VERSION
 from tests.test_hostile_files import _strict_check
 from tests.test_hostile_inputs import SECRET, Case, _check, _config, _log, hang_guard
 
@@ -290,14 +291,14 @@ def _many_rows(folder):
 
 def _deep_json(folder):
     doc = folder / "engine.json"
-    doc.write_text('{"format": "drillfric-engine-state", "version": 1, "state": '
-                   + "[" * 100_000 + "]" * 100_000 + "}", encoding="utf-8")
+    doc.write_text(f'{{"format": "drillfric-engine-state", "version": {STATE_VERSION}, '
+                   '"state": ' + "[" * 100_000 + "]" * 100_000 + "}", encoding="utf-8")
 
 
 def _wrong_type(folder):
     doc = folder / "engine.json"
-    doc.write_text('{"format": "drillfric-engine-state", "version": 1, "state": [1, 2]}',
-                   encoding="utf-8")
+    doc.write_text(f'{{"format": "drillfric-engine-state", "version": {STATE_VERSION}, '
+                   '"state": [1, 2]}', encoding="utf-8")
 
 
 def _truncated_arrays(folder):
@@ -978,3 +979,79 @@ def test_live_json_of_a_run_that_ended_says_so(tmp_path):
     assert result.exit_code == 0, result.output
     final = json.loads((tmp_path / "out" / "live.json").read_text())
     assert final["running"] is False and final["alerts"][0]["kind"] == "run_ended"
+
+
+# ------------------------------------------------ the sixth attack (issue 30)
+def test_a_torque_zero_offset_withholds_friction_not_prints_it(tmp_path):
+    """2500 N·m added to the demo's torque printed μ_k 0.322 (truth 0.28), status ok: the
+    torque read 2.5 kN·m with the string in the slips. Every friction factor is now withheld
+    with the offset named (docs/theory.md §2.1 "The torque's zero")."""
+    import json
+
+    import pandas as pd
+
+    demo = Path(__file__).resolve().parents[1] / "examples" / "demo"
+    frame = pd.read_csv(demo / "demo.csv")
+    frame["surface_torque_Nm"] += 2500.0
+    frame.to_csv(tmp_path / "off.csv", index=False)
+    result = CliRunner().invoke(cli, ["run", str(tmp_path / "off.csv"), "--config",
+                                      str(demo / "demo.toml"), "--out", str(tmp_path / "o"),
+                                      "--no-report"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(next((tmp_path / "o").glob("*/summary.json")).read_text())
+    zero = summary["torque_zero"]
+    assert zero["verdict"] == "offset" and 2000.0 < zero["in_slips_torque_Nm"] < 3000.0
+    assert summary["mu_k"] is None and "torque-zero" in summary["mu_k_reason"]
+    assert all(s["mu_k"] is None and s["mu_s"] is None for s in summary["segments"])
+    assert any("torque_zero_offset" in s["quality_flags"] for s in summary["segments"])
+
+
+def test_the_torque_at_rest_is_the_same_in_any_chunking_and_after_a_restore():
+    import numpy as np
+    import pandas as pd
+
+    from drillfric.config import config_from_dict
+    from drillfric.torque_zero import TorqueAtRest
+
+    rng = np.random.default_rng(3)
+    n = 5000
+    frame = pd.DataFrame({"surface_rpm": np.where(rng.random(n) < 0.5, 0.0, 60.0),
+                          "hookload_N": rng.choice([3e5, 1.2e6], n),
+                          "surface_torque_Nm": rng.normal(400.0, 50.0, n)})
+    cfg = config_from_dict({})
+    whole, parts = TorqueAtRest(cfg), TorqueAtRest(cfg)
+    whole.feed(frame)
+    for a in range(0, n, 777):
+        parts.feed(frame.iloc[a:a + 777])
+        restored = TorqueAtRest(cfg)
+        restored.restore(parts.state())
+        parts = restored
+    assert np.array_equal(whole.counts, parts.counts)
+    zero, rows = whole.in_band(2.9e5, 3.1e5)
+    assert rows == int(((frame.surface_rpm == 0) & (frame.hookload_N == 3e5)).sum())
+    assert zero == pytest.approx(400.0, rel=0.08)  # to the 15 % of its bin
+
+
+@pytest.mark.parametrize(("section", "says"), [
+    ('tool_joint_od_m = 0.10', "smaller than od_m"),  # μ_k 0.380, μ_s 1.04 printed
+    ('tool_joint_od_m = 0.30', "does not fit in the hole"),  # μ_k 0.197, μ_s 0.347 printed
+])
+def test_a_tool_joint_that_cannot_be_is_refused(section, says, tmp_path, capsys):
+    root = tmp_path / "sandbox"
+    root.mkdir()
+    path = _log(root / "w.csv")
+    _config(path.with_suffix(".toml"), f"""[well]
+bit_depth_m = 2000.0
+bit_diameter_m = 0.2159
+[[string.sections]]
+name = "dp"
+od_m = 0.1465
+id_m = 0.123
+{section}
+[[string.sections]]
+name = "bha"
+od_m = 0.1714
+id_m = 0.0714
+length_m = 200
+""")
+    _strict_check(Case(["run", "w.csv", "--out", "out"], (2,), (says,)), root, capsys)

@@ -64,8 +64,18 @@ def judge(summary: dict) -> dict:
             found.insert(0, (WellFlag.MU_K_WITHHELD, "" if said else f"no well μ_k: {reason}"))
     warnings = list(summary.get("warnings") or [])
     warnings += [line for flag, line in found if line and line not in warnings]
+    if confidence == "none" and summary.get("segments"):
+        warnings.append(_nothing_estimated(summary["segments"]))
     return {"mu_k_confidence": confidence, "mu_k_reason": reason,
             "quality_flags": [flag.value for flag, _ in found], "warnings": warnings}
+
+
+def _nothing_estimated(segments: list[dict]) -> str:
+    """The warning of a log whose segments were all skipped or failed: nothing estimated
+    (a column of unreadable numbers made every segment's nulls too many, exit 0, silent)."""
+    first = next((s.get("message") for s in segments if s.get("message")), "")
+    return (f"nothing estimated: none of the {len(segments)} segment(s) was estimated "
+            f"(skipped or failed; the first says: {first})")
 
 
 def _no_mu_k(summary: dict) -> str:

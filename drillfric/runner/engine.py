@@ -44,6 +44,7 @@ from drillfric.io.tracks import TrackAccumulator
 from drillfric.io.well import Well, frame_source
 from drillfric.result import RunProgress, SegmentRecord, WellResult
 from drillfric.segmentation import Segment, SegmentStream
+from drillfric.torque_zero import TorqueAtRest, withhold_offset, zero_check
 from drillfric.vocabulary import Kind, Status
 
 from .estimator import SegmentEstimator, first_chunk
@@ -95,7 +96,9 @@ class Engine:
         self.moves = MoveFinder(cfg)  # pick-ups and slack-offs (docs/theory.md §2.2)
         #: Per-chunk accumulators, fed after the log check and the segment stream with the
         #: rows' rig states (and bit depths) in :meth:`feed_raw`; ``state()``/``restore(state)``.
-        self.accumulators = {"hook": self.hook, "tracks": self.tracks, "moves": self.moves}
+        self.rest = TorqueAtRest(cfg)  # the torque channel's zero (drillfric.torque_zero)
+        self.accumulators = {"hook": self.hook, "tracks": self.tracks, "moves": self.moves,
+                             "rest": self.rest}
         self.stream = SegmentStream(cfg)
         self.estimator = SegmentEstimator(well)
         self.calibration = StringWeightCalibration(well) \
@@ -149,6 +152,7 @@ class Engine:
         done = self.stream.feed(chunk)
         states = self.stream.last_states
         self.hook.feed(chunk, states)
+        self.rest.feed(chunk, states)
         self.tracks.feed(chunk, states)
         self.moves.feed(chunk, states, self.stream.last_bit_depth_m)
         return done
@@ -231,17 +235,20 @@ class Engine:
             well, calibration = self.calibration.current(plateaus)
             self._revise(well, calibration.scale)
         weighed = judge(self.records, plateaus, self.well.config, calibration)
-        records, pools = pool_short_segments(weighed.records)
+        zero = zero_check(self.rest, weighed.summary["block_weight_N"], weighed.records)
+        records, pools = pool_short_segments(withhold_offset(weighed.records, zero))
         records, friction_log = assess_bit_torque(records, pools,
                                                   self.well.config.well.bit_diameter_m)
         self._note_revisions(records)
         summary = summarise(self.well, records, pools, rows=self.check.rows,
                             assumed=self.well.assumed + self.estimator.assumed,
-                            warnings=warnings + weighed.warnings,
+                            warnings=warnings + weighed.warnings + zero.warnings(),
                             wall_s=time.perf_counter() - self.t_wall,
                             resampled_rate_hz=self.estimator.rate_hz,
                             requested_rate_hz=self.rate_hz)
-        summary.update(hookload=weighed.summary, mu_k_reason=weighed.mu_k_reason(summary["mu_k"]),
+        summary.update(hookload=weighed.summary, torque_zero=zero.summary(),
+                       mu_k_reason=weighed.mu_k_reason(summary["mu_k"])
+                       or zero.mu_k_reason(summary["mu_k"]),
                        off_bottom_friction_log=friction_log,
                        time_origin_utc=iso(self.tracker.origin), revisions=self.revisions,
                        resumed=self.resumed)

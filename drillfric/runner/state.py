@@ -26,7 +26,7 @@ from drillfric.io.atomic import own_file
 
 #: ``engine.json`` ``format`` and ``version`` of the state this drillfric writes and reads.
 STATE_FORMAT = "drillfric-engine-state"
-STATE_VERSION = 1
+STATE_VERSION = 2  # 2: the torque at rest (drillfric.torque_zero) joined the accumulators
 _DOC, _ARRAYS = "engine.json", "arrays.npz"
 _FRAME_NAME = re.compile(r"^frame-\d{1,6}\.parquet$")
 _FIX = "run the well again from its start (drillfric fleet --force)"
