@@ -224,6 +224,11 @@ class SegmentRecord:
                                              "logging resolves the stick-slip cycle, the bit "
                                              "is off bottom and the trace passes the "
                                              "kinematic check")
+    bit_speed_windows_withheld: int | None = _f("", "30-s windows of a trace shown whose bit "
+                                                    "speed is withheld (null rows) by the "
+                                                    "window-by-window kinematic check or "
+                                                    "because it depends on an unidentified "
+                                                    "μ_s (docs/bit_speed.md)")
     bit_speed_reason: str | None = _f("", "why the bit speed is not reported")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
                                               "the spacing, the averaging interval and the "
@@ -380,7 +385,8 @@ def segment_arrow_types() -> dict[str, pa.DataType]:
     type): numbers float64, flags and counts as declared, text string, ``quality_flags``
     a list of strings, ``starts`` a list of (μ_s, μ_k) pairs and segment ids a list of
     ints."""
-    kinds = {"float": "float64", "float | None": "float64", "int": "int32", "bool": "bool",
+    kinds = {"float": "float64", "float | None": "float64", "int": "int32",
+             "int | None": "int32", "bool": "bool",
              "bool | None": "bool", "tuple[Flag, ...]": "list<string>",
              "tuple[tuple[float, float], ...]": "list<list<float64>>",
              "tuple[int, ...]": "list<int32>"}

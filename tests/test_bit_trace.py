@@ -213,3 +213,33 @@ def test_statistics_note_only_beyond_the_validated_severity():
     note = statistics_note(3.2)
     # the withheld estimate itself is not printed (it reads up to 26 % low there)
     assert "3.2" not in note and "2.1 or more" in note and "docs/bit_speed.md" in note
+
+
+def test_a_30_s_runaway_inside_a_long_trace_is_withheld_window_by_window():
+    """Issue 33: on an independent plant a trace shown as resolved averaged 213 RPM over a
+    window in which the bit averaged 33 — the whole-segment check allowed it the segment's
+    twist range. Window by window, the runaway's window goes (its rows null); the stick-slip
+    windows around it, whose mean equals the top drive's, stay."""
+    from drillfric.estimation import bit_trace
+
+    rpm = 2 * np.pi / 60
+    t = np.arange(0.0, 300.0, 0.1)
+    top = np.full(t.size, 60.0 * rpm)
+    bit = 60.0 * rpm * (1.0 + np.sin(2 * np.pi * t / 5.0))  # stick-slip about the top drive
+    runaway = (t >= 120.0) & (t < 150.0)
+    bit[runaway] = 213.0 * rpm
+    torque = 20e3 + 5e3 * np.sin(2 * np.pi * t / 5.0)
+    compliance = 55.0 / 25e3  # ~55 rad of twist at 25 kN·m
+    verdict = bit_trace.window_check(t, bit, t, top, torque, compliance, 1.0, 0.5 * rpm)
+    assert verdict.windows == 10 and verdict.withheld == ((120.0, 150.0),)
+    assert "ahead of the top drive" in verdict.reason and not verdict.too_many
+    unknown = bit_trace.window_check(t, bit, t, top, torque, compliance, 1.0, 0.5 * rpm,
+                                     unknown_spans=((0.0, 40.0),))
+    assert unknown.withheld[:2] == ((0.0, 30.0), (30.0, 60.0))
+
+
+def test_window_grid_joins_a_short_last_window():
+    from drillfric.estimation.bit_trace import window_grid
+
+    assert window_grid(10.0, 100.0) == [(10.0, 40.0), (40.0, 70.0), (70.0, 100.0)]
+    assert window_grid(0.0, 65.0) == [(0.0, 30.0), (30.0, 65.0)]

@@ -284,3 +284,126 @@ def statistics_note(severity: float) -> str:
     return (f"severe stick-slip: stuck fraction and severity withheld, the estimated "
             f"severity is {SEVERITY_VALIDATED_BELOW:g} or more, beyond where they are "
             "validated; there they read up to 26 % and 0.13 low (docs/bit_speed.md)")
+
+
+# ---------------------------------------------------------------------- window by window
+#: Windows of the window-by-window check [s]: a fixed grid from the segment's first row
+#: (docs/bit_speed.md "Window by window"); a partial last window counts when at least
+#: :data:`MIN_WINDOW_S` long, else it joins the window before.
+WINDOW_S = 30.0
+MIN_WINDOW_S = 15.0
+#: Share of a trace's windows withheld beyond which the whole trace is withheld [-].
+MAX_WITHHELD_SHARE = 0.5
+
+
+@dataclass(frozen=True)
+class WindowVerdict:
+    """The windows of a trace withheld by the window-by-window check.
+
+    Attributes
+    ----------
+    windows : int
+        Windows of the trace.
+    withheld : tuple of (float, float)
+        [t_from_s, t_to_s) of each withheld window [s].
+    reason : str
+        Why (the worst window, or the creep), "" when none is withheld.
+    """
+
+    windows: int
+    withheld: tuple[tuple[float, float], ...] = ()
+    reason: str = ""
+
+    @property
+    def too_many(self) -> bool:
+        """More than :data:`MAX_WITHHELD_SHARE` of the windows withheld."""
+        return self.windows > 0 and len(self.withheld) > MAX_WITHHELD_SHARE * self.windows
+
+
+def window_grid(t_from_s: float, t_to_s: float) -> list[tuple[float, float]]:
+    """[start, end) of the :data:`WINDOW_S` windows from ``t_from_s`` to ``t_to_s`` [s].
+
+    Examples
+    --------
+    >>> window_grid(0.0, 70.0)
+    [(0.0, 30.0), (30.0, 70.0)]
+    >>> window_grid(0.0, 80.0)
+    [(0.0, 30.0), (30.0, 60.0), (60.0, 80.0)]
+    """
+    edges = list(np.arange(t_from_s, t_to_s, WINDOW_S)) + [t_to_s]
+    if len(edges) > 2 and edges[-1] - edges[-2] < MIN_WINDOW_S:
+        del edges[-2]
+    return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+
+
+def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
+                 compliance: float, travel_s: float, noise_rad_s: float,
+                 unknown_spans: tuple = ()) -> WindowVerdict:
+    """The kinematic check of docs/bit_speed.md window by window.
+
+    Over a window of length T the bit's mean speed is the top drive's minus the change of
+    the string's twist over T (module docstring), and the twist at any instant is bounded
+    by the torque the string carries then: C·(τ_hi − min(τ_lo, 0)) with the surface torque's
+    extremes over the window and one wave travel time ``travel_s`` before it (what reaches
+    the string's far end started at the top that much earlier). A window whose trace mean
+    differs from the top drive's by more than that twist over T, the speed noise's random
+    walk and :data:`MEAN_LAG_TOLERANCE_RPM` claims a bit running away from its string: it
+    is withheld. So are the windows overlapping ``unknown_spans`` ([t_from_s, t_to_s)
+    pairs): where μ_s was not identified, a creep's and its break-free's bit speed depend
+    on it.
+
+    Parameters
+    ----------
+    time_s, bit_rad_s : ndarray
+        The trace [s], [rad/s].
+    surface_time_s, surface_rad_s, torque_Nm : ndarray
+        The measured top-drive speed [rad/s] and string torque [N·m] on their times [s].
+    compliance : float
+        The string's torsional compliance C [rad/(N·m)] (:func:`compliance_rad_Nm`).
+    travel_s : float
+        One-way torsional wave travel time along the string [s].
+    noise_rad_s : float
+        Standard deviation of the measured speed [rad/s].
+    """
+    t, bit = np.asarray(time_s, float), np.asarray(bit_rad_s, float)
+    ts, ws = np.asarray(surface_time_s, float), np.asarray(surface_rad_s, float)
+    tau = np.asarray(torque_Nm, float)
+    if t.size < 2 or ts.size < 2:
+        return WindowVerdict(0)
+    dt = float(np.median(np.diff(ts)))
+    grid = window_grid(float(t[0]), float(t[-1]) + float(np.median(np.diff(t))))
+    withheld, worst = [], (0.0, "")
+    for a, b in grid:
+        if any(lo < b and hi > a for lo, hi in unknown_spans):
+            withheld.append((a, b))
+            continue
+        inside, top = (t >= a) & (t < b), (ts >= a) & (ts < b)
+        load = (ts >= a - travel_s) & (ts < b) & np.isfinite(tau)
+        if inside.sum() < 2 or top.sum() < 2 or not load.any():
+            continue
+        span = b - a
+        lo, hi = np.percentile(tau[load], TORQUE_PERCENTILES)
+        twist = compliance * (max(hi, 0.0) - min(lo, 0.0))
+        walk = NOISE_SIGMAS * noise_rad_s * np.sqrt(dt * span)
+        allowed = (twist + walk) / span + MEAN_LAG_TOLERANCE_RPM * RPM_TO_RAD_S
+        gap = float(np.mean(bit[inside]) - np.mean(ws[top]))
+        if abs(gap) > allowed:
+            withheld.append((a, b))
+            if abs(gap) - allowed > worst[0]:
+                worst = (abs(gap) - allowed, _window_reason(a, b, gap, allowed))
+    reason = worst[1] or ("bit speed withheld over the creep and its break-free: μ_s was "
+                          "not identified, and the bit's speed there depends on it")
+    return WindowVerdict(len(grid), tuple(withheld), reason if withheld else "")
+
+
+def _window_reason(a: float, b: float, gap_rad_s: float, allowed_rad_s: float) -> str:
+    side = "ahead of" if gap_rad_s > 0 else "behind"
+    return (f"the estimated bit runs {abs(gap_rad_s) / RPM_TO_RAD_S:.1f} RPM {side} the top "
+            f"drive on average over {a:.0f}–{b:.0f} s where the string's twist allows "
+            f"{allowed_rad_s / RPM_TO_RAD_S:.1f} RPM (window-by-window kinematic check, "
+            "docs/bit_speed.md)")
+
+
+def travel_time_s(string) -> float:
+    """One-way torsional wave travel time along ``string`` [s]: Σ L_i/c_i."""
+    return float(sum(s.length_m / s.wave_speed_m_s for s in string.sections))

@@ -136,6 +136,9 @@ class SegmentEstimate:
         (:func:`drillfric.estimation.bit_trace.bit_speed_claim`); else the reason.
     kinematics : KinematicCheck
         The trace's kinematic check (docs/bit_speed.md).
+    bit_windows_withheld : tuple of (float, float)
+        [t_from_s, t_to_s) of the 30-s windows whose bit speed is withheld (window by
+        window, docs/bit_speed.md) in a trace shown otherwise.
     bit_statistics : bool
         Whether the stuck fraction and the severity may be reported: the logging resolves
         the cycle, the bit is off bottom and the estimated severity is below
@@ -180,6 +183,7 @@ class SegmentEstimate:
     evidence: FitEvidence | None = field(default=None, repr=False)
     bit_speed: Resolution | None = None
     kinematics: bit_trace.KinematicCheck | None = None
+    bit_windows_withheld: tuple = ()
     bit_statistics: bool = False
     logged: LoggingInterval | None = None
     torque_terms: bit_torque.TorqueTerms | None = None
@@ -591,6 +595,11 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                                                * RPM_TO_RAD_S)
     logging = bit_speed_resolution(models)
     claim = bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom)
+    windows = _windows(cfg, models, refined, final.time_s, bit.rad_s)
+    if claim.resolved and windows.too_many:
+        claim = replace(claim, resolved=False, reason=(
+            f"bit speed withheld: {len(windows.withheld)} of its {windows.windows} 30-s "
+            f"windows fail: {windows.reason}"))
     drift = claim.resolved and kinematics.approximate
     severe = bit_trace.statistics_note(estimate.stick_slip_severity)
     statistics = logging.resolved and not models.on_bottom
@@ -600,13 +609,44 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                                     if models.on_bottom else None, verdict.mu_k)
     return replace(estimate, evidence=fitted, torque_terms=terms,
                    bit_speed=claim, kinematics=kinematics,
+                   bit_windows_withheld=windows.withheld if claim.resolved else (),
                    bit_statistics=statistics and not severe,
                    flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ())
                    + ((Flag.STICK_SLIP_BEYOND_VALIDATED,) if statistics and severe else ()),
                    messages=estimate.messages + ((bit_trace.drift_note(kinematics),)
                                                  if drift else ())
-                   + ((severe,) if statistics and severe else ()),
+                   + ((severe,) if statistics and severe else ())
+                   + ((_windows_note(windows),) if claim.resolved and windows.withheld
+                      else ()),
                    logged=models.logged)
+
+
+def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
+             bit_rad_s: np.ndarray) -> bit_trace.WindowVerdict:
+    """The window-by-window check of the trace (docs/bit_speed.md "Window by window"); where
+    μ_s was not identified, the windows of the start-up from rest and of each creep with its
+    break-free (to a wave round trip and 10 s after its end) depend on it."""
+    travel = bit_trace.travel_time_s(models.string)
+    unknown = ()
+    if refined.mu_s is None:
+        settled = time_s[settled_mask(time_s)]
+        start = ((time_s[0], settled[0] if settled.size else time_s[-1]),)
+        creeps = tuple((a, b + 2.0 * travel + 10.0) for a, b in
+                       (refined.details.creeps_found or []))
+        unknown = start + creeps
+    meas = models.meas
+    return bit_trace.window_check(time_s, bit_rad_s, meas.time_s, meas.surface_rad_s,
+                                  meas.motor_torque_Nm,
+                                  bit_trace.compliance_rad_Nm(models.string), travel,
+                                  cfg.observer.speed_noise_rpm * RPM_TO_RAD_S, unknown)
+
+
+def _windows_note(windows: bit_trace.WindowVerdict) -> str:
+    """The message of a trace shown with some windows withheld."""
+    spans = ", ".join(f"{a:.0f}–{b:.0f} s" for a, b in windows.withheld[:6])
+    more = f" and {len(windows.withheld) - 6} more" if len(windows.withheld) > 6 else ""
+    return (f"bit speed withheld over {len(windows.withheld)} of {windows.windows} 30-s "
+            f"windows ({spans}{more}; null rows in estimates.parquet): {windows.reason}")
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,

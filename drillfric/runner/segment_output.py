@@ -73,6 +73,7 @@ def _bit_fields(est: SegmentEstimate) -> dict:
         return logged | kept | dict(bit_speed_resolved=False,
                                     bit_speed_reason=est.bit_speed.reason)
     return logged | kept | dict(bit_speed_resolved=True,
+                                bit_speed_windows_withheld=len(est.bit_windows_withheld),
                                 bit_rms_error_rpm=est.bit_rms_error_rpm)
 
 
@@ -123,7 +124,8 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
     carry most of the weight) with the members' min–max bit speed as
     ``bit_rpm_est_min/max`` (NaN on the starts' rows). Where the logging does not resolve
-    the stick-slip cycle the bit columns are null: no trace is drawn from such data.
+    the stick-slip cycle the bit columns are null: no trace is drawn from such data; so are
+    they in the 30-s windows the window-by-window check withheld (``est.bit_windows_withheld``).
     """
     first = _record_frame(seg_id, est.first, 0, data,
                           np.abs(est.first.bha_rad_s_est) <= omega_c, est)
@@ -132,9 +134,16 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
     frame = pd.concat([first, seeded], ignore_index=True)
-    if not est.bit_speed.resolved:
-        frame[["bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max"]] = np.nan
-        frame["bit_stuck"] = pd.array([None] * len(frame), dtype="boolean")
+    gone = np.zeros(len(frame), dtype=bool) if est.bit_speed.resolved else \
+        np.ones(len(frame), dtype=bool)
+    t = frame["time_s"].to_numpy(float)
+    for a, b in est.bit_windows_withheld:
+        gone |= (t >= a) & (t < b)
+    if gone.any():
+        frame.loc[gone, ["bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max"]] = np.nan
+        stuck = frame["bit_stuck"].astype("boolean")
+        stuck[gone] = pd.NA
+        frame["bit_stuck"] = stuck
     return frame
 
 

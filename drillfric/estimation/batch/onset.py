@@ -2,7 +2,8 @@
 
 Where stick-slip data hold no creep that identifies μ_s, the model is run on the start-up
 and the next :data:`SCAN_COMPARED_S` of rotation of one run for μ_s on a grid above μ_k:
-the highest μ_s below which the model's bit never sticks bounds the truth from below. None
+the highest μ_s below which the model's bit never sticks, lowered by
+:data:`ONSET_MODEL_MARGIN` for the model's form, bounds the truth from below. None
 is given where sticking is not monotone in μ_s (bistable) or never happens below
 ``observer.mu_max``.
 """
@@ -49,6 +50,14 @@ def onset_scan(model: Model, win: Window, mu_k: float,
     return (scan[first - 1][0] if first > 0 else mu_k), False, scan
 
 
+#: Share the onset bound is lowered by for the model's form [-]: where the bit first
+#: sticks depends on how the string is discretised and damped, and on a lumped plant of
+#: 25-m segments (benchmarks/plants/lumped.py) it stuck at μ_s up to 3.6 % below the
+#: highest μ_s at which drillfric's model did not — bounds of 0.26, 0.32, 0.38 over truths
+#: of 0.251, 0.314, 0.376 (docs/validation.md "The second plant family").
+ONSET_MODEL_MARGIN = 0.05
+
+
 @dataclass(frozen=True)
 class BoundOutcome:
     """What the onset stage found.
@@ -92,6 +101,7 @@ def onset_bound(model: Model, wins: list[Window], mu_k: float, cells: int,
         return BoundOutcome(None, scan, (Flag.STICK_SLIP_NOT_REPRODUCED,), (
             f"the model does not stick-slip for μ_s ≤ {model.settings.mu_max}: no lower "
             "bound",))
+    bound = max(mu_k, bound * (1.0 - ONSET_MODEL_MARGIN))
     weak = " (the model sticks for any μ_s above μ_k: no more than μ_s ≥ μ_k)" \
         if bound == mu_k else ""
     why = "no creep fit passed its checks" if had_creep else "no creep"
