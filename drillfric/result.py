@@ -49,6 +49,8 @@ class Flag(StrEnum):
     TORQUE_ZERO_OFFSET = "torque_zero_offset"
     RELAXATION_CYCLES = "relaxation_cycles"
     MU_K_UNCERTAIN = "mu_k_uncertain"
+    MU_K_DEPENDS_ON_MU_S = "mu_k_depends_on_mu_s"
+    FACTORS_RUN_AWAY = "factors_run_away"
 
 
 #: What each flag means (docs/outputs.md).
@@ -94,6 +96,13 @@ FLAG_MEANINGS = {
                             "μ_k not converged",
     Flag.MU_K_UNCERTAIN: "the mean torque of the record's torque cycles scatters too much: "
                          "μ_k's 2σ statistical uncertainty exceeds 5 %, not converged",
+    Flag.FACTORS_RUN_AWAY: "the observer seeded with the fitted factors drives the bit "
+                           "ahead of or behind the top drive over most of the rotation, "
+                           "three times beyond any twist the string can hold: the factors "
+                           "do not describe the record, μ_k not converged",
+    Flag.MU_K_DEPENDS_ON_MU_S: "the model stick-slipped only with μ_s = 4 μ_k, not 2.5 μ_k, "
+                               "and the mean-torque μ_k of the two differ by more than 5 %: "
+                               "the unidentified μ_s sets μ_k, not converged",
     Flag.POOLED: "too short alone; pooled with other short segments at the same depth whose "
                  "μ_k agree (summary.json pooled)",
     Flag.HOOKLOAD_CONTRADICTS_STRING: "the hook load contradicts the configured string's "

@@ -18,6 +18,7 @@ gaps, so :class:`Segmenter` reproduces :func:`segment` exactly on data fed in ch
 
 from __future__ import annotations
 
+import heapq
 from dataclasses import dataclass
 
 import numpy as np
@@ -169,11 +170,12 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
                 hole = hole_in_m[i]
             elif np.isnan(hole) or bit > hole:
                 hole = bit
-        if depth_mode != _DEPTH_NONE and not np.isnan(bit):
+        # weight on the bit puts it on bottom whatever the depths say (a hole-depth
+        # channel a few metres deep labelled drilling off bottom: the bit torque in μ_k)
+        on_bottom = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
+        if depth_mode != _DEPTH_NONE and not np.isnan(bit) and not on_bottom:
             # going down faster than any drilling: running into hole that was already there
             on_bottom = hole - bit <= on_bottom_m and v_down <= max_rop_m_s
-        else:
-            on_bottom = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
         was = turning
         turning, dip_start = _still_turning(rpm[i], torque_Nm[i], time_s[i], turning, level,
                                             dip_start, rotating_rpm, stop_rpm, dip_s,
@@ -356,9 +358,8 @@ def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int,
 
     ``on`` is the turning state per sample (:data:`TURNING_STATES`; unknown samples already
     carry the previous one). Runs shorter than ``dwell_s`` (first to last sample, plus one
-    sample interval) take the kind of the run before them (the first run: of the run after
-    it); then equal neighbours merge. Returns (start, end, state) with indices relative to
-    the piece.
+    sample interval) take the kind of their longer neighbour, the shortest first, and equal
+    neighbours merge. Returns (start, end, state) with indices relative to the piece.
     """
     change = np.flatnonzero(on[1:] != on[:-1]) + 1
     bounds = np.concatenate(([0], change, [on.size]))
@@ -371,19 +372,45 @@ def _kind_runs(t: np.ndarray, on: np.ndarray, dwell_s: float) -> list[tuple[int,
     def duration(run):
         return t[run[1] - 1] - t[run[0]] + step
 
-    for k, run in enumerate(runs):
-        if duration(run) < dwell_s:
-            run[2] = runs[k - 1][2] if k > 0 else None
-    # leading short runs take the kind of the first long run (or stay as they are)
-    first_kind = next((r[2] for r in runs if r[2] is not None), int(on[0]))
-    merged: list[list] = []
-    for run in runs:
-        kind = first_kind if run[2] is None else run[2]
-        if merged and merged[-1][2] == kind:
-            merged[-1][1] = run[1]
-        else:
-            merged.append([run[0], run[1], kind])
-    return [tuple(r) for r in merged]
+    # the shortest run under the dwell first: it takes the kind of its longer neighbour and
+    # merges with it (a chain of short runs no longer passes one run's kind along: 1-s
+    # off-bottom blips every 15 s of drilling made a drilled stand off bottom)
+    return _absorb_short(runs, duration, dwell_s)
+
+
+def _absorb_short(runs: list[list], duration, dwell_s: float) -> list[tuple[int, int, int]]:
+    """Runs [start, end, kind] with every run shorter than ``dwell_s`` absorbed, the
+    shortest first, into its longer neighbour (equal neighbours then merge); O(n log n)."""
+    prev = list(range(-1, len(runs) - 1))
+    nxt = list(range(1, len(runs) + 1))
+    nxt[-1] = -1
+    alive = [True] * len(runs)
+    heap = [(duration(r), k) for k, r in enumerate(runs)]
+    heapq.heapify(heap)
+    while heap:
+        d, k = heapq.heappop(heap)
+        if not alive[k] or d != duration(runs[k]):
+            continue  # merged away, or grown since pushed
+        if d >= dwell_s:
+            break
+        near = [j for j in (prev[k], nxt[k]) if j >= 0]
+        if not near:
+            break
+        runs[k][2] = runs[max(near, key=lambda j: duration(runs[j]))][2]
+        for j in near:  # equal neighbours join run k
+            if runs[j][2] == runs[k][2]:
+                runs[k][0], runs[k][1] = min(runs[k][0], runs[j][0]), max(runs[k][1], runs[j][1])
+                alive[j] = False
+                if j == prev[k]:
+                    prev[k] = prev[j]
+                    if prev[k] >= 0:
+                        nxt[prev[k]] = k
+                else:
+                    nxt[k] = nxt[j]
+                    if nxt[k] >= 0:
+                        prev[nxt[k]] = k
+        heapq.heappush(heap, (duration(runs[k]), k))
+    return [tuple(r) for k, r in enumerate(runs) if alive[k]]
 
 
 #: Largest fraction of null speed/torque samples a segment may have; fewer are bridged by

@@ -243,3 +243,16 @@ def test_window_grid_joins_a_short_last_window():
 
     assert window_grid(10.0, 100.0) == [(10.0, 40.0), (40.0, 70.0), (70.0, 100.0)]
     assert window_grid(0.0, 65.0) == [(0.0, 30.0), (30.0, 65.0)]
+
+
+def test_a_seeded_trace_running_away_for_most_of_the_rotation_says_the_factors_are_wrong():
+    """The lumped plant's false μ_k (0.125 for 0.157, 10 Hz): the observer seeded with it ran
+    the bit 38.7 RPM ahead for 242 s of 300, 981 rad against the 119 the string can hold; a
+    right μ_k's trace drifted as far only through a break-free (62 s)."""
+    from drillfric.estimation.bit_trace import KinematicCheck, runs_away
+
+    wrong = KinematicCheck(False, 981.0, 119.0, 154.0, 396.0, 38.7)
+    assert runs_away(wrong, settled_s=300.0)
+    break_free = KinematicCheck(False, 1135.0, 119.0, 40.0, 102.0, 82.1)
+    assert not runs_away(break_free, settled_s=300.0)
+    assert not runs_away(KinematicCheck(False, 300.0, 119.0, 0.0, 280.0, 5.0), 300.0)

@@ -36,6 +36,7 @@ from drillfric.segmentation import (
     _classify_kernel,
     _column,
     _compiled_kernel,
+    _kind_runs,
     _pumps,
     classify,
     segment,
@@ -521,3 +522,29 @@ def test_block_reckoning_without_a_slips_threshold_is_refused_not_silently_wrong
     # 15 m lowered before the connection and 15 m after it: the second stand's median bit
     # depth is 1022.5 m (the empty block's 28-m climb in the slips moved the bit to 994.5 m)
     assert segments["bit_depth_m"].max() == pytest.approx(1022.5, abs=0.5)
+
+
+def test_weight_on_the_bit_puts_it_on_bottom_whatever_the_depths_say():
+    """The seventh attack (issue 30): a hole-depth channel reading 3 m below the bit labelled
+    drilling (WOB 30 kN) off bottom, and its bit torque went into μ_k (0.323 for 0.28)."""
+    n = 120
+    bit = np.linspace(2250.0, 2250.7, n)
+    states = classify(frame(np.full(n, 80.0), bit_depth_m=bit, hole_depth_m=bit + 3.0,
+                            wob_N=np.full(n, 30e3)), cfg())
+    assert np.all(states == ROTATING_ON_BOTTOM)
+    lifted = classify(frame(np.full(n, 80.0), bit_depth_m=bit, hole_depth_m=bit + 3.0,
+                            wob_N=np.full(n, 2e3)), cfg())
+    assert np.all(lifted == ROTATING_OFF_BOTTOM)
+
+
+def test_short_blips_do_not_pass_one_runs_kind_down_a_chain():
+    """1-s off-bottom blips every 15 s of drilling after a 30-s off-bottom start made the
+    whole drilled stand one off-bottom segment (each short run took its predecessor's
+    already reassigned kind): the blips now join the drilling around them."""
+    kinds = [ROTATING_OFF_BOTTOM] * 30
+    for _ in range(12):
+        kinds += [ROTATING_ON_BOTTOM] * 14 + [ROTATING_OFF_BOTTOM]
+    on = np.array(kinds, dtype=np.int8)
+    runs = _kind_runs(np.arange(on.size, dtype=float), on, 20.0)
+    assert [(a, b, k) for a, b, k in runs] == [(0, 30, ROTATING_OFF_BOTTOM),
+                                               (30, on.size, ROTATING_ON_BOTTOM)]

@@ -117,6 +117,22 @@ class KinematicCheck:
                 f"range allows {self.allowed_rad:.0f} rad (kinematic check, docs/bit_speed.md)")
 
 
+#: A seeded trace drifting beyond this many times its allowance, over at least
+#: :data:`RUNAWAY_SHARE` of the settled rotation, says the fitted factors do not describe
+#: the record (the lumped plant's false μ_k: −20 % at 10 Hz, its trace 38.7 RPM ahead for
+#: 242 s, 981 rad against 119; right factors drifted at most 9.5× over ≤ 62 s there).
+RUNAWAY_TIMES = 3.0
+RUNAWAY_SHARE = 0.5
+
+
+def runs_away(check: KinematicCheck, settled_s: float) -> bool:
+    """Whether the trace of the seeded pass runs away from its top drive for most of the
+    settled rotation (``settled_s`` [s]): :data:`RUNAWAY_TIMES` × its allowance over at least
+    :data:`RUNAWAY_SHARE` of it."""
+    return (not check.passed and check.drift_rad > RUNAWAY_TIMES * check.allowed_rad
+            and check.t_to_s - check.t_from_s >= RUNAWAY_SHARE * settled_s)
+
+
 def compliance_rad_Nm(string) -> float:
     """Torsional compliance of the whole string C = Σ L_i/(G_i J_i) [rad/(N·m)].
 

@@ -601,12 +601,19 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
             f"bit speed withheld: {len(windows.withheld)} of its {windows.windows} 30-s "
             f"windows fail: {windows.reason}"))
     drift = claim.resolved and kinematics.approximate
+    settled = final.time_s[settled_mask(final.time_s)]
+    runaway = estimate.converged and bit_trace.runs_away(
+        kinematics, float(settled[-1] - settled[0]) if settled.size > 1 else 0.0)
     severe = bit_trace.statistics_note(estimate.stick_slip_severity)
     statistics = logging.resolved and not models.on_bottom
     fitted = fit_evidence(cfg, models, verdict, refined.mu_s)
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(cfg, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
+    if runaway:
+        estimate = replace(estimate, converged=False,
+                           flags=estimate.flags + (Flag.FACTORS_RUN_AWAY,),
+                           messages=estimate.messages + (_runaway_note(estimate, kinematics),))
     return replace(estimate, evidence=fitted, torque_terms=terms,
                    bit_speed=claim, kinematics=kinematics,
                    bit_windows_withheld=windows.withheld if claim.resolved else (),
@@ -619,6 +626,15 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                    + ((_windows_note(windows),) if claim.resolved and windows.withheld
                       else ()),
                    logged=models.logged)
+
+
+def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) -> str:
+    """Why a segment whose seeded trace runs away is not converged."""
+    side = "ahead of" if check.lag_rpm > 0 else "behind"
+    return (f"not converged: the observer seeded with μ_k = {estimate.mu_k:.3f} runs the bit "
+            f"{abs(check.lag_rpm):.1f} RPM {side} the top drive over {check.t_from_s:.0f}–"
+            f"{check.t_to_s:.0f} s, {check.drift_rad / check.allowed_rad:.0f}× the twist the "
+            "string can hold: the fitted factors do not describe this record")
 
 
 def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,

@@ -22,7 +22,8 @@ from drillfric.vocabulary import Method
 UNRELIABLE_BOUND = frozenset({Flag.REGIME_MISMATCH, Flag.BISTABLE_REGIME,
                               Flag.STICK_SLIP_NOT_REPRODUCED, Flag.RELAXATION_CYCLES})
 #: Batch flags under which a batch μ_k is not converged (docs/batch_refinement.md).
-NOT_CONVERGED = frozenset({Flag.MU_K_NOT_CONVERGED, Flag.RELAXATION_CYCLES})
+NOT_CONVERGED = frozenset({Flag.MU_K_NOT_CONVERGED, Flag.RELAXATION_CYCLES,
+                           Flag.MU_K_DEPENDS_ON_MU_S})
 #: Friction factors usually seen with steel in mud-filled hole; outside, a segment is flagged
 #: ``outside_typical_range`` (check string, survey, torque units) but not changed.
 TYPICAL_MU = (0.05, 0.8)

@@ -112,6 +112,18 @@ class LogCheck:
                              file=file, fix=f"negate it: [channels] {m.channel.key} = "
                                             f'{{ column = "{printable(m.column)}", scale = -1 }}')
 
+    def duplicates_note(self, duplicates: int) -> str | None:
+        """A warning when more than 1 % of the rows repeated an earlier sample's time and
+        were dropped (timestamps cut to whole seconds on a 20-Hz log dropped 95 % of it,
+        silently), or None."""
+        if duplicates <= 0.01 * (duplicates + self.rows):
+            return None
+        share = 100.0 * duplicates / (duplicates + self.rows)
+        return (f"{duplicates} rows ({share:.0f} % of the log) repeat an earlier row's time "
+                "and were dropped (the first row of each time kept): are the timestamps cut "
+                "to whole seconds or coarser than the logging? Log them to full resolution, "
+                "or give a time_s column")
+
     def nothing_found(self, segments: int) -> str | None:
         """Why a run found no rotating segment at all (a warning), or None."""
         if segments:

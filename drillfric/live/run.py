@@ -447,7 +447,9 @@ def _open_view(record: SegmentRecord, folder: Path) -> dict:
     why = bit_speed_withheld(record.to_json())
     bit_rpm, stalled_s = (None, None) if why else _bit_tail(folder, record.id)
     if bit_rpm is None and not why:
-        why = "no estimated bit speed in this publication"
+        why = ("the latest 30-s window's bit speed is withheld (window-by-window kinematic "
+               "check: the segment's message says why)" if record.bit_speed_windows_withheld
+               else "no estimated bit speed in this publication")
     return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
             "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
             "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,

@@ -57,6 +57,13 @@ from .state import read_state, write_state
 REVISE_SCALE = 1e-3
 
 
+#: The channels that tell on bottom from off bottom (docs/segmentation.md).
+BOTTOM_CHANNELS = frozenset({"bit_depth_m", "block_position_m", "hole_depth_m", "wob_N"})
+BOTTOM_UNKNOWN = ("bit on or off bottom: no bit depth, block position or WOB in the log, so "
+                  "every rotation counts as off bottom — drilling would put its bit torque "
+                  "into μ_k")
+
+
 class Engine:
     """A time-log run that takes its rows in chunks and can be saved and continued.
 
@@ -148,6 +155,8 @@ class Engine:
         if self.check.rows == 0 and len(chunk):
             self.estimator.rate_hz = first_chunk(self.well, chunk, self.rate_hz, self.warnings)
             self.estimator.has_truth = "bit_rpm" in chunk
+            if not BOTTOM_CHANNELS & set(chunk.columns):
+                self.estimator.assumed.append(BOTTOM_UNKNOWN)
         self.check.feed(chunk)
         done = self.stream.feed(chunk)
         states = self.stream.last_states
@@ -227,8 +236,9 @@ class Engine:
             raise InputError("no data rows", file=self.well.files.data,
                              fix="check that the file holds samples below its header")
         self.check.finish(self.tracker.duplicates)
-        warnings = self.warnings + [w for w in (self.check.nothing_found(len(self.records)),)
-                                    if w]
+        warnings = self.warnings + [w for w in (
+            self.check.duplicates_note(self.tracker.duplicates),
+            self.check.nothing_found(len(self.records))) if w]
         plateaus = self.hook.close()
         calibration = None
         if self.calibration is not None:

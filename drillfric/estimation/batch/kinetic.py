@@ -26,6 +26,7 @@ from drillfric.estimation.batch.harness import (
 )
 from drillfric.estimation.batch.settings import (
     MIN_CYCLES,
+    MU_K_CLAIM,
     MU_K_MAX_RUNS,
     MU_K_TOLERANCE,
     PRE_ROLL_S,
@@ -193,14 +194,23 @@ def fit_kinetic(model: Model, wins: list[Window], target_Nm: float, stick_slip: 
     t_est, t_fixed = model.t_parts(cells)
     top = model.settings.mu_max
     x0 = float(np.clip((target_Nm - viscous - t_fixed) / t_est, min(0.01, top), min(1.0, top)))
+    tried = []
     for ratio in (PROVISIONAL_RATIO, 4.0) if stick_slip else (1.0,):
         def mu_s_of(mu_k, ratio=ratio):
             return max(ratio * mu_k, mu_s_seed or 0.0) if stick_slip else mu_k
         fit = fit_mean_torque(model, wins, target_Nm, mu_s_of, x0, cells)
+        tried.append((ratio, fit.mu_k))
         if fit.sticks == stick_slip:
             break
         x0 = fit.mu_k
     flags, messages = [], []
+    if len(tried) > 1 and abs(tried[-1][1] / tried[0][1] - 1.0) > MU_K_CLAIM:
+        flags.append(Flag.MU_K_DEPENDS_ON_MU_S)
+        messages.append(
+            f"μ_k depends on the μ_s the model assumes: {tried[0][1]:.3f} with μ_s = "
+            f"{tried[0][0]:g} μ_k (the model does not stick), {tried[-1][1]:.3f} with "
+            f"{tried[-1][0]:g} μ_k — more than {100 * MU_K_CLAIM:.0f} % apart, and μ_s is not "
+            "known: not converged")
     if fit.sticks != stick_slip:
         flags.append(Flag.REGIME_MISMATCH)
         messages.append("the model could not be put in the data's regime "
