@@ -43,6 +43,7 @@ class Flag(StrEnum):
     POOLED = "pooled"
     BIT_SPEED_DRIFT = "bit_speed_drift"
     STICK_SLIP_BEYOND_VALIDATED = "stick_slip_beyond_validated"
+    STICK_SLIP_UNDETERMINED = "stick_slip_undetermined"
     HOOKLOAD_CONTRADICTS_STRING = "hookload_contradicts_string"
     STRING_WEIGHT_UNVERIFIED = "string_weight_unverified"
     STRING_WEIGHT_CALIBRATED = "string_weight_calibrated"
@@ -81,6 +82,9 @@ FLAG_MEANINGS = {
     Flag.BIT_SPEED_DRIFT: "the bit-speed trace drifts from the top drive by more than the "
                           "string's twist allows, by under a third of its stick-slip swing: "
                           "shown, its phase approximate",
+    Flag.STICK_SLIP_UNDETERMINED: "stuck fraction and severity withheld: the ensemble's "
+                                  "members, whose μ_s spans its uncertainty, disagree on them "
+                                  "beyond ±0.05 / ±12 % (docs/bit_speed.md)",
     Flag.STICK_SLIP_BEYOND_VALIDATED: "stick-slip more severe than the stuck fraction and the "
                                       "severity are validated for (estimated severity ≥ 2.1): "
                                       "both withheld",

@@ -256,3 +256,18 @@ def test_a_seeded_trace_running_away_for_most_of_the_rotation_says_the_factors_a
     break_free = KinematicCheck(False, 1135.0, 119.0, 40.0, 102.0, 82.1)
     assert not runs_away(break_free, settled_s=300.0)
     assert not runs_away(KinematicCheck(False, 300.0, 119.0, 0.0, 280.0, 5.0), 300.0)
+
+
+def test_stick_slip_statistics_the_data_do_not_fix_are_withheld():
+    """Issue 33 item 4: on the lumped plant stuck fractions of 0.06 were printed for 0.23
+    (estimated severity 0.94, the bit grazing rest) and 0.56 for 0.65 (members carrying
+    μ_s ±15 % gave 0.40–0.59). Members that agree, away from the edge of rest, keep them."""
+    from drillfric.estimation.bit_trace import members_disagree
+
+    t = np.arange(0.0, 60.0, 0.1)
+    stick = np.clip(np.sin(2 * np.pi * t / 5.0), -0.3, None) + 0.3  # stops each cycle
+    same = np.column_stack([6.0 * stick] * 3)
+    assert members_disagree(same, 2.0, 0.1) == ""
+    spread = np.column_stack([6.0 * stick, 6.0 * (stick + 0.25), 6.0 * (stick + 0.6)])
+    assert "members" in members_disagree(spread, 2.0, 0.1)
+    assert "edge of rest" in members_disagree(same, 0.9, 0.1)

@@ -67,6 +67,16 @@ DRIFT_SHARE_OF_SWING = 1.0 / 3.0
 #: 2.88 already read 2.41 (−16 %). A truth ≥ 2.88 read −26 % low at worst gives ≥ 2.13,
 #: so an estimate below 2.1 comes from stick-slip where every record was within tolerance.
 SEVERITY_VALIDATED_BELOW = 2.1
+#: Estimated severities [-] at which the bit grazes rest: (ω99 − ω1)/(2ω̄) ≈ 1 puts its
+#: slowest speeds near zero, and the stuck fraction, a threshold statistic, turns on whether
+#: it just stops. On the lumped plant every estimate in 0.77–0.94 was outside the tolerance
+#: (stuck 0.06 for 0.14–0.23, severity −15…−27 %), and the 100-RPM record's 0.87 too, while
+#: 0.59–0.71 (the bit well clear of rest) and 1.63 held (docs/validation.md).
+GRAZING = (0.75, 1.3)
+#: The stated tolerances of the stuck fraction [-] and of the severity [share] (docs/
+#: bit_speed.md "Stuck fraction and severity").
+STUCK_TOLERANCE = 0.05
+SEVERITY_TOLERANCE = 0.12
 
 
 @dataclass(frozen=True)
@@ -423,3 +433,35 @@ def _window_reason(a: float, b: float, gap_rad_s: float, allowed_rad_s: float) -
 def travel_time_s(string) -> float:
     """One-way torsional wave travel time along ``string`` [s]: Σ L_i/c_i."""
     return float(sum(s.length_m / s.wave_speed_m_s for s in string.sections))
+
+
+def members_disagree(member_bit_rad_s: np.ndarray, severity: float,
+                     omega_c_rad_s: float) -> str:
+    """Why the stuck fraction and the severity are not determined by the data ("" when they
+    are): the ensemble's members carry μ_s across its uncertainty (``observer.
+    ensemble_spread``), and where their own statistics (each member's trace, shape (S, R)
+    columns) spread beyond the tolerance — ±:data:`STUCK_TOLERANCE` stuck, ±:data:`SEVERITY_
+    TOLERANCE` of the severity (half the range) — the μ_s the data did not fix decides them
+    (on the lumped plant, docs/validation.md: stuck 0.06 for 0.23, severity −25 %)."""
+    if GRAZING[0] <= severity <= GRAZING[1]:
+        return (f"stuck fraction and severity withheld: an estimated severity of {severity:.2f} "
+                "puts the bit's slowest speeds at the edge of rest, where whether it stops "
+                "each cycle — and so both numbers — depends on the friction law's detail "
+                "more than on the data (docs/bit_speed.md)")
+    bit = np.asarray(member_bit_rad_s, dtype=float)
+    if bit.ndim != 2 or bit.shape[1] < 2 or bit.shape[0] < 2:
+        return ""
+    own_stuck = np.mean(np.abs(bit) <= omega_c_rad_s, axis=0)
+    mean = np.abs(np.mean(bit, axis=0))
+    lo, hi = np.percentile(bit, [1.0, 99.0], axis=0)
+    own_severity = np.where(mean > 1e-9, (hi - lo) / (2.0 * np.maximum(mean, 1e-9)), 0.0)
+    stuck_half = 0.5 * float(np.ptp(own_stuck))
+    severity_half = 0.5 * float(np.ptp(own_severity))
+    if stuck_half <= STUCK_TOLERANCE and severity_half <= SEVERITY_TOLERANCE * max(severity,
+                                                                                  1e-9):
+        return ""
+    return (f"stuck fraction and severity withheld: the ensemble's members, whose μ_s spans "
+            f"its uncertainty, give {np.min(own_stuck):.2f}–{np.max(own_stuck):.2f} stuck and "
+            f"a severity of {np.min(own_severity):.2f}–{np.max(own_severity):.2f}, beyond "
+            f"±{STUCK_TOLERANCE:g} and ±{100 * SEVERITY_TOLERANCE:.0f} %: the data do not fix "
+            "them (docs/bit_speed.md)")

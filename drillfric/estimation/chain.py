@@ -604,6 +604,9 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     settled = final.time_s[settled_mask(final.time_s)]
     runaway = estimate.converged and bit_trace.runs_away(
         kinematics, float(settled[-1] - settled[0]) if settled.size > 1 else 0.0)
+    late = settled_mask(final.time_s)
+    undetermined = bit_trace.members_disagree(final.bit_rad_s_est[late],
+                                              estimate.stick_slip_severity, cfg.omega_c_rad_s)
     severe = bit_trace.statistics_note(estimate.stick_slip_severity)
     statistics = logging.resolved and not models.on_bottom
     fitted = fit_evidence(cfg, models, verdict, refined.mu_s)
@@ -617,12 +620,15 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     return replace(estimate, evidence=fitted, torque_terms=terms,
                    bit_speed=claim, kinematics=kinematics,
                    bit_windows_withheld=windows.withheld if claim.resolved else (),
-                   bit_statistics=statistics and not severe,
+                   bit_statistics=statistics and not severe and not undetermined,
                    flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ())
-                   + ((Flag.STICK_SLIP_BEYOND_VALIDATED,) if statistics and severe else ()),
+                   + ((Flag.STICK_SLIP_BEYOND_VALIDATED,) if statistics and severe else ())
+                   + ((Flag.STICK_SLIP_UNDETERMINED,) if statistics and undetermined
+                      and not severe else ()),
                    messages=estimate.messages + ((bit_trace.drift_note(kinematics),)
                                                  if drift else ())
                    + ((severe,) if statistics and severe else ())
+                   + ((undetermined,) if statistics and undetermined and not severe else ())
                    + ((_windows_note(windows),) if claim.resolved and windows.withheld
                       else ()),
                    logged=models.logged)
@@ -672,7 +678,9 @@ def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag
     late = settled_mask(final.time_s)
     members, weights = final.bit_rad_s_est[late], bit.weights[late]
     messages = list(verdict.messages)
-    if Flag.CREEP_FIT_AT_BOUND in verdict.flags:
+    fits = refined.details.creep_fits
+    at_top = bool(fits) and fits[-1][1] > 1.05 * verdict.mu_k  # not at μ_s = μ_k
+    if Flag.CREEP_FIT_AT_BOUND in verdict.flags and at_top:
         messages.append(_creep_advice(models.string, models.td.T_N_Nm, verdict.mu_k, refined,
                                       models.meas))
     return SegmentEstimate(

@@ -22,7 +22,8 @@ from drillfric.vocabulary import Kind, Method, Status
 #: ``stick_slip_beyond_validated`` only the bit-speed trace and its statistics).
 _POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
                        "estimators_disagree", "bit_speed_drift", "mu_k_uncertain",
-                       "bistable_regime", "stick_slip_beyond_validated"})
+                       "bistable_regime", "stick_slip_beyond_validated",
+                       "stick_slip_undetermined"})
 #: Short segments pool when the string's friction torque added between their bit depths is
 #: at most this share of the torque at the deeper one, |ΔT_N|/T_N (docs/theory.md "Pooling
 #: along depth"). The reported μ_k is the torque-weighted mean of μ(x) over the whole

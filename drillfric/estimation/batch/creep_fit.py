@@ -153,7 +153,11 @@ def fit_creeps(model: Model, creeps, mu_k: float, cells: int, rotating: list[Win
             "fitted",))
     mu, runs = fit_creep(model, wins, mu_k, n, lo, hi)
     fits = [(model.grid(n)[0].n_cells, mu, runs)]
-    if min(mu - lo, hi - mu) < 0.01 * (hi - lo):
+    if mu - lo < 0.01 * (hi - lo):
+        return CreepOutcome(None, fits=fits, flags=(Flag.CREEP_FIT_AT_BOUND,), messages=(
+            f"creep fit ran to its lower bound μ_s = {mu:.3f}: the break-over shows no static "
+            "friction above the kinetic (μ_s ≈ μ_k), not reported as identified",))
+    if hi - mu < 0.01 * (hi - lo):
         return CreepOutcome(None, fits=fits, flags=(Flag.CREEP_FIT_AT_BOUND,), messages=(
             f"creep fit ran to its search bound (μ_s = {mu:.3f}): not reported",))
     move = None

@@ -343,7 +343,7 @@ def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOut
         flags += onset.flags
         messages += onset.messages
         method = "stick_slip_onset" if onset.bound is not None else "none"
-    if mu_s is None and not rotation.stick_slip and kinetic is not None:
+    if mu_s is None and not rotation.stick_slip and kinetic is not None and not creeps:
         messages.append("no stick-slip and no creep start-up: μ_s is not in the data; a creep "
                         "break-over from rest (below ω_c for 10–30 s) would make it measurable")
     return _Static(mu_s, kinetic, None if onset is None else onset.bound, method, used, creep,
