@@ -34,9 +34,10 @@ lumped plant given drillfric's F_c profile, which isolates the numerics from the
 model.
 
 Run: ``python benchmarks/validate_lumped.py [--quick] [--json FILE] [--no-cross-check]``
-(``--quick``: 8 records, 2 lengths × 2 severities × 100 Hz and 1 Hz, ≈ 10 minutes on one
-core; the full sweep: μ_k 0.15–0.35, μ_s/μ_k 1.0–2.4, 1500/3000/6000 m, five rates, creep
-start-ups with and without break-over, two seeds — several hours).
+(``--quick``: 8 records, 2 lengths × 2 severities × 100 Hz and 1 Hz, under a minute; the
+full sweep: μ_k 0.15–0.35, μ_s/μ_k 1.0–2.4, 1500/3000/6000 m, five rates, creep start-ups
+with and without break-over, two seeds, 150 records — about 7 minutes on one core, 7 Dec
+2026; docs/validation.md "The second plant family").
 """
 
 from __future__ import annotations
