@@ -304,7 +304,8 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         _positive("on_bottom_m", 0.5, "m", "Bit within this distance of hole depth counts "
                   "as on bottom."),
         _positive("wob_on_bottom_N", 10e3, "N", "WOB above which the bit counts as on bottom "
-                  "when depths are missing."),
+                  "when depths are missing, and while turning within a stand (30 m) of the "
+                  "hole's bottom whatever the depth channels say."),
         _positive("max_gap_s", 10.0, "s", "A gap in the time base longer than this splits a "
                   "segment."),
         _positive("kind_dwell_s", 20.0, "s", "A change between on and off bottom must last "

@@ -170,16 +170,23 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
                 hole = hole_in_m[i]
             elif np.isnan(hole) or bit > hole:
                 hole = bit
-        # weight on the bit puts it on bottom whatever the depths say (a hole-depth
-        # channel a few metres deep labelled drilling off bottom: the bit torque in μ_k)
-        on_bottom = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
-        if depth_mode != _DEPTH_NONE and not np.isnan(bit) and not on_bottom:
+        weighted = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
+        if depth_mode != _DEPTH_NONE and not np.isnan(bit):
             # going down faster than any drilling: running into hole that was already there
             on_bottom = hole - bit <= on_bottom_m and v_down <= max_rop_m_s
+            near = hole - bit <= WOB_NEAR_BOTTOM_M
+        else:
+            on_bottom = weighted
+            near = True
         was = turning
         turning, dip_start = _still_turning(rpm[i], torque_Nm[i], time_s[i], turning, level,
                                             dip_start, rotating_rpm, stop_rpm, dip_s,
                                             dip_fraction)
+        # a turning bit with weight on it, within a stand of the hole's bottom, drills
+        # whatever the depths say (a hole-depth channel 3 m deep labelled 30-kN drilling off
+        # bottom: the bit torque went into μ_k); not while tripping, where a WOB computed
+        # from the hook load reads the slack-off's drag
+        on_bottom = on_bottom or (turning and weighted and near)
         if turning and rpm[i] > rotating_rpm and not np.isnan(torque_Nm[i]):
             dt_level = time_s[i] - t_prev if was and have_prev > 0 else _LOAD_TAU_S
             level += (abs(torque_Nm[i]) - level) * min(1.0, dt_level / _LOAD_TAU_S)
@@ -213,6 +220,10 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
     carry[7], carry[8] = level, dip_start
     return states, bit_out
 
+
+#: A turning bit with weight on it counts as on bottom within this depth of the hole's
+#: bottom whatever the depth channels' gap says [m] (one stand).
+WOB_NEAR_BOTTOM_M = 30.0
 
 #: :func:`_classify_kernel` compiled (on first use); inputs up to :data:`_PLAIN_ROWS` rows
 #: run the plain function (no numba import or kernel load for a small file).

@@ -271,3 +271,13 @@ def test_stick_slip_statistics_the_data_do_not_fix_are_withheld():
     spread = np.column_stack([6.0 * stick, 6.0 * (stick + 0.25), 6.0 * (stick + 0.6)])
     assert "members" in members_disagree(spread, 2.0, 0.1)
     assert "edge of rest" in members_disagree(same, 0.9, 0.1)
+
+
+def test_steady_members_agree_on_their_statistics():
+    """Review: five steady members at 60 RPM (severities 0.01–0.02) were called undetermined
+    — 12 % of a near-zero severity is no spread at all (a floor of 0.05 now)."""
+    from drillfric.estimation.bit_trace import members_disagree
+
+    rng = np.random.default_rng(1)
+    steady = 2 * np.pi + rng.normal(0.0, 0.03, (600, 5))
+    assert members_disagree(steady, 0.015, 0.1) == ""

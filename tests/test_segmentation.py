@@ -548,3 +548,15 @@ def test_short_blips_do_not_pass_one_runs_kind_down_a_chain():
     runs = _kind_runs(np.arange(on.size, dtype=float), on, 20.0)
     assert [(a, b, k) for a, b, k in runs] == [(0, 30, ROTATING_OFF_BOTTOM),
                                                (30, on.size, ROTATING_ON_BOTTOM)]
+
+
+def test_a_wob_read_from_slack_off_drag_does_not_put_a_tripping_bit_on_bottom():
+    """Review of the WOB rule: a WOB computed from the hook load reads a slack-off's drag
+    (25 kN); 220 m above the hole, not turning, the bit is tripping, not on bottom."""
+    n = 120
+    t = np.arange(n, dtype=float)
+    states = classify(frame(np.zeros(n), bit_depth_m=1000.0 + 0.3 * t,
+                            hole_depth_m=np.full(n, 1300.0),
+                            wob_N=np.where(t >= 60.0, 25e3, 0.0)), cfg())
+    assert not np.any(states == SLIDING_ON_BOTTOM)
+    assert np.all(states[70:] == TRIPPING)

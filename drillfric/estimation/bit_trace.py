@@ -77,6 +77,9 @@ GRAZING = (0.75, 1.3)
 #: bit_speed.md "Stuck fraction and severity").
 STUCK_TOLERANCE = 0.05
 SEVERITY_TOLERANCE = 0.12
+#: Members' severities closer than this are in agreement whatever their size [-] (steady
+#: rotation reads 0.01–0.02, where 12 % of it is no spread at all).
+SEVERITY_FLOOR = 0.05
 
 
 @dataclass(frozen=True)
@@ -457,8 +460,8 @@ def members_disagree(member_bit_rad_s: np.ndarray, severity: float,
     own_severity = np.where(mean > 1e-9, (hi - lo) / (2.0 * np.maximum(mean, 1e-9)), 0.0)
     stuck_half = 0.5 * float(np.ptp(own_stuck))
     severity_half = 0.5 * float(np.ptp(own_severity))
-    if stuck_half <= STUCK_TOLERANCE and severity_half <= SEVERITY_TOLERANCE * max(severity,
-                                                                                  1e-9):
+    if stuck_half <= STUCK_TOLERANCE and \
+            severity_half <= max(SEVERITY_TOLERANCE * severity, SEVERITY_FLOOR):
         return ""
     return (f"stuck fraction and severity withheld: the ensemble's members, whose μ_s spans "
             f"its uncertainty, give {np.min(own_stuck):.2f}–{np.max(own_stuck):.2f} stuck and "

@@ -75,7 +75,7 @@ def _nothing_estimated(segments: list[dict]) -> str:
     (a column of unreadable numbers made every segment's nulls too many, exit 0, silent)."""
     first = next((s.get("message") for s in segments if s.get("message")), "")
     return (f"nothing estimated: none of the {len(segments)} segment(s) was estimated "
-            f"(skipped or failed; the first says: {first})")
+            f"(skipped or failed" + (f"; the first says: {first})" if first else ")"))
 
 
 def _no_mu_k(summary: dict) -> str:

@@ -536,32 +536,30 @@ def _numeric(values: pd.Series) -> np.ndarray:
 
 _FLOAT32_MAX = float(np.finfo(np.float32).max)
 _DECIMAL_COMMA = r"^-?(?:\d{1,3}(?:\.\d{3})+|\d+),\d+$"  # 17.730,5 or 1234,5
-#: Thousands commas: any 16,111 or 1,234,567 of a column that shows them unambiguously,
-#: with a decimal point (16,111.8) or two groups or more (1,234,567).
-_THOUSANDS = r"^-?\d{1,3}(?:,\d{3})+(?:\.\d+)?$"
+#: Thousands commas where a cell shows them unambiguously: with a decimal point (16,111.8)
+#: or two groups or more (1,234,567); a lone 16,950 stays a decimal comma (16.95).
 _THOUSANDS_SURE = r"^-?\d{1,3}(?:(?:,\d{3})+\.\d+|(?:,\d{3}){2,}(?:\.\d+)?)$"
 
 
 def _text_numbers(text: pd.Series) -> np.ndarray:
     """Numbers from text; a column read as text because of one bad token may still use a
     decimal comma (and thousands dots), which are read as such (only the bad cell is NaN),
-    or thousands commas where the column shows them unambiguously (a quoted "16,111.8" in
-    a comma-separated file was read as null: every segment skipped, exit 0).
+    or thousands commas where a cell shows them unambiguously (a quoted "16,111.8" in a
+    comma-separated file was read as null: every segment skipped, exit 0).
 
     Examples
     --------
     >>> _text_numbers(pd.Series(["1,5", "17.730,25", "***", "2.5"], dtype="string")).tolist()
     [1.5, 17730.25, nan, 2.5]
-    >>> _text_numbers(pd.Series(["16,111.8", "16,950", "-200"], dtype="string")).tolist()
-    [16111.8, 16950.0, -200.0]
+    >>> _text_numbers(pd.Series(["16,111.8", "1,234,567", "-200"], dtype="string")).tolist()
+    [16111.8, 1234567.0, -200.0]
     """
     out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
-    if text.str.fullmatch(_THOUSANDS_SURE).fillna(False).any():
-        grouped = text.str.fullmatch(_THOUSANDS).fillna(False).to_numpy(dtype=bool)
+    grouped = text.str.fullmatch(_THOUSANDS_SURE).fillna(False).to_numpy(dtype=bool)
+    if grouped.any():  # cell by cell: the same in any chunking
         out[grouped] = pd.to_numeric(text[grouped].str.replace(",", "", regex=False),
                                      errors="coerce").to_numpy(dtype=float, na_value=np.nan)
-        return out
-    comma = text.str.fullmatch(_DECIMAL_COMMA).fillna(False).to_numpy(dtype=bool)
+    comma = text.str.fullmatch(_DECIMAL_COMMA).fillna(False).to_numpy(dtype=bool) & ~grouped
     if comma.any():
         fixed = text[comma].str.replace(".", "", regex=False).str.replace(",", ".", regex=False)
         out[comma] = pd.to_numeric(fixed, errors="coerce").to_numpy(dtype=float,
