@@ -59,9 +59,9 @@ REVISE_SCALE = 1e-3
 
 #: The channels that tell on bottom from off bottom (docs/segmentation.md).
 BOTTOM_CHANNELS = frozenset({"bit_depth_m", "block_position_m", "wob_N"})
-BOTTOM_UNKNOWN = ("bit on or off bottom: no bit depth, block position or WOB in the log, so "
-                  "every rotation counts as off bottom — drilling would put its bit torque "
-                  "into μ_k")
+BOTTOM_UNKNOWN = ("on or off bottom: the log has no bit-depth, block-position or WOB "
+                  "channel, so every rotation counts as off bottom — drilling would put its "
+                  "bit torque into μ_k")
 
 
 class Engine:
