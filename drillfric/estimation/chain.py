@@ -605,14 +605,12 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     runaway = estimate.converged and bit_trace.runs_away(
         kinematics, float(settled[-1] - settled[0]) if settled.size > 1 else 0.0)
     late = settled_mask(final.time_s)
-    for a, b in windows.withheld:  # the statistics leave out what the trace withholds
-        late &= ~((final.time_s >= a) & (final.time_s < b))
-    if windows.withheld:
-        estimate = _statistics_over(estimate, final, bit, late, cfg.omega_c_rad_s)
-    undetermined = bit_trace.members_disagree(final.bit_rad_s_est[late],
-                                              estimate.stick_slip_severity, cfg.omega_c_rad_s) \
-        if late.any() else ("stuck fraction and severity withheld: every settled window of "
-                            "the bit trace is withheld")
+    cut = any(np.any(late & (final.time_s >= a) & (final.time_s < b))
+              for a, b in windows.withheld)
+    undetermined = ("stuck fraction and severity withheld: the bit trace is withheld over some "
+                    "of their windows (window by window, docs/bit_speed.md)") if cut else \
+        bit_trace.members_disagree(final.bit_rad_s_est[late], estimate.stick_slip_severity,
+                                   cfg.omega_c_rad_s)
     severe = bit_trace.statistics_note(estimate.stick_slip_severity)
     statistics = logging.resolved and not models.on_bottom
     fitted = fit_evidence(cfg, models, verdict, refined.mu_s)
@@ -638,19 +636,6 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                    + ((_windows_note(windows),) if claim.resolved and windows.withheld
                       else ()),
                    logged=models.logged)
-
-
-def _statistics_over(estimate: SegmentEstimate, final, bit, rows: np.ndarray,
-                     omega_c_rad_s: float) -> SegmentEstimate:
-    """The stuck fraction and severity over ``rows`` only (the settled rows outside the
-    windows the trace withholds); NaN when none is left."""
-    if not rows.any():
-        return replace(estimate, stick_slip_severity=float("nan"),
-                       stuck_fraction=float("nan"))
-    members, weights = final.bit_rad_s_est[rows], bit.weights[rows]
-    return replace(estimate,
-                   stick_slip_severity=bit_trace.mixture_severity(members, weights),
-                   stuck_fraction=bit_trace.stuck_share(members, weights, omega_c_rad_s))
 
 
 def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) -> str:
