@@ -602,3 +602,41 @@ def test_cased_effective_5_hz_seed_8_halves_blind_to_the_cased_top():
     assert len(problems) == 1
     assert "halves cannot be compared: noise ±7.0 % (2σ) at this rate > 6 %" in problems[0]
     assert creep_checks.problems(0.412, replace(seed_8, halves_twist_noise=(0.01, 0.01))) == []
+
+
+def _model_whose_sticking_needs(ratio_mu_k: dict):
+    """A stand-in for the batch model: fit_mean_torque answers, per provisional μ_s/μ_k
+    ratio, the root μ_k and whether the model then sticks (``ratio_mu_k``: ratio → (μ_k,
+    sticks))."""
+    from types import SimpleNamespace
+
+    grid = SimpleNamespace(rho_j_kg_m=np.ones(10), dx_true_m=np.ones(10))
+    model = SimpleNamespace(data=SimpleNamespace(w_bar=np.full(100, 6.0)), k_t=0.0,
+                            grid=lambda cells: (grid, None),
+                            t_parts=lambda cells: (1e5, 0.0),
+                            settings=SimpleNamespace(mu_max=1.5))
+
+    def fit(model, wins, target, mu_s_of, x0, cells):
+        ratio = round(mu_s_of(1.0), 6)
+        mu_k, sticks = ratio_mu_k[ratio]
+        return kinetic.MeanTorqueFit(mu_k, 0.0, [(mu_k, 0.0)], sticks)
+    return model, fit
+
+
+@pytest.mark.parametrize(("at_4", "flagged"), [(0.150, False), (0.125, True)])
+def test_mu_k_that_moves_with_the_assumed_mu_s_is_not_converged(at_4, flagged, monkeypatch):
+    """Issue 33: when the model stick-slips only at μ_s = 4 μ_k, not 2.5 μ_k, the μ_k of the
+    two differ; more than 5 % apart, the unidentified μ_s sets μ_k: not converged
+    (mu_k_depends_on_mu_s, in the verdict's NOT_CONVERGED)."""
+    from types import SimpleNamespace
+
+    from drillfric.estimation.verdict import NOT_CONVERGED
+    from drillfric.result import Flag
+
+    model, fit = _model_whose_sticking_needs({2.5: (0.155, False), 4.0: (at_4, True)})
+    monkeypatch.setattr(kinetic, "fit_mean_torque", fit)
+    wins = [SimpleNamespace(used=np.arange(10, 100))]
+    out = kinetic.fit_kinetic(model, wins, 15e3, True, None, 100)
+    assert out.mu_k == at_4
+    assert (Flag.MU_K_DEPENDS_ON_MU_S in out.flags) is flagged
+    assert Flag.MU_K_DEPENDS_ON_MU_S in NOT_CONVERGED

@@ -603,16 +603,20 @@ linear_mass_kg_m = 220.0
                   capsys)
 
 
-def test_a_simulation_that_diverges_is_one_line_and_no_file(tmp_path, capsys):
-    """kp_Nms_rad = 1e7 (in range): the explicit PI drive diverged and simulate wrote inf and
-    1e305 with exit 0."""
+@pytest.mark.parametrize(("settings", "says"), [
+    # the explicit PI drive diverged: simulate wrote inf and 1e305 with exit 0
+    ("bit_depth_m = 2000.0\nkp_Nms_rad = 1e7\nduration_s = 20\ncells = 200", "diverged"),
+    # 0.05 Hz over a 20-s stand recorded one row and exited 0
+    ("bit_depth_m = 1000.0\ncells = 20\nduration_s = 20\nrate_hz = 0.05", "rate_hz"),
+])
+def test_a_simulation_that_cannot_be_a_record_is_one_line_and_no_file(settings, says,
+                                                                     tmp_path, capsys):
     root = tmp_path / "sandbox"
     root.mkdir()
-    (root / "sk.toml").write_text("[simulate]\nbit_depth_m = 2000.0\nkp_Nms_rad = 1e7\n"
-                                  "duration_s = 20\ncells = 200\n")
-    _strict_check(Case(["simulate", "sk.toml", "--out", "out/sk.csv"], (2,), ("diverged",)),
-                  root, capsys)
-    assert not (root / "out" / "sk.csv").exists()
+    (root / "s.toml").write_text(f"[simulate]\n{settings}\n")
+    _strict_check(Case(["simulate", "s.toml", "--out", "out/s.csv"], (2,), (says,)), root,
+                  capsys)
+    assert not (root / "out" / "s.csv").exists()
 
 
 @pytest.mark.parametrize("edit", ["text_time", "huge_id", "negative_rows", "carried_rows"])
@@ -928,17 +932,6 @@ def test_an_in_range_setting_that_makes_no_sense_names_its_key(table, key, value
     args = ["run", "w.csv", "--out", "out"] if table == "batch" else \
         ["simulate", "w.toml", "--out", "out/s.csv"]
     _strict_check(Case(args, (2,), (f"{table}.{key}",)), root, capsys)
-
-
-def test_a_simulated_stand_of_fewer_rows_than_a_record_is_refused(tmp_path, capsys):
-    """0.05 Hz over a 20-s stand recorded one row and exited 0."""
-    root = tmp_path / "sandbox"
-    root.mkdir()
-    (root / "s.toml").write_text("[simulate]\nbit_depth_m = 1000.0\ncells = 20\n"
-                                 "duration_s = 20\nrate_hz = 0.05\n")
-    _strict_check(Case(["simulate", "s.toml", "--out", "out/s.csv"], (2,), ("rate_hz",)),
-                  root, capsys)
-    assert not (root / "out" / "s.csv").exists()
 
 
 def test_live_json_of_a_failed_run_says_so_not_stale_numbers(tmp_path):

@@ -575,7 +575,7 @@ def _run_python(inertia, k, c, d, cap_s, cap_k, omega_sw, kp, ki, mode, series, 
     wm = dv = df = 0.0
     kin = 0.5 * np.sum(inertia * v * v)
     spr = 0.5 * np.sum(k * phi * phi)
-    _record_py(out, 0, v, phi, k, c, 0.0, kin, spr, wm, dv, df, 0.0)
+    _record(out, 0, v, phi, k, c, 0.0, kin, spr, wm, dv, df, 0.0)
     for step in range(n_steps):
         s_new = series[step + 1]
         dw = np.zeros(n + 1)
@@ -629,16 +629,18 @@ def _run_python(inertia, k, c, d, cap_s, cap_k, omega_sw, kp, ki, mode, series, 
         if (step + 1) % rec_every == 0:
             kin = 0.5 * np.sum(inertia * v * v)
             spr = 0.5 * np.sum(k * phi * phi)
-            _record_py(out, (step + 1) // rec_every, v, phi, k, c, tau_m, kin, spr, wm, dv,
+            _record(out, (step + 1) // rec_every, v, phi, k, c, tau_m, kin, spr, wm, dv,
                        df, sweeps)
     return integ
 
 
-def _record_py(out, row, v, phi, k, c, tau_m, kin, spr, wm, dv, df, sweeps):
+def _record(out, row, v, phi, k, c, tau_m, kin, spr, wm, dv, df, sweeps):
+    """Row ``row`` of the record array (:data:`REC`): both kernels write it (compiled for
+    the numba one, :data:`_record_nb`)."""
     out[row, 0] = v[0]
     out[row, 1] = k[1] * phi[1] + c[1] * (v[0] - v[1])
     out[row, 2] = tau_m
-    out[row, 3] = v[-1]
+    out[row, 3] = v[v.size - 1]
     out[row, 4] = kin
     out[row, 5] = spr
     out[row, 6] = wm
@@ -752,24 +754,11 @@ def _run_loops(inertia, k, c, d, cap_s, cap_k, omega_sw, kp, ki, mode, series, d
     return integ
 
 
-def _record_loops(out, row, v, phi, k, c, tau_m, kin, spr, wm, dv, df, sweeps):
-    out[row, 0] = v[0]
-    out[row, 1] = k[1] * phi[1] + c[1] * (v[0] - v[1])
-    out[row, 2] = tau_m
-    out[row, 3] = v[v.size - 1]
-    out[row, 4] = kin
-    out[row, 5] = spr
-    out[row, 6] = wm
-    out[row, 7] = dv
-    out[row, 8] = df
-    out[row, 9] = sweeps
-
-
 if njit is not None:
-    _record_nb = njit(cache=False)(_record_loops)
+    _record_nb = njit(cache=False)(_record)
     run_numba = njit(cache=False)(_run_loops)
 else:  # pragma: no cover
-    _record_nb = _record_loops
+    _record_nb = _record
     run_numba = None
 run_numpy = _run_python
 

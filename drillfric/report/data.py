@@ -264,17 +264,8 @@ def segment_estimates(result_dir: Path, ids: list[int],
     path = Path(result_dir) / "estimates.parquet"
     if not ids or not path.is_file():
         return {}
-    import pyarrow.parquet as pq
-
-    try:
-        names = _numbers_schema(path)
-        columns = [c for c in ESTIMATE_NAMES if c in names]  # older results lack some
-        table = pq.read_table(path, columns=columns,
-                              filters=[("segment_id", "in", [int(i) for i in ids])])
-    except (OSError, ValueError, TypeError, NotImplementedError) as exc:  # pyarrow's too
-        raise InputError(f"unreadable estimates ({exc})", file=path,
-                         fix="rerun 'drillfric run' to rewrite the results") from None
-    frame = table.to_pandas()
+    frame = _read_estimates(path, lambda names: [c for c in ESTIMATE_NAMES if c in names],
+                            [("segment_id", "in", [int(i) for i in ids])])  # older lack some
     out = {}
     for seg_id, rows in frame.groupby("segment_id", sort=True):
         parts = []
@@ -289,6 +280,23 @@ def segment_estimates(result_dir: Path, ids: list[int],
     return out
 
 
+def _read_estimates(path: Path, pick, filters: list) -> pd.DataFrame | None:
+    """Rows of estimates.parquet: the columns ``pick`` takes from the file's (None: read
+    nothing, return None), pyarrow ``filters``. A file that is not a table of numbers, or
+    that pyarrow cannot read — it raises OSError, ValueError, TypeError or
+    NotImplementedError for a crafted one — is one line naming it."""
+    import pyarrow.parquet as pq
+
+    try:
+        columns = pick(_numbers_schema(path))
+        if columns is None:
+            return None
+        return pq.read_table(path, columns=columns, filters=filters).to_pandas()
+    except (OSError, ValueError, TypeError, NotImplementedError) as exc:
+        raise InputError(f"unreadable estimates ({exc})", file=path,
+                         fix="rerun 'drillfric run' to rewrite the results") from None
+
+
 #: Columns of the final pass that say what the fit reproduces (every sample is read).
 _FIT_COLUMNS = ("segment_id", "start_id", "time_s", "surface_torque_Nm", "surface_torque_fit_Nm")
 
@@ -300,16 +308,9 @@ def final_torques(result_dir: Path, ids: list[int]) -> dict[int, pd.DataFrame]:
     path = Path(result_dir) / "estimates.parquet"
     if not ids or not path.is_file():
         return {}
-    import pyarrow.parquet as pq
-
-    try:
-        if "surface_torque_fit_Nm" not in _numbers_schema(path):
-            return {}
-        table = pq.read_table(path, columns=list(_FIT_COLUMNS),
-                              filters=[("segment_id", "in", [int(i) for i in ids]),
-                                       ("start_id", "=", FINAL_START_ID)])
-    except (OSError, ValueError, TypeError, NotImplementedError) as exc:
-        raise InputError(f"unreadable estimates ({exc})", file=path,
-                         fix="rerun 'drillfric run' to rewrite the results") from None
-    frame = table.to_pandas()
+    frame = _read_estimates(
+        path, lambda names: list(_FIT_COLUMNS) if "surface_torque_fit_Nm" in names else None,
+        [("segment_id", "in", [int(i) for i in ids]), ("start_id", "=", FINAL_START_ID)])
+    if frame is None:
+        return {}
     return {int(i): rows for i, rows in frame.groupby("segment_id", sort=True)}
