@@ -20,8 +20,13 @@ only wires them):
 
 from __future__ import annotations
 
+import contextlib
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 
+import numba
 import numpy as np
 
 from drillfric import torque_drag, torsional
@@ -587,6 +592,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     refined = batch_fit(cfg, models)
     tick(0.5)
     verdict = decide(evidence(cfg, models, diag, refined))
+    fitted_result = beside(fit_evidence, cfg, models, verdict, refined.mu_s)
     final, bit = seeded_pass(cfg, models, verdict, out_rate)
     tick(0.2)
     estimate = _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
@@ -613,7 +619,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                                    cfg.omega_c_rad_s)
     severe = bit_trace.statistics_note(estimate.stick_slip_severity)
     statistics = logging.resolved and not models.on_bottom
-    fitted = fit_evidence(cfg, models, verdict, refined.mu_s)
+    fitted = fitted_result()
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(cfg, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
@@ -636,6 +642,37 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                    + ((_windows_note(windows),) if claim.resolved and windows.withheld
                       else ()),
                    logged=models.logged)
+
+
+def beside(work, *args):
+    """``work(*args)`` started on a thread of its own when numba may use more than one
+    thread, else deferred; returns the callable that gives its result (raising what it
+    raised).
+
+    The seeded ensemble (5 members on 2 threads) leaves one core idle for a third of its
+    pass; the fitted model over the segment (:func:`fit_evidence`, a nogil plant run that
+    does not depend on the ensemble) fills it at a low priority (:func:`_yielding`; issue
+    32, docs/performance.md). With one
+    numba thread (a fleet running one well per core) nothing runs beside: no
+    oversubscription. The numbers are the same either way (neither touches the other's
+    arrays).
+    """
+    if numba.get_num_threads() < 2:
+        return lambda: work(*args)
+    pool = ThreadPoolExecutor(1, thread_name_prefix="drillfric-beside")
+    job = pool.submit(_yielding, work, *args)
+    pool.shutdown(wait=False)
+    return job.result
+
+
+def _yielding(work, *args):
+    """``work(*args)`` on a thread that yields its core to the ensemble's member threads
+    (Linux: the thread's nice value 19, so it runs where a core would idle, instead of
+    slowing the member thread the ensemble waits for)."""
+    if hasattr(os, "setpriority"):
+        with contextlib.suppress(OSError):
+            os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+    return work(*args)
 
 
 def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) -> str:
