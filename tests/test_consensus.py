@@ -62,8 +62,10 @@ def test_consensus_uses_converged_segments_and_never_invents_mu_s():
 
 def test_consensus_states_its_uncertainty_and_support():
     """Issue 25 item 1: the headline's ± combines the supporting segments' scatter with
-    their own uncertainty (never below the fit's 2 % torque match); the support counts the
-    segments behind it of the off-bottom ones, an unconverged outlier in neither."""
+    their own 95 % half-width (never below the validated tolerance, 5 % at 100 Hz: issue 33
+    item 5, where the 2 % torque match excluded the truth on the second plant family); the
+    support counts the segments behind it of the off-bottom ones, an unconverged outlier in
+    neither."""
     records = [_seg(i, mu, converged=True, flags=()) for i, mu in
                enumerate((0.20, 0.21, 0.22, 0.23, 0.24), 1)] + [_seg(6, 0.9)]
     found = consensus(records)
@@ -71,10 +73,24 @@ def test_consensus_states_its_uncertainty_and_support():
     assert found["mu_k_range"] == [0.20, 0.24]
     scatter = (np.percentile([0.20, 0.21, 0.22, 0.23, 0.24], 84)
                - np.percentile([0.20, 0.21, 0.22, 0.23, 0.24], 16)) / 2
-    assert found["mu_k_uncertainty"] == pytest.approx(np.hypot(scatter, 0.02 * 0.22))
+    assert found["mu_k_uncertainty"] == pytest.approx(np.hypot(scatter, 0.05 * 0.22))
     alone = consensus([_seg(1, 0.30, converged=True, flags=())])
-    assert alone["mu_k_uncertainty"] == pytest.approx(0.006)  # the fit's 2 % alone
+    assert alone["mu_k_uncertainty"] == pytest.approx(0.015)  # the 5 % tolerance alone
+    coarse = consensus([_seg(1, 0.30, converged=True, flags=(), sample_interval_s=1.0)])
+    assert coarse["mu_k_uncertainty"] == pytest.approx(0.030)  # 1-s logging: 10 %
     assert alone["mu_k_support"] == {"segments": 1, "of": 1}
     none = consensus([_seg(1, 0.30)])
     assert none["mu_k"] is None and none["mu_k_uncertainty"] is None
     assert none["mu_k_support"] == {"segments": 0, "of": 1}
+
+
+def test_mu_s_plus_minus_holds_its_validated_tolerance():
+    """Issue 33 item 5, the demo's μ_s = 0.585 ± 0.003 for a true 0.600: the spread of the
+    creep fits behind one claim leaves out the model-form error, so the ± of an identified
+    μ_s is never narrower than its validated tolerance (claims within 10 % on both plant
+    families, docs/validation.md): 0.585 ± 0.059 holds 0.600."""
+    found = consensus([_seg(1, 0.28, converged=True, flags=(), mu_s=0.585,
+                            mu_s_identifiable=True, mu_s_spread=0.003)])
+    assert found["mu_s"] == pytest.approx(0.585)
+    assert found["mu_s_uncertainty"] == pytest.approx(0.0585)
+    assert abs(0.600 - found["mu_s"]) <= found["mu_s_uncertainty"]
