@@ -34,6 +34,7 @@ kernels, 27 Nov 2026).
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import tempfile
 import time
@@ -121,7 +122,9 @@ def score(summary: dict, rate: str, stands, wob_N: float) -> dict:
     log = summary["off_bottom_friction_log"]
     out = {"log": [(len(e["segment_ids"]), e["mu_k"]) for e in log],
            "log_status": [mu_status(e["mu_k"], rate) for e in log],
+           "log_u": [e["mu_k_uncertainty"] for e in log],
            "well": mu_status(summary["mu_k"], rate), "well_mu_k": summary["mu_k"],
+           "well_u": summary["mu_k_uncertainty"],
            "t_bit": [], "reasons": set()}
     for g in summary["segments"]:
         if g["kind"] != "on_bottom_rotating" or g["status"] != "ok":
@@ -195,6 +198,7 @@ def main() -> None:
                         help="bit laws WOB[t]:μ_bit, or WOB[t]:μ_bit:r:ω_b[RPM] for a "
                         "rate-weakening bit")
     parser.add_argument("--rates", default=",".join(RATES))
+    parser.add_argument("--json", type=Path, help="also write the records to FILE")
     args = parser.parse_args()
     print(f"truth μ_s {MU_S}, μ_k {MU_K}; {STANDS} stands from {FIRST_M:g} m, {RPM:g} RPM, "
           f"{ON_BOTTOM_S:g} s on bottom per stand\n")
@@ -211,6 +215,13 @@ def main() -> None:
             for law in laws:
                 rows += run_case(rotation, law, args.rates.split(","), Path(tmp))
     summarise(rows)
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1, default=_plain))
+
+
+def _plain(value):
+    """JSON for what the records hold beside plain values (sets of reasons, numpy floats)."""
+    return sorted(value) if isinstance(value, set) else float(value)
 
 
 def summarise(rows: list[dict]) -> None:

@@ -272,7 +272,8 @@ def score(result, case: Case, rate: str, truth: dict, plant_cols: dict) -> dict:
     s = result.summary
     segs = [g for g in s["segments"] if g["status"] == "ok"]
     out = {"case": case.name, "rate": rate, "segments": len(s["segments"]), "ok": len(segs),
-           "mu_k": s["mu_k"], "mu_k_eff": truth["mu_k_eff"],
+           "mu_k": s["mu_k"], "mu_k_u": s["mu_k_uncertainty"], "mu_s": s["mu_s"],
+           "mu_s_u": s["mu_s_uncertainty"], "mu_k_eff": truth["mu_k_eff"],
            "mu_s_eff": truth["mu_s_eff"], "td_ratio": truth["ratio"]}
     out["mu_k_err"] = None if s["mu_k"] is None else s["mu_k"] / truth["mu_k_eff"] - 1.0
     out["seg_mu_k"] = [g["mu_k"] for g in segs]

@@ -175,7 +175,9 @@ def score(result, plant: str, rate: str, zone_truth: dict) -> dict:
     segs = [g for g in s["segments"] if g["status"] == "ok"]
     rotation = sum(g["duration_s"] for g in segs)
     out = {"plant": plant, "rate": rate, "segments": len(s["segments"]), "ok": len(segs),
-           "rotation_s": rotation, "mu_k": s["mu_k"], "mu_k_truth": zone_truth["mu_k"],
+           "rotation_s": rotation, "mu_k": s["mu_k"], "mu_k_u": s["mu_k_uncertainty"],
+           "mu_s": s["mu_s"], "mu_s_u": s["mu_s_uncertainty"], "mu_s_truth": zone_truth["mu_s"],
+           "mu_k_truth": zone_truth["mu_k"],
            "zone": s.get("friction_zone")}
     out["mu_k_err"] = None if s["mu_k"] is None else s["mu_k"] / zone_truth["mu_k"] - 1.0
     out["mu_k_ok"] = out["mu_k_err"] is not None and abs(out["mu_k_err"]) <= MU_K_TOL[rate]
