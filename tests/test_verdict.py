@@ -1,4 +1,5 @@
-"""What a segment may claim: :func:`drillfric.estimation.verdict.decide`, rule by rule.
+"""What a segment may claim: :func:`drillfric.estimation.verdict.decide` and
+:func:`~drillfric.estimation.verdict.decide_trace`, rule by rule.
 
 A pure function, so every branch is a row of a table: the evidence changed from a plain
 converged stick-slip segment, what the verdict must then say, and why (the rules are in
@@ -11,12 +12,16 @@ from dataclasses import replace
 
 import pytest
 
+from drillfric.estimation.bit_trace import KinematicCheck, WindowVerdict
+from drillfric.estimation.sampling import Resolution
 from drillfric.estimation.verdict import (
     DISAGREEMENT,
     MIN_CONVERGED_ROTATION_S,
     TYPICAL_MU,
     Evidence,
+    TraceEvidence,
     decide,
+    decide_trace,
 )
 from drillfric.result import Flag
 from drillfric.vocabulary import Method
@@ -128,3 +133,76 @@ def test_soft_drive_5hz_segment_off_5pc_states_its_uncertainty_and_is_not_claime
     assert any("0.237 ± 0.017 (2σ)" in m for m in loose.messages)
     tight = decide(replace(base, batch_mu_k_sigma=0.004))
     assert tight.converged and Flag.MU_K_UNCERTAIN not in tight.flags
+
+
+# ------------------------------------------------------------------ the bit trace's rules
+#: Off bottom, logged at a rate that resolves the cycle, the trace keeping to its top drive
+#: in every one of 10 windows, converged factors, nothing severe or undetermined.
+RESOLVED = Resolution(True, 40.0)
+PASSED = KinematicCheck(True, 5.0, 20.0, 0.0, 30.0, 0.1, 20.0)
+#: Failed, but by a mean lag under a third of the trace's swing: phase approximate.
+DRIFTING = KinematicCheck(False, 60.0, 20.0, 0.0, 30.0, 3.0, 40.0)
+FAILED = KinematicCheck(False, 400.0, 20.0, 0.0, 30.0, 30.0, 40.0)
+PLAIN_TRACE = TraceEvidence(logging=RESOLVED, on_bottom=False, check=PASSED,
+                            windows=WindowVerdict(10), converged=True)
+SOME = WindowVerdict(10, ((0.0, 30.0), (30.0, 60.0)), "creep")
+MOST = WindowVerdict(10, tuple((30.0 * k, 30.0 * k + 30.0) for k in range(6)), "creep")
+
+TRACE_CASES = [
+    ("plain", {}, dict(shown=True, windows=(), statistics=True, converged=True, flags=()),
+     "a resolved trace that keeps to its top drive is shown with its statistics"),
+    ("not_resolved", dict(logging=Resolution(False, 2.0, "1 Hz")),
+     dict(shown=False, statistics=False, flags=()),
+     "a log that cannot resolve the cycle shows neither trace nor statistics"),
+    ("on_bottom", dict(on_bottom=True), dict(shown=False, statistics=False, flags=()),
+     "on bottom the model has no bit–rock torque: trace and statistics withheld"),
+    ("check_failed", dict(check=FAILED), dict(shown=False, statistics=True, flags=()),
+     "a trace running away from its top drive is withheld; statistics stand apart"),
+    ("check_approximate", dict(check=DRIFTING),
+     dict(shown=True, flags=(Flag.BIT_SPEED_DRIFT,)),
+     "a lag under a third of the swing: shown with its phase approximate"),
+    ("some_windows", dict(windows=SOME), dict(shown=True, windows=SOME.withheld, flags=()),
+     "a few windows withheld: the trace is shown with those rows null"),
+    ("most_windows", dict(windows=MOST), dict(shown=False, windows=(), flags=()),
+     "more than half the windows withheld: the whole trace is"),
+    ("runaway", dict(runaway_note="runs away"),
+     dict(converged=False, flags=(Flag.FACTORS_RUN_AWAY,)),
+     "regression (lumped plant, 10 Hz: μ_k 0.125 for 0.157 shown converged): the seeded "
+     "trace runs away, so the factors do not describe the record"),
+    ("runaway_unconverged", dict(runaway_note="runs away", converged=False),
+     dict(converged=False, flags=()), "an unconverged segment is not flagged again"),
+    ("severe", dict(severe_note="severe"),
+     dict(statistics=False, flags=(Flag.STICK_SLIP_BEYOND_VALIDATED,)),
+     "severe stick-slip: statistics withheld as beyond the validated range"),
+    ("undetermined", dict(undetermined_note="members disagree"),
+     dict(statistics=False, flags=(Flag.STICK_SLIP_UNDETERMINED,)),
+     "members that disagree: statistics withheld as undetermined"),
+    ("severe_before_undetermined", dict(severe_note="severe", undetermined_note="why"),
+     dict(statistics=False, flags=(Flag.STICK_SLIP_BEYOND_VALIDATED,)),
+     "one reason is enough: severe is said, not both"),
+    ("undetermined_unlogged", dict(undetermined_note="why", logging=Resolution(False, 2.0)),
+     dict(statistics=False, flags=()),
+     "statistics a log cannot resolve are not flagged as undetermined"),
+]
+
+
+@pytest.mark.parametrize("change, expected, why", [c[1:] for c in TRACE_CASES],
+                         ids=[c[0] for c in TRACE_CASES])
+def test_decide_trace(change, expected, why):
+    v = decide_trace(replace(PLAIN_TRACE, **change))
+    got = dict(shown=v.bit_speed.resolved, windows=v.windows_withheld,
+               statistics=v.statistics, converged=v.converged, flags=v.flags)
+    assert {k: got[k] for k in expected} == expected, why
+
+
+def test_every_trace_flag_and_withheld_window_is_explained():
+    """Each trace rule that flags or withholds adds its line, in the order of its flag."""
+    v = decide_trace(replace(PLAIN_TRACE, check=DRIFTING, windows=SOME,
+                             runaway_note="runs away", undetermined_note="members disagree"))
+    assert v.flags == (Flag.FACTORS_RUN_AWAY, Flag.BIT_SPEED_DRIFT,
+                       Flag.STICK_SLIP_UNDETERMINED)
+    assert v.messages[0] == "runs away" and "phase approximate" in v.messages[1]
+    assert v.messages[2] == "members disagree"
+    assert "withheld over 2 of 10 30-s windows" in v.messages[3]
+    withheld = decide_trace(replace(PLAIN_TRACE, windows=MOST))
+    assert "6 of its 10 30-s windows fail: creep" in withheld.bit_speed.reason

@@ -48,7 +48,7 @@ from drillfric.estimation.observer import (
 )
 from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_interval, resolution
 from drillfric.estimation.torque_scale import check_torque_scale
-from drillfric.estimation.verdict import Evidence, Verdict, decide
+from drillfric.estimation.verdict import Evidence, TraceEvidence, Verdict, decide, decide_trace
 from drillfric.friction import FrictionProfile
 from drillfric.result import Flag
 from drillfric.units import RPM_TO_RAD_S
@@ -599,17 +599,10 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, cfg.observer.speed_noise_rpm
                                                * RPM_TO_RAD_S)
-    logging = bit_speed_resolution(models)
-    claim = bit_trace.bit_speed_claim(logging, kinematics, models.on_bottom)
     windows = _windows(cfg, models, refined, final.time_s, bit.rad_s)
-    if claim.resolved and windows.too_many:
-        claim = replace(claim, resolved=False, reason=(
-            f"bit speed withheld: {len(windows.withheld)} of its {windows.windows} 30-s "
-            f"windows fail: {windows.reason}"))
-    drift = claim.resolved and kinematics.approximate
     settled = final.time_s[settled_mask(final.time_s)]
-    runaway = estimate.converged and bit_trace.runs_away(
-        kinematics, float(settled[-1] - settled[0]) if settled.size > 1 else 0.0)
+    runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
+                                  if settled.size > 1 else 0.0)
     late = settled_mask(final.time_s)
     cut = any(np.any(late & (final.time_s >= a) & (final.time_s < b))
               for a, b in windows.withheld)
@@ -617,31 +610,21 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                     "of their windows (window by window, docs/bit_speed.md)") if cut else \
         bit_trace.members_disagree(final.bit_rad_s_est[late], estimate.stick_slip_severity,
                                    cfg.omega_c_rad_s)
-    severe = bit_trace.statistics_note(estimate.stick_slip_severity)
-    statistics = logging.resolved and not models.on_bottom
+    trace = decide_trace(TraceEvidence(
+        logging=bit_speed_resolution(models), on_bottom=models.on_bottom, check=kinematics,
+        windows=windows, converged=estimate.converged,
+        runaway_note=_runaway_note(estimate, kinematics) if runaway else None,
+        severe_note=bit_trace.statistics_note(estimate.stick_slip_severity),
+        undetermined_note=undetermined))
     fitted = fitted_result()
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(cfg, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
-    if runaway:
-        estimate = replace(estimate, converged=False,
-                           flags=estimate.flags + (Flag.FACTORS_RUN_AWAY,),
-                           messages=estimate.messages + (_runaway_note(estimate, kinematics),))
-    return replace(estimate, evidence=fitted, torque_terms=terms,
-                   bit_speed=claim, kinematics=kinematics,
-                   bit_windows_withheld=windows.withheld if claim.resolved else (),
-                   bit_statistics=statistics and not severe and not undetermined,
-                   flags=estimate.flags + ((Flag.BIT_SPEED_DRIFT,) if drift else ())
-                   + ((Flag.STICK_SLIP_BEYOND_VALIDATED,) if statistics and severe else ())
-                   + ((Flag.STICK_SLIP_UNDETERMINED,) if statistics and undetermined
-                      and not severe else ()),
-                   messages=estimate.messages + ((bit_trace.drift_note(kinematics),)
-                                                 if drift else ())
-                   + ((severe,) if statistics and severe else ())
-                   + ((undetermined,) if statistics and undetermined and not severe else ())
-                   + ((_windows_note(windows),) if claim.resolved and windows.withheld
-                      else ()),
-                   logged=models.logged)
+    return replace(estimate, evidence=fitted, torque_terms=terms, converged=trace.converged,
+                   bit_speed=trace.bit_speed, kinematics=kinematics,
+                   bit_windows_withheld=trace.windows_withheld,
+                   bit_statistics=trace.statistics, flags=estimate.flags + trace.flags,
+                   messages=estimate.messages + trace.messages, logged=models.logged)
 
 
 def beside(work, *args):
@@ -702,14 +685,6 @@ def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
                                   meas.motor_torque_Nm,
                                   bit_trace.compliance_rad_Nm(models.string), travel,
                                   cfg.observer.speed_noise_rpm * RPM_TO_RAD_S, unknown)
-
-
-def _windows_note(windows: bit_trace.WindowVerdict) -> str:
-    """The message of a trace shown with some windows withheld."""
-    spans = ", ".join(f"{a:.0f}–{b:.0f} s" for a, b in windows.withheld[:6])
-    more = f" and {len(windows.withheld) - 6} more" if len(windows.withheld) > 6 else ""
-    return (f"bit speed withheld over {len(windows.withheld)} of {windows.windows} 30-s "
-            f"windows ({spans}{more}; null rows in estimates.parquet): {windows.reason}")
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,

@@ -1,19 +1,33 @@
 """What a segment's estimates may claim: the rules an engineer is most likely to change.
 
-A pure function of the estimators' results (:class:`Evidence`) to the numbers reported and
-the words beside them (:class:`Verdict`): which μ_k is reported and by which method, whether
-it counts as converged, whether a μ_s lower bound may be shown, and the flags and messages.
-No model runs here — every rule can be tested on its own (tests/test_verdict.py), and
-docs/batch_refinement.md explains each.
+Two pure functions, each a table of rules (issue 31 item 4):
+
+- :func:`decide`, from the estimators' results (:class:`Evidence`) to the numbers reported
+  and the words beside them (:class:`Verdict`): which μ_k is reported and by which method,
+  whether it counts as converged, whether a μ_s lower bound may be shown, and the flags and
+  messages (docs/batch_refinement.md);
+- :func:`decide_trace`, from what the checks of the seeded bit trace found
+  (:class:`TraceEvidence`) to what of the bit speed and its stick-slip statistics may be
+  shown (:class:`TraceVerdict`), and whether the trace's runaway undoes the convergence
+  (docs/bit_speed.md).
+
+No model runs here — every rule can be tested on its own (tests/test_verdict.py).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from drillfric.estimation.batch.settings import MU_K_CLAIM
+from drillfric.estimation.bit_trace import (
+    KinematicCheck,
+    WindowVerdict,
+    bit_speed_claim,
+    drift_note,
+)
+from drillfric.estimation.sampling import Resolution
 from drillfric.result import Flag
 from drillfric.vocabulary import Method
 
@@ -199,3 +213,124 @@ def _long_enough(ev: Evidence, flags: list, messages: list) -> bool:
     messages.append(f"only {ev.turning_s:.0f} s of rotation (< "
                     f"{MIN_CONVERGED_ROTATION_S:.0f} s): not converged")
     return False
+
+
+@dataclass(frozen=True)
+class TraceEvidence:
+    """What the checks of a segment's seeded bit trace found (docs/bit_speed.md).
+
+    Attributes
+    ----------
+    logging : Resolution
+        Whether the logging resolves the stick-slip cycle.
+    on_bottom : bool
+    check : KinematicCheck
+        The whole trace's kinematic check.
+    windows : WindowVerdict
+        The window-by-window check.
+    converged : bool
+        The segment's friction factors converged (:func:`decide`).
+    runaway_note : str or None
+        Why the seeded trace runs away from the top drive (None: it does not).
+    severe_note : str or None
+        Why the stick-slip is beyond the validated range of its statistics (None: within).
+    undetermined_note : str or None
+        Why the statistics are undetermined: members that disagree, a grazing bit, or
+        windows the trace withholds (None: determined).
+    """
+
+    logging: Resolution
+    on_bottom: bool
+    check: KinematicCheck
+    windows: WindowVerdict
+    converged: bool
+    runaway_note: str | None = None
+    severe_note: str | None = None
+    undetermined_note: str | None = None
+
+
+@dataclass(frozen=True)
+class TraceVerdict:
+    """What of the bit speed a segment shows.
+
+    Attributes
+    ----------
+    bit_speed : Resolution
+        ``resolved`` (the trace is shown) or the reason it is withheld.
+    windows_withheld : tuple of (float, float)
+        [t_from_s, t_to_s) of the 30-s windows withheld in a shown trace [s].
+    statistics : bool
+        Whether the stuck fraction and the stick-slip severity are shown.
+    converged : bool
+        The segment's convergence after the trace's verdict.
+    flags : tuple of Flag
+        Flags to add to the segment's.
+    messages : tuple of str
+        Messages to add, in the order of the flags.
+    """
+
+    bit_speed: Resolution
+    windows_withheld: tuple
+    statistics: bool
+    converged: bool
+    flags: tuple
+    messages: tuple
+
+
+def decide_trace(ev: TraceEvidence) -> TraceVerdict:
+    """Apply the bit-speed and stick-slip rules to one segment's :class:`TraceEvidence`.
+
+    1. The trace is shown where the logging resolves the cycle, off bottom, and the
+       kinematic check passes (:func:`~drillfric.estimation.bit_trace.bit_speed_claim`),
+       and not when more than half its 30-s windows are withheld;
+    2. a shown trace whose check passed only approximately is flagged ``bit_speed_drift``;
+    3. a converged segment whose seeded trace runs away is not converged
+       (``factors_run_away``);
+    4. the stuck fraction and severity are shown only where the logging resolves the
+       cycle off bottom, withheld as ``stick_slip_beyond_validated`` in severe stick-slip,
+       else as ``stick_slip_undetermined`` where undetermined;
+    5. a shown trace with withheld windows says which.
+
+    Examples
+    --------
+    >>> from drillfric.estimation.bit_trace import KinematicCheck, WindowVerdict
+    >>> check = KinematicCheck(True, 1.0, 5.0, 0.0, 30.0, 0.0)
+    >>> v = decide_trace(TraceEvidence(Resolution(True, 40.0), False, check,
+    ...                                WindowVerdict(10), True))
+    >>> (v.bit_speed.resolved, v.statistics, v.converged, v.flags)
+    (True, True, True, ())
+    """
+    claim = bit_speed_claim(ev.logging, ev.check, ev.on_bottom)
+    if claim.resolved and ev.windows.too_many:
+        claim = replace(claim, resolved=False, reason=(
+            f"bit speed withheld: {len(ev.windows.withheld)} of its {ev.windows.windows} "
+            f"30-s windows fail: {ev.windows.reason}"))
+    flags, messages = [], []
+    runaway = ev.converged and ev.runaway_note is not None
+    if runaway:
+        flags.append(Flag.FACTORS_RUN_AWAY)
+        messages.append(ev.runaway_note)
+    if claim.resolved and ev.check.approximate:
+        flags.append(Flag.BIT_SPEED_DRIFT)
+        messages.append(drift_note(ev.check))
+    logged = ev.logging.resolved and not ev.on_bottom
+    if logged and ev.severe_note:
+        flags.append(Flag.STICK_SLIP_BEYOND_VALIDATED)
+        messages.append(ev.severe_note)
+    elif logged and ev.undetermined_note:
+        flags.append(Flag.STICK_SLIP_UNDETERMINED)
+        messages.append(ev.undetermined_note)
+    if claim.resolved and ev.windows.withheld:
+        messages.append(windows_note(ev.windows))
+    return TraceVerdict(
+        bit_speed=claim, windows_withheld=ev.windows.withheld if claim.resolved else (),
+        statistics=logged and not ev.severe_note and not ev.undetermined_note,
+        converged=ev.converged and not runaway, flags=tuple(flags), messages=tuple(messages))
+
+
+def windows_note(windows: WindowVerdict) -> str:
+    """The message of a trace shown with some windows withheld."""
+    spans = ", ".join(f"{a:.0f}–{b:.0f} s" for a, b in windows.withheld[:6])
+    more = f" and {len(windows.withheld) - 6} more" if len(windows.withheld) > 6 else ""
+    return (f"bit speed withheld over {len(windows.withheld)} of {windows.windows} 30-s "
+            f"windows ({spans}{more}; null rows in estimates.parquet): {windows.reason}")
