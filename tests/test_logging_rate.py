@@ -1,6 +1,7 @@
 """Rate-aware honesty (issue 14.4; drillfric.estimation.sampling, docs/bit_speed.md "Logging
 rate"): a bit-speed trace only where the log resolves the stick-slip cycle, from the
-spacing, the averaging interval or held values — whatever the configuration says.
+spacing, the averaging interval, held values or a moving average written at the full rate
+— whatever the configuration says.
 
 The end-to-end cases use the demo's first stand (creep start-up and severe stick-slip at
 2210 m, 20 Hz, examples/demo) as an EDR would have written it. The shortest stick-slip
@@ -68,6 +69,30 @@ def test_resolution_says_why_and_what_the_swing_shows():
     assert sampling.resolution(sampling.LoggingInterval(0.05, "samples"), 3.3).resolved
 
 
+@pytest.mark.parametrize("rate_hz", [20.0, 100.0])
+@pytest.mark.parametrize("width_s", [0.5, 2.0, 5.0])
+def test_a_moving_average_at_the_full_rate_gives_its_width(rate_hz, width_s):
+    """A w-sample moving average puts a null at every multiple of 1/(wΔt) in the spectrum
+    of the differences: found to the sample, on a random walk with white noise (a signal
+    whose raw spectrum has no nulls of its own)."""
+    rng = np.random.default_rng(int(rate_hz + 10 * width_s))
+    t = np.arange(0.0, 600.0, 1.0 / rate_hz)
+    raw = np.cumsum(rng.normal(size=t.size)) + 3.0 * rng.normal(size=t.size)
+    w = int(round(width_s * rate_hz))
+    smoothed = np.convolve(raw, np.ones(w) / w, mode="valid")
+    assert sampling.moving_average_s(t, raw) is None
+    assert sampling.moving_average_s(t[:smoothed.size], smoothed) == pytest.approx(width_s)
+    logged = sampling.logging_interval(t[:smoothed.size], smoothed, raw[:smoothed.size])
+    assert logged.kind == "moving averages" and logged.interval_s == pytest.approx(width_s)
+
+
+def test_the_demo_as_logged_is_not_taken_for_moving_averages(first_stand):
+    """The demo's stand (20 Hz spot values with sensor noise, stick-slip): no moving
+    average found in either channel."""
+    assert sampling.moving_average_s(first_stand["time_s"], first_stand["surface_rpm"],
+                                     first_stand["surface_torque_Nm"]) is None
+
+
 # --- end to end ------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -121,3 +146,21 @@ def test_held_values_are_seen_without_configuration(first_stand, tmp_path):
     assert seg["bit_speed_resolved"] is False and "held values" in seg["bit_speed_reason"]
     assert "creep_rate_too_low" in seg["quality_flags"]
     assert not seg["mu_s_identifiable"]
+
+
+def test_a_5_s_moving_average_at_20_hz_is_not_a_20_hz_log(first_stand, tmp_path):
+    """Regression (issue 30, sixth attack): speed and torque smoothed by a 5-s moving
+    average and written at the demo's 20 Hz reported the bit trace as resolved, with a
+    stuck fraction of 0.23 for 0.55–0.68 and a severity of 1.35 for 2.5–4.6. The log holds
+    one value per 5 s: no bit speed, no statistics, and the reason names the smoothing."""
+    smooth = dict(first_stand)
+    for name in ("surface_rpm", "surface_torque_Nm"):
+        smooth[name] = pd.Series(first_stand[name]).rolling(100, min_periods=1).mean().to_numpy()
+    seg, estimates = _run(tmp_path / "w", smooth, tmp_path)
+    assert seg["sample_interval_s"] == pytest.approx(5.0)
+    assert seg["bit_speed_resolved"] is False
+    assert "5-s moving averages" in seg["bit_speed_reason"]
+    assert "smoothing off" in seg["bit_speed_reason"]
+    assert seg["stuck_fraction"] is None and seg["stick_slip_severity"] is None
+    rows = estimates[estimates["segment_id"] == seg["id"]]
+    assert rows["bit_rpm_est"].isna().all()

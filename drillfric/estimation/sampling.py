@@ -10,7 +10,10 @@ of (docs/bit_speed.md "Logging rate"):
   spacing is its averaging interval;
 - the update interval of held values: a log resampled from a slower one (forward-filled)
   repeats each value until the next update, so the speed and torque change only every k
-  samples (:func:`held_interval_s`).
+  samples (:func:`held_interval_s`);
+- the width of a moving average written at the full rate: an acquisition system that
+  smooths a channel over w samples and logs every sample looks like a fast log but holds
+  no more than one value per w samples (:func:`moving_average_s`).
 
 The shortest stick-slip cycle is the string's first torsional period, a quarter wave from
 the top drive to the free bit: 4 × the wave travel time (docs/theory.md §3). Below
@@ -32,6 +35,21 @@ MIN_SAMPLES_PER_CYCLE = 6.0
 #: Held values: share of the changes that must come at one regular step for the log to be
 #: taken as resampled from a slower one, and the least number of changes looked at.
 HELD_SHARE, HELD_MIN_CHANGES = 0.8, 10
+#: Moving averages: the spectrum of the sample-to-sample differences of a w-sample moving
+#: average is |2 sin(π f w Δt)|²/w² times the raw signal's, with a null at every multiple of
+#: 1/(w Δt). A log is taken as smoothed when the mean log-power at those frequencies lies
+#: this far below the mean log-power half-way between them (e³ ≈ 20×; raw logs of the demo,
+#: the 24 h benchmark well and the real field logs score −0.2 … −1.5, moving averages of
+#: 1–5 s at 20 Hz −5 … −9: docs/bit_speed.md "Smoothed logs").
+SMOOTHED_DEPTH = 3.0
+#: ...with at least this many nulls below the Nyquist frequency (fewer cannot be told from
+#: the raw spectrum's own dips)...
+SMOOTHED_MIN_NULLS = 4
+#: ...and at least this many samples (the spectrum's resolution: nulls 4 bins apart at the
+#: widest width looked at, a quarter of an 8192-sample block: 20 s at 100 Hz).
+SMOOTHED_MIN_SAMPLES = 1024
+_WELCH_SAMPLES = 8192
+_BLOCKS = 32
 #: Relative torque swing within an interval, (max − min)/|mean|, above which the string is
 #: said to stick-slip: a sinusoidal swing of the batch fit's stick-slip threshold (std/mean
 #: 0.1, docs/theory.md §6.4) spans 2√2·0.1 ≈ 0.3.
@@ -47,7 +65,8 @@ class LoggingInterval:
     interval_s : float
         Effective sample interval [s].
     kind : str
-        What sets it: "samples" (the spacing), "means" (averaging) or "held values".
+        What sets it: "samples" (the spacing), "means" (averaging), "held values" or
+        "moving averages".
     torque_swing : float or None
         Median (max − min)/|mean| of the torque within each logged interval [-]; None
         without min/max channels.
@@ -109,6 +128,85 @@ def held_interval_s(time_s, *series) -> float | None:
     return float(np.mean(steps[regular])) * float(np.median(np.diff(t)))
 
 
+def moving_average_s(time_s, *series) -> float | None:
+    """Width of a moving average written at the full rate [s], or None (module docstring).
+
+    For each of ``series`` and each width w of 2 … :data:`_WELCH_SAMPLES`/4 samples with at
+    least :data:`SMOOTHED_MIN_NULLS` nulls below the Nyquist frequency, the score is the
+    mean of log P(k/(wΔt)) − log P((k + ½)/(wΔt)) over the median spectrum P of the
+    sample-to-sample differences (:func:`_median_spectrum`). A score at or below
+    −:data:`SMOOTHED_DEPTH` says the series is smoothed; of the widths that score within
+    70 % of the deepest, the widest is the moving average's (the nulls of w samples are
+    also those of its divisors). Returns
+    the widest over the series times the median sample spacing.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> t = np.arange(20000) * 0.05
+    >>> x = np.cumsum(rng.normal(size=t.size)) + rng.normal(size=t.size)
+    >>> moving_average_s(t, x) is None
+    True
+    >>> smoothed = np.convolve(x, np.ones(40) / 40, mode="valid")
+    >>> round(moving_average_s(t[:smoothed.size], smoothed), 6)
+    2.0
+    """
+    t = np.asarray(time_s, dtype=float)
+    if t.size < SMOOTHED_MIN_SAMPLES:
+        return None
+    dt = float(np.median(np.diff(t)))
+    widths = [w for w in (_smoothed_width(np.asarray(x, dtype=float)) for x in series)
+              if w is not None]
+    return max(widths) * dt if widths else None
+
+
+def _smoothed_width(x: np.ndarray) -> int | None:
+    """The moving average's width in samples (:func:`moving_average_s`), or None."""
+    d = np.diff(x[np.isfinite(x)])
+    if d.size < SMOOTHED_MIN_SAMPLES or not np.any(d):
+        return None
+    f, power = _median_spectrum(d)
+    log_p = np.log(power + 1e-300 + 1e-12 * power.max())
+    widths, nulls = _NULLS
+    resolved = widths <= (f.size - 1) // 2  # nulls ≥ 4 bins apart in this spectrum
+    widths, nulls = widths[resolved], nulls[resolved]
+    gap = np.interp(nulls / widths, f, log_p) - np.interp((nulls + 0.5) / widths, f, log_p)
+    candidates = np.unique(widths)
+    scores = np.bincount(widths, weights=gap)[candidates] / np.bincount(widths)[candidates]
+    deepest = float(scores.min())
+    if deepest > -SMOOTHED_DEPTH:
+        return None
+    return int(candidates[scores <= 0.7 * deepest].max())
+
+
+def _median_spectrum(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Frequencies [cycles per sample] and the median over at most :data:`_BLOCKS` Hann
+    periodograms of :data:`_WELCH_SAMPLES`-sample blocks spread evenly over ``d`` (a
+    median, so that a jump or a gap in a few blocks does not fill the nulls; a bounded
+    number of blocks, so that a long segment costs no more than a few)."""
+    from scipy.signal import periodogram
+
+    n = min(d.size, _WELCH_SAMPLES)
+    blocks = int(min(_BLOCKS, max(1, 2 * d.size // n - 1)))
+    starts = np.linspace(0, d.size - n, blocks).astype(int)
+    f, power = periodogram(d[starts[:, None] + np.arange(n)], window="hann",
+                           detrend="constant", axis=-1)
+    return f, np.median(power, axis=0)
+
+
+def _null_table() -> tuple[np.ndarray, np.ndarray]:
+    """Every (width w, null k) pair :func:`_smoothed_width` looks at: w from
+    2·:data:`SMOOTHED_MIN_NULLS` + 1 to a quarter of a Welch segment, k = 1 … (w − 1)/2."""
+    widths = np.arange(2 * SMOOTHED_MIN_NULLS + 1, _WELCH_SAMPLES // 4 + 1)
+    counts = (widths - 1) // 2
+    w = np.repeat(widths, counts)
+    k = np.arange(w.size) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    return w, k
+
+
+_NULLS = _null_table()
+
+
 def interval_torque_swing(mean_Nm, min_Nm, max_Nm) -> float | None:
     """Median relative torque swing within each logged interval, (max − min)/|mean| [-].
 
@@ -137,7 +235,10 @@ def logging_interval(time_s, surface_rpm, torque_Nm, *, averaging_s: float | Non
         if swing is not None:
             averaging_s = max(averaging_s or 0.0, spacing)
     held = held_interval_s(t, surface_rpm, torque_Nm) or 0.0
-    candidates = [(averaging_s or 0.0, "means"), (held, "held values"), (spacing, "samples")]
+    # held values are a moving average of their hold over their updates: said as held
+    smoothed = 0.0 if held else moving_average_s(t, surface_rpm, torque_Nm) or 0.0
+    candidates = [(averaging_s or 0.0, "means"), (held, "held values"),
+                  (smoothed, "moving averages"), (spacing, "samples")]
     interval, kind = max(candidates, key=lambda c: c[0])
     return LoggingInterval(interval, kind, swing)
 
@@ -147,10 +248,12 @@ def resolution(logged: LoggingInterval, period_s: float) -> Resolution:
     per_cycle = period_s / max(logged.interval_s, 1e-12)
     if per_cycle >= MIN_SAMPLES_PER_CYCLE:
         return Resolution(True, per_cycle)
+    fix = ("log the raw samples (the acquisition system's smoothing off) to see the bit"
+           if logged.kind == "moving averages" else
+           f"log at ≥ {MIN_SAMPLES_PER_CYCLE / period_s:.2g} Hz to see the bit")
     reason = (f"bit speed not resolved: {logged.interval_s:.3g}-s {logged.kind} give "
               f"{per_cycle:.2g} per stick-slip cycle (the shortest, {period_s:.2g} s, needs "
-              f"≥ {MIN_SAMPLES_PER_CYCLE:g}); log at ≥ {MIN_SAMPLES_PER_CYCLE / period_s:.2g} "
-              "Hz to see the bit")
+              f"≥ {MIN_SAMPLES_PER_CYCLE:g}); {fix}")
     if logged.torque_swing is not None:
         verdict = ("the string is probably stick-slipping" if logged.torque_swing
                    > STICK_SLIP_SWING else "no sign of stick-slip")
