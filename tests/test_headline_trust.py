@@ -40,6 +40,9 @@ def test_one_stand_headline_is_low_confidence_with_uncertainty_and_support(tmp_p
     assert summary["mu_k_support"] == {"segments": 1, "of": 1}
     # a 95 % half-width no narrower than the validated 5 % (issue 33 item 5)
     assert 0.05 * summary["mu_k"] <= summary["mu_k_uncertainty"] < 0.1 * summary["mu_k"]
+    # the segment's own μ_k ± is the same kind of interval, its statistical part beside it
+    note = summary["segments"][0]["message"]
+    assert "(95 %: " in note and "statistical 2σ ±" in note
     assert summary["mu_k_confidence"] == "low" and "low_support" in summary["quality_flags"]
     assert any("rests on 1 of 1 off-bottom segments" in w for w in summary["warnings"])
     assert f"± {summary['mu_k_uncertainty']:.3f}" in html

@@ -26,7 +26,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from drillfric.estimation.consensus import POOL_TORQUE_SHARE, mean_half_width, mu_k_tolerance
+from drillfric.estimation.batch.settings import mu_k_tolerance
+from drillfric.estimation.consensus import POOL_TORQUE_SHARE, mean_half_width
 from drillfric.result import SegmentRecord
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.vocabulary import Kind, Status

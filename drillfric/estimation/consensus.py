@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.stats import t as student_t
 
+from drillfric.estimation.batch.settings import mu_k_tolerance
 from drillfric.result import Flag, SegmentRecord
 from drillfric.vocabulary import Kind, Method, Status
 
@@ -38,27 +39,11 @@ POOL_DEPTH_M = 5.0
 _P95 = 0.975
 #: ...and together they hold at least this much rotation [s] (the converged minimum).
 POOL_MIN_ROTATION_S = 90.0
-#: Validated μ_k tolerance (docs/validation.md) by effective sample interval [s]: logged
-#: at ≤ 0.2 s within 5 %, coarser within 10 %; the 95 % half-width of a converged μ_k.
-MU_K_TOLERANCE = ((0.2, 0.05), (np.inf, 0.10))
-
 #: Validated tolerance of an identified μ_s (docs/validation.md: every claim within 10 % on
 #: both plant families), relative: the floor of a μ_s's 95 % half-width, since the spread
 #: of the fits behind one claim leaves out the model-form error (the demo's 0.585 ± 0.003
 #: for a true 0.600).
 MU_S_TOLERANCE = 0.10
-
-
-def mu_k_tolerance(sample_interval_s: float | None) -> float:
-    """Relative 95 % half-width of a converged μ_k logged at this interval [-].
-
-    Examples
-    --------
-    >>> mu_k_tolerance(0.01), mu_k_tolerance(1.0)
-    (0.05, 0.1)
-    """
-    interval = 0.0 if sample_interval_s is None else sample_interval_s
-    return next(tol for limit, tol in MU_K_TOLERANCE if interval <= limit)
 
 
 def mean_half_width(mu: np.ndarray) -> float:

@@ -40,6 +40,7 @@ from drillfric.estimation.batch.settings import (
     STICK_SLIP_FLUCTUATION,
     TORQUE_SMOOTH_S,
     BatchSettings,
+    mu_k_tolerance,
 )
 from drillfric.estimation.creep import find_creeps, rotating_runs
 from drillfric.estimation.drive import DriveModel
@@ -260,7 +261,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     flags += static.flags
     messages += static.messages
     if static.kinetic is not None and rotation.target_error is not None:
-        messages.append(_uncertainty_note(model, rotation, static.kinetic.mu_k, cells))
+        messages.append(_uncertainty_note(model, rotation, static.kinetic.mu_k, cells,
+                                          max(data.dt, sample_interval_s or 0.0)))
     return BatchResult(
         mu_k=None if static.kinetic is None else static.kinetic.mu_k,
         mu_k_method="mean_torque", mu_s=static.mu_s, mu_s_identifiable=static.mu_s is not None,
@@ -360,14 +362,21 @@ def _mu_k_sigma(model: Model, rotation: _Rotation, cells: int) -> float | None:
     return float(np.sqrt(2.0) * rotation.target_error[0] / model.t_n(cells))
 
 
-def _uncertainty_note(model: Model, rotation: _Rotation, mu_k: float, cells: int) -> str:
-    """The message stating μ_k's statistical uncertainty."""
+def _uncertainty_note(model: Model, rotation: _Rotation, mu_k: float, cells: int,
+                      sample_interval_s: float | None) -> str:
+    """The message stating μ_k's 95 % half-width — its statistical 2σ, never below the
+    validated tolerance of the logging (:func:`~drillfric.estimation.batch.settings.
+    mu_k_tolerance`: model-form error included) — and the statistical part."""
     two_sigma = 2.0 * _mu_k_sigma(model, rotation, cells)
+    tolerance = mu_k_tolerance(sample_interval_s)
+    half = max(two_sigma, tolerance * mu_k)
     err, n = rotation.target_error
-    return (f"μ_k = {mu_k:.3f} ± {two_sigma:.3f} (2σ, ±{100 * two_sigma / mu_k:.1f} %): the "
-            f"mean torque of {n} whole cycles (or {STEADY_BLOCK_S:g}-s blocks of steady "
-            f"rotation) is known to "
-            f"±{err:.0f} N·m (1σ), the model's as well")
+    why = ("its statistical 2σ" if two_sigma >= tolerance * mu_k else
+           f"the validated {100 * tolerance:.0f} % of this logging, model-form error included")
+    return (f"μ_k = {mu_k:.3f} ± {half:.3f} (95 %: {why}; statistical 2σ ± {two_sigma:.3f}, "
+            f"±{100 * two_sigma / mu_k:.1f} %: the mean torque of {n} whole cycles (or "
+            f"{STEADY_BLOCK_S:g}-s blocks of steady rotation) is known to ±{err:.0f} N·m (1σ), "
+            "the model's as well)")
 
 
 def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Static,

@@ -81,6 +81,23 @@ MU_K_REFIT_MOVE = 0.2  #: μ_k refitted when the creep μ_s moves the model's μ
 #: A μ_k is claimed converged within this share [-]: its statistical uncertainty (2σ, from
 #: the scatter of the record's whole torque cycles, data and model alike) must be within it.
 MU_K_CLAIM = 0.05
+#: Validated μ_k tolerance (docs/validation.md, both plant families) by effective sample
+#: interval [s]: logged at ≤ 0.2 s within 5 %, coarser within 10 %; the floor of a
+#: converged μ_k's 95 % half-width (model-form error included).
+VALIDATED_MU_K = ((0.2, 0.05), (float("inf"), 0.10))
+
+
+def mu_k_tolerance(sample_interval_s: float | None) -> float:
+    """Relative 95 % half-width of a converged μ_k logged at this interval [-]
+    (:data:`VALIDATED_MU_K`).
+
+    Examples
+    --------
+    >>> mu_k_tolerance(0.01), mu_k_tolerance(1.0)
+    (0.05, 0.1)
+    """
+    interval = 0.0 if sample_interval_s is None else sample_interval_s
+    return next(tol for limit, tol in VALIDATED_MU_K if interval <= limit)
 
 # --- sticking and the stick-slip-onset bound (docs/theory.md §6.2, §6.4) --------------------
 STUCK_FRACTION = 0.01  #: the model's bit sticks when this share of samples is near rest
