@@ -244,8 +244,12 @@ class SegmentRecord:
                                                     "μ_s (docs/bit_speed.md)")
     bit_speed_reason: str | None = _f("", "why the bit speed is not reported")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
-                                              "the spacing, the averaging interval and the "
-                                              "update interval of held values")
+                                              "the spacing, the averaging interval, the "
+                                              "update interval of held values and the width "
+                                              "of a moving average written at the full rate")
+    samples_dropped: int | None = _f("", "speed or torque samples dropped before estimation "
+                                         "as isolated spikes or drop-outs (EDR defects, "
+                                         "docs/ingestion.md)")
     interval_torque_swing: float | None = _f("-", "median (max − min)/|mean| of the torque "
                                                   "within each logged interval (min/max "
                                                   "channels; > 0.3: stick-slip)")

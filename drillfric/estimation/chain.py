@@ -32,7 +32,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import DrillfricError, ModelError
-from drillfric.estimation import batch, bit_torque, bit_trace
+from drillfric.estimation import batch, bit_torque, bit_trace, spikes
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -158,6 +158,8 @@ class SegmentEstimate:
     friction_zone : str
         Which factor μ is: "open_hole" (the cased part's factor given) or "effective"
         (torque-weighted over the whole string).
+    samples_dropped : int
+        Speed or torque samples dropped as isolated spikes or drop-outs.
     """
 
     mu_s: float | None
@@ -193,6 +195,7 @@ class SegmentEstimate:
     logged: LoggingInterval | None = None
     torque_terms: bit_torque.TorqueTerms | None = None
     friction_zone: str = "effective"
+    samples_dropped: int = 0
 
 
 def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
@@ -379,6 +382,8 @@ class SegmentModels:
         The configuration's friction zones and law (docs/theory.md §3.2).
     batch_settings : BatchSettings
         The configuration's settings of the speed-driven fit.
+    dropped : int
+        Samples dropped as isolated spikes or drop-outs (:mod:`drillfric.estimation.spikes`).
     """
 
     path: WellPath
@@ -390,6 +395,7 @@ class SegmentModels:
     logged: LoggingInterval
     profile: FrictionProfile
     batch_settings: batch.BatchSettings
+    dropped: int = 0
 
 
 def build_models(cfg, path: WellPath | None, data: SegmentData, *,
@@ -415,11 +421,14 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
                           f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
                           "torque", fix=fix)
     check_torque_scale(data, td.T_N_Nm, cfg.omega_c_rad_s, torque_channel=torque_channel)
+    string = build_string(cfg.sections, data.bit_depth_m)
+    bad = spikes.defects(data.time_s, 4.0 * bit_trace.travel_time_s(string), data.surface_rpm,
+                         data.surface_torque_Nm, cfg.rig.top_drive_inertia_kg_m2)
+    data = _without(data, bad)
     meas = Measurements.from_samples(
         data.time_s, data.surface_rpm * RPM_TO_RAD_S, data.surface_torque_Nm,
         torque_kind=cfg.rig.torque_kind,
         top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2, rate_hz=rate_hz)
-    string = build_string(cfg.sections, data.bit_depth_m)
     profile = FrictionProfile.from_config(cfg)
     observer = build_observer(cfg, string, td, cfg.model.cells, sample_dt_s=meas.dt_s,
                               profile=profile)
@@ -428,7 +437,17 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
                               torque_min_Nm=data.torque_min_Nm,
                               torque_max_Nm=data.torque_max_Nm)
     return SegmentModels(path, string, td, meas, observer, on_bottom, logged, profile,
-                         batch.BatchSettings.from_config(cfg))
+                         batch.BatchSettings.from_config(cfg), int(bad.sum()))
+
+
+def _without(data: SegmentData, drop: np.ndarray) -> SegmentData:
+    """``data`` without the samples where ``drop`` is true (every per-sample array)."""
+    if not drop.any():
+        return data
+    keep = ~drop
+    return replace(data, **{name: getattr(data, name)[keep] for name in (
+        "time_s", "surface_rpm", "surface_torque_Nm", "bit_rpm", "torque_min_Nm",
+        "torque_max_Nm") if getattr(data, name) is not None})
 
 
 def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
@@ -624,7 +643,18 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
                    bit_speed=trace.bit_speed, kinematics=kinematics,
                    bit_windows_withheld=trace.windows_withheld,
                    bit_statistics=trace.statistics, flags=estimate.flags + trace.flags,
-                   messages=estimate.messages + trace.messages, logged=models.logged)
+                   messages=estimate.messages + trace.messages + _dropped_note(models),
+                   logged=models.logged, samples_dropped=models.dropped)
+
+
+def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
+    """The message of a segment whose log had isolated spikes or drop-outs."""
+    if not models.dropped:
+        return ()
+    return (f"{models.dropped} speed or torque sample(s) dropped as isolated spikes or "
+            "drop-outs (a value that leaves its neighbours and is back within 3 samples "
+            "moves faster than the string can; bridged by interpolation, docs/ingestion.md "
+            "\"EDR defects\")",)
 
 
 def beside(work, *args):

@@ -66,7 +66,8 @@ def _bit_fields(est: SegmentEstimate) -> dict:
     stuck fraction and severity stay where only the kinematic check withheld it; they are
     null where the stick-slip is beyond their validated range, the reason in the message)."""
     logged = dict(sample_interval_s=est.logged.interval_s,
-                  interval_torque_swing=est.logged.torque_swing)
+                  interval_torque_swing=est.logged.torque_swing,
+                  samples_dropped=est.samples_dropped)
     kept = dict(stick_slip_severity=est.stick_slip_severity,
                 stuck_fraction=est.stuck_fraction) if est.bit_statistics else {}
     if not est.bit_speed.resolved:
