@@ -7,7 +7,7 @@ import json
 import click
 import numpy as np
 
-from drillfric.io.text import terminal_text
+from drillfric.io.text import plural, terminal_text
 from drillfric.vocabulary import Status
 
 from .common import unit_system, units_option
@@ -195,7 +195,7 @@ def _survey_line(sv: dict | None, units: str) -> str:
 
     if sv is None:
         return "survey     none — a vertical well is assumed (see below)"
-    return (f"survey     {sv['stations']} stations to "
+    return (f"survey     {plural(sv['stations'], 'station')} to "
             f"{format_value(sv['md_max_m'], 'length', units)} MD, max inclination "
             f"{sv['inc_max_deg']:.1f}°, TVD {format_value(sv['tvd_max_m'], 'length', units)}")
 
@@ -207,9 +207,9 @@ def render(s: dict, units: str = "si") -> str:
     lines += [""] + _channel_table(s, units) + [""]
     dropped = []
     if s["duplicates_dropped"]:
-        dropped.append(f"{s['duplicates_dropped']} repeated timestamps dropped")
+        dropped.append(f"{plural(s['duplicates_dropped'], 'repeated timestamp')} dropped")
     if s["untimed_dropped"]:
-        dropped.append(f"{s['untimed_dropped']} rows without a time dropped")
+        dropped.append(f"{plural(s['untimed_dropped'], 'row')} without a time dropped")
     lines.append(f"rows       {s['rows']}" + (f" ({'; '.join(dropped)})" if dropped else ""))
     span = s["t_end_s"] - s["t_start_s"]
     start = (f"from {s['origin']}" if s["origin"] else

@@ -16,7 +16,7 @@ import click
 import numpy as np
 
 from drillfric.files import require_file
-from drillfric.io.text import printable
+from drillfric.io.text import plural, printable
 
 from .common import Quantity, UserError, echo, unit_system, units_option, warn
 
@@ -264,8 +264,8 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
         cases.append(LoadCase.ROTATING_ON_BOTTOM)
     work = len(grid) * len(mus) * len(cases) * max(grid) / cfg.model.element_length_m
     if work > MAX_BROOMSTICK_WORK:
-        raise UserError(f"the broomstick of {len(grid)} depths × {len(mus)} friction factors "
-                        f"× {len(cases)} load cases at {cfg.model.element_length_m:g}-m elements "
+        raise UserError(f"the broomstick of {_grid_text(grid, mus, cases)} at "
+                        f"{cfg.model.element_length_m:g}-m elements "
                         f"is {work:.3g} element solves; the budget is {MAX_BROOMSTICK_WORK:.0e} "
                         "— fix: fewer --depths or --frictions, or a longer --element-length")
     path = no_survey_path(max(grid), cfg.tortuosity_rad_m) if path is None else path
@@ -296,12 +296,12 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
     from drillfric.units import format_value as show
 
     if measured is not None:
-        echo(f"measured: {len(measured)} rotating segment(s) of the log drawn on the plot"
+        echo(f"measured: {plural(len(measured), 'rotating segment')} of the log drawn on the "
+             "plot"
              + (f"; implied block weight {check['block_weight_N'] / 1e3:.0f} kN "
                 "(median measured − modelled rotating hook load)"
                 if check and check["checked"] else ""))
-    echo(f"broomstick: {len(grid)} depths × {len(mus)} friction factors × {len(cases)} "
-         f"load cases ({show(grid[0], 'length', units, '.0f')}–"
+    echo(f"broomstick: {_grid_text(grid, mus, cases)} ({show(grid[0], 'length', units, '.0f')}–"
          f"{show(grid[-1], 'length', units, '.0f')})")
     last = table[table["bit_depth_m"] == table["bit_depth_m"].max()]
     for row in last.itertuples():
@@ -312,3 +312,9 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
     for target in (out, plot):
         if target is not None:
             echo(f"written {target}")
+
+
+def _grid_text(grid, mus, cases) -> str:
+    """``"50 depths × 3 friction factors × 3 load cases"`` of a broomstick."""
+    return (f"{plural(len(grid), 'depth')} × {plural(len(mus), 'friction factor')} × "
+            f"{plural(len(cases), 'load case')}")

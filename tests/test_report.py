@@ -264,7 +264,7 @@ def test_failed_and_skipped_segments_are_reported(demo, tmp_path):
     assert "failed because &lt;b&gt;reasons&lt;/b&gt;" in html
     assert 'id="segment-1"' not in html and 'id="segment-2"' not in html
     assert 'id="segment-3"' in html
-    assert "1 segment(s) failed" in html
+    assert "1 segment failed" in html
 
 
 def test_result_without_segments_renders(tmp_path, demo):
@@ -273,7 +273,7 @@ def test_result_without_segments_renders(tmp_path, demo):
     for name in ("estimates.parquet", "profiles.parquet", "segments.parquet"):
         (result / name).unlink()
     html = write_well_report(result, pdf=True).read_text(encoding="utf-8")
-    assert "0 of 0 estimated segment(s) drawn" in html
+    assert "0 of 0 estimated segments drawn" in html
     assert (result / "report.pdf").stat().st_size > 0
 
 

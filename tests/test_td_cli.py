@@ -235,7 +235,7 @@ def test_broomstick_of_a_well_with_a_log_draws_measured_points(tmp_path):
     result = invoke(DEMO / "demo.csv", "--broomstick", "--depths", "1500:2300:100",
                     "--frictions", "0.2,0.3", "--plot", plot)
     assert result.exit_code == 0, result.output
-    assert "measured: 4 rotating segment(s)" in result.output
+    assert "measured: 4 rotating segments" in result.output
     assert "inconsistent" not in result.output
     assert plot.stat().st_size > 1000
 

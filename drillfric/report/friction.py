@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from drillfric.io.text import plural
 from drillfric.vocabulary import Status
 
 from .display import SI, Units, fmt
@@ -125,7 +126,7 @@ def _evidence(row: dict) -> str:
         seconds = row.get(f"{side}_s")
         if seconds is not None and np.isfinite(seconds):
             parts.append(f"{side.replace('_', '-')} {seconds:.0f} s "
-                         f"({int(row[f'{side}_rows'])} rows)")
+                         f"({plural(int(row[f'{side}_rows']), 'row')})")
     return ", ".join(parts)
 
 
