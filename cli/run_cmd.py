@@ -199,13 +199,15 @@ def _print(result, units: str | None = None) -> None:
     """Warnings, the result line (in ``--units``, else the well's ``[well] units``) and the
     report's path (only when it was written)."""
     from drillfric.estimation.headline import INDICATIVE_WARNING
+    from drillfric.units import display_text
 
+    system = unit_system(units, result.summary.get("config", {}))
     for note in result.summary["assumed"]:
-        warn(f"{result.well}: assumed {note} — the numbers are indicative")
+        warn(f"{result.well}: assumed {display_text(note, system)} — the numbers are "
+             "indicative")
     for note in result.warnings:
         if not note.startswith(INDICATIVE_WARNING):  # the assumed lines above say it
             warn(f"{result.well}: {note}")
-    system = unit_system(units, result.summary.get("config", {}))
     click.echo(terminal_text(_describe(result, system)))  # printed even with --quiet
     if result.report is not None:
         echo(f"report: {result.report}")

@@ -187,16 +187,23 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
                             "the nominal tortuosity survey.tortuosity_deg_30m)")
         bit_depth = path.md_max_m
     _check_depth(bit_depth, "the bit depth")
-    for note in cfg.assumed_with(path):
-        if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
-            warn(f"assumed {note}")
-    kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
     system = unit_system(units, cfg)
+    _warn_assumed(cfg, path, system)
+    kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
     if broomstick:
         _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw, system,
                     measured)
     else:
         _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, system)
+
+
+def _warn_assumed(cfg, path, system: str) -> None:
+    """A warning per assumption, its quantities in the display units of ``system``."""
+    from drillfric.units import display_text
+
+    for note in cfg.assumed_with(path):
+        if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
+            warn(f"assumed {display_text(note, system)}")
 
 
 def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, units) -> None:
