@@ -166,27 +166,18 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
     """Soft-string torque and drag (docs/theory.md §2) for WELL_OR_CONFIG.
 
     WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file or a
-    NAME.survey.csv beside it) or a well on disk (docs/ingestion.md). Without a survey the hole is
-    vertical with the nominal tortuosity survey.tortuosity_deg_30m, and --bit-depth is
-    required.
+    NAME.survey.csv beside it) or a well on disk (docs/ingestion.md). The bit depth is
+    --bit-depth, else the configuration's [well] bit_depth_m, else the survey's last
+    station. Without a survey the hole is vertical with the nominal tortuosity
+    survey.tortuosity_deg_30m, and --bit-depth (or [well] bit_depth_m) is required.
     """
     overrides = {"model.friction": friction, "model.element_length_m": element_length}
     measured = None
     if broomstick and well_or_config.suffix.lower() != ".toml":
         cfg, path, measured = _load_with_log(well_or_config, config, survey, overrides)
-        if bit_depth is None and path is None and len(measured):
-            bit_depth = float(measured["bit_depth_m"].max())
     else:
         cfg, path = _load(well_or_config, config, survey, overrides)
-    if bit_depth is None:
-        bit_depth = cfg.well.bit_depth_m
-    if bit_depth is None:
-        if path is None:
-            raise UserError("no survey: give --bit-depth or [well] bit_depth_m (the hole is "
-                            "taken as vertical, with "
-                            "the nominal tortuosity survey.tortuosity_deg_30m)")
-        bit_depth = path.md_max_m
-    _check_depth(bit_depth, "the bit depth")
+    bit_depth = _bit_depth(bit_depth, cfg, path, measured)
     system = unit_system(units, cfg)
     _warn_assumed(cfg, path, system)
     kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
@@ -195,6 +186,22 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
                     measured)
     else:
         _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, system)
+
+
+def _bit_depth(option: float | None, cfg, path, measured) -> float:
+    """The bit depth [m]: ``--bit-depth``, else ``[well] bit_depth_m``, else (a broomstick
+    of a log without survey) the log's deepest, else the survey's last station."""
+    depth = option if option is not None else cfg.well.bit_depth_m
+    if depth is None and path is None and measured is not None and len(measured):
+        depth = float(measured["bit_depth_m"].max())
+    if depth is None:
+        if path is None:
+            raise UserError("no survey: give --bit-depth or [well] bit_depth_m (the hole is "
+                            "taken as vertical, with "
+                            "the nominal tortuosity survey.tortuosity_deg_30m)")
+        depth = path.md_max_m
+    _check_depth(depth, "the bit depth")
+    return depth
 
 
 def _warn_assumed(cfg, path, system: str) -> None:
