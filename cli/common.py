@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import click
 
 from drillfric.errors import DrillfricError
-from drillfric.io.text import one_line, terminal_text
+from drillfric.io.text import one_line, plural, terminal_text
 
 
 @dataclass
@@ -243,7 +243,8 @@ def well_progress(name: str):
 
         def update(event) -> None:
             bar.update(task, completed=event.rows_done, total=event.rows_total,
-                       detail=f"{event.rows_done:,} rows, {event.segments_done} segments")
+                       detail=f"{plural(event.rows_done, 'row', spec=',')}, "
+                              f"{plural(event.segments_done, 'segment')}")
 
         yield update
 

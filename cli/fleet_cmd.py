@@ -15,6 +15,7 @@ from pathlib import Path
 
 import click
 
+from drillfric.io.text import plural
 from drillfric.vocabulary import WellStatus
 
 from .common import UserError, compile_kernels_once, echo, interrupted_exit_code, progress
@@ -29,15 +30,16 @@ def _closing_line(result) -> str:
     ok, skipped, failed = (result.count(s) for s in ("ok", "skipped", "failed"))
     total = len(result.wells)
     if skipped == total:
-        return (f"fleet: all {total} wells ok (unchanged since the last run; --force to "
+        return (f"fleet: all {plural(total, 'well')} ok (unchanged since the last run; --force to "
                 f"redo them) — {result.out_root}")
     parts = [f"{ok + skipped} ok ({ok} processed, {skipped} unchanged)", f"{failed} failed"]
     stale = sum(w.stale_dir is not None for w in result.wells)
     if stale:
-        parts.append(f"{stale} failed well(s) keep an earlier run's results, marked stale")
+        parts.append(f"{plural(stale, 'failed well')} {'keeps' if stale == 1 else 'keep'} an "
+                     "earlier run's results, marked stale")
     if result.failed_segments:
-        parts.append(f"{result.failed_segments} segments failed")
-    return (f"fleet: {total} wells — {', '.join(parts)} in {result.wall_s:.1f} s — "
+        parts.append(f"{plural(result.failed_segments, 'segment')} failed")
+    return (f"fleet: {plural(total, 'well')} — {', '.join(parts)} in {result.wall_s:.1f} s — "
             f"{result.manifest}")
 
 
@@ -71,7 +73,7 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
     if scheduler is None:  # local workers share this user's kernel cache
         compile_kernels_once()
     try:
-        with progress(f"fleet ({len(specs)} wells)", total=len(specs)) as advance:
+        with progress(f"fleet ({plural(len(specs), 'well')})", total=len(specs)) as advance:
             result = run_many(specs, out, workers=workers or _default_workers(),
                               scheduler=scheduler, force=force, progress=advance,
                               report=report)
@@ -87,8 +89,9 @@ def command(source: Path, out: Path, scheduler, workers, force, report, config) 
         click.secho(f"note: {note}", err=True)
     empty = result.nothing_estimated
     if empty:
-        click.secho(f"warning: nothing estimated in {len(empty)} of {len(result.wells)} "
-                    f"well(s) (every segment skipped: too short, no rotation …): "
+        click.secho(f"warning: nothing estimated in {len(empty)} of "
+                    f"{plural(len(result.wells), 'well')} (every segment skipped: too short, no "
+                    "rotation …): "
                     f"{_some(empty)} — see {result.out_root}/NAME/summary.json", err=True,
                     fg="yellow")
     echo(_closing_line(result))

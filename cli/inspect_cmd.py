@@ -7,12 +7,13 @@ import json
 import click
 import numpy as np
 
-from drillfric.io.text import terminal_text
+from drillfric.io.text import plural, terminal_text
 from drillfric.vocabulary import Status
 
 from .common import unit_system, units_option
 
-#: Channel quantities shown in the display units of ``--units`` (others as stored).
+#: Channel quantities shown in the display units of ``--units`` (kN, kN·m, bar … in SI;
+#: the others, e.g. time and rotary speed, as stored).
 _SHOWN = {"length": "length", "force": "force", "torque": "torque",
           "rotary speed": "rotary speed", "pressure": "pressure", "flow rate": "flow rate",
           "speed": "speed"}
@@ -165,20 +166,28 @@ def _segment(seg) -> dict:
 
 
 def _num(value: float | None) -> str:
-    return "—" if value is None else f"{value:.4g}"
+    """A table value: 4 significant digits, whole numbers without an exponent up to 1e9.
+
+    Examples
+    --------
+    >>> _num(24999.4), _num(254.93), _num(None), _num(3e12)
+    ('24999', '254.9', '—', '3e+12')
+    """
+    if value is None:
+        return "—"
+    return f"{value:.0f}" if 1e4 <= abs(value) < 1e9 else f"{value:.4g}"
 
 
 def _channel_table(s: dict, units: str) -> list[str]:
-    """The channel table: source column and unit, nulls, min/median/max in the SI unit of the
-    canonical column (``units = "si"``) or the display unit of ``--units field``."""
+    """The channel table: source column and unit, nulls, min/median/max in the display unit
+    of ``units`` (kN, not 2.549e+05 N), else the unit of the canonical column."""
     from drillfric.io.channels import BY_NAME
     from drillfric.units import display_factor, display_unit
 
-    head = ("channel", "column", "unit", "from", "SI unit" if units == "si" else "shown in",
-            "nulls", "min", "median", "max")
+    head = ("channel", "column", "unit", "from", "shown in", "nulls", "min", "median", "max")
     rows = [head]
     for name, c in s["channels"].items():
-        quantity = _SHOWN.get(BY_NAME[name].kind) if units != "si" else None
+        quantity = _SHOWN.get(BY_NAME[name].kind)
         shown, scale = ((display_unit(quantity, units), display_factor(quantity, units))
                         if quantity else (c["si_unit"], 1.0))
         rows.append((name, c["column"], c["unit"], c["unit_source"], shown,
@@ -195,7 +204,7 @@ def _survey_line(sv: dict | None, units: str) -> str:
 
     if sv is None:
         return "survey     none — a vertical well is assumed (see below)"
-    return (f"survey     {sv['stations']} stations to "
+    return (f"survey     {plural(sv['stations'], 'station')} to "
             f"{format_value(sv['md_max_m'], 'length', units)} MD, max inclination "
             f"{sv['inc_max_deg']:.1f}°, TVD {format_value(sv['tvd_max_m'], 'length', units)}")
 
@@ -207,9 +216,9 @@ def render(s: dict, units: str = "si") -> str:
     lines += [""] + _channel_table(s, units) + [""]
     dropped = []
     if s["duplicates_dropped"]:
-        dropped.append(f"{s['duplicates_dropped']} repeated timestamps dropped")
+        dropped.append(f"{plural(s['duplicates_dropped'], 'repeated timestamp')} dropped")
     if s["untimed_dropped"]:
-        dropped.append(f"{s['untimed_dropped']} rows without a time dropped")
+        dropped.append(f"{plural(s['untimed_dropped'], 'row')} without a time dropped")
     lines.append(f"rows       {s['rows']}" + (f" ({'; '.join(dropped)})" if dropped else ""))
     span = s["t_end_s"] - s["t_start_s"]
     start = (f"from {s['origin']}" if s["origin"] else
@@ -227,8 +236,7 @@ def render(s: dict, units: str = "si") -> str:
                                                                         else ""))
     lines.append(_survey_line(s["survey"], units))
     lines.append(_segments_line(s["segments"]))
-    lines += [f"assumed    {note}" for note in s["assumed"]]
-    return "\n".join(lines)
+    return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
 def _segments_line(segments: list[dict]) -> str:
@@ -263,5 +271,11 @@ def render_depth_log(s: dict, units: str = "si") -> str:
     lines.append(f"windows    {len(s['segments'])} of "
                  f"{format_value(s['window_m'], 'length', units, '.0f')}: {len(ok)} usable"
                  + (f" ({detail})" if ok else "") + f", {len(s['segments']) - len(ok)} skipped")
-    lines += [f"assumed    {note}" for note in s["assumed"]]
-    return "\n".join(lines)
+    return "\n".join(lines + _assumed_lines(s["assumed"], units))
+
+
+def _assumed_lines(notes: list[str], units: str) -> list[str]:
+    """What was assumed, its quantities in the display units of ``units``."""
+    from drillfric.units import display_text
+
+    return [f"assumed    {display_text(note, units)}" for note in notes]

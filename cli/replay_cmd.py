@@ -7,6 +7,8 @@ from pathlib import Path
 
 import click
 
+from drillfric.io.text import plural
+
 from .common import UserError, echo
 
 #: Fastest replay (times real time): a day of log in under a second; beyond, the pace is
@@ -53,7 +55,8 @@ def command(file: Path, target: str, speed: float, tick: float, seed: int,
                         "into")
     text, span_s = recorded_text(file)
     wall = replay(text, path, rate_bps=len(text) / span_s * speed, tick_s=tick, seed=seed)
-    echo(f"replayed {len(text)} bytes ({span_s:.0f} s of log) into {target} in {wall:.1f} s")
+    echo(f"replayed {plural(len(text), 'byte')} ({span_s:.0f} s of log) into {target} in "
+         f"{wall:.1f} s")
 
 
 def _wits0(file: Path, target: str, speed: float, drop_after: int | None) -> None:
@@ -72,7 +75,8 @@ def _wits0(file: Path, target: str, speed: float, drop_after: int | None) -> Non
     t0 = time.monotonic()
     served = serve(frames, canonical["time_s"].to_numpy(float), address.host, address.port,
                    speed=speed, drop_after=drop_after,
-                   ready=lambda: echo(f"serving {len(frames)} WITS0 frames ({clock}) on "
+                   ready=lambda: echo(f"serving {plural(len(frames), 'WITS0 frame')} ({clock}) on "
                                       f"{address}"))
-    echo(f"replayed {served.frames} frames of {file} over {served.connections} "
-         f"connection(s) to {address} in {time.monotonic() - t0:.1f} s")
+    echo(f"replayed {plural(served.frames, 'frame')} of {file} over "
+         f"{plural(served.connections, 'connection')} to {address} in "
+         f"{time.monotonic() - t0:.1f} s")

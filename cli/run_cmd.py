@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from drillfric.errors import DrillfricError
-from drillfric.io.text import terminal_text
+from drillfric.io.text import plural, terminal_text
 from drillfric.vocabulary import WellStatus
 
 from .common import (
@@ -73,7 +73,7 @@ def _describe(result, units: str = "si") -> str:
     mu_s = _fmt(s["mu_s"]) if s["mu_s"] is not None else (
         f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
         else "not identifiable")
-    return (f"{result.well}: {c['segments']} segment{'s' * (c['segments'] != 1)} "
+    return (f"{result.well}: {plural(c['segments'], 'segment')} "
             f"({c['estimated']} estimated, "
             f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed"
             f"{_depths(s['segments'], units)}); {_mu_k_text(s)}, μ_s = {mu_s}")
@@ -87,7 +87,7 @@ def _mu_k_text(summary: dict) -> str:
     u, support = summary.get("mu_k_uncertainty"), summary.get("mu_k_support") or {}
     text = f"μ_k = {_fmt(summary['mu_k'])}" + (f" ± {_fmt(u)}" if u is not None else "")
     if "of" in support:
-        text += f" ({support['segments']} of {support['of']} off-bottom segments"
+        text += f" ({support['segments']} of {plural(support['of'], 'off-bottom segment')}"
         text += ", low confidence)" if summary.get("mu_k_confidence") == "low" else ")"
     return text
 
@@ -99,7 +99,8 @@ def _describe_depth_log(result, units: str) -> str:
     s, c, log = result.summary, result.summary["counts"], result.summary["friction_log"]
     off = (f"μ off bottom = {_fmt(s['mu_k'])}" if s["mu_k"] is not None else
            f"μ off bottom: none ({log.get('mu_k_reason') or 'no off-bottom window'})")
-    return (f"{result.well}: friction log of a depth-indexed log, {c['segments']} windows of "
+    return (f"{result.well}: friction log of a depth-indexed log, "
+            f"{plural(c['segments'], 'window')} of "
             f"{format_value(log['window_m'], 'length', units, '.0f')} ({c['estimated']} "
             f"estimated, {c['skipped']} skipped, {c['failed']} failed"
             f"{_depths(s['segments'], units)}); {off}, apparent "
@@ -198,13 +199,15 @@ def _print(result, units: str | None = None) -> None:
     """Warnings, the result line (in ``--units``, else the well's ``[well] units``) and the
     report's path (only when it was written)."""
     from drillfric.estimation.headline import INDICATIVE_WARNING
+    from drillfric.units import display_text
 
+    system = unit_system(units, result.summary.get("config", {}))
     for note in result.summary["assumed"]:
-        warn(f"{result.well}: assumed {note} — the numbers are indicative")
+        warn(f"{result.well}: assumed {display_text(note, system)} — the numbers are "
+             "indicative")
     for note in result.warnings:
         if not note.startswith(INDICATIVE_WARNING):  # the assumed lines above say it
             warn(f"{result.well}: {note}")
-    system = unit_system(units, result.summary.get("config", {}))
     click.echo(terminal_text(_describe(result, system)))  # printed even with --quiet
     if result.report is not None:
         echo(f"report: {result.report}")
@@ -223,7 +226,7 @@ def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, work
     from .common import progress
 
     specs = [WellSpec(Path(w), config=config, survey=survey) for w in wells]
-    with progress(f"run ({len(specs)} wells)", total=len(specs)) as advance:
+    with progress(f"run ({plural(len(specs), 'well')})", total=len(specs)) as advance:
         result = run_many(specs, out, workers=workers, force=True, progress=advance,
                           overrides=overrides, rate_hz=rate, pdf=pdf, report=report,
                           fleet_files=False)

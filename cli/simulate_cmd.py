@@ -12,6 +12,8 @@ from pathlib import Path
 
 import click
 
+from drillfric.io.text import plural
+
 from .common import Quantity, echo, progress, warn
 
 
@@ -122,8 +124,8 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     written = write_well(out, pd.DataFrame(result.columns), config=sim.written_config(cfg),
                          survey=well_path, truth=result.truth(), keep=keep)
     rows = len(result.columns["time_s"])
-    echo(f"wrote {out}: {rows} rows, {plan.total_s:.0f} s at {result.rate_hz:g} Hz, "
-         f"{len(plan.stands)} stand(s), μ_s = {result.settings.mu_s:g}, "
+    echo(f"wrote {out}: {plural(rows, 'row')}, {plan.total_s:.0f} s at {result.rate_hz:g} Hz, "
+         f"{plural(len(plan.stands), 'stand')}, μ_s = {result.settings.mu_s:g}, "
          f"μ_k = {result.settings.mu_k:g}")
     for s in result.stands:
         echo(f"  stand {s.index}: bit {s.bit_depth_m:g} m, {s.start} to {s.rpm:g} RPM, "

@@ -16,7 +16,7 @@ import click
 import numpy as np
 
 from drillfric.files import require_file
-from drillfric.io.text import printable
+from drillfric.io.text import plural, printable
 
 from .common import Quantity, UserError, echo, unit_system, units_option, warn
 
@@ -166,37 +166,51 @@ def command(well_or_config, bit_depth, friction, load_case, wob, bit_torque, rpm
     """Soft-string torque and drag (docs/theory.md §2) for WELL_OR_CONFIG.
 
     WELL_OR_CONFIG is a well configuration (.toml, with its [survey] file or a
-    NAME.survey.csv beside it) or a well on disk (docs/ingestion.md). Without a survey the hole is
-    vertical with the nominal tortuosity survey.tortuosity_deg_30m, and --bit-depth is
-    required.
+    NAME.survey.csv beside it) or a well on disk (docs/ingestion.md). The bit depth is
+    --bit-depth, else the configuration's [well] bit_depth_m, else the survey's last
+    station. Without a survey the hole is vertical with the nominal tortuosity
+    survey.tortuosity_deg_30m, and --bit-depth (or [well] bit_depth_m) is required.
     """
     overrides = {"model.friction": friction, "model.element_length_m": element_length}
     measured = None
     if broomstick and well_or_config.suffix.lower() != ".toml":
         cfg, path, measured = _load_with_log(well_or_config, config, survey, overrides)
-        if bit_depth is None and path is None and len(measured):
-            bit_depth = float(measured["bit_depth_m"].max())
     else:
         cfg, path = _load(well_or_config, config, survey, overrides)
-    if bit_depth is None:
-        bit_depth = cfg.well.bit_depth_m
-    if bit_depth is None:
-        if path is None:
-            raise UserError("no survey: give --bit-depth or [well] bit_depth_m (the hole is "
-                            "taken as vertical, with "
-                            "the nominal tortuosity survey.tortuosity_deg_30m)")
-        bit_depth = path.md_max_m
-    _check_depth(bit_depth, "the bit depth")
-    for note in cfg.assumed_with(path):
-        if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
-            warn(f"assumed {note}")
-    kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
+    bit_depth = _bit_depth(bit_depth, cfg, path, measured)
     system = unit_system(units, cfg)
+    _warn_assumed(cfg, path, system)
+    kw = {"wob_N": wob, "bit_torque_Nm": bit_torque, "rpm": rpm, "axial_speed_m_s": axial_speed}
     if broomstick:
         _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw, system,
                     measured)
     else:
         _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, system)
+
+
+def _bit_depth(option: float | None, cfg, path, measured) -> float:
+    """The bit depth [m]: ``--bit-depth``, else ``[well] bit_depth_m``, else (a broomstick
+    of a log without survey) the log's deepest, else the survey's last station."""
+    depth = option if option is not None else cfg.well.bit_depth_m
+    if depth is None and path is None and measured is not None and len(measured):
+        depth = float(measured["bit_depth_m"].max())
+    if depth is None:
+        if path is None:
+            raise UserError("no survey: give --bit-depth or [well] bit_depth_m (the hole is "
+                            "taken as vertical, with "
+                            "the nominal tortuosity survey.tortuosity_deg_30m)")
+        depth = path.md_max_m
+    _check_depth(depth, "the bit depth")
+    return depth
+
+
+def _warn_assumed(cfg, path, system: str) -> None:
+    """A warning per assumption, its quantities in the display units of ``system``."""
+    from drillfric.units import display_text
+
+    for note in cfg.assumed_with(path):
+        if not note.startswith("top-drive"):  # the rig is irrelevant to torque and drag
+            warn(f"assumed {display_text(note, system)}")
 
 
 def _profile(cfg, path, bit_depth, friction, load_case, out, as_json, kw, units) -> None:
@@ -264,8 +278,8 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
         cases.append(LoadCase.ROTATING_ON_BOTTOM)
     work = len(grid) * len(mus) * len(cases) * max(grid) / cfg.model.element_length_m
     if work > MAX_BROOMSTICK_WORK:
-        raise UserError(f"the broomstick of {len(grid)} depths × {len(mus)} friction factors "
-                        f"× {len(cases)} load cases at {cfg.model.element_length_m:g}-m elements "
+        raise UserError(f"the broomstick of {_grid_text(grid, mus, cases)} at "
+                        f"{cfg.model.element_length_m:g}-m elements "
                         f"is {work:.3g} element solves; the budget is {MAX_BROOMSTICK_WORK:.0e} "
                         "— fix: fewer --depths or --frictions, or a longer --element-length")
     path = no_survey_path(max(grid), cfg.tortuosity_rad_m) if path is None else path
@@ -296,12 +310,12 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
     from drillfric.units import format_value as show
 
     if measured is not None:
-        echo(f"measured: {len(measured)} rotating segment(s) of the log drawn on the plot"
+        echo(f"measured: {plural(len(measured), 'rotating segment')} of the log drawn on the "
+             "plot"
              + (f"; implied block weight {check['block_weight_N'] / 1e3:.0f} kN "
                 "(median measured − modelled rotating hook load)"
                 if check and check["checked"] else ""))
-    echo(f"broomstick: {len(grid)} depths × {len(mus)} friction factors × {len(cases)} "
-         f"load cases ({show(grid[0], 'length', units, '.0f')}–"
+    echo(f"broomstick: {_grid_text(grid, mus, cases)} ({show(grid[0], 'length', units, '.0f')}–"
          f"{show(grid[-1], 'length', units, '.0f')})")
     last = table[table["bit_depth_m"] == table["bit_depth_m"].max()]
     for row in last.itertuples():
@@ -312,3 +326,9 @@ def _broomstick(cfg, path, bit_depth, frictions, depths, out, plot, as_json, kw,
     for target in (out, plot):
         if target is not None:
             echo(f"written {target}")
+
+
+def _grid_text(grid, mus, cases) -> str:
+    """``"50 depths × 3 friction factors × 3 load cases"`` of a broomstick."""
+    return (f"{plural(len(grid), 'depth')} × {plural(len(mus), 'friction factor')} × "
+            f"{plural(len(cases), 'load case')}")

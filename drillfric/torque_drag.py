@@ -96,10 +96,13 @@ class TDResult:
         return float(self.md_m[-1])
 
     def __repr__(self) -> str:
+        """One line, in kN and kN·m: ``<TDResult pick_up at 2300.0 m, friction 0.25: hook
+        load 997.8 kN, surface torque 0.00 kN·m, T_N 68.76 kN·m, 1151 nodes>``."""
         friction = "varies" if self.friction is None else f"{self.friction:g}"
         return (f"<TDResult {self.load_case} at {self.bit_depth_m:.1f} m, friction {friction}: "
-                f"hook load {self.hookload_N:.4g} N, surface torque "
-                f"{self.surface_torque_Nm:.4g} N·m, {self.md_m.size} nodes>")
+                f"hook load {self.hookload_N / 1e3:.1f} kN, surface torque "
+                f"{self.surface_torque_Nm / 1e3:.2f} kN·m, T_N {self.T_N_Nm / 1e3:.2f} kN·m, "
+                f"{self.md_m.size} nodes>")
 
     def fc_at(self, md_m) -> np.ndarray:
         """F_c [N·m/m] of the element containing each measured depth (bit → last element)."""

@@ -164,7 +164,9 @@ DISPLAY_UNITS = {
            "side force": ("N/m", "newton/meter"), "density": ("kg/m³", "kilogram/meter**3"),
            "linear mass": ("kg/m", "kilogram/meter"), "pressure": ("bar", "bar"),
            "rotary speed": ("RPM", "revolution/minute"), "flow rate": ("L/min", "liter/minute"),
-           "speed": ("m/h", "meter/hour"), "time": ("s", "second")},
+           "speed": ("m/h", "meter/hour"), "time": ("s", "second"),
+           "moment of inertia": ("kg·m²", "kilogram*meter**2"),
+           "dogleg severity": ("°/30 m", "degree/(30*meter)")},
     "field": {"length": ("ft", "foot"), "diameter": ("in", "inch"),
               "force": ("klbf", "kilopound_force"),
               "torque": ("kft·lbf", "kilofoot*force_pound"),
@@ -172,14 +174,16 @@ DISPLAY_UNITS = {
               "density": ("ppg", "pound_per_gallon"), "linear mass": ("lb/ft", "pound/foot"),
               "pressure": ("psi", "psi"), "rotary speed": ("RPM", "revolution/minute"),
               "flow rate": ("gpm", "gallon/minute"), "speed": ("ft/h", "foot/hour"),
-              "time": ("s", "second")},
+              "time": ("s", "second"), "moment of inertia": ("lb·ft²", "pound*foot**2"),
+              "dogleg severity": ("°/100 ft", "degree/(100*foot)")},
 }
 #: The SI unit each displayed quantity is stored in (the value handed to :func:`to_display`).
 _STORED = {"length": "meter", "diameter": "meter", "force": "newton", "torque": "newton*meter",
            "side force": "newton/meter", "density": "kilogram/meter**3",
            "linear mass": "kilogram/meter", "pressure": "pascal",
            "rotary speed": "revolution/minute", "flow rate": "meter**3/second",
-           "speed": "meter/second", "time": "second"}
+           "speed": "meter/second", "time": "second",
+           "moment of inertia": "kilogram*meter**2", "dogleg severity": "degree/(30*meter)"}
 #: Unit systems of :data:`DISPLAY_UNITS` (``--units``, ``[well] units``).
 UNIT_SYSTEMS = tuple(DISPLAY_UNITS)
 
@@ -509,7 +513,8 @@ def display_unit(quantity: str, system: str | None = "si") -> str:
     quantity : str
         A key of :data:`DISPLAY_UNITS` tables: ``length``, ``diameter``, ``force``,
         ``torque``, ``side force``, ``density``, ``linear mass``, ``pressure``,
-        ``rotary speed``, ``flow rate``, ``speed``, ``time``.
+        ``rotary speed``, ``flow rate``, ``speed``, ``time``, ``moment of inertia``,
+        ``dogleg severity``.
     system : str
         ``"si"`` (default) or ``"field"``.
 
@@ -530,9 +535,10 @@ def display_factor(quantity: str, system: str | None = "si") -> float:
     >>> round(display_factor("length", "field"), 6)
     3.28084
     """
-    reg = registry()
-    return float(reg.Quantity(1.0, _STORED[quantity]).to(_system(system)[quantity][1])
-                 .magnitude)
+    reg = registry()  # expressions, not units: "degree/(30*meter)" has a scale
+    ratio = reg.parse_expression(_STORED[quantity]) / reg.parse_expression(
+        _system(system)[quantity][1])
+    return float(ratio.to("dimensionless").magnitude)
 
 
 def to_display(values, quantity: str, system: str | None = "si"):
@@ -558,3 +564,36 @@ def format_value(value, quantity: str, system: str | None = "si", spec: str = ".
     if value is None or not np.isfinite(value):
         return "—"
     return f"{format(to_display(value, quantity, system), spec)} {display_unit(quantity, system)}"
+
+
+#: Quantities drillfric's own notes (what was assumed) write in SI, by their spelling after
+#: the number ("1200 kg/m³", "1.0°/30 m"), for :func:`display_text`.
+_NOTE_UNITS = {"°/30 m": "dogleg severity", " kg/m³": "density",
+               " kg·m²": "moment of inertia", " m": "length"}
+_NOTE_QUANTITY = re.compile(r"(\d+(?:\.\d+)?)(" + "|".join(_NOTE_UNITS)
+                            + r")(?![\w/·³²])")
+
+
+def display_text(text: str, system: str | None = "si") -> str:
+    """A note of drillfric's own (what was assumed) with its SI quantities — lengths
+    ``m``, densities ``kg/m³``, inertias ``kg·m²``, doglegs ``°/30 m`` — in the display
+    units of ``system``; unchanged in ``"si"``, whose display units these are.
+
+    Examples
+    --------
+    >>> display_text("mud density 1200 kg/m³, 110 m of HWDP, 1.0°/30 m", "field")
+    'mud density 10.0 ppg, 361 ft of HWDP, 1.02°/100 ft'
+    >>> display_text("top-drive inertia 2900 kg·m²", "si")
+    'top-drive inertia 2900 kg·m²'
+    """
+    def shown(match: re.Match) -> str:
+        spelled = match.group(2)
+        quantity = _NOTE_UNITS[spelled]
+        label = display_unit(quantity, system)
+        if label == spelled.strip():
+            return match.group(0)
+        value = float(match.group(1)) * display_factor(quantity, system)
+        number = f"{value:.0f}" if abs(value) >= 100 else f"{value:#.3g}"
+        return f"{number}{spelled[:len(spelled) - len(spelled.lstrip())]}{label}"
+
+    return _NOTE_QUANTITY.sub(shown, text)

@@ -16,6 +16,15 @@ REPO = Path(__file__).resolve().parents[1]
 #: Real field data, read in place; tests using it skip when the folder is absent.
 REAL_DATA = REPO.parent / "shared" / "data" / "real"
 DEMO = REPO / "examples" / "demo"
+
+
+def documented_result_files() -> set[str]:
+    """The files of ``OUT/NAME`` docs/outputs.md's table names (``state/`` as ``state``)."""
+    text = (REPO / "docs" / "outputs.md").read_text(encoding="utf-8")
+    table = text.split("## `drillfric run WELL")[1].split("###")[0]
+    return {name.rstrip("/") for line in table.splitlines() if line.startswith("| `")
+            for name in [line.split("`")[1]]}
+
 #: Three stands (100 s of rotation each, so they converge) with 40-s connections.
 SCENARIO = """connection_s = 40.0
 [defaults]

@@ -187,6 +187,11 @@ def test_notebook_reprs_are_one_line_not_the_arrays():
     for name, text in shown.items():
         assert text.startswith(f"<{name} ") and "\n" not in text and len(text) < 300, text
     assert "2300.0 m" in shown["TDResult"] and "'demo'" in shown["Well"]
+    # the key facts, in engineering units: sizes, depths, rate, loads
+    assert "7 channels" in shown["Well"] and "59 stations to 2430 m" in shown["Well"]
+    assert " kN," in shown["TDResult"] and " kN·m" in shown["TDResult"]
+    assert "e+0" not in shown["TDResult"] and "1151 nodes" in shown["TDResult"]
+    assert "4 stands at bit 2210–2300 m, 20801 rows at 20 Hz, 1040 s" in shown["Simulation"]
 
 
 def test_dir_lists_the_public_api():

@@ -10,6 +10,7 @@ numbers.
 from __future__ import annotations
 
 import json
+import shutil
 from fractions import Fraction
 
 import pandas as pd
@@ -159,3 +160,15 @@ def test_inspect_shows_channels_in_field_units():
     assert result.exit_code == 0, result.output
     line = next(ln for ln in result.output.splitlines() if ln.startswith("bit_depth_m"))
     assert " ft " in line and "7251" in line  # 2210 m = 7250.7 ft
+
+
+def test_inspect_states_what_was_assumed_in_field_units(tmp_path):
+    """Issue 35: the assumed string, mud and tortuosity in ft, ppg and °/100 ft as well."""
+    shutil.copy(DEMO / "demo.csv", tmp_path / "w.csv")  # no config, no survey: defaults
+    result = CliRunner().invoke(cli, ["inspect", str(tmp_path / "w.csv"), "--units", "field"])
+    assert result.exit_code == 0, result.output
+    assumed = [ln for ln in result.output.splitlines() if ln.startswith("assumed")]
+    assert any("361 ft 5in HWDP + 394 ft 8in collars" in ln for ln in assumed), assumed
+    assert any("mud density 10.0 ppg" in ln for ln in assumed), assumed
+    assert any("1.02°/100 ft" in ln for ln in assumed), assumed
+    assert not any(unit in ln for ln in assumed for unit in (" m ", "kg/m³", "°/30 m"))

@@ -259,7 +259,7 @@ def test_failed_well_marks_last_nights_results_stale_and_unchanged_wells_are_ok(
     night = fleet(source, "--out", out, "--workers", "1")
     assert night.exit_code == 1
     assert "2 ok (0 processed, 2 unchanged), 1 failed" in night.output
-    assert "1 failed well(s) keep an earlier run's results, marked stale" in night.output
+    assert "1 failed well keeps an earlier run's results, marked stale" in night.output
     stale = json.loads((out / "w2" / "STALE.json").read_text())
     assert "time goes backwards" in stale["reason"] and stale["since_utc"]
     summary = json.loads((out / "w2" / "summary.json").read_text())

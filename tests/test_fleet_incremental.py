@@ -61,7 +61,7 @@ def test_appended_rows_continue_from_the_state(stands, tmp_path):  # noqa: F811
     written = pd.read_parquet(out / "three" / "segments.parquet")
     _same_results(type(result)(result.well, _summary(out), written), whole)
     rows = pd.read_parquet(out / "fleet_summary.parquet")
-    assert "new segment(s)" in rows["well_changes"].iloc[0]
+    assert "new segment" in rows["well_changes"].iloc[0]
     assert rows["well_new_segments"].iloc[0] >= 1
     assert run_many([WellSpec(data)], out, workers=1).wells[0].changes[0].startswith(
         "no new data since")

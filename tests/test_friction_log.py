@@ -31,7 +31,7 @@ from drillfric.result import Flag
 from drillfric.runner.depth_log import run_depth_log
 from drillfric.torque_drag import solve
 from drillfric.vocabulary import Kind, Method, Status
-from tests.conftest import REPO
+from tests.conftest import REPO, documented_result_files
 
 MU = 0.27  # the synthetic log's friction factor
 WOB_N = 80e3  # on-bottom windows' weight on bit
@@ -220,6 +220,7 @@ def test_run_writes_the_result_files_of_a_time_log(depth_log, tmp_path):
     profiles = pd.read_parquet(folder / "profiles.parquet")
     assert set(profiles["segment_id"]) == set(range(1, WINDOWS + 1))
     assert (folder / "wellpath.parquet").is_file() and (folder / "report.html").is_file()
+    assert {p.name for p in folder.iterdir()} <= documented_result_files()  # issue 35
 
 
 def _with_columns(depth_log, folder, drop=(), **columns):

@@ -229,7 +229,7 @@ def test_a_fleet_in_which_nothing_was_estimated_says_so_and_exits_1(tmp_path):
     result = CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out",
                                       str(root / "out"), "--workers", "1"])
     assert result.exit_code == 1, result.output
-    assert "nothing estimated in 2 of 2 well(s)" in result.output and "a, b" in result.output
+    assert "nothing estimated in 2 of 2 wells" in result.output and "a, b" in result.output
 
 
 def test_a_manual_run_into_a_fleets_out_is_redone_next_night_not_unchanged(tmp_path):
@@ -242,7 +242,7 @@ def test_a_manual_run_into_a_fleets_out_is_redone_next_night_not_unchanged(tmp_p
     first = CliRunner().invoke(cli, fleet)
     assert "1 processed" in first.output, first.output
     again = CliRunner().invoke(cli, fleet)
-    assert "all 1 wells ok (unchanged" in again.output, again.output
+    assert "all 1 well ok (unchanged" in again.output, again.output
     other = _config(root / "other.toml", "[well]\nbit_depth_m = 1800.0\n")
     manual = CliRunner().invoke(cli, ["run", str(path), "--config", str(other), "--out",
                                       str(out)])
@@ -891,7 +891,7 @@ def test_out_equal_to_a_directory_wells_data_folder_runs_every_night(tmp_path, c
                                          "--workers", "1", "--no-report"])
         assert "data folder holds files" not in night.output, night.output
         assert "error" not in night.output.lower() and ("0 failed" in night.output or
-                                                       "all 1 wells ok" in night.output), \
+                                                       "all 1 well ok" in night.output), \
             night.output
 
 

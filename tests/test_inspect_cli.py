@@ -37,6 +37,18 @@ def test_table(good):
         assert text in out
 
 
+def test_table_in_engineering_units(tmp_path):
+    """Issue 35: forces in kN, torques in kN·m, pressures in bar — not 2.549e+05 N."""
+    (tmp_path / "w.csv").write_text("TIME,SRPM,STOR [kN.m],HKLD [klbf],SPP [psi]\n"
+                                    "0,60,10,100,3000\n0.2,61,11,101,3100\n")
+    out = _inspect(tmp_path / "w.csv").output
+    shown = {ln.split()[0]: ln.split()[-6:] for ln in out.splitlines() if ln.strip()}
+    assert shown["hookload_N"] == ["kN", "0", "(0.0%)", "444.8", "447", "449.3"]
+    assert shown["surface_torque_Nm"] == ["kN·m", "0", "(0.0%)", "10", "10.5", "11"]
+    assert shown["standpipe_pressure_Pa"] == ["bar", "0", "(0.0%)", "206.8", "210.3", "213.7"]
+    assert "e+0" not in out
+
+
 def test_json_keys(good):
     result = _inspect(good, "--json")
     doc = json.loads(result.output)
@@ -94,8 +106,9 @@ def test_dsats_acceptance(real_data):
     result = _inspect(path, "--config", EXAMPLES / "dsats_1hz.toml")
     assert result.exit_code == 0, result.output
     lines = {ln.split()[0]: ln for ln in result.output.splitlines() if ln.strip()}
-    assert "ft.lbf" in lines["surface_torque_Nm"] and "N.m" in lines["surface_torque_Nm"]
+    assert "ft.lbf" in lines["surface_torque_Nm"] and "kN·m" in lines["surface_torque_Nm"]
     assert "klbf" in lines["hookload_N"] and "1458 (2.9%)" in lines["hookload_N"]
+    assert "254.9" in lines["hookload_N"] and "23.27" in lines["standpipe_pressure_Pa"]
     assert "1 Hz nominal" in lines["rate"] and "0.31–1.69 s" in lines["rate"]
     doc = json.loads(_inspect(path, "--config", EXAMPLES / "dsats_1hz.toml", "--json").output)
     assert doc["channels"]["surface_torque_Nm"]["null_count"] == 1458

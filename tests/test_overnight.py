@@ -15,8 +15,8 @@ def test_new_segments_and_severe_stick_slip_in_them_only():
     out = changes(_summary(0.25, [1.5, 0.2, 0.4, 1.3]), history, ran=True,
                   data_changed_utc=None)
     assert out["new_segments"] == 2
-    assert out["notes"] == ["2 new segment(s)",
-                            "severe stick-slip (the bit stops) in segment(s) 4"]
+    assert out["notes"] == ["2 new segments",
+                            "severe stick-slip (the bit stops) in 1 segment: 4"]
 
 
 def test_mu_k_moved_beyond_its_own_spread_needs_three_nights():
@@ -40,4 +40,4 @@ def test_severe_stick_slip_with_statistics_withheld_is_still_noted():
     summary = _summary(0.25, [0.2, None])
     summary["segments"][1]["quality_flags"] = ["stick_slip_beyond_validated"]
     out = changes(summary, [], ran=True, data_changed_utc=None)
-    assert "severe stick-slip (the bit stops) in segment(s) 2" in out["notes"]
+    assert "severe stick-slip (the bit stops) in 1 segment: 2" in out["notes"]

@@ -20,7 +20,7 @@ from drillfric.cli.main import cli
 from drillfric.estimation.diagnostics import stick_slip_severity
 from drillfric.io.well import open_well
 from drillfric.result import ESTIMATE_NAMES, SEGMENT_KEYS
-from tests.conftest import REPO
+from tests.conftest import REPO, documented_result_files
 
 #: Several seconds a test, or a costly shared fixture: not in the fast lane
 #: (`pytest -m "not slow"`, docs/performance.md "The test suite").
@@ -58,6 +58,7 @@ def test_outputs_follow_the_interface(demo_run):
     assert len(pd.read_parquet(out / "segments.parquet")) == len(summary["segments"])
     assert str(out / "report.html") in printed  # the run ends with the report's path
     assert not list(out.parent.glob(".*tmp*")), "temporary directory left behind"
+    assert names <= documented_result_files()  # tracks.parquet was missing (issue 35)
 
 
 def test_every_stand_found_and_estimated(demo_run, truth):

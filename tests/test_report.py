@@ -264,7 +264,7 @@ def test_failed_and_skipped_segments_are_reported(demo, tmp_path):
     assert "failed because &lt;b&gt;reasons&lt;/b&gt;" in html
     assert 'id="segment-1"' not in html and 'id="segment-2"' not in html
     assert 'id="segment-3"' in html
-    assert "1 segment(s) failed" in html
+    assert "1 segment failed" in html
 
 
 def test_result_without_segments_renders(tmp_path, demo):
@@ -273,7 +273,7 @@ def test_result_without_segments_renders(tmp_path, demo):
     for name in ("estimates.parquet", "profiles.parquet", "segments.parquet"):
         (result / name).unlink()
     html = write_well_report(result, pdf=True).read_text(encoding="utf-8")
-    assert "0 of 0 estimated segment(s) drawn" in html
+    assert "0 of 0 estimated segments drawn" in html
     assert (result / "report.pdf").stat().st_size > 0
 
 
@@ -429,6 +429,23 @@ def test_fleet_report_rows_links_and_failures_first(demo, tmp_path):
     wells_plotted = {s["attributes"]["label"]["value"] for s in _legend_items(
         bokeh_items(html)["bk-fleet"])}
     assert wells_plotted == {"alpha", "bravo", "charlie"}
+
+
+def test_fleet_friction_axis_starts_at_zero(tmp_path):
+    """Issue 35: three wells with the same μ_k (0.2768–0.2798 over their stands) were drawn on
+    an auto-scaled axis of that span, a zigzag; the μ_k axis starts at 0 as a well's does."""
+    segments = [{"id": i + 1, "kind": "off_bottom_rotating", "status": "ok",
+                 "bit_depth_m": 2000.0 + 30 * i, "mu_k": mu, "converged": True}
+                for i, mu in enumerate((0.2768, 0.2798, 0.2771, 0.2795))]
+    wells = [{"well": name, "status": "ok", "message": "", "result_dir": Path(name),
+              "summary": {"well": name, "mu_k": 0.278, "segments": segments}}
+             for name in ("a", "b", "c")]
+    html = write_fleet_report(tmp_path, wells).read_text(encoding="utf-8")
+    ranges = list(bokeh_nodes(bokeh_items(html)["bk-fleet"], "DataRange1d"))
+    depth = [r for r in ranges if r.get("attributes", {}).get("flipped")]
+    mu = [r for r in ranges if "start" in r.get("attributes", {}) and r not in depth]
+    assert len(depth) == 1 and len(mu) == 1, ranges
+    assert mu[0]["attributes"]["start"] == 0.0
 
 
 def test_fleet_link_is_relative_and_encoded(tmp_path, monkeypatch):

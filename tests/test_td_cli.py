@@ -227,6 +227,20 @@ def test_no_survey_is_vertical_with_the_nominal_tortuosity(tmp_path):
 DEMO = Path(__file__).resolve().parents[1] / "examples" / "demo"
 
 
+def test_config_bit_depth_wins_over_the_logs_deepest_without_a_survey(tmp_path):
+    """Issue 35: [well] bit_depth_m is td's bit depth for a log without survey too — the
+    profile, and the broomstick, whose default was the log's deepest stand (2300 m)."""
+    data = tmp_path / "w.csv"
+    data.write_bytes((DEMO / "demo.csv").read_bytes())
+    (tmp_path / "w.toml").write_text("[well]\nbit_depth_m = 2100.0\n")
+    profile = invoke(data, "--json")
+    assert profile.exit_code == 0, profile.output
+    assert json.loads(profile.stdout)["bit_depth_m"] == 2100.0
+    broom = invoke(data, "--broomstick", "--frictions", "0.2", "--json")
+    assert broom.exit_code == 0, broom.output
+    assert max(row["bit_depth_m"] for row in json.loads(broom.stdout)) == 2100.0
+
+
 def test_broomstick_of_a_well_with_a_log_draws_measured_points(tmp_path):
     """`td --broomstick demo.csv`: the log is segmented, its 4 rotating stands are drawn
     on the plot, and the consistent demo string passes the weight check (the simulated
@@ -235,7 +249,7 @@ def test_broomstick_of_a_well_with_a_log_draws_measured_points(tmp_path):
     result = invoke(DEMO / "demo.csv", "--broomstick", "--depths", "1500:2300:100",
                     "--frictions", "0.2,0.3", "--plot", plot)
     assert result.exit_code == 0, result.output
-    assert "measured: 4 rotating segment(s)" in result.output
+    assert "measured: 4 rotating segments" in result.output
     assert "inconsistent" not in result.output
     assert plot.stat().st_size > 1000
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drillfric.io.text import plural
 from drillfric.result import Flag
 
 #: Nights of history kept per well.
@@ -56,14 +57,14 @@ def changes(summary: dict | None, history: list[dict], *, ran: bool,
         return {"new_segments": None, "notes": []}
     segments = summary.get("segments") or []
     before = history[-1]["segments"] if history else 0
-    notes = [f"{len(segments) - before} new segment(s)"] if len(segments) > before else []
+    notes = [plural(len(segments) - before, "new segment")] if len(segments) > before else []
     notes += _moved(summary.get("mu_k"), [h["mu_k"] for h in history[-HISTORY_NIGHTS:]
                                           if h.get("mu_k") is not None])
     severe = [s["id"] for s in segments[before:] if (s.get("stick_slip_severity") or 0.0)
               > SEVERE_STICK_SLIP
               or Flag.STICK_SLIP_BEYOND_VALIDATED in (s.get("quality_flags") or ())]
     if severe:
-        notes.append(f"severe stick-slip (the bit stops) in segment(s) "
+        notes.append(f"severe stick-slip (the bit stops) in {plural(len(severe), 'segment')}: "
                      f"{', '.join(map(str, severe))}")
     return {"new_segments": max(len(segments) - before, 0), "notes": notes}
 
@@ -76,4 +77,4 @@ def _moved(mu_k: float | None, recent: list[float]) -> list[str]:
     if abs(mu_k - centre) <= max(spread, MU_K_FLOOR):
         return []
     return [f"μ_k moved to {mu_k:.3f} from {centre:.3f} (beyond its spread of "
-            f"{spread:.3f} over {len(recent)} nights)"]
+            f"{spread:.3f} over {plural(len(recent), 'night')})"]

@@ -61,6 +61,21 @@ def terminal_text(text) -> str:
 _BLANKS = str.maketrans({"\n": " ", "\r": " ", "\t": " "})
 
 
+def plural(n, noun: str, many: str | None = None, spec: str = "") -> str:
+    """``n`` (formatted with ``spec``) and ``noun`` in the number ``n`` asks for:
+    ``"1 segment"``, ``"2 segments"`` (``many``: the plural of a noun that does not take an
+    ``s``); every count shown to people goes through it.
+
+    Examples
+    --------
+    >>> plural(1, "segment"), plural(0, "warning"), plural(2, "box", "boxes")
+    ('1 segment', '0 warnings', '2 boxes')
+    >>> plural(20801, "row", spec=",")
+    '20,801 rows'
+    """
+    return f"{n:{spec}} {noun if n == 1 else many or noun + 's'}"
+
+
 def listing(names, *, recognised: bool, limit: int = 12) -> str:
     """Column names for a message, or a word saying why they are not shown.
 

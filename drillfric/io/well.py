@@ -57,7 +57,7 @@ from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
 from drillfric.io.parts import open_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
-from drillfric.io.text import printable
+from drillfric.io.text import plural, printable
 from drillfric.io.timebase import (
     TimeBase,
     TimeTracker,
@@ -185,12 +185,13 @@ class Well:
     mappings: dict[str, Mapping] = field(default_factory=dict, repr=False)
 
     def __repr__(self) -> str:
+        """One line: name, data file, index, channels, survey (stations, last MD [m])."""
         survey = "no survey" if self.survey is None else \
-            f"survey of {self.survey.md_m.size} stations to {self.survey.md_m[-1]:.0f} m"
+            f"survey of {plural(self.survey.md_m.size, 'station')} to {self.survey.md_m[-1]:.0f} m"
         index = "depth-indexed" if self.depth_indexed else "time-indexed"
+        channels = ", ".join(self.channels) or "not read"
         return (f"<Well {self.name!r}: {self.files.data.name}, {index}, "
-                f"{len(self.mappings)} channels ({', '.join(self.channels) or 'not read'}), "
-                f"{survey}>")
+                f"{plural(len(self.mappings), 'channel')} ({channels}), {survey}>")
 
     @property
     def channels(self) -> dict[str, Mapping]:

@@ -23,7 +23,7 @@ from drillfric.io.digest import sha256_prefix
 from drillfric.io.parts import folder_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import FORMATS
-from drillfric.io.text import printable
+from drillfric.io.text import plural, printable
 from drillfric.io.well import Well, open_well, with_parts
 from drillfric.io.wellfiles import arriving_data
 from drillfric.runner.resume import csv_mark, parquet_mark, parts_mark
@@ -94,12 +94,13 @@ class Tail:
         except FileNotFoundError:
             size, identity = 0, self._identity
         if size < self.end:
-            raise InputError(f"the file shrank to {size} bytes after {self.end} were read",
+            raise InputError(f"the file shrank to {plural(size, 'byte')} after {self.end} were "
+                             "read",
                              file=self.path, fix="append to the file; restart live on a new "
                                                  "--out for a rewritten file")
         if self.end and self._identity not in (None, identity) and not self._same_start():
             raise InputError("the file was replaced by another (renamed over it) whose first "
-                             f"{self.end} bytes are not the ones read: its rows cannot "
+                             f"{plural(self.end, 'byte')} are not the ones read: its rows cannot "
                              "continue them", file=self.path,
                              fix="append to the file; restart live on a new --out for a "
                                  "rewritten file")

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from drillfric.io.text import plural
 from drillfric.vocabulary import Status
 
 from .display import SI, Units, fmt
@@ -125,7 +126,7 @@ def _evidence(row: dict) -> str:
         seconds = row.get(f"{side}_s")
         if seconds is not None and np.isfinite(seconds):
             parts.append(f"{side.replace('_', '-')} {seconds:.0f} s "
-                         f"({int(row[f'{side}_rows'])} rows)")
+                         f"({plural(int(row[f'{side}_rows']), 'row')})")
     return ", ".join(parts)
 
 
@@ -259,8 +260,9 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
 
 
 def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
-    """μ_k versus bit depth (display ``units``) of every well, a colour per well; legend
-    click hides a well."""
+    """μ_k versus bit depth (display ``units``) of every well, a colour per well, the μ_k axis
+    from 0 (an auto-scaled 0.2768–0.2798 drew three equal wells as a zigzag); legend click
+    hides a well."""
     from bokeh.models import HoverTool, Legend, LegendItem
     from bokeh.palettes import Category10, Category20
     from bokeh.plotting import figure
@@ -269,6 +271,7 @@ def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
                  tools=_TOOLS, active_scroll="wheel_zoom", x_axis_label="μ_k [-]",
                  y_axis_label=units.axis("bit depth", "length"))
     fig.y_range.flipped = True
+    fig.x_range.start = 0.0  # from 0, as each well's log: equal wells must not zigzag
     palette = Category10[10] if len(logs) <= 10 else Category20[20]
     items, renderers = [], []
     for index, (name, seg) in enumerate(logs):

@@ -20,6 +20,7 @@ import pandas as pd
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
+from drillfric.io.text import plural
 from drillfric.io.timebase import clock_at
 from drillfric.result import Flag
 from drillfric.vocabulary import Kind, Method, Status
@@ -53,6 +54,7 @@ def environment() -> Environment:
                       autoescape=select_autoescape(["html", "j2"], default=True),
                       trim_blocks=True, lstrip_blocks=True)
     env.filters["num"] = fmt
+    env.filters["plural"] = plural
     return env
 
 

@@ -18,6 +18,7 @@ import pandas as pd
 from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
 from drillfric.io.atomic import write_text_replacing
+from drillfric.io.text import plural
 from drillfric.io.timebase import clock_at
 from drillfric.vocabulary import Status
 
@@ -300,8 +301,8 @@ def _broomstick_note(check: dict, units: Units) -> str | None:
         return None
     if check["warning"]:
         return check["warning"]
-    return (f"String weight consistent with the hook load in {check['checked']} off-bottom "
-            f"segment(s): implied travelling-block weight "
+    return (f"String weight consistent with the hook load in "
+            f"{plural(check['checked'], 'off-bottom segment')}: implied travelling-block weight "
             f"{units.text(check['block_weight_N'], 'force')} {units.label('force')} (median "
             "measured − modelled).")
 
@@ -483,7 +484,7 @@ def no_friction_note(segments: pd.DataFrame) -> str:
         return "No friction log: the run found no rotating segment."
     status = segments["status"].value_counts()
     parts = ", ".join(f"{int(status[k])} {k}" for k in ("skipped", "failed") if k in status)
-    return (f"No friction factor to draw: none of the {len(segments)} segment(s) was "
+    return (f"No friction factor to draw: none of the {plural(len(segments), 'segment')} was "
             f"estimated with a bit depth ({parts or 'no bit depth'}); their depths and "
             "reasons are in the diagnostics table.")
 
@@ -608,8 +609,9 @@ def headline_lines(head: dict) -> list[tuple[str, bool]]:
     if head["apparent"]:
         what = "window" if head["depth_indexed"] else "stand"
         lines.append((f"apparent μ on bottom: {head['apparent']['value']} (bit torque "
-                      f"included, not μ_k; median of {head['apparent']['count']} converged "
-                      f"on-bottom {what}(s))", True))
+                      f"included, not μ_k; median of "
+                      f"{plural(head['apparent']['count'], 'converged on-bottom ' + what)})",
+                      True))
     lines.append((f"μ_s (consensus): {head['mu_s']}", True))
     zone = " — ".join(x for x in (head["zone"], head["profile"]) if x)
     if zone:
@@ -625,7 +627,8 @@ def headline_lines(head: dict) -> list[tuple[str, bool]]:
     if head["indicative"]:
         lines.append(("INDICATIVE: defaults were assumed (see Run details)", False))
     if head["warnings"]:
-        lines.append((f"WARNING: {len(head['warnings'])} warning(s), see Run details", False))
+        lines.append((f"WARNING: {plural(len(head['warnings']), 'warning')}, see Run details",
+                      False))
     return lines
 
 

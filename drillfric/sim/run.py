@@ -38,6 +38,7 @@ from drillfric import torsional
 from drillfric.config import Config
 from drillfric.drillstring import build_string
 from drillfric.errors import ConfigError, InputError, ModelError
+from drillfric.io.text import plural
 from drillfric.sim.scenario import Scenario, Stand, base_stand, load_scenario, single_stand
 from drillfric.sim.settings import Noise, PlantSettings
 from drillfric.units import RPM_TO_RAD_S
@@ -116,10 +117,14 @@ class Simulation:
     notes: tuple = field(default_factory=tuple)
 
     def __repr__(self) -> str:
-        n = len(next(iter(self.columns.values()), ()))
+        """One line: the truth, the stands' bit depths [m], rows, rate and span [s], columns."""
+        time = np.asarray(self.columns.get("time_s", ()), dtype=float)
+        span = f", {time[-1] - time[0]:.0f} s" if time.size else ""
+        depths = [s.bit_depth_m for s in self.stands]
+        bits = f" at bit {min(depths):.0f}–{max(depths):.0f} m" if depths else ""
         return (f"<Simulation μ_s {self.settings.mu_s:g}, μ_k {self.settings.mu_k:g}: "
-                f"{len(self.stands)} stand{'s' * (len(self.stands) != 1)}, {n} rows at "
-                f"{self.rate_hz:g} Hz; columns {', '.join(self.columns)}>")
+                f"{plural(len(self.stands), 'stand')}{bits}, {plural(time.size, 'row')} at "
+                f"{self.rate_hz:g} Hz{span}; columns {', '.join(self.columns)}>")
 
     def truth(self) -> dict:
         """Ground truth as plain data (NAME.truth.json, file metadata)."""
