@@ -11,7 +11,7 @@ wider than the quantity's tolerance.
 
 Usage::
 
-    python benchmarks/coverage.py [--lumped FILE] [--trust FILE] [--drilling FILE]
+    python benchmarks/interval_coverage.py [--lumped FILE] [--trust FILE] [--drilling FILE]
 """
 
 from __future__ import annotations
