@@ -435,7 +435,8 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
     logged = logging_interval(data.time_s, data.surface_rpm, data.surface_torque_Nm,
                               averaging_s=cfg.rig.sample_averaging_s, model_dt_s=meas.dt_s,
                               torque_min_Nm=data.torque_min_Nm,
-                              torque_max_Nm=data.torque_max_Nm)
+                              torque_max_Nm=data.torque_max_Nm,
+                              echo_s=2.0 * bit_trace.travel_time_s(string))
     return SegmentModels(path, string, td, meas, observer, on_bottom, logged, profile,
                          batch.BatchSettings.from_config(cfg), int(bad.sum()))
 

@@ -45,6 +45,12 @@ SMOOTHED_DEPTH = 3.0
 #: ...with at least this many nulls below the Nyquist frequency (fewer cannot be told from
 #: the raw spectrum's own dips)...
 SMOOTHED_MIN_NULLS = 4
+#: ...scored at the nulls in the upper half of the band only (frequencies ≥ this many
+#: cycles per sample, where the noise, not the signal, fills a raw log's spectrum): a
+#: stick-slip torque of nearly half-wave-symmetric shape has mostly odd harmonics, a comb
+#: with nulls at the even ones, which over the whole band took a 5-Hz spot-sampled lumped
+#: record's torque for a 2.2-s moving average (docs/bit_speed.md "Smoothed logs")...
+SMOOTHED_BAND = 0.25
 #: ...and at least this many samples (the spectrum's resolution: nulls 4 bins apart at the
 #: widest width looked at, a quarter of an 8192-sample block: 20 s at 100 Hz).
 SMOOTHED_MIN_SAMPLES = 1024
@@ -128,7 +134,7 @@ def held_interval_s(time_s, *series) -> float | None:
     return float(np.mean(steps[regular])) * float(np.median(np.diff(t)))
 
 
-def moving_average_s(time_s, *series) -> float | None:
+def moving_average_s(time_s, *series, echo_s: float | None = None) -> float | None:
     """Width of a moving average written at the full rate [s], or None (module docstring).
 
     For each of ``series`` and each width w of 2 … :data:`_WELCH_SAMPLES`/4 samples with at
@@ -137,8 +143,13 @@ def moving_average_s(time_s, *series) -> float | None:
     sample-to-sample differences (:func:`_median_spectrum`). A score at or below
     −:data:`SMOOTHED_DEPTH` says the series is smoothed; of the widths that score within
     70 % of the deepest, the widest is the moving average's (the nulls of w samples are
-    also those of its divisors). Returns
-    the widest over the series times the median sample spacing.
+    also those of its divisors). Returns the widest over the series times the median sample
+    spacing.
+
+    ``echo_s``: the string's round-trip wave travel time [s]. A torque wave and its echo
+    off the bit, τ(t) ∝ g(t) − g(t − echo_s), put the same comb of nulls into the spectrum
+    as a moving average of that width (the second plant family's 3000-m string at 5 Hz:
+    2.2 s); widths within 10 % of echo_s/j, j = 1, 2, …, are not taken.
 
     Examples
     --------
@@ -155,12 +166,13 @@ def moving_average_s(time_s, *series) -> float | None:
     if t.size < SMOOTHED_MIN_SAMPLES:
         return None
     dt = float(np.median(np.diff(t)))
-    widths = [w for w in (_smoothed_width(np.asarray(x, dtype=float)) for x in series)
+    echo = None if not echo_s else echo_s / dt
+    widths = [w for w in (_smoothed_width(np.asarray(x, dtype=float), echo) for x in series)
               if w is not None]
     return max(widths) * dt if widths else None
 
 
-def _smoothed_width(x: np.ndarray) -> int | None:
+def _smoothed_width(x: np.ndarray, echo: float | None = None) -> int | None:
     """The moving average's width in samples (:func:`moving_average_s`), or None."""
     d = np.diff(x[np.isfinite(x)])
     if d.size < SMOOTHED_MIN_SAMPLES or not np.any(d):
@@ -168,15 +180,32 @@ def _smoothed_width(x: np.ndarray) -> int | None:
     f, power = _median_spectrum(d)
     log_p = np.log(power + 1e-300 + 1e-12 * power.max())
     widths, nulls = _NULLS
-    resolved = widths <= (f.size - 1) // 2  # nulls ≥ 4 bins apart in this spectrum
+    # nulls ≥ 4 bins apart in this spectrum, in its upper half: a stick-slip cycle's odd
+    # harmonics make a comb of their own below (see SMOOTHED_BAND)
+    resolved = (widths <= (f.size - 1) // 2) & (nulls / widths >= SMOOTHED_BAND)
+    if echo:  # the string's echo and its divisors [samples] (moving_average_s)
+        j = np.maximum(np.round(echo / widths), 1.0)
+        resolved &= np.abs(widths * j - echo) > 0.1 * echo
     widths, nulls = widths[resolved], nulls[resolved]
-    gap = np.interp(nulls / widths, f, log_p) - np.interp((nulls + 0.5) / widths, f, log_p)
+    at = np.interp(nulls / widths, f, log_p)
     candidates = np.unique(widths)
-    scores = np.bincount(widths, weights=gap)[candidates] / np.bincount(widths)[candidates]
-    deepest = float(scores.min())
-    if deepest > -SMOOTHED_DEPTH:
+    if candidates.size == 0:
         return None
-    return int(candidates[scores <= 0.7 * deepest].max())
+    count = np.bincount(widths)[candidates]
+
+    def mean_gap(offset: float) -> np.ndarray:
+        """Per width: mean log-power at the nulls minus at ``offset`` of a null spacing."""
+        gap = at - np.interp((nulls + offset) / widths, f, log_p)
+        return np.bincount(widths, weights=gap)[candidates] / count
+
+    scores = mean_gap(0.5)
+    # a comb of nulls, not of lines: a quarter spacing from a null a moving average keeps
+    # half its peak power, a line spectrum (a periodic signal) its floor
+    comb = mean_gap(0.25) <= 0.5 * scores
+    if not comb.any() or scores[comb].min() > -SMOOTHED_DEPTH:
+        return None
+    deepest = float(scores[comb].min())
+    return int(candidates[comb & (scores <= 0.7 * deepest)].max())
 
 
 def _median_spectrum(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -224,9 +253,10 @@ def interval_torque_swing(mean_Nm, min_Nm, max_Nm) -> float | None:
 
 def logging_interval(time_s, surface_rpm, torque_Nm, *, averaging_s: float | None = None,
                      model_dt_s: float | None = None, torque_min_Nm=None,
-                     torque_max_Nm=None) -> LoggingInterval:
+                     torque_max_Nm=None, echo_s: float | None = None) -> LoggingInterval:
     """The effective interval of a segment's log (module docstring); ``model_dt_s`` is the
-    step the estimator resamples to when it is coarser than the log (``run --rate``) [s]."""
+    step the estimator resamples to when it is coarser than the log (``run --rate``) [s];
+    ``echo_s`` the string's round-trip wave travel time [s] (:func:`moving_average_s`)."""
     t = np.asarray(time_s, dtype=float)
     spacing = max(float(np.median(np.diff(t))) if t.size > 1 else 0.0, model_dt_s or 0.0)
     swing = None
@@ -236,7 +266,8 @@ def logging_interval(time_s, surface_rpm, torque_Nm, *, averaging_s: float | Non
             averaging_s = max(averaging_s or 0.0, spacing)
     held = held_interval_s(t, surface_rpm, torque_Nm) or 0.0
     # held values are a moving average of their hold over their updates: said as held
-    smoothed = 0.0 if held else moving_average_s(t, surface_rpm, torque_Nm) or 0.0
+    smoothed = 0.0 if held else moving_average_s(t, surface_rpm, torque_Nm,
+                                                  echo_s=echo_s) or 0.0
     candidates = [(averaging_s or 0.0, "means"), (held, "held values"),
                   (smoothed, "moving averages"), (spacing, "samples")]
     interval, kind = max(candidates, key=lambda c: c[0])
