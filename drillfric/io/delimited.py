@@ -50,6 +50,7 @@ class CsvLayout:
     Attributes
     ----------
     delimiter, decimal : str
+        The decimal mark; with a decimal comma, a dot groups thousands ("17.240,5").
     header : bool
         Whether the first line names the columns.
     units_row : bool
@@ -216,7 +217,10 @@ def _delimiter_score(lines: list[str], delimiter: str) -> tuple[int, int]:
 def open_delimited(path: Path) -> RawSource:
     """Open a delimited text log (layout from :func:`sniff_csv`), read in chunks."""
     layout = sniff_csv(path)
-    kwargs = dict(sep=layout.delimiter, decimal=layout.decimal, header=None,
+    # a decimal comma's locale groups thousands with a dot: "17.240" is 17240, never 17.24
+    # (issue 30, eighth attack: every value ≥ 1000 of such a file shrank 1000×)
+    grouping = {"thousands": "."} if layout.decimal == "," else {}
+    kwargs = dict(sep=layout.delimiter, decimal=layout.decimal, header=None, **grouping,
                   names=layout.columns, skipinitialspace=True,
                   skiprows=(1 + layout.units_row) if layout.header else 0,
                   na_values=[str(v) for v in NULL_VALUES], skip_blank_lines=True,

@@ -73,3 +73,15 @@ def test_dlis_depth_frame_first_surface_frame_with_array_channel():
     assert source.depth_index is None
     assert source.units["HKLD"] == "klbf"
     np.testing.assert_array_equal(frame["SRPM"].to_numpy(), 60.0 + np.arange(20))
+
+
+def test_csv_decimal_comma_thousands_dot():
+    """Regression (issue 30, eighth attack): a ';'-separated export with decimal commas
+    ("0,05") writes its integers with a thousands dot ("17.240", "791.504"); the dot was
+    read as a decimal point, so every value ≥ 1000 shrank 1000× (hook load 791.504 N, bit
+    depth 2.21 m) and the run blamed the string's length."""
+    _, frame = _read("csv_decimal_comma_thousands_dot.csv")
+    assert frame["TIME [s]"].tolist() == [0.0, 0.05, 0.1]
+    assert frame["TORQUE [N.m]"].tolist() == [-200.0, 17240.0, 950.5]
+    assert frame["HKLD [N]"].tolist() == [791504.0, 794686.0, 1002300.25]
+    assert frame["BIT DEPTH [m]"].tolist() == [2210.0, 2210.0, 2210.5]
