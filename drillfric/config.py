@@ -480,6 +480,9 @@ CHANNEL_KEYS = ("time", "measured_depth", "surface_rpm", "surface_torque", "hook
                 "flow_in", "flow_out", "pump_rate", "surface_torque_min", "surface_torque_max",
                 "surface_rpm_min", "surface_rpm_max", "hookload_min", "hookload_max")
 _CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
+#: Magnitudes a channel's `scale` may have: a sign flip or a factor no unit conversion
+#: gives (1e300 had been taken, overflowing every value: issue 30, eighth attack).
+CHANNEL_SCALE = (1e-6, 1e6)
 
 
 def default(dotted: str) -> Any:
@@ -654,9 +657,12 @@ def _channels(raw: Any, file: str | None) -> dict:
             if not isinstance(value, _CHANNEL_FIELDS[key]) or isinstance(value, bool):
                 raise ConfigError(f"channels.{name}.{key} has the wrong type", file=file,
                                   fix='e.g. { column = "SRPM", unit = "rpm", scale = -1 }')
-            if key == "scale" and not (_is_number(value) and value != 0):
-                raise ConfigError(f"channels.{name}.scale must be a finite, non-zero number",
-                                  file=file, fix="e.g. scale = -1 for a log of opposite sign")
+            if key == "scale" and not (_is_number(value) and
+                                       CHANNEL_SCALE[0] <= abs(value) <= CHANNEL_SCALE[1]):
+                raise ConfigError(f"channels.{name}.scale must be a number of magnitude "
+                                  f"{CHANNEL_SCALE[0]:g}–{CHANNEL_SCALE[1]:g}", file=file,
+                                  fix="e.g. scale = -1 for a log of opposite sign; a unit "
+                                      "goes in `unit`")
         out[name] = dict(spec)
     return out
 
@@ -859,7 +865,7 @@ def schema_markdown() -> str:
               '`surface_torque = { column = "STOR", unit = "kN.m" }`. A column may be a name or '
               "a 0-based index (headerless files). `mnemonics = [...]` adds names to recognise; "
               "`scale` multiplies the values after the unit conversion (`scale = -1` for a "
-              "log of opposite sign).",
+              f"log of opposite sign; magnitude {CHANNEL_SCALE[0]:g}–{CHANNEL_SCALE[1]:g}).",
               "", "Channel keys: " + ", ".join(f"`{c}`" for c in CHANNEL_KEYS), ""]
     return "\n".join(lines)
 

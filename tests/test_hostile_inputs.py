@@ -433,6 +433,14 @@ def case_unknown_channel_scale_key(root):
     return [Case(["run", "w.csv", "--out", "out"], (2,), ("scale",))]
 
 
+def case_channel_scale_of_1e300(root):
+    """Regression (issue 30, eighth attack): a scale of 1e300 was taken, every value
+    overflowed, a RuntimeWarning leaked and the error printed a 300-digit number."""
+    _config(_log(root / "w.csv").with_suffix(".toml"),
+            '[channels]\nsurface_torque = { column = "surface_torque_Nm", scale = 1e300 }\n')
+    return [Case(["run", "w.csv", "--out", "out"], (2,), ("scale", "1e-06–1e+06"))]
+
+
 CASES = {name[5:]: fn for name, fn in sorted(globals().items()) if name.startswith("case_")}
 
 
