@@ -123,3 +123,19 @@ def test_bursts_of_torque_zeros_while_turning_change_no_number(tmp_path):
     dirty = _run(tmp_path / "dirty", frame, tmp_path)
     assert dirty["samples_dropped"] >= 0.9 * burst.sum()
     assert dirty["mu_k"] == pytest.approx(clean["mu_k"], rel=0.01)
+
+
+@pytest.mark.slow
+def test_gaps_shorter_than_max_gap_are_not_drawn_through(tmp_path):
+    """Regression (issue 30, eighth attack): 8-s holes every 30 s (under the 10-s
+    `max_gap_s`, so one segment) were bridged and the bit trace drawn through them, 72 RPM
+    RMS from the bit inside the holes, shown as resolved with 3 windows withheld. The bit's
+    motion over a gap longer than the wave travel time was not observed: every window over
+    one is withheld (here all of them: the trace is), μ_k stays."""
+    frame = pd.read_csv(DEMO / "demo.csv")
+    frame = frame[frame["time_s"] < 230.0]
+    frame = frame[~((frame["time_s"] % 30.0 > 10.0) & (frame["time_s"] % 30.0 < 18.0))]
+    seg = _run(tmp_path / "holes", frame.reset_index(drop=True), tmp_path)
+    assert seg["mu_k"] == pytest.approx(0.28, rel=0.05)
+    assert seg["bit_speed_resolved"] is False
+    assert "gap longer than the string's wave travel time" in seg["bit_speed_reason"]

@@ -367,7 +367,7 @@ def window_grid(t_from_s: float, t_to_s: float) -> list[tuple[float, float]]:
 
 def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
                  compliance: float, travel_s: float, noise_rad_s: float,
-                 unknown_spans: tuple = ()) -> WindowVerdict:
+                 unknown_spans: tuple = (), gap_spans: tuple = ()) -> WindowVerdict:
     """The kinematic check of docs/bit_speed.md window by window.
 
     Over a window of length T the bit's mean speed is the top drive's minus the change of
@@ -379,7 +379,8 @@ def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
     walk and :data:`MEAN_LAG_TOLERANCE_RPM` claims a bit running away from its string: it
     is withheld. So are the windows overlapping ``unknown_spans`` ([t_from_s, t_to_s)
     pairs): where μ_s was not identified, a creep's and its break-free's bit speed depend
-    on it.
+    on it; and the windows overlapping ``gap_spans``, stretches the log has no sample in
+    (:func:`data_gaps`), over which the trace is the observer's guess.
 
     Parameters
     ----------
@@ -401,28 +402,63 @@ def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
         return WindowVerdict(0)
     dt = float(np.median(np.diff(ts)))
     grid = window_grid(float(t[0]), float(t[-1]) + float(np.median(np.diff(t))))
-    withheld, worst = [], (0.0, "")
+    withheld, worst, why = [], (0.0, ""), []
     for a, b in grid:
-        if any(lo < b and hi > a for lo, hi in unknown_spans):
-            withheld.append((a, b))
-            continue
-        inside, top = (t >= a) & (t < b), (ts >= a) & (ts < b)
-        load = (ts >= a - travel_s) & (ts < b) & np.isfinite(tau)
-        if inside.sum() < 2 or top.sum() < 2 or not load.any():
-            continue
-        span = b - a
-        lo, hi = np.percentile(tau[load], TORQUE_PERCENTILES)
-        twist = compliance * (max(hi, 0.0) - min(lo, 0.0))
-        walk = NOISE_SIGMAS * noise_rad_s * np.sqrt(dt * span)
-        allowed = (twist + walk) / span + MEAN_LAG_TOLERANCE_RPM * RPM_TO_RAD_S
-        gap = float(np.mean(bit[inside]) - np.mean(ws[top]))
-        if abs(gap) > allowed:
-            withheld.append((a, b))
-            if abs(gap) - allowed > worst[0]:
-                worst = (abs(gap) - allowed, _window_reason(a, b, gap, allowed))
-    reason = worst[1] or ("bit speed withheld over the creep and its break-free: μ_s was "
-                          "not identified, and the bit's speed there depends on it")
-    return WindowVerdict(len(grid), tuple(withheld), reason if withheld else "")
+        for spans, reason in ((gap_spans, _GAP_REASON), (unknown_spans, _CREEP_REASON)):
+            if any(lo < b and hi > a for lo, hi in spans):
+                withheld.append((a, b))
+                why.append(reason)
+                break
+        else:
+            off = _off_its_string(a, b, (t, bit), (ts, ws, tau), compliance, travel_s,
+                                  noise_rad_s * np.sqrt(dt))
+            if off is not None:
+                withheld.append((a, b))
+                worst = max(worst, off)
+    reasons = [worst[1]] * bool(worst[1]) + sorted(set(why), key=why.index)
+    return WindowVerdict(len(grid), tuple(withheld), "; ".join(reasons) if withheld else "")
+
+
+
+#: Why windows over a creep or over a gap of the log are withheld.
+_CREEP_REASON = ("bit speed withheld over the creep and its break-free: μ_s was not "
+                 "identified, and the bit's speed there depends on it")
+_GAP_REASON = ("bit speed withheld where the log has a gap longer than the string's wave "
+               "travel time: the bit's motion there was not observed")
+
+
+def _off_its_string(a: float, b: float, trace, top, compliance: float, travel_s: float,
+                    walk_rad: float) -> tuple[float, str] | None:
+    """(excess [rad/s], reason) of a window [a, b) whose trace mean runs off its top drive
+    by more than the twist its torques allow (:func:`window_check`), else None.
+    ``trace`` = (t, ω̂_bit), ``top`` = (t, ω₀, τ), ``walk_rad``: the speed noise's random
+    walk per √s [rad]."""
+    (t, bit), (ts, ws, tau) = trace, top
+    inside, turning = (t >= a) & (t < b), (ts >= a) & (ts < b)
+    load = (ts >= a - travel_s) & (ts < b) & np.isfinite(tau)
+    if inside.sum() < 2 or turning.sum() < 2 or not load.any():
+        return None
+    span = b - a
+    lo, hi = np.percentile(tau[load], TORQUE_PERCENTILES)
+    twist = compliance * (max(hi, 0.0) - min(lo, 0.0))
+    allowed = (twist + NOISE_SIGMAS * walk_rad * np.sqrt(span)) / span \
+        + MEAN_LAG_TOLERANCE_RPM * RPM_TO_RAD_S
+    gap = float(np.mean(bit[inside]) - np.mean(ws[turning]))
+    if abs(gap) <= allowed:
+        return None
+    return abs(gap) - allowed, _window_reason(a, b, gap, allowed)
+
+
+def data_gaps(time_s, longer_than_s: float) -> tuple[tuple[float, float], ...]:
+    """[t_from_s, t_to_s) of each stretch between samples of ``time_s`` [s] longer than
+    ``longer_than_s`` [s].
+
+    >>> data_gaps([0.0, 0.1, 0.2, 5.2, 5.3], 1.0)
+    ((0.2, 5.2),)
+    """
+    t = np.asarray(time_s, dtype=float)
+    at = np.flatnonzero(np.diff(t) > longer_than_s)
+    return tuple((float(t[i]), float(t[i + 1])) for i in at)
 
 
 def _window_reason(a: float, b: float, gap_rad_s: float, allowed_rad_s: float) -> str:

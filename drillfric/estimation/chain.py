@@ -619,7 +619,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, cfg.observer.speed_noise_rpm
                                                * RPM_TO_RAD_S)
-    windows = _windows(cfg, models, refined, final.time_s, bit.rad_s)
+    windows = _windows(cfg, models, refined, final.time_s, bit.rad_s, data.time_s)
     settled = final.time_s[settled_mask(final.time_s)]
     runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
                                   if settled.size > 1 else 0.0)
@@ -699,10 +699,12 @@ def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) ->
 
 
 def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
-             bit_rad_s: np.ndarray) -> bit_trace.WindowVerdict:
+             bit_rad_s: np.ndarray, sample_times_s: np.ndarray) -> bit_trace.WindowVerdict:
     """The window-by-window check of the trace (docs/bit_speed.md "Window by window"); where
     μ_s was not identified, the windows of the start-up from rest and of each creep with its
-    break-free (to a wave round trip and 10 s after its end) depend on it."""
+    break-free (to a wave round trip and 10 s after its end) depend on it; windows over a
+    gap between the logged samples ``sample_times_s`` [s] longer than the wave travel time
+    were not observed."""
     travel = bit_trace.travel_time_s(models.string)
     unknown = ()
     if refined.mu_s is None:
@@ -715,7 +717,8 @@ def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
     return bit_trace.window_check(time_s, bit_rad_s, meas.time_s, meas.surface_rad_s,
                                   meas.motor_torque_Nm,
                                   bit_trace.compliance_rad_Nm(models.string), travel,
-                                  cfg.observer.speed_noise_rpm * RPM_TO_RAD_S, unknown)
+                                  cfg.observer.speed_noise_rpm * RPM_TO_RAD_S, unknown,
+                                  bit_trace.data_gaps(sample_times_s, travel))
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,
