@@ -216,7 +216,7 @@ def test_fleet_writing_into_its_own_wells_folder_does_not_take_its_outputs_for_w
     for night in (1, 2):
         result = CliRunner().invoke(cli, ["fleet", str(root / "wells"), "--out",
                                           str(root / "wells"), "--workers", "1"])
-        assert "fleet_summary" not in result.output and "1 wells" in result.output, \
+        assert "fleet_summary" not in result.output and "fleet (1 well)" in result.output, \
             (night, result.output)
 
 
