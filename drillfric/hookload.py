@@ -22,6 +22,7 @@ segment records.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -435,11 +436,34 @@ _WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
              "mu_k_observer", "mu_s_observer", "mu_td")
 
 
+#: A note that states a friction factor: μ_k or μ_s, a relation and a number.
+_STATES_FRICTION = re.compile(r"μ_[ks][^;]{0,12}?(=|≥|≤|≈|<|>)\s*[-+]?\d")
+
+
 def withhold_friction(record: SegmentRecord, why: str,
                       flag: Flag = Flag.HOOKLOAD_CONTRADICTS_STRING) -> SegmentRecord:
-    """``record`` with its friction numbers null, ``why`` in its message and ``flag``."""
+    """``record`` with its friction numbers null, ``why`` in its message and ``flag``.
+
+    The notes of its message that state a friction factor are left out (a reader would take
+    "μ_k = 0.038 ± 0.003" in a withheld segment for a result: issue 35 item 6), and how many
+    is said.
+
+    Examples
+    --------
+    >>> r = SegmentRecord(mu_k=0.2, message="fit note; μ_k = 0.200 ± 0.010 (95 %: …)")
+    >>> for note in withhold_friction(r, "the hook load says so").message.split("; "):
+    ...     print(note)
+    fit note
+    1 note stating the withheld friction factors left out
+    friction factors withheld: the hook load says so
+    """
     nulls = {name: None for name in _WITHHELD}
-    message = "; ".join(filter(None, [record.message, f"friction factors withheld: {why}"]))
+    notes = [n for n in (record.message or "").split("; ") if n]
+    kept = [n for n in notes if not _STATES_FRICTION.search(n)]
+    cut = len(notes) - len(kept)
+    left_out = (f"{cut} note{'s' * (cut != 1)} stating the withheld friction factors left "
+                "out") if cut else ""
+    message = "; ".join(filter(None, kept + [left_out, f"friction factors withheld: {why}"]))
     return replace(record, **nulls, converged=False, message=message,
                    quality_flags=record.quality_flags + (flag,))
 

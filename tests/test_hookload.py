@@ -13,6 +13,7 @@ tests/test_pipeline.py::test_dsats_runs_end_to_end (one 4-minute run of that log
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
 import numpy as np
@@ -350,6 +351,9 @@ def test_no_slips_is_unverified_not_consistent(hanging_stand):
         assert estimated and all(s["mu_k"] is None and s["mu_s"] is None
                                  and "string_weight_unverified" in s["quality_flags"]
                                  for s in estimated)
+        # issue 35 item 6: no friction factor printed in a withheld segment's notes
+        assert not any(re.search(r"μ_[ks][^;]{0,12}?(=|≥|≤|≈)\s*\d", s["message"] or "")
+                       for s in estimated), [s["message"] for s in estimated]
 
 
 def test_no_slips_configured_block_weight_catches_wrong_string(hanging_stand):
