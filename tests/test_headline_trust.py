@@ -62,3 +62,21 @@ def test_withheld_headline_says_why_in_summary_and_report(tmp_path):
         summary["quality_flags"])
     assert any(w.startswith("indicative:") for w in summary["warnings"])
     assert ">withheld</span>" in html and summary["mu_k_reason"] in unescape(html)
+
+
+def test_segments_outside_the_typical_range_count_only_where_their_mu_is_shown():
+    """Issue 35 item 6 (DSATS): "13 segment(s) outside the typical μ range" was warned
+    although the hook-load check had withheld all 13 μ. A withheld μ is no reading to
+    check; a shown one still is."""
+    from drillfric.estimation.headline import judge
+
+    def seg(i, mu_k):
+        return {"id": i, "kind": "off_bottom_rotating", "status": "ok", "mu_k": mu_k,
+                "quality_flags": ["outside_typical_range"]}
+
+    base = {"counts": {"estimated": 2}, "mu_k": None, "warnings": [], "assumed": []}
+    withheld = judge(base | {"segments": [seg(1, None), seg(2, None)]})
+    assert "segments_outside_typical_range" not in withheld["quality_flags"]
+    shown = judge(base | {"segments": [seg(1, 0.9), seg(2, None)]})
+    assert "segments_outside_typical_range" in shown["quality_flags"]
+    assert any("1 segment(s) outside the typical μ range" in w for w in shown["warnings"])

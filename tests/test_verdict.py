@@ -206,3 +206,19 @@ def test_every_trace_flag_and_withheld_window_is_explained():
     assert "withheld over 2 of 10 30-s windows" in v.messages[3]
     withheld = decide_trace(replace(PLAIN_TRACE, windows=MOST))
     assert "6 of its 10 30-s windows fail: creep" in withheld.bit_speed.reason
+
+
+def test_a_withheld_bound_is_not_stated_in_the_fits_note():
+    """Issue 35 item 6 (DSATS segment 64): the notes said both "μ_s ≥ 0.62 from the
+    stick-slip onset" and "μ_s lower bound withheld on bottom". Withheld, the bound is no
+    longer stated; the rest of the fit's note stays. Shown, it is."""
+    note = ("μ_s not identifiable (stick-slip, no creep); μ_s ≥ 0.31 from the stick-slip "
+            "onset")
+    ev = replace(PLAIN, batch_messages=(note,), mu_s_lower_bound=0.31)
+    shown = decide(ev)
+    assert shown.mu_s_lower_bound == 0.31 and note in shown.messages
+    withheld = decide(replace(ev, on_bottom=True))
+    assert withheld.mu_s_lower_bound is None
+    assert "μ_s not identifiable (stick-slip, no creep)" in withheld.messages
+    assert not any("≥ 0.31" in m for m in withheld.messages)
+    assert any("withheld on bottom" in m for m in withheld.messages)

@@ -114,8 +114,10 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
         found.append((WellFlag.INDICATIVE, f"{INDICATIVE_WARNING} {len(summary['assumed'])} "
                       "default(s) assumed (summary.json assumed), e.g. "
                       f"{summary['assumed'][0]}"))
+    # only where the μ is shown: a withheld segment's μ is no reading to check (issue 35
+    # item 6: "13 segment(s) outside the typical μ range" beside 13 withheld μ)
     outside = [s["id"] for s in segments if Flag.OUTSIDE_TYPICAL_RANGE in
-               (s.get("quality_flags") or ())]
+               (s.get("quality_flags") or ()) and s.get("mu_k") is not None]
     if outside:
         found.append((WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE, f"{len(outside)} segment(s) "
                       f"outside the typical μ range {TYPICAL_MU[0]}–{TYPICAL_MU[1]} "

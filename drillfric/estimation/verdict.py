@@ -16,6 +16,7 @@ No model runs here — every rule can be tested on its own (tests/test_verdict.p
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -171,7 +172,22 @@ def decide(ev: Evidence) -> Verdict:
                    messages=tuple(messages))
 
 
+#: The fit's note of its onset bound (batch/onset.py), left out where the bound is withheld:
+#: "μ_s ≥ 0.62 from the stick-slip onset" beside "μ_s lower bound withheld on bottom" said
+#: both (issue 35 item 6).
+_BOUND_NOTE = re.compile(r";?\s*μ_s ≥ [\d.]+ from the stick-slip onset(?: \([^)]*\))?")
+
+
 def _shown_bound(ev: Evidence, messages: list) -> float | None:
+    """The onset bound shown, or None with why in ``messages`` (the fit's note of the bound
+    then left out of them)."""
+    bound = _bound_or_why(ev, messages)
+    if bound is None and ev.mu_s_lower_bound is not None:
+        messages[:] = [_BOUND_NOTE.sub("", m) for m in messages]
+    return bound
+
+
+def _bound_or_why(ev: Evidence, messages: list) -> float | None:
     if ev.mu_s_lower_bound is None:
         return None
     if ev.on_bottom:
