@@ -843,3 +843,20 @@ def test_fleet_worst_severity_is_severe_where_one_is_withheld():
               "quality_flags": ["stick_slip_beyond_validated"]}
     assert _worst([mild])["severity"] == "0.90"
     assert _worst([mild, severe])["severity"] == "severe"
+
+
+def test_empty_friction_log_names_estimated_but_withheld_segments():
+    """Issue 35 item 3 (DSATS): the friction log said "none of the 76 segment(s) was
+    estimated with a bit depth (47 skipped)" where 29 had been estimated at 934–1120 m and
+    withheld by the hook-load check. It now says so."""
+    from drillfric.report.well import no_friction_note
+
+    seg = pd.DataFrame({"status": ["ok", "ok", "skipped"],
+                        "bit_depth_m": [934.0, 1120.0, None], "mu_k": [None, None, None],
+                        "quality_flags": [["hookload_contradicts_string"],
+                                          ["hookload_contradicts_string"], []]})
+    note = no_friction_note(seg)
+    assert "2 segments of 3 were estimated at 934–1120 m" in note
+    assert "withheld by the hook-load check" in note and "1 skipped" in note
+    skipped = no_friction_note(seg.assign(status=["skipped"] * 3))
+    assert "none of the 3 segments was estimated with a bit depth" in skipped

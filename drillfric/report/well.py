@@ -484,9 +484,32 @@ def no_friction_note(segments: pd.DataFrame) -> str:
         return "No friction log: the run found no rotating segment."
     status = segments["status"].value_counts()
     parts = ", ".join(f"{int(status[k])} {k}" for k in ("skipped", "failed") if k in status)
+    estimated = segments[(segments["status"] == Status.OK) & segments["bit_depth_m"].notna()]
+    if len(estimated):  # estimated at a depth, their μ withheld (issue 35 item 3)
+        why = _withheld_by(estimated)
+        return (f"No friction factor to draw: {plural(len(estimated), 'segment')} of "
+                f"{len(segments)} were estimated at "
+                f"{estimated['bit_depth_m'].min():.0f}–{estimated['bit_depth_m'].max():.0f} m "
+                f"and their friction factors withheld{why}" + (f" ({parts})" if parts else "")
+                + "; their reasons are in the diagnostics table.")
     return (f"No friction factor to draw: none of the {plural(len(segments), 'segment')} was "
             f"estimated with a bit depth ({parts or 'no bit depth'}); their depths and "
             "reasons are in the diagnostics table.")
+
+
+#: Segment flags that withhold its friction factors, and what the friction log says of them.
+_WITHHOLDERS = {"hookload_contradicts_string": "the hook-load check",
+                "string_weight_unverified": "the hook-load check (string weight unverified)",
+                "torque_zero_offset": "the torque-zero check"}
+
+
+def _withheld_by(segments: pd.DataFrame) -> str:
+    """" by …" naming the checks that withheld ``segments``' friction factors, or "" (not
+    converged)."""
+    flags = {f for row in segments.get("quality_flags", pd.Series(dtype=object))
+             for f in (row if row is not None else ())}
+    checks = [text for flag, text in _WITHHOLDERS.items() if flag in flags]
+    return (" by " + " and ".join(checks)) if checks else " (not converged)"
 
 
 def _missing_evidence(est: pd.DataFrame) -> str | None:
