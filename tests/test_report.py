@@ -769,6 +769,23 @@ def test_weight_check_rule_and_tolerance():
     assert on_bottom["checked"] == 0 and on_bottom["warning"] is None
 
 
+def test_weight_check_counts_only_segments_with_their_own_model_as_summary_does():
+    """Issue 35 item 2 (DSATS): the report's notice counted a skipped segment (no modelled
+    hook load of its own) with the broomstick table's value and named it the worst, while
+    summary.json, which counts only the segments' own, said otherwise. The table fills in
+    only for results with no segment's own model (older results)."""
+    from drillfric.report.broomstick import weight_check
+
+    table = pd.DataFrame({"load_case": ["rotating_off_bottom"] * 2,
+                          "friction_factor": [0.2, 0.2], "bit_depth_m": [0.0, 3000.0],
+                          "hookload_N": [0.0, 3e6]})
+    points = _points([800, 820], [700, np.nan])
+    check = weight_check(points, table)
+    assert check["checked"] == 1 and check["warning"] is None
+    older = weight_check(_points([800, 820], [np.nan, np.nan]), table)
+    assert older["checked"] == 2
+
+
 def test_report_warns_when_the_string_is_heavier_than_the_hook_load(evidence, tmp_path):
     """A modelled rotating hook load 20 % above the measured one is shown as a warning at
     the top and beside the broomstick; the consistent demo gets the implied block weight."""

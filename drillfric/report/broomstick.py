@@ -151,8 +151,11 @@ def weight_check(points: pd.DataFrame, table: pd.DataFrame | None = None,
     off = points[(points["kind"] == Kind.OFF_BOTTOM) & points["hookload_N"].notna()]
     model = off["hookload_model_N"].to_numpy(float) if "hookload_model_N" in off else \
         np.full(len(off), np.nan)
-    if table is not None and len(off):
-        model = np.where(np.isfinite(model), model, rotating_hookload(table, off["bit_depth_m"]))
+    if table is not None and len(off) and not np.isfinite(model).any():
+        # results without the segments' own modelled hook load (older ones, depth logs);
+        # otherwise only the segments that have one count, as in summary.json (a skipped
+        # segment's table value had made the report's worst case: issue 35 item 2)
+        model = rotating_hookload(table, off["bit_depth_m"])
     good = np.isfinite(model) & (off["hookload_N"].to_numpy(float) > 0)
     measured, model, ids = (off["hookload_N"].to_numpy(float)[good], model[good],
                             off["segment_id"].to_numpy()[good])
