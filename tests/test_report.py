@@ -877,3 +877,20 @@ def test_empty_friction_log_names_estimated_but_withheld_segments():
     assert "withheld by the hook-load check" in note and "1 skipped" in note
     skipped = no_friction_note(seg.assign(status=["skipped"] * 3))
     assert "none of the 3 segments was estimated with a bit depth" in skipped
+
+
+def test_an_empty_severity_panel_says_why():
+    """Issue 35 item 10: the stick-slip severity panel was empty in every friction log
+    (demo, DSATS, F-5, live) with no note why. It now counts the reasons: severe stick-slip
+    (beyond the validated range), undetermined, bit speed not resolved or withheld, on
+    bottom."""
+    from drillfric.report.friction import severity_note
+
+    seg = pd.DataFrame({"status": ["ok", "ok", "ok", "ok", "skipped"],
+                        "kind": ["off_bottom_rotating"] * 3 + ["on_bottom_rotating"] * 2,
+                        "quality_flags": [["stick_slip_beyond_validated"],
+                                          ["stick_slip_undetermined"], [], [], []],
+                        "bit_speed_resolved": [True, True, False, False, None]})
+    assert severity_note(seg) == (
+        "no severity shown: 1 severe (beyond the validated range), 1 undetermined, "
+        "1 bit speed not resolved or withheld, 1 on bottom")

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.io.text import plural
-from drillfric.vocabulary import Status
+from drillfric.vocabulary import Kind, Status
 
 from .display import SI, Units, fmt
 from .figures import (
@@ -253,10 +253,44 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
         line = sev.scatter("stick_slip_severity", "depth", source=cds["severity"],
                            marker="circle", size=8, color="#8e44ad")
         sev.add_tools(HoverTool(renderers=[line], tooltips=_tips(units)))
+    else:  # say why the panel is empty (issue 35 item 10)
+        sev.title.text = severity_note(segments)
+        sev.title.text_font_size = "10px"
+        sev.title.text_font_style = "normal"
     sev.add_layout(Span(location=1.0, dimension="height", line_dash="dashed",
                         line_color="#c0392b"))
     sev.x_range.start = 0.0
     return gridplot([[mu, sev]], merge_tools=True, toolbar_location="right")
+
+
+#: Why a segment shows no stick-slip severity, by flag or field, in the order said.
+_NO_SEVERITY = (("stick_slip_beyond_validated", "severe (beyond the validated range)"),
+                ("stick_slip_undetermined", "undetermined"))
+
+
+def severity_note(segments: pd.DataFrame) -> str:
+    """Why the severity panel is empty: the estimated segments' reasons, counted (severe
+    stick-slip, undetermined, bit speed not resolved or withheld, on bottom).
+
+    >>> severity_note(pd.DataFrame({"status": ["ok", "ok"], "kind": ["off_bottom_rotating"] * 2,
+    ...     "quality_flags": [["stick_slip_beyond_validated"], []],
+    ...     "bit_speed_resolved": [True, False]}))
+    'no severity shown: 1 severe (beyond the validated range), 1 bit speed not resolved or withheld'
+    """
+    ok = segments[segments["status"] == Status.OK] if "status" in segments else segments
+    counts: dict[str, int] = {}
+    for _, row in ok.iterrows():
+        flags = set(row.get("quality_flags") if row.get("quality_flags") is not None else ())
+        why = next((text for flag, text in _NO_SEVERITY if flag in flags), None)
+        if why is None and row.get("kind") == Kind.ON_BOTTOM:
+            why = "on bottom"
+        elif why is None and row.get("bit_speed_resolved") is not True:
+            why = "bit speed not resolved or withheld"
+        if why:
+            counts[why] = counts.get(why, 0) + 1
+    if not counts:
+        return "no severity shown: no estimated segment"
+    return "no severity shown: " + ", ".join(f"{n} {why}" for why, n in counts.items())
 
 
 def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
