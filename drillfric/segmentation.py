@@ -461,7 +461,8 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
                 continue  # a blip of speed noise, not rotation
             status, message = _status(t1 - t0, n_null, i1 - i0, min_s)
             if KINDS[state] in COMBINED_MOTION_KINDS:
-                status, message = "skipped", _combined_motion(KINDS[state], finite, t1 - t0)
+                status, message = "skipped", _combined_motion(KINDS[state], depth,
+                                                              t[i0:i1])
             out.append(Segment(
                 id=first_id + len(out),
                 kind=KINDS[state],
@@ -473,10 +474,29 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
     return out
 
 
-def _combined_motion(kind: str, depth_m: np.ndarray, duration_s: float) -> str:
-    """Why a reaming / back-reaming segment is not estimated."""
-    speed = abs(depth_m[-1] - depth_m[0]) / duration_s if depth_m.size > 1 and \
-        duration_s > 0 else float("nan")
+#: A bit depth changing faster than this within one sample is no pipe motion (trips run
+#: at up to ~1.5 m/s): a depth reset or a re-zeroed block [m/s].
+DEPTH_JUMP_M_S = 5.0
+
+
+def _combined_motion(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> str:
+    """Why a reaming / back-reaming segment is not estimated: the pipe's speed (median over
+    the samples), or the jump of the depth channel that made it look like reaming (a depth
+    reset 127 → 168 m in 2 s had read "running in at 0 m/s": issue 35 item 7).
+
+    >>> _combined_motion("reaming", np.r_[np.full(5, 127.0), np.full(5, 168.2)],
+    ...                  np.arange(10.0)).split(" (")[0]
+    'reaming? the bit depth jumps by 41.2 m within one sample'
+    """
+    ok = np.isfinite(depth_m)
+    d, t = np.asarray(depth_m, float)[ok], np.asarray(time_s, float)[ok]
+    step = np.abs(np.diff(d))
+    rate = step / np.maximum(np.diff(t), 1e-9)
+    if rate.size and rate.max() > DEPTH_JUMP_M_S:
+        return (f"{kind.replace('_', '-')}? the bit depth jumps by {step[rate.argmax()]:.1f} m "
+                "within one sample (a depth reset or a re-zeroed block, not pipe motion): "
+                "μ and the bit speed are withheld; check the depth channel")
+    speed = float(np.median(rate)) if rate.size else float("nan")
     way = "running in" if kind == Kind.REAMING else "pulling out"
     return (f"{kind.replace('_', '-')}: the pipe is {way} at {speed:.2g} m/s while it turns, "
             "so the wall friction splits between axial and tangential and the rotating model "
