@@ -303,10 +303,13 @@ def test_csv_cut_mid_line_continues_from_its_last_complete_line(stands, tmp_path
     out = tmp_path / "out"
     assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
     assert _summary(out)["inputs"]["rows"] == half  # header line 0: half - 1 rows, the cut
+    # said, not silent (issue 35 item 16: a truncated CSV in a fleet was "ok" without a word)
+    assert any("last line has no line end" in w for w in _summary(out)["warnings"])
     with open(data, "ab") as fh:
         fh.write(lines[half][len(cut):] + b"".join(lines[half + 1:]))
     assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
     assert _summary(out)["resumed"] == {"from_row": half - 1, "reason": ""}
+    assert not any("last line has no line end" in w for w in _summary(out)["warnings"])
     written = pd.read_parquet(out / "three" / "segments.parquet")
     _same_results(type(whole)(whole.well, _summary(out), written), whole)
 

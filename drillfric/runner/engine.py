@@ -238,7 +238,7 @@ class Engine:
         self.check.finish(self.tracker.duplicates)
         warnings = self.warnings + [w for w in (
             self.check.duplicates_note(self.tracker.duplicates),
-            self.check.nothing_found(len(self.records))) if w]
+            self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail)) if w]
         plateaus = self.hook.close()
         calibration = None
         if self.calibration is not None:
@@ -443,3 +443,14 @@ def _published(record: SegmentRecord) -> dict:
 def _revision(old: SegmentRecord, new: SegmentRecord, why: str) -> dict:
     return {"segment": new.id, "reason": why, "before": _published(old),
             "after": _published(new)}
+
+
+def _cut_line_note(well: Well, tail: list) -> str:
+    """The warning of a text log whose last line has no line end (cut, or still being
+    written): its row is read as it stands (issue 35 item 16: a truncated CSV in a fleet
+    was "ok" without a word)."""
+    if not any(len(chunk) for chunk in tail):
+        return ""
+    return (f"{well.files.data.name}: its last line has no line end (the file was cut, or is "
+            "still being written): that row is read as it stands, and read again by a later "
+            "run when complete")
