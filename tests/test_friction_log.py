@@ -221,6 +221,11 @@ def test_run_writes_the_result_files_of_a_time_log(depth_log, tmp_path):
     assert set(profiles["segment_id"]) == set(range(1, WINDOWS + 1))
     assert (folder / "wellpath.parquet").is_file() and (folder / "report.html").is_file()
     assert {p.name for p in folder.iterdir()} <= documented_result_files()  # issue 35
+    # issue 35 item 9: nothing of the dynamic estimate in a depth log's report — no creep
+    # break-over advice, no friction law, no "withheld" badge for μ_k
+    html = (folder / "report.html").read_text(encoding="utf-8")
+    assert 'id="mu-s-advice"' not in html and "step law" not in html
+    assert 'id="headline-confidence">withheld' not in html
 
 
 def _with_columns(depth_log, folder, drop=(), **columns):

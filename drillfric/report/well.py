@@ -157,7 +157,7 @@ def _header(data: ResultData, units: Units) -> dict:
         "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                           summary.get("mu_s_lower_bound")),
         "mu_s_identified": summary.get("mu_s") is not None,
-        "zone": zone, "profile": str(summary.get("friction_profile") or ""),
+        "zone": zone, "profile": _profile_text(summary, data.depth_indexed),
         "units": units.system, "depth_indexed": data.depth_indexed,
         "counts": summary.get("counts") or {}, "assumed": [str(a) for a in
                                                            summary.get("assumed") or []],
@@ -168,6 +168,13 @@ def _header(data: ResultData, units: Units) -> dict:
         "string": (string_columns, string_rows),
         "converged_meaning": CONVERGED_MEANING,
     }
+
+
+def _profile_text(summary: dict, depth_indexed: bool) -> str:
+    """The friction profile the headline names; a depth log's without the friction law (it
+    acts in the dynamic model only: issue 35 item 9)."""
+    text = str(summary.get("friction_profile") or "")
+    return text.split("; ")[0] if depth_indexed else text
 
 
 def headline_trust(summary: dict) -> dict:
