@@ -286,13 +286,14 @@ def test_steady_members_agree_on_their_statistics():
 def test_windows_over_a_gap_of_the_log_are_withheld():
     """A window holding a stretch the log has no sample in is withheld, whatever the trace
     there (the observer's guess), with the reason; the others are judged as before."""
-    from drillfric.estimation.bit_trace import data_gaps, window_check
+    from drillfric.estimation.bit_trace import window_check
+    from drillfric.io.timebase import find_gaps
 
     t = np.arange(0.0, 90.0, 0.05)
     w = np.full(t.size, 6.0)
     tau = np.full(t.size, 10e3)
     logged = t[(t < 40.0) | (t > 48.0)]
-    gaps = data_gaps(logged, 0.8)
+    gaps = find_gaps(logged, 0.8, 20.0)
     assert gaps == ((pytest.approx(39.95), pytest.approx(48.05)),)
     verdict = window_check(t, w, t, w, tau, 1e-5, 0.8, 0.01, gap_spans=gaps)
     assert verdict.withheld == ((30.0, 60.0),)

@@ -26,8 +26,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from drillfric.estimation.batch.settings import mu_k_tolerance
-from drillfric.estimation.consensus import POOL_TORQUE_SHARE, mean_half_width
+from drillfric.estimation.consensus import POOL_TORQUE_SHARE, entry_half_width
 from drillfric.result import SegmentRecord
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.vocabulary import Kind, Status
@@ -169,9 +168,8 @@ def rate_of_penetration_m_h(rows: pd.DataFrame) -> float | None:
 def friction_log(records: list[SegmentRecord], pools: list[dict]) -> list[dict]:
     """The off-bottom μ_k of a record along depth (summary.json ``off_bottom_friction_log``): each
     converged segment and each pool of short ones, shallow to deep, with the μ_k's 95 %
-    half-width (its validated tolerance, or twice the standard error of the members'
-    scatter when larger) and the T_N at its ends (for the distance to an on-bottom
-    segment)."""
+    half-width (:func:`~drillfric.estimation.consensus.entry_half_width`) and the T_N at
+    its ends (for the distance to an on-bottom segment)."""
     by_id = {r.id: r for r in records}
     pooled = {i for p in pools for i in p["segment_ids"]}
     entries = []
@@ -185,13 +183,10 @@ def friction_log(records: list[SegmentRecord], pools: list[dict]) -> list[dict]:
 
 
 def _entry(members: list[SegmentRecord], mu_k: float) -> dict:
-    mu = np.array([r.mu_k for r in members])
-    tol = max(mu_k_tolerance(r.sample_interval_s) for r in members) * mu_k
-    scatter = mean_half_width(mu)
     ends = sorted(members, key=lambda r: r.bit_depth_m)
     return {"segment_ids": [r.id for r in members], "md_from_m": ends[0].bit_depth_m,
             "md_to_m": ends[-1].bit_depth_m, "mu_k": float(mu_k),
-            "mu_k_uncertainty": float(max(tol, scatter)),
+            "mu_k_uncertainty": float(entry_half_width(members, mu_k)),
             "rotation_s": float(sum(r.duration_s for r in members)),
             "T_N_from_Nm": ends[0].T_N_Nm, "T_N_to_Nm": ends[-1].T_N_Nm}
 

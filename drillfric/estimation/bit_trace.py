@@ -380,7 +380,8 @@ def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
     is withheld. So are the windows overlapping ``unknown_spans`` ([t_from_s, t_to_s)
     pairs): where μ_s was not identified, a creep's and its break-free's bit speed depend
     on it; and the windows overlapping ``gap_spans``, stretches the log has no sample in
-    (:func:`data_gaps`), over which the trace is the observer's guess.
+    (:func:`drillfric.io.timebase.find_gaps`), over which the trace is the observer's
+    guess.
 
     Parameters
     ----------
@@ -419,7 +420,6 @@ def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
     return WindowVerdict(len(grid), tuple(withheld), "; ".join(reasons) if withheld else "")
 
 
-
 #: Why windows over a creep or over a gap of the log are withheld.
 _CREEP_REASON = ("bit speed withheld over the creep and its break-free: μ_s was not "
                  "identified, and the bit's speed there depends on it")
@@ -447,18 +447,6 @@ def _off_its_string(a: float, b: float, trace, top, compliance: float, travel_s:
     if abs(gap) <= allowed:
         return None
     return abs(gap) - allowed, _window_reason(a, b, gap, allowed)
-
-
-def data_gaps(time_s, longer_than_s: float) -> tuple[tuple[float, float], ...]:
-    """[t_from_s, t_to_s) of each stretch between samples of ``time_s`` [s] longer than
-    ``longer_than_s`` [s].
-
-    >>> data_gaps([0.0, 0.1, 0.2, 5.2, 5.3], 1.0)
-    ((0.2, 5.2),)
-    """
-    t = np.asarray(time_s, dtype=float)
-    at = np.flatnonzero(np.diff(t) > longer_than_s)
-    return tuple((float(t[i]), float(t[i + 1])) for i in at)
 
 
 def _window_reason(a: float, b: float, gap_rad_s: float, allowed_rad_s: float) -> str:

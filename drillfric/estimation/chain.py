@@ -50,6 +50,7 @@ from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_i
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import Evidence, TraceEvidence, Verdict, decide, decide_trace
 from drillfric.friction import FrictionProfile
+from drillfric.io.timebase import find_gaps
 from drillfric.result import Flag
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.vocabulary import Kind, Method
@@ -382,8 +383,11 @@ class SegmentModels:
         The configuration's friction zones and law (docs/theory.md §3.2).
     batch_settings : BatchSettings
         The configuration's settings of the speed-driven fit.
+    sample_times_s : ndarray
+        Times of the logged samples the measurements rest on [s]: the segment's, without
+        the EDR defects :mod:`drillfric.estimation.spikes` dropped.
     dropped : int
-        Samples dropped as isolated spikes or drop-outs (:mod:`drillfric.estimation.spikes`).
+        How many samples were so dropped.
     """
 
     path: WellPath
@@ -395,6 +399,7 @@ class SegmentModels:
     logged: LoggingInterval
     profile: FrictionProfile
     batch_settings: batch.BatchSettings
+    sample_times_s: np.ndarray = field(repr=False)
     dropped: int = 0
 
 
@@ -438,7 +443,7 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
                               torque_max_Nm=data.torque_max_Nm,
                               echo_s=2.0 * bit_trace.travel_time_s(string))
     return SegmentModels(path, string, td, meas, observer, on_bottom, logged, profile,
-                         batch.BatchSettings.from_config(cfg), int(bad.sum()))
+                         batch.BatchSettings.from_config(cfg), data.time_s, int(bad.sum()))
 
 
 def _without(data: SegmentData, drop: np.ndarray) -> SegmentData:
@@ -619,11 +624,11 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, cfg.observer.speed_noise_rpm
                                                * RPM_TO_RAD_S)
-    windows = _windows(cfg, models, refined, final.time_s, bit.rad_s, data.time_s)
-    settled = final.time_s[settled_mask(final.time_s)]
+    windows = _windows(cfg, models, refined, final.time_s, bit.rad_s)
+    late = settled_mask(final.time_s)
+    settled = final.time_s[late]
     runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
                                   if settled.size > 1 else 0.0)
-    late = settled_mask(final.time_s)
     cut = any(np.any(late & (final.time_s >= a) & (final.time_s < b))
               for a, b in windows.withheld)
     undetermined = ("stuck fraction and severity withheld: the bit trace is withheld over some "
@@ -652,10 +657,9 @@ def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
     """The message of a segment whose log had isolated spikes or drop-outs."""
     if not models.dropped:
         return ()
-    return (f"{models.dropped} speed or torque sample(s) dropped as isolated spikes or "
-            "drop-outs (a value that leaves its neighbours and is back within 3 samples "
-            "moves faster than the string can; bridged by interpolation, docs/ingestion.md "
-            "\"EDR defects\")",)
+    return (f"{models.dropped} speed or torque sample(s) dropped as spikes, drop-outs or "
+            "samples lost while turning (values no motion of the string or the top drive can "
+            "take; bridged by interpolation, docs/ingestion.md \"EDR defects\")",)
 
 
 def beside(work, *args):
@@ -666,10 +670,9 @@ def beside(work, *args):
     The seeded ensemble (5 members on 2 threads) leaves one core idle for a third of its
     pass; the fitted model over the segment (:func:`fit_evidence`, a nogil plant run that
     does not depend on the ensemble) fills it at a low priority (:func:`_yielding`; issue
-    32, docs/performance.md). With one
-    numba thread (a fleet running one well per core) nothing runs beside: no
-    oversubscription. The numbers are the same either way (neither touches the other's
-    arrays).
+    32, docs/performance.md). With one numba thread (a fleet running one well per core)
+    nothing runs beside: no oversubscription. The numbers are the same either way
+    (neither touches the other's arrays).
     """
     if numba.get_num_threads() < 2:
         return lambda: work(*args)
@@ -699,12 +702,12 @@ def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) ->
 
 
 def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
-             bit_rad_s: np.ndarray, sample_times_s: np.ndarray) -> bit_trace.WindowVerdict:
+             bit_rad_s: np.ndarray) -> bit_trace.WindowVerdict:
     """The window-by-window check of the trace (docs/bit_speed.md "Window by window"); where
     μ_s was not identified, the windows of the start-up from rest and of each creep with its
     break-free (to a wave round trip and 10 s after its end) depend on it; windows over a
-    gap between the logged samples ``sample_times_s`` [s] longer than the wave travel time
-    were not observed."""
+    gap between the logged samples (``models.sample_times_s``, after the EDR defects were
+    dropped) longer than the wave travel time were not observed."""
     travel = bit_trace.travel_time_s(models.string)
     unknown = ()
     if refined.mu_s is None:
@@ -718,7 +721,7 @@ def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
                                   meas.motor_torque_Nm,
                                   bit_trace.compliance_rad_Nm(models.string), travel,
                                   cfg.observer.speed_noise_rpm * RPM_TO_RAD_S, unknown,
-                                  bit_trace.data_gaps(sample_times_s, travel))
+                                  find_gaps(models.sample_times_s, travel, 1.0 / meas.dt_s))
 
 
 def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,

@@ -151,9 +151,8 @@ def consensus(records: list[SegmentRecord], pools: list[dict] = ()) -> dict:
     k_rows = [r for r in ok if r.mu_k is not None]
     mu_k = [r.mu_k for r in k_rows] + [p["mu_k"] for p in pools]
     by_id = {r.id: r for r in records}
-    own_k = [_own_mu_k([r], r.mu_k, _observer_spread(r)) for r in k_rows] + [
-        _own_mu_k([by_id[i] for i in p["segment_ids"]], p["mu_k"], p["mu_k_spread"])
-        for p in pools]
+    own_k = [entry_half_width([r], r.mu_k) for r in k_rows] + [
+        entry_half_width([by_id[i] for i in p["segment_ids"]], p["mu_k"]) for p in pools]
     s_rows = [r for r in ok if r.mu_s_identifiable and r.mu_s is not None]
     mu_s = [r.mu_s for r in s_rows]
     bounds = [r.mu_s_lower_bound for r in ok if r.mu_s_lower_bound is not None]
@@ -170,20 +169,27 @@ def consensus(records: list[SegmentRecord], pools: list[dict] = ()) -> dict:
             "mu_s_support": {"segments": len(s_rows) if mu_s else len(bounds), "of": off}}
 
 
-def _observer_spread(record: SegmentRecord) -> float:
-    """The spread of a segment's observer starts where the observer gave its μ_k, else 0."""
-    return (record.mu_k_spread or 0.0) if record.method == Method.OBSERVER else 0.0
+def entry_half_width(members: list[SegmentRecord], mu_k: float) -> float:
+    """The 95 % half-width of one μ_k entry — a converged segment, or a pool of ``members``
+    — [-]: the validated tolerance of its logging (:func:`mu_k_tolerance`, 5 % at ≤ 0.2 s,
+    else 10 %: the model-form error found on both plant families, docs/validation.md
+    "Calibrated intervals"), or where larger the scatter of a pool's pieces
+    (:func:`mean_half_width`) or half the spread of the observer's starts that gave a
+    segment's number. One rule for the headline's ū and the friction log's entries. (A
+    torque match of 2 % had been the floor; on the second plant family every headline ± so
+    made excluded the truth, errors 2–4 %.)
 
-
-def _own_mu_k(members: list[SegmentRecord], mu_k: float, spread: float) -> float:
-    """The 95 % half-width of one entry's μ_k (a segment, or a pool of ``members``) [-]:
-    half the spread of its observer starts or pieces, never below the validated tolerance
-    of its logging (:func:`mu_k_tolerance`, 5 % at ≤ 0.2 s, else 10 %: the model-form error
-    found on both plant families, docs/validation.md "Calibrated intervals"). A torque
-    match of 2 % had been the floor; on the second plant family every headline ± so made
-    excluded the truth (errors 2–4 %)."""
+    Examples
+    --------
+    >>> from drillfric.result import SegmentRecord
+    >>> round(entry_half_width([SegmentRecord(mu_k=0.3, sample_interval_s=0.01)], 0.3), 4)
+    0.015
+    """
     tolerance = max(mu_k_tolerance(r.sample_interval_s) for r in members)
-    return max(spread / 2.0, tolerance * mu_k)
+    scatter = mean_half_width(np.array([r.mu_k for r in members]))
+    observer = max(((r.mu_k_spread or 0.0) / 2.0 for r in members
+                    if r.method == Method.OBSERVER), default=0.0)
+    return max(tolerance * mu_k, scatter, observer)
 
 
 def uncertainty(values: list[float], own: list[float]) -> float | None:

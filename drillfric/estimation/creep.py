@@ -47,7 +47,7 @@ def smooth(values, dt_s: float, width_s: float) -> np.ndarray:
     return uniform_filter1d(y, size=n, mode="nearest")
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Maximal index ranges [i0, i1] (inclusive) where ``mask`` is true."""
     edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
     starts = np.flatnonzero(edges == 1)
@@ -74,7 +74,7 @@ def rotating_runs(omega_bar_rad_s, omega_c_rad_s: float,
     [(1, 2), (4, 4)]
     """
     rest = REST_FRACTION * omega_c_rad_s if rest_rad_s is None else rest_rad_s
-    return _runs(np.asarray(omega_bar_rad_s, dtype=float) > rest)
+    return true_runs(np.asarray(omega_bar_rad_s, dtype=float) > rest)
 
 
 def bridge_loaded_dips(runs: list[tuple[int, int]], time_s, torque_Nm, *,
@@ -156,7 +156,7 @@ def find_creeps(time_s, surface_rad_s, omega_c_rad_s: float, *, torque_Nm=None,
     top = CREEP_TOP_FRACTION * omega_c_rad_s
     tau_bar = None if torque_Nm is None else smooth(torque_Nm, dt, smooth_s)
     creeps = []
-    for r0, r1 in _runs(np.abs(w_bar) <= rest):
+    for r0, r1 in true_runs(np.abs(w_bar) <= rest):
         start = r1 + 1
         if start >= t.size or (t[r1] - t[r0] < rest_s - 0.5 * dt and r0 > 0):
             continue

@@ -137,14 +137,16 @@ def held_interval_s(time_s, *series) -> float | None:
 def moving_average_s(time_s, *series, echo_s: float | None = None) -> float | None:
     """Width of a moving average written at the full rate [s], or None (module docstring).
 
-    For each of ``series`` and each width w of 2 … :data:`_WELCH_SAMPLES`/4 samples with at
-    least :data:`SMOOTHED_MIN_NULLS` nulls below the Nyquist frequency, the score is the
-    mean of log P(k/(wΔt)) − log P((k + ½)/(wΔt)) over the median spectrum P of the
-    sample-to-sample differences (:func:`_median_spectrum`). A score at or below
-    −:data:`SMOOTHED_DEPTH` says the series is smoothed; of the widths that score within
-    70 % of the deepest, the widest is the moving average's (the nulls of w samples are
-    also those of its divisors). Returns the widest over the series times the median sample
-    spacing.
+    For each of ``series`` and each width w of 2·:data:`SMOOTHED_MIN_NULLS` + 1 …
+    :data:`_WELCH_SAMPLES`/4 samples whose nulls lie at least 4 bins apart, the score is
+    the mean of log P(k/(wΔt)) − log P((k + ½)/(wΔt)) over its nulls in the upper half of
+    the band (:data:`SMOOTHED_BAND`), P the median spectrum of the sample-to-sample
+    differences (:func:`_median_spectrum`); a width counts only where a quarter spacing
+    from its nulls keeps power (a comb of nulls, not of a periodic signal's lines). A score
+    at or below −:data:`SMOOTHED_DEPTH` says the series is smoothed; of the widths that
+    score within 70 % of the deepest, the widest is the moving average's (the nulls of w
+    samples are also those of its divisors). Returns the widest over the series times the
+    median sample spacing.
 
     ``echo_s``: the string's round-trip wave travel time [s]. A torque wave and its echo
     off the bit, τ(t) ∝ g(t) − g(t − echo_s), put the same comb of nulls into the spectrum

@@ -22,6 +22,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import median_filter
 
+from drillfric.estimation.creep import true_runs
+from drillfric.units import RPM_TO_RAD_S
+
 #: Half the neighbourhood [samples]: a pulse of up to this many samples is isolated (an
 #: EDR's spikes and drop-outs are single samples, two where they happen to fall side by
 #: side: 1 in 10 of them at 5 % of the samples; a soft drive's speed dips last 3 samples or
@@ -94,15 +97,10 @@ def lost_torque(surface_rpm, torque_Nm) -> np.ndarray:
     """
     w = np.abs(np.asarray(surface_rpm, dtype=float))
     q = np.asarray(torque_Nm, dtype=float)
-    lost = np.zeros(q.size, dtype=bool)
     if q.size < 3:
-        return lost
-    zero = (q == 0.0) & (w >= 0.5 * float(np.median(w))) & (w > 0.0)
-    floor = FLOOR_SHARE * float(np.median(np.abs(q)))
-    for start, end in _runs(zero):
-        if start > 0 and end < q.size and min(abs(q[start - 1]), abs(q[end])) > floor:
-            lost[start:end] = True
-    return lost
+        return np.zeros(q.size, dtype=bool)
+    turning = (w >= 0.5 * float(np.median(w))) & (w > 0.0)
+    return _zeros_between(q, turning, FLOOR_SHARE * float(np.median(np.abs(q))))
 
 
 def lost_speed(time_s, surface_rpm, torque_Nm, top_drive_inertia_kg_m2: float) -> np.ndarray:
@@ -124,22 +122,22 @@ def lost_speed(time_s, surface_rpm, torque_Nm, top_drive_inertia_kg_m2: float) -
     """
     t = np.asarray(time_s, dtype=float)
     w = np.asarray(surface_rpm, dtype=float)
-    lost = np.zeros(w.size, dtype=bool)
     if w.size < 3:
-        return lost
+        return np.zeros(w.size, dtype=bool)
     step_rpm = (2.0 * float(np.max(np.abs(torque_Nm))) * float(np.median(np.diff(t)))
-                / top_drive_inertia_kg_m2) * 30.0 / np.pi
+                / top_drive_inertia_kg_m2) / RPM_TO_RAD_S
     jump = max(step_rpm, FLOOR_SHARE * float(np.median(np.abs(w))))
-    for start, end in _runs(w == 0.0):
-        if start > 0 and end < w.size and min(abs(w[start - 1]), abs(w[end])) > jump:
-            lost[start:end] = True
+    return _zeros_between(w, np.ones(w.size, dtype=bool), jump)
+
+
+def _zeros_between(x: np.ndarray, candidate: np.ndarray, beyond: float) -> np.ndarray:
+    """Runs of exact zeros of ``x`` where ``candidate`` holds, with a sample on each side
+    whose magnitude exceeds ``beyond`` (a boolean mask)."""
+    lost = np.zeros(x.size, dtype=bool)
+    for first, last in true_runs((x == 0.0) & candidate):
+        if first > 0 and last + 1 < x.size and min(abs(x[first - 1]), abs(x[last + 1])) > beyond:
+            lost[first:last + 1] = True
     return lost
-
-
-def _runs(flags: np.ndarray):
-    """[start, end) of each run of true values in ``flags``."""
-    edges = np.flatnonzero(np.diff(np.r_[0, flags.astype(np.int8), 0]))
-    return zip(edges[::2], edges[1::2], strict=True)
 
 
 def defects(time_s, cycle_s: float, surface_rpm, torque_Nm,
