@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,7 @@ from drillfric import torque_drag, torsional  # noqa: E402
 from drillfric.drillstring import build_string  # noqa: E402
 from drillfric.estimation.chain import SegmentData, build_observer, estimate_segment  # noqa: E402
 from drillfric.estimation.observer import Measurements, ObserverState, observe  # noqa: E402
+from drillfric.estimation.settings import ChainSettings  # noqa: E402
 from tests.synthetic import RPM, build_and_hold, config, noisy  # noqa: E402
 
 STARTS = [[0.2, 0.05], [0.5, 0.2], [0.9, 0.4], [0.9, 0.1]]
@@ -59,9 +61,10 @@ def record(mu_s, mu_k, depth, path, rpm, creep, cfg):
 
 def paper_observer(cfg_paper, data: SegmentData, path):
     """The observer alone with the printed laws and backstepping gains."""
-    string = build_string(cfg_paper.sections, data.bit_depth_m)
-    td = torque_drag.solve_config(cfg_paper, path, data.bit_depth_m)
-    obs = build_observer(cfg_paper, string, td, 500)
+    settings = replace(ChainSettings.from_config(cfg_paper), cells=500)
+    string = settings.td.string(data.bit_depth_m)
+    td = settings.td.solve(path, data.bit_depth_m)
+    obs = build_observer(settings, string, td)
     meas = Measurements.from_samples(data.time_s, data.surface_rpm * RPM,
                                      data.surface_torque_Nm)
     out, _ = observe(obs, meas, ObserverState.from_starts(obs, STARTS))
@@ -70,9 +73,9 @@ def paper_observer(cfg_paper, data: SegmentData, path):
 
 
 def main() -> None:
-    cfg = config()
-    cfg_paper = config(gains="backstepping")
-    cfg_paper.values["observer"]["law"] = "paper"
+    cfg = config(observer={"starts": STARTS})
+    settings = ChainSettings.from_config(cfg)
+    cfg_paper = config(gains="backstepping", observer={"law": "paper"})
     print("| truth | μ_s/μ_k | start-up | rate | μ_k chain (err) | μ_k observer starts "
           "(worst err) | μ_s chain | μ_s bound | bit RMS err [RPM] | severity | paper laws "
           "μ_k (worst err) | paper μ_s range | time [s] |")
@@ -86,8 +89,7 @@ def main() -> None:
                 data = SegmentData(rec.time_s[::k], w[::k] / RPM, q[::k], depth,
                                    bit_rpm=rec.bit_rad_s[::k] / RPM)
                 t0 = time.perf_counter()
-                cfg.values["observer"]["starts"] = STARTS
-                est = estimate_segment(cfg, path, data)
+                est = estimate_segment(settings, path, data)
                 wall = time.perf_counter() - t0
                 tail = est.first.time_s > est.first.time_s[-1] - 60.0
                 obs_k = est.first.mu_k[tail].mean(axis=0)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -29,6 +30,9 @@ from drillfric.errors import ModelError
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.vocabulary import LoadCase
 from drillfric.wellpath import WellPath, no_survey_path
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: Load cases (docs/theory.md §2 step 3): σ is the axial share of the friction (+1 pulling out,
 #: −1 running in, 0 rotating), the torque share is the tangential one.
@@ -380,7 +384,7 @@ def _result(mesh: _Mesh, force, torque, normal, load_case, friction) -> TDResult
                     friction=friction)
 
 
-def config_friction(cfg, friction: float | None = None) -> Friction:
+def config_friction(cfg: Config, friction: float | None = None) -> Friction:
     """Friction factor from a configuration: ``friction`` if given, else per hole section.
 
     Above ``model.casing_shoe_md_m`` the cased value applies, below it the open-hole value;
@@ -410,32 +414,76 @@ class SectionFriction:
         return np.where(np.asarray(md_m) < self.shoe_md_m, self.cased, self.open_hole)
 
 
-def solve_config(cfg, path: WellPath | None, bit_depth_m: float, **kw) -> TDResult:
-    """:func:`solve` with the string, muds, element length and friction from a Config.
+@dataclass(frozen=True)
+class TDSettings:
+    """What a well's configuration sets for its torque and drag, derived once per well.
 
-    Parameters
+    Attributes
     ----------
-    cfg : drillfric.config.Config
-    path : WellPath or None
-        Hole geometry. None: no survey, the assumed path to the bit — vertical with the
-        nominal tortuosity ``survey.tortuosity_deg_30m``
-        (:func:`drillfric.wellpath.no_survey_path`; exactly vertical when it is 0).
-    bit_depth_m : float
-        Bit measured depth [m].
-    **kw
-        Passed to :func:`solve` (``friction`` overrides the configured friction).
+    sections : tuple of dict
+        ``[[string.sections]]``, top-down (:func:`drillfric.drillstring.build_string`).
+    friction : Friction
+        The configured friction factor, per hole section (:func:`config_friction`) [-].
+    mud_out_kg_m3, mud_in_kg_m3 : float
+        Mud density in the annulus and inside the string [kg/m³].
+    element_length_m : float
+        Soft-string element length [m] (``model.element_length_m``).
+    casing_shoe_md_m : float or None
+        The casing shoe, a node of every mesh [m] (``model.casing_shoe_md_m``).
+    tortuosity_rad_m : float
+        Tortuosity of the path assumed without a survey [rad/m].
     """
-    path = no_survey_path(bit_depth_m, cfg.tortuosity_rad_m) if path is None else path
-    string = build_string(cfg.sections, bit_depth_m)
-    kw = dict(kw)
-    kw["friction"] = config_friction(cfg, kw.get("friction"))
-    kw.setdefault("mud_out_kg_m3", cfg.fluid.mud_density_kg_m3)
-    kw.setdefault("mud_in_kg_m3", cfg.inner_mud_density_kg_m3)
-    kw.setdefault("element_length_m", cfg.model.element_length_m)
-    shoe = cfg.model.casing_shoe_md_m
-    if shoe is not None:
-        kw.setdefault("extra_nodes_m", (shoe,))
-    return solve(path, string, **kw)
+
+    sections: tuple
+    friction: Friction
+    mud_out_kg_m3: float
+    mud_in_kg_m3: float
+    element_length_m: float
+    casing_shoe_md_m: float | None
+    tortuosity_rad_m: float
+
+    @classmethod
+    def from_config(cls, cfg: Config) -> TDSettings:
+        """The torque-and-drag settings of a :class:`drillfric.config.Config`."""
+        return cls(cfg.sections, config_friction(cfg), cfg.fluid.mud_density_kg_m3,
+                   cfg.inner_mud_density_kg_m3, cfg.model.element_length_m,
+                   cfg.model.casing_shoe_md_m, cfg.tortuosity_rad_m)
+
+    def path_to(self, path: WellPath | None, bit_depth_m: float) -> WellPath:
+        """``path``, or without a survey the assumed one to the bit: vertical with the
+        nominal tortuosity (:func:`drillfric.wellpath.no_survey_path`)."""
+        return no_survey_path(bit_depth_m, self.tortuosity_rad_m) if path is None else path
+
+    def string(self, bit_depth_m: float) -> DrillString:
+        """The configured string with its bit at ``bit_depth_m`` [m]."""
+        return build_string(self.sections, bit_depth_m)
+
+    def solve(self, path: WellPath | None, bit_depth_m: float, **kw) -> TDResult:
+        """:func:`solve` with these settings' string, muds, element length and friction.
+
+        Parameters
+        ----------
+        path : WellPath or None
+            Hole geometry; None: the assumed path to the bit (:meth:`path_to`).
+        bit_depth_m : float
+            Bit measured depth [m].
+        **kw
+            Passed to :func:`solve` (``friction`` overrides the configured friction).
+        """
+        kw = dict(kw)
+        kw["friction"] = self.friction if kw.get("friction") is None else float(kw["friction"])
+        kw.setdefault("mud_out_kg_m3", self.mud_out_kg_m3)
+        kw.setdefault("mud_in_kg_m3", self.mud_in_kg_m3)
+        kw.setdefault("element_length_m", self.element_length_m)
+        if self.casing_shoe_md_m is not None:
+            kw.setdefault("extra_nodes_m", (self.casing_shoe_md_m,))
+        return solve(self.path_to(path, bit_depth_m), self.string(bit_depth_m), **kw)
+
+
+def solve_config(cfg: Config, path: WellPath | None, bit_depth_m: float, **kw) -> TDResult:
+    """:func:`solve` from a configuration (an entry point: the API's ``td``, the simulator):
+    :meth:`TDSettings.solve` of :meth:`TDSettings.from_config`."""
+    return TDSettings.from_config(cfg).solve(path, bit_depth_m, **kw)
 
 
 def back_calculate_friction(path: WellPath, string: DrillString, *,

@@ -40,8 +40,9 @@ def build_and_hold(kop_m: float, hold_deg: float, td_m: float,
     return minimum_curvature(md, inc, np.zeros(4))
 
 
-def config(gains: str = "kalman", **model):
-    """Well configuration with the A&S drill pipe and a two-section BHA."""
+def config(gains: str = "kalman", observer: dict | None = None, **model):
+    """Well configuration with the A&S drill pipe and a two-section BHA (``observer``: more
+    ``[observer]`` keys, ``model``: ``[model]`` keys)."""
     sections = [
         {"name": "DP", "od_m": 0.146529, "id_m": 0.123024, "tool_joint_od_m": 0.1778,
          "shear_modulus_Pa": 61e9},
@@ -51,7 +52,7 @@ def config(gains: str = "kalman", **model):
          "shear_modulus_Pa": 67e9}]
     return config_from_dict({"string": {"sections": sections},
                              "model": {"k_t_per_s": 0.1, **model},
-                             "observer": {"gains": gains}})
+                             "observer": {"gains": gains, **(observer or {})}})
 
 
 @dataclass(frozen=True)

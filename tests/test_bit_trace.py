@@ -21,6 +21,7 @@ from drillfric.estimation.bit_trace import (
 from drillfric.estimation.chain import SegmentData, estimate_segment
 from drillfric.estimation.diagnostics import stick_slip_severity
 from drillfric.estimation.sampling import Resolution
+from drillfric.estimation.settings import ChainSettings
 from drillfric.result import Flag
 from tests.synthetic import RPM, build_and_hold, config, noisy, simulate
 
@@ -178,7 +179,8 @@ def test_severe_stick_slip_statistics_withheld_not_printed_low():
     late = rec.time_s > 30.0
     assert stick_slip_severity(rec.bit_rad_s[late]) > 2.9  # beyond the validated 1.9–2.9
     w, q = noisy(rec)
-    est = estimate_segment(cfg, path, SegmentData(rec.time_s, w / RPM, q, 2000.0))
+    est = estimate_segment(ChainSettings.from_config(cfg), path,
+                           SegmentData(rec.time_s, w / RPM, q, 2000.0))
     assert est.stick_slip_severity >= SEVERITY_VALIDATED_BELOW
     assert not est.bit_statistics
     assert Flag.STICK_SLIP_BEYOND_VALIDATED in est.flags
@@ -201,7 +203,8 @@ def test_stick_slip_statistics_below_the_limit_are_reported_within_tolerance():
     stuck = float(np.mean(np.abs(rec.bit_rad_s[late]) <= 1.0))
     assert 1.0 < truth < 2.0  # the bit stops, below the validated-range limit
     w, q = noisy(rec)
-    est = estimate_segment(cfg, path, SegmentData(rec.time_s, w / RPM, q, 2000.0))
+    est = estimate_segment(ChainSettings.from_config(cfg), path,
+                           SegmentData(rec.time_s, w / RPM, q, 2000.0))
     assert est.bit_statistics and Flag.STICK_SLIP_BEYOND_VALIDATED not in est.flags
     assert est.stick_slip_severity == pytest.approx(truth, rel=0.12)
     assert est.stuck_fraction == pytest.approx(stuck, abs=0.05)

@@ -16,13 +16,14 @@ from drillfric.errors import ConfigError, ModelError
 from drillfric.estimation import lumped
 from drillfric.estimation.gains import (
     Gains,
+    GainSettings,
     KalmanNoise,
     Tuning,
     backstepping_gains,
     characteristic_dN,
     characteristic_N,
+    design_gains,
     error_system,
-    gains_from_config,
     injection_on_nodes,
     kalman_filter_gain,
     kalman_gains,
@@ -344,23 +345,23 @@ def test_bad_inputs_raise_model_errors():
         kalman_gains(as_params(k_t_per_s=0.1), [0.0], T_N, 0.0)
 
 
-def test_gains_from_config_selects_the_design():
+def test_gain_settings_select_the_design():
     string = as_string()
     x = np.linspace(5.0, string.bha_top_m - 5.0, 20)
     base = {"string": {"sections": AS_SECTIONS}}
     custom = config_from_dict({**base, "observer": {"gains": "backstepping", "kappa1": 0.8,
                                                     "lambda0_per_s": 12.0,
                                                     "poles_per_s": [0.8, 2.0]}})
-    g = gains_from_config(custom, string, T_N, x, 2e-3)
+    g = design_gains(GainSettings.from_config(custom), string, T_N, x, 2e-3)
     ref = backstepping_gains(LumpedParams.from_string(string, 2900.0), Tuning(0.8, 12.0, 0.8, 2.0),
                              x, T_N)
     assert g.P0 == pytest.approx(ref.P0) and g.l_k == pytest.approx(ref.l_k)
-    kal = gains_from_config(config_from_dict({**base, "observer": {"gains": "kalman"}}),
-                            string, T_N, x, 2e-3)
+    kal = design_gains(GainSettings.from_config(config_from_dict(
+        {**base, "observer": {"gains": "kalman"}})), string, T_N, x, 2e-3)
     assert kal.design == "kalman" and kal.p_beta.shape == x.shape
     assert g.design == "backstepping"
     with pytest.raises(ConfigError, match="poles_per_s"):
-        gains_from_config(config_from_dict({**base, "observer": {"gains": "backstepping",
+        GainSettings.from_config(config_from_dict({**base, "observer": {"gains": "backstepping",
                                                                  "poles_per_s": [1.0]}}),
                           string, T_N, x, 2e-3)
 
@@ -379,13 +380,12 @@ def test_kalman_injection_follows_the_logging_interval():
     top-drive injection and friction adaptation than a 100 Hz one."""
     from drillfric.config import config_from_dict
     from drillfric.drillstring import build_string
-    from drillfric.estimation.gains import gains_from_config
 
     cfg = config_from_dict({"string": {"sections": AS_SECTIONS}, "model": {"k_t_per_s": 0.1}})
     string = build_string(cfg.sections, 2500.0)
     x = np.linspace(1.0, string.bha_top_m - 1.0, 200)
-    fast = gains_from_config(cfg, string, 50e3, x, 1e-3, sample_dt_s=0.01)
-    slow = gains_from_config(cfg, string, 50e3, x, 1e-3, sample_dt_s=0.2)
+    fast = design_gains(GainSettings.from_config(cfg), string, 50e3, x, 1e-3, sample_dt_s=0.01)
+    slow = design_gains(GainSettings.from_config(cfg), string, 50e3, x, 1e-3, sample_dt_s=0.2)
     assert slow.p0 < fast.p0 and slow.l_k < fast.l_k
 
 

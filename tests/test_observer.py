@@ -13,7 +13,7 @@ import pytest
 
 from drillfric import torsional
 from drillfric.errors import InputError, ModelError
-from drillfric.estimation.gains import gains_from_config
+from drillfric.estimation.gains import GainSettings, design_gains
 from drillfric.estimation.observer import Measurements, Observer, ObserverState, observe
 from tests.synthetic import RPM, build_and_hold, config, noisy, simulate
 
@@ -25,7 +25,8 @@ def make_observer(case, cfg, cells=400, **kw) -> Observer:
     plant = torsional.Plant(grid, case.td.fc_at(grid.x_m), 0.0, 0.0, cfg.omega_c_rad_s,
                             cfg.model.k_t_per_s, cfg.rig.top_drive_inertia_kg_m2)
     n_pipe = grid.section_start[1]
-    gains = gains_from_config(cfg, case.string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s)
+    gains = design_gains(GainSettings.from_config(cfg), case.string, plant.T_N_Nm,
+                         grid.x_m[:n_pipe], grid.dt_s)
     return Observer(plant, gains, **kw)
 
 

@@ -30,13 +30,13 @@ import numba
 import numpy as np
 
 from drillfric import torque_drag, torsional
-from drillfric.drillstring import DrillString, build_string
+from drillfric.drillstring import DrillString
 from drillfric.errors import DrillfricError, ModelError
 from drillfric.estimation import batch, bit_torque, bit_trace, spikes
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
-from drillfric.estimation.gains import gains_from_config
+from drillfric.estimation.gains import design_gains
 from drillfric.estimation.observer import (
     BitSpeedEstimate,
     Measurements,
@@ -47,14 +47,15 @@ from drillfric.estimation.observer import (
     observe,
 )
 from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_interval, resolution
+from drillfric.estimation.settings import ChainSettings
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import Evidence, TraceEvidence, Verdict, decide, decide_trace
 from drillfric.friction import FrictionProfile
 from drillfric.io.timebase import find_gaps
 from drillfric.result import Flag
 from drillfric.units import RPM_TO_RAD_S
-from drillfric.vocabulary import Kind, Method
-from drillfric.wellpath import WellPath, no_survey_path
+from drillfric.vocabulary import Kind, LoadCase, Method
+from drillfric.wellpath import WellPath
 
 #: Largest cell of the batch fit's model [m] (docs/theory.md §6.4).
 BATCH_MAX_DX_M = 5.0
@@ -199,39 +200,41 @@ class SegmentEstimate:
     samples_dropped: int = 0
 
 
-def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
+def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
+              ) -> WellPath:
     """The survey's path, or without one the assumed tortuous vertical path to the bit."""
     if path is None:
-        return no_survey_path(bit_depth_m, cfg.tortuosity_rad_m)
+        return settings.td.path_to(None, bit_depth_m)
     if bit_depth_m > path.md_max_m + 1e-6:
         raise DrillfricError(f"the survey ends at {path.md_max_m:.1f} m, above the bit at "
                              f"{bit_depth_m:.1f} m", fix="extend the survey to the bit depth")
     return path
 
 
-def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
+def build_observer(settings: ChainSettings, string, td: torque_drag.TDResult,
                    sample_dt_s: float | None = None, mu_s: float = 0.0,
-                   mu_k: float = 0.0, profile: FrictionProfile | None = None) -> Observer:
-    """Observer for this string and F_c profile from the configuration (docs/theory.md §5);
-    ``sample_dt_s`` is the logging interval of the measurements [s]. With a cased zone of
-    unknown static friction, (``mu_s``, ``mu_k``) tie it to the open hole's ratio (the
-    observer's own μ̂ multiply the open hole's F_c only: docs/theory.md §3.2). ``profile``:
-    the configuration's friction zones when already built."""
-    grid = torsional.make_grid(string, cells)
-    plant = (profile or FrictionProfile.from_config(cfg)).plant(
-        grid, td.fc_at(grid.x_m), mu_s, mu_k, omega_c_rad_s=cfg.omega_c_rad_s,
-        k_t_per_s=cfg.model.k_t_per_s, top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
+                   mu_k: float = 0.0) -> Observer:
+    """Observer for this string and F_c profile (docs/theory.md §5); ``sample_dt_s`` is the
+    logging interval of the measurements [s]. With a cased zone of unknown static friction,
+    (``mu_s``, ``mu_k``) tie it to the open hole's ratio (the observer's own μ̂ multiply the
+    open hole's F_c only: docs/theory.md §3.2)."""
+    grid = torsional.make_grid(string, settings.cells)
+    batch_settings = settings.batch
+    plant = settings.friction.plant(
+        grid, td.fc_at(grid.x_m), mu_s, mu_k, omega_c_rad_s=batch_settings.omega_c_rad_s,
+        k_t_per_s=batch_settings.k_t_per_s,
+        top_drive_inertia_kg_m2=batch_settings.top_drive_inertia_kg_m2,
         cased_static="tied" if mu_k > 0 else "kinetic")
     n_pipe = int(grid.section_start[1])
-    gains = gains_from_config(cfg, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s,
-                              sample_dt_s)
-    return Observer(plant, gains, law=cfg.observer.law, mu_max=cfg.observer.mu_max,
-                    deadlock_s=cfg.observer.deadlock_s,
-                    hold=cfg.observer.interpolation == "hold")
+    gains = design_gains(settings.gains, string, plant.T_N_Nm, grid.x_m[:n_pipe], grid.dt_s,
+                         sample_dt_s)
+    observer = settings.observer
+    return Observer(plant, gains, law=observer.law, mu_max=observer.mu_max,
+                    deadlock_s=observer.deadlock_s, hold=observer.interpolation == "hold")
 
 
-def _starts(cfg, warm, mu_max) -> np.ndarray:
-    starts = [list(s) for s in cfg.observer.starts]
+def _starts(settings: ChainSettings, warm, mu_max) -> np.ndarray:
+    starts = [list(s) for s in settings.observer.starts]
     if warm is not None and all(v is not None for v in warm):
         starts.append([max(warm[0], warm[1]), warm[1]])
     out = np.clip(np.asarray(starts, dtype=float), 0.0, mu_max)
@@ -239,10 +242,10 @@ def _starts(cfg, warm, mu_max) -> np.ndarray:
     return out
 
 
-def _batch_cells(cfg, bit_depth_m: float) -> int:
+def _batch_cells(settings: ChainSettings, bit_depth_m: float) -> int:
     """Cells of the speed-driven fit: ``model.cells``, refined to Δx ≤ 5 m (docs/theory.md §6.4:
     at 10 m the fit was biased by 10–14 %)."""
-    return max(int(cfg.model.cells), int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
+    return max(settings.cells, int(np.ceil(bit_depth_m / BATCH_MAX_DX_M)))
 
 
 def ensemble_starts(mu_s: float, mu_k: float, members: int, spread: float,
@@ -268,14 +271,15 @@ def ensemble_starts(mu_s: float, mu_k: float, members: int, spread: float,
     return np.column_stack([mu_s_members, np.full(offsets.size, mu_k)])
 
 
-def _final_pass(cfg, observer: Observer, meas: Measurements, mu_s: float, mu_k: float, *,
-                adapt: bool, output_rate_hz: float) -> ObserverRecord:
+def _final_pass(settings: ChainSettings, observer: Observer, meas: Measurements,
+                mu_s: float, mu_k: float, *, adapt: bool, output_rate_hz: float
+                ) -> ObserverRecord:
     """The observer over the whole segment from the refined factors, as an ensemble
     (``observer.ensemble_members``, ``observer.ensemble_spread``); μ̂ held unless ``adapt``."""
     if not adapt:
         observer = replace(observer, gains=replace(observer.gains, l_k=0.0, l_s=0.0))
-    members = ensemble_starts(mu_s, mu_k, cfg.observer.ensemble_members,
-                              cfg.observer.ensemble_spread, observer.mu_max)
+    members = ensemble_starts(mu_s, mu_k, settings.observer.ensemble_members,
+                              settings.observer.ensemble_spread, observer.mu_max)
     state = ObserverState.from_starts(observer, members, omega0_rad_s=meas.surface_rad_s[0],
                                       t_s=meas.t0_s, torque_top_Nm=_initial_torque(meas))
     final, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz)
@@ -300,22 +304,21 @@ def _open_hole_friction(profile: FrictionProfile):
     return lambda mu: torque_drag.SectionFriction(profile.shoe_md_m, cased(mu), mu)
 
 
-def _td_cross_check(models: SegmentModels, cfg) -> float | None:
+def _td_cross_check(models: SegmentModels, settings: ChainSettings) -> float | None:
     """Static friction factor from the mean rotating string torque (T&D back-calculation)."""
-    meas = models.meas
-    rotating = np.abs(meas.surface_rad_s) > 2.0 * cfg.omega_c_rad_s
+    meas, td = models.meas, settings.td
+    rotating = np.abs(meas.surface_rad_s) > 2.0 * settings.omega_c_rad_s
     if rotating.sum() < 10:
         return None
     torque = batch.measured_string_torque(meas.time_s, meas.surface_rad_s,
                                           meas.motor_torque_Nm, "motor",
-                                          cfg.rig.top_drive_inertia_kg_m2)
+                                          settings.top_drive_inertia_kg_m2)
     try:
         return float(torque_drag.back_calculate_friction(
             models.path, models.string, surface_torque_Nm=float(np.mean(torque[rotating])),
-            load_case="rotating_off_bottom", friction_of=_open_hole_friction(models.profile),
-            mud_out_kg_m3=cfg.fluid.mud_density_kg_m3,
-            mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
-            element_length_m=cfg.model.element_length_m))
+            load_case="rotating_off_bottom", friction_of=_open_hole_friction(settings.friction),
+            mud_out_kg_m3=td.mud_out_kg_m3, mud_in_kg_m3=td.mud_in_kg_m3,
+            element_length_m=td.element_length_m))
     except DrillfricError:
         return None
 
@@ -379,10 +382,6 @@ class SegmentModels:
     on_bottom : bool
     logged : LoggingInterval
         The log's effective sample interval (docs/bit_speed.md "Logging rate").
-    profile : FrictionProfile
-        The configuration's friction zones and law (docs/theory.md §3.2).
-    batch_settings : BatchSettings
-        The configuration's settings of the speed-driven fit.
     sample_times_s : ndarray
         Times of the logged samples the measurements rest on [s]: the segment's, without
         the EDR defects :mod:`drillfric.estimation.spikes` dropped.
@@ -397,13 +396,11 @@ class SegmentModels:
     observer: Observer
     on_bottom: bool
     logged: LoggingInterval
-    profile: FrictionProfile
-    batch_settings: batch.BatchSettings
     sample_times_s: np.ndarray = field(repr=False)
     dropped: int = 0
 
 
-def build_models(cfg, path: WellPath | None, data: SegmentData, *,
+def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentData, *,
                  rate_hz: float | None = None, torque_channel=None) -> SegmentModels:
     """Step 1: string, torque and drag, measurements and observer of one segment.
 
@@ -416,34 +413,32 @@ def build_models(cfg, path: WellPath | None, data: SegmentData, *,
     """
     fix = "give the well's survey" + (
         "" if path is not None else " (or a nominal survey.tortuosity_deg_30m > 0)")
-    path = _path_for(cfg, path, data.bit_depth_m)
+    path = _path_for(settings, path, data.bit_depth_m)
     on_bottom = data.kind == Kind.ON_BOTTOM
-    td = torque_drag.solve_config(cfg, path, data.bit_depth_m,
-                                  load_case="rotating_on_bottom" if on_bottom
-                                  else "rotating_off_bottom", wob_N=data.wob_N)
+    td = settings.td.solve(path, data.bit_depth_m, wob_N=data.wob_N,
+                           load_case=LoadCase.ROTATING_ON_BOTTOM if on_bottom
+                           else LoadCase.ROTATING_OFF_BOTTOM)
     if td.T_N_Nm < 1.0:
         raise SkipSegment(f"no side force on the string at {data.bit_depth_m:.0f} m (T_N = "
                           f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
                           "torque", fix=fix)
-    check_torque_scale(data, td.T_N_Nm, cfg.omega_c_rad_s, torque_channel=torque_channel)
-    string = build_string(cfg.sections, data.bit_depth_m)
+    check_torque_scale(data, td.T_N_Nm, settings.omega_c_rad_s, torque_channel=torque_channel)
+    string = settings.td.string(data.bit_depth_m)
     bad = spikes.defects(data.time_s, 4.0 * bit_trace.travel_time_s(string), data.surface_rpm,
-                         data.surface_torque_Nm, cfg.rig.top_drive_inertia_kg_m2)
+                         data.surface_torque_Nm, settings.top_drive_inertia_kg_m2)
     data = _without(data, bad)
     meas = Measurements.from_samples(
         data.time_s, data.surface_rpm * RPM_TO_RAD_S, data.surface_torque_Nm,
-        torque_kind=cfg.rig.torque_kind,
-        top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2, rate_hz=rate_hz)
-    profile = FrictionProfile.from_config(cfg)
-    observer = build_observer(cfg, string, td, cfg.model.cells, sample_dt_s=meas.dt_s,
-                              profile=profile)
+        torque_kind=settings.torque_kind,
+        top_drive_inertia_kg_m2=settings.top_drive_inertia_kg_m2, rate_hz=rate_hz)
+    observer = build_observer(settings, string, td, sample_dt_s=meas.dt_s)
     logged = logging_interval(data.time_s, data.surface_rpm, data.surface_torque_Nm,
-                              averaging_s=cfg.rig.sample_averaging_s, model_dt_s=meas.dt_s,
+                              averaging_s=settings.sample_averaging_s, model_dt_s=meas.dt_s,
                               torque_min_Nm=data.torque_min_Nm,
                               torque_max_Nm=data.torque_max_Nm,
                               echo_s=2.0 * bit_trace.travel_time_s(string))
-    return SegmentModels(path, string, td, meas, observer, on_bottom, logged, profile,
-                         batch.BatchSettings.from_config(cfg), data.time_s, int(bad.sum()))
+    return SegmentModels(path, string, td, meas, observer, on_bottom, logged, data.time_s,
+                         int(bad.sum()))
 
 
 def _without(data: SegmentData, drop: np.ndarray) -> SegmentData:
@@ -456,19 +451,19 @@ def _without(data: SegmentData, drop: np.ndarray) -> SegmentData:
         "torque_max_Nm") if getattr(data, name) is not None})
 
 
-def starts_pass(cfg, models: SegmentModels, warm: tuple | None,
+def starts_pass(settings: ChainSettings, models: SegmentModels, warm: tuple | None,
                 output_rate_hz: float) -> tuple[np.ndarray, ObserverRecord, Diagnostics]:
     """Step 2: the observer from every start over ``observer.starts_window_s``; returns the
     starts (μ_s, μ_k), their record and its diagnostics."""
     meas, observer = models.meas, models.observer
-    starts = _starts(cfg, warm, observer.mu_max)
+    starts = _starts(settings, warm, observer.mu_max)
     state = ObserverState.from_starts(observer, starts, omega0_rad_s=meas.surface_rad_s[0],
                                       t_s=meas.t0_s, torque_top_Nm=_initial_torque(meas))
-    window_end = min(meas.t_end_s, meas.t0_s + cfg.observer.starts_window_s)
+    window_end = min(meas.t_end_s, meas.t0_s + settings.observer.starts_window_s)
     first, _ = observe(observer, meas, state, output_rate_hz=output_rate_hz,
                        t_end_s=window_end)
     check_bounded(first, meas)
-    return starts, first, diagnose(first, cfg.omega_c_rad_s)
+    return starts, first, diagnose(first, settings.omega_c_rad_s)
 
 
 #: How far the observer's surface-speed estimate may stray beyond the logged speed before
@@ -491,22 +486,22 @@ def check_bounded(record: ObserverRecord, meas: Measurements) -> None:
                              "that the torque and speed channels are the top drive's")
 
 
-def batch_fit(cfg, models: SegmentModels) -> batch.BatchResult:
+def batch_fit(settings: ChainSettings, models: SegmentModels) -> batch.BatchResult:
     """Step 3: the speed-driven fit over the first ``batch.window_s`` (docs/theory.md §6.4)."""
-    meas, settings = models.meas, models.batch_settings
-    n_fit = min(meas.surface_rad_s.size, int(settings.window_s / meas.dt_s) + 1)
+    meas = models.meas
+    n_fit = min(meas.surface_rad_s.size, int(settings.batch.window_s / meas.dt_s) + 1)
     return batch.refine(meas.time_s[:n_fit], meas.surface_rad_s[:n_fit],
                         meas.motor_torque_Nm[:n_fit], string=models.string,
-                        fc_Nm_m=models.td.fc_at, settings=settings, torque_kind="motor",
-                        cells=_batch_cells(cfg, models.string.bit_depth_m),
-                        profile=models.profile, sample_interval_s=models.logged.interval_s)
+                        fc_Nm_m=models.td.fc_at, settings=settings.batch, torque_kind="motor",
+                        cells=_batch_cells(settings, models.string.bit_depth_m),
+                        profile=settings.friction, sample_interval_s=models.logged.interval_s)
 
 
-def evidence(cfg, models: SegmentModels, diag: Diagnostics,
+def evidence(settings: ChainSettings, models: SegmentModels, diag: Diagnostics,
              refined: batch.BatchResult) -> Evidence:
     """What steps 2 and 3 found, for :func:`~drillfric.estimation.verdict.decide`."""
     meas = models.meas
-    turning_s = float(np.sum(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s) * meas.dt_s)
+    turning_s = float(np.sum(np.abs(meas.surface_rad_s) > settings.omega_c_rad_s) * meas.dt_s)
     return Evidence(batch_mu_k=refined.mu_k, batch_flags=tuple(refined.flags),
                     batch_messages=tuple(refined.messages),
                     mu_s_lower_bound=refined.mu_s_lower_bound,
@@ -517,34 +512,34 @@ def evidence(cfg, models: SegmentModels, diag: Diagnostics,
                     batch_mu_k_sigma=refined.details.mu_k_sigma)
 
 
-def seeded_pass(cfg, models: SegmentModels, verdict: Verdict,
+def seeded_pass(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
                 output_rate_hz: float) -> tuple[ObserverRecord, BitSpeedEstimate]:
     """Step 5: the ensemble seeded with the verdict's factors over the whole segment, and
     the bit speed it gives (weighted mean and band)."""
     observer = models.observer
-    if not models.profile.static_known:  # tie the cased μ_s to the seed
+    if not settings.friction.static_known:  # tie the cased μ_s to the seed
         observer = replace(observer, plant=build_observer(
-            cfg, models.string, models.td, cfg.model.cells, models.meas.dt_s,
-            verdict.mu_s_seed, verdict.mu_k, models.profile).plant)
-    final = _final_pass(cfg, observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
-                        adapt=verdict.adapt_final or cfg.observer.adapt_final,
+            settings, models.string, models.td, models.meas.dt_s, verdict.mu_s_seed,
+            verdict.mu_k).plant)
+    final = _final_pass(settings, observer, models.meas, verdict.mu_s_seed, verdict.mu_k,
+                        adapt=verdict.adapt_final or settings.observer.adapt_final,
                         output_rate_hz=output_rate_hz)
     bit = ensemble_bit_speed(final, _memory_s(observer, models.meas),
-                             cfg.observer.speed_noise_rpm * RPM_TO_RAD_S)
+                             settings.speed_noise_rad_s)
     return final, bit
 
 
-def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | None
-                 ) -> FitEvidence:
+def fit_evidence(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
+                 mu_s: float | None) -> FitEvidence:
     """Step 6: the fitted speed-driven model over the whole segment against the measured
     string torque, with its misfit relative to the torque swing."""
     meas = models.meas
     t, measured, model = batch.model_string_torque(
         meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
-        fc_Nm_m=models.td.fc_at, settings=models.batch_settings,
+        fc_Nm_m=models.td.fc_at, settings=settings.batch,
         mu_s=mu_s if mu_s is not None else verdict.mu_s_seed, mu_k=verdict.mu_k,
-        cells=_batch_cells(cfg, models.string.bit_depth_m), profile=models.profile)
-    fast = np.flatnonzero(np.abs(meas.surface_rad_s) > cfg.omega_c_rad_s)
+        cells=_batch_cells(settings, models.string.bit_depth_m), profile=settings.friction)
+    fast = np.flatnonzero(np.abs(meas.surface_rad_s) > settings.omega_c_rad_s)
     scored = t >= (t[fast[0]] + EVIDENCE_SKIP_S if fast.size else np.inf)
     if scored.sum() < 10:
         return FitEvidence(t, measured, model, None, None, None)
@@ -555,7 +550,7 @@ def fit_evidence(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | Non
                        float(high - low), float(np.mean(measured[scored])), scored)
 
 
-def _model_at(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | None):
+def _model_at(settings: ChainSettings, models: SegmentModels, verdict: Verdict, mu_s: float | None):
     """(μ-scale, bit torque [N·m]) → the evidence's model string torque at (scale·μ_s,
     scale·μ_k) with that Coulomb bit [N·m] (the torque line of
     :func:`drillfric.estimation.bit_torque.torque_terms`)."""
@@ -565,9 +560,9 @@ def _model_at(cfg, models: SegmentModels, verdict: Verdict, mu_s: float | None):
     def model_at(scale: float, bit_Nm: float = 0.0) -> np.ndarray:
         return batch.model_string_torque(
             meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
-            fc_Nm_m=models.td.fc_at, settings=models.batch_settings, mu_s=scale * mu_s,
-            mu_k=scale * verdict.mu_k, cells=_batch_cells(cfg, models.string.bit_depth_m),
-            profile=models.profile, bit_torque_Nm=bit_Nm)[2]
+            fc_Nm_m=models.td.fc_at, settings=settings.batch, mu_s=scale * mu_s,
+            mu_k=scale * verdict.mu_k, cells=_batch_cells(settings, models.string.bit_depth_m),
+            profile=settings.friction, bit_torque_Nm=bit_Nm)[2]
     return model_at
 
 
@@ -578,7 +573,7 @@ def bit_speed_resolution(models: SegmentModels) -> Resolution:
     return resolution(models.logged, 4.0 * models.observer.plant.grid.travel_time_s)
 
 
-def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
+def estimate_segment(settings: ChainSettings, path: WellPath | None, data: SegmentData, *,
                      warm: tuple | None = None, rate_hz: float | None = None,
                      output_rate_hz: float | None = None, progress=None,
                      torque_channel=None) -> SegmentEstimate:
@@ -586,7 +581,8 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
 
     Parameters
     ----------
-    cfg : Config
+    settings : ChainSettings
+        The well's settings (:meth:`ChainSettings.from_config`, built once per well).
     path : WellPath or None
         Well path; None: no survey, a vertical hole with the nominal tortuosity
         ``survey.tortuosity_deg_30m`` (exactly vertical when it is 0).
@@ -610,21 +606,20 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         The segment cannot be estimated (survey above the bit, implausible torque scale).
     """
     tick = progress or (lambda amount: None)
-    out_rate = output_rate_hz or cfg.observer.output_rate_hz
-    models = build_models(cfg, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
-    starts, first, diag = starts_pass(cfg, models, warm, out_rate)
+    out_rate = output_rate_hz or settings.observer.output_rate_hz
+    models = build_models(settings, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
+    starts, first, diag = starts_pass(settings, models, warm, out_rate)
     tick(0.3)
-    refined = batch_fit(cfg, models)
+    refined = batch_fit(settings, models)
     tick(0.5)
-    verdict = decide(evidence(cfg, models, diag, refined))
-    fitted_result = beside(fit_evidence, cfg, models, verdict, refined.mu_s)
-    final, bit = seeded_pass(cfg, models, verdict, out_rate)
+    verdict = decide(evidence(settings, models, diag, refined))
+    fitted_result = beside(fit_evidence, settings, models, verdict, refined.mu_s)
+    final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
-    estimate = _assemble(cfg, models, data, starts, first, diag, refined, verdict, final, bit)
+    estimate = _assemble(settings, models, data, starts, first, diag, refined, verdict, final, bit)
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
-                                               bit.rad_s, cfg.observer.speed_noise_rpm
-                                               * RPM_TO_RAD_S)
-    windows = _windows(cfg, models, refined, final.time_s, bit.rad_s)
+                                               bit.rad_s, settings.speed_noise_rad_s)
+    windows = _windows(settings, models, refined, final.time_s, bit.rad_s)
     late = settled_mask(final.time_s)
     settled = final.time_s[late]
     runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
@@ -634,7 +629,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
     undetermined = ("stuck fraction and severity withheld: the bit trace is withheld over some "
                     "of their windows (window by window, docs/bit_speed.md)") if cut else \
         bit_trace.members_disagree(final.bit_rad_s_est[late], estimate.stick_slip_severity,
-                                   cfg.omega_c_rad_s)
+                                   settings.omega_c_rad_s)
     trace = decide_trace(TraceEvidence(
         logging=bit_speed_resolution(models), on_bottom=models.on_bottom, check=kinematics,
         windows=windows, converged=estimate.converged,
@@ -642,7 +637,7 @@ def estimate_segment(cfg, path: WellPath | None, data: SegmentData, *,
         severe_note=bit_trace.statistics_note(estimate.stick_slip_severity),
         undetermined_note=undetermined))
     fitted = fitted_result()
-    terms = bit_torque.torque_terms(models.meas, fitted, _model_at(cfg, models, verdict,
+    terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
     return replace(estimate, evidence=fitted, torque_terms=terms, converged=trace.converged,
@@ -701,7 +696,7 @@ def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) ->
             "string can hold: the fitted factors do not describe this record")
 
 
-def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
+def _windows(settings: ChainSettings, models: SegmentModels, refined, time_s: np.ndarray,
              bit_rad_s: np.ndarray) -> bit_trace.WindowVerdict:
     """The window-by-window check of the trace (docs/bit_speed.md "Window by window"); where
     μ_s was not identified, the windows of the start-up from rest and of each creep with its
@@ -720,14 +715,14 @@ def _windows(cfg, models: SegmentModels, refined, time_s: np.ndarray,
     return bit_trace.window_check(time_s, bit_rad_s, meas.time_s, meas.surface_rad_s,
                                   meas.motor_torque_Nm,
                                   bit_trace.compliance_rad_Nm(models.string), travel,
-                                  cfg.observer.speed_noise_rpm * RPM_TO_RAD_S, unknown,
+                                  settings.speed_noise_rad_s, unknown,
                                   find_gaps(models.sample_times_s, travel, 1.0 / meas.dt_s))
 
 
-def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag, refined,
-              verdict: Verdict, final, bit) -> SegmentEstimate:
+def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData, starts,
+              first, diag, refined, verdict: Verdict, final, bit) -> SegmentEstimate:
     """The segment's estimate from the chain's results (diagnostics of what is reported)."""
-    reported = diagnose(bit.record(final), cfg.omega_c_rad_s)
+    reported = diagnose(bit.record(final), settings.omega_c_rad_s)
     late = settled_mask(final.time_s)
     members, weights = final.bit_rad_s_est[late], bit.weights[late]
     messages = list(verdict.messages)
@@ -738,17 +733,18 @@ def _assemble(cfg, models: SegmentModels, data: SegmentData, starts, first, diag
                                       models.meas))
     return SegmentEstimate(
         mu_s=refined.mu_s, mu_k=verdict.mu_k, mu_s_identifiable=refined.mu_s_identifiable,
-        mu_s_lower_bound=verdict.mu_s_lower_bound, mu_s_spread=_mu_s_spread(cfg, refined, diag),
+        mu_s_lower_bound=verdict.mu_s_lower_bound,
+        mu_s_spread=_mu_s_spread(settings, refined, diag),
         mu_k_spread=diag.mu_k_spread, converged=verdict.converged, method=verdict.method,
         settling_time_s=diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
         stick_slip_severity=bit_trace.mixture_severity(members, weights),
-        stuck_fraction=bit_trace.stuck_share(members, weights, cfg.omega_c_rad_s),
+        stuck_fraction=bit_trace.stuck_share(members, weights, settings.omega_c_rad_s),
         mu_k_observer=diag.mu_k, mu_s_observer=diag.mu_s,
-        mu_td=_td_cross_check(models, cfg), T_N_Nm=models.observer.plant.T_N_Nm,
+        mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags, messages=tuple(messages), starts=starts, first=first,
         final=final, bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data),
         td=models.td, mu_s_seed=verdict.mu_s_seed,
-        friction_zone=models.profile.zone)
+        friction_zone=settings.friction.zone)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,
@@ -774,7 +770,8 @@ def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult
             f"{twist / speed:.0f} s of creep (for μ_s ≈ 2μ_k) — hold the creep longer")
 
 
-def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | None:
+def _mu_s_spread(settings: ChainSettings, refined: batch.BatchResult, diag: Diagnostics
+                 ) -> float | None:
     """Uncertainty of the reported μ_s [-]: the creep fit's change on grid refinement.
 
     The observer starts' μ_s spread means something only under the paper's law; with the
@@ -782,7 +779,7 @@ def _mu_s_spread(cfg, refined: batch.BatchResult, diag: Diagnostics) -> float | 
     """
     if refined.mu_s is not None and refined.details.creep_grid_move is not None:
         return float(refined.details.creep_grid_move * refined.mu_s)
-    return diag.mu_s_spread if cfg.observer.law == "paper" else None
+    return diag.mu_s_spread if settings.observer.law == "paper" else None
 
 
 def _memory_s(observer: Observer, meas: Measurements) -> float:
@@ -801,10 +798,10 @@ def _bit_error(time_s: np.ndarray, bit: BitSpeedEstimate, data: SegmentData) -> 
     return float(np.sqrt(np.mean(error**2)))
 
 
-def check_segment(data: SegmentData, cfg) -> None:
+def check_segment(data: SegmentData, settings: ChainSettings) -> None:
     """Raise SkipSegment when a segment has too little to estimate from."""
     if data.time_s.size < 20:
         raise SkipSegment(f"only {data.time_s.size} samples")
-    if np.nanmax(np.abs(data.surface_rpm)) * RPM_TO_RAD_S <= cfg.omega_c_rad_s:
+    if np.nanmax(np.abs(data.surface_rpm)) * RPM_TO_RAD_S <= settings.omega_c_rad_s:
         raise SkipSegment("the top drive never turns faster than ω_c")
 

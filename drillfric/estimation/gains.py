@@ -19,16 +19,20 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg
 
 from drillfric.config import default
 from drillfric.drillstring import DrillString
-from drillfric.errors import ConfigError, ModelError
+from drillfric.errors import ModelError
 from drillfric.estimation import lumped
 from drillfric.estimation.lumped import Injection, LumpedParams
 from drillfric.units import RPM_TO_RAD_S
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 
 @dataclass(frozen=True)
@@ -406,27 +410,50 @@ def kalman_gains(params: LumpedParams, x_m, T_N_Nm: float, dt_s: float, *,
                  p1=float(gain[2 * n + 1]), p_d=p_d, l_k=l_k, l_s=2.0 * l_k, design="kalman")
 
 
-def tuning_from_config(cfg) -> Tuning:
-    """Backstepping tuning from the ``[observer]`` table (kappa1, lambda0_per_s, poles_per_s)."""
-    poles = cfg.observer.poles_per_s
-    if (len(poles) != 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                   for v in poles)):
-        raise ConfigError(f"observer.poles_per_s must be two numbers [z, p], got {poles!r}",
-                          file=None if cfg.source is None else str(cfg.source),
-                          fix="write poles_per_s = [1.0, 1.5]")
-    return Tuning(kappa1=cfg.observer.kappa1, lambda0_per_s=cfg.observer.lambda0_per_s,
-                  z_per_s=float(poles[0]), p_per_s=float(poles[1]))
+@dataclass(frozen=True)
+class GainSettings:
+    """What the configuration sets for the observer's gains (docs/theory.md §5.1), SI;
+    derived once per well (:meth:`from_config`).
+
+    Attributes
+    ----------
+    design : str
+        ``"kalman"`` or ``"backstepping"`` (``observer.gains``).
+    tuning : Tuning or None
+        The backstepping design's tuning (None for the Kalman design).
+    speed_noise_rad_s : float
+        Standard deviation of the logged speed's noise [rad/s] (``observer.speed_noise_rpm``):
+        the Kalman design's measurement noise.
+    top_drive_inertia_kg_m2 : float
+        I_TD of the design model [kg·m²].
+    k_t_per_s : float
+        Viscous damping rate of the design model [1/s].
+    """
+
+    design: str
+    tuning: Tuning | None
+    speed_noise_rad_s: float
+    top_drive_inertia_kg_m2: float
+    k_t_per_s: float
+
+    @classmethod
+    def from_config(cls, cfg: Config) -> GainSettings:
+        """The gain settings of ``[observer]``, ``[rig]`` and ``[model]``."""
+        obs = cfg.observer
+        tuning = None if obs.gains == "kalman" else Tuning(
+            kappa1=obs.kappa1, lambda0_per_s=obs.lambda0_per_s,
+            z_per_s=float(obs.poles_per_s[0]), p_per_s=float(obs.poles_per_s[1]))
+        return cls(obs.gains, tuning, obs.speed_noise_rpm * RPM_TO_RAD_S,
+                   cfg.rig.top_drive_inertia_kg_m2, cfg.model.k_t_per_s)
 
 
-def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float,
-                      sample_dt_s: float | None = None) -> Gains:
-    """Observer gains of the design selected by ``observer.gains`` (docs/theory.md §5.1).
+def design_gains(settings: GainSettings, string: DrillString, T_N_Nm: float, x_m,
+                 dt_s: float, sample_dt_s: float | None = None) -> Gains:
+    """Observer gains of the design ``settings`` select (docs/theory.md §5.1).
 
     Parameters
     ----------
-    cfg : drillfric.config.Config
-        Uses observer.gains, observer.kappa1, observer.lambda0_per_s, observer.poles_per_s,
-        rig.top_drive_inertia_kg_m2 and model.k_t_per_s (Kalman design model).
+    settings : GainSettings
     string : DrillString
         The string at the current bit depth.
     T_N_Nm : float
@@ -437,16 +464,15 @@ def gains_from_config(cfg, string: DrillString, T_N_Nm: float, x_m, dt_s: float,
         Observer time step [s].
     sample_dt_s : float, optional
         Logging interval of the measured speed [s]: the Kalman design's measurement-noise
-        intensity is σ²·Δt_log with σ = ``observer.speed_noise_rpm`` (white noise of that
+        intensity is σ²·Δt_log with σ = ``settings.speed_noise_rad_s`` (white noise of that
         standard deviation per sample), so slower logs get a gentler injection. Default:
         the 100 Hz value of :class:`KalmanNoise`.
     """
-    params = LumpedParams.from_string(string, cfg.rig.top_drive_inertia_kg_m2,
-                                      k_t_per_s=cfg.model.k_t_per_s)
-    if cfg.observer.gains == "kalman":
+    params = LumpedParams.from_string(string, settings.top_drive_inertia_kg_m2,
+                                      k_t_per_s=settings.k_t_per_s)
+    if settings.tuning is None:
         noise = KalmanNoise()
         if sample_dt_s is not None:
-            sigma = cfg.observer.speed_noise_rpm * RPM_TO_RAD_S
-            noise = KalmanNoise(speed_psd=sigma**2 * sample_dt_s)
+            noise = KalmanNoise(speed_psd=settings.speed_noise_rad_s**2 * sample_dt_s)
         return kalman_gains(params, x_m, T_N_Nm, dt_s, noise=noise)
-    return backstepping_gains(params, tuning_from_config(cfg), x_m, T_N_Nm)
+    return backstepping_gains(params, settings.tuning, x_m, T_N_Nm)

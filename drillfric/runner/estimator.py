@@ -10,6 +10,7 @@ import pandas as pd
 
 from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.chain import SegmentData, SkipSegment, check_segment, estimate_segment
+from drillfric.estimation.settings import ChainSettings
 from drillfric.io.timebase import check_plausible_rate, nominal_rate_hz
 from drillfric.io.well import Well
 from drillfric.result import SegmentRecord
@@ -79,6 +80,7 @@ class SegmentEstimator:
 
     def __init__(self, well: Well):
         self.well = well
+        self.settings = ChainSettings.from_config(well.config)  # once per well
         self.rate_hz: float | None = None
         self.has_truth = False
         self.warm: tuple | None = None
@@ -92,10 +94,9 @@ class SegmentEstimator:
         if seg.status != Status.OK:
             return segment_record(seg, depth, Status.SKIPPED, seg.message, rows), {}
         data = _segment_data(rows, seg, depth)
-        cfg = self.well.config
         try:
-            check_segment(data, cfg)
-            est = estimate_segment(cfg, self.well.survey, data, warm=self.warm,
+            check_segment(data, self.settings)
+            est = estimate_segment(self.settings, self.well.survey, data, warm=self.warm,
                                    rate_hz=self.rate_hz,
                                    torque_channel=self.well.channels["surface_torque_Nm"])
         except SkipSegment as exc:
@@ -105,7 +106,7 @@ class SegmentEstimator:
         if est.converged and seg.kind == Kind.OFF_BOTTOM:
             self.warm = (est.mu_s_seed, est.mu_k)
         return (segment_record(seg, depth, Status.OK, seg.message, rows, est),
-                output_frames(seg, est, data, rows, cfg.omega_c_rad_s))
+                output_frames(seg, est, data, rows, self.settings.omega_c_rad_s))
 
     def state(self) -> dict:
         """What passes to the next segment (plain values)."""

@@ -102,11 +102,13 @@ def _compile(part: str) -> None:
 
     from drillfric.config import config_from_dict
     from drillfric.estimation import chain
+    from drillfric.estimation.settings import ChainSettings
 
     cfg = config_from_dict({})
-    models = chain.build_models(cfg, None, _segment())
+    settings = ChainSettings.from_config(cfg)
+    models = chain.build_models(settings, None, _segment())
     if part == "observer":
-        chain.starts_pass(cfg, models, None, 10.0)
+        chain.starts_pass(settings, models, None, 10.0)
         return
     from drillfric import torsional
     from drillfric.segmentation import _PLAIN_ROWS, classify
