@@ -34,7 +34,6 @@ from scipy.signal import lfilter
 from drillfric import torque_drag
 from drillfric.errors import ModelError
 from drillfric.segmentation import IDLE, TRIPPING
-from drillfric.wellpath import no_survey_path
 
 #: Relative uncertainty of the hook-load reading (dead-line anchor sensors are specified to
 #: ±2–5 % of reading). A scale error multiplies the block's reading too, so it applies to
@@ -237,18 +236,18 @@ def find_moves(frame: pd.DataFrame, cfg) -> tuple[list[Move], int]:
 
 
 # --------------------------------------------------------------------------- physics
-def hookload_curves(cfg, path, bit_depth_m: float) -> tuple[np.ndarray, np.ndarray]:
+def hookload_curves(td: torque_drag.TDSettings, path, bit_depth_m: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
     """The model's pick-up and slack-off hook loads, no block, at every μ of
     :data:`MU_GRID` [N] (docs/theory.md §2, one μ along the whole string).
 
-    ``path`` None: the assumed path of :func:`drillfric.torque_drag.solve_config`.
+    ``path`` None: the assumed path of :meth:`drillfric.torque_drag.TDSettings.path_to`.
     """
-    path = no_survey_path(bit_depth_m, cfg.tortuosity_rad_m) if path is None else path
-    shoe = cfg.model.casing_shoe_md_m
+    shoe = td.casing_shoe_md_m
     table = torque_drag.broomstick(
-        path, cfg.sections, [bit_depth_m], MU_GRID, load_cases=(PICK_UP, SLACK_OFF),
-        mud_out_kg_m3=cfg.fluid.mud_density_kg_m3, mud_in_kg_m3=cfg.inner_mud_density_kg_m3,
-        element_length_m=cfg.model.element_length_m,
+        td.path_to(path, bit_depth_m), td.sections, [bit_depth_m], MU_GRID,
+        load_cases=(PICK_UP, SLACK_OFF), mud_out_kg_m3=td.mud_out_kg_m3,
+        mud_in_kg_m3=td.mud_in_kg_m3, element_length_m=td.element_length_m,
         extra_nodes_m=() if shoe is None else (shoe,))
     hook = table["hookload_N"].to_numpy(float).reshape(2, MU_GRID.size)
     return hook[0], hook[1]
@@ -495,7 +494,7 @@ def _verdict(found: dict[str, Estimate], why: str) -> dict:
                   "source": source, "status": _OK, "reason": "; ".join(reasons) or None}
 
 
-def drag_log(moves: list[Move], too_short: int, cfg, path,
+def drag_log(moves: list[Move], too_short: int, td: torque_drag.TDSettings, path,
              hookload_summary: dict) -> tuple[dict, pd.DataFrame]:
     """summary.json ``drag`` and drag_log.parquet (:data:`DRAG_COLUMNS`) of a well.
 
@@ -503,8 +502,9 @@ def drag_log(moves: list[Move], too_short: int, cfg, path,
     ----------
     moves, too_short : list of Move, int
         :meth:`MoveFinder.close` and :attr:`MoveFinder.too_short`.
-    cfg : Config
-        The well's configuration (the string calibrated, when the hook-load check did).
+    td : TDSettings
+        The well's torque-and-drag settings (its configured string: a string-weight
+        calibration's scale enters through ``hookload_summary``'s string ratio).
     path : WellPath or None
     hookload_summary : dict
         summary.json ``hookload`` (:func:`drillfric.hookload.judge`).
@@ -515,7 +515,7 @@ def drag_log(moves: list[Move], too_short: int, cfg, path,
     def curves(depth: float):
         key = round(depth, 1)
         if key not in cache:
-            cache[key] = hookload_curves(cfg, path, key)
+            cache[key] = hookload_curves(td, path, key)
         return cache[key]
 
     rows = [connection_row(up, down, hook, curves) for up, down in pair_moves(moves)]

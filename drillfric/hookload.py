@@ -32,7 +32,7 @@ from drillfric import torque_drag
 from drillfric.drillstring import section_from_config
 from drillfric.kernels.lazy import lazy_jit
 from drillfric.result import Flag, SegmentRecord
-from drillfric.vocabulary import Kind, Status
+from drillfric.vocabulary import Kind, LoadCase, Status
 
 #: Heaviest plausible travelling equipment (block, hook, top drive, elevators) [N]: about
 #: 70 t, above the heaviest offshore top-drive systems. Without an in-slips plateau a hook
@@ -120,14 +120,13 @@ class BlockWeight:
 
 
 # --------------------------------------------------------------------------- physics
-def modelled_string_weight_N(cfg, path, bit_depth_m: float) -> float:
+def modelled_string_weight_N(td: torque_drag.TDSettings, path, bit_depth_m: float) -> float:
     """Modelled rotating off-bottom hook load of the configured string [N]: the string's
     buoyed weight along the path, no block (docs/theory.md §2, σ = 0).
 
     For a vertical string of one section it is ρ_steel·A·L·g·(1 − ρ_mud/ρ_steel).
     """
-    td = torque_drag.solve_config(cfg, path, bit_depth_m, load_case="rotating_off_bottom")
-    return float(td.hookload_N)
+    return float(td.solve(path, bit_depth_m, load_case=LoadCase.ROTATING_OFF_BOTTOM).hookload_N)
 
 
 def scaled_sections(sections, scale: float, mud_out_kg_m3: float,
@@ -627,11 +626,12 @@ class StringWeightCalibration:
 
     def __init__(self, well):
         self.well = well
+        self.td = torque_drag.TDSettings.from_config(well.config)
         self.points: list[tuple] = []
 
     def add(self, done) -> None:
         """Take the points of finished segments ``done`` (segment, rows)."""
-        self.points += _points(done, self.well.config, self.well.survey)
+        self.points += _points(done, self.td, self.well.survey)
 
     def current(self, plateaus: list[Plateau]):
         """The well with its string's buoyed weight scaled to the hook load (else
@@ -663,7 +663,7 @@ class StringWeightCalibration:
         self.points = [tuple(map(float, p)) for p in np.asarray(state["points"]).reshape(-1, 3)]
 
 
-def _points(done, cfg, path) -> list[tuple]:
+def _points(done, td: torque_drag.TDSettings, path) -> list[tuple]:
     """(bit depth, median hook load, modelled string weight) of finished off-bottom
     segments."""
     out = []
@@ -677,5 +677,5 @@ def _points(done, cfg, path) -> list[tuple]:
         if path is not None and seg.bit_depth_m > path.md_max_m:
             continue
         out.append((seg.bit_depth_m, float(np.nanmedian(hook)),
-                    modelled_string_weight_N(cfg, path, seg.bit_depth_m)))
+                    modelled_string_weight_N(td, path, seg.bit_depth_m)))
     return out

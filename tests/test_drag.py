@@ -25,6 +25,7 @@ from drillfric import drag, torque_drag
 from drillfric.config import config_from_dict, load_config
 from drillfric.drillstring import build_string
 from drillfric.io.survey import read_survey
+from drillfric.torque_drag import TDSettings
 from drillfric.wellpath import minimum_curvature
 from tests.conftest import REPO
 
@@ -51,11 +52,12 @@ def test_vertical_hole_has_no_drag():
     """Vertical: pick-up = slack-off = the buoyed weight for every μ, so the pair gives no
     μ, and neither does a single hook load with a block: withheld, "no drag"."""
     cfg = _config()
-    pu, so = drag.hookload_curves(cfg, None, 2000.0)
+    pu, so = drag.hookload_curves(TDSettings.from_config(cfg), None, 2000.0)
     assert np.ptp(pu) < 1e-6 * pu[0] and np.allclose(pu, so, rtol=1e-12)
     row = drag.connection_row(_move("pick_up", 2000.0, BLOCK_N + pu[0]),
                               _move("slack_off", 2000.0, BLOCK_N + so[0], t0=60.0),
-                              _hook(BLOCK_N), lambda d: drag.hookload_curves(cfg, None, d))
+                              _hook(BLOCK_N),
+                              lambda d: drag.hookload_curves(TDSettings.from_config(cfg), None, d))
     assert row["status"] == "withheld" and row["mu_drag"] is None
     assert "no drag to measure" in row["reason"]
 
@@ -69,7 +71,7 @@ def test_straight_slant_pick_up_minus_slack_off(theta_deg, mu):
     theta = np.radians(theta_deg)
     md = np.linspace(0.0, 3000.0, 31)
     path = minimum_curvature(md, np.full(md.size, theta), np.zeros(md.size))
-    pu, so = drag.hookload_curves(cfg, path, 2000.0)
+    pu, so = drag.hookload_curves(TDSettings.from_config(cfg), path, 2000.0)
     w = build_string(cfg.sections, 2000.0).buoyed_weight_N_m(
         np.array([1000.0]), cfg.fluid.mud_density_kg_m3, cfg.inner_mud_density_kg_m3)[0]
     assert pu - so == pytest.approx(2 * drag.MU_GRID * w * 2000.0 * np.sin(theta), rel=1e-9,
@@ -93,7 +95,7 @@ def test_without_block_a_lone_move_gives_nothing():
     md = np.linspace(0.0, 3000.0, 31)
     path = minimum_curvature(md, np.full(md.size, 0.7), np.zeros(md.size))
     row = drag.connection_row(_move("pick_up", 2000.0, 500e3), None, _hook(None),
-                              lambda d: drag.hookload_curves(cfg, path, d))
+                              lambda d: drag.hookload_curves(TDSettings.from_config(cfg), path, d))
     assert row["status"] == "withheld" and "no block weight and no pick-up/slack-off pair" \
         in row["reason"]
 
@@ -267,11 +269,11 @@ def test_dsats_connections(real_data):
                                                                  "bit_depth_m"]), True)
     hook = {"block_weight_N": block.weight_N, "block_weight_evidence": block.evidence(),
             "tolerance": 0.1, "string_weight_ratio": None}
-    summary, log = drag.drag_log(moves, finder.too_short, cfg, well.survey,
+    summary, log = drag.drag_log(moves, finder.too_short, TDSettings.from_config(cfg), well.survey,
                                  hook | {"verdict": "contradicted", "reason": "0.3×"})
     assert summary["estimated"] == 0 and summary["connections"] >= 10
     assert log["reason"].str.contains("contradicts the configured string").all()
-    _, diagnostic = drag.drag_log(moves, finder.too_short, cfg, well.survey,
+    _, diagnostic = drag.drag_log(moves, finder.too_short, TDSettings.from_config(cfg), well.survey,
                                   hook | {"verdict": "consistent"})
     pairs = diagnostic[diagnostic["pick_up_hookload_N"].notna()
                        & diagnostic["slack_off_hookload_N"].notna()]

@@ -27,6 +27,7 @@ from drillfric.config import config_from_dict, load_config
 from drillfric.drillstring import G_ACCEL
 from drillfric.estimation.consensus import consensus
 from drillfric.result import Flag, SegmentRecord
+from drillfric.torque_drag import TDSettings
 from drillfric.vocabulary import Kind, Status
 from tests.conftest import REPO
 
@@ -52,7 +53,8 @@ def test_vertical_string_weight_is_its_buoyed_weight(mud):
     (to rounding: the march sums the same weights element by element)."""
     area = np.pi * (PIPE["od_m"] ** 2 - PIPE["id_m"] ** 2) / 4.0
     expected = 7850.0 * area * 1500.0 * G_ACCEL * (1.0 - mud / 7850.0)
-    got = hookload.modelled_string_weight_N(_vertical(mud), None, 1500.0)
+    got = hookload.modelled_string_weight_N(TDSettings.from_config(_vertical(mud)), None,
+                                            1500.0)
     assert got == pytest.approx(expected, rel=1e-9)
 
 
@@ -63,8 +65,9 @@ def test_scaled_sections_scale_the_buoyed_weight_only():
     for scale in (0.65, 1.4):
         scaled = hookload.scaled_sections(cfg.sections, scale, 1300.0, 1300.0)
         twin = _vertical(1300.0, scaled)
-        assert hookload.modelled_string_weight_N(twin, None, 2000.0) == pytest.approx(
-            scale * hookload.modelled_string_weight_N(cfg, None, 2000.0), rel=1e-9)
+        weight = [hookload.modelled_string_weight_N(TDSettings.from_config(c), None, 2000.0)
+                  for c in (twin, cfg)]
+        assert weight[0] == pytest.approx(scale * weight[1], rel=1e-9)
         assert [s["od_m"] for s in scaled] == [s["od_m"] for s in cfg.sections]
 
 
@@ -246,8 +249,8 @@ def _ratio(folder, config_text, plant_text):
     weights = []
     for name, text in (("cfg", config_text), ("plant", plant_text)):
         (folder / f"{name}.toml").write_text(text)
-        weights.append(hookload.modelled_string_weight_N(load_config(folder / f"{name}.toml"),
-                                                         path, 2210.0))
+        td = TDSettings.from_config(load_config(folder / f"{name}.toml"))
+        weights.append(hookload.modelled_string_weight_N(td, path, 2210.0))
     return weights[0] / weights[1]
 
 

@@ -40,14 +40,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from drillfric.drillstring import build_string
 from drillfric.errors import InputError, ModelError
 from drillfric.estimation.verdict import TYPICAL_MU
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import Flag, SegmentRecord
-from drillfric.torque_drag import TDResult, back_calculate_friction, solve
+from drillfric.torque_drag import TDResult, TDSettings, back_calculate_friction, solve
 from drillfric.vocabulary import Kind, Method, Status
-from drillfric.wellpath import no_survey_path
 
 #: What a depth log cannot give, said in every summary and segment message.
 NO_OBSERVER = ("depth-indexed log: no time series, so no observer — μ_s is not identifiable "
@@ -230,13 +228,13 @@ def bit_torque_Nm(wob_N: float, cfg) -> float:
     return cfg.friction_log.bit_mu * wob_N * cfg.friction_log.bit_diameter_m / 3.0
 
 
-def back_calculate(window: Window, well: Well) -> WindowResult:
-    """The friction factor of one window (docs/ingestion.md *Depth-indexed logs*).
+def back_calculate(window: Window, well: Well, td: TDSettings) -> WindowResult:
+    """The friction factor of one window (docs/ingestion.md *Depth-indexed logs*), with the
+    well's torque-and-drag settings ``td``.
 
     A window with too few rotating rows, or a bit beyond the survey, is skipped; one whose
     torque no friction factor in [0, 2] reproduces has failed (with the model's message).
     """
-    cfg = well.config
     base = _base_record(window)
     problem = _skip_reason(window, well)
     if problem:
@@ -244,14 +242,12 @@ def back_calculate(window: Window, well: Well) -> WindowResult:
                                                   message=f"{problem}; {NO_OBSERVER}"))
     on = window.kind is Kind.ON_BOTTOM
     wob = window.wob_N if on and np.isfinite(window.wob_N) else 0.0
-    torque_bit = bit_torque_Nm(wob, cfg) if on else 0.0
+    torque_bit = bit_torque_Nm(wob, well.config) if on else 0.0
     kw = {"load_case": "rotating_on_bottom" if on else "rotating_off_bottom", "wob_N": wob,
-          "bit_torque_Nm": torque_bit, "mud_out_kg_m3": cfg.fluid.mud_density_kg_m3,
-          "mud_in_kg_m3": cfg.inner_mud_density_kg_m3,
-          "element_length_m": cfg.model.element_length_m}
-    path = well.survey if well.survey is not None else no_survey_path(
-        window.bit_depth_m, cfg.tortuosity_rad_m)
-    string = build_string(cfg.sections, window.bit_depth_m)
+          "bit_torque_Nm": torque_bit, "mud_out_kg_m3": td.mud_out_kg_m3,
+          "mud_in_kg_m3": td.mud_in_kg_m3, "element_length_m": td.element_length_m}
+    path = td.path_to(well.survey, window.bit_depth_m)
+    string = td.string(window.bit_depth_m)
     try:
         mu = back_calculate_friction(path, string, surface_torque_Nm=window.surface_torque_Nm,
                                      **kw)
@@ -312,9 +308,9 @@ def estimate(well: Well, log: pd.DataFrame | None = None,
     """
     log = read_depth_log(well) if log is None else log
     found, assumed = windows(log, well.config)
-    results = []
+    results, td = [], TDSettings.from_config(well.config)
     for window in found:
-        results.append(back_calculate(window, well))
+        results.append(back_calculate(window, well, td))
         if progress:
             progress(len(results))
     return results, assumed

@@ -172,7 +172,7 @@ def resolve_files(path, config, survey, peek: bool = True) -> tuple[WellFiles, d
         raise InputError("file not found", file=path, fix="check the path")
     config_path = given_file(config)
     raw = _mapping(config)
-    look = raw is None and config_path is None  # find the configuration beside the data
+    look = config is None  # find the configuration beside the data (none given)
     if path.is_dir() and not (path / "well.toml").is_file() and witsml.split_log(path):
         data_path, parts = _data(path)
         config_path = _sidecar(data_path, ".toml") if look else config_path

@@ -16,7 +16,7 @@ import socket
 import sys
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -81,8 +81,9 @@ def parse_address(text: str, what: str = "SOURCE") -> Address:
 @dataclass(frozen=True)
 class Setup:
     """What a WITS0 live run needs from ``--config``: the items read, the ``[wits0]``
-    settings, and :func:`~drillfric.io.well.open_well` keywords for the recording (its
-    configuration without ``[channels]``, which name WITS items, not recording columns)."""
+    settings, and :func:`~drillfric.io.well.open_well` keywords for the recording (the
+    configuration read once, without ``[channels]``, which name WITS items, not recording
+    columns; the survey it names)."""
 
     row: Row
     units: str
@@ -104,11 +105,10 @@ def setup(address: Address, config: Path | None, name: str | None) -> Setup:
     from drillfric.config import config_from_dict
 
     raw = {} if config is None else read_toml(config)
-    rest = {k: v for k, v in raw.items() if k != "channels"}
     cfg = config_from_dict(raw, file=config)  # every key checked, [channels] too
     settings = cfg.wits0
     row = Row(item_map(cfg.channels, settings.units, file=config))
-    open_kw: dict = {"config": rest}
+    open_kw: dict = {"config": replace(cfg, channels={})}
     named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
     if isinstance(named, str) and config is not None:
         open_kw["survey"] = Path(config).parent / named

@@ -22,6 +22,7 @@ from drillfric.estimation.friction_log import (
     estimate,
     read_depth_log,
 )
+from drillfric.friction import FrictionProfile
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import RunProgress, WellResult
 from drillfric.torque_drag import TDResult
@@ -68,7 +69,8 @@ def _friction_log(well: Well, sink: Sink, rate_hz, progress, chunk_rows,
     assumed = [n for n in well.assumed if n != TOP_DRIVE_INERTIA_ASSUMED]
     summary = summarise(well, records, [], rows=len(log),
                         assumed=assumed + _assumptions(well, results, notes),
-                        warnings=warnings, wall_s=time.perf_counter() - t_wall)
+                        warnings=warnings, wall_s=time.perf_counter() - t_wall,
+                        profile=FrictionProfile.from_config(well.config))
     summary.update(index="depth", friction_log=_log_summary(well, log, results),
                    hookload=dict(UNCHECKED))
     if any(r.record.status is Status.OK for r in results):

@@ -44,6 +44,7 @@ from drillfric.io.tracks import TrackAccumulator
 from drillfric.io.well import Well, frame_source
 from drillfric.result import RunProgress, SegmentRecord, WellResult
 from drillfric.segmentation import Segment, SegmentStream
+from drillfric.torque_drag import TDSettings
 from drillfric.torque_zero import TorqueAtRest, withhold_offset, zero_check
 from drillfric.vocabulary import Kind, Status
 
@@ -254,6 +255,7 @@ class Engine:
                             assumed=self.well.assumed + self.estimator.assumed,
                             warnings=warnings + weighed.warnings + zero.warnings(),
                             wall_s=time.perf_counter() - self.t_wall,
+                            profile=self.estimator.settings.friction,
                             resampled_rate_hz=self.estimator.rate_hz,
                             requested_rate_hz=self.rate_hz)
         summary.update(hookload=weighed.summary, torque_zero=zero.summary(),
@@ -263,8 +265,8 @@ class Engine:
                        time_origin_utc=iso(self.tracker.origin), revisions=self.revisions,
                        resumed=self.resumed)
         summary["drag"], drag_table = drag_log(self.moves.close(), self.moves.too_short,
-                                               self.well.config, self.well.survey,
-                                               weighed.summary)
+                                               TDSettings.from_config(self.well.config),
+                                               self.well.survey, weighed.summary)
         self.published = {r.id: _published(r) for r in records}
         self._open_ids = open_ids
         return finish(self.sink, self.well, summary, records, tracks=self.tracks.result(),

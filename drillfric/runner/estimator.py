@@ -79,13 +79,26 @@ class SegmentEstimator:
     warm start, the fallback bit depth and what was assumed for it)."""
 
     def __init__(self, well: Well):
+        self._well: Well | None = None
         self.well = well
-        self.settings = ChainSettings.from_config(well.config)  # once per well
         self.rate_hz: float | None = None
         self.has_truth = False
         self.warm: tuple | None = None
         self.fallback_depth: float | None = None
         self.assumed: list[str] = []
+
+    @property
+    def well(self) -> Well:
+        """The well estimated (a string-weight calibration replaces it with its string
+        rescaled, :class:`drillfric.hookload.StringWeightCalibration`)."""
+        return self._well
+
+    @well.setter
+    def well(self, well: Well) -> None:
+        """Set the well; the chain's settings are derived once per configuration."""
+        if self._well is None or well.config is not self._well.config:
+            self.settings = ChainSettings.from_config(well.config)
+        self._well = well
 
     def segment(self, seg: Segment, rows: pd.DataFrame) -> tuple[SegmentRecord, dict]:
         """The record and output rows (estimates, profile; none when not estimated) of one

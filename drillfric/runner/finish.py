@@ -42,6 +42,7 @@ ReportWriter = Callable[[Path], None]
 
 def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, rows: int,
               assumed: list[str], warnings: list[str], wall_s: float,
+              profile: FrictionProfile,
               resampled_rate_hz: float | None = None,
               requested_rate_hz: float | None = None) -> dict:
     """summary.json (docs/outputs.md) from what a run found.
@@ -59,6 +60,8 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, ro
         What was assumed (makes the numbers indicative) and what the user should know.
     wall_s : float
         Run time [s].
+    profile : FrictionProfile
+        The well's friction zones and law (the estimation's own, built once per well).
     resampled_rate_hz, requested_rate_hz : float, optional
         The rate the estimation resampled to and the rate asked for [Hz].
     """
@@ -67,7 +70,6 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, ro
     inputs.update(rows=rows, resampled_rate_hz=resampled_rate_hz,
                   requested_rate_hz=requested_rate_hz)
     count = {s: sum(r.status is s for r in records) for s in Status}
-    profile = FrictionProfile.from_config(well.config)
     return {"well": well.name, "drillfric_version": __version__, **consensus(records, pools),
             "friction_zone": profile.zone, "friction_profile": profile.describe(),
             "pooled": pools, "segments": [r.to_json() for r in records], "inputs": inputs,
