@@ -439,8 +439,7 @@ _WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
 _STATES_FRICTION = re.compile(r"μ_[ks][^;]{0,12}?(=|≥|≤|≈|<|>)\s*[-+]?\d")
 
 
-def withhold_friction(record: SegmentRecord, why: str,
-                      flag: Flag = Flag.HOOKLOAD_CONTRADICTS_STRING) -> SegmentRecord:
+def withhold_friction(record: SegmentRecord, why: str, flag: Flag) -> SegmentRecord:
     """``record`` with its friction numbers null, ``why`` in its message and ``flag``.
 
     The notes of its message that state a friction factor are left out (a reader would take
@@ -450,7 +449,8 @@ def withhold_friction(record: SegmentRecord, why: str,
     Examples
     --------
     >>> r = SegmentRecord(mu_k=0.2, message="fit note; μ_k = 0.200 ± 0.010 (95 %: …)")
-    >>> for note in withhold_friction(r, "the hook load says so").message.split("; "):
+    >>> withheld = withhold_friction(r, "the hook load says so", Flag.TORQUE_ZERO_OFFSET)
+    >>> for note in withheld.message.split("; "):
     ...     print(note)
     fit note
     1 note stating the withheld friction factors left out
@@ -465,6 +465,44 @@ def withhold_friction(record: SegmentRecord, why: str,
     message = "; ".join(filter(None, kept + [left_out, f"friction factors withheld: {why}"]))
     return replace(record, **nulls, converged=False, message=message,
                    quality_flags=record.quality_flags + (flag,))
+
+
+@dataclass(frozen=True)
+class WeightVerdict:
+    """What the string-weight check does to one segment.
+
+    Attributes
+    ----------
+    withhold : str
+        Why its friction factors are withheld ("" when they are not).
+    flag : Flag or None
+        The flag it gets (None: none).
+    """
+
+    withhold: str = ""
+    flag: Flag | None = None
+
+
+def weight_verdict(status: Status, contradiction: str, unverified: str,
+                   calibrated: bool) -> WeightVerdict:
+    """The string-weight check's rule for one segment (docs/theory.md §2.1), in order:
+
+    1. not estimated (skipped, failed): nothing;
+    2. the hook load contradicts the string (well-wide, or this segment's ``contradiction``):
+       withheld, ``hookload_contradicts_string``;
+    3. no block weight to weigh the string (``unverified``, the reason): withheld,
+       ``string_weight_unverified``;
+    4. the string's weight was ``calibrated`` to the hook load: shown,
+       ``string_weight_calibrated``;
+    5. else shown, no flag.
+    """
+    if status is not Status.OK:
+        return WeightVerdict()
+    if contradiction:
+        return WeightVerdict(contradiction, Flag.HOOKLOAD_CONTRADICTS_STRING)
+    if unverified:
+        return WeightVerdict(unverified, Flag.STRING_WEIGHT_UNVERIFIED)
+    return WeightVerdict(flag=Flag.STRING_WEIGHT_CALIBRATED if calibrated else None)
 
 
 def _unverified(block: BlockWeight) -> str:
@@ -515,20 +553,17 @@ def judge(records: list, plateaus: list[Plateau], cfg,
             well_problem = (f"the hook load contradicts the configured string in {len(bad)} of "
                             f"{len(points)} off-bottom segments ({problems[bad[0]]})")
     unverified = _unverified(block) if block.weight_N is None and not well_problem else ""
+    calibrated = calibration is not None and calibration.scale is not None
     out, withheld = [], []
     for r in records:
-        why = well_problem or problems.get(r.id, "")
-        if why and r.status is Status.OK:
-            out.append(withhold_friction(r, why))
+        rule = weight_verdict(r.status, well_problem or problems.get(r.id, ""), unverified,
+                              calibrated)
+        if rule.withhold:
+            out.append(withhold_friction(r, rule.withhold, rule.flag))
             withheld.append(r.id)
-        elif unverified and r.status is Status.OK:
-            out.append(withhold_friction(r, unverified, Flag.STRING_WEIGHT_UNVERIFIED))
-            withheld.append(r.id)
-        elif calibration is not None and calibration.scale is not None \
-                and r.status is Status.OK:
-            out.append(replace(r, quality_flags=r.quality_flags + (Flag.STRING_WEIGHT_CALIBRATED,)))
         else:
-            out.append(r)
+            out.append(r if rule.flag is None else
+                       replace(r, quality_flags=r.quality_flags + (rule.flag,)))
     summary.update(verdict=_verdict(well_problem, block, calibration),
                    withheld_segments=withheld, reason=well_problem or unverified or None)
     contradicted = [i for i in withheld if well_problem or problems.get(i)]

@@ -141,6 +141,46 @@ class WellFlag(StrEnum):
     SEGMENTS_FAILED = "segments_failed"
 
 
+_FIT = "drillfric.estimation.batch."
+_VERDICT = "drillfric.estimation.verdict."
+#: The rule table of the flags: for each, the function(s) that raise it (dotted names), pure
+#: rules of evidence, each held by a table of cases in the tests. The fit's stages raise
+#: what they find (evidence); :func:`drillfric.estimation.verdict.decide` and
+#: :func:`~drillfric.estimation.verdict.decide_trace` decide what a segment claims from it;
+#: the well-wide checks (string weight, torque zero, pooling) then withhold or mark. No
+#: other function raises a flag (tests/test_rule_table.py scans the code for it).
+FLAG_RAISED_BY = {
+    Flag.OBSERVER_NOT_CONVERGED: ("drillfric.estimation.chain.evidence",),
+    Flag.OBSERVER_DEADLOCK_AVERTED: ("drillfric.estimation.chain.evidence",),
+    Flag.NO_ROTATION: (_FIT + "fit.refine",),
+    Flag.ROTATION_TOO_SHORT: (_FIT + "fit.refine",),
+    Flag.REGIME_MISMATCH: (_FIT + "kinetic.fit_kinetic",),
+    Flag.MU_K_NOT_CONVERGED: (_FIT + "kinetic.fit_kinetic",),
+    Flag.CREEP_RATE_TOO_LOW: (_FIT + "fit._static_stages",),
+    Flag.CREEP_FIT_AT_BOUND: (_FIT + "creep_fit.fit_creeps",),
+    Flag.CREEP_NOT_GRID_CONVERGED: (_FIT + "creep_fit.fit_creeps",),
+    Flag.MU_S_NOT_EXPLAINED: (_FIT + "creep_fit._judged",),
+    Flag.BISTABLE_REGIME: (_FIT + "onset.onset_bound",),
+    Flag.STICK_SLIP_NOT_REPRODUCED: (_FIT + "onset.onset_bound",),
+    Flag.ESTIMATORS_DISAGREE: (_VERDICT + "_batch_converged",),
+    Flag.TOO_SHORT_TO_CONVERGE: (_VERDICT + "_long_enough",),
+    Flag.OUTSIDE_TYPICAL_RANGE: (_VERDICT + "decide", "drillfric.estimation.friction_log._record"),
+    Flag.BIT_TORQUE_IN_FRICTION: (_VERDICT + "decide", "drillfric.estimation.friction_log._record"),
+    Flag.POOLED: ("drillfric.estimation.consensus._pooled",),
+    Flag.BIT_SPEED_DRIFT: (_VERDICT + "decide_trace",),
+    Flag.STICK_SLIP_BEYOND_VALIDATED: (_VERDICT + "decide_trace",),
+    Flag.STICK_SLIP_UNDETERMINED: (_VERDICT + "decide_trace",),
+    Flag.HOOKLOAD_CONTRADICTS_STRING: ("drillfric.hookload.weight_verdict",),
+    Flag.STRING_WEIGHT_UNVERIFIED: ("drillfric.hookload.weight_verdict",),
+    Flag.STRING_WEIGHT_CALIBRATED: ("drillfric.hookload.weight_verdict",),
+    Flag.TORQUE_ZERO_OFFSET: ("drillfric.torque_zero.withhold_offset",),
+    Flag.RELAXATION_CYCLES: (_FIT + "fit.refine",),
+    Flag.MU_K_UNCERTAIN: (_VERDICT + "_batch_converged",),
+    Flag.MU_K_DEPENDS_ON_MU_S: (_FIT + "kinetic.fit_kinetic",),
+    Flag.FACTORS_RUN_AWAY: (_VERDICT + "decide_trace",),
+}
+
+
 #: What each well flag means (docs/outputs.md); each comes with a line in ``warnings``.
 WELL_FLAG_MEANINGS = {
     WellFlag.MU_K_WITHHELD: "segments were estimated but none gives a well μ_k (null): "
@@ -438,6 +478,11 @@ _ARROW = {"float64": pa.float64(), "int32": pa.int32(), "bool": pa.bool_(),
           "list<int32>": pa.list_(pa.int32())}
 
 
+def _short(dotted: str) -> str:
+    """A rule's dotted name without the package: ``estimation.verdict.decide``."""
+    return dotted.removeprefix("drillfric.")
+
+
 def outputs_markdown() -> str:
     """The column reference of docs/outputs.md, rendered from this schema."""
     lines = ["## segments (summary.json `segments`, segments.parquet)", "",
@@ -447,9 +492,12 @@ def outputs_markdown() -> str:
     lines += ["", "## estimates.parquet", "", "| column | type | unit | meaning |",
               "|---|---|---|---|"]
     lines += [f"| `{c.name}` | {c.type} | {c.unit} | {c.doc} |" for c in ESTIMATE_COLUMNS]
-    lines += ["", "## flags (segments' `quality_flags`)", "", "| flag | meaning |",
-              "|---|---|"]
-    lines += [f"| `{f.value}` | {FLAG_MEANINGS[f]} |" for f in Flag]
+    lines += ["", "## flags (segments' `quality_flags`)", "",
+              "Each flag is raised by the rule named beside it (`drillfric.result."
+              "FLAG_RAISED_BY`), a pure function of the evidence.", "",
+              "| flag | meaning | raised by |", "|---|---|---|"]
+    lines += [f"| `{f.value}` | {FLAG_MEANINGS[f]} | "
+              f"{', '.join(f'`{_short(r)}`' for r in FLAG_RAISED_BY[f])} |" for f in Flag]
     lines += ["", "## well flags (summary.json `quality_flags`)", "", "| flag | meaning |",
               "|---|---|"]
     lines += [f"| `{f.value}` | {WELL_FLAG_MEANINGS[f]} |" for f in WellFlag]

@@ -398,6 +398,34 @@ def test_creep_at_1_hz_is_not_fitted():
     assert res.mu_k == pytest.approx(0.187, rel=0.10)
 
 
+@pytest.mark.slow
+def test_creep_fit_with_no_room_above_mu_k_is_at_its_bound():
+    """The rule of ``creep_fit_at_bound`` (drillfric.result.FLAG_RAISED_BY): with μ_k at the
+    clamp ``observer.mu_max`` (0.15 below the data's 0.187) no μ_s above μ_k can be
+    searched: the creep is not fitted, μ_s not reported, and the message names the clamp."""
+    string, fc, rec = cached_case(0.6, 0.187, "creep", 120.0, 40.0, md_m=2500.0,
+                                  kop_m=1500.0)
+    res = estimate(string, fc, *sample(rec, 100.0, seed=0, speed_rpm=0.1),
+                   settings=replace(SETTINGS, mu_max=0.15))
+    assert "creep_fit_at_bound" in res.flags and res.mu_s is None
+    assert any("within observer.mu_max = 0.15" in m for m in res.messages)
+
+
+@pytest.mark.slow
+def test_creep_fit_that_keeps_moving_on_refinement_is_not_reported(monkeypatch):
+    """The rule of ``creep_not_grid_converged``: a creep μ_s that still moves on the last
+    grid refinement is not reported (here every move counts as too large: the
+    convergence threshold set to 0), with each grid's μ_s in the message."""
+    from drillfric.estimation.batch import creep_fit
+
+    monkeypatch.setattr(creep_fit, "CREEP_CONVERGENCE", 0.0)
+    string, fc, rec = cached_case(0.6, 0.187, "creep", 120.0, 40.0, md_m=2500.0,
+                                  kop_m=1500.0)
+    res = estimate(string, fc, *sample(rec, 100.0, seed=0, speed_rpm=0.1))
+    assert "creep_not_grid_converged" in res.flags and res.mu_s is None
+    assert any("not grid-converged" in m and "cells" in m for m in res.messages)
+
+
 # --- the configuration reaches the fit (issue 21: settings bound at import time) ----------
 
 def test_batch_settings_take_every_key_from_the_configuration():

@@ -13,6 +13,7 @@ import pytest
 
 from drillfric import torsional
 from drillfric.errors import InputError, ModelError
+from drillfric.estimation.diagnostics import diagnose
 from drillfric.estimation.gains import GainSettings, design_gains
 from drillfric.estimation.observer import Measurements, Observer, ObserverState, observe
 from tests.synthetic import RPM, build_and_hold, config, noisy, simulate
@@ -210,6 +211,7 @@ def test_deadlock_guard_releases_a_stuck_observer(steady):
     out, _ = observe(obs, meas, ObserverState.from_starts(obs, [[1.4, 1.2]]))
     assert out.deadlock_events[0] >= 1
     assert abs(out.mu_k[-100:, 0].mean() - 0.15) < 0.15 * 0.05
+    assert "deadlock_averted" in diagnose(out, 1.0).flags  # observer_deadlock_averted
 
 
 def test_paper_law_moves_mu_s_corrected_holds_it():

@@ -15,7 +15,16 @@ only wires them):
 5. :func:`seeded_pass` — the observer once more over the whole segment, seeded with the
    refined factors (held, not adapted, by default) as a small ensemble spread over the
    uncertainty of μ_s: the bit speed is the weighted ensemble mean, the members' min–max its
-   band.
+   band;
+6. :func:`fit_evidence` — the fitted speed-driven model over the whole segment against the
+   measured torque (run beside step 5);
+7. :func:`bit_speed_resolution` — whether the logging resolves the stick-slip cycle;
+8. :func:`trace_verdict` — the trace's checks and
+   :func:`drillfric.estimation.verdict.decide_trace`, what of it may be shown (pure rules).
+
+The estimate is built once from what the steps gave (``_assemble``): every flag and withheld
+field comes from the two rule tables of :mod:`drillfric.estimation.verdict`. The steps take
+the well's :class:`~drillfric.estimation.settings.ChainSettings`, never the configuration.
 """
 
 from __future__ import annotations
@@ -49,7 +58,14 @@ from drillfric.estimation.observer import (
 from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_interval, resolution
 from drillfric.estimation.settings import ChainSettings
 from drillfric.estimation.torque_scale import check_torque_scale
-from drillfric.estimation.verdict import Evidence, TraceEvidence, Verdict, decide, decide_trace
+from drillfric.estimation.verdict import (
+    Evidence,
+    TraceEvidence,
+    TraceVerdict,
+    Verdict,
+    decide,
+    decide_trace,
+)
 from drillfric.friction import FrictionProfile
 from drillfric.io.timebase import find_gaps
 from drillfric.result import Flag
@@ -616,7 +632,22 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     fitted_result = beside(fit_evidence, settings, models, verdict, refined.mu_s)
     final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
-    estimate = _assemble(settings, models, data, starts, first, diag, refined, verdict, final, bit)
+    trace, kinematics = trace_verdict(settings, models, refined, verdict, final, bit)
+    fitted = fitted_result()
+    terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
+                                                                 refined.mu_s)
+                                    if models.on_bottom else None, verdict.mu_k)
+    return _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
+                                                   trace, final, bit, fitted, terms,
+                                                   kinematics))
+
+
+def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
+                  verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate
+                  ) -> tuple[TraceVerdict, bit_trace.KinematicCheck]:
+    """Step 8: the checks of the seeded trace (whole-segment kinematics, window by window,
+    the members' statistics) and what of it the rules of
+    :func:`~drillfric.estimation.verdict.decide_trace` show."""
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, settings.speed_noise_rad_s)
     windows = _windows(settings, models, refined, final.time_s, bit.rad_s)
@@ -624,28 +655,20 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     settled = final.time_s[late]
     runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
                                   if settled.size > 1 else 0.0)
+    severity = bit_trace.mixture_severity(final.bit_rad_s_est[late], bit.weights[late])
     cut = any(np.any(late & (final.time_s >= a) & (final.time_s < b))
               for a, b in windows.withheld)
     undetermined = ("stuck fraction and severity withheld: the bit trace is withheld over some "
                     "of their windows (window by window, docs/bit_speed.md)") if cut else \
-        bit_trace.members_disagree(final.bit_rad_s_est[late], estimate.stick_slip_severity,
+        bit_trace.members_disagree(final.bit_rad_s_est[late], severity,
                                    settings.omega_c_rad_s)
     trace = decide_trace(TraceEvidence(
         logging=bit_speed_resolution(models), on_bottom=models.on_bottom, check=kinematics,
-        windows=windows, converged=estimate.converged,
-        runaway_note=_runaway_note(estimate, kinematics) if runaway else None,
-        severe_note=bit_trace.statistics_note(estimate.stick_slip_severity),
+        windows=windows, converged=verdict.converged,
+        runaway_note=_runaway_note(verdict.mu_k, kinematics) if runaway else None,
+        severe_note=bit_trace.statistics_note(severity),
         undetermined_note=undetermined))
-    fitted = fitted_result()
-    terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
-                                                                 refined.mu_s)
-                                    if models.on_bottom else None, verdict.mu_k)
-    return replace(estimate, evidence=fitted, torque_terms=terms, converged=trace.converged,
-                   bit_speed=trace.bit_speed, kinematics=kinematics,
-                   bit_windows_withheld=trace.windows_withheld,
-                   bit_statistics=trace.statistics, flags=estimate.flags + trace.flags,
-                   messages=estimate.messages + trace.messages + _dropped_note(models),
-                   logged=models.logged, samples_dropped=models.dropped)
+    return trace, kinematics
 
 
 def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
@@ -687,10 +710,10 @@ def _yielding(work, *args):
     return work(*args)
 
 
-def _runaway_note(estimate: SegmentEstimate, check: bit_trace.KinematicCheck) -> str:
+def _runaway_note(mu_k: float, check: bit_trace.KinematicCheck) -> str:
     """Why a segment whose seeded trace runs away is not converged."""
     side = "ahead of" if check.lag_rpm > 0 else "behind"
-    return (f"not converged: the observer seeded with μ_k = {estimate.mu_k:.3f} runs the bit "
+    return (f"not converged: the observer seeded with μ_k = {mu_k:.3f} runs the bit "
             f"{abs(check.lag_rpm):.1f} RPM {side} the top drive over {check.t_from_s:.0f}–"
             f"{check.t_to_s:.0f} s, {check.drift_rad / check.allowed_rad:.0f}× the twist the "
             "string can hold: the fitted factors do not describe this record")
@@ -719,9 +742,30 @@ def _windows(settings: ChainSettings, models: SegmentModels, refined, time_s: np
                                   find_gaps(models.sample_times_s, travel, 1.0 / meas.dt_s))
 
 
-def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData, starts,
-              first, diag, refined, verdict: Verdict, final, bit) -> SegmentEstimate:
-    """The segment's estimate from the chain's results (diagnostics of what is reported)."""
+@dataclass(frozen=True)
+class Steps:
+    """What the chain's steps gave for one segment, for :func:`_assemble`."""
+
+    starts: np.ndarray
+    first: ObserverRecord
+    diag: Diagnostics
+    refined: batch.BatchResult
+    verdict: Verdict
+    trace: TraceVerdict
+    final: ObserverRecord
+    bit: BitSpeedEstimate
+    fitted: FitEvidence
+    terms: bit_torque.TorqueTerms | None
+    kinematics: bit_trace.KinematicCheck
+
+
+def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
+              steps: Steps) -> SegmentEstimate:
+    """The segment's estimate from the chain's results, built once: the factors' verdict
+    and the trace's verdict decide every flag and withheld field (diagnostics of what is
+    reported)."""
+    verdict, trace, refined, final, bit = (steps.verdict, steps.trace, steps.refined,
+                                           steps.final, steps.bit)
     reported = diagnose(bit.record(final), settings.omega_c_rad_s)
     late = settled_mask(final.time_s)
     members, weights = final.bit_rad_s_est[late], bit.weights[late]
@@ -734,17 +778,21 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
     return SegmentEstimate(
         mu_s=refined.mu_s, mu_k=verdict.mu_k, mu_s_identifiable=refined.mu_s_identifiable,
         mu_s_lower_bound=verdict.mu_s_lower_bound,
-        mu_s_spread=_mu_s_spread(settings, refined, diag),
-        mu_k_spread=diag.mu_k_spread, converged=verdict.converged, method=verdict.method,
-        settling_time_s=diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
+        mu_s_spread=_mu_s_spread(settings, refined, steps.diag),
+        mu_k_spread=steps.diag.mu_k_spread, converged=trace.converged, method=verdict.method,
+        settling_time_s=steps.diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
         stick_slip_severity=bit_trace.mixture_severity(members, weights),
         stuck_fraction=bit_trace.stuck_share(members, weights, settings.omega_c_rad_s),
-        mu_k_observer=diag.mu_k, mu_s_observer=diag.mu_s,
+        mu_k_observer=steps.diag.mu_k, mu_s_observer=steps.diag.mu_s,
         mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
-        flags=verdict.flags, messages=tuple(messages), starts=starts, first=first,
-        final=final, bit=bit, bit_rms_error_rpm=_bit_error(final.time_s, bit, data),
-        td=models.td, mu_s_seed=verdict.mu_s_seed,
-        friction_zone=settings.friction.zone)
+        flags=verdict.flags + trace.flags,
+        messages=tuple(messages) + trace.messages + _dropped_note(models),
+        starts=steps.starts, first=steps.first, final=final, bit=bit,
+        bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=models.td,
+        mu_s_seed=verdict.mu_s_seed, evidence=steps.fitted, bit_speed=trace.bit_speed,
+        kinematics=steps.kinematics, bit_windows_withheld=trace.windows_withheld,
+        bit_statistics=trace.statistics, logged=models.logged, torque_terms=steps.terms,
+        friction_zone=settings.friction.zone, samples_dropped=models.dropped)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,

@@ -1,0 +1,120 @@
+"""One rule table for the flags (issue 31 item 4): ``drillfric.result.FLAG_RAISED_BY`` names,
+for every flag, the pure rule(s) that raise it, and no other function of drillfric raises one.
+
+A flag raised anywhere else would be a decision the table does not show: the scan below
+reads every ``Flag.X`` of the package outside a comparison (a comparison reads a flag, it
+does not raise it) and checks that its function is the one the table names. The string-
+weight check's rule, the last that was decided inline, is tested here by its table.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+from pathlib import Path
+
+import pytest
+
+from drillfric.hookload import weight_verdict
+from drillfric.result import FLAG_RAISED_BY, Flag
+from drillfric.vocabulary import Status
+
+PACKAGE = Path(__file__).resolve().parents[1] / "drillfric"
+TESTS = Path(__file__).resolve().parent
+
+
+def _resolve(dotted: str):
+    module, _, name = dotted.rpartition(".")
+    return getattr(importlib.import_module(module), name, None)
+
+
+def test_every_flag_has_a_rule_that_exists():
+    assert set(FLAG_RAISED_BY) == set(Flag)
+    for flag, rules in FLAG_RAISED_BY.items():
+        for dotted in rules:
+            assert callable(_resolve(dotted)), f"{flag.value}: {dotted} does not exist"
+
+
+def _raising_functions(path: Path, root: Path = PACKAGE.parent) -> list[tuple[str, str]]:
+    """(flag member, dotted function) of every ``Flag.X`` in ``path`` (a module under
+    ``root``) outside a comparison and inside a function (module constants group flags, they
+    raise none)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    module = ".".join(path.relative_to(root).with_suffix("").parts)
+    found = []
+
+    def visit(node, function, comparing):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            function = node.name if function is None else function
+        comparing = comparing or isinstance(node, ast.Compare)
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
+                and node.value.id == "Flag" and function and not comparing:
+            found.append((node.attr, f"{module}.{function}"))
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                and node.func.id == "Flag" and function:
+            found.append(("<built from a string>", f"{module}.{function}"))
+        for child in ast.iter_child_nodes(node):
+            visit(child, function, comparing)
+
+    visit(tree, None, False)
+    return found
+
+
+def test_no_function_outside_the_table_raises_a_flag():
+    built = {r for f in (Flag.OBSERVER_NOT_CONVERGED, Flag.OBSERVER_DEADLOCK_AVERTED)
+             for r in FLAG_RAISED_BY[f]}
+    stray = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.name == "result.py":
+            continue
+        for member, function in _raising_functions(path):
+            allowed = built if member.startswith("<") else FLAG_RAISED_BY[Flag[member]]
+            if function not in allowed:
+                stray.append(f"{member} in {function}")
+    assert not stray, f"flags raised outside drillfric.result.FLAG_RAISED_BY: {stray}"
+
+
+def test_the_scan_sees_a_planted_flag(tmp_path):
+    """The scan itself: a flag appended in a function is seen, a comparison is not."""
+    planted = tmp_path / "drillfric" / "probe.py"
+    planted.parent.mkdir()
+    planted.write_text("def raise_one(flags):\n    flags.append(Flag.POOLED)\n"
+                       "def read_one(flags):\n    return Flag.POOLED in flags\n")
+    assert _raising_functions(planted, tmp_path) == [("POOLED", "drillfric.probe.raise_one")]
+
+
+def test_every_flag_is_exercised_by_a_test():
+    """Each flag's rule is held by a test that names the flag (this file aside)."""
+    text = "\n".join(p.read_text(encoding="utf-8") for p in TESTS.glob("test_*.py")
+                     if p.name != Path(__file__).name)
+    untested = [f.value for f in Flag if f"Flag.{f.name}" not in text
+                and f'"{f.value}"' not in text and f"'{f.value}'" not in text
+                and f.value.removeprefix("observer_") not in text]
+    assert not untested
+
+
+#: The string-weight rule, case by case: (status, contradiction, unverified, calibrated) →
+#: (withheld, flag), and why.
+WEIGHT_CASES = [
+    (Status.OK, "", "", False, False, None, "nothing against the string: shown, no flag"),
+    (Status.OK, "the hook load says 1.4×", "", False, True, Flag.HOOKLOAD_CONTRADICTS_STRING,
+     "a contradiction withholds"),
+    (Status.OK, "the hook load says 1.4×", "no block", True, True,
+     Flag.HOOKLOAD_CONTRADICTS_STRING, "a contradiction outranks the rest"),
+    (Status.OK, "", "no block weight", False, True, Flag.STRING_WEIGHT_UNVERIFIED,
+     "a string weight the log cannot measure withholds"),
+    (Status.OK, "", "", True, False, Flag.STRING_WEIGHT_CALIBRATED,
+     "a calibrated string is shown, marked"),
+    (Status.SKIPPED, "the hook load says 1.4×", "", True, False, None,
+     "a segment not estimated has nothing to withhold or mark"),
+    (Status.FAILED, "", "no block weight", False, False, None, "nor has a failed one"),
+]
+
+
+@pytest.mark.parametrize("status, contradiction, unverified, calibrated, withheld, flag, why",
+                         WEIGHT_CASES, ids=[c[-1] for c in WEIGHT_CASES])
+def test_weight_verdict(status, contradiction, unverified, calibrated, withheld, flag, why):
+    rule = weight_verdict(status, contradiction, unverified, calibrated)
+    assert bool(rule.withhold) is withheld and rule.flag is flag, why
+    if withheld:
+        assert rule.withhold == (contradiction or unverified)
