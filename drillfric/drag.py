@@ -26,6 +26,7 @@ the log, withholding with the reason what the data cannot give.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -34,6 +35,9 @@ from scipy.signal import lfilter
 from drillfric import torque_drag
 from drillfric.errors import ModelError
 from drillfric.segmentation import IDLE, TRIPPING
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: Relative uncertainty of the hook-load reading (dead-line anchor sensors are specified to
 #: ±2–5 % of reading). A scale error multiplies the block's reading too, so it applies to
@@ -131,7 +135,7 @@ class MoveFinder:
     cfg : Config
     """
 
-    def __init__(self, cfg):
+    def __init__(self, cfg: Config):
         self._max_gap_s = float(cfg.segmentation.max_gap_s)
         self._prev = (np.nan, np.nan)  # time and depth of the previous row
         self._zi = np.zeros(1)         # smoothing filter state
@@ -224,7 +228,7 @@ class MoveFinder:
                                    float(np.median(hw)), float((q3 - q1) / 2)))
 
 
-def find_moves(frame: pd.DataFrame, cfg) -> tuple[list[Move], int]:
+def find_moves(frame: pd.DataFrame, cfg: Config) -> tuple[list[Move], int]:
     """The moves of a whole log in memory, and how many were too short
     (:class:`MoveFinder` on :func:`drillfric.segmentation.SegmentStream`'s states)."""
     from drillfric.segmentation import SegmentStream

@@ -24,10 +24,14 @@ every model the estimator builds (:meth:`FrictionProfile.plant`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from drillfric import torsional
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: Hypotheses for an unknown cased static factor: tied to the open hole's μ_s/μ_k, or none.
 CASED_STATIC = ("tied", "kinetic")
@@ -64,7 +68,7 @@ class FrictionProfile:
     law_exponent: float = 1.0
 
     @classmethod
-    def from_config(cls, cfg) -> FrictionProfile:
+    def from_config(cls, cfg: Config) -> FrictionProfile:
         """The profile of ``[model]``: casing keys and friction law."""
         m = cfg.model
         stribeck = m.friction_law == "stribeck"

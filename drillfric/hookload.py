@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -33,6 +34,9 @@ from drillfric.drillstring import section_from_config
 from drillfric.kernels.lazy import lazy_jit
 from drillfric.result import Flag, SegmentRecord
 from drillfric.vocabulary import Kind, LoadCase, Status
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: Heaviest plausible travelling equipment (block, hook, top drive, elevators) [N]: about
 #: 70 t, above the heaviest offshore top-drive systems. Without an in-slips plateau a hook
@@ -245,7 +249,7 @@ class PlateauFinder:
     cfg : Config
     """
 
-    def __init__(self, cfg):
+    def __init__(self, cfg: Config):
         self._seg = cfg.segmentation
         self._carry = np.array([np.nan, np.nan, 0.0, 0.0, np.nan, 0.0, 0.0, np.nan])
         self._last = (np.nan, np.nan)  # time and depth of the previous row
@@ -321,7 +325,7 @@ class PlateauFinder:
                           for a, b, n, level in zip(*(o[:k] for o in out), strict=True)]
 
 
-def find_plateaus(frame: pd.DataFrame, cfg) -> list[Plateau]:
+def find_plateaus(frame: pd.DataFrame, cfg: Config) -> list[Plateau]:
     """The plateaus of a whole log in memory (:class:`PlateauFinder`)."""
     finder = PlateauFinder(cfg)
     finder.feed(frame)
@@ -371,7 +375,7 @@ def block_weight(plateaus: list[Plateau], points: pd.DataFrame,
                        "slips_hookload_N" if configured else "log", tuple(plateaus))
 
 
-def block_weight_of(plateaus: list[Plateau], points: pd.DataFrame, cfg) -> BlockWeight:
+def block_weight_of(plateaus: list[Plateau], points: pd.DataFrame, cfg: Config) -> BlockWeight:
     """The block weight of a well: from the log (:func:`block_weight`), else the configured
     ``hookload.block_weight_N`` (source ``"config"``), else none."""
     block = block_weight(plateaus, points, cfg.segmentation.slips_hookload_N is not None)
@@ -512,7 +516,7 @@ def _unverified(block: BlockWeight) -> str:
             "weight) — a string 40 % off the configured one would pass")
 
 
-def judge(records: list, plateaus: list[Plateau], cfg,
+def judge(records: list, plateaus: list[Plateau], cfg: Config,
           calibration: Calibration | None = None) -> Outcome:
     """Check the configured string against the hook load; withhold what it contradicts.
 
@@ -602,7 +606,7 @@ def _verdict(well_problem: str, block: BlockWeight, calibration: Calibration | N
     return "consistent" if block.weight_N is not None else "unverified"
 
 
-def _summary_base(cfg, block: BlockWeight, calibration: Calibration | None,
+def _summary_base(cfg: Config, block: BlockWeight, calibration: Calibration | None,
                   checked: int) -> dict:
     """summary.json ``hookload`` before the verdict."""
     return {"verdict": None, "reason": None, "tolerance": cfg.hookload.tolerance,
@@ -617,7 +621,7 @@ def _summary_base(cfg, block: BlockWeight, calibration: Calibration | None,
 
 
 def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWeight,
-              calibration: Calibration | None, cfg) -> list[str]:
+              calibration: Calibration | None, cfg: Config) -> list[str]:
     out = []
     if well_problem:
         fix = ("check [[string.sections]] (linear masses, lengths), the mud density and the "

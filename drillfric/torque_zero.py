@@ -19,6 +19,7 @@ cannot tell from friction.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -26,6 +27,9 @@ import pandas as pd
 from drillfric.hookload import band_N, withhold_friction
 from drillfric.result import Flag
 from drillfric.vocabulary import Kind, Status
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: Hook-load bins [N]: 3 % wide from 10 kN to 10 MN (a block weighs 10–60 t).
 HOOK_EDGES_N = np.geomspace(1e4, 1e7, 235)
@@ -50,7 +54,7 @@ class TorqueAtRest:
         ``segmentation.rotating_stop_rpm`` is the speed at or below which a row is at rest.
     """
 
-    def __init__(self, cfg):
+    def __init__(self, cfg: Config):
         self._stop_rpm = float(cfg.segmentation.rotating_stop_rpm)
         self.counts = np.zeros((HOOK_EDGES_N.size + 1, TORQUE_EDGES_NM.size + 1), np.int64)
 

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -46,6 +47,9 @@ from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import Flag, SegmentRecord
 from drillfric.torque_drag import TDResult, TDSettings, back_calculate_friction, solve
 from drillfric.vocabulary import Kind, Method, Status
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: What a depth log cannot give, said in every summary and segment message.
 NO_OBSERVER = ("depth-indexed log: no time series, so no observer — μ_s is not identifiable "
@@ -132,7 +136,7 @@ def bit_depth(log: pd.DataFrame) -> np.ndarray:
     return np.where(np.isfinite(bit), bit, log["measured_depth_m"].to_numpy(float))
 
 
-def on_bottom(log: pd.DataFrame, cfg) -> tuple[np.ndarray, np.ndarray, list[str]]:
+def on_bottom(log: pd.DataFrame, cfg: Config) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Whether each row is on bottom, which rows the data leave unknown, and notes.
 
     A row of a depth-indexed drilling log is a depth of hole drilled: on bottom unless the
@@ -167,7 +171,7 @@ def on_bottom(log: pd.DataFrame, cfg) -> tuple[np.ndarray, np.ndarray, list[str]
 
 
 # --------------------------------------------------------------------------- windows
-def windows(log: pd.DataFrame, cfg) -> tuple[list[Window], list[str]]:
+def windows(log: pd.DataFrame, cfg: Config) -> tuple[list[Window], list[str]]:
     """The depth windows of a log, one :class:`Window` per window and load case with rows.
 
     Windows are ``[friction_log] window_m`` long and aligned on its multiples (2820–2850 m),
@@ -212,7 +216,7 @@ def _window(wid: int, kind: Kind, top: float, width: float, log: pd.DataFrame,
 
 
 # --------------------------------------------------------------------------- back-calculation
-def bit_torque_Nm(wob_N: float, cfg) -> float:
+def bit_torque_Nm(wob_N: float, cfg: Config) -> float:
     """Bit torque assumed on bottom [N·m]: T_bit = μ_bit·WOB·D_bit/3 (a Coulomb bit face,
     as the simulator's, docs/simulator.md), 0 without WOB or with μ_bit = 0.
 

@@ -20,6 +20,8 @@ load exceeds its measured median hook load by more than :data:`HOOKLOAD_TOLERANC
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pandas as pd
 
@@ -28,6 +30,9 @@ from drillfric.io.text import plural
 from drillfric.vocabulary import Kind, LoadCase
 
 from .display import SI, Units
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
 
 #: Relative tolerance of the weight check (the run's, which flags it in summary.json).
 HOOKLOAD_TOLERANCE = STRING_WEIGHT_TOLERANCE
@@ -72,7 +77,7 @@ def measured_points_from_windows(windows: pd.DataFrame) -> pd.DataFrame:
                         ).reset_index(drop=True)
 
 
-def measured_points_from_log(surface: pd.DataFrame, cfg) -> pd.DataFrame:
+def measured_points_from_log(surface: pd.DataFrame, cfg: Config) -> pd.DataFrame:
     """Measured points straight from a log: segment it (:mod:`drillfric.segmentation`) and
     take each rotating segment's median hook load and mean surface torque [N], [N·m].
 
@@ -98,7 +103,7 @@ def _mean(frame: pd.DataFrame, col: str) -> float:
     return float(frame[col].mean()) if col in frame and frame[col].notna().any() else np.nan
 
 
-def model_table(cfg, path, bit_depths_m, frictions=DEFAULT_FRICTIONS) -> pd.DataFrame:
+def model_table(cfg: Config, path, bit_depths_m, frictions=DEFAULT_FRICTIONS) -> pd.DataFrame:
     """The broomstick model lines (:func:`drillfric.torque_drag.broomstick`) of a config.
 
     ``path`` None: the assumed path of a well without survey (vertical with the nominal
@@ -116,7 +121,7 @@ def model_table(cfg, path, bit_depths_m, frictions=DEFAULT_FRICTIONS) -> pd.Data
                       element_length_m=cfg.model.element_length_m)
 
 
-def default_depths(cfg, deepest_m: float, count: int = 40) -> np.ndarray:
+def default_depths(cfg: Config, deepest_m: float, count: int = 40) -> np.ndarray:
     """Bit depths of the model lines: from just below the BHA to ``deepest_m``."""
     from drillfric.drillstring import build_string
 

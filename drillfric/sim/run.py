@@ -320,7 +320,7 @@ def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario,
     return cpu_s
 
 
-def _run_stand(cfg, settings, path, stand: Stand, index: int, t0: float, rate: float):
+def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float, rate: float):
     plant, td = plant_for(cfg, settings, path, stand)
     rec, _ = torsional.run(plant, _drive(stand, settings), stand.total_s, rate)
     surface_torque = rec.motor_torque_Nm if settings.torque_kind == "motor" \
@@ -390,7 +390,7 @@ def _drilled_m(stand: Stand, time_s: np.ndarray) -> np.ndarray:
     return stand.rop_m_h / 3600.0 * np.clip(time_s - stand.idle_s, 0.0, stand.duration_s)
 
 
-def _connection(t0: float, span: float, rate: float, before: Stand, after: Stand, cfg):
+def _connection(t0: float, span: float, rate: float, before: Stand, after: Stand, cfg: Config):
     """Rows of a connection: no rotation, torque released, in slips, bit moving down."""
     t = t0 + np.arange(1, int(np.floor(span * rate + 1e-9)) + 1) / rate
     t = t[t < t0 + span - 0.5 / rate]

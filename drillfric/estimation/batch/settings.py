@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from drillfric.config import default
+from drillfric.config import Config, default
 
 
 @dataclass(frozen=True)
@@ -50,7 +50,7 @@ class BatchSettings:
     window_s: float = default("batch.window_s")
 
     @classmethod
-    def from_config(cls, cfg) -> BatchSettings:
+    def from_config(cls, cfg: Config) -> BatchSettings:
         """The settings of a :class:`drillfric.config.Config`."""
         return cls(omega_c_rad_s=cfg.omega_c_rad_s, k_t_per_s=cfg.model.k_t_per_s,
                    top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
