@@ -380,14 +380,15 @@ def _result(mesh: _Mesh, force, torque, normal, load_case, friction) -> TDResult
                     friction=friction)
 
 
-def config_friction(cfg, friction: float | None = None) -> Friction:
-    """Friction factor from a configuration: ``friction`` if given, else per hole section.
+def config_friction(cfg, friction: Friction | None = None) -> Friction:
+    """Friction factor from a configuration: ``friction`` if given (a number, or a function of
+    measured depth like :class:`SectionFriction`), else per hole section.
 
     Above ``model.casing_shoe_md_m`` the cased value applies, below it the open-hole value;
     a missing one falls back to ``model.friction``.
     """
     if friction is not None:
-        return float(friction)
+        return friction if callable(friction) else float(friction)
     base = cfg.model.friction
     shoe = cfg.model.casing_shoe_md_m
     cased, open_ = cfg.model.friction_cased, cfg.model.friction_open

@@ -564,6 +564,32 @@ class State:
         return cls(omega + torque / grid.zeta_Nms, omega - torque / grid.zeta_Nms,
                    np.array([float(omega_rad_s), 0.0]), t_s)
 
+    def on_grid(self, old: Grid, new: Grid) -> State:
+        """This state (on grid ``old``) on the grid of a string that has moved along the
+        hole, ``new`` (docs/theory.md §3.3, stand phases): ω and τ kept at each distance
+        above the bit — the BHA and the lower string carry their motion and twist — and
+        linearly interpolated between cell centres; pipe the new string has above the old
+        one's top cell takes the top cell's ω and τ. Top drive and time are kept.
+
+        Examples
+        --------
+        >>> from drillfric.drillstring import Section, DrillString
+        >>> def grid(length):
+        ...     return make_grid(DrillString((Section("dp", 0.15, 0.12, length, 0.075, 40.0,
+        ...                                           79.3e9),)), cells=10)
+        >>> a, b = grid(1000.0), grid(1100.0)
+        >>> st = State.wound(a, np.full(10, 10.0), 3000.0, 0.2)
+        >>> moved = st.on_grid(a, b)
+        >>> float(moved.torque_Nm(b)[0]), round(float(moved.torque_Nm(b)[-1]), 6)
+        (2900.0, 1110.0)
+        """
+        above_bit = float(np.sum(old.length_m)) - old.x_m
+        d_new = float(np.sum(new.length_m)) - new.x_m
+        omega = np.interp(-d_new, -above_bit, self.omega_rad_s)
+        torque = np.interp(-d_new, -above_bit, self.torque_Nm(old))
+        return State(omega + torque / new.zeta_Nms, omega - torque / new.zeta_Nms,
+                     self.top.copy(), self.t_s)
+
     @property
     def omega_rad_s(self) -> np.ndarray:
         """Angular velocity ω = (α + β)/2 of every cell [rad/s]."""
@@ -631,9 +657,14 @@ def kernel_args(plant: Plant, drive: Drive) -> tuple:
             drive.t0_s, drive.dt_s, drive.kp_Nms_rad, drive.ki_Nm_rad)
 
 
+def model_steps(duration_s: float, dt_s: float) -> int:
+    """Whole model steps that cover ``duration_s`` [-] (:func:`run` advances by as many)."""
+    return int(np.ceil(duration_s / dt_s * (1 - 1e-12)))
+
+
 def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
         state: State | None = None, *, backend: str = "numba",
-        axial: Axial | None = None) -> tuple[Record, State]:
+        axial: Axial | None = None, times_s: np.ndarray | None = None) -> tuple[Record, State]:
     """Advance the plant for ``duration_s`` and record at ``rate_hz`` (docs/theory.md §3.1).
 
     Parameters
@@ -651,6 +682,9 @@ def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
     axial : Axial, optional
         Axial pipe speed v(t) (docs/theory.md §3.3; needs ``plant.contact_radius_m``). None
         (default) or v = 0 throughout is the plant without axial motion, bit for bit.
+    times_s : ndarray, optional
+        Record at these times [s] instead of every 1/``rate_hz`` from ``state.t_s``; they
+        must lie within the steps run, [t_s, t_s + :func:`model_steps`·Δt].
 
     Returns
     -------
@@ -662,8 +696,9 @@ def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
                          f"{rate_hz} Hz")
     state = State.rest(plant.grid) if state is None else state
     alpha, beta, top = state.alpha.copy(), state.beta.copy(), state.top.copy()
-    times = record_times(state.t_s, duration_s, rate_hz)
-    n_steps = int(np.ceil(duration_s / plant.grid.dt_s * (1 - 1e-12)))
+    n_steps = model_steps(duration_s, plant.grid.dt_s)
+    times = record_times(state.t_s, duration_s, rate_hz) if times_s is None \
+        else np.asarray(times_s, dtype=float)
     out = np.empty((times.size, len(RECORD_COLUMNS)))
     if backend == "numba":
         from drillfric.kernels.plant import run_plant
