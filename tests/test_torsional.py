@@ -760,6 +760,31 @@ def test_axial_motion_ends_stick_slip():
         assert stuck[v] == 0.0 and bit_min[v] > 0.95 * 40 * RPM and swing[v] < 0.01
 
 
+def test_state_on_another_grid_keeps_the_twist_above_the_bit():
+    """docs/theory.md §3.3 (stand phases): carried to the same grid a state is unchanged to
+    round-off (ω ± τ/ζ re-formed); carried to the string 30 m longer, each cell keeps the
+    torque and speed of the old string at its distance above the bit: a string wound by
+    μF_c = 2 N·m/m from 8 kN·m at the top (linear in x, so the interpolation is exact)
+    reads τ = 8000 − 2(x − 30) at depth x of the new string, and the 30 m of new pipe at
+    the top the old top cell's torque. 1e-9: interpolation and sums of lengths."""
+    rng = np.random.default_rng(3)
+    g = T.make_grid(two_section_string(), 200)
+    state = T.State(rng.normal(0, 2, g.n_cells), rng.normal(0, 2, g.n_cells),
+                    np.array([1.0, 2.0]), 7.0)
+    same = state.on_grid(g, g)
+    np.testing.assert_allclose(same.alpha, state.alpha, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(same.beta, state.beta, rtol=1e-9, atol=1e-12)
+    assert same.t_s == 7.0 and list(same.top) == [1.0, 2.0]
+    wound = T.State.wound(g, np.full(g.n_cells, 20.0), 8000.0, 0.1, omega_rad_s=3.0)
+    longer = T.make_grid(two_section_string(2300.0), 200)
+    moved = wound.on_grid(g, longer)
+    x = longer.x_m
+    inside = x - 30.0 >= g.x_m[0]
+    expected = np.where(inside, 8000.0 - 2.0 * (x - 30.0), wound.torque_Nm(g)[0])
+    np.testing.assert_allclose(moved.torque_Nm(longer), expected, rtol=1e-9)
+    np.testing.assert_allclose(moved.omega_rad_s, 3.0, rtol=1e-12)
+
+
 def test_axial_motion_needs_the_contact_radius():
     """Axial motion splits the friction by ωr_c against v: without r_c per cell the plant
     refuses it (and a radius that is not positive), rather than guessing."""
