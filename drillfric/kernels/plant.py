@@ -331,8 +331,9 @@ def cell_update_axial(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_
     law the contact counts as at rest when s ≤ ω_c, and the static cap holds the cell as in
     :func:`cell_update`; otherwise the friction force opposes the contact's slip, and its
     torsional share ω/s of the cap (eq. 3.3b) is taken semi-implicitly with the magnitude
-    at step k, d = ω**·cap/(s + cap) (eq. 3.3c): exact in steady sliding, never past rest.
-    The Stribeck law takes its cap at the contact speed s.
+    at step k, d = clamp(ω**·cap/(s + cap), ±cap) (eq. 3.3c): exact in steady sliding,
+    never past rest, never beyond the Coulomb cap. The Stribeck law takes its cap at the
+    contact speed s.
     """
     an = a_src - kt_dt * w_src_a
     bn = b_src - kt_dt * w_src_b
@@ -340,7 +341,7 @@ def cell_update_axial(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_
     s = np.sqrt(w_old * w_old + u_j * u_j)
     cap = friction_cap(s, fcap_j, fix_s_j, fix_k_j, mu_s, mu_k, omega_c, inv_vs, delta, law,
                        fixed)
-    slide = w * cap / (s + cap)
+    slide = min(max(w * cap / (s + cap), -cap), cap)
     if law == LAW_STEP:
         held = min(max(w, -cap), cap)
         d = held if s <= omega_c else slide

@@ -123,7 +123,7 @@ def damp_and_friction_axial(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, fix_s, fi
     s = np.sqrt(w_old * w_old + u * u)
     cap = friction_cap(s, mu_s * fcap + fix_s, mu_k * fcap + fix_k, omega_c, inv_vs, delta,
                        law)
-    d = w * cap / (s + cap)
+    d = np.minimum(np.maximum(w * cap / (s + cap), -cap), cap)
     if law == LAW_STEP:
         d = np.where(s <= omega_c, np.minimum(np.maximum(w, -cap), cap), d)
     a_new[:] = an - d
