@@ -115,7 +115,7 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     for note in result.notes:
         warn(note)
     if well_path is None:  # the path simulate() assumed; written as NAME.survey.csv
-        well_path = no_survey_path(max(s.bit_depth_m for s in plan.stands),
+        well_path = no_survey_path(max(s.reach_m for s in plan.stands),
                                    cfg.tortuosity_rad_m)
         warn(f"no survey: simulated on a vertical hole with a nominal tortuosity of "
              f"{cfg.survey.tortuosity_deg_30m:g}°/30 m (survey.tortuosity_deg_30m), "
@@ -129,6 +129,15 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
          f"μ_k = {result.settings.mu_k:g}")
     for s in result.stands:
         echo(f"  stand {s.index}: bit {s.bit_depth_m:g} m, {s.start} to {s.rpm:g} RPM, "
-             f"T_N = {s.T_N_Nm / 1e3:.1f} kN·m, bit stuck {100 * s.bit_stuck_fraction:.0f} % "
-             f"of the rotating time")
+             f"{_reaming(s)}T_N = {s.T_N_Nm / 1e3:.1f} kN·m, bit stuck "
+             f"{100 * s.bit_stuck_fraction:.0f} % of the rotating time")
     echo("sidecars: " + ", ".join(str(p) for k, p in written.items() if k != "data"))
+
+
+def _reaming(stand) -> str:
+    """'reaming to 2266.4 m at 0.3 m/s, ' for a stand whose pipe moves, else ''."""
+    if not stand.axial_speed_m_s:
+        return ""
+    way = "reaming" if stand.axial_speed_m_s > 0 else "back-reaming"
+    return (f"{way} to {stand.bit_depth_m + stand.travel_m:.1f} m at "
+            f"{abs(stand.axial_speed_m_s):g} m/s, ")

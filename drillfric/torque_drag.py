@@ -384,14 +384,15 @@ def _result(mesh: _Mesh, force, torque, normal, load_case, friction) -> TDResult
                     friction=friction)
 
 
-def config_friction(cfg: Config, friction: float | None = None) -> Friction:
-    """Friction factor from a configuration: ``friction`` if given, else per hole section.
+def config_friction(cfg: Config, friction: Friction | None = None) -> Friction:
+    """Friction factor from a configuration: ``friction`` if given (a number, or a function of
+    measured depth like :class:`SectionFriction`), else per hole section.
 
     Above ``model.casing_shoe_md_m`` the cased value applies, below it the open-hole value;
     a missing one falls back to ``model.friction``.
     """
     if friction is not None:
-        return float(friction)
+        return friction if callable(friction) else float(friction)
     base = cfg.model.friction
     shoe = cfg.model.casing_shoe_md_m
     cased, open_ = cfg.model.friction_cased, cfg.model.friction_open
@@ -471,7 +472,9 @@ class TDSettings:
             Passed to :func:`solve` (``friction`` overrides the configured friction).
         """
         kw = dict(kw)
-        kw["friction"] = self.friction if kw.get("friction") is None else float(kw["friction"])
+        given = kw.get("friction")
+        kw["friction"] = self.friction if given is None else (
+            given if callable(given) else float(given))
         kw.setdefault("mud_out_kg_m3", self.mud_out_kg_m3)
         kw.setdefault("mud_in_kg_m3", self.mud_in_kg_m3)
         kw.setdefault("element_length_m", self.element_length_m)

@@ -222,6 +222,10 @@ class Plant:
         step law at ω_c.
     stribeck_exponent : float
         Stribeck exponent δ, 1 ≤ δ ≤ 2 [-] (1 and 2 are the fast variants of the kernel).
+    contact_radius_m : ndarray, optional
+        Contact radius r_c of each cell [m] (tool-joint OD/2 for drill pipe, body OD/2 for
+        collars; :func:`contact_radius`): needed only to run with axial pipe motion
+        (:class:`Axial`, docs/theory.md §3.3), where the friction splits by ωr_c against v.
     """
 
     grid: Grid
@@ -238,6 +242,7 @@ class Plant:
     stribeck_exponent: float = 1.0
     bit_weakening_ratio: float = 1.0
     bit_weakening_speed_rad_s: float = 10.0 * RPM_TO_RAD_S  # the config's default, 10 RPM
+    contact_radius_m: np.ndarray | None = None
 
     def __post_init__(self):
         if self.top_drive_inertia_kg_m2 <= 0:
@@ -271,6 +276,11 @@ class Plant:
                              f"{self.bit_weakening_speed_rad_s} rad/s",
                              fix="set simulate.bit_weakening_ratio ≥ 1 and "
                              "simulate.bit_weakening_rpm > 0")
+        rc = self.contact_radius_m
+        if rc is not None and (np.shape(rc) != (self.grid.n_cells,)
+                               or not np.all(np.asarray(rc) > 0) or not np.all(np.isfinite(rc))):
+            raise ModelError("contact_radius_m must be one finite, positive radius per cell",
+                             fix="give r_c [m] of each cell (torsional.contact_radius)")
         if not 1.0 <= self.stribeck_exponent <= 2.0:
             raise ModelError(f"the Stribeck exponent must be in [1, 2], got "
                              f"{self.stribeck_exponent}", fix="set simulate.stribeck_exponent")
@@ -366,10 +376,76 @@ class Plant:
             -abs(omega_rad_s) / self.bit_weakening_speed_rad_s)
         return float(self.bit_torque_cap_Nm * (1.0 + weak))
 
-    def friction_torque_Nm(self, omega_rad_s: float) -> float:
+    def friction_torque_Nm(self, omega_rad_s: float, axial_speed_m_s: float = 0.0) -> float:
         """Coulomb torque of the whole string turning uniformly at ω, Σ friction·Δx [N·m]
-        (docs/theory.md §3.2; the steady rotating surface torque without viscous part)."""
-        return float(np.sum(self.friction_Nm_m(omega_rad_s) * self.grid.dx_true_m))
+        (docs/theory.md §3.2; the steady rotating surface torque without viscous part).
+
+        With the pipe also moving axially at v (docs/theory.md eq. 3.3d) each cell carries
+        the torsional share ω r_c/√((ωr_c)² + v²) of the friction at its contact speed
+        √(ω² + (v/r_c)²) (``contact_radius_m`` needed).
+
+        Examples
+        --------
+        >>> from drillfric.drillstring import Section, DrillString
+        >>> g = make_grid(DrillString((Section("dp", 0.15, 0.12, 1000.0, 0.075, 40.0,
+        ...                                    79.3e9),)), cells=10)
+        >>> p = Plant(g, np.full(10, 10.0), 0.3, 0.2, 1.0, contact_radius_m=np.full(10, 0.1))
+        >>> round(p.friction_torque_Nm(4.0), 6), round(p.friction_torque_Nm(4.0, 0.3), 6)
+        (2000.0, 1600.0)
+        """
+        if axial_speed_m_s == 0.0:
+            return float(np.sum(self.friction_Nm_m(omega_rad_s) * self.grid.dx_true_m))
+        if self.contact_radius_m is None:
+            raise ModelError("axial motion needs the contact radius of every cell",
+                             fix="give Plant.contact_radius_m (torsional.contact_radius)")
+        u = abs(axial_speed_m_s) / np.asarray(self.contact_radius_m, dtype=float)
+        contact = np.hypot(omega_rad_s, u)
+        f_k = self.mu_k * self.fc_Nm_m + self.fixed_k_Nm_m
+        f_s = self.mu_s * self.fc_Nm_m + self.fixed_s_Nm_m
+        weight = np.array([self.static_weight(c) for c in contact])
+        per_m = (f_k + (f_s - f_k) * weight) * abs(omega_rad_s) / contact
+        return float(np.sum(per_m * self.grid.dx_true_m))
+
+
+def contact_radius(string: DrillString, grid: Grid) -> np.ndarray:
+    """Contact radius r_c of each cell [m], of the section at the cell centre (the soft-string
+    r_c of docs/theory.md §2: tool-joint OD/2 for drill pipe, body OD/2 for collars)."""
+    return np.asarray(string.along("contact_radius_m", grid.x_m), dtype=float)
+
+
+@dataclass(frozen=True)
+class Axial:
+    """Axial pipe speed v(t), uniform along the string (axially rigid; docs/theory.md §3.3),
+    as a uniformly sampled series (linear in between, held beyond its ends).
+
+    Attributes
+    ----------
+    values : ndarray
+        v [m/s]; its sign (running in or pulling out) does not change the torsional share.
+    dt_s : float
+        Sample interval [s].
+    t0_s : float
+        Time of ``values[0]`` [s].
+    """
+
+    values: np.ndarray
+    dt_s: float
+    t0_s: float = 0.0
+
+    def __post_init__(self):
+        v = np.asarray(self.values, dtype=float)
+        if not self.dt_s > 0 or v.ndim != 1 or v.size < 1 or not np.all(np.isfinite(v)):
+            raise ModelError("an axial speed series needs finite values and dt_s > 0")
+
+    def kernel_args(self, plant: Plant) -> tuple | None:
+        """(v, t0, dt, 1/r_c per cell) for the kernels, None when v = 0 throughout."""
+        if not np.any(np.asarray(self.values) != 0.0):
+            return None
+        if plant.contact_radius_m is None:
+            raise ModelError("axial motion needs the contact radius of every cell",
+                             fix="give Plant.contact_radius_m (torsional.contact_radius)")
+        return (np.asarray(self.values, dtype=float), self.t0_s, self.dt_s,
+                1.0 / np.asarray(plant.contact_radius_m, dtype=float))
 
 
 def bit_torque_cap(bit_mu: float, wob_N: float, bit_diameter_m: float) -> float:
@@ -488,6 +564,32 @@ class State:
         return cls(omega + torque / grid.zeta_Nms, omega - torque / grid.zeta_Nms,
                    np.array([float(omega_rad_s), 0.0]), t_s)
 
+    def on_grid(self, old: Grid, new: Grid) -> State:
+        """This state (on grid ``old``) on the grid of a string that has moved along the
+        hole, ``new`` (docs/theory.md §3.3, stand phases): ω and τ kept at each distance
+        above the bit — the BHA and the lower string carry their motion and twist — and
+        linearly interpolated between cell centres; pipe the new string has above the old
+        one's top cell takes the top cell's ω and τ. Top drive and time are kept.
+
+        Examples
+        --------
+        >>> from drillfric.drillstring import Section, DrillString
+        >>> def grid(length):
+        ...     return make_grid(DrillString((Section("dp", 0.15, 0.12, length, 0.075, 40.0,
+        ...                                           79.3e9),)), cells=10)
+        >>> a, b = grid(1000.0), grid(1100.0)
+        >>> st = State.wound(a, np.full(10, 10.0), 3000.0, 0.2)
+        >>> moved = st.on_grid(a, b)
+        >>> float(moved.torque_Nm(b)[0]), round(float(moved.torque_Nm(b)[-1]), 6)
+        (2900.0, 1110.0)
+        """
+        above_bit = float(np.sum(old.length_m)) - old.x_m
+        d_new = float(np.sum(new.length_m)) - new.x_m
+        omega = np.interp(-d_new, -above_bit, self.omega_rad_s)
+        torque = np.interp(-d_new, -above_bit, self.torque_Nm(old))
+        return State(omega + torque / new.zeta_Nms, omega - torque / new.zeta_Nms,
+                     self.top.copy(), self.t_s)
+
     @property
     def omega_rad_s(self) -> np.ndarray:
         """Angular velocity ω = (α + β)/2 of every cell [rad/s]."""
@@ -555,8 +657,14 @@ def kernel_args(plant: Plant, drive: Drive) -> tuple:
             drive.t0_s, drive.dt_s, drive.kp_Nms_rad, drive.ki_Nm_rad)
 
 
+def model_steps(duration_s: float, dt_s: float) -> int:
+    """Whole model steps that cover ``duration_s`` [-] (:func:`run` advances by as many)."""
+    return int(np.ceil(duration_s / dt_s * (1 - 1e-12)))
+
+
 def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
-        state: State | None = None, *, backend: str = "numba") -> tuple[Record, State]:
+        state: State | None = None, *, backend: str = "numba",
+        axial: Axial | None = None, times_s: np.ndarray | None = None) -> tuple[Record, State]:
     """Advance the plant for ``duration_s`` and record at ``rate_hz`` (docs/theory.md §3.1).
 
     Parameters
@@ -571,6 +679,12 @@ def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
         Initial state (default: at rest, no twist, at t = 0). Not modified.
     backend : str
         "numba" (compiled kernel) or "numpy" (the twin, for tests and benchmarks).
+    axial : Axial, optional
+        Axial pipe speed v(t) (docs/theory.md §3.3; needs ``plant.contact_radius_m``). None
+        (default) or v = 0 throughout is the plant without axial motion, bit for bit.
+    times_s : ndarray, optional
+        Record at these times [s] instead of every 1/``rate_hz`` from ``state.t_s``; they
+        must lie within the steps run, [t_s, t_s + :func:`model_steps`·Δt].
 
     Returns
     -------
@@ -582,8 +696,9 @@ def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
                          f"{rate_hz} Hz")
     state = State.rest(plant.grid) if state is None else state
     alpha, beta, top = state.alpha.copy(), state.beta.copy(), state.top.copy()
-    times = record_times(state.t_s, duration_s, rate_hz)
-    n_steps = int(np.ceil(duration_s / plant.grid.dt_s * (1 - 1e-12)))
+    n_steps = model_steps(duration_s, plant.grid.dt_s)
+    times = record_times(state.t_s, duration_s, rate_hz) if times_s is None \
+        else np.asarray(times_s, dtype=float)
     out = np.empty((times.size, len(RECORD_COLUMNS)))
     if backend == "numba":
         from drillfric.kernels.plant import run_plant
@@ -591,6 +706,7 @@ def run(plant: Plant, drive: Drive, duration_s: float, rate_hz: float,
         from drillfric.kernels.plant_numpy import run_plant
     else:
         raise ModelError(f"unknown backend '{backend}'", fix="use 'numba' or 'numpy'")
-    run_plant(alpha, beta, top, state.t_s, n_steps, *kernel_args(plant, drive), times, out)
+    run_plant(alpha, beta, top, state.t_s, n_steps, *kernel_args(plant, drive), times, out,
+              axial=None if axial is None else axial.kernel_args(plant))
     rec = Record(times, *(out[:, k] for k in range(out.shape[1])))
     return rec, State(alpha, beta, top, state.t_s + n_steps * plant.grid.dt_s)

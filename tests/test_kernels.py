@@ -164,11 +164,12 @@ def test_zero_fixed_part_is_bit_identical(law):
     assert kernels.variant(plant.law_speed_rad_s, plant.stribeck_exponent, args[4],
                            args[5]) == (code, False)
     outputs = []
-    for kernel in (kernels.run_plant, kernels.plant_kernel(code, True)):
+    no_axial = kernels.axial_args(None, plant.grid.n_cells)[0]
+    for kernel, extra in ((kernels.run_plant, ()), (kernels.plant_kernel(code, True), no_axial)):
         state = T.State.rest(plant.grid)
         times = np.linspace(0.0, 3000 * plant.grid.dt_s, 301)
         out = np.empty((times.size, len(T.RECORD_COLUMNS)))
-        kernel(state.alpha, state.beta, state.top, 0.0, 3000, *args, times, out)
+        kernel(state.alpha, state.beta, state.top, 0.0, 3000, *args, times, out, *extra)
         outputs.append((out, state.alpha, state.beta))
     for x, y in zip(*outputs, strict=True):
         np.testing.assert_array_equal(x, y)
@@ -184,3 +185,102 @@ def test_exp_neg_matches_the_exponential():
     np.testing.assert_allclose(fast, want, rtol=4e-16, atol=0)
     np.testing.assert_array_equal(kernels_numpy.exp_neg(x), fast)
     assert kernels.exp_neg(1e3) == pytest.approx(np.exp(-40.0), rel=4e-16)
+
+
+def _axial(plant):
+    """``plant`` with the contact radius of Well B's string at its cells (docs/theory.md
+    §3.3)."""
+    from drillfric.sim.well_b import well_b_string
+
+    return dataclasses.replace(plant, contact_radius_m=T.contact_radius(well_b_string(),
+                                                                        plant.grid))
+
+
+@pytest.mark.parametrize("law", ["step", "stribeck-1", "stribeck-1.5"])
+def test_axial_motion_agrees_with_twin(law):
+    """docs/theory.md §3.3: Well B (cased zone above 1600 m as a fixed part) in stick-slip at
+    40 RPM, the pipe then moving at 0.03 m/s (inside the static band ω_c·r_c = 0.066 m/s:
+    cells still stick), −0.3 m/s (pulling out, no cell can stick), back to rest and running
+    in at 0.1 m/s: kernel and twin agree to round-off over 10 000 steps (tolerance as the
+    tests above; measured bit-identical — the same operations, np.sqrt and numba's sqrt both
+    correctly rounded)."""
+    plant = _axial(cased_open(well_b_plant(cells=200, k_t_per_s=0.2), **LAWS[law]))
+    drive = T.Drive("pi", np.array([0.0, 40 * RPM]), 5.0)
+    axial = T.Axial(np.array([0.0, 0.0, 0.03, 0.03, -0.3, -0.3, 0.0, 0.0, 0.1]), 4.0)
+    out = [T.run(plant, drive, 10_000 * plant.grid.dt_s, 50.0, backend=backend, axial=axial)
+           for backend in ("numba", "numpy")]
+    _assert_same(*out)
+    pulling = out[0][0].time_s > 20.0
+    assert np.ptp(out[0][0].bit_rad_s[~pulling]) > 40 * RPM  # it oscillated strongly first
+
+
+@pytest.mark.parametrize("law", ["step", "stribeck-1"])
+def test_axial_kernel_at_zero_speed_is_bit_identical(law):
+    """docs/theory.md §3.3: v = 0 is today's plant bit for bit. The axial variant of the
+    kernel, run with v = 0 throughout, takes every step through :func:`pass_cells` and gives
+    the same bits as the kernel without axial motion (which :func:`run_plant` runs when there
+    is no axial series or it is zero) — in stick-slip, where one differing cell would show."""
+    plant = _axial(dataclasses.replace(well_b_plant(cells=200, k_t_per_s=0.2), **LAWS[law]))
+    drive = T.Drive("pi", np.array([0.0, 40 * RPM]), 5.0)
+    args = T.kernel_args(plant, drive)
+    code = kernels.law_code(plant.law_speed_rad_s, float(plant.stribeck_exponent))
+    zero = (np.zeros(4), 0.0, 1.0, 1.0 / plant.contact_radius_m)
+    runs = ((kernels.run_plant, {}), (kernels.run_plant, {"axial": zero}),
+            (kernels.plant_kernel(code, False, True), None))
+    outputs = []
+    for kernel, kw in runs:
+        state = T.State.rest(plant.grid)
+        times = np.linspace(0.0, 3000 * plant.grid.dt_s, 301)
+        out = np.empty((times.size, len(T.RECORD_COLUMNS)))
+        extra = zero if kw is None else ()
+        kernel(state.alpha, state.beta, state.top, 0.0, 3000, *args, times, out, *extra,
+               **(kw or {}))
+        outputs.append((out, state.alpha, state.beta))
+    for other in outputs[1:]:
+        for x, y in zip(outputs[0], other, strict=True):
+            np.testing.assert_array_equal(x, y)
+
+
+def test_axial_cell_rule_bounds_and_matches_twin():
+    """docs/theory.md eq. (3.3c), the friction one cell loses in a step while the pipe moves,
+    over 20 000 random cells (speeds ±20 rad/s, u = |v|/r_c 0–8 rad/s, caps 0–2 rad/s, step
+    and Stribeck laws): never more than the cap (Coulomb bound), never past rest (|d| ≤
+    |ω**|, same sign), held only inside the static band (step law), exact in steady
+    sliding (ω^k = ω^{k+1} ⇒ d = cap·ω/s); the compiled cell and the twin give the same
+    bits. The bounds hold to the round-off of forming d back from ω** − d (1e-14·|ω**|)."""
+    rng = np.random.default_rng(36)
+    n = 20_000
+    w_old = rng.uniform(-20, 20, n) * (rng.random(n) > 0.2)
+    w = w_old + rng.normal(0, 3, n) * (rng.random(n) > 0.5)
+    u, fcap = rng.uniform(0, 8, n) * (rng.random(n) > 0.1), rng.uniform(0, 2, n)
+    for law, inv_vs in ((kernels.LAW_STEP, 0.0), (kernels.LAW_STRIBECK_1, 1.0 / 0.8)):
+        twin_a, twin_b = np.zeros(n), np.zeros(n)
+        kernels_numpy.damp_and_friction_axial(w_old, w_old, twin_a, twin_b, np.zeros(n),
+                                              np.zeros(n), 0.0, fcap, np.zeros(n),
+                                              np.zeros(n), 0.6, 0.3, 1.0, inv_vs, 1.0, law, u)
+        twin_a[:], twin_b[:] = w, w  # same call with ω** = w: α* = β* = w
+        kernels_numpy.damp_and_friction_axial(w_old, w_old, twin_a, twin_b, np.zeros(n),
+                                              np.zeros(n), 0.0, fcap, np.zeros(n),
+                                              np.zeros(n), 0.6, 0.3, 1.0, inv_vs, 1.0, law, u)
+        d = w - twin_a
+        compiled = np.array([kernels.cell_update_axial(w[j], w[j], 0.0, 0.0, w_old[j], 0.0,
+                                                       fcap[j], 0.0, 0.0, 0.6, 0.3, 1.0,
+                                                       inv_vs, 1.0, law, False, u[j])[0]
+                             for j in range(n)])
+        np.testing.assert_array_equal(compiled, twin_a)
+        s = np.sqrt(w_old * w_old + u * u)
+        cap = np.where(s <= 1.0, 0.6, 0.3) * fcap if law == kernels.LAW_STEP else \
+            (0.3 + 0.3 * np.exp(-s * inv_vs)) * fcap
+        slack = 1e-14 * np.abs(w)  # d = ω** − (ω** − d) re-rounds at the scale of ω**
+        assert np.all(np.abs(d) <= cap + slack)
+        assert np.all(np.abs(d) <= np.abs(w) + slack) and np.all(d * w >= -slack * cap)
+        if law == kernels.LAW_STEP:
+            sliding = s > 1.0
+            steady_w = w_old + cap * w_old / np.where(sliding, s, 1.0)  # ends it at ω^k
+            twin_a[:], twin_b[:] = steady_w, steady_w
+            kernels_numpy.damp_and_friction_axial(w_old, w_old, twin_a, twin_b,
+                                                  np.zeros(n), np.zeros(n), 0.0, fcap,
+                                                  np.zeros(n), np.zeros(n), 0.6, 0.3, 1.0,
+                                                  0.0, 1.0, law, u)
+            np.testing.assert_allclose(twin_a[sliding], w_old[sliding], rtol=1e-12,
+                                       atol=1e-12)

@@ -661,6 +661,143 @@ def test_energy_conserved_without_friction_under_the_stribeck_law(seed, delta):
     assert T.energy(g, out) == pytest.approx(T.energy(g, state), rel=1e-11)
 
 
+# ------------------------------------------------------------- axial motion (§3.3)
+
+def _viscous_Nm(grid, k_t, omega):
+    return k_t * omega * float(np.sum(grid.rho_j_kg_m * grid.dx_model_m))
+
+
+@pytest.mark.parametrize("v", [0.1, 0.3, -0.3, 1.0])
+def test_steady_rotation_with_axial_motion_gives_the_split_torque(v):
+    """docs/theory.md eq. (3.3d): a string turning steadily at Ω while it moves axially at v
+    needs τ(0) = Σ μ_k F_c Δx·Ωr_c/√((Ωr_c)² + v²) + k_tΩ∫ρJ dx — each cell's friction
+    opposes its contact's slip and only the tangential share loads the torque. The sign of
+    v (running in or pulling out) does not matter. The expected value is summed here from
+    the cells, independent of ``Plant.friction_torque_Nm`` (which must agree to round-off).
+    Pipe r_c = 0.073 m, collars 0.105 m: at 60 RPM the pipe's share is 0.84 (v = 0.3 m/s)
+    to 0.42 (v = 1 m/s), 0.98–0.40 for the collars — far outside the tolerance. Tolerance
+    0.5 % as for pure rotation (the O(k_tΔt) speed gradient; measured ≤ 0.1 %)."""
+    string = two_section_string()
+    g, fc = _string_and_fc()
+    rc = T.contact_radius(string, g)
+    k_t, omega = 0.3, 60 * RPM
+    plant = T.Plant(g, fc, 0.3, 0.2, 0.5, k_t, contact_radius_m=rc)
+    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, omega]), 10.0), 100.0, 10.0,
+                   axial=T.Axial(np.array([v]), 1.0))
+    share = omega * rc / np.sqrt((omega * rc) ** 2 + v**2)
+    friction = float(np.sum(0.2 * fc * g.dx_true_m * share))
+    assert plant.friction_torque_Nm(omega, v) == pytest.approx(friction, rel=1e-12)
+    assert friction < 0.99 * 0.2 * plant.T_N_Nm
+    expected = friction + _viscous_Nm(g, k_t, omega)
+    assert rec.motor_torque_Nm[-1] == pytest.approx(expected, rel=5e-3)
+    assert rec.string_torque_Nm[-1] == pytest.approx(expected, rel=5e-3)
+    assert rec.bit_rad_s[-1] == pytest.approx(omega, rel=5e-3)
+
+
+@pytest.mark.parametrize("case, v", [("rotating_pick_up", 0.3), ("rotating_slack_off", -0.3),
+                                     ("rotating_pick_up", 0.15)])
+def test_steady_axial_torque_equals_torque_and_drag(case, v):
+    """docs/theory.md §2 steps 3–4 and eq. (3.3d): the plant turning steadily at 60 RPM while
+    moving at v, with F_c of the soft-string model's rotating pick-up / slack-off case at the
+    same μ_k, v and RPM (the axial friction changes the tension, hence F_N), needs the
+    surface torque of that case: both sum μ_k·N·r_c·ωr_c/√((ωr_c)² + v²) along the string.
+    Deviated well (vertical to 500 m, built to 60° at 1500 m, held to 2600 m), bit at 2500
+    m. |v| > ω_c·r_c in every cell (0.073 m/s for the pipe, 0.105 m/s for the collars), so
+    no cell sticks (slower, inside the static band, this string stick-slips at μ_s = 0.35).
+    Tolerance 0.5 %: the plant samples F_c at its 500 cell centres where torque and drag
+    sums it over 2-m elements, and the O(k_tΔt) speed gradient (measured ≤ 0.09 %)."""
+    from drillfric.torque_drag import solve
+    from drillfric.wellpath import minimum_curvature
+
+    path = minimum_curvature([0, 500, 1500, 2600], np.radians([0, 0, 60, 60]),
+                             np.radians([0, 0, 30, 30]))
+    string = two_section_string()
+    rpm, k_t = 60.0, 0.1
+    td = solve(path, string, friction=0.25, load_case=case, axial_speed_m_s=abs(v), rpm=rpm)
+    g = T.make_grid(string, 500)
+    plant = T.Plant(g, td.fc_at(g.x_m), 0.35, 0.25, 1.0, k_t,
+                    contact_radius_m=T.contact_radius(string, g))
+    rec, _ = T.run(plant, T.Drive("pi", np.array([0.0, rpm * RPM]), 10.0), 100.0, 10.0,
+                   axial=T.Axial(np.array([v]), 1.0))
+    rotating = solve(path, string, friction=0.25, load_case="rotating_off_bottom")
+    if abs(v) >= 0.3:  # the split is far outside the tolerance (at 0.15 m/s the share is 0.95)
+        assert td.surface_torque_Nm < 0.97 * rotating.surface_torque_Nm
+    surface = rec.motor_torque_Nm[-1] - _viscous_Nm(g, k_t, rpm * RPM)
+    assert surface == pytest.approx(td.surface_torque_Nm, rel=5e-3)
+
+
+def test_axial_motion_ends_stick_slip():
+    """docs/theory.md §3.3: a moving contact cannot stick. Well B (μ_s 0.885, μ_k 0.425,
+    ω_c = 0.9 rad/s; 200 cells) stick-slips at 40 RPM with the pipe at rest (bit stuck
+    ~70 % of the time, torque swing ~1.2 μ_kT_N). Inside the static band, |v| = 0.03 m/s <
+    ω_c·r_c = 0.066 m/s (pipe), cells can still stick, and it still stick-slips. With |v|
+    well above ω_c·r_c in every cell (0.2 and 0.5 m/s; 0.11 m/s for the largest collar) no
+    cell can stick, the friction grows with ω (the share ωr_c/√((ωr_c)² + v²)) and damps
+    the torsional waves: the stick-slip is gone — the bit never slows below 95 % of the
+    set-point, the torque swing is below 1 % of the mean (measured 0: steady) — and the
+    swing shrinks from > 50 % to < 1 % of the mean as v grows. Statistics after 60 s, as in
+    the stick-slip test of Well B.
+    (The steady bit turns 2.3 % below the top drive at 200 cells, 1.2 % at 400: the
+    Courant-1 scheme's first-order steady offset, half the per-step friction speed change of
+    the heavy bottom cells, docs/theory.md §3.3 — hence 95 %, not the 0.5 % of a fine grid.)"""
+    from drillfric.sim.well_b import well_b_plant, well_b_string
+
+    base = well_b_plant(cells=200)
+    plant = T.Plant(base.grid, base.fc_Nm_m, base.mu_s, base.mu_k, base.omega_c_rad_s,
+                    base.k_t_per_s, contact_radius_m=T.contact_radius(well_b_string(),
+                                                                      base.grid))
+    drive = T.Drive("pi", np.array([0.0, 40 * RPM]), 10.0)
+    swing, stuck, bit_min = {}, {}, {}
+    for v in (0.0, 0.03, 0.2, 0.5):
+        rec, _ = T.run(plant, drive, 150.0, 20.0, axial=T.Axial(np.array([v]), 1.0))
+        late = rec.time_s > 60.0
+        swing[v] = np.ptp(rec.motor_torque_Nm[late]) / np.mean(rec.motor_torque_Nm[late])
+        stuck[v] = np.mean(np.abs(rec.bit_rad_s[late]) < 0.1 * plant.omega_c_rad_s)
+        bit_min[v] = rec.bit_rad_s[late].min()
+    for v in (0.0, 0.03):
+        assert stuck[v] > 0.2 and swing[v] > 0.5
+    for v in (0.2, 0.5):
+        assert stuck[v] == 0.0 and bit_min[v] > 0.95 * 40 * RPM and swing[v] < 0.01
+
+
+def test_state_on_another_grid_keeps_the_twist_above_the_bit():
+    """docs/theory.md §3.3 (stand phases): carried to the same grid a state is unchanged to
+    round-off (ω ± τ/ζ re-formed); carried to the string 30 m longer, each cell keeps the
+    torque and speed of the old string at its distance above the bit: a string wound by
+    μF_c = 2 N·m/m from 8 kN·m at the top (linear in x, so the interpolation is exact)
+    reads τ = 8000 − 2(x − 30) at depth x of the new string, and the 30 m of new pipe at
+    the top the old top cell's torque. 1e-9: interpolation and sums of lengths."""
+    rng = np.random.default_rng(3)
+    g = T.make_grid(two_section_string(), 200)
+    state = T.State(rng.normal(0, 2, g.n_cells), rng.normal(0, 2, g.n_cells),
+                    np.array([1.0, 2.0]), 7.0)
+    same = state.on_grid(g, g)
+    np.testing.assert_allclose(same.alpha, state.alpha, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(same.beta, state.beta, rtol=1e-9, atol=1e-12)
+    assert same.t_s == 7.0 and list(same.top) == [1.0, 2.0]
+    wound = T.State.wound(g, np.full(g.n_cells, 20.0), 8000.0, 0.1, omega_rad_s=3.0)
+    longer = T.make_grid(two_section_string(2300.0), 200)
+    moved = wound.on_grid(g, longer)
+    x = longer.x_m
+    inside = x - 30.0 >= g.x_m[0]
+    expected = np.where(inside, 8000.0 - 2.0 * (x - 30.0), wound.torque_Nm(g)[0])
+    np.testing.assert_allclose(moved.torque_Nm(longer), expected, rtol=1e-9)
+    np.testing.assert_allclose(moved.omega_rad_s, 3.0, rtol=1e-12)
+
+
+def test_axial_motion_needs_the_contact_radius():
+    """Axial motion splits the friction by ωr_c against v: without r_c per cell the plant
+    refuses it (and a radius that is not positive), rather than guessing."""
+    g, fc = _string_and_fc(cells=50)
+    plant = T.Plant(g, fc, 0.6, 0.3, 1.0)
+    drive = T.Drive("pi", np.array([1.0]), 1.0)
+    with pytest.raises(ModelError, match="contact radius"):
+        T.run(plant, drive, 1.0, 10.0, axial=T.Axial(np.array([0.1]), 1.0))
+    with pytest.raises(ModelError, match="contact_radius_m"):
+        T.Plant(g, fc, 0.6, 0.3, 1.0, contact_radius_m=np.zeros(g.n_cells))
+    T.run(plant, drive, 1.0, 10.0, axial=T.Axial(np.zeros(3), 1.0))  # v = 0: not needed
+
+
 @pytest.fixture(scope="module")
 def well_b():
     """A&S 2018 Well B (docs/reference_cases.md), 500 cells, k_t = 0.1 1/s, 40 RPM, 300 s."""

@@ -14,6 +14,9 @@ observer (docs/theory.md §5, a copy of this plant plus injections) reuses:
 - :func:`pass_cells` — steps 1–3 fused in one vectorised pass over every cell (exact
   shift; the ghost cells make section ends like any other cell), with the observer's
   per-cell injections when asked;
+- :func:`cell_update_axial`, :func:`pass_cells_axial` — the same for a string that also
+  moves axially at v (docs/theory.md §3.3: friction at the contact speed, its tangential
+  share taken semi-implicitly), run for the steps with v ≠ 0;
 - :func:`drive_value`, :func:`motor_torque`, :func:`top_drive_step` — the top-drive input
   (PI on a set-point series, prescribed torque, or prescribed speed) and step 4, taken
   trapezoidally and solved *before* step 1 because the top inflow α(0) = 2ω̄₀ − β(0) uses
@@ -204,6 +207,17 @@ def padded(x, section_start):
 
 
 @njit(cache=True)
+def padded_inverse_radius(inv_rc, section_start):
+    """1/r_c per cell [1/m] in the ghost layout of :func:`padded`, with 1 in the ghost and
+    padding cells instead of 0 (their axial contact speed is then |v| > 0)."""
+    out = np.ones(row_length(section_start))
+    for s in range(section_start.size - 1):
+        for j in range(section_start[s], section_start[s + 1]):
+            out[j + 1 + 2 * s] = inv_rc[j]
+    return out
+
+
+@njit(cache=True)
 def unpadded(xp, section_start, out):
     """The real cells of ``xp`` (ghost layout of :func:`padded`) into ``out`` (length n)."""
     for s in range(section_start.size - 1):
@@ -306,6 +320,59 @@ def pass_cells(A, B, W, cur, end, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c
         W[nxt, j] = 0.5 * (an + bn)
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def cell_update_axial(a_src, b_src, w_src_a, w_src_b, w_old, kt_dt, fcap_j, fix_s_j, fix_k_j,
+                      mu_s, mu_k, omega_c, inv_vs, delta, law, fixed, u_j):
+    """Steps 2–3 of docs/theory.md §3.1 for one cell of a string that also moves axially
+    (docs/theory.md §3.3, eqs. 3.3a–3.3c); returns (α, β) at step k+1 [rad/s].
+
+    ``u_j`` = |v|/r_c [rad/s] is the axial pipe speed in the cell's angular units. The
+    contact speed s = √((ω^k)² + u_j²) [rad/s] (eq. 3.3a) decides the regime: under the step
+    law the contact counts as at rest when s ≤ ω_c, and the static cap holds the cell as in
+    :func:`cell_update`; otherwise the friction force opposes the contact's slip, and its
+    torsional share ω/s of the cap (eq. 3.3b) is taken semi-implicitly with the magnitude
+    at step k, d = clamp(ω**·cap/(s + cap), ±cap) (eq. 3.3c): exact in steady sliding,
+    never past rest, never beyond the Coulomb cap. The Stribeck law takes its cap at the
+    contact speed s.
+    """
+    an = a_src - kt_dt * w_src_a
+    bn = b_src - kt_dt * w_src_b
+    w = 0.5 * (an + bn)
+    s = np.sqrt(w_old * w_old + u_j * u_j)
+    cap = friction_cap(s, fcap_j, fix_s_j, fix_k_j, mu_s, mu_k, omega_c, inv_vs, delta, law,
+                       fixed)
+    slide = min(max(w * cap / (s + cap), -cap), cap)
+    if law == LAW_STEP:
+        held = min(max(w, -cap), cap)
+        d = held if s <= omega_c else slide
+    else:
+        d = slide
+    return an - d, bn - d
+
+
+@njit(cache=True, error_model="numpy")
+def pass_cells_axial(A, B, W, cur, end, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k, omega_c,
+                     inv_vs, delta, law, fixed, inv_rc, v_abs):
+    """:func:`pass_cells` (without injection) for a string moving axially at speed
+    ``v_abs`` = |v| [m/s]: the cells through :func:`cell_update_axial` with u_j = |v|/r_c,
+    ``inv_rc`` = 1/r_c per cell [1/m] in the ghost layout of :func:`padded` with 1 in the
+    ghost cells (:func:`padded_inverse_radius`: s + cap > 0 in every cell, no 0/0 even in
+    the meaningless ghost updates). ``law`` and ``fixed`` must be compile-time constants at
+    the call site (one vectorised loop each; NumPy's error model: no zero-division check
+    that would stop the compiler from vectorising)."""
+    literally(law)
+    literally(fixed)
+    nxt = 1 - cur
+    for j in range(1, end):
+        an, bn = cell_update_axial(A[cur, j - 1], B[cur, j + 1], W[cur, j - 1], W[cur, j + 1],
+                                   W[cur, j], kt_dt, fcap[j], fix_s[j] if fixed else 0.0,
+                                   fix_k[j] if fixed else 0.0, mu_s, mu_k, omega_c, inv_vs,
+                                   delta, law, fixed, v_abs * inv_rc[j])
+        A[nxt, j] = an
+        B[nxt, j] = bn
+        W[nxt, j] = 0.5 * (an + bn)
+
+
 @njit(cache=True)
 def work_buffer(alpha, beta, section_start, cells):
     """All the rows the cell loop touches, in one array of :func:`row_length` columns: the
@@ -376,9 +443,13 @@ def bit_cap(cap_k_rel, weak_rel, inv_speed, w_bit):
     return cap_k_rel + weak_rel * exp_neg(abs(w_bit) * inv_speed)
 
 
-def plant_kernel(law: int, fixed: bool):
+def plant_kernel(law: int, fixed: bool, axial: bool = False):
     """The compiled plant kernel for one friction-law variant (``law``, :func:`law_code`) with
-    or without a fixed friction part: :func:`run_plant` without the variant dispatch.
+    or without a fixed friction part, and with or without axial pipe motion (``axial``):
+    :func:`run_plant` without the variant dispatch. Its last four arguments are the axial
+    speed series ``v_ax`` [m/s] (start ``v_t0``, interval ``v_dt``) and 1/r_c per cell
+    ``inv_rc`` [1/m]; the kernel without ``axial`` reads none of them, and the one with it
+    runs a step at v = 0 through :func:`pass_cells`, bit for bit the kernel without.
 
     The variant flags are constants of the compiled code (closure variables), so the cell
     loop of :func:`pass_cells` is branch-free and vectorised, and no reference counting
@@ -391,10 +462,11 @@ def plant_kernel(law: int, fixed: bool):
     def kernel(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
                fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
                bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times,
-               out):
+               out, v_ax, v_t0, v_dt, inv_rc):
         last = alpha.size + 2 * section_start.size - 4  # the bit cell in the ghost layout
         X = work_buffer(alpha, beta, section_start, (fcap, fix_s, fix_k))
         A, B, W, fcap_p, fix_s_p, fix_k_p = X[0:2], X[2:4], X[4:6], X[6], X[7], X[8]
+        inv_rc_p = padded_inverse_radius(inv_rc, section_start) if axial else fcap_p
         end = padded_size(section_start) - 1
         cur = np.int64(0)  # typed, not Literal[0]: pass_cells and inflows compile once
         inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
@@ -444,8 +516,14 @@ def plant_kernel(law: int, fixed: bool):
             inflows(A, B, W, cur, section_start, junction_z, 2.0 * omega_bar - beta0,
                     omega_bar, cap)
             w_face = W[cur, last + 1]
-            pass_cells(A, B, W, cur, end, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k,
-                       omega_c, inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
+            v_now = drive_value(v_ax, v_t0, v_dt, t) if axial else 0.0
+            if v_now != 0.0:
+                pass_cells_axial(A, B, W, cur, end, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s,
+                                 mu_k, omega_c, inv_vs, law_exp, law, fixed, inv_rc_p,
+                                 abs(v_now))
+            else:
+                pass_cells(A, B, W, cur, end, kt_dt, fcap_p, fix_s_p, fix_k_p, mu_s, mu_k,
+                           omega_c, inv_vs, law_exp, law, fixed, fcap_p, fcap_p, 0.0, False)
             if mode == _MODE_PI:
                 integral += dt * (u_now - omega0)
             elif mode == _MODE_FED:
@@ -468,9 +546,22 @@ def variant(law_speed: float, law_exp: float, fix_k, fix_s) -> tuple[int, bool]:
     return law_code(law_speed, law_exp), bool(np.any(fix_k) or np.any(fix_s))
 
 
+def axial_args(axial, n_cells: int) -> tuple:
+    """The kernel's axial arguments (v series [m/s], its t0 [s], its interval [s], 1/r_c per
+    cell [1/m]) from ``axial`` = (v, v_t0, v_dt, inv_rc) or None, and whether any v ≠ 0 (the
+    axial variant runs only then: without, the call is that of the kernel before axial
+    motion existed)."""
+    if axial is None or not np.any(np.asarray(axial[0]) != 0.0):
+        return (np.zeros(1), 0.0, 1.0, np.zeros(n_cells)), False
+    v, v_t0, v_dt, inv_rc = axial
+    return (np.ascontiguousarray(v, dtype=float).ravel(), float(v_t0), float(v_dt),
+            np.ascontiguousarray(inv_rc, dtype=float)), True
+
+
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
               fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
-              bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
+              bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out,
+              axial=None):
     """Advance ``n_steps`` steps from time ``t0`` and record at ``times`` (docs/theory.md §3.1).
 
     ``alpha``, ``beta`` (cells) and ``top`` = [ω₀, PI integral] are updated in place.
@@ -486,12 +577,17 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
     values, τ(0) from ω₀ and β(0) at the step, τ_bit the bit torque applied over the step),
     linearly interpolated
     between the bracketing steps; ``times`` must lie in [t0, t0 + n_steps·dt].
+    Axial pipe motion (docs/theory.md §3.3): ``axial`` = (v [m/s], v_t0 [s], v_dt [s],
+    1/r_c per cell [1/m]), v a uniform series like ``u``, taken at the start of each step
+    (:func:`axial_args`); None (default) or all v = 0 is the plant without it, bit for bit.
     Argument order: see :func:`drillfric.torsional.kernel_args`. Runs the compiled
     :func:`plant_kernel` of the call's variant (:func:`variant`).
     """
-    key = variant(law_speed, law_exp, fix_k, fix_s)
+    ax, moving = axial_args(axial, alpha.size)
+    key = variant(law_speed, law_exp, fix_k, fix_s) + (moving,)
     if key not in _KERNELS:
         _KERNELS[key] = plant_kernel(*key)
     _KERNELS[key](alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
                   fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
-                  bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out)
+                  bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out,
+                  *ax)

@@ -11,7 +11,13 @@ import math
 
 import numpy as np
 
-from drillfric.kernels.plant import LAW_STEP, LAW_STRIBECK, LAW_STRIBECK_1, LAW_STRIBECK_2
+from drillfric.kernels.plant import (
+    LAW_STEP,
+    LAW_STRIBECK,
+    LAW_STRIBECK_1,
+    LAW_STRIBECK_2,
+    axial_args,
+)
 
 _MODE_PI, _MODE_TORQUE, _MODE_SPEED, _MODE_FED = 0, 1, 2, 3
 _EXP_COEF = (1.6059043836821613e-10, 2.08767569878681e-09, 2.505210838544172e-08,
@@ -106,6 +112,24 @@ def damp_and_friction(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, fix_s, fix_k, m
     b_new[:] = bn - d
 
 
+def damp_and_friction_axial(a, b, a_new, b_new, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s,
+                            mu_k, omega_c, inv_vs, delta, law, u):
+    """Steps 2–3 of a string moving axially, in place (docs/theory.md §3.3, eqs. 3.3a–3.3c);
+    ``u`` = |v|/r_c per cell [rad/s]. See :func:`drillfric.kernels.plant.cell_update_axial`."""
+    w_old = 0.5 * (a + b)
+    an = a_new - kt_dt * w_a
+    bn = b_new - kt_dt * w_b
+    w = 0.5 * (an + bn)
+    s = np.sqrt(w_old * w_old + u * u)
+    cap = friction_cap(s, mu_s * fcap + fix_s, mu_k * fcap + fix_k, omega_c, inv_vs, delta,
+                       law)
+    d = np.minimum(np.maximum(w * cap / (s + cap), -cap), cap)
+    if law == LAW_STEP:
+        d = np.where(s <= omega_c, np.minimum(np.maximum(w, -cap), cap), d)
+    a_new[:] = an - d
+    b_new[:] = bn - d
+
+
 def motor_torque(mode, u_now, u_aux, omega0, integral, tau0, kp, ki, dt, inv_itd):
     """Motor torque τ_m at step k [N·m] (PI, prescribed torque, prescribed speed or fed)."""
     if mode == _MODE_PI:
@@ -131,8 +155,10 @@ def bit_cap(cap_k_rel, weak_rel, inv_speed, w_bit):
 
 def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fcap, fix_k,
               fix_s, dt, kt_dt, mu_s, mu_k, omega_c, law_speed, law_exp, bit_cap_rel,
-              bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out):
+              bit_weak_rel, bit_inv_speed, inv_itd, mode, u, u_t0, u_dt, kp, ki, times, out,
+              axial=None):
     """NumPy twin of :func:`drillfric.kernels.plant.run_plant` (same arguments and effects)."""
+    (v_ax, v_t0, v_dt, inv_rc), moving = axial_args(axial, alpha.size)
     law = law_code(law_speed, law_exp)
     inv_vs = 1.0 / law_speed if law != LAW_STEP else 0.0
     a, b = alpha.copy(), beta.copy()
@@ -174,8 +200,13 @@ def run_plant(alpha, beta, top, t0, n_steps, section_start, junction_z, zeta, fc
         transport(a, b, a2, b2, w_a, w_b, section_start, junction_z, 2.0 * omega_bar - b[0],
                   omega_bar, cap)
         w_face = 0.5 * (a[-1] + b2[-1])
-        damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k,
-                          omega_c, inv_vs, law_exp, law)
+        v_now = drive_value(v_ax, v_t0, v_dt, t) if moving else 0.0
+        if v_now != 0.0:
+            damp_and_friction_axial(a, b, a2, b2, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s,
+                                    mu_k, omega_c, inv_vs, law_exp, law, abs(v_now) * inv_rc)
+        else:
+            damp_and_friction(a, b, a2, b2, w_a, w_b, kt_dt, fcap, fix_s, fix_k, mu_s, mu_k,
+                              omega_c, inv_vs, law_exp, law)
         if mode == _MODE_PI:
             integral += dt * (u_now - omega0)
         elif mode == _MODE_FED:

@@ -69,6 +69,15 @@ class StandResult:
     ``bit_power_torque_Nm`` is the bit's mean power over its mean speed over the same span,
     ⟨τ_bit·ω_bit⟩/⟨ω_bit⟩ [N·m] (docs/theory.md §2.3): the torque Teale's MSE and μ_bit
     describe — a stuck bit's holding torque does no work and is not in it.
+    A reaming stand (docs/simulator.md, Reaming) adds its axial speed ``axial_speed_m_s``
+    [m/s] (+ running in), the times its pipe is at that speed (``axial_start_s`` to
+    ``axial_end_s``), its signed ``travel_m`` [m], the bit depth its plant models
+    while it moves (``plant_bit_depth_m``, the middle of the travel), and the soft-string
+    rotating slack-off / pick-up case at the truth's μ_k, |v| and ``rpm`` there:
+    ``T_N_moving_Nm`` (the axial friction changes the tension, hence F_N),
+    ``hookload_moving_N`` (string only, no block) and ``torque_moving_Nm`` (the steady
+    surface torque without the viscous part, docs/theory.md eq. 3.3d). ``T_N_Nm`` and
+    ``hookload_N`` stay those of the rotation in place at ``bit_depth_m``.
     """
 
     index: int
@@ -92,6 +101,14 @@ class StandResult:
     bit_weakening_ratio: float = 1.0
     bit_weakening_rpm: float = 10.0
     bit_power_torque_Nm: float = 0.0
+    axial_speed_m_s: float = 0.0
+    axial_start_s: float | None = None
+    axial_end_s: float | None = None
+    travel_m: float = 0.0
+    plant_bit_depth_m: float | None = None
+    hookload_moving_N: float | None = None
+    torque_moving_Nm: float | None = None
+    T_N_moving_Nm: float | None = None
 
 
 @dataclass(frozen=True)
@@ -155,6 +172,24 @@ def fc_profile(cfg: Config, path: WellPath | None, bit_depth_m: float, wob_N: fl
     return solve_config(cfg, path, bit_depth_m, load_case="rotating_off_bottom")
 
 
+def moving_profile(cfg: Config, settings: PlantSettings, path: WellPath | None,
+                   bit_depth_m: float, axial_speed_m_s: float, rpm: float):
+    """Soft-string profile of a string turning at ``rpm`` while it moves at
+    ``axial_speed_m_s`` (> 0 running in: ``rotating_slack_off``; < 0 pulling out:
+    ``rotating_pick_up``), at the truth's kinetic friction factors (docs/theory.md §2 steps
+    3–4, §3.3): the axial share of the friction changes the tension, hence F_N, F_c and the
+    hook load, so the factor matters here as it does not for pure rotation."""
+    from drillfric.torque_drag import SectionFriction, solve_config
+
+    friction = settings.mu_k
+    if settings.cased:
+        friction = SectionFriction(settings.casing_shoe_md_m, settings.mu_k_cased,
+                                   settings.mu_k)
+    case = "rotating_slack_off" if axial_speed_m_s > 0 else "rotating_pick_up"
+    return solve_config(cfg, path, bit_depth_m, load_case=case, friction=friction,
+                        axial_speed_m_s=abs(axial_speed_m_s), rpm=rpm)
+
+
 def check_depths(scenario: Scenario, path: WellPath | None, file=None) -> None:
     """Every stand must lie within the survey (raises InputError)."""
     if path is None:
@@ -164,6 +199,20 @@ def check_depths(scenario: Scenario, path: WellPath | None, file=None) -> None:
             raise InputError(f"stand {i} at {stand.bit_depth_m:g} m is deeper than the survey "
                              f"({path.md_max_m:g} m)", file=file,
                              fix="extend the survey or move the stand up")
+        if stand.reach_m > path.md_max_m + 1e-6:
+            raise InputError(f"stand {i} reams from {stand.bit_depth_m:g} m to "
+                             f"{stand.end_depth_m:g} m, deeper than the survey "
+                             f"({path.md_max_m:g} m)", file=file,
+                             fix="extend the survey, ream up, or shorten the stand")
+
+
+def check_travel(scenario: Scenario, file=None) -> None:
+    """A back-reaming stand must end below the surface (raises InputError)."""
+    for i, stand in enumerate(scenario.stands, start=1):
+        if stand.bit_depth_m + min(stand.travel_m, 0.0) <= 0.0:
+            raise InputError(f"stand {i} back-reams {-stand.travel_m:.4g} m from "
+                             f"{stand.bit_depth_m:g} m: the bit would leave the hole",
+                             file=file, fix="a slower or shorter back-ream")
 
 
 def _drive(stand: Stand, settings: PlantSettings) -> torsional.Drive:
@@ -190,16 +239,43 @@ def _interp_steps(t: np.ndarray, t_pts: np.ndarray, values: np.ndarray) -> np.nd
     return np.where(t >= t_pts[-1], values[-1], v0 + frac * (v1 - v0))
 
 
-def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None,
-              stand: Stand) -> tuple[torsional.Plant, object]:
-    """Plant of one stand: string at the stand's depth, F_c from torque and drag."""
-    string = build_string(cfg.sections, stand.bit_depth_m)
+def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None, stand: Stand,
+              depth_m: float | None = None,
+              moving: bool = False) -> tuple[torsional.Plant, object]:
+    """Plant of one stand: string at the stand's depth (or ``depth_m``), F_c from torque and
+    drag — of the string moving at the stand's axial speed when ``moving``
+    (:func:`moving_profile`), else of the rotating one."""
+    depth = stand.bit_depth_m if depth_m is None else depth_m
+    string = build_string(cfg.sections, depth)
     grid = torsional.make_grid(string, settings.cells)
-    td = fc_profile(cfg, path, stand.bit_depth_m, stand.wob_N)
+    if moving:
+        td = moving_profile(cfg, settings, path, depth, stand.axial_speed_m_s, stand.rpm)
+    else:
+        td = fc_profile(cfg, path, depth, stand.wob_N)
     cap = torsional.bit_torque_cap(settings.bit_mu, stand.wob_N, settings.bit_diameter_m)
     plant = settings.plant(grid, td.fc_at(grid.x_m), cap, stand.bit_weakening_ratio,
-                           stand.bit_weakening_rpm)
+                           stand.bit_weakening_rpm, torsional.contact_radius(string, grid))
     return plant, td
+
+
+def _axial(stand: Stand) -> torsional.Axial | None:
+    """The stand's axial pipe speed as the kernel's series (None when it turns in place)."""
+    if not stand.moving:
+        return None
+    knots = stand.axial_knots()
+    t = np.arange(0.0, stand.total_s + _SERIES_DT_S, _SERIES_DT_S)
+    return torsional.Axial(_interp_steps(t, knots[:, 0], knots[:, 1]), _SERIES_DT_S, 0.0)
+
+
+def _moved_m(axial: torsional.Axial | None, time_s: np.ndarray) -> np.ndarray:
+    """Distance moved along the hole since the stand began [m] (+ running in): the exact
+    integral of the series the plant was driven with (piecewise linear between samples),
+    interpolated at ``time_s`` (within (Δt²/8)·|dv/dt|, ~1e-5 m)."""
+    if axial is None:
+        return np.zeros(time_s.size)
+    v = np.asarray(axial.values)
+    moved = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * axial.dt_s)])
+    return np.interp(time_s, axial.t0_s + axial.dt_s * np.arange(v.size), moved)
 
 
 def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
@@ -232,10 +308,10 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     settings = PlantSettings.from_config(cfg)
     noise = Noise.from_config(cfg) if noise is None else noise
     check_depths(scenario, path, cfg.source)
+    check_travel(scenario, cfg.source)
     check_work(cfg, settings, scenario, rate)
     if path is None:
-        path = no_survey_path(max(s.bit_depth_m for s in scenario.stands),
-                              cfg.tortuosity_rad_m)
+        path = no_survey_path(max(s.reach_m for s in scenario.stands), cfg.tortuosity_rad_m)
     parts, stands, t0 = [], [], 0.0
     for i, stand in enumerate(scenario.stands):
         if i > 0 and scenario.connection_s > 0:
@@ -307,7 +383,7 @@ def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario,
                           fix="a higher [simulate] rate_hz (--rate) or longer stands")
     cell_steps = 0.0
     for stand in scenario.stands:
-        string = build_string(cfg.sections, stand.bit_depth_m)
+        string = build_string(cfg.sections, stand.plant_depth_m)
         travel = sum(sec.length_m / sec.wave_speed_m_s for sec in string.sections)
         cell_steps += stand.total_s * settings.cells ** 2 / travel
     cpu_s = cell_steps * SIM_CELL_STEP_S
@@ -320,20 +396,64 @@ def check_work(cfg: Config, settings: PlantSettings, scenario: Scenario,
     return cpu_s
 
 
+def _phases(stand: Stand) -> list[tuple[float, float, bool]]:
+    """(end [s from stand start], bit depth of the plant [m], moving) of each phase of a
+    stand: one for a stand turning in place; for a reaming stand the rotation in place at
+    ``bit_depth_m`` until the block starts, the motion (ramps included) on the string at the
+    middle of the travel, and the stop at the end depth (docs/simulator.md, Reaming).
+    Phases of no duration (a stand without a stop) are left out."""
+    if not stand.moving:
+        return [(stand.total_s, stand.bit_depth_m, False)]
+    knots = stand.axial_knots()
+    phases = [(knots[1, 0], stand.bit_depth_m, False), (knots[4, 0], stand.plant_depth_m, True),
+              (stand.total_s, stand.end_depth_m, False)]
+    return [p for i, p in enumerate(phases) if i == 0 or p[0] > phases[i - 1][0]]
+
+
+def _run_phases(cfg: Config, settings, path, stand: Stand, rate: float):
+    """Run the plant through the stand's phases (:func:`_phases`), each on its own string,
+    the state carried from one to the next aligned at the bit
+    (:meth:`~drillfric.torsional.State.on_grid`), records at the stand's common times.
+
+    Returns (record, plants, torque-and-drag results), one plant and result per phase."""
+    drive, axial = _drive(stand, settings), _axial(stand)
+    times = torsional.record_times(0.0, stand.total_s, rate)
+    recs, plants, tds, state = [], [], [], None
+    phases = _phases(stand)
+    for k, (end, depth, moving) in enumerate(phases):
+        plant, td = plant_for(cfg, settings, path, stand, depth, moving)
+        state = torsional.State.rest(plant.grid) if state is None \
+            else state.on_grid(plants[-1].grid, plant.grid)
+        start = state.t_s
+        stop = start + torsional.model_steps(end - start, plant.grid.dt_s) * plant.grid.dt_s
+        eps = 1e-9 * plant.grid.dt_s
+        mine = times[(times >= start - eps) & ((times < stop - eps) | (k == len(phases) - 1))]
+        rec, state = torsional.run(plant, drive, end - start, rate, state, times_s=mine,
+                                   axial=axial if moving else None)
+        recs.append(rec)
+        plants.append(plant)
+        tds.append(td)
+    columns = {f: np.concatenate([getattr(r, f) for r in recs])
+               for f in torsional.Record.__dataclass_fields__}
+    return torsional.Record(**columns), plants, tds
+
+
 def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float, rate: float):
-    plant, td = plant_for(cfg, settings, path, stand)
-    rec, _ = torsional.run(plant, _drive(stand, settings), stand.total_s, rate)
+    rec, plants, tds = _run_phases(cfg, settings, path, stand, rate)
+    plant, td, axial = plants[0], tds[0], _axial(stand)
     surface_torque = rec.motor_torque_Nm if settings.torque_kind == "motor" \
         else rec.string_torque_Nm
     n = rec.time_s.size
     off = 0.0 if stand.on_bottom else cfg.simulate.off_bottom_m
-    depth = stand.bit_depth_m + _drilled_m(stand, rec.time_s)
+    depth = stand.bit_depth_m + _drilled_m(stand, rec.time_s) + _moved_m(axial, rec.time_s)
+    hole = np.full(n, stand.reach_m + off) if stand.moving else depth + off
     rotating = rec.time_s >= stand.idle_s + stand.start_up_s
     stuck = float(np.mean(np.abs(rec.bit_rad_s[rotating]) < 0.1 * settings.omega_c_rad_s)) \
         if rotating.any() else 0.0
+    hookload = _hookload(cfg, path, stand, td, tds, axial, depth, rec.time_s)
     cols = {"time_s": rec.time_s + t0, "surface_rpm": rec.surface_rad_s / RPM_TO_RAD_S,
-            "surface_torque_Nm": surface_torque, "hookload_N": np.full(n, td.hookload_N),
-            "bit_depth_m": depth, "hole_depth_m": depth + off,
+            "surface_torque_Nm": surface_torque, "hookload_N": hookload,
+            "bit_depth_m": depth, "hole_depth_m": hole,
             "wob_N": np.full(n, stand.wob_N), "bit_rpm": rec.bit_rad_s / RPM_TO_RAD_S,
             "string_torque_Nm": rec.string_torque_Nm}
     grid = plant.grid
@@ -346,14 +466,48 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
                          T_N_Nm=plant.T_N_Nm, T_N_cased_Nm=cased_T_N,
                          hookload_N=float(td.hookload_N),
                          cells=plant.grid.n_cells, dt_s=plant.grid.dt_s,
-                         max_rounding_m=float(np.max(np.abs(plant.grid.rounding_m))),
+                         max_rounding_m=max(float(np.max(np.abs(p.grid.rounding_m)))
+                                            for p in plants),
                          bit_stuck_fraction=stuck, creep_end_s=creep_end,
                          bit_torque_time_mean_Nm=_mean_bit_torque_Nm(stand, rec),
                          bit_power_torque_Nm=_power_bit_torque_Nm(stand, rec),
                          bit_torque_k_Nm=plant.bit_torque_cap_Nm,
                          bit_weakening_ratio=stand.bit_weakening_ratio,
-                         bit_weakening_rpm=stand.bit_weakening_rpm)
+                         bit_weakening_rpm=stand.bit_weakening_rpm,
+                         **_reaming_truth(stand, plants, tds, t0))
     return cols, result
+
+
+def _reaming_truth(stand: Stand, plants, tds, t0: float) -> dict:
+    """The reaming fields of :class:`StandResult` (none for a stand turning in place): those
+    of the moving phase (:func:`_phases`)."""
+    if not stand.moving:
+        return {}
+    knots = stand.axial_knots()
+    return {"axial_speed_m_s": stand.axial_speed_m_s, "axial_start_s": t0 + knots[2, 0],
+            "axial_end_s": t0 + knots[3, 0], "travel_m": stand.travel_m,
+            "plant_bit_depth_m": stand.plant_depth_m, "T_N_moving_Nm": plants[1].T_N_Nm,
+            "hookload_moving_N": float(tds[1].hookload_N),
+            "torque_moving_Nm": float(tds[1].surface_torque_Nm)}
+
+
+def _hookload(cfg, path, stand: Stand, td, tds, axial, depth_m: np.ndarray,
+              time_s: np.ndarray) -> np.ndarray:
+    """Hook load of the stand's rows without the block [N]: the rotating case's (``td``) for
+    a stand turning in place. A reaming stand: the rotating hook load H_rot(d) at the
+    recorded bit depth d (linear between the start, middle and end of the travel) plus the
+    drag of the moving case at the middle, H_v − H_rot (``tds[1]``,
+    :func:`moving_profile`), times v(t)/v — all of it at full speed, none at rest, linear
+    over the block's ramps (docs/simulator.md, Reaming)."""
+    if axial is None:
+        return np.full(time_s.size, td.hookload_N)
+    ends = (stand.bit_depth_m, stand.plant_depth_m, stand.end_depth_m)
+    rest = [fc_profile(cfg, path, d).hookload_N for d in ends]
+    order = np.argsort(ends)
+    at_rest = np.interp(depth_m, np.asarray(ends)[order], np.asarray(rest)[order])
+    v = np.interp(time_s, axial.t0_s + axial.dt_s * np.arange(np.size(axial.values)),
+                  axial.values)
+    return at_rest + (tds[1].hookload_N - rest[1]) * v / stand.axial_speed_m_s
 
 
 def _mean_bit_torque_Nm(stand: Stand, rec: torsional.Record) -> float:
@@ -461,7 +615,7 @@ def simulate_config(config, *, out=None, overrides: dict | None = None, survey=N
     result = simulate(cfg, well_path, stands, progress=progress)
     if out is not None:
         if well_path is None:
-            well_path = no_survey_path(max(s.bit_depth_m for s in stands.stands),
+            well_path = no_survey_path(max(s.reach_m for s in stands.stands),
                                        cfg.tortuosity_rad_m)
         keep = tuple(p for p in (Path(config), survey_path) if p is not None)
         write_well(out, pd.DataFrame(result.columns), config=written_config(cfg),

@@ -51,6 +51,15 @@ class Stand:
         Prescribed motor torque instead of the PI controller.
     stop : bool
         Stop rotation at the end (False for a single-stand run).
+    axial_speed_m_s : float
+        Speed of the pipe along the hole while it turns off bottom [m/s]: > 0 running in
+        (reaming, the bit depth grows), < 0 pulling out (back-reaming); 0 (default) rotates
+        in place. The string moves from ``axial_delay_s`` after the start-up to the start
+        of the stop, reaching the speed in ``axial_ramp_s`` and slowing to rest in as long
+        (docs/simulator.md, Reaming; docs/theory.md §3.3).
+    axial_delay_s, axial_ramp_s : float
+        Rotation in place between the end of the start-up and the start of the axial motion,
+        and the block's acceleration time [s].
     """
 
     bit_depth_m: float
@@ -71,6 +80,9 @@ class Stand:
     setpoint_rpm: tuple | None = None
     motor_torque_Nm: tuple | None = None
     stop: bool = True
+    axial_speed_m_s: float = 0.0
+    axial_delay_s: float = 0.0
+    axial_ramp_s: float = 2.0
 
     @property
     def start_up_s(self) -> float:
@@ -105,9 +117,45 @@ class Stand:
 
     @property
     def end_depth_m(self) -> float:
-        """Recorded bit depth at the end of the stand [m] (after drilling ``rop_m_h``)."""
+        """Recorded bit depth at the end of the stand [m] (after drilling ``rop_m_h``, or
+        reaming ``travel_m``)."""
         drilled = self.rop_m_h / 3600.0 * self.duration_s if self.on_bottom else 0.0
-        return self.bit_depth_m + drilled
+        return self.bit_depth_m + drilled + self.travel_m
+
+    @property
+    def moving(self) -> bool:
+        """The pipe moves along the hole while it turns (reaming or back-reaming)."""
+        return self.axial_speed_m_s != 0.0
+
+    def axial_knots(self) -> np.ndarray:
+        """Axial pipe speed (t [s] from stand start, v [m/s]) knots of the trapezoid: at rest
+        until ``axial_delay_s`` after the start-up, ``axial_ramp_s`` up to the speed, held,
+        ``axial_ramp_s`` down to rest at the start of the stop."""
+        begin = self.idle_s + self.start_up_s + self.axial_delay_s
+        end = self.idle_s + self.duration_s
+        v, ramp = self.axial_speed_m_s, self.axial_ramp_s
+        return np.array([(0.0, 0.0), (begin, 0.0), (begin + ramp, v), (end - ramp, v),
+                         (end, 0.0), (max(self.total_s, end), 0.0)])
+
+    @property
+    def travel_m(self) -> float:
+        """Signed distance the pipe moves along the hole in the stand [m] (+ running in):
+        the integral of the trapezoid of :meth:`axial_knots`."""
+        if not self.moving:
+            return 0.0
+        knots = self.axial_knots()
+        return float(np.sum(np.diff(knots[:, 0]) * 0.5 * (knots[1:, 1] + knots[:-1, 1])))
+
+    @property
+    def plant_depth_m(self) -> float:
+        """Bit depth of the string the plant models [m]: ``bit_depth_m``, or the middle of
+        the travel of a reaming stand (the median depth of its reaming rows)."""
+        return self.bit_depth_m + 0.5 * self.travel_m
+
+    @property
+    def reach_m(self) -> float:
+        """Deepest bit depth the stand's plant or its travel needs the hole to reach [m]."""
+        return max(self.bit_depth_m, self.bit_depth_m + self.travel_m)
 
     @property
     def on_bottom(self) -> bool:
@@ -196,6 +244,36 @@ def _check_stand(stand: Stand, where: str, file) -> None:
         raise ConfigError(f"{where}: the start-up ({stand.start_up_s:g} s) is longer than "
                           f"duration_s ({stand.duration_s:g} s)", file=file,
                           fix="increase duration_s or shorten the ramp/creep")
+    if stand.moving:
+        _check_reaming(stand, where, file)
+
+
+#: Fastest axial pipe speed a stand may ream at [m/s] (trips run at up to ~1.5 m/s).
+MAX_AXIAL_SPEED_M_S = 1.5
+
+
+def _check_reaming(stand: Stand, where: str, file) -> None:
+    """A reaming stand turns off bottom on the PI set-point shape, within the trip speeds,
+    with room in its hold for the block's two ramps."""
+    if not abs(stand.axial_speed_m_s) <= MAX_AXIAL_SPEED_M_S:
+        raise ConfigError(f"{where}.axial_speed_m_s must be within ±{MAX_AXIAL_SPEED_M_S:g} "
+                          f"m/s, got {stand.axial_speed_m_s:g}", file=file)
+    if stand.on_bottom or stand.rpm <= 0:
+        raise ConfigError(f"{where}: reaming (axial_speed_m_s ≠ 0) turns off bottom: it needs "
+                          "rpm > 0 and wob_N = 0", file=file,
+                          fix="drill in a stand of its own; ream with rpm > 0")
+    if stand.setpoint_rpm is not None or stand.motor_torque_Nm is not None:
+        raise ConfigError(f"{where}: reaming takes the set-point shape (rpm), not "
+                          "setpoint_rpm or motor_torque_Nm", file=file,
+                          fix="give rpm, ramp_s and duration_s")
+    if stand.axial_delay_s < 0 or stand.axial_ramp_s < 0:
+        raise ConfigError(f"{where}.axial_delay_s and axial_ramp_s must be ≥ 0", file=file)
+    room = stand.duration_s - stand.start_up_s - stand.axial_delay_s
+    if room < 2.0 * stand.axial_ramp_s:
+        raise ConfigError(f"{where}: the axial motion has {room:g} s between the start-up plus "
+                          f"axial_delay_s and the stop, less than its two ramps "
+                          f"(2 × {stand.axial_ramp_s:g} s)", file=file,
+                          fix="increase duration_s or shorten axial_delay_s/axial_ramp_s")
 
 
 def load_scenario(path: str | Path, base: Stand) -> Scenario:

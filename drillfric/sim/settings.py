@@ -156,10 +156,11 @@ class PlantSettings:
         return np.clip((self.casing_shoe_md_m - top) / grid.dx_true_m, 0.0, 1.0)
 
     def plant(self, grid: torsional.Grid, fc_Nm_m: np.ndarray, bit_torque_cap_Nm: float,
-              bit_weakening_ratio: float = 1.0,
-              bit_weakening_rpm: float = 10.0) -> torsional.Plant:
+              bit_weakening_ratio: float = 1.0, bit_weakening_rpm: float = 10.0,
+              contact_radius_m: np.ndarray | None = None) -> torsional.Plant:
         """The true plant on ``grid`` with the capacity profile F_c at the cell centres and
-        the bit T_k = ``bit_torque_cap_Nm`` [N·m], r, ω_b [RPM] (:class:`Stand`).
+        the bit T_k = ``bit_torque_cap_Nm`` [N·m], r, ω_b [RPM] (:class:`Stand`), and the
+        cells' contact radius [m] (needed by a reaming stand, docs/theory.md §3.3).
 
         With a cased truth, each cell's F_c is split by the share of its true length above
         the shoe: that share times μ_k_cased, μ_s_cased is the fixed part of the profile,
@@ -177,4 +178,4 @@ class PlantSettings:
                                fixed_k, fixed_s,
                                self.stribeck_speed_rad_s if stribeck else None,
                                self.stribeck_exponent, bit_weakening_ratio,
-                               bit_weakening_rpm * RPM_TO_RAD_S)
+                               bit_weakening_rpm * RPM_TO_RAD_S, contact_radius_m)
