@@ -12,12 +12,13 @@ from __future__ import annotations
 import ast
 import importlib
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
 from drillfric.hookload import weight_verdict
 from drillfric.result import FLAG_RAISED_BY, Flag
-from drillfric.vocabulary import Status
+from drillfric.vocabulary import Method, Status
 
 PACKAGE = Path(__file__).resolve().parents[1] / "drillfric"
 TESTS = Path(__file__).resolve().parent
@@ -118,3 +119,27 @@ def test_weight_verdict(status, contradiction, unverified, calibrated, withheld,
     assert bool(rule.withhold) is withheld and rule.flag is flag, why
     if withheld:
         assert rule.withhold == (contradiction or unverified)
+
+
+#: The rule of a segment's stated μ_k interval: (method, converged after both verdicts) →
+#: the interval stated? A μ_k not converged was off by −20 % to +80 % on the lumped plant,
+#: beyond the validated tolerance its ± rests on (docs/validation.md "Calibrated intervals").
+INTERVAL_CASES = [
+    (Method.BATCH, True, True, "a converged batch μ_k states its 95 % interval"),
+    (Method.BATCH, False, False, "a batch μ_k not converged states none, and says so"),
+    (Method.OBSERVER, False, False, "the observer's consensus has no batch interval"),
+]
+
+
+@pytest.mark.parametrize("method, converged, stated, why", INTERVAL_CASES,
+                         ids=[c[-1] for c in INTERVAL_CASES])
+def test_interval_note(method, converged, stated, why):
+    from drillfric.estimation.chain import _interval_note
+
+    refined = SimpleNamespace(interval_note="μ_k = 0.200 ± 0.010 (95 %: …)")
+    notes = _interval_note(refined, SimpleNamespace(method=method, mu_k=0.2),
+                           SimpleNamespace(converged=converged))
+    assert any("(95 %" in n for n in notes) is stated, why
+    if method is Method.BATCH and not converged:
+        assert notes == ("μ_k = 0.200 is not converged: no interval is stated for it (the "
+                         "flags say why)",)

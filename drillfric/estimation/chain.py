@@ -786,13 +786,28 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         mu_k_observer=steps.diag.mu_k, mu_s_observer=steps.diag.mu_s,
         mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags + trace.flags,
-        messages=tuple(messages) + trace.messages + _dropped_note(models),
+        messages=tuple(messages) + _interval_note(refined, verdict, trace) + trace.messages
+        + _dropped_note(models),
         starts=steps.starts, first=steps.first, final=final, bit=bit,
         bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=models.td,
         mu_s_seed=verdict.mu_s_seed, evidence=steps.fitted, bit_speed=trace.bit_speed,
         kinematics=steps.kinematics, bit_windows_withheld=trace.windows_withheld,
         bit_statistics=trace.statistics, logged=models.logged, torque_terms=steps.terms,
         friction_zone=settings.friction.zone, samples_dropped=models.dropped)
+
+
+def _interval_note(refined: batch.BatchResult, verdict: Verdict, trace: TraceVerdict
+                   ) -> tuple[str, ...]:
+    """The fit's note of μ_k's 95 % interval, stated only for a converged batch μ_k: a μ_k
+    the rules do not call converged (estimators that disagree, a seeded trace that runs
+    away, a mean torque too uncertain…) may be off by more than the validated tolerance
+    the interval rests on — the lumped plant's were −20 % to +80 % — so it gets no ±."""
+    if refined.interval_note is None or verdict.method is not Method.BATCH:
+        return ()
+    if trace.converged:
+        return (refined.interval_note,)
+    return (f"μ_k = {verdict.mu_k:.3f} is not converged: no interval is stated for it (the "
+            "flags say why)",)
 
 
 def _creep_advice(string, T_N_Nm: float, mu_k: float, refined: batch.BatchResult,

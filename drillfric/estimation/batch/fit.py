@@ -141,6 +141,9 @@ class BatchResult:
         Model runs spent.
     messages : tuple of str
         One line per notable decision, for the report.
+    interval_note : str or None
+        The note stating μ_k's 95 % interval (its half-width and statistical part), kept apart
+        from ``messages``: a segment states it only where its μ_k is converged.
     details : BatchDetails
         Traces: residuals of the μ_k search, the onset scan, the creep fits, T_N, cells.
     """
@@ -155,6 +158,7 @@ class BatchResult:
     flags: tuple[Flag, ...]
     runs: int
     messages: tuple[str, ...]
+    interval_note: str | None = None
     details: BatchDetails = field(default_factory=BatchDetails)
 
 
@@ -260,15 +264,16 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                             rate_hz=1.0 / max(data.dt, sample_interval_s or 0.0))
     flags += static.flags
     messages += static.messages
+    interval = None
     if static.kinetic is not None and rotation.target_error is not None:
-        messages.append(_uncertainty_note(model, rotation, static.kinetic.mu_k, cells,
-                                          max(data.dt, sample_interval_s or 0.0)))
+        interval = _uncertainty_note(model, rotation, static.kinetic.mu_k, cells,
+                                     max(data.dt, sample_interval_s or 0.0))
     return BatchResult(
         mu_k=None if static.kinetic is None else static.kinetic.mu_k,
         mu_k_method="mean_torque", mu_s=static.mu_s, mu_s_identifiable=static.mu_s is not None,
         mu_s_lower_bound=static.bound, mu_s_method=static.method,
         creep_segments=static.creeps, flags=tuple(flags), runs=model.runs,
-        messages=tuple(messages),
+        messages=tuple(messages), interval_note=interval,
         details=_details(model, cells, creeps, rotation, static, cycles))
 
 
