@@ -443,8 +443,9 @@ _WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
 _STATES_FRICTION = re.compile(r"μ_[ks][^;]{0,12}?(=|≥|≤|≈|<|>)\s*[-+]?\d")
 
 
-def withhold_friction(record: SegmentRecord, why: str, flag: Flag) -> SegmentRecord:
-    """``record`` with its friction numbers null, ``why`` in its message and ``flag``.
+def withhold_friction(record: SegmentRecord, why: str, flag: Flag | None) -> SegmentRecord:
+    """``record`` with its friction numbers null, ``why`` in its message and ``flag`` (None:
+    no new flag, the record's own say why).
 
     The notes of its message that state a friction factor are left out (a reader would take
     "μ_k = 0.038 ± 0.003" in a withheld segment for a result: issue 35 item 6), and how many
@@ -467,8 +468,9 @@ def withhold_friction(record: SegmentRecord, why: str, flag: Flag) -> SegmentRec
     left_out = (f"{cut} note{'s' * (cut != 1)} stating the withheld friction factors left "
                 "out") if cut else ""
     message = "; ".join(filter(None, kept + [left_out, f"friction factors withheld: {why}"]))
+    flags = record.quality_flags + ((flag,) if flag is not None else ())
     return replace(record, **nulls, converged=False, message=message,
-                   quality_flags=record.quality_flags + (flag,))
+                   quality_flags=tuple(dict.fromkeys(flags)))
 
 
 @dataclass(frozen=True)

@@ -143,3 +143,42 @@ def test_interval_note(method, converged, stated, why):
     if method is Method.BATCH and not converged:
         assert notes == ("μ_k = 0.200 is not converged: no interval is stated for it (the "
                          "flags say why)",)
+
+
+#: The rule of a segment's friction factors withheld outright: (method, converged, flags)
+#: → withheld, and why.
+WITHHELD_CASES = [
+    (Method.BATCH, True, (), False, "a converged fit is shown"),
+    (Method.BATCH, False, (Flag.ESTIMATORS_DISAGREE,), False,
+     "a batch μ_k the observer disagrees with is shown, not converged (its fit stands)"),
+    (Method.BATCH, False, (Flag.MU_K_UNCERTAIN,), False, "so is an uncertain one"),
+    (Method.OBSERVER, False, (Flag.ROTATION_TOO_SHORT,), True,
+     "an observer consensus that did not converge has nothing under it"),
+    (Method.OBSERVER, True, (), False, "a converged observer consensus is shown"),
+    (Method.BATCH, False, (Flag.FACTORS_RUN_AWAY,), True,
+     "factors that run the bit away do not describe the record"),
+]
+
+
+@pytest.mark.parametrize("method, converged, flags, withheld, why", WITHHELD_CASES,
+                         ids=[c[-1] for c in WITHHELD_CASES])
+def test_withheld_factors(method, converged, flags, withheld, why):
+    from drillfric.estimation.verdict import withheld_factors
+
+    assert bool(withheld_factors(method, converged, flags)) is withheld, why
+
+
+def test_a_withheld_segment_keeps_its_flags_once_and_states_no_factor():
+    """Applying it: every friction number null, the reason in the message, the notes that
+    stated a factor left out, and no flag doubled."""
+    from drillfric.hookload import withhold_friction
+    from drillfric.result import SegmentRecord
+
+    record = SegmentRecord(mu_k=0.2, mu_k_observer=0.21, converged=False,
+                           quality_flags=(Flag.FACTORS_RUN_AWAY,),
+                           message="fit note; μ_k = 0.200 is not converged")
+    out = withhold_friction(record, "the factors do not describe this record", None)
+    assert out.mu_k is None and out.mu_k_observer is None and not out.converged
+    assert out.quality_flags == (Flag.FACTORS_RUN_AWAY,)
+    assert "0.200" not in out.message and out.message.endswith(
+        "friction factors withheld: the factors do not describe this record")

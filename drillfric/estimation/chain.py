@@ -65,6 +65,7 @@ from drillfric.estimation.verdict import (
     Verdict,
     decide,
     decide_trace,
+    withheld_factors,
 )
 from drillfric.friction import FrictionProfile
 from drillfric.io.timebase import find_gaps
@@ -178,6 +179,9 @@ class SegmentEstimate:
         (torque-weighted over the whole string).
     samples_dropped : int
         Speed or torque samples dropped as isolated spikes or drop-outs.
+    factors_withheld : str
+        Why the segment's friction factors are not shown ("" when they are:
+        :func:`~drillfric.estimation.verdict.withheld_factors`).
     """
 
     mu_s: float | None
@@ -214,6 +218,7 @@ class SegmentEstimate:
     torque_terms: bit_torque.TorqueTerms | None = None
     friction_zone: str = "effective"
     samples_dropped: int = 0
+    factors_withheld: str = ""
 
 
 def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
@@ -793,7 +798,9 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         mu_s_seed=verdict.mu_s_seed, evidence=steps.fitted, bit_speed=trace.bit_speed,
         kinematics=steps.kinematics, bit_windows_withheld=trace.windows_withheld,
         bit_statistics=trace.statistics, logged=models.logged, torque_terms=steps.terms,
-        friction_zone=settings.friction.zone, samples_dropped=models.dropped)
+        friction_zone=settings.friction.zone, samples_dropped=models.dropped,
+        factors_withheld=withheld_factors(verdict.method, trace.converged,
+                                          verdict.flags + trace.flags))
 
 
 def _interval_note(refined: batch.BatchResult, verdict: Verdict, trace: TraceVerdict

@@ -155,7 +155,8 @@ def decide(ev: Evidence) -> Verdict:
         converged = _batch_converged(ev, flags, messages)
     else:
         mu_k, method, converged = ev.observer_mu_k, Method.OBSERVER, ev.observer_converged
-        messages.append("batch refinement gave no μ_k: observer consensus reported")
+        messages.append("batch refinement gave no μ_k: the observer's consensus stands in "
+                        "for it where it converged")
         converged = _long_enough(ev, flags, messages) and converged
     if not TYPICAL_MU[0] <= mu_k <= TYPICAL_MU[1]:
         flags.append(Flag.OUTSIDE_TYPICAL_RANGE)
@@ -229,6 +230,36 @@ def _long_enough(ev: Evidence, flags: list, messages: list) -> bool:
     messages.append(f"only {ev.turning_s:.0f} s of rotation (< "
                     f"{MIN_CONVERGED_ROTATION_S:.0f} s): not converged")
     return False
+
+
+def withheld_factors(method: Method, converged: bool, flags: tuple) -> str:
+    """Why a segment's friction factors are not shown at all ("" when they are): its μ_k is
+    not a fit that merely failed a convergence test but has nothing under it.
+
+    1. the batch fit gave no μ_k and the observer's consensus did not converge (its starts
+       disagree, or too little rotation): on the lumped plant such values were +40 % to
+       +80 % off at 6000 m (docs/validation.md "Calibrated intervals");
+    2. the observer seeded with the fitted factors runs the bit away from the top drive
+       (``factors_run_away``): the factors do not describe the record (one was −20 % off).
+
+    Any other μ_k not converged is shown as such, with no interval (its fit stands, e.g.
+    the batch μ_k where the observer disagrees with it).
+
+    Examples
+    --------
+    >>> withheld_factors(Method.BATCH, True, ())
+    ''
+    >>> withheld_factors(Method.OBSERVER, False, ())[:40]
+    'the batch fit gave no μ_k and the observ'
+    """
+    if method is Method.OBSERVER and not converged:
+        return ("the batch fit gave no μ_k and the observer's consensus did not converge "
+                "(its starts disagree or the rotation is too short): such a consensus was "
+                "off by up to +80 % on a plant it was not built around")
+    if Flag.FACTORS_RUN_AWAY in flags:
+        return ("the observer seeded with the fitted factors runs the bit away from the top "
+                "drive: the factors do not describe this record")
+    return ""
 
 
 @dataclass(frozen=True)

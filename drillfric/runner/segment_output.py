@@ -10,6 +10,7 @@ import pandas as pd
 from drillfric.estimation.bit_torque import rate_of_penetration_m_h
 from drillfric.estimation.chain import SegmentData, SegmentEstimate
 from drillfric.estimation.observer import ObserverRecord
+from drillfric.hookload import withhold_friction
 from drillfric.io.timebase import clock_at, origin_of
 from drillfric.result import SEEDED_START_ID, SegmentRecord
 from drillfric.segmentation import Segment
@@ -26,7 +27,7 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
                 **_drilling(seg, rows))
     if est is None:
         return SegmentRecord(**base)
-    return SegmentRecord(**base | dict(
+    record = SegmentRecord(**base | dict(
         message="; ".join([message] * bool(message) + list(est.messages)),
         mu_s=est.mu_s, mu_k=est.mu_k, mu_s_identifiable=est.mu_s_identifiable,
         mu_s_lower_bound=est.mu_s_lower_bound, mu_s_spread=est.mu_s_spread,
@@ -36,6 +37,8 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
         **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est)))
+    return withhold_friction(record, est.factors_withheld, None) if est.factors_withheld \
+        else record
 
 
 def _drilling(seg: Segment, rows: pd.DataFrame) -> dict:
