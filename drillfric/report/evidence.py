@@ -28,7 +28,14 @@ from matplotlib.figure import Figure
 
 from .data import FINAL_START_ID
 from .display import SI, Units, row_flags
-from .interactive import TimeAxis, float32, time_figure, time_label, time_values
+from .interactive import (
+    TimeAxis,
+    float32,
+    time_axis,
+    time_figure,
+    time_label,
+    time_values,
+)
 
 MEASURED = "#555555"
 OBSERVER = "#1f5fa8"
@@ -307,6 +314,7 @@ def evidence_figure(est: pd.DataFrame, segment: dict,
         ax.grid(True, color="#dddddd", linewidth=0.6)
         ax.legend(fontsize=6, loc="upper right", ncol=3)
     axes[-1].set_xlabel(time_label(origin), fontsize=8)
+    time_axis(origin).style_matplotlib(axes[-1])
     return fig
 
 

@@ -32,13 +32,16 @@ HTML_DPI = 90
 #: Columns of the diagnostics table (HTML and PDF), in order: heading, the quantity whose
 #: display unit the heading names (None: no unit or a fixed one; at ``{unit}``, else at the
 #: end) and the cell's CSS class
-#: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap).
+#: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap — every
+#: column whose text can grow, so that the table fits the page and the message keeps its
+#: room).
 DIAGNOSTIC_COLUMNS = (
     ("seg.", None, ""), ("kind", None, "wrap"), ("bit depth", "length", "num"),
-    ("time", None, "wrap"), ("μ_s", None, "num"), ("μ_k / apparent μ", None, "num"),
+    ("time", None, "wrap"), ("μ_s", None, "num wrap"), ("μ_k / apparent μ", None, "num"),
     ("μ_TD", None, "num"),
     ("μ zone", None, "wrap"), ("spread μ_s / μ_k", None, "num"), ("settling [s]", None, "num"),
-    ("residual [rpm]", None, "num"), ("misfit / swing {unit} (quality)", "torque", "num"),
+    ("residual [rpm]", None, "num"),
+    ("misfit / swing {unit} (quality)", "torque", "num wrap"),
     ("severity", None, "num"), ("stuck", None, "num"),
     ("hook load", "force", "num"), ("bit speed (interval)", None, "wrap"),
     ("observability", None, "wrap"), ("status", None, "wrap"), ("message", None, ""))
@@ -125,15 +128,33 @@ def row_class(row: dict) -> str:
 
 
 def clock_span(row: dict, origin) -> str:
-    """A segment's time span: UTC clock times when known, else log seconds."""
+    """A segment's time span: UTC clock times when known, else log time ``h:mm:ss``; "—"
+    without a time (a depth-indexed log's windows).
+
+    >>> clock_span({"t_start_s": 49570.0, "t_end_s": 49702.0}, None)
+    '13:46:10–13:48:22'
+    >>> clock_span({"t_start_s": None, "t_end_s": None}, None)
+    '—'
+    """
     start, end = row.get("clock_start_utc"), row.get("clock_end_utc")
-    if origin is not None and math.isfinite(row.get("t_start_s", math.nan)):
-        start = clock_at(origin, row["t_start_s"]).isoformat()
-        end = clock_at(origin, row["t_end_s"]).isoformat()
+    t0, t1 = (_finite(row.get(key)) for key in ("t_start_s", "t_end_s"))
+    if origin is not None and t0 is not None and t1 is not None:
+        start, end = clock_at(origin, t0).isoformat(), clock_at(origin, t1).isoformat()
     if isinstance(start, str) and isinstance(end, str):
         a, b = pd.Timestamp(start), pd.Timestamp(end)
         return f"{a:%H:%M:%S}–{b:%H:%M:%S}"
-    return f"{fmt(row.get('t_start_s'), '.0f')}–{fmt(row.get('t_end_s'), '.0f')} s"
+    if t0 is None or t1 is None:
+        return "—"
+    return f"{clock(t0)}–{clock(t1)}"
+
+
+def _finite(value) -> float | None:
+    """``value`` as a finite float, or None (missing, NaN, not a number)."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if math.isfinite(number) else None
 
 
 def pair(a, b, spec: str = ".3f") -> str:
