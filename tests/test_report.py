@@ -884,7 +884,7 @@ def test_an_empty_severity_panel_says_why():
     (demo, DSATS, F-5, live) with no note why. It now counts the reasons: severe stick-slip
     (beyond the validated range), undetermined, bit speed not resolved or withheld, on
     bottom."""
-    from drillfric.report.friction import severity_note
+    from drillfric.report.render import severity_note
 
     seg = pd.DataFrame({"status": ["ok", "ok", "ok", "ok", "skipped"],
                         "kind": ["off_bottom_rotating"] * 3 + ["on_bottom_rotating"] * 2,

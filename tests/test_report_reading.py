@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import pandas as pd
 
+from drillfric.report import figures
 from drillfric.report.data import segments_frame
 from drillfric.report.display import SI
+from drillfric.report.lead import segment_lead, short_reason
 from drillfric.report.render import DIAGNOSTIC_COLUMNS, clock_span, diagnostic_rows
 
 #: A depth-indexed log's window (volve_usrop_f5): no time at all.
@@ -45,3 +47,76 @@ def test_cells_that_can_grow_wrap():
     for name in ("μ_s", "misfit / swing {unit} (quality)", "time", "status",
                  "bit speed (interval)"):
         assert "wrap" in classes[name], name
+
+
+#: A DSATS segment the hook-load check withheld (its message as summary.json has it).
+WITHHELD = {"id": 3, "kind": "off_bottom_rotating", "status": "ok", "mu_k": None,
+            "mu_s": None, "mu_s_identifiable": False, "mu_s_lower_bound": None,
+            "converged": False, "method": "batch", "bit_depth_m": 1002.1,
+            "t_start_s": 10757.0, "t_end_s": 10862.0,
+            "quality_flags": ["too_short_to_converge", "hookload_contradicts_string"],
+            "message": "μ_s not identifiable (stick-slip, no creep); only 63 s of rotation "
+                       "(< 90 s): not converged; 4 notes stating the withheld friction "
+                       "factors left out; friction factors withheld: the hook load "
+                       "contradicts the configured string: the string weight it measures "
+                       "is 0.21× the modelled one, beyond ±5%"}
+
+
+def test_lead_of_a_withheld_segment_says_why_first():
+    """Issue 35 item 11: the lead names what was withheld and the start of its reason, as
+    summary.json's note begins — not the bookkeeping note, not a number it withheld."""
+    lead = segment_lead(WITHHELD)
+    assert lead.found == "no μ_k; μ_s not identifiable"
+    assert lead.withheld == (
+        "only 63 s of rotation (< 90 s): not converged",
+        "friction factors withheld: the hook load contradicts the configured string …")
+    for item in lead.withheld:
+        assert item.removesuffix(" …") in WITHHELD["message"]
+
+
+def test_lead_of_an_estimated_segment_states_its_numbers():
+    """The found line carries summary.json's μ_k (3 decimals), its status and μ_s."""
+    row = {**WITHHELD, "mu_k": 0.27853, "converged": True, "quality_flags": [],
+           "mu_s": 0.58540, "mu_s_identifiable": True, "stick_slip_severity": 0.84,
+           "message": "μ_k = 0.279 ± 0.014 (95 %: the validated 5 %; statistical 2σ)"}
+    lead = segment_lead(row)
+    assert lead.found == ("μ_k 0.279, converged (batch fit); μ_s 0.585 (identified); "
+                          "stick-slip severity 0.84")
+    assert lead.withheld == () and lead.lines() == [f"Found: {lead.found}"]
+
+
+def test_short_reason_cuts_only_outside_brackets():
+    note = ("bit speed withheld over 2 of 7 30-s windows (1–31 s: creep; null rows): bit "
+            "speed withheld over the creep: μ_s was not identified")
+    assert short_reason(note) == ("bit speed withheld over 2 of 7 30-s windows (1–31 s: "
+                                  "creep; null rows): bit speed withheld over the creep …")
+
+
+def _visible_axes_are_labelled(fig) -> bool:
+    """No mark without its axes, and every axis drawn has its label (issue 35 item 4:
+    DSATS's page 1 drew a column of grey diamonds without axes)."""
+    for ax in fig.axes:
+        if not ax.axison and (ax.lines or ax.collections or ax.patches):
+            return False
+        if ax.axison and not ax.get_xlabel():
+            return False
+    return True
+
+
+def test_friction_log_of_withheld_segments_is_a_sentence_without_marks():
+    """Every friction factor withheld, some segments skipped: the page says why (the note
+    given) and draws no mark — no unlabelled diamonds at μ = 0."""
+    skipped = {**WITHHELD, "id": 4, "status": "skipped", "message": "too short: 4.7 s < 30 s"}
+    segments = segments_frame([WITHHELD, skipped])
+    fig = figures.friction_log_figure(segments, empty_note="No friction factor: withheld.")
+    assert _visible_axes_are_labelled(fig)
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert texts == ["No friction factor: withheld."]
+
+
+def test_an_empty_severity_panel_says_why():
+    """A depth log has no severity: its panel keeps its axis label and says why."""
+    segments = segments_frame([{**DEPTH_WINDOW, "friction_zone": "effective"}])
+    fig = figures.friction_log_figure(segments)
+    assert _visible_axes_are_labelled(fig)
+    assert fig.axes[1].get_title(loc="left") == "no severity shown: 1 on bottom"

@@ -121,7 +121,7 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
     head = [wrap_cell(h, c) for h, c in zip(columns, chars, strict=True)]
     body = [[wrap_cell(v, c) for v, c in zip(r, chars, strict=True)] for r in rows]
     full = int(width_in * 72.0 / (_CHAR_EM * font_pt)) - 4
-    wrapped = [_wrap_note(n, full) for n in (notes or [""] * len(rows))]
+    wrapped = [wrap_lines(n, full) for n in (notes or [""] * len(rows))]
     pages: list[Figure] = []
     state = {"y": 0.0}
 
@@ -129,7 +129,7 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
         fig = blank_page(title + (" (continued)" if pages else ""))
         state["y"] = PAGE_IN[1] - _TOP_IN
         if lead and not pages:
-            lines = _wrap_note(lead, full)
+            lines = wrap_lines(lead, full)
             fig.text(_MARGIN_IN / PAGE_IN[0], state["y"] / PAGE_IN[1], "\n".join(lines),
                      fontsize=font_pt, va="top", parse_math=False)
             state["y"] -= len(lines) * line_in + 0.12
@@ -166,11 +166,19 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
     return pages
 
 
-def _wrap_note(text: str, chars: int) -> list[str]:
-    """A note wrapped to ``chars`` a line, every line kept."""
+def wrap_lines(text: str, chars: int) -> list[str]:
+    """``text`` wrapped to ``chars`` a line, every line kept (nothing is cut: the PDF
+    wraps, it never clips); [] for blank text."""
     return [w for part in str(text).splitlines() for w in
             (textwrap.wrap(part, max(chars, 1), break_on_hyphens=False) or [""])] \
         if str(text).strip() else []
+
+
+def line_chars(width_in: float, font_pt: float, bold: bool = False) -> int:
+    """How many characters of the sans-serif font fit on ``width_in`` at ``font_pt``
+    (bold about 10 % wider), with a little room to spare."""
+    em = _CHAR_EM * (1.1 if bold else 1.0)
+    return int(width_in * 72.0 / (em * font_pt)) - 2
 
 
 def _draw_row(fig: Figure, cells: list[list[str]], col_in: list[float], y_in: float,

@@ -109,6 +109,36 @@ def severity_text(row: dict) -> str:
     return fmt(row.get("stick_slip_severity"), ".2f")
 
 
+#: Why a segment shows no stick-slip severity, by flag or field, in the order said.
+_NO_SEVERITY = (("stick_slip_beyond_validated", "severe (beyond the validated range)"),
+                ("stick_slip_undetermined", "undetermined"))
+
+
+def severity_note(segments: pd.DataFrame) -> str:
+    """Why the severity panel is empty: the estimated segments' reasons, counted (severe
+    stick-slip, undetermined, bit speed not resolved or withheld, on bottom).
+
+    >>> severity_note(pd.DataFrame({"status": ["ok", "ok"], "kind": ["off_bottom_rotating"] * 2,
+    ...     "quality_flags": [["stick_slip_beyond_validated"], []],
+    ...     "bit_speed_resolved": [True, False]}))
+    'no severity shown: 1 severe (beyond the validated range), 1 bit speed not resolved or withheld'
+    """
+    ok = segments[segments["status"] == Status.OK] if "status" in segments else segments
+    counts: dict[str, int] = {}
+    for _, row in ok.iterrows():
+        flags = set(row.get("quality_flags") if row.get("quality_flags") is not None else ())
+        why = next((text for flag, text in _NO_SEVERITY if flag in flags), None)
+        if why is None and row.get("kind") == Kind.ON_BOTTOM:
+            why = "on bottom"
+        elif why is None and row.get("bit_speed_resolved") is not True:
+            why = "bit speed not resolved or withheld"
+        if why:
+            counts[why] = counts.get(why, 0) + 1
+    if not counts:
+        return "no severity shown: no estimated segment"
+    return "no severity shown: " + ", ".join(f"{n} {why}" for why, n in counts.items())
+
+
 def observability(row: dict) -> str:
     """Whether the segment identifies μ_s, bounds it, or says nothing about it."""
     if row.get("status") != Status.OK:

@@ -37,6 +37,7 @@ from .evidence import (
 )
 from .friction import friction_plot, friction_signature, friction_sources
 from .interactive import LONG_LOG_S, Embedder
+from .lead import segment_lead
 from .pdf import table_pages, write_pdf
 from .render import (
     CONVERGED_MEANING,
@@ -339,6 +340,7 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
     row["severity_text"] = severity_text(row)
     row["notes"] = message_parts(str(row.get("message") or ""))
     row["flag_items"] = flag_items(row)
+    row["lead"] = segment_lead(row)
     return row
 
 
@@ -590,9 +592,12 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
         pages.append((title, fig))
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
-        figure = evidence_figure(est, row, axis, size, units,
-                                 not row["bit_unresolved"], notes=segment_notes(row, units))
-        pages.append((f"Segment {row['id']} — bit at {row['depth']}, {row['span']}", figure))
+        title = f"Segment {row['id']} — bit at {row['depth']}, {row['span']}"
+        figure = evidence_figure(est, row, axis, size, units, not row["bit_unresolved"],
+                                 notes=segment_lead_lines(row, size))
+        pages.append((title, figure))
+        pages += [("", p) for p in table_pages(f"{title}: detail", ["", ""],
+                                               segment_detail(row, units))]
     columns, rows, notes, common = pdf_diagnostics(report.diagnostics, units)
     lead = ("Each row's message is below it. " + ("In every segment: " + "; ".join(common)
                                                    if common else "")).strip()
@@ -609,30 +614,43 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
 
 #: Headline lines of the PDF's first page [in from the top of the page, per line].
 _HEADLINE_TOP_IN, _HEADLINE_LINE_IN = 0.75, 0.24
+#: Font sizes of the headline's bold and plain lines [pt].
+_HEADLINE_PT = {True: 11.0, False: 9.0}
 
 
 def _first_page(report: Report, size):
-    """Page 1: the headline numbers and the friction log versus depth."""
-    lines = headline_lines(report.head)
+    """Page 1: the headline numbers — each line wrapped to the page, never cut (a withheld
+    μ_k's reason runs to three lines) — and the friction log versus depth."""
+    from .pdf import line_chars, wrap_lines
+
+    width_in = size[0] - 2 * 0.45
+    lines = [(part, strong, text.startswith(("INDICATIVE", "WARNING")))
+             for text, strong in headline_lines(report.head)
+             for part in wrap_lines(text, line_chars(width_in, _HEADLINE_PT[strong], strong))]
     top = _HEADLINE_TOP_IN + _HEADLINE_LINE_IN * len(lines) + 0.35
-    fig = figures.friction_log_figure(report.data.segments, size, report.units, top_in=top,
-                                      drag=report.data.drag_log)
-    for index, (text, strong) in enumerate(lines):
+    data = report.data
+    fig = figures.friction_log_figure(
+        data.segments, size, report.units, top_in=top, drag=data.drag_log,
+        empty_note=no_friction_note(data.segments))
+    for index, (text, strong, warning) in enumerate(lines):
         fig.text(0.45 / size[0], 1 - (_HEADLINE_TOP_IN + _HEADLINE_LINE_IN * index) / size[1],
-                 text, fontsize=11 if strong else 9, va="top", parse_math=False,
+                 text, fontsize=_HEADLINE_PT[strong], va="top", parse_math=False,
                  weight="bold" if strong else "normal",
-                 color="#a04000" if text.startswith(("INDICATIVE", "WARNING")) else "#222222")
+                 color="#a04000" if warning else "#222222")
     return fig
 
 
 def headline_lines(head: dict) -> list[tuple[str, bool]]:
-    """The headline of the PDF's first page as ``(text, bold)``."""
+    """The headline of the PDF's first page as ``(text, bold)``, unwrapped; the report's
+    HTML headline says the same (a depth log has no withheld dynamic μ_k to warn of)."""
     trust = head["trust"]
-    mu_k = " ".join(filter(None, [f"μ_k off bottom (consensus): {head['mu_k']}",
+    value = head["mu_k"] if head["mu_k"] != "—" or not head["mu_k_reason"] else "none"
+    mu_k = " ".join(filter(None, [f"μ_k off bottom (consensus): {value}",
                                   trust["uncertainty"],
                                   f"({trust['support']})" if trust["support"] else ""]))
     lines = [(mu_k + (f" — {head['mu_k_reason']}" if head["mu_k_reason"] else ""), True)]
-    if trust["confidence"] in ("low", "withheld"):
+    if trust["confidence"] == "low" or (trust["confidence"] == "withheld"
+                                        and not head["depth_indexed"]):
         lines.append((f"WARNING: μ_k {trust['confidence']}"
                       + (f": {', '.join(trust['reasons'])}" if trust["reasons"] else ""),
                       False))
@@ -686,35 +704,40 @@ def pdf_diagnostics(diagnostics: list[dict], units: Units
             notes, shared)
 
 
-#: Characters per line of a segment page's notes (7 pt on A4 landscape) and most lines.
-_NOTE_CHARS, _NOTE_LINES = 190, 7
+def segment_lead_lines(row: dict, size) -> list[str]:
+    """What a segment's PDF page says above its panels: its lead (what was found, what was
+    withheld and why; :mod:`drillfric.report.lead`), wrapped to the page, every line kept."""
+    from .pdf import line_chars, wrap_lines
+
+    chars = line_chars(size[0] * (0.98 - 0.09), 7.0)
+    return [part for line in row["lead"].lines() for part in wrap_lines(line, chars)]
 
 
-def segment_notes(row: dict, units: Units) -> list[str]:
-    """What a segment's PDF page says above its panels (the HTML header's facts): μ and
-    the friction zone, torque fit, hook load, logging interval, bit speed (why not
-    resolved), what the fit reproduces, flags and the estimators' notes, wrapped to
-    :data:`_NOTE_CHARS`."""
-    import textwrap
-
-    facts = [f"{row['mu_name']} {fmt(row['mu_k'])} ({row['zone']}), μ_s {row['mu_s_text']}",
-             f"μ_k {row['status_word']}",
-             f"torque misfit / swing {row['torque']} {units.label('torque')} "
-             f"(fit quality {row['quality']})",
-             f"hook load measured / model {row['hookload']} {units.label('force')}"]
-    if row["interval"]:
-        facts.append(f"logged every {row['interval']}")
-    facts.append(f"bit speed {row['bit_speed']}")
-    lines = ["; ".join(facts)]
+def segment_detail(row: dict, units: Units) -> list[list[str]]:
+    """The rest of a segment's section as label–value rows for the page after its panels
+    (the HTML's folded detail): the fit's numbers, what the fit reproduces, every flag with
+    its meaning and every note of the estimators, in full."""
+    rows = [["μ", f"{row['mu_name']} {fmt(row['mu_k'])} ({row['zone']}), μ_s "
+                  f"{row['mu_s_text']}, μ_TD {fmt(row['mu_td'])}; μ_k {row['status_word']}"],
+            ["torque fit", f"misfit / swing {row['torque']} {units.label('torque')} (fit "
+                           f"quality {row['quality']})"],
+            ["hook load", f"measured / model {row['hookload']} {units.label('force')}"],
+            ["bit speed", row["bit_speed"] + (f" (logged every {row['interval']})"
+                                              if row["interval"] else "")],
+            ["stick-slip", f"severity {row['severity_text']}"],
+            ["observer starts", f"(μ_s, μ_k) {row['starts_text']}"]]
     if row["fit_sentence"]:
-        lines.append(row["fit_sentence"])
-    if row["flag_items"]:
-        lines.append("flags: " + ", ".join(flag for flag, _, _ in row["flag_items"]))
-    if row["note_flags"]:
-        lines.append("notes: " + ", ".join(label for _, label, _ in row["note_flags"]))
-    lines += row["notes"]
-    wrapped = [w for line in lines for w in textwrap.wrap(line, _NOTE_CHARS)]
-    return wrapped[:_NOTE_LINES - 1] + ["…"] if len(wrapped) > _NOTE_LINES else wrapped
+        rows.append(["fit", row["fit_sentence"]])
+    rows += _labelled("flags", [f"{label}: {meaning}" if meaning else label
+                                for _, label, meaning in row["flag_items"]])
+    rows += _labelled("notes (not warnings)", [f"{label}: {meaning}"
+                                               for _, label, meaning in row["note_flags"]])
+    return rows + _labelled("estimator notes", row["notes"])
+
+
+def _labelled(label: str, texts: list[str]) -> list[list[str]]:
+    """Rows of a label–value table: ``label`` beside the first of ``texts`` only."""
+    return [[label if i == 0 else "", text] for i, text in enumerate(texts)]
 
 
 def _header_lines(report: Report) -> list[list[str]]:
