@@ -11,9 +11,9 @@ import re
 import pytest
 from markupsafe import escape
 
+from drillfric.io.text import split_notes
 from drillfric.report import write_well_report
 from drillfric.report.lead import segment_lead
-from drillfric.report.render import message_parts
 from tests.test_report import copy_result, demo_result_dir
 
 #: Several seconds a test (the demo's run, a PDF): not in the fast lane.
@@ -50,7 +50,7 @@ def test_pdf_holds_every_note_of_every_segment_whole(demo):
             assert squeeze(line) in pages[first], (seg["id"], line)
         detail = pages[first + 1]
         assert detail.startswith(f"Segment {seg['id']} — ") and ": detail" in detail
-        for note in message_parts(seg["message"]):
+        for note in split_notes(seg["message"]):
             assert squeeze(note) in detail, (seg["id"], note)
     assert "μ_s = 0.605 of the creep fit not reported" in " ".join(pages)
 
@@ -74,7 +74,7 @@ def test_pdf_headline_keeps_a_long_withheld_reason_whole(demo, tmp_path):
     first = pdf_pages(result)[0]
     assert f"μ_k off bottom (consensus): none — {reason}" in first
     assert "— —" not in first
-    assert "No friction factor to draw: 4 segments of 4 were estimated" in first
+    assert "No friction factor to draw: all 4 segments were estimated" in first
     assert "withheld by the hook-load check" in first.split("No friction factor")[1]
 
 

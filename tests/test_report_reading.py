@@ -120,3 +120,20 @@ def test_an_empty_severity_panel_says_why():
     fig = figures.friction_log_figure(segments)
     assert _visible_axes_are_labelled(fig)
     assert fig.axes[1].get_title(loc="left") == "no severity shown: 1 on bottom"
+
+
+def test_withholding_leaves_no_fragment_of_a_withheld_mu_k():
+    """DSATS: the hook-load check cut "μ_k = 0.038 ± 0.003 (95 %: …; statistical 2σ …)" at
+    its bracketed "; ", and the segment's notes kept "statistical 2σ ± 0.004, ±10.9 %: …",
+    a number of the μ_k it withheld. The whole note goes."""
+    from drillfric.hookload import withhold_friction
+    from drillfric.io.text import split_notes
+    from drillfric.result import SegmentRecord
+
+    record = SegmentRecord(mu_k=0.038, message=(
+        "fit note; μ_k = 0.038 ± 0.003 (95 %: the validated 5 %; statistical 2σ ± 0.004, "
+        "±10.9 %: 12 whole cycles); only 63 s of rotation (< 90 s): not converged"))
+    notes = split_notes(withhold_friction(record, "the hook load says so").message)
+    assert notes == ["fit note", "only 63 s of rotation (< 90 s): not converged",
+                     "1 note stating the withheld friction factors left out",
+                     "friction factors withheld: the hook load says so"]

@@ -286,7 +286,7 @@ def test_empty_friction_log_is_a_sentence_not_an_axis(demo, tmp_path):
     html = write_well_report(result).read_text(encoding="utf-8")
     assert "bk-friction" not in bokeh_items(html)
     note = _section(html, "no-friction").split("</p>")[0]
-    assert "none of the 4 segments" in note and "4 skipped" in note
+    assert "no segment was estimated with a bit depth (4 segments: 4 skipped)" in note
     item = bokeh_items(write_well_report(demo).read_text(encoding="utf-8"))["bk-friction"]
     ranges = [n["attributes"] for n in bokeh_nodes(item, "DataRange1d")]
     assert any(r.get("start") == 0.0 for r in ranges)

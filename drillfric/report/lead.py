@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from drillfric.io.text import split_notes
 from drillfric.vocabulary import Status
 
 from .display import fmt
@@ -19,7 +20,6 @@ from .render import (
     bit_speed_text,
     bit_speed_unresolved,
     is_apparent,
-    message_parts,
     mu_name,
     mu_s_text,
     severity_text,
@@ -72,7 +72,7 @@ def segment_lead(row: dict) -> Lead:
 def withheld_notes(row: dict) -> list[str]:
     """The notes of the segment's ``message`` that say what was withheld, not reported or
     not converged, and why — in full, in the message's order."""
-    return [note for note in message_parts(str(row.get("message") or ""))
+    return [note for note in split_notes(str(row.get("message") or ""))
             if _WITHHOLDING.search(note) and _LEFT_OUT not in note]
 
 

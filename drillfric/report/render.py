@@ -239,19 +239,6 @@ def zone_text(segments: pd.DataFrame) -> str:
     return zones.pop().replace("_", " ") if len(zones) == 1 else ""
 
 
-def message_parts(message: str) -> list[str]:
-    """A segment's message as its notes: split at "; " outside parentheses (the notes of
-    the estimation steps are joined with "; ", and a note may hold one in brackets)."""
-    parts, depth, start = [], 0, 0
-    for i, char in enumerate(message):
-        depth += {"(": 1, ")": -1}.get(char, 0)
-        if depth == 0 and message.startswith("; ", i):
-            parts.append(message[start:i])
-            start = i + 2
-    parts.append(message[start:])
-    return [p.strip() for p in parts if p.strip()]
-
-
 def flag_items(row: dict) -> list[tuple[str, str, str]]:
     """The segment's flags as ``(flag, label, meaning)`` (docs/outputs.md, flags); an
     unknown flag (a newer drillfric's) keeps its name with no meaning.

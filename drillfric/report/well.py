@@ -18,7 +18,7 @@ import pandas as pd
 from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
 from drillfric.io.atomic import write_text_replacing
-from drillfric.io.text import plural
+from drillfric.io.text import plural, share, split_notes
 from drillfric.io.timebase import clock_at
 from drillfric.vocabulary import Status
 
@@ -54,7 +54,6 @@ from .render import (
     flag_items,
     interval_text,
     is_apparent,
-    message_parts,
     mu_name,
     mu_s_text,
     non_default_rows,
@@ -189,8 +188,8 @@ def headline_trust(summary: dict) -> dict:
     flags = set(summary.get("quality_flags") or [])
     lowering = [f.value for f in LOWERING if f.value in flags]
     return {"uncertainty": f"± {fmt(u)}" if has_mu and u is not None else "",
-            "support": (f"{support['segments']} of {support['of']} off-bottom segment"
-                        f"{'s' * (support['of'] != 1)}") if has_mu and "of" in support else "",
+            "support": share(support["segments"], support["of"], "off-bottom segment")
+            if has_mu and "of" in support else "",
             "confidence": confidence,
             "reasons": [f.replace("_", " ") for f in lowering] if confidence == "low" else []}
 
@@ -338,7 +337,7 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
     row["zone"] = str(row.get("friction_zone") or "—").replace("_", " ")
     row["starts_text"] = starts_text(row)
     row["severity_text"] = severity_text(row)
-    row["notes"] = message_parts(str(row.get("message") or ""))
+    row["notes"] = split_notes(str(row.get("message") or ""))
     row["flag_items"] = flag_items(row)
     row["lead"] = segment_lead(row)
     return row
@@ -496,14 +495,15 @@ def no_friction_note(segments: pd.DataFrame) -> str:
     estimated = segments[(segments["status"] == Status.OK) & segments["bit_depth_m"].notna()]
     if len(estimated):  # estimated at a depth, their μ withheld (issue 35 item 3)
         why = _withheld_by(estimated)
-        return (f"No friction factor to draw: {plural(len(estimated), 'segment')} of "
-                f"{len(segments)} were estimated at "
+        verb = "was" if len(estimated) == 1 else "were"
+        return (f"No friction factor to draw: {share(len(estimated), len(segments), 'segment')} "
+                f"{verb} estimated at "
                 f"{estimated['bit_depth_m'].min():.0f}–{estimated['bit_depth_m'].max():.0f} m "
                 f"and their friction factors withheld{why}" + (f" ({parts})" if parts else "")
                 + "; their reasons are in the diagnostics table.")
-    return (f"No friction factor to draw: none of the {plural(len(segments), 'segment')} was "
-            f"estimated with a bit depth ({parts or 'no bit depth'}); their depths and "
-            "reasons are in the diagnostics table.")
+    return (f"No friction factor to draw: no segment was estimated with a bit depth "
+            f"({plural(len(segments), 'segment')}: {parts or 'no bit depth'}); their depths "
+            "and reasons are in the diagnostics table.")
 
 
 #: Segment flags that withhold its friction factors, and what the friction log says of them.
@@ -697,7 +697,7 @@ def pdf_diagnostics(diagnostics: list[dict], units: Units
     names = [name for name, _, _ in DIAGNOSTIC_COLUMNS]
     keep = [names.index(n) for n in PDF_DIAGNOSTICS]
     headings = [h for h, _ in diagnostic_columns(units)]
-    parts = [message_parts(r["cells"][-1]) for r in diagnostics]
+    parts = [split_notes(r["cells"][-1]) for r in diagnostics]
     shared = [p for p in parts[0] if all(p in q for q in parts)] if len(parts) > 2 else []
     notes = ["; ".join(p for p in q if p not in shared) for q in parts]
     return ([headings[i] for i in keep], [[r["cells"][i] for i in keep] for r in diagnostics],
