@@ -6,6 +6,9 @@ withheld and why. These tests build the report's pieces from summary-like record
 
 from __future__ import annotations
 
+import re
+
+import numpy as np
 import pandas as pd
 
 from drillfric.report import figures
@@ -74,6 +77,13 @@ def test_lead_of_a_withheld_segment_says_why_first():
         assert item.removesuffix(" …") in WITHHELD["message"]
 
 
+def test_lead_names_a_bit_speed_the_logging_cannot_resolve():
+    row = {**WITHHELD, "message": "", "bit_speed_resolved": False,
+           "bit_speed_reason": "bit speed not resolved: 1-s samples give 1.3 per cycle"}
+    assert segment_lead(row).withheld == (
+        "bit speed not resolved: 1-s samples give 1.3 per cycle",)
+
+
 def test_lead_of_an_estimated_segment_states_its_numbers():
     """The found line carries summary.json's μ_k (3 decimals), its status and μ_s."""
     row = {**WITHHELD, "mu_k": 0.27853, "converged": True, "quality_flags": [],
@@ -137,3 +147,32 @@ def test_withholding_leaves_no_fragment_of_a_withheld_mu_k():
     assert notes == ["fit note", "only 63 s of rotation (< 90 s): not converged",
                      "1 note stating the withheld friction factors left out",
                      "friction factors withheld: the hook load says so"]
+
+
+def test_static_log_time_axis_ticks_whole_hours_and_minutes():
+    """The PDF's time axes of a 13.9-h log without clock time: ticks on whole hours read
+    h:mm:ss (not 13.76 h); a 12-min segment of it ticks on whole minutes."""
+    from matplotlib.figure import Figure
+
+    from drillfric.report.interactive import time_axis
+
+    axis = time_axis(None, span_s=50000.0)
+    ax = Figure().subplots()
+    for span, step in (((6.0, 49998.0), 7200.0), ((20047.0, 20807.0), 120.0)):
+        ax.set_xlim(*span)
+        axis.style_matplotlib(ax)
+        ticks = ax.xaxis.get_major_locator()()
+        assert set(np.diff(ticks)) == {step}
+        labels = [ax.xaxis.get_major_formatter()(t, i) for i, t in enumerate(ticks)]
+        assert all(re.fullmatch(r"\d+:\d\d:\d\d", label) for label in labels), labels
+    assert axis.label == "log time [h:mm:ss]"
+
+
+def test_a_skipped_segment_has_no_zone_not_nan():
+    """DSATS's diagnostics read "nan" in the μ zone column of every skipped segment."""
+    skipped = {**WITHHELD, "status": "skipped", "friction_zone": None}
+    rows = diagnostic_rows(segments_frame([skipped, {**WITHHELD, "id": 4,
+                                                     "friction_zone": "open_hole"}]), SI)
+    zone = [name for name, _, _ in DIAGNOSTIC_COLUMNS].index("μ zone")
+    assert [r["cells"][zone] for r in rows] == ["—", "open hole"]
+    assert not any("nan" in cell for r in rows for cell in r["cells"][:-1])

@@ -218,14 +218,14 @@ class TimeAxis:
             AdaptiveTicker(mantissas=[1, 2, 3, 6, 12, 24], base=3600, min_interval=3600.0)])
 
     def style_matplotlib(self, ax) -> None:
-        """The same for a static figure: ticks from :data:`CLOCK_STEPS_S`, labelled
-        ``h:mm`` (``h:mm:ss`` where the ticks are closer than a minute)."""
+        """The same for a static figure: ticks :data:`CLOCK_STEPS_S` apart, labelled
+        ``h:mm:ss`` (:func:`drillfric.report.render.clock`)."""
         if not self.hours or self.clock:
             return
         from matplotlib.ticker import FuncFormatter
 
         ax.xaxis.set_major_locator(_clock_locator())
-        ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: _tick_text(ax, value)))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda seconds, _: clock(seconds)))
 
 
 def _clock_locator():
@@ -242,15 +242,6 @@ def _clock_locator():
             return np.arange(np.ceil(vmin / step) * step, vmax + step * 1e-6, step)
 
     return ClockLocator()
-
-
-def _tick_text(ax, seconds: float) -> str:
-    """A tick's log time: ``h:mm`` when the ticks are a minute or more apart, else
-    ``h:mm:ss`` (:func:`drillfric.report.render.clock`)."""
-    ticks = ax.xaxis.get_majorticklocs()
-    step = float(np.diff(ticks).min()) if len(ticks) > 1 else 0.0
-    text = clock(seconds)
-    return text[:-3] if step >= 60 and text.endswith(":00") else text
 
 
 def time_axis(origin: pd.Timestamp | TimeAxis | None, span_s: float = 0.0) -> TimeAxis:

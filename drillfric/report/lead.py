@@ -65,7 +65,7 @@ def segment_lead(row: dict) -> Lead:
     """
     withheld = [short_reason(note) for note in withheld_notes(row)]
     if bit_speed_unresolved(row) and row.get("status") == Status.OK:
-        withheld.append(short_reason(bit_speed_text(row)))
+        withheld.append(short_reason(f"bit speed {bit_speed_text(row)}"))
     return Lead(_found(row), tuple(withheld))
 
 
@@ -77,22 +77,26 @@ def withheld_notes(row: dict) -> list[str]:
 
 
 def short_reason(note: str) -> str:
-    """A note cut after the first clause of its reason: up to its second ``": "`` outside
-    brackets, with "…" when cut (the whole note is in the segment's detail).
+    """A note cut after the first clause of its reason: what it says, its first ``": "``,
+    then the reason up to its next ``": "``, ``", "`` or ``"; "`` outside brackets, with "…"
+    when cut (the whole note is in the segment's detail).
 
     >>> short_reason("friction factors withheld: the hook load contradicts the string: "
     ...              "it weighs 0.21× the model")
     'friction factors withheld: the hook load contradicts the string …'
+    >>> short_reason("severe stick-slip: severity withheld, the estimate is 2.1 or more")
+    'severe stick-slip: severity withheld …'
     >>> short_reason("only 63 s of rotation (< 90 s): not converged")
     'only 63 s of rotation (< 90 s): not converged'
     """
-    depth, colons = 0, 0
+    depth, subject = 0, False
     for i, char in enumerate(note):
         depth += {"(": 1, ")": -1}.get(char, 0)
-        if depth == 0 and note.startswith(": ", i):
-            colons += 1
-            if colons == 2:
-                return note[:i] + " …"
+        if depth or not note.startswith((": ", ", ", "; "), i):
+            continue
+        if subject:
+            return note[:i] + " …"
+        subject = note.startswith(": ", i)
     return note
 
 

@@ -230,6 +230,17 @@ def interval_text(row: dict) -> str:
     return "" if interval == "—" else f"{interval} s"
 
 
+def row_zone(row: dict) -> str:
+    """A segment's friction zone as shown ("open hole", "effective"), "—" when it has none
+    (a skipped segment: None in summary.json, NaN in a table — never "nan").
+
+    >>> row_zone({"friction_zone": "open_hole"}), row_zone({"friction_zone": float("nan")})
+    ('open hole', '—')
+    """
+    zone = row.get("friction_zone")
+    return zone.replace("_", " ") if isinstance(zone, str) and zone else "—"
+
+
 def zone_text(segments: pd.DataFrame) -> str:
     """The friction zone the estimated segments' μ are for ("open hole", "effective"), or
     "" when they differ or the results do not say (older results)."""
@@ -375,7 +386,7 @@ def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None,
         kind = str(row.get("kind") or "—").replace("_rotating", "").replace("_", " ")
         cells = [str(row["id"]), kind, units.text(row["bit_depth_m"], "length", ".1f"),
                  clock_span(row, origin), mu_s if ok else "—", mu_k_cell(row),
-                 fmt(row["mu_td"]), str(row.get("friction_zone") or "—").replace("_", " "),
+                 fmt(row["mu_td"]), row_zone(row),
                  pair(row["mu_s_spread"], row["mu_k_spread"]),
                  fmt(row["settling_time_s"], ".1f"), fmt(row["residual_rms_rpm"], ".2f"),
                  _torque_fit(row, units, quality), severity_text(row),

@@ -59,6 +59,7 @@ from .render import (
     non_default_rows,
     note_flags,
     now_utc,
+    row_zone,
     severity_text,
     status_word,
     string_table,
@@ -334,7 +335,7 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
     row["bit_unresolved"] = bit_speed_unresolved(row)
     row["interval"] = interval_text(row)
     row["interval_swing"] = fmt(row.get("interval_torque_swing"), ".0%")
-    row["zone"] = str(row.get("friction_zone") or "—").replace("_", " ")
+    row["zone"] = row_zone(row)
     row["starts_text"] = starts_text(row)
     row["severity_text"] = severity_text(row)
     row["notes"] = split_notes(str(row.get("message") or ""))
