@@ -176,3 +176,21 @@ def test_a_skipped_segment_has_no_zone_not_nan():
     zone = [name for name, _, _ in DIAGNOSTIC_COLUMNS].index("μ zone")
     assert [r["cells"][zone] for r in rows] == ["—", "open hole"]
     assert not any("nan" in cell for r in rows for cell in r["cells"][:-1])
+
+
+def test_pdf_segment_page_leads_with_a_regime_the_fit_misses():
+    """The HTML shows a fit that misses the data's regime in a red box before the detail;
+    the PDF says it above the panels too, wrapped, not in the detail alone."""
+    from drillfric.report.lead import Lead
+    from drillfric.report.pdf import PAGE_IN
+    from drillfric.report.well import segment_lead_lines
+
+    sentence = ("The fit reproduces the mean torque (μ_k) but not the regime: over the "
+                "second half its model keeps stick-slip (torque swing 1.1 kN·m) where the "
+                "measured torque is steady (0.2 kN·m); read μ_k with care. ") * 2
+    row = {"lead": Lead("μ_k 0.279, not converged (batch fit)", ()), "fit_mismatch": True,
+           "fit_sentence": sentence.strip()}
+    lines = segment_lead_lines(row, PAGE_IN)
+    assert lines[0] == "Found: μ_k 0.279, not converged (batch fit)"
+    assert " ".join(lines[1:]) == sentence.strip() and len(lines) > 2
+    assert segment_lead_lines({**row, "fit_mismatch": False}, PAGE_IN) == lines[:1]

@@ -707,11 +707,13 @@ def pdf_diagnostics(diagnostics: list[dict], units: Units
 
 def segment_lead_lines(row: dict, size) -> list[str]:
     """What a segment's PDF page says above its panels: its lead (what was found, what was
-    withheld and why; :mod:`drillfric.report.lead`), wrapped to the page, every line kept."""
+    withheld and why; :mod:`drillfric.report.lead`) and, when the fit misses the data's
+    regime, that sentence (the HTML's red box), wrapped to the page, every line kept."""
     from .pdf import line_chars, wrap_lines
 
     chars = line_chars(size[0] * (0.98 - 0.09), 7.0)
-    return [part for line in row["lead"].lines() for part in wrap_lines(line, chars)]
+    lines = row["lead"].lines() + ([row["fit_sentence"]] if row["fit_mismatch"] else [])
+    return [part for line in lines for part in wrap_lines(line, chars)]
 
 
 def segment_detail(row: dict, units: Units) -> list[list[str]]:
