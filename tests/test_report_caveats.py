@@ -57,7 +57,7 @@ def test_pdf_holds_every_note_of_every_segment_whole(demo):
 
 def test_pdf_headline_keeps_a_long_withheld_reason_whole(demo, tmp_path):
     """DSATS's withheld reason ran off page 1: the headline wraps it, whole, and says
-    "none", not "— —"."""
+    "none", not "— —" (the HTML's headline too)."""
     reason = ("withheld by the hook-load check (docs/theory.md §2.1): the hook load "
               "contradicts the configured string: the string weight it measures is 0.21× "
               "the modelled one (median of 16 off-bottom segments, block weight 147 kN "
@@ -76,6 +76,8 @@ def test_pdf_headline_keeps_a_long_withheld_reason_whole(demo, tmp_path):
     assert "— —" not in first
     assert "No friction factor to draw: all 4 segments were estimated" in first
     assert "withheld by the hook-load check" in first.split("No friction factor")[1]
+    html = (result / "report.html").read_text(encoding="utf-8")  # the HTML says it alike
+    assert '<b>none</b> <span class="why">— withheld by the hook-load check' in html
 
 
 def test_html_segment_leads_with_found_and_withheld_and_folds_the_rest(demo):
