@@ -194,3 +194,16 @@ def test_pdf_segment_page_leads_with_a_regime_the_fit_misses():
     assert lines[0] == "Found: μ_k 0.279, not converged (batch fit)"
     assert " ".join(lines[1:]) == sentence.strip() and len(lines) > 2
     assert segment_lead_lines({**row, "fit_mismatch": False}, PAGE_IN) == lines[:1]
+
+
+def test_pdf_table_cell_longer_than_a_row_continues_under_it():
+    """A cell of 40 lines used to end in "…" after 14: its rest now follows under its row
+    (across the full width, onto the next page when it must); every word is printed."""
+    from drillfric.report.pdf import table_pages
+
+    long = " ".join(f"word{i}" for i in range(900))
+    pages = table_pages("Run details", ["", ""], [["WARNING", long], ["rows", "12"]])
+    text = " ".join(t.get_text() for page in pages for t in page.texts)
+    text = re.sub(r"\s+", " ", text.replace("(continued below)", "")
+                  .replace("WARNING, continued:", ""))
+    assert long in text and "…" not in text
