@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from drillfric.errors import DrillfricError
-from drillfric.io.text import plural, terminal_text
+from drillfric.io.text import plural, share, terminal_text
 from drillfric.vocabulary import WellStatus
 
 from .common import (
@@ -87,7 +87,7 @@ def _mu_k_text(summary: dict) -> str:
     u, support = summary.get("mu_k_uncertainty"), summary.get("mu_k_support") or {}
     text = f"μ_k = {_fmt(summary['mu_k'])}" + (f" ± {_fmt(u)}" if u is not None else "")
     if "of" in support:
-        text += f" ({support['segments']} of {plural(support['of'], 'off-bottom segment')}"
+        text += f" ({share(support['segments'], support['of'], 'off-bottom segment')}"
         text += ", low confidence)" if summary.get("mu_k_confidence") == "low" else ")"
     return text
 

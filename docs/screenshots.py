@@ -26,7 +26,7 @@ sys.path.insert(0, str(REPO))
 
 #: Page sections shot, by element id → file name.
 SECTIONS = {"tracks": "tracks", "friction": "friction-log", "broomstick": "broomstick",
-            "segment-3": "segment", "diagnostics": "diagnostics"}
+            "segment-1": "segment", "diagnostics": "diagnostics"}
 
 
 def _result(tmp: Path) -> tuple[Path, bool]:

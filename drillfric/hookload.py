@@ -31,6 +31,7 @@ import pandas as pd
 
 from drillfric import torque_drag
 from drillfric.drillstring import section_from_config
+from drillfric.io.text import plural, share, split_notes
 from drillfric.kernels.lazy import lazy_jit
 from drillfric.result import Flag, SegmentRecord
 from drillfric.vocabulary import Kind, LoadCase, Status
@@ -462,7 +463,7 @@ def withhold_friction(record: SegmentRecord, why: str, flag: Flag | None) -> Seg
     friction factors withheld: the hook load says so
     """
     nulls = {name: None for name in _WITHHELD}
-    notes = [n for n in (record.message or "").split("; ") if n]
+    notes = split_notes(record.message or "")  # a "; " in brackets is inside its note
     kept = [n for n in notes if not _STATES_FRICTION.search(n)]
     cut = len(notes) - len(kept)
     left_out = (f"{cut} note{'s' * (cut != 1)} stating the withheld friction factors left "
@@ -550,14 +551,15 @@ def judge(records: list, plateaus: list[Plateau], cfg: Config,
         if abs(ratio - 1.0) > tol:
             well_problem = (f"the hook load contradicts the configured string: the string "
                             f"weight it measures is {ratio:.2f}× the modelled one (median of "
-                            f"{len(points)} off-bottom segments, block weight "
+                            f"{plural(len(points), 'off-bottom segment')}, block weight "
                             f"{block.weight_N / 1e3:.0f} kN from {block.source}), beyond "
                             f"±{tol:.0%}")
     else:
         bad = [i for i, why in problems.items() if why]
         if len(bad) > len(points) / 2:
-            well_problem = (f"the hook load contradicts the configured string in {len(bad)} of "
-                            f"{len(points)} off-bottom segments ({problems[bad[0]]})")
+            well_problem = (f"the hook load contradicts the configured string in "
+                            f"{share(len(bad), len(points), 'off-bottom segment')} "
+                            f"({problems[bad[0]]})")
     unverified = _unverified(block) if block.weight_N is None and not well_problem else ""
     calibrated = calibration is not None and calibration.scale is not None
     out, withheld = [], []
@@ -591,9 +593,15 @@ def _unchecked(records) -> list[str]:
     if not ids:
         return []
     return [f"string weight not checked: no off-bottom rotating segment with a hook load to "
-            f"weigh it against, so the friction factors of segment(s) {', '.join(ids)} rest "
+            f"weigh it against, so the friction factors of {_segments(ids)} rest "
             "on the configured string's weight (μ scales as 1/W; docs/theory.md §2.1): log "
             "the hook load, and rotate off bottom"]
+
+
+def _segments(ids) -> str:
+    """``"segment 3"`` or ``"segments 1, 3, 4"``."""
+    ids = [str(i) for i in ids]
+    return f"segment{'s' * (len(ids) != 1)} {', '.join(ids)}"
 
 
 def _verdict(well_problem: str, block: BlockWeight, calibration: Calibration | None) -> str:
@@ -632,7 +640,7 @@ def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWei
         extra = f" ({calibration.reason})" if calibration and calibration.reason else ""
         out.append(f"friction factors withheld: {well_problem}{extra}; {fix}")
     elif withheld:
-        out.append(f"friction factors of segment(s) {', '.join(map(str, withheld))} withheld: "
+        out.append(f"friction factors of {_segments(withheld)} withheld: "
                    f"their hook load contradicts the configured string "
                    f"({problems[withheld[0]]})")
     if calibration is not None and calibration.scale is not None:

@@ -102,7 +102,7 @@ def test_spikes_and_drop_outs_in_a_stand_change_no_number(tmp_path):
     dirty = _run(tmp_path / "dirty", frame, tmp_path)
     # (the stand's rows are a little shorter than the turning rows picked from)
     assert clean["samples_dropped"] == 0 and 28 <= dirty["samples_dropped"] <= 30
-    assert f"{dirty['samples_dropped']} speed or torque sample(s) dropped" in dirty["message"]
+    assert f"{dirty['samples_dropped']} speed or torque samples dropped" in dirty["message"]
     assert dirty["mu_k"] == pytest.approx(clean["mu_k"], rel=0.005)
     for key in ("mu_s", "mu_s_lower_bound"):
         assert dirty[key] == (None if clean[key] is None else

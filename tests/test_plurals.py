@@ -9,7 +9,7 @@ import pytest
 from drillfric.cli.fleet_cmd import _closing_line
 
 from drillfric.fleet.overnight import changes
-from drillfric.io.text import plural
+from drillfric.io.text import plural, share
 from drillfric.report.render import environment
 from drillfric.report.well import headline_lines
 
@@ -62,3 +62,27 @@ def test_report_headline_one_warning():
     assert "WARNING: 1 warning, see" in text
     assert "median of 1 converged on-bottom stand)" in text
 
+
+
+@pytest.mark.parametrize(("part", "whole", "text"), [
+    (1, 1, "the only off-bottom segment"), (4, 4, "all 4 off-bottom segments"),
+    (7, 9, "7 of 9 off-bottom segments"), (0, 1, "0 of 1 off-bottom segment")])
+def test_a_share_reads_as_said(part, whole, text):
+    """Issue 35: the warnings said "rests on 1 of 1 off-bottom segments"."""
+    assert share(part, whole, "off-bottom segment") == text
+
+
+def test_well_warnings_count_naturally():
+    """The headline's warnings of one stand, one default, one failed segment: no "(s)"
+    and no "1 of 1 … segments"."""
+    from drillfric.estimation.headline import judge
+
+    segment = {"id": 1, "kind": "off_bottom_rotating", "status": "failed", "mu_k": None,
+               "quality_flags": []}
+    summary = {"mu_k": 0.25, "mu_k_uncertainty": 0.01, "counts": {"estimated": 1},
+               "mu_k_support": {"segments": 1, "of": 1}, "assumed": ["mud density"],
+               "warnings": [], "segments": [segment]}
+    text = " | ".join(judge(summary)["warnings"])
+    assert "rests on the only off-bottom segment" in text
+    assert "1 default assumed" in text and "1 segment failed (segment 1)" in text
+    assert "(s)" not in text and "1 of 1" not in text

@@ -347,8 +347,8 @@ def test_any_well_name_is_escaped_in_fleet_report(name):
 
 def test_pdf_pages_are_a4_landscape_numbered_and_in_order(evidence):
     """report.pdf: headline with the friction log, run details, time tracks, broomstick,
-    well path, profiles, one page per drawn segment, diagnostics, the string and the
-    non-default settings as appendices — every
+    well path, profiles, one page per drawn segment and its detail page, diagnostics, the
+    string and the non-default settings as appendices — every
     page A4 landscape (one size), titled, numbered "page n of N", none blank (issue 16,
     item 6). A table longer than a page carries on a "(continued)" page under its title."""
     from pypdf import PdfReader
@@ -359,7 +359,8 @@ def test_pdf_pages_are_a4_landscape_numbered_and_in_order(evidence):
     n_segments = sum(s["status"] == "ok" for s in summary["segments"])
     expected = (["Friction report — demo", "Run details", "Time tracks", "Broomstick",
                  "Well path", "Normal force and F_c profiles"]
-                + [f"Segment {i}" for i in range(1, n_segments + 1)]
+                + [page for i in range(1, n_segments + 1)
+                   for page in (f"Segment {i} — bit at", ": detail")]
                 + ["Diagnostics", "Appendix: drill string", "Appendix: settings"])
     reader = PdfReader(pdf)
     texts = [page.extract_text() for page in reader.pages]
@@ -800,7 +801,7 @@ def test_report_warns_when_the_string_is_heavier_than_the_hook_load(evidence, tm
     html = write_well_report(result).read_text(encoding="utf-8")
     warning = html.split('id="weight-warning">')[1].split("</li>")[0]
     assert "string weight inconsistent with the hook load" in warning
-    assert "4 of 4" in warning
+    assert "in all 4 off-bottom segments" in warning
 
 
 def test_broomstick_measured_points_from_a_log():
@@ -873,10 +874,10 @@ def test_empty_friction_log_names_estimated_but_withheld_segments():
                         "quality_flags": [["hookload_contradicts_string"],
                                           ["hookload_contradicts_string"], []]})
     note = no_friction_note(seg)
-    assert "2 segments of 3 were estimated at 934–1120 m" in note
+    assert "2 of 3 segments were estimated at 934–1120 m" in note
     assert "withheld by the hook-load check" in note and "1 skipped" in note
     skipped = no_friction_note(seg.assign(status=["skipped"] * 3))
-    assert "none of the 3 segments was estimated with a bit depth" in skipped
+    assert "no segment was estimated with a bit depth (3 segments: 3 skipped)" in skipped
 
 
 def test_an_empty_severity_panel_says_why():
@@ -884,7 +885,7 @@ def test_an_empty_severity_panel_says_why():
     (demo, DSATS, F-5, live) with no note why. It now counts the reasons: severe stick-slip
     (beyond the validated range), undetermined, bit speed not resolved or withheld, on
     bottom."""
-    from drillfric.report.friction import severity_note
+    from drillfric.report.render import severity_note
 
     seg = pd.DataFrame({"status": ["ok", "ok", "ok", "ok", "skipped"],
                         "kind": ["off_bottom_rotating"] * 3 + ["on_bottom_rotating"] * 2,

@@ -248,9 +248,11 @@ def test_header_span_is_the_logs_not_the_segments(evidence, tmp_path):
     assert "not included" in run and "run took" not in html
 
 
-def test_long_log_without_clock_is_plotted_in_hours_with_a_rig_state_legend(tmp_path):
-    """A 2-hour log without clock time: the tracks' axis is log time in hours (0…2, not
-    0…7200 s), and the rig-state strip has a legend naming its colours."""
+def test_long_log_without_clock_is_plotted_in_log_clock_time_with_a_rig_state_legend(
+        tmp_path):
+    """A 2-hour log without clock time: the tracks' axis reads log time as h:mm:ss (issue
+    35 item 13: not decimal hours, not 0…7200 s) with ticks on whole minutes or hours, and
+    the rig-state strip has a legend naming its colours."""
     result = synthetic_result(tmp_path / "long", hours=2.0, log_rate_hz=2.0, n_segments=2,
                               segment_s=600.0, n_starts=1, estimate_rate_hz=1.0)
     summary = json.loads((result / "summary.json").read_text())
@@ -261,8 +263,12 @@ def test_long_log_without_clock_is_plotted_in_hours_with_a_rig_state_legend(tmp_
     html = write_well_report(result).read_text(encoding="utf-8")
     item = bokeh_items(html)["bk-tracks"]
     x = sources(item)["trace:surface_torque_Nm"]["x"]
-    assert 1.9 < np.nanmax(x) <= 2.0 and "log time [h]" in json.dumps(item,
-                                                                       ensure_ascii=False)
+    text = json.dumps(item, ensure_ascii=False)
+    assert 6800 < np.nanmax(x) <= 7200 and "log time [h:mm:ss]" in text
+    formats = {f["attributes"]["format"] for f in bokeh_nodes(item, "NumeralTickFormatter")}
+    assert formats == {"00:00:00"}  # numbro's h:mm:ss of seconds
+    bases = {t["attributes"]["base"] for t in bokeh_nodes(item, "AdaptiveTicker")}
+    assert bases == {60, 3600}  # ticks on whole seconds, minutes and hours
     states = [n for n in bokeh_nodes(item, "LegendItem")
               if n["attributes"].get("label") == {"type": "field", "field": "what"}]
     assert len(states) == 1
@@ -280,7 +286,7 @@ def test_empty_friction_log_is_a_sentence_not_an_axis(demo, tmp_path):
     html = write_well_report(result).read_text(encoding="utf-8")
     assert "bk-friction" not in bokeh_items(html)
     note = _section(html, "no-friction").split("</p>")[0]
-    assert "none of the 4 segments" in note and "4 skipped" in note
+    assert "no segment was estimated with a bit depth (4 segments: 4 skipped)" in note
     item = bokeh_items(write_well_report(demo).read_text(encoding="utf-8"))["bk-friction"]
     ranges = [n["attributes"] for n in bokeh_nodes(item, "DataRange1d")]
     assert any(r.get("start") == 0.0 for r in ranges)

@@ -200,8 +200,8 @@ def test_segment_headers_show_zone_interval_bit_speed_and_notes(evidence):
 
 
 def test_flags_are_badges_with_their_meaning(evidence, tmp_path):
-    """A creep fit check that failed (mu_s_not_explained) shows in the segment header with
-    the flag's meaning from docs/outputs.md, and in the diagnostics message."""
+    """A creep fit check that failed (mu_s_not_explained) shows in the segment's detail
+    with the flag's meaning from docs/outputs.md, and in the diagnostics message."""
     from drillfric.result import FLAG_MEANINGS, Flag
 
     def unexplained(summary):
@@ -209,7 +209,7 @@ def test_flags_are_badges_with_their_meaning(evidence, tmp_path):
 
     result = copy_result(evidence, tmp_path / "w", unexplained)
     html = write_well_report(result, segments="all").read_text(encoding="utf-8")
-    header = _segment_section(html, 1).split("</p>")[1]
+    header = _segment_section(html, 1).split('class="seg-flags"')[1].split("</p>")[0]
     meaning = str(escape(FLAG_MEANINGS[Flag.MU_S_NOT_EXPLAINED]))
     assert ">mu s not explained</span>" in header and meaning in header
     assert "mu_s_not_explained" in _diagnostic_cells(html)[0][-1]

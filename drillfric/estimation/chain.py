@@ -68,6 +68,7 @@ from drillfric.estimation.verdict import (
     withheld_factors,
 )
 from drillfric.friction import FrictionProfile
+from drillfric.io.text import plural
 from drillfric.io.timebase import find_gaps
 from drillfric.result import Flag
 from drillfric.units import RPM_TO_RAD_S
@@ -680,7 +681,7 @@ def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
     """The message of a segment whose log had isolated spikes or drop-outs."""
     if not models.dropped:
         return ()
-    return (f"{models.dropped} speed or torque sample(s) dropped as spikes, drop-outs or "
+    return (f"{plural(models.dropped, 'speed or torque sample')} dropped as spikes, drop-outs or "
             "samples lost while turning (values no motion of the string or the top drive can "
             "take; bridged by interpolation, docs/ingestion.md \"EDR defects\")",)
 

@@ -11,6 +11,7 @@ changes them.
 from __future__ import annotations
 
 from drillfric.estimation.verdict import TYPICAL_MU
+from drillfric.io.text import plural, share
 from drillfric.result import Flag, WellFlag
 from drillfric.vocabulary import Kind, Status
 
@@ -74,8 +75,8 @@ def _nothing_estimated(segments: list[dict]) -> str:
     """The warning of a log whose segments were all skipped or failed: nothing estimated
     (a column of unreadable numbers made every segment's nulls too many, exit 0, silent)."""
     first = next((s.get("message") for s in segments if s.get("message")), "")
-    return (f"nothing estimated: none of the {len(segments)} segment(s) was estimated "
-            f"(skipped or failed" + (f"; the first says: {first})" if first else ")"))
+    return (f"nothing estimated: no segment was estimated ({plural(len(segments), 'segment')} "
+            f"skipped or failed" + (f"; the first says: {first})" if first else ")"))
 
 
 def _no_mu_k(summary: dict) -> str:
@@ -91,9 +92,10 @@ def _no_mu_k(summary: dict) -> str:
     if not off:
         return "no off-bottom rotating segment: only apparent friction on bottom"
     if not done:
-        return f"none of the {len(off)} off-bottom segments was estimated (skipped or failed)"
-    return (f"none of the {len(done)} estimated off-bottom segments converged (their "
-            "messages say why)")
+        return (f"no off-bottom segment was estimated ({plural(len(off), 'off-bottom segment')} "
+                "skipped or failed)")
+    return (f"no off-bottom segment converged ({plural(len(done), 'estimated off-bottom segment')}"
+            "; their messages say why)")
 
 
 def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
@@ -104,28 +106,29 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
     support = summary.get("mu_k_support") or {}
     mu_k, u = summary.get("mu_k"), summary.get("mu_k_uncertainty")
     if mu_k is not None and support.get("segments", 0) < MIN_SUPPORT:
-        found.append((WellFlag.LOW_SUPPORT, f"the well μ_k {mu_k:.3f} rests on "
-                      f"{support.get('segments', 0)} of {support.get('of', 0)} off-bottom "
-                      f"segments (fewer than {MIN_SUPPORT}): low confidence"))
+        backing = share(support.get("segments", 0), support.get("of", 0), "off-bottom segment")
+        found.append((WellFlag.LOW_SUPPORT, f"the well μ_k {mu_k:.3f} rests on {backing} "
+                      f"(fewer than {MIN_SUPPORT}): low confidence"))
     if mu_k is not None and u is not None and u > MAX_RELATIVE_UNCERTAINTY * mu_k:
         found.append((WellFlag.WIDE_SPREAD, f"the well μ_k {mu_k:.3f} ± {u:.3f}: its "
                       f"segments disagree by more than {MAX_RELATIVE_UNCERTAINTY:.0%}"))
     if summary.get("assumed"):
-        found.append((WellFlag.INDICATIVE, f"{INDICATIVE_WARNING} {len(summary['assumed'])} "
-                      "default(s) assumed (summary.json assumed), e.g. "
+        found.append((WellFlag.INDICATIVE, f"{INDICATIVE_WARNING} "
+                      f"{plural(len(summary['assumed']), 'default')} assumed (summary.json "
+                      "assumed), e.g. "
                       f"{summary['assumed'][0]}"))
     # only where the μ is shown: a withheld segment's μ is no reading to check (issue 35
-    # item 6: "13 segment(s) outside the typical μ range" beside 13 withheld μ)
+    # item 6: "13 segments outside the typical μ range" beside 13 withheld μ)
     outside = [s["id"] for s in segments if Flag.OUTSIDE_TYPICAL_RANGE in
                (s.get("quality_flags") or ()) and s.get("mu_k") is not None]
     if outside:
-        found.append((WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE, f"{len(outside)} segment(s) "
+        found.append((WellFlag.SEGMENTS_OUTSIDE_TYPICAL_RANGE, f"{plural(len(outside), 'segment')} "
                       f"outside the typical μ range {TYPICAL_MU[0]}–{TYPICAL_MU[1]} "
                       f"({_ids(outside)}): check the string, the survey and the torque units"))
     heavy = _heavier_than_measured(segments)
     if heavy:
         found.append((WellFlag.STRING_WEIGHT_INCONSISTENT, f"{STRING_WEIGHT_WARNING}: in "
-                      f"{len(heavy)} off-bottom segment(s) ({_ids(heavy)}) the modelled "
+                      f"{plural(len(heavy), 'off-bottom segment')} ({_ids(heavy)}) the modelled "
                       "rotating hook load exceeds the measured one by more than "
                       f"{STRING_WEIGHT_TOLERANCE:.0%}; check the string's linear masses and "
                       "lengths, the mud density and the hook-load channel"))
@@ -138,7 +141,7 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
         found.append((WellFlag.HOOKLOAD_CONTRADICTS_STRING, ""))  # the check's own warning
     failed = [s["id"] for s in segments if s.get("status") == Status.FAILED]
     if failed:
-        found.append((WellFlag.SEGMENTS_FAILED, f"{len(failed)} segment(s) failed "
+        found.append((WellFlag.SEGMENTS_FAILED, f"{plural(len(failed), 'segment')} failed "
                       f"({_ids(failed)}): their messages say why"))
     return found
 

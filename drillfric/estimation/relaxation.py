@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drillfric.estimation.creep import REST_FRACTION, smooth
+from drillfric.io.text import plural
 
 #: Shortest stall counted [s]: as long as the longest bridged soft-torque dip
 #: (segmentation.dip_max_s) and longer than the stick-slip period of a string up to ~6 km
@@ -89,7 +90,7 @@ class RelaxationCycles:
     def describe(self, interval_s: float) -> str:
         """One line for the messages; ``interval_s`` is the log's effective interval [s]."""
         period = "" if self.period_s is None else f", every {self.period_s:.0f} s"
-        return (f"relaxation cycles of a soft top drive ({self.stalls} stall(s) of "
+        return (f"relaxation cycles of a soft top drive ({plural(self.stalls, 'stall')} of "
                 f"{self.stall_s:.0f} s: the top drive crawls at "
                 f"{self.crawl_rad_s * 30 / np.pi:.1f} RPM (below "
                 f"{self.crawl_line_rad_s * 30 / np.pi:.1f} RPM) while the torque winds up "

@@ -76,6 +76,44 @@ def plural(n, noun: str, many: str | None = None, spec: str = "") -> str:
     return f"{n:{spec}} {noun if n == 1 else many or noun + 's'}"
 
 
+def share(part: int, whole: int, noun: str, many: str | None = None) -> str:
+    """``part`` of ``whole`` counted as one says it: ``"the only segment"``, ``"all 4
+    segments"``, ``"2 of 9 segments"`` — never "1 of 1 segments" (:func:`plural` for the
+    noun).
+
+    Examples
+    --------
+    >>> share(1, 1, "off-bottom segment"), share(4, 4, "segment"), share(1, 3, "segment")
+    ('the only off-bottom segment', 'all 4 segments', '1 of 3 segments')
+    >>> share(0, 1, "segment")
+    '0 of 1 segment'
+    """
+    if part == whole == 1:
+        return f"the only {noun}"
+    if part == whole > 1:
+        return f"all {plural(whole, noun, many)}"
+    return f"{part} of {plural(whole, noun, many)}"
+
+
+def split_notes(message: str) -> list[str]:
+    """A segment's message as its notes: split at "; " outside brackets (the notes of the
+    estimation steps are joined with "; ", and a note may hold one in brackets).
+
+    Examples
+    --------
+    >>> split_notes("fit note; μ_k = 0.279 ± 0.014 (95 %: 5 %; statistical ± 0.002)")
+    ['fit note', 'μ_k = 0.279 ± 0.014 (95 %: 5 %; statistical ± 0.002)']
+    """
+    parts, depth, start = [], 0, 0
+    for i, char in enumerate(message):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if depth == 0 and message.startswith("; ", i):
+            parts.append(message[start:i])
+            start = i + 2
+    parts.append(message[start:])
+    return [p.strip() for p in parts if p.strip()]
+
+
 def listing(names, *, recognised: bool, limit: int = 12) -> str:
     """Column names for a message, or a word saying why they are not shown.
 

@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.estimation.headline import STRING_WEIGHT_TOLERANCE
-from drillfric.io.text import plural
+from drillfric.io.text import share
 from drillfric.vocabulary import Kind, LoadCase
 
 from .display import SI, Units
@@ -173,8 +173,9 @@ def weight_check(points: pd.DataFrame, table: pd.DataFrame | None = None,
     if bad.size:
         k = int(np.argmax(ratio))
         force = units.label("force")
-        warning = (f"string weight inconsistent with the hook load: in {bad.size} of "
-                   f"{plural(measured.size, 'off-bottom segment')} the modelled rotating hook load "
+        warning = (f"string weight inconsistent with the hook load: in "
+                   f"{share(bad.size, measured.size, 'off-bottom segment')} the modelled "
+                   "rotating hook load "
                    f"exceeds the measured one by more than {tolerance:.0%} (worst: segment "
                    f"{ids[k]}, model {units.text(model[k], 'force')} {force} vs measured "
                    f"{units.text(measured[k], 'force')} {force}). The hook also carries the "

@@ -28,7 +28,14 @@ from matplotlib.figure import Figure
 
 from .data import FINAL_START_ID
 from .display import SI, Units, row_flags
-from .interactive import TimeAxis, float32, time_figure, time_label, time_values
+from .interactive import (
+    TimeAxis,
+    float32,
+    time_axis,
+    time_figure,
+    time_label,
+    time_values,
+)
 
 MEASURED = "#555555"
 OBSERVER = "#1f5fa8"
@@ -307,6 +314,7 @@ def evidence_figure(est: pd.DataFrame, segment: dict,
         ax.grid(True, color="#dddddd", linewidth=0.6)
         ax.legend(fontsize=6, loc="upper right", ncol=3)
     axes[-1].set_xlabel(time_label(origin), fontsize=8)
+    time_axis(origin).style_matplotlib(axes[-1])
     return fig
 
 
@@ -331,8 +339,10 @@ def _series_axes(ax, key: str, series: dict, x, t, est, origin) -> None:
 
 def _mu_axes(ax, est: pd.DataFrame, segment: dict, origin) -> None:
     note = mu_withheld(segment)
-    if note:
-        ax.set_title(note, fontsize=8, color="#c9302c", loc="left")
+    if note:  # inside the axes: a title would run into the panel above
+        ax.text(0.005, 0.97, note, transform=ax.transAxes, fontsize=7, color="#c9302c",
+                va="top", ha="left", parse_math=False, zorder=5,
+                bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "none"})
     for start_id, rows in est.groupby("start_id", sort=True):
         final = start_id == FINAL_START_ID
         kw = {"color": "black", "linewidth": 1.4} if final else {"linewidth": 0.8}

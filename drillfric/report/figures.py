@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from drillfric.vocabulary import Status
 
 from .display import SI, Units
-from .render import is_apparent, zone_text
+from .render import is_apparent, severity_note, zone_text
 
 #: Colours of the friction factors (μ_k, μ_s, torque-and-drag back-calculation).
 MU_K_COLOR = "#1f5fa8"
@@ -164,7 +164,7 @@ def profiles_figure(profiles: pd.DataFrame | None, segments: pd.DataFrame,
 def friction_log_figure(segments: pd.DataFrame,
                         size: tuple[float, float] = (_WIDTH_IN, 5.5),
                         units: Units = SI, top_in: float = 0.75,
-                        drag: pd.DataFrame | None = None) -> Figure:
+                        drag: pd.DataFrame | None = None, empty_note: str = "") -> Figure:
     """μ_s and μ_k versus bit depth, one point per segment (stand), with spread bars, and
     the stick-slip severity versus bit depth beside it.
 
@@ -178,11 +178,14 @@ def friction_log_figure(segments: pd.DataFrame,
     ``drag`` (drag_log.parquet): the drag-based μ of each connection whose μ is given, a
     green ✚ with its uncertainty as bars and its own legend entry — a second friction log,
     independent of the torque.
-    Segments without an estimate are grey diamonds on the left edge. Markers are not
-    clipped at the axes' edges. ``top_in``: room above the axes [in] (a page's headline).
+    Segments without an estimate are grey diamonds at μ = 0. Markers are not clipped at
+    the axes' edges. ``top_in``: room above the axes [in] (a page's headline).
     Right: severity (ω_max − ω_min)/(2 ω_mean) of the
-    estimated bit speed; beyond the dashed line at 1 the bit stops. Depths in display
+    estimated bit speed; beyond the dashed line at 1 the bit stops; without any, the panel
+    says why (:func:`~drillfric.report.render.severity_note`). Depths in display
     ``units``; the μ axis names the friction zone when the segments share one.
+    With no friction factor to draw, the figure is ``empty_note`` (default: the counts) and
+    no axis: no mark is drawn without its axes and labels.
     """
     fig = _new(size[1], size[0], left_in=0.9, wspace=0.08, top_in=top_in)
     ax, ax_sev = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [2.2, 1]})
@@ -208,15 +211,16 @@ def friction_log_figure(segments: pd.DataFrame,
         ax.plot(td["mu_td"], td["depth"], "x", color=TD_COLOR,
                 label="μ from torque and drag", clip_on=False)
     none = seg[(seg["status"] != Status.OK) & seg["depth"].notna()]
+    drawn = _drag_points(ax, drag, units)
+    if not ok["mu_k"].notna().any() and not drawn:
+        ax.clear()
+        _note(ax, empty_note or "No friction factor to draw: no segment was estimated "
+                                f"({len(none)} without an estimate).")
+        ax_sev.set_axis_off()
+        return fig
     if len(none):
         ax.plot(np.zeros(len(none)), none["depth"], "d", color="#888888",
                 markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")
-    drawn = _drag_points(ax, drag, units)
-    if not ok["mu_k"].notna().any() and not drawn:
-        _note(ax, "No friction factor to draw: no segment was estimated "
-                  f"({len(none)} without an estimate).")
-        ax_sev.set_axis_off()
-        return fig
     zone = zone_text(segments)
     ax.set(xlabel=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
            ylabel=units.axis("bit depth", "length"))
@@ -229,6 +233,8 @@ def friction_log_figure(segments: pd.DataFrame,
                 clip_on=False)
     ax_sev.axvline(1.0, color=MU_S_COLOR, linestyle="--", linewidth=0.8)
     ax_sev.set(xlabel="stick-slip severity [-]")
+    if not len(sev):
+        ax_sev.set_title(severity_note(segments), fontsize="small", loc="left", wrap=True)
     ax_sev.set_xlim(left=0.0, right=max(1.2, 1.1 * float(sev["stick_slip_severity"].max()))
                     if len(sev) else 1.2)
     ax_sev.grid(True, color="#dddddd", linewidth=0.6)

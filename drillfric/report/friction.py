@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.io.text import plural
-from drillfric.vocabulary import Kind, Status
+from drillfric.vocabulary import Status
 
 from .display import SI, Units, fmt
 from .figures import (
@@ -31,7 +31,7 @@ from .figures import (
     drag_rows,
 )
 from .interactive import MIN_WIDTH_PX
-from .render import is_apparent, mu_k_cell, mu_s_text, severity_text, zone_text
+from .render import is_apparent, mu_k_cell, mu_s_text, severity_note, severity_text, zone_text
 
 _TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
 
@@ -261,36 +261,6 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
                         line_color="#c0392b"))
     sev.x_range.start = 0.0
     return gridplot([[mu, sev]], merge_tools=True, toolbar_location="right")
-
-
-#: Why a segment shows no stick-slip severity, by flag or field, in the order said.
-_NO_SEVERITY = (("stick_slip_beyond_validated", "severe (beyond the validated range)"),
-                ("stick_slip_undetermined", "undetermined"))
-
-
-def severity_note(segments: pd.DataFrame) -> str:
-    """Why the severity panel is empty: the estimated segments' reasons, counted (severe
-    stick-slip, undetermined, bit speed not resolved or withheld, on bottom).
-
-    >>> severity_note(pd.DataFrame({"status": ["ok", "ok"], "kind": ["off_bottom_rotating"] * 2,
-    ...     "quality_flags": [["stick_slip_beyond_validated"], []],
-    ...     "bit_speed_resolved": [True, False]}))
-    'no severity shown: 1 severe (beyond the validated range), 1 bit speed not resolved or withheld'
-    """
-    ok = segments[segments["status"] == Status.OK] if "status" in segments else segments
-    counts: dict[str, int] = {}
-    for _, row in ok.iterrows():
-        flags = set(row.get("quality_flags") if row.get("quality_flags") is not None else ())
-        why = next((text for flag, text in _NO_SEVERITY if flag in flags), None)
-        if why is None and row.get("kind") == Kind.ON_BOTTOM:
-            why = "on bottom"
-        elif why is None and row.get("bit_speed_resolved") is not True:
-            why = "bit speed not resolved or withheld"
-        if why:
-            counts[why] = counts.get(why, 0) + 1
-    if not counts:
-        return "no severity shown: no estimated segment"
-    return "no severity shown: " + ", ".join(f"{n} {why}" for why, n in counts.items())
 
 
 def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):

@@ -27,6 +27,8 @@ from markupsafe import Markup
 
 from drillfric.io.timebase import clock_at
 
+from .render import clock
+
 #: Width of the interactive figures when the page is wider than this [px] (they stretch).
 MIN_WIDTH_PX = 600
 #: Tools of every time-axis figure: zoom and pan along time, box zoom, reset, hover, save.
@@ -154,15 +156,20 @@ def with_data(item: dict, target: str, data: dict[str, dict]) -> dict:
     return out
 
 
-#: Logs longer than this without clock time are plotted in log hours, not seconds [s].
+#: Logs longer than this without clock time are plotted in log time ``h:mm:ss``, not
+#: seconds [s].
 LONG_LOG_S = 3600.0
+#: Tick spacings of a log-time axis in ``h:mm:ss`` [s]: whole seconds, minutes and hours
+#: (never a decimal hour such as 13.76 h).
+CLOCK_STEPS_S = (1, 2, 5, 10, 15, 30, 60, 120, 300, 600, 900, 1800,
+                 3600, 7200, 10800, 21600, 43200, 86400)
 
 
 @dataclass(frozen=True)
 class TimeAxis:
     """How log time is plotted: clock time (UTC) when the log has it (``origin``, the clock
-    time of log time 0), else log hours for a log longer than :data:`LONG_LOG_S`
-    (``hours``), else log seconds."""
+    time of log time 0), else log time read as ``h:mm:ss`` for a log longer than
+    :data:`LONG_LOG_S` (``hours``: ticks on whole minutes and hours), else log seconds."""
 
     origin: pd.Timestamp | None = None
     hours: bool = False
@@ -178,23 +185,63 @@ class TimeAxis:
         return "clock" if self.clock else ("hours" if self.hours else "seconds")
 
     def values(self, time_s) -> np.ndarray:
-        """Log time [s] as plotted: naive-UTC datetimes, hours or seconds."""
+        """Log time [s] as plotted: naive-UTC datetimes, else seconds (an ``h:mm:ss`` axis
+        plots seconds and labels them as such)."""
         seconds = np.asarray(time_s, dtype=float)
         if self.origin is not None:
             return clock_at(self.origin.tz_convert("UTC").tz_localize(None), seconds).to_numpy()
-        return seconds / 3600.0 if self.hours else seconds
+        return seconds
 
     @property
     def label(self) -> str:
         """Axis label."""
-        return {"clock": "time [UTC]", "hours": "log time [h]",
+        return {"clock": "time [UTC]", "hours": "log time [h:mm:ss]",
                 "seconds": "log time [s]"}[self.kind]
 
     def hover(self) -> tuple[tuple[str, str], dict]:
         """The hover field of the time and its Bokeh formatters."""
         if self.clock:
             return ("time", "@x{%F %T}"), {"@x": "datetime"}
-        return ("time", "@x{0.000} h" if self.hours else "@x{0.0} s"), {}
+        return ("time", "@x{00:00:00} log time" if self.hours else "@x{0.0} s"), {}
+
+    def style_bokeh(self, fig) -> None:
+        """Ticks of an ``h:mm:ss`` axis on whole minutes and hours, labelled ``h:mm:ss``
+        (Bokeh's numeral format ``00:00:00``: no script of ours, the page's CSP holds)."""
+        if not self.hours or self.clock:
+            return
+        from bokeh.models import AdaptiveTicker, CompositeTicker, NumeralTickFormatter
+
+        fig.xaxis.formatter = NumeralTickFormatter(format="00:00:00")
+        fig.xaxis.ticker = CompositeTicker(tickers=[
+            AdaptiveTicker(mantissas=[1, 2, 5, 10, 15, 30], base=60, min_interval=1.0,
+                           max_interval=1800.0),
+            AdaptiveTicker(mantissas=[1, 2, 3, 6, 12, 24], base=3600, min_interval=3600.0)])
+
+    def style_matplotlib(self, ax) -> None:
+        """The same for a static figure: ticks :data:`CLOCK_STEPS_S` apart, labelled
+        ``h:mm:ss`` (:func:`drillfric.report.render.clock`)."""
+        if not self.hours or self.clock:
+            return
+        from matplotlib.ticker import FuncFormatter
+
+        ax.xaxis.set_major_locator(_clock_locator())
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda seconds, _: clock(seconds)))
+
+
+def _clock_locator():
+    """A matplotlib locator of ticks :data:`CLOCK_STEPS_S` apart, at most 8 on the axis."""
+    from matplotlib.ticker import Locator
+
+    class ClockLocator(Locator):
+        def __call__(self):
+            return self.tick_values(*self.axis.get_view_interval())
+
+        def tick_values(self, vmin, vmax):
+            step = next((s for s in CLOCK_STEPS_S if (vmax - vmin) / s <= 8),
+                        CLOCK_STEPS_S[-1])
+            return np.arange(np.ceil(vmin / step) * step, vmax + step * 1e-6, step)
+
+    return ClockLocator()
 
 
 def time_axis(origin: pd.Timestamp | TimeAxis | None, span_s: float = 0.0) -> TimeAxis:
@@ -235,6 +282,7 @@ def time_figure(height: int, y_label: str, *, x_range=None, axis: TimeAxis | Non
     fig.yaxis.axis_label_text_font_size = "11px"
     fig.xaxis.visible = x_label is not None
     fig.grid.grid_line_color = "#e5e5e5"
+    axis.style_bokeh(fig)
     return fig
 
 

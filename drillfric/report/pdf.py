@@ -3,7 +3,8 @@
 Tables are drawn here rather than with ``Axes.table``: their cells wrap to the column width
 (instead of the font shrinking until a wide table fits), rows grow to the lines they need,
 and a table continues on the next page with its header repeated; a row may carry a note
-across the full width (a diagnostics message), wrapped and never cut. Every page carries
+across the full width (a diagnostics message), wrapped and never cut, and a cell too long
+for a page's row continues there. Nothing is cut: text wraps. Every page carries
 the well's name and "page n of N" in its footer, below every axis and its tick labels
 (:func:`clear_footer`).
 """
@@ -23,7 +24,8 @@ from .render import quiet_glyphs
 PAGE_IN = (11.69, 8.27)
 #: Font size of table text [pt] (readable in print; the old tables shrank to ~4 pt).
 TABLE_FONT_PT = 7.5
-#: Longest cell shown [lines]; longer cells end in "…" (report.html has them whole).
+#: Longest cell drawn in its row [lines]; the rest of a longer cell follows under the row,
+#: across the full width (a row is never taller than a page, and nothing is cut).
 MAX_CELL_LINES = 14
 _MARGIN_IN = 0.45
 _TOP_IN = 0.85      # room for the page title
@@ -45,16 +47,27 @@ def blank_page(title: str) -> Figure:
 
 
 def wrap_cell(text: str, chars: int) -> list[str]:
-    """``text`` wrapped to ``chars`` characters a line (long words broken), at most
-    :data:`MAX_CELL_LINES` lines."""
+    """``text`` wrapped to ``chars`` characters a line (long words broken), every line."""
     lines = []
     for part in str(text).splitlines() or [""]:
         lines += textwrap.wrap(part, max(chars, 1), break_long_words=True,
                                break_on_hyphens=False) or [""]
-    if len(lines) > MAX_CELL_LINES:
-        lines = lines[:MAX_CELL_LINES]
-        lines[-1] = lines[-1][:max(chars - 1, 1)] + "…"
     return lines
+
+
+def _overflow(cells: list[list[str]], row: list[str], heading: list[str]
+              ) -> tuple[list[list[str]], str]:
+    """A row's wrapped cells cut to :data:`MAX_CELL_LINES` lines, and the rest of each cut
+    cell as a note ("heading, continued: …"; a table without headings names the row by its
+    first cell) to print under the row."""
+    kept, rest = [], []
+    for lines, name in zip(cells, heading, strict=True):
+        if len(lines) <= MAX_CELL_LINES:
+            kept.append(lines)
+            continue
+        kept.append([*lines[:MAX_CELL_LINES - 1], "(continued below)"])
+        rest.append(f"{name or row[0]}, continued: " + " ".join(lines[MAX_CELL_LINES - 1:]))
+    return kept, "\n".join(rest)
 
 
 def column_chars(columns: list[str], rows: list[list[str]], budget: int) -> list[float]:
@@ -119,9 +132,12 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
     chars = [int(w * 72.0 / (_CHAR_EM * font_pt)) - 1 for w in col_in]
     line_in = 1.22 * font_pt / 72.0
     head = [wrap_cell(h, c) for h, c in zip(columns, chars, strict=True)]
-    body = [[wrap_cell(v, c) for v, c in zip(r, chars, strict=True)] for r in rows]
+    cut = [_overflow([wrap_cell(v, c) for v, c in zip(r, chars, strict=True)], r, columns)
+           for r in rows]
+    body = [cells for cells, _ in cut]
     full = int(width_in * 72.0 / (_CHAR_EM * font_pt)) - 4
-    wrapped = [_wrap_note(n, full) for n in (notes or [""] * len(rows))]
+    wrapped = [wrap_lines("\n".join(filter(None, (rest, note))), full)
+               for (_, rest), note in zip(cut, notes or [""] * len(rows), strict=True)]
     pages: list[Figure] = []
     state = {"y": 0.0}
 
@@ -129,7 +145,7 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
         fig = blank_page(title + (" (continued)" if pages else ""))
         state["y"] = PAGE_IN[1] - _TOP_IN
         if lead and not pages:
-            lines = _wrap_note(lead, full)
+            lines = wrap_lines(lead, full)
             fig.text(_MARGIN_IN / PAGE_IN[0], state["y"] / PAGE_IN[1], "\n".join(lines),
                      fontsize=font_pt, va="top", parse_math=False)
             state["y"] -= len(lines) * line_in + 0.12
@@ -166,11 +182,19 @@ def table_pages(title: str, columns: list[str], rows: list[list[str]],
     return pages
 
 
-def _wrap_note(text: str, chars: int) -> list[str]:
-    """A note wrapped to ``chars`` a line, every line kept."""
+def wrap_lines(text: str, chars: int) -> list[str]:
+    """``text`` wrapped to ``chars`` a line, every line kept (nothing is cut: the PDF
+    wraps, it never clips); [] for blank text."""
     return [w for part in str(text).splitlines() for w in
             (textwrap.wrap(part, max(chars, 1), break_on_hyphens=False) or [""])] \
         if str(text).strip() else []
+
+
+def line_chars(width_in: float, font_pt: float, bold: bool = False) -> int:
+    """How many characters of the sans-serif font fit on ``width_in`` at ``font_pt``
+    (bold about 10 % wider), with a little room to spare."""
+    em = _CHAR_EM * (1.1 if bold else 1.0)
+    return int(width_in * 72.0 / (em * font_pt)) - 2
 
 
 def _draw_row(fig: Figure, cells: list[list[str]], col_in: list[float], y_in: float,

@@ -32,13 +32,16 @@ HTML_DPI = 90
 #: Columns of the diagnostics table (HTML and PDF), in order: heading, the quantity whose
 #: display unit the heading names (None: no unit or a fixed one; at ``{unit}``, else at the
 #: end) and the cell's CSS class
-#: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap).
+#: in the HTML table (``num``: right-aligned number, ``wrap``: text that may wrap — every
+#: column whose text can grow, so that the table fits the page and the message keeps its
+#: room).
 DIAGNOSTIC_COLUMNS = (
     ("seg.", None, ""), ("kind", None, "wrap"), ("bit depth", "length", "num"),
-    ("time", None, "wrap"), ("μ_s", None, "num"), ("μ_k / apparent μ", None, "num"),
+    ("time", None, "wrap"), ("μ_s", None, "num wrap"), ("μ_k / apparent μ", None, "num"),
     ("μ_TD", None, "num"),
     ("μ zone", None, "wrap"), ("spread μ_s / μ_k", None, "num"), ("settling [s]", None, "num"),
-    ("residual [rpm]", None, "num"), ("misfit / swing {unit} (quality)", "torque", "num"),
+    ("residual [rpm]", None, "num"),
+    ("misfit / swing {unit} (quality)", "torque", "num wrap"),
     ("severity", None, "num"), ("stuck", None, "num"),
     ("hook load", "force", "num"), ("bit speed (interval)", None, "wrap"),
     ("observability", None, "wrap"), ("status", None, "wrap"), ("message", None, ""))
@@ -106,6 +109,36 @@ def severity_text(row: dict) -> str:
     return fmt(row.get("stick_slip_severity"), ".2f")
 
 
+#: Why a segment shows no stick-slip severity, by flag or field, in the order said.
+_NO_SEVERITY = (("stick_slip_beyond_validated", "severe (beyond the validated range)"),
+                ("stick_slip_undetermined", "undetermined"))
+
+
+def severity_note(segments: pd.DataFrame) -> str:
+    """Why the severity panel is empty: the estimated segments' reasons, counted (severe
+    stick-slip, undetermined, bit speed not resolved or withheld, on bottom).
+
+    >>> severity_note(pd.DataFrame({"status": ["ok", "ok"], "kind": ["off_bottom_rotating"] * 2,
+    ...     "quality_flags": [["stick_slip_beyond_validated"], []],
+    ...     "bit_speed_resolved": [True, False]}))
+    'no severity shown: 1 severe (beyond the validated range), 1 bit speed not resolved or withheld'
+    """
+    ok = segments[segments["status"] == Status.OK] if "status" in segments else segments
+    counts: dict[str, int] = {}
+    for _, row in ok.iterrows():
+        flags = set(row.get("quality_flags") if row.get("quality_flags") is not None else ())
+        why = next((text for flag, text in _NO_SEVERITY if flag in flags), None)
+        if why is None and row.get("kind") == Kind.ON_BOTTOM:
+            why = "on bottom"
+        elif why is None and row.get("bit_speed_resolved") is not True:
+            why = "bit speed not resolved or withheld"
+        if why:
+            counts[why] = counts.get(why, 0) + 1
+    if not counts:
+        return "no severity shown: no estimated segment"
+    return "no severity shown: " + ", ".join(f"{n} {why}" for why, n in counts.items())
+
+
 def observability(row: dict) -> str:
     """Whether the segment identifies μ_s, bounds it, or says nothing about it."""
     if row.get("status") != Status.OK:
@@ -125,15 +158,33 @@ def row_class(row: dict) -> str:
 
 
 def clock_span(row: dict, origin) -> str:
-    """A segment's time span: UTC clock times when known, else log seconds."""
+    """A segment's time span: UTC clock times when known, else log time ``h:mm:ss``; "—"
+    without a time (a depth-indexed log's windows).
+
+    >>> clock_span({"t_start_s": 49570.0, "t_end_s": 49702.0}, None)
+    '13:46:10–13:48:22'
+    >>> clock_span({"t_start_s": None, "t_end_s": None}, None)
+    '—'
+    """
     start, end = row.get("clock_start_utc"), row.get("clock_end_utc")
-    if origin is not None and math.isfinite(row.get("t_start_s", math.nan)):
-        start = clock_at(origin, row["t_start_s"]).isoformat()
-        end = clock_at(origin, row["t_end_s"]).isoformat()
+    t0, t1 = (_finite(row.get(key)) for key in ("t_start_s", "t_end_s"))
+    if origin is not None and t0 is not None and t1 is not None:
+        start, end = clock_at(origin, t0).isoformat(), clock_at(origin, t1).isoformat()
     if isinstance(start, str) and isinstance(end, str):
         a, b = pd.Timestamp(start), pd.Timestamp(end)
         return f"{a:%H:%M:%S}–{b:%H:%M:%S}"
-    return f"{fmt(row.get('t_start_s'), '.0f')}–{fmt(row.get('t_end_s'), '.0f')} s"
+    if t0 is None or t1 is None:
+        return "—"
+    return f"{clock(t0)}–{clock(t1)}"
+
+
+def _finite(value) -> float | None:
+    """``value`` as a finite float, or None (missing, NaN, not a number)."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if math.isfinite(number) else None
 
 
 def pair(a, b, spec: str = ".3f") -> str:
@@ -179,6 +230,17 @@ def interval_text(row: dict) -> str:
     return "" if interval == "—" else f"{interval} s"
 
 
+def row_zone(row: dict) -> str:
+    """A segment's friction zone as shown ("open hole", "effective"), "—" when it has none
+    (a skipped segment: None in summary.json, NaN in a table — never "nan").
+
+    >>> row_zone({"friction_zone": "open_hole"}), row_zone({"friction_zone": float("nan")})
+    ('open hole', '—')
+    """
+    zone = row.get("friction_zone")
+    return zone.replace("_", " ") if isinstance(zone, str) and zone else "—"
+
+
 def zone_text(segments: pd.DataFrame) -> str:
     """The friction zone the estimated segments' μ are for ("open hole", "effective"), or
     "" when they differ or the results do not say (older results)."""
@@ -186,19 +248,6 @@ def zone_text(segments: pd.DataFrame) -> str:
         return ""
     zones = set(segments.loc[segments["status"] == Status.OK, "friction_zone"].dropna())
     return zones.pop().replace("_", " ") if len(zones) == 1 else ""
-
-
-def message_parts(message: str) -> list[str]:
-    """A segment's message as its notes: split at "; " outside parentheses (the notes of
-    the estimation steps are joined with "; ", and a note may hold one in brackets)."""
-    parts, depth, start = [], 0, 0
-    for i, char in enumerate(message):
-        depth += {"(": 1, ")": -1}.get(char, 0)
-        if depth == 0 and message.startswith("; ", i):
-            parts.append(message[start:i])
-            start = i + 2
-    parts.append(message[start:])
-    return [p.strip() for p in parts if p.strip()]
 
 
 def flag_items(row: dict) -> list[tuple[str, str, str]]:
@@ -337,7 +386,7 @@ def diagnostic_rows(segments: pd.DataFrame, units: Units, origin=None,
         kind = str(row.get("kind") or "—").replace("_rotating", "").replace("_", " ")
         cells = [str(row["id"]), kind, units.text(row["bit_depth_m"], "length", ".1f"),
                  clock_span(row, origin), mu_s if ok else "—", mu_k_cell(row),
-                 fmt(row["mu_td"]), str(row.get("friction_zone") or "—").replace("_", " "),
+                 fmt(row["mu_td"]), row_zone(row),
                  pair(row["mu_s_spread"], row["mu_k_spread"]),
                  fmt(row["settling_time_s"], ".1f"), fmt(row["residual_rms_rpm"], ".2f"),
                  _torque_fit(row, units, quality), severity_text(row),

@@ -23,7 +23,14 @@ from matplotlib.figure import Figure
 from drillfric.segmentation import RIG_STATES
 
 from .display import SI, Units
-from .interactive import TimeAxis, float32, time_figure, time_label, time_values
+from .interactive import (
+    TimeAxis,
+    float32,
+    time_axis,
+    time_figure,
+    time_label,
+    time_values,
+)
 
 
 @dataclass(frozen=True)
@@ -301,6 +308,7 @@ def tracks_figure(tracks: pd.DataFrame, segments: pd.DataFrame,
                                                                           "#777777"))
     strip.set_yticks([0.25, 0.75], ["rig state", "segments"], fontsize=7)
     strip.set_xlabel(time_label(origin), fontsize=8)
+    time_axis(origin).style_matplotlib(strip)
     strip.tick_params(labelsize=7)
     used = sorted(set(runs["code"]))
     fig.legend(handles=[Patch(color=STATE_COLORS[c], label=RIG_STATES[c].replace("_", " "))

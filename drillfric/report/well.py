@@ -18,7 +18,7 @@ import pandas as pd
 from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.headline import LOWERING, STRING_WEIGHT_WARNING
 from drillfric.io.atomic import write_text_replacing
-from drillfric.io.text import plural
+from drillfric.io.text import plural, share, split_notes
 from drillfric.io.timebase import clock_at
 from drillfric.vocabulary import Status
 
@@ -37,6 +37,7 @@ from .evidence import (
 )
 from .friction import friction_plot, friction_signature, friction_sources
 from .interactive import LONG_LOG_S, Embedder
+from .lead import segment_lead
 from .pdf import table_pages, write_pdf
 from .render import (
     CONVERGED_MEANING,
@@ -53,12 +54,12 @@ from .render import (
     flag_items,
     interval_text,
     is_apparent,
-    message_parts,
     mu_name,
     mu_s_text,
     non_default_rows,
     note_flags,
     now_utc,
+    row_zone,
     severity_text,
     status_word,
     string_table,
@@ -188,8 +189,8 @@ def headline_trust(summary: dict) -> dict:
     flags = set(summary.get("quality_flags") or [])
     lowering = [f.value for f in LOWERING if f.value in flags]
     return {"uncertainty": f"± {fmt(u)}" if has_mu and u is not None else "",
-            "support": (f"{support['segments']} of {support['of']} off-bottom segment"
-                        f"{'s' * (support['of'] != 1)}") if has_mu and "of" in support else "",
+            "support": share(support["segments"], support["of"], "off-bottom segment")
+            if has_mu and "of" in support else "",
             "confidence": confidence,
             "reasons": [f.replace("_", " ") for f in lowering] if confidence == "low" else []}
 
@@ -334,11 +335,12 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
     row["bit_unresolved"] = bit_speed_unresolved(row)
     row["interval"] = interval_text(row)
     row["interval_swing"] = fmt(row.get("interval_torque_swing"), ".0%")
-    row["zone"] = str(row.get("friction_zone") or "—").replace("_", " ")
+    row["zone"] = row_zone(row)
     row["starts_text"] = starts_text(row)
     row["severity_text"] = severity_text(row)
-    row["notes"] = message_parts(str(row.get("message") or ""))
+    row["notes"] = split_notes(str(row.get("message") or ""))
     row["flag_items"] = flag_items(row)
+    row["lead"] = segment_lead(row)
     return row
 
 
@@ -494,14 +496,15 @@ def no_friction_note(segments: pd.DataFrame) -> str:
     estimated = segments[(segments["status"] == Status.OK) & segments["bit_depth_m"].notna()]
     if len(estimated):  # estimated at a depth, their μ withheld (issue 35 item 3)
         why = _withheld_by(estimated)
-        return (f"No friction factor to draw: {plural(len(estimated), 'segment')} of "
-                f"{len(segments)} were estimated at "
+        verb = "was" if len(estimated) == 1 else "were"
+        return (f"No friction factor to draw: {share(len(estimated), len(segments), 'segment')} "
+                f"{verb} estimated at "
                 f"{estimated['bit_depth_m'].min():.0f}–{estimated['bit_depth_m'].max():.0f} m "
                 f"and their friction factors withheld{why}" + (f" ({parts})" if parts else "")
                 + "; their reasons are in the diagnostics table.")
-    return (f"No friction factor to draw: none of the {plural(len(segments), 'segment')} was "
-            f"estimated with a bit depth ({parts or 'no bit depth'}); their depths and "
-            "reasons are in the diagnostics table.")
+    return (f"No friction factor to draw: no segment was estimated with a bit depth "
+            f"({plural(len(segments), 'segment')}: {parts or 'no bit depth'}); their depths "
+            "and reasons are in the diagnostics table.")
 
 
 #: Segment flags that withhold its friction factors, and what the friction log says of them.
@@ -590,9 +593,12 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
         pages.append((title, fig))
     for row in report.segment_rows:
         est = report.estimates[int(row["id"])]
-        figure = evidence_figure(est, row, axis, size, units,
-                                 not row["bit_unresolved"], notes=segment_notes(row, units))
-        pages.append((f"Segment {row['id']} — bit at {row['depth']}, {row['span']}", figure))
+        title = f"Segment {row['id']} — bit at {row['depth']}, {row['span']}"
+        figure = evidence_figure(est, row, axis, size, units, not row["bit_unresolved"],
+                                 notes=segment_lead_lines(row, size))
+        pages.append((title, figure))
+        pages += [("", p) for p in table_pages(f"{title}: detail", ["", ""],
+                                               segment_detail(row, units))]
     columns, rows, notes, common = pdf_diagnostics(report.diagnostics, units)
     lead = ("Each row's message is below it. " + ("In every segment: " + "; ".join(common)
                                                    if common else "")).strip()
@@ -609,30 +615,43 @@ def _pdf_pages(report: Report, size) -> list[tuple[str, object]]:
 
 #: Headline lines of the PDF's first page [in from the top of the page, per line].
 _HEADLINE_TOP_IN, _HEADLINE_LINE_IN = 0.75, 0.24
+#: Font sizes of the headline's bold and plain lines [pt].
+_HEADLINE_PT = {True: 11.0, False: 9.0}
 
 
 def _first_page(report: Report, size):
-    """Page 1: the headline numbers and the friction log versus depth."""
-    lines = headline_lines(report.head)
+    """Page 1: the headline numbers — each line wrapped to the page, never cut (a withheld
+    μ_k's reason runs to three lines) — and the friction log versus depth."""
+    from .pdf import line_chars, wrap_lines
+
+    width_in = size[0] - 2 * 0.45
+    lines = [(part, strong, text.startswith(("INDICATIVE", "WARNING")))
+             for text, strong in headline_lines(report.head)
+             for part in wrap_lines(text, line_chars(width_in, _HEADLINE_PT[strong], strong))]
     top = _HEADLINE_TOP_IN + _HEADLINE_LINE_IN * len(lines) + 0.35
-    fig = figures.friction_log_figure(report.data.segments, size, report.units, top_in=top,
-                                      drag=report.data.drag_log)
-    for index, (text, strong) in enumerate(lines):
+    data = report.data
+    fig = figures.friction_log_figure(
+        data.segments, size, report.units, top_in=top, drag=data.drag_log,
+        empty_note=no_friction_note(data.segments))
+    for index, (text, strong, warning) in enumerate(lines):
         fig.text(0.45 / size[0], 1 - (_HEADLINE_TOP_IN + _HEADLINE_LINE_IN * index) / size[1],
-                 text, fontsize=11 if strong else 9, va="top", parse_math=False,
+                 text, fontsize=_HEADLINE_PT[strong], va="top", parse_math=False,
                  weight="bold" if strong else "normal",
-                 color="#a04000" if text.startswith(("INDICATIVE", "WARNING")) else "#222222")
+                 color="#a04000" if warning else "#222222")
     return fig
 
 
 def headline_lines(head: dict) -> list[tuple[str, bool]]:
-    """The headline of the PDF's first page as ``(text, bold)``."""
+    """The headline of the PDF's first page as ``(text, bold)``, unwrapped; the report's
+    HTML headline says the same (a depth log has no withheld dynamic μ_k to warn of)."""
     trust = head["trust"]
-    mu_k = " ".join(filter(None, [f"μ_k off bottom (consensus): {head['mu_k']}",
+    value = head["mu_k"] if head["mu_k"] != "—" or not head["mu_k_reason"] else "none"
+    mu_k = " ".join(filter(None, [f"μ_k off bottom (consensus): {value}",
                                   trust["uncertainty"],
                                   f"({trust['support']})" if trust["support"] else ""]))
     lines = [(mu_k + (f" — {head['mu_k_reason']}" if head["mu_k_reason"] else ""), True)]
-    if trust["confidence"] in ("low", "withheld"):
+    if trust["confidence"] == "low" or (trust["confidence"] == "withheld"
+                                        and not head["depth_indexed"]):
         lines.append((f"WARNING: μ_k {trust['confidence']}"
                       + (f": {', '.join(trust['reasons'])}" if trust["reasons"] else ""),
                       False))
@@ -679,42 +698,49 @@ def pdf_diagnostics(diagnostics: list[dict], units: Units
     names = [name for name, _, _ in DIAGNOSTIC_COLUMNS]
     keep = [names.index(n) for n in PDF_DIAGNOSTICS]
     headings = [h for h, _ in diagnostic_columns(units)]
-    parts = [message_parts(r["cells"][-1]) for r in diagnostics]
+    parts = [split_notes(r["cells"][-1]) for r in diagnostics]
     shared = [p for p in parts[0] if all(p in q for q in parts)] if len(parts) > 2 else []
     notes = ["; ".join(p for p in q if p not in shared) for q in parts]
     return ([headings[i] for i in keep], [[r["cells"][i] for i in keep] for r in diagnostics],
             notes, shared)
 
 
-#: Characters per line of a segment page's notes (7 pt on A4 landscape) and most lines.
-_NOTE_CHARS, _NOTE_LINES = 190, 7
+def segment_lead_lines(row: dict, size) -> list[str]:
+    """What a segment's PDF page says above its panels: its lead (what was found, what was
+    withheld and why; :mod:`drillfric.report.lead`) and, when the fit misses the data's
+    regime, that sentence (the HTML's red box), wrapped to the page, every line kept."""
+    from .pdf import line_chars, wrap_lines
+
+    chars = line_chars(size[0] * (0.98 - 0.09), 7.0)
+    lines = row["lead"].lines() + ([row["fit_sentence"]] if row["fit_mismatch"] else [])
+    return [part for line in lines for part in wrap_lines(line, chars)]
 
 
-def segment_notes(row: dict, units: Units) -> list[str]:
-    """What a segment's PDF page says above its panels (the HTML header's facts): μ and
-    the friction zone, torque fit, hook load, logging interval, bit speed (why not
-    resolved), what the fit reproduces, flags and the estimators' notes, wrapped to
-    :data:`_NOTE_CHARS`."""
-    import textwrap
-
-    facts = [f"{row['mu_name']} {fmt(row['mu_k'])} ({row['zone']}), μ_s {row['mu_s_text']}",
-             f"μ_k {row['status_word']}",
-             f"torque misfit / swing {row['torque']} {units.label('torque')} "
-             f"(fit quality {row['quality']})",
-             f"hook load measured / model {row['hookload']} {units.label('force')}"]
-    if row["interval"]:
-        facts.append(f"logged every {row['interval']}")
-    facts.append(f"bit speed {row['bit_speed']}")
-    lines = ["; ".join(facts)]
+def segment_detail(row: dict, units: Units) -> list[list[str]]:
+    """The rest of a segment's section as label–value rows for the page after its panels
+    (the HTML's folded detail): the fit's numbers, what the fit reproduces, every flag with
+    its meaning and every note of the estimators, in full."""
+    rows = [["μ", f"{row['mu_name']} {fmt(row['mu_k'])} ({row['zone']}), μ_s "
+                  f"{row['mu_s_text']}, μ_TD {fmt(row['mu_td'])}; μ_k {row['status_word']}"],
+            ["torque fit", f"misfit / swing {row['torque']} {units.label('torque')} (fit "
+                           f"quality {row['quality']})"],
+            ["hook load", f"measured / model {row['hookload']} {units.label('force')}"],
+            ["bit speed", row["bit_speed"] + (f" (logged every {row['interval']})"
+                                              if row["interval"] else "")],
+            ["stick-slip", f"severity {row['severity_text']}"],
+            ["observer starts", f"(μ_s, μ_k) {row['starts_text']}"]]
     if row["fit_sentence"]:
-        lines.append(row["fit_sentence"])
-    if row["flag_items"]:
-        lines.append("flags: " + ", ".join(flag for flag, _, _ in row["flag_items"]))
-    if row["note_flags"]:
-        lines.append("notes: " + ", ".join(label for _, label, _ in row["note_flags"]))
-    lines += row["notes"]
-    wrapped = [w for line in lines for w in textwrap.wrap(line, _NOTE_CHARS)]
-    return wrapped[:_NOTE_LINES - 1] + ["…"] if len(wrapped) > _NOTE_LINES else wrapped
+        rows.append(["fit", row["fit_sentence"]])
+    rows += _labelled("flags", [f"{label}: {meaning}" if meaning else label
+                                for _, label, meaning in row["flag_items"]])
+    rows += _labelled("notes (not warnings)", [f"{label}: {meaning}"
+                                               for _, label, meaning in row["note_flags"]])
+    return rows + _labelled("estimator notes", row["notes"])
+
+
+def _labelled(label: str, texts: list[str]) -> list[list[str]]:
+    """Rows of a label–value table: ``label`` beside the first of ``texts`` only."""
+    return [[label if i == 0 else "", text] for i, text in enumerate(texts)]
 
 
 def _header_lines(report: Report) -> list[list[str]]:

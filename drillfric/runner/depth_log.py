@@ -23,6 +23,7 @@ from drillfric.estimation.friction_log import (
     read_depth_log,
 )
 from drillfric.friction import FrictionProfile
+from drillfric.io.text import plural
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import RunProgress, WellResult
 from drillfric.torque_drag import TDResult
@@ -110,7 +111,8 @@ def _no_off_bottom_reason(results: list[WindowResult]) -> str | None:
     if any(r.record.status is Status.OK for r in off):
         return None
     if off:
-        return f"none of the {len(off)} off-bottom windows was estimated (skipped or failed)"
+        return (f"no off-bottom window was estimated ({plural(len(off), 'off-bottom window')} "
+                "skipped or failed)")
     return ("no rotating row is off bottom, so the log holds only apparent on-bottom "
             "friction, bit torque included")
 

@@ -36,6 +36,7 @@ from drillfric.estimation.batch.settings import (
 )
 from drillfric.estimation.creep import smooth
 from drillfric.friction import CASED_STATIC
+from drillfric.io.text import plural
 from drillfric.result import Flag
 
 
@@ -167,7 +168,7 @@ def fit_creeps(model: Model, creeps, mu_k: float, cells: int, rotating: list[Win
         fits.append((model.grid(n)[0].n_cells, new, runs))
         move, mu = abs(new - mu) / new, new
         if move < CREEP_CONVERGENCE:
-            found = (f"μ_s = {mu:.3f} from {len(creeps)} creep start-up(s) ({fits[-1][0]} "
+            found = (f"μ_s = {mu:.3f} from {plural(len(creeps), 'creep start-up')} ({fits[-1][0]} "
                      f"cells; {100 * move:.1f} % change from {fits[-2][0]})")
             checks = measure(model, wins, mu, mu_k, n, rotating, stick_slip, cells)
             if not model.profile.static_known:

@@ -35,6 +35,7 @@ from drillfric.estimation.batch.settings import (
     BatchSettings,
 )
 from drillfric.estimation.creep import bridge_loaded_dips, rotating_runs
+from drillfric.io.text import plural
 from drillfric.result import Flag
 
 
@@ -67,7 +68,8 @@ def rotating_windows(data: FitData, settings: BatchSettings, rad_per_Nm: float,
         cycles = len(torque_pieces(data.tau[i0 + end:i1 + 1], data.dt)[0])
         if cycles < MIN_CYCLES:
             notes.append(f"rotating run {data.t[i0]:.0f}–{data.t[i1]:.0f} s holds "
-                         f"{max(cycles, 0)} whole torque cycles after its start-up (ended "
+                         f"{plural(max(cycles, 0), 'whole torque cycle')} after its start-up "
+                         f"(ended "
                          f"{data.t[i0 + end] - data.t[i0]:.0f} s in), fewer than "
                          f"{MIN_CYCLES} (or {MIN_CYCLES} {STEADY_BLOCK_S:g}-s blocks of steady "
                          "rotation): its mean torque has no stated uncertainty, not used "
