@@ -138,12 +138,14 @@ def test_withholding_leaves_no_fragment_of_a_withheld_mu_k():
     a number of the μ_k it withheld. The whole note goes."""
     from drillfric.hookload import withhold_friction
     from drillfric.io.text import split_notes
-    from drillfric.result import SegmentRecord
+    from drillfric.result import Flag, SegmentRecord
 
     record = SegmentRecord(mu_k=0.038, message=(
         "fit note; μ_k = 0.038 ± 0.003 (95 %: the validated 5 %; statistical 2σ ± 0.004, "
         "±10.9 %: 12 whole cycles); only 63 s of rotation (< 90 s): not converged"))
-    notes = split_notes(withhold_friction(record, "the hook load says so").message)
+    withheld = withhold_friction(record, "the hook load says so",
+                                 Flag.HOOKLOAD_CONTRADICTS_STRING)
+    notes = split_notes(withheld.message)
     assert notes == ["fit note", "only 63 s of rotation (< 90 s): not converged",
                      "1 note stating the withheld friction factors left out",
                      "friction factors withheld: the hook load says so"]
