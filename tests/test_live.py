@@ -171,7 +171,8 @@ def test_no_data_ever_exits_2_with_one_line(tmp_path):
 
 
 def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_trend(tmp_path):
-    from drillfric.live.run import LiveRun, _trend
+    from drillfric.live.alerts import trend_alert
+    from drillfric.live.run import LiveRun
     from drillfric.result import SegmentRecord
 
     now = [0.0]
@@ -199,8 +200,8 @@ def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_tren
         return [SegmentRecord(id=i + 1, mu_k=m, converged=True, t_end_s=100.0 * (i + 1))
                 for i, m in enumerate(mu_k)]
 
-    assert _trend(done(0.25, 0.26, 0.25, 0.27)) is None  # within 25 % of the median
-    alert = _trend(done(0.25, 0.26, 0.25, 0.34))
+    assert trend_alert(done(0.25, 0.26, 0.25, 0.27)) is None  # within 25 % of the median
+    alert = trend_alert(done(0.25, 0.26, 0.25, 0.34))
     assert alert["kind"] == "friction_trend" and alert["time_s"] == 400.0
 
 
@@ -251,7 +252,7 @@ def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it
     """Regression (issue 24): live.json ``open_segment.bit_rpm`` showed the last estimated bit
     speed of a segment whose bit trace the run withholds (not resolved, or the segment not
     estimated); it is null with ``bit_rpm_reason``, by the live page's rule."""
-    from drillfric.live.run import _open_view
+    from drillfric.live.alerts import open_view
     from drillfric.result import SegmentRecord
     from drillfric.vocabulary import Status
 
@@ -260,16 +261,16 @@ def test_open_segment_bit_rpm_is_null_with_the_reason_where_the_run_withholds_it
                   "bit_stuck": [False, False]}).to_parquet(tmp_path / "estimates.parquet",
                                                            index=False)
     resolved = SegmentRecord(id=3, status=Status.OK, bit_speed_resolved=True)
-    view = _open_view(resolved, tmp_path)
+    view = open_view(resolved, tmp_path)
     assert view["bit_rpm"] == 45.0 and view["bit_rpm_reason"] is None
     reason = "the 1-s log does not resolve the stick-slip cycle"
-    view = _open_view(SegmentRecord(id=3, status=Status.OK, bit_speed_resolved=False,
+    view = open_view(SegmentRecord(id=3, status=Status.OK, bit_speed_resolved=False,
                                     bit_speed_reason=reason), tmp_path)
     assert view["bit_rpm"] is None and view["bit_rpm_reason"] == reason
-    view = _open_view(SegmentRecord(id=3, status=Status.SKIPPED, message="too short"),
+    view = open_view(SegmentRecord(id=3, status=Status.SKIPPED, message="too short"),
                       tmp_path)
     assert view["bit_rpm"] is None and view["bit_rpm_reason"] == "segment skipped: too short"
-    view = _open_view(SegmentRecord(id=4, status=Status.OK, bit_speed_resolved=True), tmp_path)
+    view = open_view(SegmentRecord(id=4, status=Status.OK, bit_speed_resolved=True), tmp_path)
     assert view["bit_rpm"] is None and "no estimated bit speed" in view["bit_rpm_reason"]
 
 
@@ -277,7 +278,8 @@ def test_bit_stalled_alert_after_the_bit_stays_stuck_while_the_top_drive_turns(t
     """Issue 24 names a "bit stalled" alert: the estimated bit at rest (``bit_stuck``) for the
     last BIT_STALL_S of the open segment while the top drive turns — not a stick phase of
     ordinary stick-slip (1–3 s), not a stop of the top drive, not a withheld bit trace."""
-    from drillfric.live.run import BIT_STALL_S, LiveRun, _open_view
+    from drillfric.live.alerts import open_view
+    from drillfric.live.run import BIT_STALL_S, LiveRun
     from drillfric.result import SegmentRecord
     from drillfric.vocabulary import Status
 
@@ -290,7 +292,7 @@ def test_bit_stalled_alert_after_the_bit_stays_stuck_while_the_top_drive_turns(t
                       "surface_rpm": surface_rpm, "bit_rpm_est": np.where(stuck, 0.0, 80.0),
                       "bit_stuck": stuck}).to_parquet(tmp_path / "estimates.parquet",
                                                       index=False)
-        return _open_view(SegmentRecord(id=7, status=Status.OK, bit_speed_resolved=resolved,
+        return open_view(SegmentRecord(id=7, status=Status.OK, bit_speed_resolved=resolved,
                                         t_end_s=20.0), tmp_path)
 
     live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: 0.0)

@@ -1,16 +1,17 @@
 """``drillfric fleet``: many wells, incremental and fault-isolated (issue 8, docs/fleet.md).
 
-The unit of work is a well: :func:`process_well` runs :func:`drillfric.runner.run_well`
-on a worker, which writes OUT/NAME itself (temporary directory + rename, so a well directory
-is either complete or absent). The client only prepares tasks (input hashes, effective
-configuration hash), collects small result records and keeps ``OUT/manifest.json``; the
-wells come from :func:`drillfric.fleet.discovery.discover` (a folder or a manifest).
+The unit of work is a well: :func:`drillfric.fleet.task.process_well` runs
+:func:`drillfric.runner.run_well` on a worker, which writes OUT/NAME itself (temporary
+directory + rename, so a well directory is either complete or absent). The client only
+prepares tasks (input hashes, effective configuration hash), collects small result records
+and keeps ``OUT/manifest.json``; the wells come from
+:func:`drillfric.fleet.discovery.discover` (a folder or a manifest).
 
 Execution: one code path through :class:`dask.distributed.Client` — a ``LocalCluster`` of
-worker processes by default, an existing cluster with ``scheduler``; ``workers=1`` without
-a scheduler runs in this process (nothing to start). A task whose worker died is
-rescheduled by Dask and, if Dask gives up (``KilledWorker``), resubmitted by the client up
-to :data:`MAX_ATTEMPTS` times. With a remote scheduler the inputs and OUT must be on storage
+worker processes by default, an existing cluster with ``scheduler``; ``workers=1`` without a
+scheduler runs in this process (nothing to start). A task whose worker died is rescheduled
+by Dask and, if Dask gives up (``KilledWorker``), resubmitted by the client up to
+:data:`MAX_ATTEMPTS` times. With a remote scheduler the inputs and OUT must be on storage
 that every worker and the client see under the same absolute paths.
 
 Library code: no printing, no signal handlers (the CLI turns SIGTERM into
@@ -22,16 +23,12 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
-import socket
-import sys
 import time
 import uuid
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack, closing, contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
-from datetime import UTC, datetime
 from pathlib import Path
 
 import pandas as pd
@@ -40,6 +37,7 @@ from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError, OutputError
 from drillfric.fleet import overnight
 from drillfric.fleet.discovery import WellSpec
+from drillfric.fleet.task import WellTask, now_utc, process_well
 from drillfric.io.atomic import own_file, refuse_link, replacing
 from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
@@ -66,107 +64,6 @@ SAVE_EVERY_S = 2.0
 #: Seconds to wait for a ``--scheduler`` to answer.
 CONNECT_TIMEOUT_S = 20
 _LOCK = ".fleet.lock"
-
-
-# --------------------------------------------------------------------------- the task
-@dataclass(frozen=True)
-class WellTask:
-    """What a worker receives: plain, picklable, absolute paths.
-
-    ``name`` is None when the well's name may be stored inside its data file: the worker
-    then resolves it and claims its output directory, refusing the names in ``taken``
-    (other wells of the fleet) and any name another worker of this run claimed first
-    (``OUT/.claim-RUN-…`` files, made with O_EXCL; ``run`` is the run's token).
-    """
-
-    name: str | None
-    data: str
-    config: str | None
-    survey: str | None
-    out_root: str
-    overrides: dict
-    rate_hz: float | None = None
-    pdf: bool = False
-    report: bool = True
-    taken: frozenset = frozenset()
-    run: str = ""
-    resume: bool = True
-
-
-def process_well(task: WellTask) -> dict:
-    """Run one well on a worker and return its small result record (never raises).
-
-    The worker opens the well itself (the fleet's parent never opens a data file) and
-    writes OUT/NAME (atomically). The record carries the status, the message of a failure,
-    the well's name and output directory name, the files it read, the summary, timings and
-    where it ran.
-    """
-    from drillfric.api import run as run_well
-    from drillfric.io.well import open_well
-
-    _one_kernel_thread()
-    started = _now()
-    t0 = time.perf_counter()
-    record = {"status": "failed", "message": "", "summary": None, "out_dir": None,
-              "failed_segments": 0}
-    try:
-        well = open_well(task.data, config=task.config, survey=task.survey,
-                         overrides=task.overrides, name=task.name)
-        record.update(well=well.name, dir_name=well.dir_name,
-                      inputs={role: str(p.resolve()) for role, p in well.files.inputs.items()})
-        if task.name is None:
-            _claim(task, well.dir_name)
-        result = run_well(well, task.out_root, rate_hz=task.rate_hz, pdf=task.pdf,
-                          report=task.report, resume=task.resume)
-        record.update(status="ok", summary=jsonable(result.summary),
-                      out_dir=str(result.out_dir), failed_segments=result.failed)
-    except DrillfricError as exc:
-        record["message"] = exc.message
-    except Exception as exc:  # noqa: BLE001 — one bad well must not spoil the night
-        record["message"] = f"internal error: {type(exc).__name__}: {exc}"
-    record.update(started_utc=started, finished_utc=_now(),
-                  task_s=time.perf_counter() - t0, worker=f"{socket.gethostname()}:"
-                  f"{os.getpid()}", worker_version=__version__)
-    return record
-
-
-def _claim(task: WellTask, dir_name: str) -> None:
-    """Claim OUT/``dir_name`` for a well whose name was resolved on this worker."""
-    key = dir_name.casefold()
-    digest = hashlib.sha256(key.encode()).hexdigest()[:20]
-    claim = Path(task.out_root) / f".claim-{task.run}-{digest}"
-    try:
-        if key in task.taken:
-            raise FileExistsError
-        Path(task.out_root).mkdir(parents=True, exist_ok=True)
-        os.close(os.open(claim, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
-    except FileExistsError:
-        raise InputError(f"another well of this fleet writes OUT/{dir_name}: one well's "
-                         "results would be lost", file=task.data,
-                         fix="give each well its own [well] name (or 'well' column in a "
-                             "manifest)") from None
-
-
-def _one_kernel_thread() -> None:
-    """On a Dask worker (one task per core) the compiled kernels run on this thread only:
-    numba's parallel observer members (docs/performance.md) would oversubscribe the cores.
-    A process that has not imported distributed is no Dask worker (the check then costs
-    nothing: importing distributed takes 0.2 s, docs/performance.md)."""
-    if "distributed" not in sys.modules:
-        return
-    try:
-        from distributed import get_worker
-
-        get_worker()
-    except (ImportError, ValueError):
-        return
-    import numba
-
-    numba.set_num_threads(1)
-
-
-def _now() -> str:
-    return datetime.now(UTC).isoformat(timespec="seconds")
 
 
 # --------------------------------------------------------------------------- preparation
@@ -453,7 +350,7 @@ class _Manifest:
     def save(self, *, now: bool = True) -> None:
         if self.path is None or (not now and time.monotonic() - self._saved < SAVE_EVERY_S):
             return
-        self.data.update(drillfric_version=__version__, updated_utc=_now())
+        self.data.update(drillfric_version=__version__, updated_utc=now_utc())
         with replacing(self.path) as tmp:
             write_json(tmp, self.data)
         self._saved = time.monotonic()
@@ -612,11 +509,11 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
     summary = rec.get("summary") if entry["status"] == WellStatus.OK else None
     changed = overnight.changes(summary, history, ran=True, data_changed_utc=None)
     if summary is not None:
-        entry["history"] = (history + [overnight.night(summary, _now())])[
+        entry["history"] = (history + [overnight.night(summary, now_utc())])[
             -overnight.HISTORY_NIGHTS:]
     elif history:
         entry["history"] = history
-    entry["data_changed_utc"] = _now()
+    entry["data_changed_utc"] = now_utc()
     manifest.wells[name] = entry
     return WellOutcome(name, entry["status"], entry["message"],
                        Path(rec["out_dir"]) if entry["status"] == WellStatus.OK else None,
@@ -636,7 +533,7 @@ def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
     folder = Path(earlier) if earlier else out_root / (rec.get("dir_name") or job.dir_name)
     try:
         if folder.resolve().parent != out_root or \
-                not mark_stale(folder, entry["message"], _now()):
+                not mark_stale(folder, entry["message"], now_utc()):
             return None
     except OSError:
         return None

@@ -43,7 +43,8 @@ from markupsafe import Markup
 
 from drillfric.errors import DrillfricError
 from drillfric.io.results import jsonable, read_json
-from drillfric.live.run import SEVERE_STICK_SLIP, LiveRun, bit_speed_withheld
+from drillfric.live.alerts import SEVERE_STICK_SLIP, bit_speed_withheld
+from drillfric.live.run import LiveRun
 from drillfric.report.data import FINAL_START_ID, extreme_rows
 from drillfric.report.interactive import bokeh_js, json_in_script, script_hash, time_figure
 from drillfric.report.render import (

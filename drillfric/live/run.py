@@ -25,7 +25,6 @@ still start with what it had read, so no row is lost or read twice.
 from __future__ import annotations
 
 import copy
-import math
 import queue
 import threading
 import time
@@ -41,10 +40,17 @@ import pyarrow.parquet as pq
 from drillfric.errors import DrillfricError, InputError
 from drillfric.io.atomic import replacing
 from drillfric.io.results import write_json
-from drillfric.io.timebase import clock_at
 from drillfric.io.well import CHUNK_ROWS, Well
+from drillfric.live.alerts import (
+    alert,
+    ended,
+    open_view,
+    severe_stick_slip,
+    trend_alert,
+    utc_at,
+)
 from drillfric.live.source import PartsTail, Tail, follow
-from drillfric.result import Flag, SegmentRecord
+from drillfric.result import SegmentRecord
 from drillfric.runner import warmup
 from drillfric.runner.engine import Engine
 from drillfric.runner.finish import DirectorySink, MemorySink, ReportWriter, deliver
@@ -62,20 +68,13 @@ FEED_POLL_S = 0.1
 MIN_WRITE_S = 0.05
 #: Longest wait for the worker to end after live.json could not be written [s].
 STOP_WAIT_S = 30.0
-#: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
-SEVERE_STICK_SLIP = 1.0
 #: Share of a core that publications of an open segment may take on average (they come
 #: less often than every ``publish_every_s`` when one costs more).
 OPEN_SHARE = 0.1
-#: Relative change of a converged μ_k against the median of the previous five that raises a
-#: friction-trend alert.
-TREND_CHANGE = 0.25
 #: Log seconds the estimated bit must have stayed stuck, at the end of the open segment while
 #: the top drive turns, for a ``bit_stalled`` alert: longer than the stick phase of ordinary
 #: stick-slip (1–3 s at 60–120 RPM: docs/live.md).
 BIT_STALL_S = 5.0
-#: Surface speed above which the top drive counts as turning for a stall [RPM].
-STALL_SURFACE_RPM = 5.0
 #: Log seconds of surface rows kept for the live page's time tracks (:class:`RecentRows`).
 RECENT_S = 600.0
 #: The channels of :class:`RecentRows` (SI; NaN where the log lacks one).
@@ -273,7 +272,7 @@ class LiveRun:
         with self.lock:
             self.view.update(
                 last_sample_time_s=last, rows=engine.check.rows,
-                last_sample_utc=_utc(engine.tracker.origin, last) if last is not None
+                last_sample_utc=utc_at(engine.tracker.origin, last) if last is not None
                 else None,
                 rig_state=RIG_STATES[int(states[-1])] if states is not None and len(states)
                 else self.view["rig_state"])
@@ -349,11 +348,11 @@ class LiveRun:
         done = [r for r in closed if r.status is Status.OK and r.converged]
         with self.lock:
             self.view.update(segments_closed=len(closed),
-                             open_segment=_open_view(opened[-1], folder) if opened else None,
+                             open_segment=open_view(opened[-1], folder) if opened else None,
                              latest=None if not done else
                              {"segment": done[-1].id, "mu_k": done[-1].mu_k,
                               "mu_s": done[-1].mu_s, "t_end_s": done[-1].t_end_s},
-                             trend_alert=_trend(done))
+                             trend_alert=trend_alert(done))
 
     # ------------------------------------------------------------------ live.json
     def status(self) -> dict:
@@ -361,19 +360,19 @@ class LiveRun:
         with self.lock:
             view = dict(self.view)
         idle = self.clock() - self.last_data
-        alerts = _ended(self.error, self.done.is_set(), view["last_sample_time_s"])
+        alerts = ended(self.error, self.done.is_set(), view["last_sample_time_s"])
         if self.engine is not None and idle >= self.stopped_s:
-            alerts.append(_alert("data_stopped", f"no new data for {idle:.0f} s",
+            alerts.append(alert("data_stopped", f"no new data for {idle:.0f} s",
                                  view["last_sample_time_s"]))
         elif idle >= self.stale_s:
-            alerts.append(_alert("data_stale", f"no new data for {idle:.0f} s",
+            alerts.append(alert("data_stale", f"no new data for {idle:.0f} s",
                                  view["last_sample_time_s"]))
-        severe = _severe_stick_slip(view["open_segment"] or {})
+        severe = severe_stick_slip(view["open_segment"] or {})
         if severe:
-            alerts.append(_alert("severe_stick_slip", severe, view["last_sample_time_s"]))
+            alerts.append(alert("severe_stick_slip", severe, view["last_sample_time_s"]))
         stalled = (view["open_segment"] or {}).get("bit_stalled_s")
         if stalled is not None and stalled >= BIT_STALL_S:
-            alerts.append(_alert("bit_stalled", f"estimated bit speed at rest for the last "
+            alerts.append(alert("bit_stalled", f"estimated bit speed at rest for the last "
                                  f"{stalled:.0f} s of the open segment while the top drive "
                                  "turns", (view["open_segment"] or {}).get("t_end_s")))
         if view["trend_alert"] is not None:
@@ -439,116 +438,6 @@ def _seed(sink: MemorySink, folder: Path, ids: set[int]) -> None:
         frame = pd.read_parquet(profiles)
         sink.frames["profile"] += [p.reset_index(drop=True) for i, p in
                                    frame.groupby("segment_id", sort=True) if i in ids]
-
-
-def _open_view(record: SegmentRecord, folder: Path) -> dict:
-    """live.json ``open_segment``: the open segment's numbers as estimated so far; its bit
-    speed null with ``bit_rpm_reason`` where the run withholds it (:func:`bit_speed_withheld`)."""
-    why = bit_speed_withheld(record.to_json())
-    bit_rpm, stalled_s = (None, None) if why else _bit_tail(folder, record.id)
-    if bit_rpm is None and not why:
-        why = ("the latest 30-s window's bit speed is withheld (window-by-window kinematic "
-               "check: the segment's message says why)" if record.bit_speed_windows_withheld
-               else "no estimated bit speed in this publication")
-    return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
-            "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
-            "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
-            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
-            "stick_slip_severity": record.stick_slip_severity,
-            "stick_slip_beyond_validated":
-                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
-
-
-def _severe_stick_slip(open_segment: dict) -> str:
-    """The ``severe_stick_slip`` alert's message ("" when none): the open segment's severity
-    at least :data:`SEVERE_STICK_SLIP`, or withheld as beyond its validated range (an
-    estimated severity ≥ 2.1, docs/bit_speed.md: severe by far)."""
-    ssi = open_segment.get("stick_slip_severity")
-    if ssi is not None and ssi >= SEVERE_STICK_SLIP:
-        return f"stick-slip severity {ssi:.2f} in the open segment (≥ {SEVERE_STICK_SLIP:g})"
-    if open_segment.get("stick_slip_beyond_validated"):
-        return ("severe stick-slip in the open segment: severity beyond its validated range "
-                "(estimated ≥ 2.1; the number is withheld, docs/bit_speed.md)")
-    return ""
-
-
-def bit_speed_withheld(record: dict) -> str:
-    """Why a segment's estimated bit speed is not shown ("" when it is): the segment was not
-    estimated (status not ``ok``), or its bit trace is not resolved (``bit_speed_resolved``
-    false: docs/bit_speed.md) — the one rule of live.json and the live page. ``record``:
-    the segment as in summary.json."""
-    if record.get("status") != Status.OK:
-        return f"segment {record.get('status', 'not published')}: {record.get('message', '')}"
-    if record.get("bit_speed_resolved") is False:
-        return record.get("bit_speed_reason") or "bit speed not resolved"
-    return ""
-
-
-def _bit_tail(folder: Path, seg_id: int) -> tuple[float | None, float | None]:
-    """The last estimated bit speed [RPM] of segment ``seg_id`` (its last row group) and how
-    long [s] the estimated bit has been stuck (``bit_stuck``) at its end while the top drive
-    turned (above :data:`STALL_SURFACE_RPM`); (None, None) without estimates."""
-    path = folder / "estimates.parquet"
-    if not path.is_file():
-        return None, None
-    source = pq.ParquetFile(path)
-    for i in reversed(range(source.num_row_groups)):
-        table = source.read_row_group(i, columns=["segment_id", "time_s", "surface_rpm",
-                                                  "bit_rpm_est", "bit_stuck"])
-        if table.num_rows and int(table["segment_id"][0].as_py()) == seg_id:
-            value = table["bit_rpm_est"][-1].as_py()
-            last = None if value is None or not math.isfinite(value) else float(value)
-            return last, _stalled_s(table.to_pandas())
-    return None, None
-
-
-def _stalled_s(rows: pd.DataFrame) -> float:
-    """Log seconds of the trailing rows whose bit is stuck while the top drive turns."""
-    stalled = rows["bit_stuck"].fillna(False).to_numpy(bool) & \
-        (rows["surface_rpm"].to_numpy(float) > STALL_SURFACE_RPM)
-    if not stalled.size or not stalled[-1]:
-        return 0.0
-    moving = np.flatnonzero(~stalled)
-    first = moving[-1] + 1 if moving.size else 0
-    t = rows["time_s"].to_numpy(float)
-    return float(t[-1] - t[first])
-
-
-def _trend(done: list[SegmentRecord]) -> dict | None:
-    """A friction-trend alert when the newest converged μ_k moved by :data:`TREND_CHANGE`
-    or more against the median of the five before it."""
-    if len(done) < 3 or done[-1].mu_k is None:
-        return None
-    before = sorted(r.mu_k for r in done[-6:-1] if r.mu_k is not None)
-    if not before:
-        return None
-    median = before[len(before) // 2]
-    if median > 0 and abs(done[-1].mu_k / median - 1.0) >= TREND_CHANGE:
-        return _alert("friction_trend", f"μ_k {done[-1].mu_k:.3f} in segment {done[-1].id} "
-                      f"against {median:.3f} before", done[-1].t_end_s)
-    return None
-
-
-def _ended(error: BaseException | None, done: bool, time_s: float | None) -> list[dict]:
-    """The alert of a run that ended: ``run_failed`` with its one-line reason (the numbers
-    shown are the last published, not current), or ``run_ended``; none while it runs."""
-    if error is not None:
-        reason = error.message if isinstance(error, DrillfricError) else type(error).__name__
-        return [_alert("run_failed", f"the live run stopped, the numbers shown are its last: "
-                                     f"{reason}", time_s)]
-    if done:
-        return [_alert("run_ended", "the live run ended; the numbers shown are final", time_s)]
-    return []
-
-
-def _alert(kind: str, message: str, time_s: float | None) -> dict:
-    return {"kind": kind, "message": message, "time_s": time_s}
-
-
-def _utc(origin, time_s: float) -> str | None:
-    if origin is None:
-        return None
-    return clock_at(pd.Timestamp(origin), time_s).isoformat()
 
 
 def run_live(path: Path, out_root: Path, *, until_idle_s: float | None = None,

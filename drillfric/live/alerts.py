@@ -1,0 +1,135 @@
+"""What live.json says beside the numbers: the open segment's view and the alerts
+(docs/live.md "live.json"), pure functions of the run's records and its published files.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+
+from drillfric.errors import DrillfricError
+from drillfric.io.timebase import clock_at
+from drillfric.result import Flag, SegmentRecord
+from drillfric.vocabulary import Status
+
+#: Bit-speed swing (max − min)/(2·mean) from which stick-slip is called severe (docs/live.md).
+SEVERE_STICK_SLIP = 1.0
+#: Relative change of a converged μ_k against the median of the previous five that raises a
+#: friction-trend alert.
+TREND_CHANGE = 0.25
+#: Surface speed above which the top drive counts as turning for a stall [RPM].
+STALL_SURFACE_RPM = 5.0
+
+
+def open_view(record: SegmentRecord, folder: Path) -> dict:
+    """live.json ``open_segment``: the open segment's numbers as estimated so far; its bit
+    speed null with ``bit_rpm_reason`` where the run withholds it (:func:`bit_speed_withheld`)."""
+    why = bit_speed_withheld(record.to_json())
+    bit_rpm, stalled_s = (None, None) if why else bit_tail(folder, record.id)
+    if bit_rpm is None and not why:
+        why = ("the latest 30-s window's bit speed is withheld (window-by-window kinematic "
+               "check: the segment's message says why)" if record.bit_speed_windows_withheld
+               else "no estimated bit speed in this publication")
+    return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
+            "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
+            "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
+            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
+            "stick_slip_severity": record.stick_slip_severity,
+            "stick_slip_beyond_validated":
+                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
+
+
+def severe_stick_slip(open_segment: dict) -> str:
+    """The ``severe_stick_slip`` alert's message ("" when none): the open segment's severity
+    at least :data:`SEVERE_STICK_SLIP`, or withheld as beyond its validated range (an
+    estimated severity ≥ 2.1, docs/bit_speed.md: severe by far)."""
+    ssi = open_segment.get("stick_slip_severity")
+    if ssi is not None and ssi >= SEVERE_STICK_SLIP:
+        return f"stick-slip severity {ssi:.2f} in the open segment (≥ {SEVERE_STICK_SLIP:g})"
+    if open_segment.get("stick_slip_beyond_validated"):
+        return ("severe stick-slip in the open segment: severity beyond its validated range "
+                "(estimated ≥ 2.1; the number is withheld, docs/bit_speed.md)")
+    return ""
+
+
+def bit_speed_withheld(record: dict) -> str:
+    """Why a segment's estimated bit speed is not shown ("" when it is): the segment was not
+    estimated (status not ``ok``), or its bit trace is not resolved (``bit_speed_resolved``
+    false: docs/bit_speed.md) — the one rule of live.json and the live page. ``record``:
+    the segment as in summary.json."""
+    if record.get("status") != Status.OK:
+        return f"segment {record.get('status', 'not published')}: {record.get('message', '')}"
+    if record.get("bit_speed_resolved") is False:
+        return record.get("bit_speed_reason") or "bit speed not resolved"
+    return ""
+
+
+def bit_tail(folder: Path, seg_id: int) -> tuple[float | None, float | None]:
+    """The last estimated bit speed [RPM] of segment ``seg_id`` (its last row group) and how
+    long [s] the estimated bit has been stuck (``bit_stuck``) at its end while the top drive
+    turned (above :data:`STALL_SURFACE_RPM`); (None, None) without estimates."""
+    path = folder / "estimates.parquet"
+    if not path.is_file():
+        return None, None
+    source = pq.ParquetFile(path)
+    for i in reversed(range(source.num_row_groups)):
+        table = source.read_row_group(i, columns=["segment_id", "time_s", "surface_rpm",
+                                                  "bit_rpm_est", "bit_stuck"])
+        if table.num_rows and int(table["segment_id"][0].as_py()) == seg_id:
+            value = table["bit_rpm_est"][-1].as_py()
+            last = None if value is None or not math.isfinite(value) else float(value)
+            return last, stalled_s(table.to_pandas())
+    return None, None
+
+
+def stalled_s(rows: pd.DataFrame) -> float:
+    """Log seconds of the trailing rows whose bit is stuck while the top drive turns."""
+    stalled = rows["bit_stuck"].fillna(False).to_numpy(bool) & \
+        (rows["surface_rpm"].to_numpy(float) > STALL_SURFACE_RPM)
+    if not stalled.size or not stalled[-1]:
+        return 0.0
+    moving = np.flatnonzero(~stalled)
+    first = moving[-1] + 1 if moving.size else 0
+    t = rows["time_s"].to_numpy(float)
+    return float(t[-1] - t[first])
+
+
+def trend_alert(done: list[SegmentRecord]) -> dict | None:
+    """A friction-trend alert when the newest converged μ_k moved by :data:`TREND_CHANGE`
+    or more against the median of the five before it."""
+    if len(done) < 3 or done[-1].mu_k is None:
+        return None
+    before = sorted(r.mu_k for r in done[-6:-1] if r.mu_k is not None)
+    if not before:
+        return None
+    median = before[len(before) // 2]
+    if median > 0 and abs(done[-1].mu_k / median - 1.0) >= TREND_CHANGE:
+        return alert("friction_trend", f"μ_k {done[-1].mu_k:.3f} in segment {done[-1].id} "
+                      f"against {median:.3f} before", done[-1].t_end_s)
+    return None
+
+
+def ended(error: BaseException | None, done: bool, time_s: float | None) -> list[dict]:
+    """The alert of a run that ended: ``run_failed`` with its one-line reason (the numbers
+    shown are the last published, not current), or ``run_ended``; none while it runs."""
+    if error is not None:
+        reason = error.message if isinstance(error, DrillfricError) else type(error).__name__
+        return [alert("run_failed", f"the live run stopped, the numbers shown are its last: "
+                                     f"{reason}", time_s)]
+    if done:
+        return [alert("run_ended", "the live run ended; the numbers shown are final", time_s)]
+    return []
+
+
+def alert(kind: str, message: str, time_s: float | None) -> dict:
+    return {"kind": kind, "message": message, "time_s": time_s}
+
+
+def utc_at(origin, time_s: float) -> str | None:
+    if origin is None:
+        return None
+    return clock_at(pd.Timestamp(origin), time_s).isoformat()
