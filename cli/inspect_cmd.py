@@ -229,11 +229,10 @@ def render(s: dict, units: str = "si") -> str:
     spacing = (f" (spacing median {sp['median']:.3g} s, 5–95 % {sp['p05']:.3g}–{sp['p95']:.3g}"
                f" s, min {sp['min']:.3g} s, max {sp['max']:.3g} s)") if sp else ""
     lines.append(f"rate       {s['rate_hz']:.4g} Hz nominal{spacing}")
-    limit = max(s["max_gap_s"], 5 / s["rate_hz"]) if s["rate_hz"] else s["max_gap_s"]
     gaps = s["gaps"]
     shown = ", ".join(f"{a:.6g}–{b:.6g} s" for a, b in gaps[:5]) + (" …" if len(gaps) > 5 else "")
-    lines.append(f"gaps       {len(gaps)} longer than {limit:.3g} s" + (f": {shown}" if gaps
-                                                                        else ""))
+    lines.append(f"gaps       {len(gaps)} longer than max_gap_s = {s['max_gap_s']:.3g} s (a "
+                 "segment ends at each)" + (f": {shown}" if gaps else ""))
     lines.append(_survey_line(s["survey"], units))
     lines.append(_segments_line(s["segments"]))
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
