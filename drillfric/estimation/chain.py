@@ -58,6 +58,8 @@ from drillfric.wellpath import WellPath, no_survey_path
 
 #: Largest cell of the batch fit's model [m] (docs/theory.md §6.4).
 BATCH_MAX_DX_M = 5.0
+#: Fewest samples (with speed and torque) a segment is estimated from.
+MIN_SAMPLES = 20
 
 
 class SkipSegment(DrillfricError):
@@ -203,10 +205,15 @@ def _path_for(cfg, path: WellPath | None, bit_depth_m: float) -> WellPath:
     """The survey's path, or without one the assumed tortuous vertical path to the bit."""
     if path is None:
         return no_survey_path(bit_depth_m, cfg.tortuosity_rad_m)
-    if bit_depth_m > path.md_max_m + 1e-6:
+    _check_reach(path, bit_depth_m)
+    return path
+
+
+def _check_reach(path: WellPath | None, bit_depth_m: float) -> None:
+    """Raise DrillfricError when the survey ends above the bit at ``bit_depth_m`` [m]."""
+    if path is not None and bit_depth_m > path.md_max_m + 1e-6:
         raise DrillfricError(f"the survey ends at {path.md_max_m:.1f} m, above the bit at "
                              f"{bit_depth_m:.1f} m", fix="extend the survey to the bit depth")
-    return path
 
 
 def build_observer(cfg, string, td: torque_drag.TDResult, cells: int,
@@ -801,10 +808,25 @@ def _bit_error(time_s: np.ndarray, bit: BitSpeedEstimate, data: SegmentData) -> 
     return float(np.sqrt(np.mean(error**2)))
 
 
-def check_segment(data: SegmentData, cfg) -> None:
-    """Raise SkipSegment when a segment has too little to estimate from."""
-    if data.time_s.size < 20:
+def check_segment(data: SegmentData, cfg, path: WellPath | None) -> None:
+    """The checks of a segment before the chain, in the order the chain would meet them:
+    enough samples, a top drive turning faster than ω_c, a survey ``path`` that reaches the
+    bit and a configured string that fits above it. Cheap (no model is solved), so
+    ``drillfric inspect`` makes them too and says what ``run`` will do.
+
+    Raises
+    ------
+    SkipSegment
+        Fewer than :data:`MIN_SAMPLES` samples, or never faster than ω_c: nothing to
+        estimate from.
+    DrillfricError
+        The survey ends above the bit, or the string's sections below the top one are
+        longer than the bit depth (:func:`drillfric.drillstring.build_string`).
+    """
+    if data.time_s.size < MIN_SAMPLES:
         raise SkipSegment(f"only {data.time_s.size} samples")
     if np.nanmax(np.abs(data.surface_rpm)) * RPM_TO_RAD_S <= cfg.omega_c_rad_s:
         raise SkipSegment("the top drive never turns faster than ω_c")
+    _check_reach(path, data.bit_depth_m)
+    build_string(cfg.sections, data.bit_depth_m)
 

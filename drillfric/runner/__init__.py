@@ -3,7 +3,9 @@
 - :mod:`.time_log` — a time log, stand by stand: segments, the estimation chain, pooling;
 - :mod:`.depth_log` — a depth-indexed log: the static friction log by depth window;
 - :mod:`.finish` — what both end with: the summary, the result files, the report;
-- :mod:`.segment_output` — a time-log segment's record and output rows.
+- :mod:`.segment_output` — a time-log segment's record and output rows;
+- :mod:`.preview` — what a run will do with a time log, told without estimating
+  (``drillfric inspect``).
 
 The report is written through the writer the caller passes (``report``): this layer
 computes and writes results and does not import :mod:`drillfric.report` (the layer

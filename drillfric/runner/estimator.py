@@ -5,6 +5,8 @@ resamples to (:mod:`drillfric.runner.engine` calls it as segments close).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
@@ -73,6 +75,29 @@ def check_depth_reckoning(well: Well, chunk: pd.DataFrame) -> None:
             "log a bit-depth channel, or the hook load with [segmentation] slips_hookload_N")
 
 
+@dataclass(frozen=True)
+class Precheck:
+    """What becomes of a segment before its estimation (:meth:`SegmentEstimator.precheck`).
+
+    Attributes
+    ----------
+    status : Status
+        OK: it goes to the estimation chain; SKIPPED or FAILED: it does not.
+    message : str
+        Why not (the segment's message in the results), else the segmentation's note.
+    bit_depth_m : float
+        The bit depth it is estimated at [m]: the log's, else the fallback of
+        :func:`_bit_depth_default`.
+    data : SegmentData or None
+        The estimator's samples (None unless OK).
+    """
+
+    status: Status
+    message: str
+    bit_depth_m: float
+    data: SegmentData | None = None
+
+
 class SegmentEstimator:
     """Step 2 for every segment of a well, carrying what passes from one to the next (the
     warm start, the fallback bit depth and what was assumed for it)."""
@@ -85,16 +110,31 @@ class SegmentEstimator:
         self.fallback_depth: float | None = None
         self.assumed: list[str] = []
 
+    def precheck(self, seg: Segment, rows: pd.DataFrame) -> Precheck:
+        """What becomes of a segment before its estimation: the segmentation's verdict,
+        then :func:`~drillfric.estimation.chain.check_segment` on its samples (``drillfric
+        inspect`` calls this too, so that it says what run will do)."""
+        depth = self._depth(seg)
+        if seg.status != Status.OK:
+            return Precheck(Status.SKIPPED, seg.message, depth)
+        data = _segment_data(rows, seg, depth)
+        try:
+            check_segment(data, self.well.config, self.well.survey)
+        except SkipSegment as exc:
+            return Precheck(Status.SKIPPED, exc.problem, depth)
+        except DrillfricError as exc:
+            return Precheck(Status.FAILED, exc.message, depth)
+        return Precheck(Status.OK, seg.message, depth, data)
+
     def segment(self, seg: Segment, rows: pd.DataFrame) -> tuple[SegmentRecord, dict]:
         """The record and output rows (estimates, profile; none when not estimated) of one
         segment."""
-        depth = self._depth(seg)
-        if seg.status != Status.OK:
-            return segment_record(seg, depth, Status.SKIPPED, seg.message, rows), {}
-        data = _segment_data(rows, seg, depth)
+        pre = self.precheck(seg, rows)
+        depth, data = pre.bit_depth_m, pre.data
+        if data is None:
+            return segment_record(seg, depth, pre.status, pre.message, rows), {}
         cfg = self.well.config
         try:
-            check_segment(data, cfg)
             est = estimate_segment(cfg, self.well.survey, data, warm=self.warm,
                                    rate_hz=self.rate_hz,
                                    torque_channel=self.well.channels["surface_torque_Nm"])
