@@ -15,11 +15,13 @@ contract in pyproject.toml).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import RunProgress, WellResult
 
-from .finish import ReportWriter
+if TYPE_CHECKING:  # the run's modules load when a run starts (inspect imports .preview)
+    from .finish import ReportWriter
 
 
 def run_well(well: Well, out_root=None, *, rate_hz: float | None = None,

@@ -6,12 +6,15 @@ F-9's that run failed, the string longer than the bit depth). Both answers come 
 functions run itself calls, on the log's rows in run's chunks:
 
 - :func:`refusal` — the checks of the log as a whole (the first chunk's rate, depth
-  reckoning and work budget, :func:`~drillfric.runner.estimator.first_chunk`; the log check,
-  :class:`~drillfric.io.logcheck.LogCheck`): the error run would stop with;
+  reckoning and work budget, :func:`~drillfric.runner.checks.check_first_chunk`; the log
+  check, :class:`~drillfric.io.logcheck.LogCheck`): the error run would stop with;
 - :func:`segment_verdicts` — the segments run's stream cuts, with their rows
   (:class:`~drillfric.segmentation.SegmentStream`), each through the checks before the
-  estimation chain (:meth:`~drillfric.runner.estimator.SegmentEstimator.precheck`: the
-  segmentation's verdict, the sample count, ω_c, the survey's and the string's reach).
+  estimation chain (:func:`~drillfric.runner.checks.precheck`: the segmentation's verdict,
+  the sample count, ω_c, the survey's and the string's reach of the bit).
+
+Neither imports the estimation chain (:mod:`drillfric.runner.checks`): inspect stays within
+its start-up budget.
 
 What the chain itself finds (no side force in a vertical hole, a torque in the wrong unit,
 a fit that does not converge) needs the models solved and is left to run.
@@ -19,6 +22,7 @@ a fit that does not converge) needs the models solved and is left to run.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterator
 
 import pandas as pd
@@ -28,7 +32,7 @@ from drillfric.io.logcheck import LogCheck
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.segmentation import Segment, SegmentStream
 
-from .estimator import Precheck, SegmentEstimator, first_chunk
+from .checks import Precheck, bit_depth_default, check_first_chunk, precheck
 
 
 def refusal(well: Well, surface: pd.DataFrame, duplicates_dropped: int,
@@ -48,7 +52,7 @@ def refusal(well: Well, surface: pd.DataFrame, duplicates_dropped: int,
     """
     check = LogCheck(well)
     try:
-        first_chunk(well, surface.iloc[:chunk_rows], None, [])
+        check_first_chunk(well, surface.iloc[:chunk_rows])
         for chunk in _chunks(surface, chunk_rows):
             check.feed(chunk)
         check.finish(duplicates_dropped)
@@ -61,9 +65,10 @@ def segment_verdicts(well: Well, surface: pd.DataFrame,
                      chunk_rows: int = CHUNK_ROWS) -> list[tuple[Segment, Precheck]]:
     """Every segment ``run`` cuts from ``surface`` (canonical rows), in order, with what
     becomes of it before the estimation chain (status OK: run estimates it)."""
-    stream, estimator = SegmentStream(well.config), SegmentEstimator(well)
+    stream = SegmentStream(well.config)
     done = [pair for chunk in _chunks(surface, chunk_rows) for pair in stream.feed(chunk)]
-    return [(seg, estimator.precheck(seg, rows)) for seg, rows in done + stream.close()]
+    fallback = functools.cache(lambda: bit_depth_default(well, []))
+    return [(seg, precheck(well, seg, rows, fallback)) for seg, rows in done + stream.close()]
 
 
 def _chunks(surface: pd.DataFrame, chunk_rows: int) -> Iterator[pd.DataFrame]:
