@@ -36,6 +36,10 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
     NAME.toml and NAME.survey.csv sidecars, an HDF5 file with /surface, /survey and
     /config, or a directory holding well.toml. For a depth-indexed log: the depth span and
     the windows of its friction log instead of the time base and segments.
+
+    Ends with what 'drillfric run' will do, from run's own checks before it estimates: the
+    segments (windows) it estimates (usable), skips and fails, with the reasons, or the
+    error it would stop the log with (exit code 2).
     """
     from drillfric.io.well import open_well
 
@@ -257,10 +261,10 @@ def _kinds(ok: list[dict]) -> str:
 
 
 def _counts(items: list[dict]) -> str:
-    """', N skipped' and, when any, ', N failed'."""
-    return "".join(f", {n} {status}" for status in (Status.SKIPPED, Status.FAILED)
-                   if (n := sum(g["status"] == status for g in items))
-                   or status == Status.SKIPPED)
+    """', N skipped' and, when any failed, ', N failed'."""
+    skipped = sum(g["status"] == Status.SKIPPED for g in items)
+    failed = sum(g["status"] == Status.FAILED for g in items)
+    return f", {skipped} skipped" + (f", {failed} failed" if failed else "")
 
 
 def _reasons(items: list[dict]) -> list[str]:
