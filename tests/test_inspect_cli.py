@@ -202,3 +202,25 @@ def test_inspect_lists_the_gaps_run_ends_segments_at(tmp_path):
     ends = [(s["t_start_s"], s["t_end_s"]) for s in summary["segments"]]
     assert ran.exit_code == 0, ran.output
     assert ends == [(80.0, 100.0), (111.0, 131.0)]
+
+
+def test_inspect_gives_run_s_verdict_before_the_estimation(tmp_path):
+    """Issue 35 item 5 without the field data: a 40-s rotation at 2.5-s logging (too few
+    samples) and a 100-s one with the bit at 150 m, above the default string's 230 m of
+    HWDP and collars. inspect skips the first and fails the second with run's messages."""
+    t = np.arange(0.0, 300.0, 2.5)
+    rpm = np.where(((t >= 20) & (t <= 60)) | ((t >= 120) & (t <= 220)), 80.0, 0.0)
+    pd.DataFrame({"TIME": t, "SRPM": rpm, "STOR [kN.m]": rpm / 8.0,
+                  "BITDEP [m]": 150.0, "DEPTH [m]": 900.0}).to_csv(tmp_path / "w.csv",
+                                                                   index=False)
+    doc = json.loads(_inspect(tmp_path / "w.csv", "--json").output)
+    ran = CliRunner().invoke(cli, ["-q", "run", str(tmp_path / "w.csv"), "--out",
+                                   str(tmp_path / "o"), "--no-report"])
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    verdicts = [(g["status"], g["message"]) for g in doc["segments"]]
+    assert ran.exit_code == 1
+    assert verdicts == [(g["status"], g["message"]) for g in summary["segments"]]
+    assert [v[0] for v in verdicts] == ["skipped", "failed"]
+    assert verdicts[0][1].startswith("only ") and "bit is at 150.0 m" in verdicts[1][1]
+    shown = _inspect(tmp_path / "w.csv").output
+    assert "segments   2 rotating: 0 usable, 1 skipped, 1 failed" in shown
