@@ -79,19 +79,19 @@ def summarize(well, data) -> dict:
                                                   + tb.duplicates_dropped)
         channels[name] = _channel(name, info.column, info.unit, info.source,
                                   info.null_fraction, total, data.surface)
-    survey = _survey(data.survey)
+    assumed = data.config.assumed_with(data.survey)
+    segments = [_segment(seg, pre) for seg, pre in segment_verdicts(well, data.surface, assumed)]
     return {
         "channels": channels, "rows": tb.rows, "t_start_s": tb.t_start_s,
         "t_end_s": tb.t_end_s, "rate_hz": tb.rate_hz, "gaps": [list(g) for g in tb.gaps],
-        "survey": survey,
+        "survey": _survey(data.survey),
         "well": data.name, "files": {k: str(v) for k, v in data.files.items()},
         "duplicates_dropped": tb.duplicates_dropped, "untimed_dropped": tb.untimed_dropped,
         "origin": None if tb.origin is None else tb.origin.isoformat(),
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
         "max_gap_s": data.config.segmentation.max_gap_s,
-        "assumed": data.config.assumed_with(data.survey),
-        "segments": [_segment(seg, pre) for seg, pre in segment_verdicts(well, data.surface)],
+        "assumed": assumed, "segments": segments,
     }
 
 

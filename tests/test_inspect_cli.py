@@ -224,3 +224,17 @@ def test_inspect_gives_run_s_verdict_before_the_estimation(tmp_path):
     assert verdicts[0][1].startswith("only ") and "bit is at 150.0 m" in verdicts[1][1]
     shown = _inspect(tmp_path / "w.csv").output
     assert "segments   2 rotating: 0 usable, 1 skipped, 1 failed" in shown
+
+
+def test_inspect_notes_the_bit_depth_run_assumes(tmp_path):
+    """A log without a bit depth: run estimates its segments at the default bit depth and
+    says so in summary.json ``assumed``; inspect checks them there and says so too."""
+    from drillfric.runner.checks import DEFAULT_BIT_DEPTH_M
+
+    t = np.arange(0.0, 200.0)
+    rpm = np.where((t > 20) & (t < 150), 80.0, 0.0)
+    pd.DataFrame({"TIME": t, "SRPM": rpm, "STOR [kN.m]": rpm / 8.0}).to_csv(
+        tmp_path / "w.csv", index=False)
+    doc = json.loads(_inspect(tmp_path / "w.csv", "--json").output)
+    assert [g["bit_depth_m"] for g in doc["segments"]] == [DEFAULT_BIT_DEPTH_M]
+    assert "bit depth 2500 m: neither the log nor a survey gives one" in doc["assumed"]

@@ -61,13 +61,14 @@ def refusal(well: Well, surface: pd.DataFrame, duplicates_dropped: int,
     return None
 
 
-def segment_verdicts(well: Well, surface: pd.DataFrame,
+def segment_verdicts(well: Well, surface: pd.DataFrame, assumed: list[str],
                      chunk_rows: int = CHUNK_ROWS) -> list[tuple[Segment, Precheck]]:
     """Every segment ``run`` cuts from ``surface`` (canonical rows), in order, with what
-    becomes of it before the estimation chain (status OK: run estimates it)."""
+    becomes of it before the estimation chain (status OK: run estimates it). What run
+    assumes for them (a bit depth the log does not give) is appended to ``assumed``."""
     stream = SegmentStream(well.config)
     done = [pair for chunk in _chunks(surface, chunk_rows) for pair in stream.feed(chunk)]
-    fallback = functools.cache(lambda: bit_depth_default(well, []))
+    fallback = functools.cache(lambda: bit_depth_default(well, assumed))
     return [(seg, precheck(well, seg, rows, fallback)) for seg, rows in done + stream.close()]
 
 
