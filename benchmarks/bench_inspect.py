@@ -6,10 +6,10 @@ processes, the real logs as the tests invoke them: DSATS with examples/dsats_1hz
 Volve F-4 alone (run refuses it over max_gap_s) and with its trajectory, tubular and
 max_gap_s = 60 beside it (copied into a temporary folder), F-9 A alone, USROP F-5 with
 examples/usrop_f5.toml and its survey. The wall time and the CPU time (user + system) of
-each process are printed, median and minimum of ``--runs``. With ``--before TREE`` (a checkout of other code, e.g. ``git archive`` of an
-earlier commit with ``drillfric/cli`` and ``drillfric/templates`` linked to its ``cli`` and
-``templates``) the same commands run with ``PYTHONPATH=TREE`` too, alternated with this
-code's, and both are printed.
+each process are printed, median and minimum of ``--runs``. With ``--before TREE`` (a
+checkout of other code, e.g. ``git archive`` of an earlier commit with ``drillfric/cli``
+and ``drillfric/templates`` linked to its ``cli`` and ``templates``) the same commands run
+with ``PYTHONPATH=TREE`` too, alternated with this code's, and both are printed.
 
     python benchmarks/bench_inspect.py [--runs 7] [--before TREE]
 
@@ -66,9 +66,11 @@ def timed(args: list[str], env: dict) -> tuple[float, float]:
     """Wall and CPU seconds of one fresh ``drillfric inspect ARGS``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-c", MAIN, "inspect", *args], env=env,
-                   capture_output=True, timeout=600)
+    done = subprocess.run([sys.executable, "-c", MAIN, "inspect", *args], env=env,
+                          capture_output=True, text=True, timeout=600)
     wall = time.perf_counter() - t0
+    if done.returncode not in (0, 2) or "internal error" in done.stderr:  # 2: run refuses
+        raise RuntimeError(f"inspect {' '.join(args)} failed: {done.stderr.strip()}")
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
 
