@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import click
 import numpy as np
@@ -35,6 +36,10 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
     NAME.toml and NAME.survey.csv sidecars, an HDF5 file with /surface, /survey and
     /config, or a directory holding well.toml. For a depth-indexed log: the depth span and
     the windows of its friction log instead of the time base and segments.
+
+    Ends with what 'drillfric run' will do, from run's own checks before it estimates: the
+    segments (windows) it estimates (usable), skips and fails, with the reasons, or the
+    error it would stop the log with (exit code 2).
     """
     from drillfric.io.well import open_well
 
@@ -43,9 +48,11 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
     if opened.depth_indexed:
         summary = summarize_depth_log(opened)
     else:
+        from drillfric.runner.preview import refusal
+
         data = opened.load()
-        summary = summarize(data)
-        refused = run_refusal(opened, data)
+        summary = summarize(opened, data)
+        refused = refusal(opened, data.surface, data.timebase.duplicates_dropped)
         summary["run_refuses"] = None if refused is None else refused.message
     if as_json:
         click.echo(json.dumps(summary, indent=2))
@@ -58,25 +65,12 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
         raise refused
 
 
-def run_refusal(well, data):
-    """The error ``drillfric run`` would stop this time log with (the checks of the log as
-    a whole, :class:`drillfric.io.logcheck.LogCheck`), or None."""
-    from drillfric.errors import InputError
-    from drillfric.io.logcheck import LogCheck
-
-    check = LogCheck(well)
-    try:
-        check.feed(data.surface)
-        check.finish(data.timebase.duplicates_dropped)
-    except InputError as exc:
-        return exc
-    return None
-
-
-def summarize(data) -> dict:
-    """The ``inspect --json`` document (docs/cli.md keys first, then extras)."""
+def summarize(well, data) -> dict:
+    """The ``inspect --json`` document (docs/cli.md keys first, then extras) of the opened
+    ``well`` and its loaded ``data``; its segments are those run cuts, each with what run
+    does with it before estimating (:func:`drillfric.runner.preview.segment_verdicts`)."""
     from drillfric.io.timebase import spacing_summary
-    from drillfric.segmentation import segment
+    from drillfric.runner.preview import segment_verdicts
 
     tb = data.timebase
     channels = {}
@@ -85,19 +79,19 @@ def summarize(data) -> dict:
                                                   + tb.duplicates_dropped)
         channels[name] = _channel(name, info.column, info.unit, info.source,
                                   info.null_fraction, total, data.surface)
-    survey = _survey(data.survey)
+    assumed = data.config.assumed_with(data.survey)
+    segments = [_segment(seg, pre) for seg, pre in segment_verdicts(well, data.surface, assumed)]
     return {
         "channels": channels, "rows": tb.rows, "t_start_s": tb.t_start_s,
         "t_end_s": tb.t_end_s, "rate_hz": tb.rate_hz, "gaps": [list(g) for g in tb.gaps],
-        "survey": survey,
+        "survey": _survey(data.survey),
         "well": data.name, "files": {k: str(v) for k, v in data.files.items()},
         "duplicates_dropped": tb.duplicates_dropped, "untimed_dropped": tb.untimed_dropped,
         "origin": None if tb.origin is None else tb.origin.isoformat(),
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
         "max_gap_s": data.config.segmentation.max_gap_s,
-        "assumed": data.config.assumed_with(data.survey),
-        "segments": [_segment(seg) for seg in segment(data.surface, data.config)],
+        "assumed": assumed, "segments": segments,
     }
 
 
@@ -128,7 +122,7 @@ def summarize_depth_log(well) -> dict:
     """The ``inspect --json`` document of a depth-indexed log: the interface's keys (no time
     base: ``t_start_s``, ``t_end_s``, ``rate_hz`` null), ``index = "depth"``, the depth span
     and the windows of its friction log (:mod:`drillfric.estimation.friction_log`)."""
-    from drillfric.estimation.friction_log import read_depth_log, windows
+    from drillfric.estimation.friction_log import check_window, read_depth_log, windows
 
     log = read_depth_log(well)
     channels = {m.channel.name: _channel(m.channel.name, m.column, m.unit, m.source,
@@ -137,7 +131,6 @@ def summarize_depth_log(well) -> dict:
                 for m in well.mappings.values()}
     md = log["measured_depth_m"].to_numpy(float)
     found, assumed = windows(log, well.config)
-    least = well.config.friction_log.min_rows
     files = {k: str(v) for k, v in (("data", well.files.data), ("config", well.files.config),
                                      ("survey", well.files.survey)) if v is not None}
     return {
@@ -148,21 +141,30 @@ def summarize_depth_log(well) -> dict:
         "md_step_m": float(np.median(np.diff(np.sort(md)))) if md.size > 1 else None,
         "window_m": well.config.friction_log.window_m,
         "assumed": [n for n in well.assumed if not n.startswith("top-drive")] + assumed,
-        "segments": [{"id": w.id, "kind": w.kind.value, "md_top_m": w.md_top_m,
-                      "md_bottom_m": w.md_bottom_m, "rows": w.rows,
-                      "bit_depth_m": w.bit_depth_m,
-                      "status": "ok" if w.rows >= least else "skipped"} for w in found],
+        "segments": [_window(w, *check_window(w, well)) for w in found],
     }
 
 
-def _segment(seg) -> dict:
-    """One segment of :func:`drillfric.segmentation.segment` as JSON (NaN → null)."""
+def _window(window, status, message: str) -> dict:
+    """One window of a depth log as JSON, with run's verdict before back-calculating it
+    (:func:`drillfric.estimation.friction_log.check_window`; status ``ok``: run estimates
+    it)."""
+    return {"id": window.id, "kind": window.kind.value, "md_top_m": window.md_top_m,
+            "md_bottom_m": window.md_bottom_m, "rows": window.rows,
+            "bit_depth_m": window.bit_depth_m, "status": status.value, "message": message}
+
+
+def _segment(seg, pre) -> dict:
+    """One segment as JSON (NaN → null): its span, the bit depth run estimates it at, and
+    run's verdict before estimating (:class:`drillfric.runner.estimator.Precheck`; status
+    ``ok``: run estimates it)."""
     def num(x):
         return None if x is None or not np.isfinite(x) else float(x)
 
     return {"id": seg.id, "kind": seg.kind, "t_start_s": num(seg.t_start_s),
             "t_end_s": num(seg.t_end_s), "duration_s": num(seg.duration_s),
-            "bit_depth_m": num(seg.bit_depth_m), "status": seg.status, "message": seg.message}
+            "bit_depth_m": num(pre.bit_depth_m), "status": pre.status.value,
+            "message": pre.message}
 
 
 def _num(value: float | None) -> str:
@@ -229,24 +231,52 @@ def render(s: dict, units: str = "si") -> str:
     spacing = (f" (spacing median {sp['median']:.3g} s, 5–95 % {sp['p05']:.3g}–{sp['p95']:.3g}"
                f" s, min {sp['min']:.3g} s, max {sp['max']:.3g} s)") if sp else ""
     lines.append(f"rate       {s['rate_hz']:.4g} Hz nominal{spacing}")
-    limit = max(s["max_gap_s"], 5 / s["rate_hz"]) if s["rate_hz"] else s["max_gap_s"]
     gaps = s["gaps"]
     shown = ", ".join(f"{a:.6g}–{b:.6g} s" for a, b in gaps[:5]) + (" …" if len(gaps) > 5 else "")
-    lines.append(f"gaps       {len(gaps)} longer than {limit:.3g} s" + (f": {shown}" if gaps
-                                                                        else ""))
+    lines.append(f"gaps       {len(gaps)} longer than max_gap_s = {s['max_gap_s']:.3g} s (a "
+                 "segment ends at each)" + (f": {shown}" if gaps else ""))
     lines.append(_survey_line(s["survey"], units))
-    lines.append(_segments_line(s["segments"]))
+    if s["run_refuses"]:
+        lines.append(f"segments   {len(s['segments'])} rotating, none estimated: run refuses "
+                     "the log (the error below)")
+    else:
+        lines += _segments_lines(s["segments"])
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
-def _segments_line(segments: list[dict]) -> str:
+def _segments_lines(segments: list[dict]) -> list[str]:
+    """What run does with the segments: how many it estimates (the usable ones), skips and
+    fails, and why (:func:`_reasons`)."""
     ok = [g for g in segments if g["status"] == Status.OK]
-    kinds = {k: sum(g["kind"] == k for g in ok) for k in sorted({g["kind"] for g in ok})}
-    detail = ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in kinds.items())
     seconds = sum(g["duration_s"] or 0.0 for g in ok)
-    return (f"segments   {len(segments)} rotating: {len(ok)} usable"
-            + (f" ({detail}; {seconds / 3600:.2f} h)" if ok else "")
-            + f", {len(segments) - len(ok)} skipped")
+    return [f"segments   {len(segments)} rotating: {len(ok)} usable"
+            + (f" ({_kinds(ok)}; {seconds / 3600:.2f} h)" if ok else "")
+            + _counts(segments)] + _reasons(segments)
+
+
+def _kinds(ok: list[dict]) -> str:
+    """'16 off bottom rotating, 13 on bottom rotating' of the usable segments or windows."""
+    kinds = {k: sum(g["kind"] == k for g in ok) for k in sorted({g["kind"] for g in ok})}
+    return ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in kinds.items())
+
+
+def _counts(items: list[dict]) -> str:
+    """', N skipped' and, when any failed, ', N failed'."""
+    skipped = sum(g["status"] == Status.SKIPPED for g in items)
+    failed = sum(g["status"] == Status.FAILED for g in items)
+    return f", {skipped} skipped" + (f", {failed} failed" if failed else "")
+
+
+def _reasons(items: list[dict]) -> list[str]:
+    """One line per reason run does not estimate segments (windows) for, whatever its
+    numbers: how many, skipped or failed, and the first one's message."""
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for g in items:
+        if g["status"] != Status.OK:
+            groups.setdefault((g["status"], re.sub(r"\d+(\.\d+)?", "#", g["message"])),
+                              []).append(g)
+    return [f"{'':10} {len(group)} {status} like segment {group[0]['id']}: {group[0]['message']}"
+            for (status, _), group in groups.items()]
 
 
 def render_depth_log(s: dict, units: str = "si") -> str:
@@ -266,11 +296,10 @@ def render_depth_log(s: dict, units: str = "si") -> str:
                  f"{format_value(s['md_end_m'], 'length', units)} MD{step}")
     lines.append(_survey_line(s["survey"], units))
     ok = [w for w in s["segments"] if w["status"] == Status.OK]
-    kinds = {k: sum(w["kind"] == k for w in ok) for k in sorted({w["kind"] for w in ok})}
-    detail = ", ".join(f"{n} {k.replace('_', ' ')}" for k, n in kinds.items())
     lines.append(f"windows    {len(s['segments'])} of "
                  f"{format_value(s['window_m'], 'length', units, '.0f')}: {len(ok)} usable"
-                 + (f" ({detail})" if ok else "") + f", {len(s['segments']) - len(ok)} skipped")
+                 + (f" ({_kinds(ok)})" if ok else "") + _counts(s["segments"]))
+    lines += _reasons(s["segments"])
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 

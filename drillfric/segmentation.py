@@ -338,6 +338,21 @@ def classify(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
 # Segmentation
 
 
+def is_gap(spacing_s, max_gap_s: float) -> np.ndarray:
+    """Whether a time between samples [s] is a gap: longer than ``segmentation.max_gap_s``
+    [s], where a segment ends. The one gap rule of the segmentation, of the log's check
+    (:class:`drillfric.io.logcheck.LogCheck`: a median spacing that is a gap makes every
+    sample one) and of the gaps ``inspect`` lists (:attr:`drillfric.io.timebase.TimeBase.gaps`).
+
+    Examples
+    --------
+    >>> is_gap(np.array([1.0, 10.0, 10.5, np.nan]), 10.0)
+    array([False, False,  True, False])
+    """
+    with np.errstate(invalid="ignore"):
+        return np.asarray(spacing_s, dtype=float) > max_gap_s
+
+
 def _pieces(t: np.ndarray, states: np.ndarray, max_gap_s: float) -> list[tuple[int, int]]:
     """Row ranges [start, end) of rotating stretches, split at long gaps and null runs.
 
@@ -356,8 +371,7 @@ def _pieces(t: np.ndarray, states: np.ndarray, max_gap_s: float) -> list[tuple[i
     # or the time between them exceeds max_gap_s (gap or long null run)
     n_other = np.concatenate(([0], np.cumsum(known_other)))
     between_other = n_other[rot_idx[1:]] - n_other[rot_idx[:-1] + 1] > 0
-    with np.errstate(invalid="ignore"):
-        too_far = t[rot_idx[1:]] - t[rot_idx[:-1]] > max_gap_s
+    too_far = is_gap(t[rot_idx[1:]] - t[rot_idx[:-1]], max_gap_s)
     cut = np.flatnonzero(between_other | too_far)
     starts = np.concatenate(([rot_idx[0]], rot_idx[cut + 1]))
     ends = np.concatenate((rot_idx[cut] + 1, [rot_idx[-1] + 1]))
@@ -619,8 +633,7 @@ class Segmenter:
         t, states = self._buffer["t"], self._buffer["states"]
         rotating = np.isin(states, TURNING_STATES)
         other = np.flatnonzero(~rotating & (states != UNKNOWN))
-        with np.errstate(invalid="ignore"):
-            gaps = np.flatnonzero(np.diff(t) > self._cfg.segmentation.max_gap_s) + 1
+        gaps = np.flatnonzero(is_gap(np.diff(t), self._cfg.segmentation.max_gap_s)) + 1
         candidates = np.concatenate((other, gaps))
         return int(candidates.max()) if candidates.size else 0
 

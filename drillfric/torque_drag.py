@@ -23,10 +23,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
 from drillfric.drillstring import DrillString, build_string
 from drillfric.errors import ModelError
+from drillfric.kernels.lazy import lazy_jit
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.vocabulary import LoadCase
 from drillfric.wellpath import WellPath, no_survey_path
@@ -159,7 +159,6 @@ def element_normal_force(force_lower_N: float, t_upper, t_lower, weight_N: float
     return float(np.linalg.norm(q))
 
 
-@njit(cache=True)
 def _march_many(t, weight, rc, mu, sigma, share, force_bit, torque_bit,
                 force, torque, normal):  # pragma: no cover - compiled; oracle-tested
     """Bit-to-surface march (docs/theory.md §2 steps 2–5) for k load variants on one mesh.
@@ -210,6 +209,11 @@ class _Mesh:
     @property
     def ds_m(self) -> np.ndarray:
         return np.diff(self.md_m)
+
+
+#: :func:`_march_many` compiled on first use: importing this module (``inspect``'s run
+#: checks reach :data:`MAX_ELEMENTS`) does not load numba.
+_compiled_march = lazy_jit(_march_many)
 
 
 def _check_inputs(path: WellPath, string: DrillString, mud_out: float, mud_in: float,
@@ -315,8 +319,9 @@ def _run(mesh: _Mesh, mu: np.ndarray, sigma: np.ndarray, share: np.ndarray,
     def arr(x):  # one compiled signature: C-contiguous, writable float64
         return np.require(x, dtype=np.float64, requirements=["C", "W"])
 
-    _march_many(arr(mesh.tangent), arr(mesh.weight_N), arr(mesh.rc_m), arr(mu), arr(sigma),
-                arr(share), arr(force_bit), arr(torque_bit), force, torque, normal)
+    _compiled_march()(arr(mesh.tangent), arr(mesh.weight_N), arr(mesh.rc_m), arr(mu),
+                      arr(sigma), arr(share), arr(force_bit), arr(torque_bit), force, torque,
+                      normal)
     return force.T, torque.T, normal.T
 
 

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -180,3 +181,60 @@ def test_bad_survey_through_inspect(good, tmp_path):
     result = _inspect(good, "--survey", tmp_path / "s.csv")
     assert result.exit_code == 2 and "s.csv" in result.output
     assert len(result.output.strip().splitlines()) == 1
+
+
+def test_inspect_lists_the_gaps_run_ends_segments_at(tmp_path):
+    """Issue 35 item 7: inspect listed the spacings longer than max(max_gap_s, 5 periods)
+    — none for Volve F-4 at 15 s ("0 longer than 75 s") — while run cut at max_gap_s. On a
+    0.4 Hz log an 11-s hole is no gap under the old floor (12.5 s) but ends a rotation in
+    run: inspect now lists exactly the gaps at which run's segments end."""
+    t = np.arange(0.0, 200.0, 2.5)
+    t[t >= 100.5] += 8.5  # one spacing of 11 s: 100 → 111 s
+    rpm = np.where((t >= 80.0) & (t <= 131.0), 60.0, 0.0)
+    pd.DataFrame({"TIME": t, "SRPM": rpm, "STOR [kN.m]": rpm / 6.0}).to_csv(
+        tmp_path / "w.csv", index=False)
+    doc = json.loads(_inspect(tmp_path / "w.csv", "--json").output)
+    assert doc["gaps"] == [[100.0, 111.0]] and doc["max_gap_s"] == 10.0
+    assert "gaps       1 longer than max_gap_s = 10 s" in _inspect(tmp_path / "w.csv").output
+    ran = CliRunner().invoke(cli, ["-q", "run", str(tmp_path / "w.csv"), "--out",
+                                   str(tmp_path / "o"), "--no-report"])
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    ends = [(s["t_start_s"], s["t_end_s"]) for s in summary["segments"]]
+    assert ran.exit_code == 0, ran.output
+    assert ends == [(80.0, 100.0), (111.0, 131.0)]
+
+
+def test_inspect_gives_run_s_verdict_before_the_estimation(tmp_path):
+    """Issue 35 item 5 without the field data: a 40-s rotation at 2.5-s logging (too few
+    samples) and a 100-s one with the bit at 150 m, above the default string's 230 m of
+    HWDP and collars. inspect skips the first and fails the second with run's messages."""
+    t = np.arange(0.0, 300.0, 2.5)
+    rpm = np.where(((t >= 20) & (t <= 60)) | ((t >= 120) & (t <= 220)), 80.0, 0.0)
+    pd.DataFrame({"TIME": t, "SRPM": rpm, "STOR [kN.m]": rpm / 8.0,
+                  "BITDEP [m]": 150.0, "DEPTH [m]": 900.0}).to_csv(tmp_path / "w.csv",
+                                                                   index=False)
+    doc = json.loads(_inspect(tmp_path / "w.csv", "--json").output)
+    ran = CliRunner().invoke(cli, ["-q", "run", str(tmp_path / "w.csv"), "--out",
+                                   str(tmp_path / "o"), "--no-report"])
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    verdicts = [(g["status"], g["message"]) for g in doc["segments"]]
+    assert ran.exit_code == 1
+    assert verdicts == [(g["status"], g["message"]) for g in summary["segments"]]
+    assert [v[0] for v in verdicts] == ["skipped", "failed"]
+    assert verdicts[0][1].startswith("only ") and "bit is at 150.0 m" in verdicts[1][1]
+    shown = _inspect(tmp_path / "w.csv").output
+    assert "segments   2 rotating: 0 usable, 1 skipped, 1 failed" in shown
+
+
+def test_inspect_notes_the_bit_depth_run_assumes(tmp_path):
+    """A log without a bit depth: run estimates its segments at the default bit depth and
+    says so in summary.json ``assumed``; inspect checks them there and says so too."""
+    from drillfric.runner.checks import DEFAULT_BIT_DEPTH_M
+
+    t = np.arange(0.0, 200.0)
+    rpm = np.where((t > 20) & (t < 150), 80.0, 0.0)
+    pd.DataFrame({"TIME": t, "SRPM": rpm, "STOR [kN.m]": rpm / 8.0}).to_csv(
+        tmp_path / "w.csv", index=False)
+    doc = json.loads(_inspect(tmp_path / "w.csv", "--json").output)
+    assert [g["bit_depth_m"] for g in doc["segments"]] == [DEFAULT_BIT_DEPTH_M]
+    assert "bit depth 2500 m: neither the log nor a survey gives one" in doc["assumed"]

@@ -17,7 +17,24 @@ from tests.conftest import REPO
 pytestmark = pytest.mark.slow
 
 
-def test_dsats_runs_end_to_end(real_data, tmp_path):
+@pytest.fixture(scope="module")
+def dsats_out(tmp_path_factory):
+    """OUT/NAME of the DSATS log's run with the documented config (one run: minutes)."""
+    from tests.conftest import REAL_DATA
+
+    if not REAL_DATA.is_dir():
+        pytest.skip(f"real field data not available at {REAL_DATA}")
+    out = tmp_path_factory.mktemp("dsats")
+    result = CliRunner().invoke(cli, ["-q", "run", str(REAL_DATA / "dsats_1hz" /
+                                                        "SampleData1.csv"), "--config",
+                                      str(REPO / "examples" / "dsats_1hz.toml"),
+                                      "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    (folder,) = [p for p in out.iterdir() if p.is_dir()]
+    return folder
+
+
+def test_dsats_runs_end_to_end(dsats_out):
     """Issue 6 acceptance on real data (../shared/data/real/dsats_1hz, 13.9 h at 1 Hz, no
     truth) with the documented config: segments found and estimated, nothing fails, μ_s
     null (no creep start-up in this log, so not identifiable), a report written
@@ -25,12 +42,7 @@ def test_dsats_runs_end_to_end(real_data, tmp_path):
     assumed default string is ~3× heavier than the string the log's own hook load weighs
     (rotating hook load − in-slips block weight), so no friction factor is published — per
     segment nor well-wide — and summary.json warnings and mu_k_reason say why."""
-    data = real_data / "dsats_1hz" / "SampleData1.csv"
-    result = CliRunner().invoke(cli, ["-q", "run", str(data), "--config",
-                                      str(REPO / "examples" / "dsats_1hz.toml"),
-                                      "--out", str(tmp_path)])
-    assert result.exit_code == 0, result.output
-    (out,) = [p for p in tmp_path.iterdir() if p.is_dir()]
+    out = dsats_out
     summary = json.loads((out / "summary.json").read_text())
     status = [s["status"] for s in summary["segments"]]
     assert status.count("failed") == 0 and status.count("ok") >= 20
@@ -50,3 +62,15 @@ def test_dsats_runs_end_to_end(real_data, tmp_path):
     drag_log = pd.read_parquet(out / "drag_log.parquet")
     assert drag_log["reason"].str.contains("contradicts the configured string").all()
     assert (out / "report.html").stat().st_size > 0
+
+
+def test_dsats_inspect_says_what_run_does(dsats_out):
+    """Issue 35 item 5 on the DSATS log: the segments inspect calls usable are the ones
+    run estimated, the others carry run's status and reason (tests/test_inspect_verdicts.py)."""
+    from tests.conftest import REAL_DATA
+    from tests.test_inspect_verdicts import assert_verdicts_agree, inspect_json
+
+    code, doc = inspect_json(REAL_DATA / "dsats_1hz" / "SampleData1.csv", "--config",
+                             REPO / "examples" / "dsats_1hz.toml")
+    assert code == 0
+    assert_verdicts_agree(doc, json.loads((dsats_out / "summary.json").read_text()))

@@ -56,6 +56,7 @@ from drillfric.estimation.observer import (
     observe,
 )
 from drillfric.estimation.sampling import LoggingInterval, Resolution, logging_interval, resolution
+from drillfric.estimation.segment_data import SegmentData, SkipSegment, check_reach
 from drillfric.estimation.settings import ChainSettings
 from drillfric.estimation.torque_scale import check_torque_scale
 from drillfric.estimation.verdict import (
@@ -77,40 +78,6 @@ from drillfric.wellpath import WellPath
 
 #: Largest cell of the batch fit's model [m] (docs/theory.md §6.4).
 BATCH_MAX_DX_M = 5.0
-
-
-class SkipSegment(DrillfricError):
-    """The segment holds nothing to estimate (not a failure): kept as "skipped"."""
-
-
-@dataclass(frozen=True)
-class SegmentData:
-    """The samples of one segment, in SI (rpm only in the name).
-
-    Attributes
-    ----------
-    time_s, surface_rpm, surface_torque_Nm : ndarray
-    bit_depth_m : float
-        Bit depth of the segment [m].
-    kind : Kind
-        Segment kind (off or on bottom).
-    wob_N : float
-        Median weight on bit [N] (0 off bottom).
-    bit_rpm : ndarray or None
-        Downhole truth when the input has it (validation).
-    torque_min_Nm, torque_max_Nm : ndarray or None
-        The torque's minimum and maximum within each logged interval, when the log has them.
-    """
-
-    time_s: np.ndarray
-    surface_rpm: np.ndarray
-    surface_torque_Nm: np.ndarray
-    bit_depth_m: float
-    kind: Kind = Kind.OFF_BOTTOM
-    wob_N: float = 0.0
-    bit_rpm: np.ndarray | None = None
-    torque_min_Nm: np.ndarray | None = None
-    torque_max_Nm: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -227,9 +194,7 @@ def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
     """The survey's path, or without one the assumed tortuous vertical path to the bit."""
     if path is None:
         return settings.td.path_to(None, bit_depth_m)
-    if bit_depth_m > path.md_max_m + 1e-6:
-        raise DrillfricError(f"the survey ends at {path.md_max_m:.1f} m, above the bit at "
-                             f"{bit_depth_m:.1f} m", fix="extend the survey to the bit depth")
+    check_reach(path, bit_depth_m)
     return path
 
 
@@ -867,12 +832,3 @@ def _bit_error(time_s: np.ndarray, bit: BitSpeedEstimate, data: SegmentData) -> 
     truth = np.interp(time_s[late], data.time_s, data.bit_rpm)
     error = bit.rad_s[late] / RPM_TO_RAD_S - truth
     return float(np.sqrt(np.mean(error**2)))
-
-
-def check_segment(data: SegmentData, settings: ChainSettings) -> None:
-    """Raise SkipSegment when a segment has too little to estimate from."""
-    if data.time_s.size < 20:
-        raise SkipSegment(f"only {data.time_s.size} samples")
-    if np.nanmax(np.abs(data.surface_rpm)) * RPM_TO_RAD_S <= settings.omega_c_rad_s:
-        raise SkipSegment("the top drive never turns faster than ω_c")
-

@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from drillfric.drillstring import build_string
 from drillfric.errors import InputError, ModelError
 from drillfric.estimation.verdict import TYPICAL_MU
 from drillfric.io.well import CHUNK_ROWS, Well
@@ -236,14 +237,14 @@ def back_calculate(window: Window, well: Well, td: TDSettings) -> WindowResult:
     """The friction factor of one window (docs/ingestion.md *Depth-indexed logs*), with the
     well's torque-and-drag settings ``td``.
 
-    A window with too few rotating rows, or a bit beyond the survey, is skipped; one whose
-    torque no friction factor in [0, 2] reproduces has failed (with the model's message).
+    A window :func:`check_window` does not pass is skipped or failed with its message; one
+    whose torque no friction factor in [0, 2] reproduces has failed (with the model's
+    message).
     """
     base = _base_record(window)
-    problem = _skip_reason(window, well)
-    if problem:
-        return WindowResult(window, SegmentRecord(**base, status=Status.SKIPPED,
-                                                  message=f"{problem}; {NO_OBSERVER}"))
+    status, message = check_window(window, well)
+    if status is not Status.OK:
+        return WindowResult(window, SegmentRecord(**base, status=status, message=message))
     on = window.kind is Kind.ON_BOTTOM
     wob = window.wob_N if on and np.isfinite(window.wob_N) else 0.0
     torque_bit = bit_torque_Nm(wob, well.config) if on else 0.0
@@ -260,6 +261,22 @@ def back_calculate(window: Window, well: Well, td: TDSettings) -> WindowResult:
                                                   message=exc.message), None, torque_bit)
     td = solve(path, string, friction=mu, **kw)
     return WindowResult(window, _record(base, window, mu, td, torque_bit), td, torque_bit)
+
+
+def check_window(window: Window, well: Well) -> tuple[Status, str]:
+    """What becomes of a window before its back-calculation, with the message its record
+    gets (``drillfric inspect`` calls this too): SKIPPED without enough rotating rows or
+    with the bit beyond the survey; FAILED when the configured string's sections below the
+    top one are longer than the bit depth (:func:`drillfric.drillstring.build_string`);
+    else OK and no message."""
+    problem = _skip_reason(window, well)
+    if problem:
+        return Status.SKIPPED, f"{problem}; {NO_OBSERVER}"
+    try:
+        build_string(well.config.sections, window.bit_depth_m)
+    except ModelError as exc:
+        return Status.FAILED, exc.message
+    return Status.OK, ""
 
 
 def _base_record(window: Window) -> dict:

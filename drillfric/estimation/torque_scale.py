@@ -70,7 +70,7 @@ def check_torque_scale(data, T_N_Nm: float, omega_c_rad_s: float, *,
 
     Parameters
     ----------
-    data : drillfric.estimation.chain.SegmentData
+    data : drillfric.estimation.segment_data.SegmentData
     T_N_Nm : float
         T_N = ∫F_c dx at the segment's bit depth [N·m].
     omega_c_rad_s : float

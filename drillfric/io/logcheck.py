@@ -16,6 +16,7 @@ import pandas as pd
 from drillfric.errors import InputError
 from drillfric.io.text import printable
 from drillfric.io.well import CLOCK_UNIT
+from drillfric.segmentation import is_gap
 
 
 class LogCheck:
@@ -71,7 +72,7 @@ class LogCheck:
         dt = np.diff(time_s)
         dt = dt[dt > 0]
         limit = self.well.config.segmentation.max_gap_s
-        if not dt.size or float(np.median(dt)) <= limit:
+        if not dt.size or not is_gap(np.median(dt), limit):
             return
         time, median = self.well.mappings["time"], float(np.median(dt))
         slow = (f"raise segmentation.max_gap_s above the spacing, e.g. [segmentation] "

@@ -26,6 +26,7 @@ import pandas as pd
 from drillfric.errors import InputError
 from drillfric.io.source import NULL_VALUES
 from drillfric.io.text import printable
+from drillfric.segmentation import is_gap
 
 
 @dataclass(frozen=True)
@@ -42,7 +43,8 @@ class TimeBase:
         Nominal sample rate [Hz]: 1 / median spacing (robust to jitter and gaps);
         0 for fewer than two rows.
     gaps : tuple of (float, float)
-        ``(start_s, end_s)`` of every spacing longer than ``max(max_gap_s, 5 / rate_hz)``.
+        ``(start_s, end_s)`` of every spacing longer than ``segmentation.max_gap_s``: where
+        a run ends a segment (:func:`drillfric.segmentation.is_gap`).
     duplicates_dropped : int
         Rows dropped because they repeat the previous row's timestamp.
     origin : pandas.Timestamp or None
@@ -79,7 +81,10 @@ def nominal_rate_hz(time_s: np.ndarray) -> float:
 
 def find_gaps(time_s: np.ndarray, max_gap_s: float,
               rate_hz: float) -> tuple[tuple[float, float], ...]:
-    """Spacings longer than ``max(max_gap_s, 5 / rate_hz)`` as ``(start_s, end_s)`` pairs.
+    """Spacings longer than ``max(max_gap_s, 5 / rate_hz)`` as ``(start_s, end_s)`` pairs:
+    the holes of a bit trace (the window check of :mod:`drillfric.estimation.chain` passes
+    the string's wave travel time as ``max_gap_s``), not the gaps that end a segment
+    (:attr:`TimeBase.gaps`).
 
     Five nominal periods keep jitter (spacings of 0–2 s at 1 Hz) from counting as gaps.
 
@@ -88,9 +93,14 @@ def find_gaps(time_s: np.ndarray, max_gap_s: float,
     >>> find_gaps(np.array([0.0, 1.0, 2.0, 30.0, 31.0]), 10.0, 1.0)
     ((2.0, 30.0),)
     """
-    time_s = np.asarray(time_s, dtype=float)
     limit = max(max_gap_s, 5.0 / rate_hz) if rate_hz > 0 else max_gap_s
-    idx = np.flatnonzero(np.diff(time_s) > limit)
+    return _spans(np.asarray(time_s, dtype=float), limit)
+
+
+def _spans(time_s: np.ndarray, max_gap_s: float) -> tuple[tuple[float, float], ...]:
+    """``(start_s, end_s)`` of every gap of ``time_s`` [s] (:func:`~drillfric.segmentation.
+    is_gap` with ``max_gap_s`` [s])."""
+    idx = np.flatnonzero(is_gap(np.diff(time_s), max_gap_s))
     return tuple((float(time_s[i]), float(time_s[i + 1])) for i in idx)
 
 
@@ -120,7 +130,7 @@ def summarize(time_s: np.ndarray, *, max_gap_s: float, duplicates_dropped: int =
     return TimeBase(rows=int(time_s.size),
                     t_start_s=float(time_s[0]) if time_s.size else 0.0,
                     t_end_s=float(time_s[-1]) if time_s.size else 0.0,
-                    rate_hz=rate, gaps=find_gaps(time_s, max_gap_s, rate),
+                    rate_hz=rate, gaps=_spans(time_s, max_gap_s),
                     duplicates_dropped=duplicates_dropped, origin=origin,
                     untimed_dropped=untimed_dropped, source_start_s=source_start_s)
 

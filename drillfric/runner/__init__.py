@@ -3,7 +3,9 @@
 - :mod:`.time_log` — a time log, stand by stand: segments, the estimation chain, pooling;
 - :mod:`.depth_log` — a depth-indexed log: the static friction log by depth window;
 - :mod:`.finish` — what both end with: the summary, the result files, the report;
-- :mod:`.segment_output` — a time-log segment's record and output rows.
+- :mod:`.segment_output` — a time-log segment's record and output rows;
+- :mod:`.preview` — what a run will do with a time log, told without estimating
+  (``drillfric inspect``).
 
 The report is written through the writer the caller passes (``report``): this layer
 computes and writes results and does not import :mod:`drillfric.report` (the layer
@@ -13,11 +15,13 @@ contract in pyproject.toml).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import RunProgress, WellResult
 
-from .finish import ReportWriter
+if TYPE_CHECKING:  # the run's modules load when a run starts (inspect imports .preview)
+    from .finish import ReportWriter
 
 
 def run_well(well: Well, out_root=None, *, rate_hz: float | None = None,

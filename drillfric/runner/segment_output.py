@@ -8,8 +8,9 @@ import numpy as np
 import pandas as pd
 
 from drillfric.estimation.bit_torque import rate_of_penetration_m_h
-from drillfric.estimation.chain import SegmentData, SegmentEstimate
+from drillfric.estimation.chain import SegmentEstimate
 from drillfric.estimation.observer import ObserverRecord
+from drillfric.estimation.segment_data import SegmentData
 from drillfric.hookload import withhold_friction
 from drillfric.io.timebase import clock_at, origin_of
 from drillfric.result import SEEDED_START_ID, SegmentRecord

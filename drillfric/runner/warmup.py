@@ -89,7 +89,7 @@ def _segment():
     """A short off-bottom rotation (5 s at 100 Hz, 60 RPM, 8 kN·m) at 1000 m, default string."""
     import numpy as np
 
-    from drillfric.estimation.chain import SegmentData
+    from drillfric.estimation.segment_data import SegmentData
 
     time_s = np.arange(501) / 100.0
     return SegmentData(time_s, np.full(time_s.size, 60.0), np.full(time_s.size, 8e3), 1000.0)

@@ -1,0 +1,77 @@
+"""What ``drillfric run`` will do with a time log, told without estimating it.
+
+``drillfric inspect`` shows a log and says what run will make of it (issue 35 items 5 and
+7: it had called Volve F-4's segments usable that run then skipped, "only 7 samples", and
+F-9's that run failed, the string longer than the bit depth). Both answers come from the
+functions run itself calls, on the log's rows in run's chunks:
+
+- :func:`refusal` — the checks of the log as a whole (the first chunk's rate, depth
+  reckoning and work budget, :func:`~drillfric.runner.checks.check_first_chunk`; the log
+  check, :class:`~drillfric.io.logcheck.LogCheck`): the error run would stop with;
+- :func:`segment_verdicts` — the segments run's stream cuts, with their rows
+  (:class:`~drillfric.segmentation.SegmentStream`), each through the checks before the
+  estimation chain (:func:`~drillfric.runner.checks.precheck`: the segmentation's verdict,
+  the sample count, ω_c, the survey's and the string's reach of the bit).
+
+Neither imports the estimation chain (:mod:`drillfric.runner.checks`): inspect stays within
+its start-up budget.
+
+What the chain itself finds (no side force in a vertical hole, a torque in the wrong unit,
+a fit that does not converge) needs the models solved and is left to run.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Iterator
+
+import pandas as pd
+
+from drillfric.errors import DrillfricError
+from drillfric.io.logcheck import LogCheck
+from drillfric.io.well import CHUNK_ROWS, Well
+from drillfric.segmentation import Segment, SegmentStream
+
+from .checks import Precheck, bit_depth_default, check_first_chunk, precheck
+
+
+def refusal(well: Well, surface: pd.DataFrame, duplicates_dropped: int,
+            chunk_rows: int = CHUNK_ROWS) -> DrillfricError | None:
+    """The error ``run`` would stop this time log with, or None.
+
+    Parameters
+    ----------
+    well : Well
+        The opened well.
+    surface : pandas.DataFrame
+        Its canonical rows (:attr:`drillfric.io.well.WellData.surface`).
+    duplicates_dropped : int
+        Rows dropped for a repeated time (the time base's count).
+    chunk_rows : int
+        Rows of run's chunks (the first chunk's checks look at those only).
+    """
+    check = LogCheck(well)
+    try:
+        check_first_chunk(well, surface.iloc[:chunk_rows])
+        for chunk in _chunks(surface, chunk_rows):
+            check.feed(chunk)
+        check.finish(duplicates_dropped)
+    except DrillfricError as exc:
+        return exc
+    return None
+
+
+def segment_verdicts(well: Well, surface: pd.DataFrame, assumed: list[str],
+                     chunk_rows: int = CHUNK_ROWS) -> list[tuple[Segment, Precheck]]:
+    """Every segment ``run`` cuts from ``surface`` (canonical rows), in order, with what
+    becomes of it before the estimation chain (status OK: run estimates it). What run
+    assumes for them (a bit depth the log does not give) is appended to ``assumed``."""
+    stream = SegmentStream(well.config)
+    done = [pair for chunk in _chunks(surface, chunk_rows) for pair in stream.feed(chunk)]
+    fallback = functools.cache(lambda: bit_depth_default(well, assumed))
+    return [(seg, precheck(well, seg, rows, fallback)) for seg, rows in done + stream.close()]
+
+
+def _chunks(surface: pd.DataFrame, chunk_rows: int) -> Iterator[pd.DataFrame]:
+    for start in range(0, len(surface), chunk_rows):
+        yield surface.iloc[start:start + chunk_rows]
