@@ -47,6 +47,21 @@ def test_quantised_spot_values_are_not_held():
     assert sampling.held_interval_s(t, rpm, torque) is None
 
 
+def test_one_channel_held_sets_the_interval():
+    """Ninth attack: a torque sampled and held every 1 s beside a 10-Hz speed. The changes
+    of the two together come every sample, yet the estimate rests on 1-s torques: the
+    slowest channel sets the interval (its trace had been shown resolved, 48 RPM RMS off).
+    Quantised spot values of either channel alone still are no hold."""
+    rng = np.random.default_rng(2)
+    t = np.arange(0.0, 120.0, 0.1)
+    rpm = 60.0 + rng.normal(0.0, 3.0, t.size)
+    torque = np.repeat(12e3 + rng.normal(0.0, 500.0, t.size // 10), 10)
+    logged = sampling.logging_interval(t, rpm, torque)
+    assert logged.interval_s == pytest.approx(1.0) and logged.kind == "held values"
+    quantised = np.round(60.0 + rng.normal(0.0, 0.4, t.size))
+    assert sampling.held_interval_s(t, quantised) is None
+
+
 def test_min_max_channels_make_the_rows_interval_means():
     """With the torque's interval min/max the rows are aggregates over their spacing; the
     swing inside each interval is reported."""
