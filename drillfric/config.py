@@ -172,6 +172,11 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "(docs/torque_drag.md). An assumption: friction factors then scale about as "
             "1/tortuosity and are indicative. 0 = exactly vertical (no side force: rotating "
             "segments are skipped). Ignored when a survey is given.", min=0.0, max=10.0),
+        _positive("max_dogleg_deg_30m", 30.0, "°/30 m", "Largest dog-leg severity a survey "
+                  "station may show: beyond it the survey is refused as a suspected typo (an "
+                  "inclination of 5 for 50 bends the path 45°/30 m on each side and printed "
+                  "μ_k 35 % low); conventional wells stay below 10–15°/30 m. Raise it for a "
+                  "short-radius well.", max=300.0),
     ),
     "fluid": (
         Key("mud_density_kg_m3", float, 1200.0, "kg/m³", "Mud density in the annulus "

@@ -370,6 +370,29 @@ def _validate(table: pd.DataFrame, file) -> None:
     _check_range(table["azi_deg"].to_numpy(), 360.0, "azimuth", file)
 
 
+def check_doglegs(path: WellPath, limit_deg_30m: float, file) -> None:
+    """Refuse a path whose dog-leg severity between two stations exceeds
+    ``limit_deg_30m`` [°/30 m] (``survey.max_dogleg_deg_30m``): a bend no rotating drill
+    string follows, most often a typo (one station's inclination 5 for 50). The friction
+    factors scale with the side force such a bend invents (docs/theory.md §2).
+
+    Raises
+    ------
+    InputError
+        Naming the station and its severity.
+    """
+    dls = np.degrees(path.dls_rad_m) * 30.0
+    if not dls.size or float(np.max(dls)) <= limit_deg_30m:
+        return
+    k = int(np.argmax(dls))
+    md = path.md_m
+    raise InputError(f"survey stations {k + 1}–{k + 2} (MD {md[k]:g}–{md[k + 1]:g} m) bend "
+                     f"the path {dls[k]:.0f}°/30 m, beyond survey.max_dogleg_deg_30m = "
+                     f"{limit_deg_30m:g}°/30 m: a typo in a station?", file=file,
+                     fix="check those stations' inclination and azimuth, or raise [survey] "
+                         "max_dogleg_deg_30m for a short-radius well")
+
+
 def _check_range(values: np.ndarray, top: float, what: str, file) -> None:
     bad = (values < 0.0) | (values > top)
     if bad.any():

@@ -305,7 +305,7 @@ def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, surv
     cfg = _config(files.config, raw, config, overrides, files.string)
     given = default_name(path, files.data) if frame is None else FRAME_NAME
     shown = printable(name or cfg.well.name or given, 4096)
-    path_m = _well_path(files.survey, survey)
+    path_m = _checked(_well_path(files.survey, survey), cfg, files.survey)
     source, mappings = _open(files, cfg, frame) if header else (None, {})
     return Well(name=shown, dir_name=safe_name(shown, files.config or files.data),
                 files=files, config=cfg, survey=path_m, source=source, mappings=mappings)
@@ -381,8 +381,8 @@ def open_config(config, *, survey=None, overrides=None
                                                                        confined=False)
     if survey_path is not None:
         require_file(survey_path, "survey file")
-    return (_config(path, raw, None, overrides, find_string(path, raw)), survey_path,
-            _load_survey(survey_path))
+    cfg = _config(path, raw, None, overrides, find_string(path, raw))
+    return cfg, survey_path, _checked(_load_survey(survey_path), cfg, survey_path)
 
 
 # --------------------------------------------------------------------------- resolving
@@ -404,6 +404,16 @@ def _config(config_path: Path | None, raw: dict, config, overrides,
         table = raw.get("string") if isinstance(raw.get("string"), dict) else {}
         raw = raw | {"string": table | {"sections": witsml_objects.tubular_sections(string)}}
     return config_from_dict(raw, file=where, overrides=overrides)
+
+
+def _checked(path: WellPath | None, cfg: Config, file) -> WellPath | None:
+    """``path`` once its dog-legs pass ``survey.max_dogleg_deg_30m``
+    (:func:`drillfric.io.survey.check_doglegs`)."""
+    if path is not None:
+        from drillfric.io import survey as survey_io
+
+        survey_io.check_doglegs(path, cfg.survey.max_dogleg_deg_30m, file or "survey")
+    return path
 
 
 def _well_path(survey_path: Path | None, given) -> WellPath | None:

@@ -20,6 +20,7 @@ from drillfric.io.survey import (
     write_survey,
 )
 from drillfric.wellpath import minimum_curvature
+from tests.conftest import REPO
 
 FT = 0.3048
 VOLVE = ["F-10", "F-11_B", "F-12", "F-14", "F-15D", "F-4", "F-5"]
@@ -257,3 +258,27 @@ def test_tie_in_from_file_tvd_only(tmp_path):
     assert path.tvd_m.tolist() == [99.5, 199.5]
     path = read_survey(_write(tmp_path, "t.csv", "MD,INC,AZI,TVD\n100,0,0,\n200,0,0,199\n"))
     assert path.tvd_m.tolist() == [0.0, 100.0, 200.0]  # no TVD₀: surface station added
+
+
+def test_a_station_typo_bending_the_path_beyond_any_string_is_refused(tmp_path):
+    """Ninth attack F1: the demo survey with the inclination at 1860 m written 5.0 for 50
+    bends the path ≈ 45°/30 m on each side of it; the run printed μ_k = 0.182 for 0.28,
+    converged, status ok. Such a survey is refused in one line naming the stations, unless
+    ``[survey] max_dogleg_deg_30m`` allows it (a short-radius well)."""
+    from drillfric.io.well import open_config
+
+    table = pd.read_csv(REPO / "examples/demo/demo.survey.csv")
+    md_col, inc_col = table.columns[0], table.columns[1]
+    row = int(np.argmin(np.abs(table[md_col] - 1860.0)))
+    assert table.loc[row, inc_col] > 40.0
+    table.loc[row, inc_col] = table.loc[row, inc_col] / 10.0
+    table.to_csv(tmp_path / "typo.survey.csv", index=False)
+    (tmp_path / "typo.toml").write_text('[survey]\nfile = "typo.survey.csv"\n')
+    with pytest.raises(InputError, match=r"bend the path \d+°/30 m, beyond survey\."
+                                         r"max_dogleg_deg_30m = 30°/30 m"):
+        open_config(tmp_path / "typo.toml")
+    (tmp_path / "short.toml").write_text('[survey]\nfile = "typo.survey.csv"\n'
+                                         "max_dogleg_deg_30m = 100.0\n")
+    assert open_config(tmp_path / "short.toml")[2] is not None
+    _, _, demo = open_config(REPO / "examples/demo/demo.toml")  # 3°/30 m at most
+    assert demo is not None
