@@ -49,6 +49,16 @@ def test_a_frame_cut_at_every_byte_decodes_whole_once():
                              "0110": "2455.0", "0114": "150.0", "0118": "18.42", "0120": "41.0"}
 
 
+def test_bare_carriage_returns_end_lines():
+    """Ninth attack: a recorder ending its lines with a bare CR had no frame decoded ("no
+    WITS0 frame arrived … check the address"), while the file readers take bare CR."""
+    stream = FRAME.replace(b"\r\n", b"\r") * 2
+    for cut in (0, 7, len(stream) // 2, len(stream)):
+        decoder = Decoder()
+        frames = decoder.feed(stream[:cut]) + decoder.feed(stream[cut:])
+        assert len(frames) == 2 and frames[0]["0118"] == "18.42", cut
+
+
 def test_blank_lines_bare_newlines_unknown_codes_and_garbage_are_tolerated():
     noisy = (b"\r\n\nhello\n&&\n\n0114150.0\n9999123\n  \r\nnot an item\n012041.0\r\n!!\n"
              b"0120 stray line outside a frame\n")
@@ -156,7 +166,14 @@ def test_frames_sharing_a_second_are_spaced_by_arrival_and_time_only_increases()
     nxt = clock.time_s(datetime(2026, 11, 27, 14, 30, 16), 11.0, 0.0)
     assert nxt - times[0] == pytest.approx(1.0)
     assert clock.time_s(stamp, 11.1, 0.0) is None and clock.out_of_order == 1  # went back
-    assert clock.time_s(None, 12.0, nxt + 50.0) == nxt + 50.0  # no date/time: arrival
+    # no date/time after stamped frames: the rig's clock carried by the arrival time — not
+    # the computer's UTC clock (ninth attack: a rig clock hours behind UTC, one frame
+    # without its stamp, and every later frame was dropped as "before" it)
+    assert clock.time_s(None, 12.0, nxt + 6 * 3600.0) == pytest.approx(nxt + 1.0)
+    later = clock.time_s(datetime(2026, 11, 27, 14, 30, 18), 13.0, nxt + 6 * 3600.0)
+    assert later == pytest.approx(nxt + 2.0) and clock.out_of_order == 1
+    unstamped = FrameClock(None)  # a stream that never stamps: the computer's UTC clock
+    assert unstamped.time_s(None, 5.0, 1e9) == 1e9
     shifted = FrameClock(2.0).time_s(stamp, 0.0, 0.0)
     assert shifted == pytest.approx(times[0] - 7200.0)  # rig clock at UTC+2 → UTC
 

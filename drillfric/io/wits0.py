@@ -150,9 +150,9 @@ def _code(column, key: str, where: str) -> str:
 class Decoder:
     """Complete frames from a byte stream, each a ``{code: value text}`` mapping.
 
-    Tolerates blank lines, ``\\n`` or ``\\r\\n`` line ends, lines outside a frame and lines
-    that are no item (counted in :attr:`ignored`); a frame left open by a new ``&&`` is
-    discarded (:attr:`discarded`). Nothing grows without bound: a line longer than
+    Tolerates blank lines, ``\\n``, ``\\r\\n`` or bare ``\\r`` line ends, lines outside a
+    frame and lines that are no item (counted in :attr:`ignored`); a frame left open by a
+    new ``&&`` is discarded (:attr:`discarded`). Nothing grows without bound: a line longer than
     :data:`MAX_LINE` or a frame of more than :data:`MAX_ITEMS` items is dropped.
     """
 
@@ -167,6 +167,7 @@ class Decoder:
         """The frames completed by ``data``."""
         out = []
         start = 0
+        data = data.replace(b"\r", b"\n")  # a bare CR ends a line too (CR LF: a blank line)
         while (end := data.find(b"\n", start)) >= 0:
             piece, start = data[start:end], end + 1
             if self._overlong or len(self._pending) + len(piece) > MAX_LINE:

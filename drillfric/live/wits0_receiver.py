@@ -136,6 +136,7 @@ class FrameClock:
         self.last_s = last_s
         self._stamp: float | None = None
         self._first_arrival = 0.0
+        self._rig_arrival: float | None = None  # arrival of the last frame on the rig clock
         self.out_of_order = 0
 
     def ahead(self, clock: datetime | None, wall_s: float) -> bool:
@@ -148,9 +149,16 @@ class FrameClock:
     def time_s(self, clock: datetime | None, arrival_s: float, wall_s: float) -> float | None:
         """The time of a frame with date/time ``clock`` arriving at ``arrival_s`` (monotonic
         [s]) and wall time ``wall_s`` (UTC, [s] since 1970); None when it lies before the
-        last recorded frame (counted in :attr:`out_of_order`, not recorded)."""
+        last recorded frame (counted in :attr:`out_of_order`, not recorded). A frame without
+        date/time after frames with them keeps to the rig's clock: the last recorded time
+        plus the arrival time since (on the computer's UTC clock, one unstamped frame of a
+        rig clock behind UTC had put every later frame "before" it: all dropped)."""
         if clock is None:
-            t = wall_s if self.last_s is None else max(wall_s, self.last_s + _MIN_STEP_S)
+            if self._rig_arrival is not None:
+                t = self.last_s + max(arrival_s - self._rig_arrival, _MIN_STEP_S)
+                self._rig_arrival = arrival_s
+            else:
+                t = wall_s if self.last_s is None else max(wall_s, self.last_s + _MIN_STEP_S)
             self.last_s, self._stamp = t, None
             return t
         stamp = clock.replace(tzinfo=UTC).timestamp() - self.offset_s
@@ -163,7 +171,7 @@ class FrameClock:
         t = stamp + min(arrival_s - self._first_arrival, WITHIN_SECOND_S)
         if self.last_s is not None:
             t = min(max(t, self.last_s + _MIN_STEP_S), latest)
-        self.last_s = t
+        self.last_s, self._rig_arrival = t, arrival_s
         return t
 
 
