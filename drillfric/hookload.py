@@ -474,6 +474,33 @@ def withhold_friction(record: SegmentRecord, why: str, flag: Flag | None) -> Seg
                    quality_flags=tuple(dict.fromkeys(flags)))
 
 
+def light_string(hookload_N, model_N, tolerance: float) -> str:
+    """Why a depth-indexed log's hook load contradicts the configured string ("" when it
+    does not), one-sided: without the in-slips rows of a time log the block weight is not
+    known, but it only adds, so the logged hook load cannot be below the model's (the buoyed
+    string less the WOB, no block; rotating, so no axial drag) by more than ``tolerance``.
+    Depths and a survey in ft read as m had put it at 0.35× and printed μ 54 % low.
+
+    Parameters
+    ----------
+    hookload_N, model_N : array_like
+        Each window's median logged hook load and the model's [N].
+    tolerance : float
+        ``hookload.tolerance`` [-].
+    """
+    hook, model = np.asarray(hookload_N, float), np.asarray(model_N, float)
+    ok = np.isfinite(hook) & np.isfinite(model) & (model > 0)
+    if ok.sum() < 3:
+        return ""
+    ratio = float(np.median(hook[ok] / model[ok]))
+    if ratio >= 1.0 - tolerance:
+        return ""
+    return (f"the logged hook load is {ratio:.2f}× the configured string's weight less the "
+            f"WOB (median of {int(ok.sum())} windows), below it by more than hookload."
+            f"tolerance = {tolerance:g}, though the block only adds to it: depths or survey "
+            "in ft read as m, or a lighter string than configured?")
+
+
 @dataclass(frozen=True)
 class WeightVerdict:
     """What the string-weight check does to one segment.

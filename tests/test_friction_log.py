@@ -344,3 +344,41 @@ def test_usrop_f5_gives_a_plausible_friction_log(real_data):
                  & (raw["Rate of Penetration m/h"] > 0)).sum())
     assert light > 0 and any(f"on bottom in {light} of {len(raw)} rows" in note
                              for note in summary["assumed"])
+
+
+def test_a_hook_load_below_the_configured_string_withholds_the_depth_log(depth_log, tmp_path):
+    """Ninth attack F4: depths and survey in ft read as m put the logged hook load at 0.35×
+    the model's, and the friction log printed μ 54 % low, every window ok. The block only
+    adds to the hook load, so a depth log's may not lie below the modelled string by more
+    than hookload.tolerance: every window's friction withheld, the reason said."""
+    path, rows = depth_log
+    light = tmp_path / "light"
+    light.mkdir()
+    for name in ("d.toml", "d.survey.csv"):
+        (light / name).write_text((path.parent / name).read_text())
+    data = pd.read_csv(path)
+    data["HKLD [kN]"] = data["HKLD [kN]"] * 0.35
+    data.to_csv(light / "d.csv", index=False)
+    result = CliRunner().invoke(cli, ["run", str(light / "d.csv"), "--out",
+                                      str(tmp_path / "out"), "--no-report"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "out" / "d" / "summary.json").read_text())
+    assert summary["hookload"]["verdict"] == "contradicted"
+    assert "0.35× the configured string's weight" in summary["hookload"]["reason"]
+    assert summary["mu_k"] is None and "hook-load check" in summary["mu_k_reason"]
+    assert all(s["mu_k"] is None and "hookload_contradicts_string" in s["quality_flags"]
+               for s in summary["segments"])
+    table = pd.read_parquet(tmp_path / "out" / "d" / "friction_log.parquet")
+    assert table["mu"].isna().all()
+
+
+@pytest.mark.parametrize("ratio, withheld", [(1.0, False), (0.97, False), (1.8, False),
+                                             (0.9, True), (0.35, True)])
+def test_light_string_is_one_sided(ratio, withheld):
+    """The block weight is unknown in a depth log but only adds: any hook load above the
+    model passes, one more than the tolerance below it does not."""
+    from drillfric.hookload import light_string
+
+    model = np.array([1.0e6, 1.1e6, 1.2e6, 1.3e6])
+    assert bool(light_string(ratio * model, model, 0.05)) is withheld
+    assert light_string(ratio * model[:2], model[:2], 0.05) == ""  # too few windows to say

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -23,6 +24,7 @@ from drillfric.estimation.friction_log import (
     read_depth_log,
 )
 from drillfric.friction import FrictionProfile
+from drillfric.hookload import light_string, weight_verdict, withhold_friction
 from drillfric.io.text import plural
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.result import RunProgress, WellResult
@@ -61,6 +63,7 @@ def _friction_log(well: Well, sink: Sink, rate_hz, progress, chunk_rows,
     log = read_depth_log(well, chunk_rows)
     tick = (lambda done: progress(RunProgress(len(log), len(log), done))) if progress else None
     results, notes = estimate(well, log, tick)
+    results, weighed = _weighed(results, well.config.hookload.tolerance)
     for r in results:
         sink.add({"profile": _profile(r.window.id, r.td)} if r.td is not None else {}, False)
     records = [r.record for r in results]
@@ -73,11 +76,39 @@ def _friction_log(well: Well, sink: Sink, rate_hz, progress, chunk_rows,
                         warnings=warnings, wall_s=time.perf_counter() - t_wall,
                         profile=FrictionProfile.from_config(well.config))
     summary.update(index="depth", friction_log=_log_summary(well, log, results),
-                   hookload=dict(UNCHECKED))
-    if any(r.record.status is Status.OK for r in results):
+                   hookload=weighed)
+    if weighed["verdict"] == "contradicted":
+        withheld = f"friction factors withheld by the hook-load check: {weighed['reason']}"
+        summary["warnings"].append(withheld)
+        summary["friction_log"]["mu_k_reason"] = withheld
+        if summary["mu_k"] is None:
+            summary["mu_k_reason"] = withheld
+    elif any(r.record.status is Status.OK for r in results):
         summary["warnings"].append(UNCHECKED_WARNING)
     return finish(sink, well, summary, records,
                   tables={"friction_log.parquet": log_table(results)})
+
+
+def _weighed(results: list[WindowResult], tolerance: float
+             ) -> tuple[list[WindowResult], dict]:
+    """The windows after the one-sided hook-load check of a depth log
+    (:func:`drillfric.hookload.light_string`, over the windows that log the WOB): where the
+    hook load says the configured string is too heavy, every estimated window's friction
+    factors withheld; summary.json ``hookload``."""
+    # the model subtracts the logged WOB: a window without one says nothing of the string
+    estimated = [r for r in results if r.td is not None and np.isfinite(r.window.wob_N)]
+    why = light_string([r.window.hookload_N for r in estimated],
+                       [r.td.hookload_N for r in estimated], tolerance)
+    if not why:
+        return results, dict(UNCHECKED)
+    out = []
+    for r in results:
+        rule = weight_verdict(r.record.status, why, "", False)
+        out.append(replace(r, record=withhold_friction(r.record, rule.withhold, rule.flag))
+                   if rule.withhold else r)
+    return out, {"verdict": "contradicted", "reason": why, "tolerance": tolerance,
+                 "withheld_segments": [r.record.id for r in out
+                                       if r.record.status is Status.OK and r.td is not None]}
 
 
 def _assumptions(well: Well, results: list[WindowResult], notes: list[str]) -> list[str]:
@@ -97,7 +128,7 @@ def _log_summary(well: Well, log: pd.DataFrame, results: list[WindowResult]) -> 
     there is no off-bottom one (``mu_k_reason``, null when ``mu_k`` is given)."""
     md = log["measured_depth_m"].to_numpy(float)
     apparent = [r.record.mu_k for r in results if r.record.status is Status.OK
-                and r.window.kind is Kind.ON_BOTTOM]
+                and r.window.kind is Kind.ON_BOTTOM and r.record.mu_k is not None]
     return {"window_m": well.config.friction_log.window_m, "rows": len(log),
             "md_start_m": float(md.min()), "md_end_m": float(md.max()),
             "bit_mu": well.config.friction_log.bit_mu,
