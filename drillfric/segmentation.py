@@ -238,7 +238,7 @@ def _column(frame: pd.DataFrame, name: str) -> np.ndarray:
     return np.full(len(frame), np.nan)
 
 
-def _pumps(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
+def pumps_on(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
     """Pumps on (1), off (0) or not known (-1), from flow in, pump rate, else SPP."""
     for column, key in (("flow_in_m3_s", "pumps_on_m3_s"), ("pump_rate_spm", "pumps_on_spm"),
                         ("standpipe_pressure_Pa", "pumps_on_Pa")):
@@ -280,7 +280,7 @@ def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
         _column(frame, "surface_torque_Nm"),
         _column(frame, "hookload_N"), _column(frame, "bit_depth_m"),
         _column(frame, "hole_depth_m"), _column(frame, "block_position_m"),
-        _column(frame, "wob_N"), _pumps(frame, cfg), _depth_mode(frame),
+        _column(frame, "wob_N"), pumps_on(frame, cfg), _depth_mode(frame),
         float(seg.rotating_rpm), min(float(seg.rotating_stop_rpm), float(seg.rotating_rpm)),
         float(seg.dip_max_s), float(seg.dip_torque_fraction),
         np.nan if slips is None else float(slips),
@@ -659,7 +659,8 @@ PREROLL_S = 5.0
 #: Columns a segment's rows keep (what estimation and the segment's measured values need).
 SEGMENT_COLUMNS = ("time_s", "surface_rpm", "surface_torque_Nm", "bit_depth_m", "wob_N",
                    "bit_rpm", "hookload_N", "timestamp", "surface_torque_min_Nm",
-                   "surface_torque_max_Nm")
+                   "surface_torque_max_Nm", "flow_in_m3_s", "pump_rate_spm",
+                   "standpipe_pressure_Pa")
 
 
 class SegmentStream:

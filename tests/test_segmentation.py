@@ -37,8 +37,8 @@ from drillfric.segmentation import (
     _column,
     _compiled_kernel,
     _kind_runs,
-    _pumps,
     classify,
+    pumps_on,
     segment,
 )
 from tests.conftest import REAL_DATA, REPO
@@ -384,7 +384,7 @@ def test_compiled_kernel_matches_its_python_source():
     args = [_column(data, c) for c in ("time_s", "surface_rpm", "surface_torque_Nm",
                                         "hookload_N", "bit_depth_m", "hole_depth_m",
                                         "block_position_m", "wob_N")]
-    args += [_pumps(data, cfg()), 1, 5.0, 2.5, 10.0, 0.5, 300e3, 0.5, 10e3, 0.1, 300.0 / 3600.0,
+    args += [pumps_on(data, cfg()), 1, 5.0, 2.5, 10.0, 0.5, 300e3, 0.5, 10e3, 0.1, 300.0 / 3600.0,
              0.05]
     carry = [np.nan, np.nan, 0.0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan]
     fast = _compiled_kernel()(*args, np.array(carry))

@@ -40,6 +40,7 @@ from drillfric.estimation.bit_torque import assess as assess_bit_torque
 from drillfric.estimation.consensus import pool_short_segments
 from drillfric.hookload import PlateauFinder, StringWeightCalibration, judge
 from drillfric.io.logcheck import LogCheck
+from drillfric.io.text import plural
 from drillfric.io.tracks import TrackAccumulator
 from drillfric.io.well import Well, frame_source
 from drillfric.result import RunProgress, SegmentRecord, WellResult
@@ -50,7 +51,7 @@ from drillfric.vocabulary import Kind, Status
 
 from .estimator import SegmentEstimator, first_chunk
 from .finish import MemorySink, Sink, finish, summarise
-from .segment_output import iso
+from .segment_output import MOTOR_NOTE, iso
 from .state import read_state, write_state
 
 #: Relative change of the string-weight scale beyond which a segment estimated with the
@@ -239,7 +240,8 @@ class Engine:
         self.check.finish(self.tracker.duplicates)
         warnings = self.warnings + [w for w in (
             self.check.duplicates_note(self.tracker.duplicates),
-            self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail)) if w]
+            self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail),
+            _motor_note(self.records)) if w]
         plateaus = self.hook.close()
         calibration = None
         if self.calibration is not None:
@@ -445,6 +447,18 @@ def _published(record: SegmentRecord) -> dict:
 def _revision(old: SegmentRecord, new: SegmentRecord, why: str) -> dict:
     return {"segment": new.id, "reason": why, "before": _published(old),
             "after": _published(new)}
+
+
+def _motor_note(records: list[SegmentRecord]) -> str | None:
+    """The well's warning, once, where bit speeds were shown with the pumps on (issue 34
+    item 5: a mud motor's speed is not in them), or None."""
+    ids = [str(r.id) for r in records if MOTOR_NOTE in (r.message or "")]
+    if not ids:
+        return None
+    return (f"bit speed shown with the pumps on in {plural(len(ids), 'segment')} "
+            f"({', '.join(ids[:10])}{', …' if len(ids) > 10 else ''}): it is the string's "
+            "bottom speed — with a mud motor in the BHA the bit turns faster by the motor's "
+            "speed, which drillfric does not model")
 
 
 def _cut_line_note(well: Well, tail: list) -> str:

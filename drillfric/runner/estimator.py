@@ -5,6 +5,8 @@ resamples to (:mod:`drillfric.runner.engine` calls it as segments close).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 
@@ -18,7 +20,7 @@ from drillfric.segmentation import Segment
 from drillfric.vocabulary import Kind, Status
 
 from .checks import bit_depth_default, check_first_chunk, precheck
-from .segment_output import output_frames, segment_record
+from .segment_output import MOTOR_NOTE, output_frames, pumped, segment_record
 
 #: Relative margin by which a requested rate may exceed the data's nominal rate (timing
 #: jitter) before it counts as upsampling.
@@ -84,8 +86,11 @@ class SegmentEstimator:
             return segment_record(seg, depth, Status.FAILED, exc.message, rows), {}
         if est.converged and seg.kind == Kind.OFF_BOTTOM:
             self.warm = (est.mu_s_seed, est.mu_k)
-        return (segment_record(seg, depth, Status.OK, seg.message, rows, est),
-                output_frames(seg, est, data, rows, self.settings.omega_c_rad_s))
+        record = segment_record(seg, depth, Status.OK, seg.message, rows, est)
+        if record.bit_speed_resolved and pumped(rows, self.well.config):
+            record = replace(record, message="; ".join(filter(None, [record.message,
+                                                                     MOTOR_NOTE])))
+        return (record, output_frames(seg, est, data, rows, self.settings.omega_c_rad_s))
 
     def state(self) -> dict:
         """What passes to the next segment (plain values)."""

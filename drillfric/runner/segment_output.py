@@ -4,6 +4,8 @@ SegmentRecord` and its output rows (estimates.parquet, profiles.parquet; docs/ou
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pandas as pd
 
@@ -14,9 +16,28 @@ from drillfric.estimation.segment_data import SegmentData
 from drillfric.hookload import withhold_friction
 from drillfric.io.timebase import clock_at, origin_of
 from drillfric.result import SEEDED_START_ID, SegmentRecord
-from drillfric.segmentation import Segment
+from drillfric.segmentation import Segment, pumps_on
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.vocabulary import Kind, Status
+
+if TYPE_CHECKING:
+    from drillfric.config import Config
+
+
+#: The note of a segment whose bit speed is shown while the pumps ran (issue 34 item 5): the
+#: trace is the string's bottom speed; a mud motor would add its own (≈ k·flow).
+MOTOR_NOTE = ("the pumps were on while the string turned: the bit speed shown is the "
+              "string's bottom speed — with a mud motor the bit turns faster by the motor's "
+              "speed, which drillfric does not model")
+
+
+def pumped(rows: pd.DataFrame, cfg: Config) -> bool:
+    """Whether the pumps ran (flow, pump rate or standpipe pressure above its
+    ``segmentation.pumps_on_*``) through most of a segment's turning rows."""
+    turning = rows["surface_rpm"].to_numpy(float) > cfg.segmentation.rotating_rpm
+    on = pumps_on(rows, cfg)[turning]
+    known = on >= 0
+    return bool(known.sum()) and float(np.mean(on[known] == 1)) >= 0.5
 
 
 def segment_record(seg: Segment, depth: float, status: Status, message: str, rows: pd.DataFrame,
