@@ -804,6 +804,30 @@ def test_a_followed_file_replaced_by_another_is_one_line_not_spliced(tmp_path):
         tail.poll()
 
 
+@pytest.mark.parametrize("rewrite", ["1,2,3\n", "1,7\n2,3\n"],
+                         ids=["longer line spliced", "same length, stale value"])
+def test_a_followed_file_rewritten_in_place_is_one_line(tmp_path, rewrite):
+    """Ninth attack F6: a logger rewriting the followed file in place (same inode, no
+    rename) had live read a spliced half-line ("time goes backwards…"), or keep stale rows
+    silently when the rewrite kept the length. The last bytes read are checked at every
+    poll; appending stays fine."""
+    from drillfric.errors import InputError
+    from drillfric.live.source import Tail
+
+    path = tmp_path / "g.csv"
+    path.write_text("time_s,x\n0,1\n1,2\n")
+    tail = Tail(path)
+    tail.poll()
+    with open(path, "a") as fh:
+        fh.write("2,3\n")
+    assert tail.poll() == len(path.read_bytes())  # appended: followed on
+    with open(path, "r+") as fh:  # rewritten in place from row 1 on, same inode
+        fh.seek(len("time_s,x\n0,1\n"))
+        fh.write(rewrite)
+    with pytest.raises(InputError, match="rewritten in place"):
+        tail.poll()
+
+
 def test_pdf_tables_draw_at_most_their_cap_of_rows():
     """A summary.json of a million 'assumed' lines grew report --pdf past 5 GB."""
     from drillfric.report.pdf import MAX_TABLE_ROWS, table_pages

@@ -38,6 +38,9 @@ MAX_BLOCK = 64 * 2**20
 #: Longest line a rig log may hold [bytes]: a longer one (a never-ending line, a run of NUL
 #: bytes) is no text log, not a line to wait for.
 MAX_LINE_BYTES = 2**20
+#: Last bytes read kept and compared with the file at every poll [bytes]: a file rewritten in
+#: place (same inode) shifts or changes them.
+TAIL_BYTES = 4096
 
 
 def follow(path: Path) -> Tail | PartsTail:
@@ -76,6 +79,7 @@ class Tail:
         self.path, self.end = Path(path), 0
         self._digest = hashlib.sha256()
         self._identity: tuple[int, int] | None = None  # (device, inode) of what was read
+        self._tail = b""  # the last bytes read, to see a rewrite in place
         if start:
             self._take(start)
 
@@ -104,6 +108,11 @@ class Tail:
                              "continue them", file=self.path,
                              fix="append to the file; restart live on a new --out for a "
                                  "rewritten file")
+        if self.end and identity == self._identity and not self._same_tail():
+            raise InputError("the file was rewritten in place: its last bytes read are no longer "
+                             "the ones read", file=self.path,
+                             fix="append to the file; restart live on a new --out for a "
+                                 "rewritten file")
         self._identity = identity
         while size > self.end:  # the partial last line is read again: it may have ended
             with open(self.path, "rb") as fh:  # in blocks: memory bounded by MAX_BLOCK
@@ -118,6 +127,17 @@ class Tail:
                 break
             self._take(self.end + cut, block[:cut])
         return self.end
+
+    def _same_tail(self) -> bool:
+        """Whether the file still holds the last bytes read where they were read (a logger
+        that rewrites its file in place, same inode, shifts or changes them: the ninth
+        attack's spliced half-line, or stale rows kept silently)."""
+        try:
+            with open(self.path, "rb") as fh:
+                fh.seek(self.end - len(self._tail))
+                return fh.read(len(self._tail)) == self._tail
+        except OSError:
+            return False
 
     def _same_start(self) -> bool:
         """Whether the file now starts with the bytes read so far (a logger that rewrites
@@ -157,7 +177,7 @@ class Tail:
 
     def restart(self, found: dict | None) -> None:
         """Continue after the mark ``found`` (None: from the start)."""
-        self.end, self._digest = 0, hashlib.sha256()
+        self.end, self._digest, self._tail = 0, hashlib.sha256(), b""
         if found:
             self._take(found["bytes"])
 
@@ -167,6 +187,7 @@ class Tail:
                 fh.seek(self.end)
                 block = fh.read(end - self.end)
         self._digest.update(block)
+        self._tail = (self._tail + block)[-TAIL_BYTES:]
         self.end = end
 
     def mark(self) -> dict:
