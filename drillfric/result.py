@@ -52,6 +52,7 @@ class Flag(StrEnum):
     MU_K_UNCERTAIN = "mu_k_uncertain"
     MU_K_DEPENDS_ON_MU_S = "mu_k_depends_on_mu_s"
     FACTORS_RUN_AWAY = "factors_run_away"
+    PIPE_MOVING = "pipe_moving"
 
 
 #: What each flag means (docs/outputs.md).
@@ -123,6 +124,10 @@ FLAG_MEANINGS = {
                              "the string in the slips, where it should read zero: a zero "
                              "offset that moves μ by as much (summary.json torque_zero, "
                              "docs/theory.md §2.1): friction factors withheld (null)",
+    Flag.PIPE_MOVING: "the pipe moves along the hole as it turns (reaming, back-reaming): μ_s "
+                      "is not identifiable (no point sticks in torsion once |v| > ω_c·r_c), "
+                      "the observer's μ_k is left out of the agreement and its bit speed "
+                      "withheld (it has no axial model, docs/theory.md §3.3)",
 }
 
 
@@ -178,6 +183,7 @@ FLAG_RAISED_BY = {
     Flag.MU_K_UNCERTAIN: (_VERDICT + "_batch_converged",),
     Flag.MU_K_DEPENDS_ON_MU_S: (_FIT + "kinetic.fit_kinetic",),
     Flag.FACTORS_RUN_AWAY: (_VERDICT + "decide_trace",),
+    Flag.PIPE_MOVING: (_VERDICT + "_pipe_moving",),
 }
 
 
