@@ -503,6 +503,17 @@ def _moving_case(settings: ChainSettings, data: SegmentData, mu: float | None) -
                 friction=friction)
 
 
+def while_moving(data: SegmentData) -> SegmentData:
+    """A reaming segment's samples while the pipe moves at its speed (``axial_span_s``): the
+    moving load case's F_c holds there only — before and after, the string turns in place
+    with the rotating case's (a run of the fit has one F_c). Other segments unchanged."""
+    if not data.axial_speed_m_s or data.axial_span_s is None:
+        return data
+    t0, t1 = data.axial_span_s
+    outside = (data.time_s < t0) | (data.time_s > t1)
+    return _without(data, outside) if (~outside).sum() >= 20 else data
+
+
 def axial_series(data: SegmentData, meas: Measurements) -> torsional.Axial | None:
     """A reaming segment's axial speed on the measurements' grid: v within
     ``data.axial_span_s``, 0 outside it (the block's short ramps cut at their middle by
@@ -730,6 +741,7 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     """
     tick = progress or (lambda amount: None)
     out_rate = output_rate_hz or settings.observer.output_rate_hz
+    data = while_moving(data)
     models = build_models(settings, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
     moving_note = ()
     if models.axial is not None:  # the fixed point on μ first: the observer takes its F_c
