@@ -230,7 +230,8 @@ class SegmentRecord:
 
     id: int = _f("", "segment number, 1-based, in time order", 0)
     kind: Kind = _f("", "load case: off_bottom_rotating, on_bottom_rotating, reaming or "
-                        "back_reaming (the last two skipped)",
+                        "back_reaming (the last two estimated with the moving load case "
+                        "where the pipe's speed is steady over ≤ 30 m, docs/theory.md §3.3)",
                     Kind.OFF_BOTTOM)
     t_start_s: float = _f("s", "time of the segment's first sample", 0.0)
     t_end_s: float = _f("s", "time of the segment's last sample", 0.0)

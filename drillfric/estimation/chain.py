@@ -10,7 +10,10 @@ only wires them):
    previous segment's estimates, the warm start) over the first ``observer.starts_window_s``:
    the online estimates, their spread and settling;
 3. :func:`batch_fit` — the speed-driven fit (§6.4): μ_k by mean-torque matching, μ_s where a
-   creep identifies it, or a lower bound from the stick-slip onset;
+   creep identifies it, or a lower bound from the stick-slip onset; of a reaming segment
+   (estimated over the pipe's motion, :func:`while_moving`), :func:`moving_fit`: the fit with
+   the friction split by the axial speed, within a fixed point on μ of the moving load
+   case's F_c (§3.3), run before step 2;
 4. :func:`drillfric.estimation.verdict.decide` — what may be claimed (pure rules);
 5. :func:`seeded_pass` — the observer once more over the whole segment, seeded with the
    refined factors (held, not adapted, by default) as a small ensemble spread over the
