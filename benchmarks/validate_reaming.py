@@ -18,8 +18,8 @@ Zero false claims is the line. The hook load of each estimated reaming segment i
 against its model (the moving case at the fitted μ_k) as well.
 
 Run: ``python benchmarks/validate_reaming.py [--quick] [--json FILE]`` (quick: one truth,
-four stands, 10 and 1 Hz, ≈ 3 min on one core; full ≈ 15 min). The simulations use 1000
-cells (Δx ≈ 2.3 m; the estimator's fit runs at Δx ≤ 5 m).
+four stands, 10 and 1 Hz; the full sweep took ≈ 70 s with one numba thread). The
+simulations use 1000 cells (Δx ≈ 2.3 m; the estimator's fit runs at Δx ≤ 5 m).
 """
 
 from __future__ import annotations
