@@ -277,9 +277,15 @@ class SegmentRecord:
     fit_quality: float | None = _f("-", "torque_rms_misfit_Nm / torque_swing_Nm (stick-slip "
                                         "drifts in phase: ~0.3–0.6 is normal there)")
     surface_torque_mean_Nm: float | None = _f("N·m", "mean measured rotating string torque")
-    hookload_N: float | None = _f("N", "median measured hook load over the segment")
+    hookload_N: float | None = _f("N", "median measured hook load over the segment (of a "
+                                       "reaming segment: while the pipe moves)")
     hookload_model_N: float | None = _f("N", "modelled rotating off-bottom hook load at this "
-                                             "depth (torque and drag, no block weight)")
+                                             "depth (torque and drag, no block weight; of a "
+                                             "reaming segment the rotating slack-off / pick-up "
+                                             "case at its axial speed and the fitted μ)")
+    axial_speed_m_s: float | None = _f("m/s", "of a reaming (+, running in) or back-reaming "
+                                              "(−) segment, the pipe's steady axial speed "
+                                              "(median bit-depth rate while it moves)")
     bit_speed_resolved: bool | None = _f("", "whether a bit-speed trace is reported: the "
                                              "logging resolves the stick-slip cycle, the bit "
                                              "is off bottom and the trace passes the "

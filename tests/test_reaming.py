@@ -209,3 +209,4 @@ def test_a_back_reaming_segment_gives_mu_k_and_a_consistent_hook_load(tmp_path):
     assert "μ_s not identifiable: the pipe moves axially" in ream["message"]
     assert "95 %" in ream["message"] and "no axial model" in ream["message"]
     assert ream["hookload_model_N"] / ream["hookload_N"] == pytest.approx(1.0, abs=0.005)
+    assert ream["axial_speed_m_s"] == pytest.approx(-0.2, rel=0.02)

@@ -24,6 +24,7 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
     base = dict(id=seg.id, kind=Kind(seg.kind), t_start_s=seg.t_start_s, t_end_s=seg.t_end_s,
                 bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message,
                 hookload_N=_median(_while_moving(rows, seg), "hookload_N"), **_clock(rows, seg),
+                axial_speed_m_s=seg.axial_speed_m_s,
                 **_drilling(seg, rows))
     if est is None:
         return SegmentRecord(**base)
