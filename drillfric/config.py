@@ -323,9 +323,10 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
         _positive("ream_speed_m_s", 0.05, "m/s", "Axial pipe speed (bit depth rate, from the "
                   "bit depth or the block position) above which a string turning off bottom "
                   "is reaming (running in) or back-reaming (pulling out): the wall friction "
-                  "then splits between axial and tangential, and those segments' μ and bit "
-                  "speed are withheld (docs/segmentation.md). At 0.05 m/s and 40 RPM a 7-in "
-                  "tool joint loses under 1 % of its tangential friction.", max=100.0),
+                  "then splits between axial and tangential: those segments' μ_k comes from "
+                  "the moving load case, their μ_s and bit speed are withheld "
+                  "(docs/segmentation.md). At 0.05 m/s and 40 RPM a 7-in tool joint loses "
+                  "under 1 % of its tangential friction.", max=100.0),
         _positive("max_rop_m_h", 300.0, "m/h", "Fastest drilling: a bit going below the "
                   "known hole depth faster than this is running into existing hole (off "
                   "bottom). A huge value switches the speed gate off.", max=1e7),

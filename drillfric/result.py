@@ -52,6 +52,7 @@ class Flag(StrEnum):
     MU_K_UNCERTAIN = "mu_k_uncertain"
     MU_K_DEPENDS_ON_MU_S = "mu_k_depends_on_mu_s"
     FACTORS_RUN_AWAY = "factors_run_away"
+    PIPE_MOVING = "pipe_moving"
 
 
 #: What each flag means (docs/outputs.md).
@@ -123,6 +124,10 @@ FLAG_MEANINGS = {
                              "the string in the slips, where it should read zero: a zero "
                              "offset that moves μ by as much (summary.json torque_zero, "
                              "docs/theory.md §2.1): friction factors withheld (null)",
+    Flag.PIPE_MOVING: "the pipe moves along the hole as it turns (reaming, back-reaming): μ_s "
+                      "is not identifiable (no point sticks in torsion once |v| > ω_c·r_c), "
+                      "the observer's μ_k is left out of the agreement and its bit speed "
+                      "withheld (it has no axial model, docs/theory.md §3.3)",
 }
 
 
@@ -178,6 +183,7 @@ FLAG_RAISED_BY = {
     Flag.MU_K_UNCERTAIN: (_VERDICT + "_batch_converged",),
     Flag.MU_K_DEPENDS_ON_MU_S: (_FIT + "kinetic.fit_kinetic",),
     Flag.FACTORS_RUN_AWAY: (_VERDICT + "decide_trace",),
+    Flag.PIPE_MOVING: (_VERDICT + "_pipe_moving",),
 }
 
 
@@ -224,7 +230,8 @@ class SegmentRecord:
 
     id: int = _f("", "segment number, 1-based, in time order", 0)
     kind: Kind = _f("", "load case: off_bottom_rotating, on_bottom_rotating, reaming or "
-                        "back_reaming (the last two skipped)",
+                        "back_reaming (the last two estimated with the moving load case "
+                        "where the pipe's speed is steady over ≤ 30 m, docs/theory.md §3.3)",
                     Kind.OFF_BOTTOM)
     t_start_s: float = _f("s", "time of the segment's first sample", 0.0)
     t_end_s: float = _f("s", "time of the segment's last sample", 0.0)
@@ -270,9 +277,15 @@ class SegmentRecord:
     fit_quality: float | None = _f("-", "torque_rms_misfit_Nm / torque_swing_Nm (stick-slip "
                                         "drifts in phase: ~0.3–0.6 is normal there)")
     surface_torque_mean_Nm: float | None = _f("N·m", "mean measured rotating string torque")
-    hookload_N: float | None = _f("N", "median measured hook load over the segment")
+    hookload_N: float | None = _f("N", "median measured hook load over the segment (of a "
+                                       "reaming segment: while the pipe moves)")
     hookload_model_N: float | None = _f("N", "modelled rotating off-bottom hook load at this "
-                                             "depth (torque and drag, no block weight)")
+                                             "depth (torque and drag, no block weight; of a "
+                                             "reaming segment the rotating slack-off / pick-up "
+                                             "case at its axial speed and the fitted μ)")
+    axial_speed_m_s: float | None = _f("m/s", "of a reaming (+, running in) or back-reaming "
+                                              "(−) segment, the pipe's steady axial speed "
+                                              "(median bit-depth rate while it moves)")
     bit_speed_resolved: bool | None = _f("", "whether a bit-speed trace is reported: the "
                                              "logging resolves the stick-slip cycle, the bit "
                                              "is off bottom and the trace passes the "

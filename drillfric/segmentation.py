@@ -19,7 +19,7 @@ gaps, so :class:`Segmenter` reproduces :func:`segment` exactly on data fed in ch
 from __future__ import annotations
 
 import heapq
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -42,9 +42,10 @@ DRILLING_STATES = (ROTATING_ON_BOTTOM, SLIDING_ON_BOTTOM)
 TURNING_STATES = (ROTATING_OFF_BOTTOM, ROTATING_ON_BOTTOM, REAMING, BACK_REAMING)
 #: Segment kind of each turning state (docs/outputs.md ``kind`` values).
 KINDS = STATE_KINDS
-#: Kinds whose friction factors and bit speed are withheld: the pipe moves along the hole
-#: while it turns, so the wall friction splits between axial and tangential, and the
-#: estimators model pure rotation (docs/segmentation.md "Reaming").
+#: Kinds in which the pipe moves along the hole while it turns: the wall friction splits
+#: between axial and tangential (docs/theory.md §3.3). Estimated with their axial speed
+#: where it is steady over a short travel (:func:`axial_motion`), else skipped with why
+#: (docs/segmentation.md "Reaming").
 COMBINED_MOTION_KINDS = (Kind.REAMING, Kind.BACK_REAMING)
 
 #: How the bit depth is known: measured channel, reckoned from the block, or not at all.
@@ -62,8 +63,8 @@ class Segment:
     id : int
         Running number, 1-based, in time order.
     kind : Kind
-        Off or on bottom, reaming or back-reaming (the last two always skipped:
-        :data:`COMBINED_MOTION_KINDS`).
+        Off or on bottom, reaming or back-reaming (the last two skipped where their axial
+        speed is not steady or their travel too long: :func:`axial_motion`).
     t_start_s, t_end_s : float
         Times of the first and the last sample of the segment [s].
     i_start, i_end : int
@@ -78,6 +79,12 @@ class Segment:
         ``"ok"`` or ``"skipped"``.
     message : str
         Why the segment is skipped ("" when ok).
+    axial_speed_m_s : float or None
+        Of a reaming (> 0, running in) or back-reaming (< 0) segment, the pipe's steady
+        axial speed [m/s]: the median rate of the bit depth while it moves (None for the
+        other kinds, or where it is not known; :func:`axial_motion`).
+    axial_from_s, axial_to_s : float or None
+        When the pipe moves at that speed within the segment [s] (None likewise).
     """
 
     id: int
@@ -92,6 +99,9 @@ class Segment:
     duration_s: float
     status: str
     message: str
+    axial_speed_m_s: float | None = None
+    axial_from_s: float | None = None
+    axial_to_s: float | None = None
 
 
 # ----------------------------------------------------------------------------------------
@@ -474,9 +484,12 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
             if t1 - t0 < float(cfg.segmentation.min_rotation_s):
                 continue  # a blip of speed noise, not rotation
             status, message = _status(t1 - t0, n_null, i1 - i0, min_s)
+            motion = None
             if KINDS[state] in COMBINED_MOTION_KINDS:
-                status, message = "skipped", _combined_motion(KINDS[state], depth,
-                                                              t[i0:i1])
+                motion = axial_motion(KINDS[state], depth, t[i0:i1])
+                if motion.withheld:
+                    status, message = "skipped", motion.withheld
+            known = motion is not None and np.isfinite(motion.speed_m_s)
             out.append(Segment(
                 id=first_id + len(out),
                 kind=KINDS[state],
@@ -484,8 +497,97 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
                 bit_depth_m=float(np.median(finite)) if finite.size else float("nan"),
                 bit_depth_min_m=float(finite.min()) if finite.size else float("nan"),
                 bit_depth_max_m=float(finite.max()) if finite.size else float("nan"),
-                duration_s=t1 - t0, status=status, message=message))
+                duration_s=t1 - t0, status=status, message=message,
+                axial_speed_m_s=motion.speed_m_s if known else None,
+                axial_from_s=motion.from_s if known else None,
+                axial_to_s=motion.to_s if known else None))
     return out
+
+
+#: Span of the bit depth's rate [s]: (depth(t + span/2) − depth(t − span/2))/span, which
+#: takes the depth channel's quantisation (0.01 m: 2.5 % at 0.1 m/s) below the steadiness
+#: test's tolerance.
+AXIAL_RATE_SPAN_S = 4.0
+#: A reaming segment's pipe speed counts as steady when its 10th and 90th percentiles over
+#: the motion lie within this share of the median [-]: one speed then stands for the motion
+#: (the models take v piecewise constant, docs/theory.md §3.3).
+AXIAL_STEADY = 0.15
+#: Longest travel of a reaming segment estimated as one [m]: F_c (T_N) is taken at its
+#: median depth, which a longer travel through a changing section would not represent.
+MAX_REAM_TRAVEL_M = 30.0
+
+
+@dataclass(frozen=True)
+class AxialMotion:
+    """The pipe's motion over a reaming segment (:func:`axial_motion`).
+
+    Attributes
+    ----------
+    speed_m_s : float
+        Median rate of the bit depth while the pipe moves [m/s], + running in (NaN: none).
+    from_s, to_s : float
+        First and last time the pipe moves at half that speed or more [s].
+    withheld : str
+        Why the segment cannot be estimated ("" when it can).
+    """
+
+    speed_m_s: float
+    from_s: float
+    to_s: float
+    withheld: str = ""
+
+
+def axial_motion(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> AxialMotion:
+    """The axial speed of a reaming / back-reaming segment and whether it can be
+    estimated: a steady speed (:data:`AXIAL_STEADY`) over a travel of at most
+    :data:`MAX_REAM_TRAVEL_M`, and no jump of the depth channel.
+
+    The rate is the bit depth's change over :data:`AXIAL_RATE_SPAN_S`; the motion is where
+    its magnitude reaches half its 90th percentile (the block's ramps cut at their middle).
+
+    >>> t = np.arange(0.0, 100.0, 0.1)
+    >>> m = axial_motion("reaming", 2000.0 + 0.2 * np.clip(t - 20.0, 0.0, 60.0), t)
+    >>> round(m.speed_m_s, 3), round(m.from_s), round(m.to_s), m.withheld
+    (0.2, 20, 80, '')
+    """
+    ok = np.isfinite(depth_m) & np.isfinite(time_s)
+    d, t = np.asarray(depth_m, float)[ok], np.asarray(time_s, float)[ok]
+    nan = float("nan")
+    name = kind.replace("_", "-")
+    if t.size < 3 or t[-1] - t[0] < AXIAL_RATE_SPAN_S:
+        return AxialMotion(nan, nan, nan, f"{name}: too short to measure the pipe's speed")
+    jump = _depth_jump(kind, d, t)
+    if jump:
+        return AxialMotion(nan, nan, nan, jump)
+    half = 0.5 * AXIAL_RATE_SPAN_S
+    lo, hi = np.maximum(t - half, t[0]), np.minimum(t + half, t[-1])
+    rate = (np.interp(hi, t, d) - np.interp(lo, t, d)) / np.maximum(hi - lo, 1e-9)
+    sign = 1.0 if kind == Kind.REAMING else -1.0
+    along = sign * rate
+    peak = float(np.percentile(along, 90.0))
+    if not peak > 0:
+        return AxialMotion(nan, nan, nan, f"{name}: the bit depth does not move "
+                           f"{'down' if sign > 0 else 'up'}; μ and the bit speed are withheld")
+    moving = along >= 0.5 * peak
+    first, last = np.flatnonzero(moving)[[0, -1]]
+    core = along[first:last + 1]
+    speed = float(np.median(core))
+    p10, p90 = np.percentile(core, [10.0, 90.0])
+    motion = AxialMotion(sign * speed, float(t[first]), float(t[last]))
+    way = "running in" if sign > 0 else "pulling out"
+    if p10 < (1.0 - AXIAL_STEADY) * speed or p90 > (1.0 + AXIAL_STEADY) * speed:
+        return replace(motion, withheld=(
+            f"{name} at an unsteady speed: the pipe is {way} at {p10:.2g}–{p90:.2g} m/s "
+            f"(10th–90th percentile; median {speed:.2g} m/s), more than ±"
+            f"{100 * AXIAL_STEADY:.0f} % apart: one axial speed does not stand for the "
+            "motion, μ and the bit speed are withheld (docs/segmentation.md)"))
+    travel = speed * (motion.to_s - motion.from_s)
+    if travel > MAX_REAM_TRAVEL_M:
+        return replace(motion, withheld=(
+            f"{name} over {travel:.0f} m (> {MAX_REAM_TRAVEL_M:.0f} m): the string and its "
+            "side forces change along the travel, which one depth does not stand for; μ and "
+            "the bit speed are withheld (docs/segmentation.md)"))
+    return motion
 
 
 #: A bit depth changing faster than this within one sample is no pipe motion (trips run
@@ -493,29 +595,22 @@ def _segments(t, states, bit, nulls, cfg: Config, offset: int, first_id: int) ->
 DEPTH_JUMP_M_S = 5.0
 
 
-def _combined_motion(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> str:
-    """Why a reaming / back-reaming segment is not estimated: the pipe's speed (median over
-    the samples), or the jump of the depth channel that made it look like reaming (a depth
-    reset 127 → 168 m in 2 s had read "running in at 0 m/s": issue 35 item 7).
+def _depth_jump(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> str:
+    """Why a reaming / back-reaming segment is no pipe motion: the jump of the depth channel
+    that made it look like reaming (a depth reset 127 → 168 m in 2 s had read "running in
+    at 0 m/s": issue 35 item 7); "" when the depth moves no faster than a trip.
 
-    >>> _combined_motion("reaming", np.r_[np.full(5, 127.0), np.full(5, 168.2)],
-    ...                  np.arange(10.0)).split(" (")[0]
+    >>> _depth_jump("reaming", np.r_[np.full(5, 127.0), np.full(5, 168.2)],
+    ...             np.arange(10.0)).split(" (")[0]
     'reaming? the bit depth jumps by 41.2 m within one sample'
     """
-    ok = np.isfinite(depth_m)
-    d, t = np.asarray(depth_m, float)[ok], np.asarray(time_s, float)[ok]
-    step = np.abs(np.diff(d))
-    rate = step / np.maximum(np.diff(t), 1e-9)
+    step = np.abs(np.diff(depth_m))
+    rate = step / np.maximum(np.diff(time_s), 1e-9)
     if rate.size and rate.max() > DEPTH_JUMP_M_S:
         return (f"{kind.replace('_', '-')}? the bit depth jumps by {step[rate.argmax()]:.1f} m "
                 "within one sample (a depth reset or a re-zeroed block, not pipe motion): "
                 "μ and the bit speed are withheld; check the depth channel")
-    speed = float(np.median(rate)) if rate.size else float("nan")
-    way = "running in" if kind == Kind.REAMING else "pulling out"
-    return (f"{kind.replace('_', '-')}: the pipe is {way} at {speed:.2g} m/s while it turns, "
-            "so the wall friction splits between axial and tangential and the rotating model "
-            "(all friction tangential) does not hold: μ and the bit speed are withheld "
-            "(docs/segmentation.md)")
+    return ""
 
 
 def _nulls(frame: pd.DataFrame) -> dict[str, np.ndarray]:

@@ -32,7 +32,13 @@ class Kind(StrEnum):
     OFF_BOTTOM = "off_bottom_rotating"
     ON_BOTTOM = "on_bottom_rotating"
     REAMING = "reaming"  #: turning while running in faster than segmentation.ream_speed_m_s
-    BACK_REAMING = "back_reaming"  #: turning while pulling out (μ, bit speed withheld)
+    BACK_REAMING = "back_reaming"  #: turning while pulling out (bit speed withheld)
+
+
+#: Kinds in which the pipe moves along the hole as it turns: their μ_k (the moving load case,
+#: docs/theory.md §3.3) is kept out of the well μ_k and the report's friction log for now
+#: (docs/outputs.md).
+MOVING_KINDS = (Kind.REAMING, Kind.BACK_REAMING)
 
 
 class LoadCase(StrEnum):

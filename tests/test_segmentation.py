@@ -37,6 +37,7 @@ from drillfric.segmentation import (
     _column,
     _compiled_kernel,
     _kind_runs,
+    axial_motion,
     classify,
     pumps_on,
     segment,
@@ -120,17 +121,47 @@ def test_back_reaming_at_0_2_m_s_is_its_own_state_not_pure_rotation():
     assert np.all(slow == ROTATING_OFF_BOTTOM)
 
 
-def test_back_reaming_segment_is_skipped_with_the_reason():
-    """Issue 22: a back-reaming stretch is a segment of its own, never estimated as pure
-    rotation (μ and the bit speed withheld), cut from the rotation before it."""
+def test_back_reaming_segment_carries_its_axial_speed():
+    """Issue 22, issue 36 item 2: a back-reaming stretch is a segment of its own, cut from
+    the rotation before it, and carries the pipe's steady speed (signed, − pulling out) and
+    when it moves, for the estimators' moving load case (docs/theory.md §3.3)."""
     t = np.arange(400.0)
-    bit = 2000.0 - 0.2 * np.clip(t - 150.0, 0.0, None)
+    bit = 2000.0 - 0.2 * np.clip(t - 150.0, 0.0, 100.0)
     segs = segment(frame(np.r_[np.zeros(10), np.full(390, 40.0)], bit_depth_m=bit,
                          hole_depth_m=np.full(400, 2500.0)), cfg())
     kinds = [(s.kind, s.status) for s in segs]
-    assert kinds == [("off_bottom_rotating", "ok"), ("back_reaming", "skipped")]
-    assert "pulling out at 0.2 m/s" in segs[1].message and "withheld" in segs[1].message
-    assert segs[1].bit_depth_max_m < 2000.0
+    assert kinds[:2] == [("off_bottom_rotating", "ok"), ("back_reaming", "ok")]
+    ream = segs[1]
+    assert ream.axial_speed_m_s == pytest.approx(-0.2, rel=1e-6)
+    assert ream.axial_from_s == pytest.approx(150.0, abs=3.0)
+    assert ream.axial_to_s == pytest.approx(250.0, abs=3.0)
+    assert ream.bit_depth_max_m < 2000.0
+    assert segs[0].axial_speed_m_s is None
+
+
+@pytest.mark.parametrize(("depth", "words"), [
+    (lambda t: 2000.0 - 0.2 * np.clip(t - 150.0, 0.0, None), "over 49 m"),  # 247 s at 0.2
+    (lambda t: 2000.0 - 0.001 * np.clip(t - 150.0, 0.0, 100.0) ** 2, "unsteady speed"),
+])
+def test_reaming_that_one_speed_or_depth_cannot_stand_for_is_skipped_with_why(depth, words):
+    """A travel longer than MAX_REAM_TRAVEL_M (the string's side forces change along it) or a
+    speed that is not steady is not estimated: skipped, the reason in the message."""
+    t = np.arange(400.0)
+    segs = segment(frame(np.r_[np.zeros(10), np.full(390, 40.0)], bit_depth_m=depth(t),
+                         hole_depth_m=np.full(400, 2500.0)), cfg())
+    moving = [s for s in segs if s.kind == "back_reaming"]
+    assert moving and all(s.status == "skipped" for s in moving)
+    assert words in moving[0].message and "withheld" in moving[0].message
+
+
+def test_axial_motion_reads_the_speed_through_depth_quantisation():
+    """0.05 m/s logged at 1 Hz with a 0.01-m depth resolution: the median rate over 4 s is
+    the speed, steady within AXIAL_STEADY."""
+    t = np.arange(0.0, 300.0)
+    depth = np.round(2000.0 + 0.05 * np.clip(t - 50.0, 0.0, 200.0), 2)
+    motion = axial_motion("reaming", depth, t)
+    assert motion.withheld == "" and motion.speed_m_s == pytest.approx(0.05, rel=0.01)
+    assert abs(motion.from_s - 50.0) <= 3.0 and abs(motion.to_s - 250.0) <= 3.0
 
 
 def test_hole_depth_is_running_max_of_bit_depth():
@@ -451,7 +482,8 @@ def test_dsats_drilling_agreement(dsats_result):
     assert sum(s.status == "ok" for s in segs) >= 20
     kinds = {s.kind for s in segs}
     assert {"on_bottom_rotating", "off_bottom_rotating"} <= kinds <= set(KINDS.values())
-    assert all(s.status == "skipped" for s in segs if s.kind in COMBINED_MOTION_KINDS)
+    assert all(s.status == "skipped" or s.axial_speed_m_s is not None
+               for s in segs if s.kind in COMBINED_MOTION_KINDS)
 
 
 @pytest.mark.xfail(strict=True, reason="acceptance target (issue 6) not met on the whole "

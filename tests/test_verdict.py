@@ -90,6 +90,23 @@ CASES = [
      "an identified μ_s seeds the final pass before the model's regime value"),
     ("bound_seeds_without_model", dict(mu_s_model=None), dict(seed=0.3),
      "without a regime value the bound seeds"),
+    ("pipe_moving", dict(axial_speed_m_s=0.2),
+     dict(mu_k=0.2, converged=True, bound=None, seed=0.5, flags=(Flag.PIPE_MOVING,)),
+     "issue 36 item 2: while the pipe moves axially no point sticks in torsion once |v| > "
+     "ω_c·r_c: μ_s is not identifiable, no onset bound; the batch μ_k stands"),
+    ("pipe_moving_observer_left_out",
+     dict(axial_speed_m_s=-0.3, observer_mu_k=0.2 * DISAGREEMENT * 1.5),
+     dict(converged=True, flags=(Flag.PIPE_MOVING,)),
+     "the observer has no axial model (all its friction tangential): its μ_k is left out "
+     "of the agreement, not a disagreement"),
+    ("pipe_moving_still_needs_rotation",
+     dict(axial_speed_m_s=0.5, turning_s=MIN_CONVERGED_ROTATION_S - 1.0),
+     dict(converged=False, bound=None, flags=(Flag.PIPE_MOVING, Flag.TOO_SHORT_TO_CONVERGE)),
+     "the other rules of the batch μ_k still hold while the pipe moves"),
+    ("pipe_moving_uncertain",
+     dict(axial_speed_m_s=0.5, batch_mu_k_sigma=0.2),
+     dict(converged=False, flags=(Flag.PIPE_MOVING, Flag.MU_K_UNCERTAIN)),
+     "…and its statistical uncertainty"),
     ("flags_ordered_and_unique",
      dict(observer_flags=(Flag.OBSERVER_NOT_CONVERGED,),
           batch_flags=(Flag.MU_K_NOT_CONVERGED, Flag.MU_K_NOT_CONVERGED)),
@@ -183,6 +200,10 @@ TRACE_CASES = [
     ("undetermined_unlogged", dict(undetermined_note="why", logging=Resolution(False, 2.0)),
      dict(statistics=False, flags=()),
      "statistics a log cannot resolve are not flagged as undetermined"),
+    ("pipe_moving", dict(moving=True, undetermined_note="why"),
+     dict(shown=False, statistics=False, converged=True, flags=()),
+     "issue 36 item 2: the observer has no axial model, so neither the trace of a reaming "
+     "segment nor its statistics are shown (not validated); the factors stand"),
 ]
 
 
@@ -206,6 +227,19 @@ def test_every_trace_flag_and_withheld_window_is_explained():
     assert "withheld over 2 of 10 30-s windows" in v.messages[3]
     withheld = decide_trace(replace(PLAIN_TRACE, windows=MOST))
     assert "6 of its 10 30-s windows fail: creep" in withheld.bit_speed.reason
+    moving = decide_trace(replace(PLAIN_TRACE, moving=True))
+    assert "no axial model" in moving.bit_speed.reason
+
+
+def test_a_moving_pipe_says_why_mu_s_and_the_observer_are_left_out():
+    """The rule of issue 36 item 2 in words: μ_s not identifiable, the observer's μ_k left
+    out; the fit's note of an onset bound it would otherwise have stated is not kept."""
+    v = decide(replace(PLAIN, axial_speed_m_s=-0.3, batch_messages=(
+        "fit note; μ_s ≥ 0.30 from the stick-slip onset",)))
+    text = " | ".join(v.messages)
+    assert "μ_s not identifiable: the pipe moves axially (pulling out at 0.3 m/s" in text
+    assert "observer has no axial model" in text
+    assert v.mu_s_lower_bound is None and "onset" not in v.messages[0]
 
 
 def test_a_withheld_bound_is_not_stated_in_the_fits_note():

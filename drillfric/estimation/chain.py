@@ -10,7 +10,10 @@ only wires them):
    previous segment's estimates, the warm start) over the first ``observer.starts_window_s``:
    the online estimates, their spread and settling;
 3. :func:`batch_fit` — the speed-driven fit (§6.4): μ_k by mean-torque matching, μ_s where a
-   creep identifies it, or a lower bound from the stick-slip onset;
+   creep identifies it, or a lower bound from the stick-slip onset; of a reaming segment
+   (estimated over the pipe's motion, :func:`while_moving`), :func:`moving_fit`: the fit with
+   the friction split by the axial speed, within a fixed point on μ of the moving load
+   case's F_c (§3.3), run before step 2;
 4. :func:`drillfric.estimation.verdict.decide` — what may be claimed (pure rules);
 5. :func:`seeded_pass` — the observer once more over the whole segment, seeded with the
    refined factors (held, not adapted, by default) as a small ensemble spread over the
@@ -294,6 +297,8 @@ def _open_hole_friction(profile: FrictionProfile):
 def _td_cross_check(models: SegmentModels, settings: ChainSettings) -> float | None:
     """Static friction factor from the mean rotating string torque (T&D back-calculation)."""
     meas, td = models.meas, settings.td
+    if models.axial is not None:
+        return None  # the back-calculation models the string turning in place
     rotating = np.abs(meas.surface_rad_s) > 2.0 * settings.omega_c_rad_s
     if rotating.sum() < 10:
         return None
@@ -374,6 +379,8 @@ class SegmentModels:
         the EDR defects :mod:`drillfric.estimation.spikes` dropped.
     dropped : int
         How many samples were so dropped.
+    axial : drillfric.torsional.Axial or None
+        The pipe's axial speed on the measurements' grid while it reams (None: in place).
     """
 
     path: WellPath
@@ -385,11 +392,19 @@ class SegmentModels:
     logged: LoggingInterval
     sample_times_s: np.ndarray = field(repr=False)
     dropped: int = 0
+    axial: torsional.Axial | None = field(default=None, repr=False)
 
 
 def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentData, *,
-                 rate_hz: float | None = None, torque_channel=None) -> SegmentModels:
+                 rate_hz: float | None = None, torque_channel=None,
+                 mu_moving: float | None = None) -> SegmentModels:
     """Step 1: string, torque and drag, measurements and observer of one segment.
+
+    A reaming segment (``data.axial_speed_m_s`` ≠ 0) takes the moving load case —
+    ``rotating_slack_off`` running in, ``rotating_pick_up`` pulling out — at its |v| and
+    median RPM (docs/theory.md §2 steps 3–4): F_c then depends on μ through the axial share
+    of the drag, solved at ``mu_moving`` (default: the configured factor; :func:`moving_fit`
+    iterates it), and the models get v(t) (:func:`axial_series`).
 
     Raises
     ------
@@ -402,9 +417,13 @@ def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentDa
         "" if path is not None else " (or a nominal survey.tortuosity_deg_30m > 0)")
     path = _path_for(settings, path, data.bit_depth_m)
     on_bottom = data.kind == Kind.ON_BOTTOM
-    td = settings.td.solve(path, data.bit_depth_m, wob_N=data.wob_N,
-                           load_case=LoadCase.ROTATING_ON_BOTTOM if on_bottom
-                           else LoadCase.ROTATING_OFF_BOTTOM)
+    if data.axial_speed_m_s:
+        td = settings.td.solve(path, data.bit_depth_m, **_moving_case(settings, data,
+                                                                      mu_moving))
+    else:
+        td = settings.td.solve(path, data.bit_depth_m, wob_N=data.wob_N,
+                               load_case=LoadCase.ROTATING_ON_BOTTOM if on_bottom
+                               else LoadCase.ROTATING_OFF_BOTTOM)
     if td.T_N_Nm < 1.0:
         raise SkipSegment(f"no side force on the string at {data.bit_depth_m:.0f} m (T_N = "
                           f"{td.T_N_Nm:.2g} N·m: vertical hole), friction does not act on the "
@@ -425,7 +444,48 @@ def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentDa
                               torque_max_Nm=data.torque_max_Nm,
                               echo_s=2.0 * bit_trace.travel_time_s(string))
     return SegmentModels(path, string, td, meas, observer, on_bottom, logged, data.time_s,
-                         int(bad.sum()))
+                         int(bad.sum()), axial_series(data, meas))
+
+
+def _moving_case(settings: ChainSettings, data: SegmentData, mu: float | None) -> dict:
+    """Torque-and-drag arguments of a reaming segment's moving load case at μ (None: the
+    configured friction): |v| and the median top-drive RPM while the pipe moves."""
+    t0, t1 = data.axial_span_s or (data.time_s[0], data.time_s[-1])
+    inside = (data.time_s >= t0) & (data.time_s <= t1)
+    rpm = float(np.median(np.abs(data.surface_rpm[inside] if inside.any()
+                                 else data.surface_rpm)))
+    case = LoadCase.ROTATING_SLACK_OFF if data.axial_speed_m_s > 0 else \
+        LoadCase.ROTATING_PICK_UP
+    friction = None
+    if mu is not None:
+        friction = _open_hole_friction(settings.friction)
+        friction = friction(mu) if friction is not None else mu
+    return dict(load_case=case, axial_speed_m_s=abs(data.axial_speed_m_s), rpm=rpm,
+                friction=friction)
+
+
+def while_moving(data: SegmentData) -> SegmentData:
+    """A reaming segment's samples while the pipe moves at its speed (``axial_span_s``): the
+    moving load case's F_c holds there only — before and after, the string turns in place
+    with the rotating case's (a run of the fit has one F_c). Other segments unchanged."""
+    if not data.axial_speed_m_s or data.axial_span_s is None:
+        return data
+    t0, t1 = data.axial_span_s
+    outside = (data.time_s < t0) | (data.time_s > t1)
+    return _without(data, outside) if (~outside).sum() >= 20 else data
+
+
+def axial_series(data: SegmentData, meas: Measurements) -> torsional.Axial | None:
+    """A reaming segment's axial speed on the measurements' grid: v within
+    ``data.axial_span_s``, 0 outside it (the block's short ramps cut at their middle by
+    :func:`drillfric.segmentation.axial_motion`); None in place."""
+    if not data.axial_speed_m_s:
+        return None
+    t = meas.time_s
+    t0, t1 = data.axial_span_s or (t[0], t[-1])
+    v = np.where((t >= t0 - 0.5 * meas.dt_s) & (t <= t1 + 0.5 * meas.dt_s),
+                 data.axial_speed_m_s, 0.0)
+    return torsional.Axial(v, meas.dt_s, meas.t0_s)
 
 
 def _without(data: SegmentData, drop: np.ndarray) -> SegmentData:
@@ -481,7 +541,45 @@ def batch_fit(settings: ChainSettings, models: SegmentModels) -> batch.BatchResu
                         meas.motor_torque_Nm[:n_fit], string=models.string,
                         fc_Nm_m=models.td.fc_at, settings=settings.batch, torque_kind="motor",
                         cells=_batch_cells(settings, models.string.bit_depth_m),
-                        profile=settings.friction, sample_interval_s=models.logged.interval_s)
+                        profile=settings.friction, sample_interval_s=models.logged.interval_s,
+                        axial=models.axial)
+
+
+#: Passes of the moving load case's fixed point (docs/theory.md §3.3): F_c at μ, fit μ_k,
+#: F_c again at it; the fitted μ_k moves by a few % at most after the second pass.
+MOVING_PASSES = 3
+#: The fixed point stops once μ_k moves by less than this between passes [-].
+MOVING_TOLERANCE = 0.005
+
+
+def moving_fit(settings: ChainSettings, path: WellPath | None, data: SegmentData,
+               models: SegmentModels, rate_hz: float | None, torque_channel
+               ) -> tuple[SegmentModels, batch.BatchResult, str]:
+    """Step 3 of a reaming segment: the batch fit within a fixed point on μ.
+
+    While the pipe moves, F_c depends on μ through the axial share of the drag (the tension;
+    docs/theory.md §2 steps 3–4, §3.3): torque and drag at a μ guess (the configured
+    factor), fit μ_k, solve again at it and refit — at most :data:`MOVING_PASSES` fits,
+    stopping once μ_k moves by less than :data:`MOVING_TOLERANCE`. Returns the models and
+    fit of the last pass and the sentence that states it."""
+    refined, trail = batch_fit(settings, models), []
+    for _ in range(MOVING_PASSES - 1):
+        if refined.mu_k is None:
+            break
+        trail.append(refined.mu_k)
+        models = build_models(settings, path, data, rate_hz=rate_hz,
+                              torque_channel=torque_channel, mu_moving=refined.mu_k)
+        refined = batch_fit(settings, models)
+        if refined.mu_k is None or abs(refined.mu_k / trail[-1] - 1.0) < MOVING_TOLERANCE:
+            break
+    way = "reaming (rotating slack-off)" if data.axial_speed_m_s > 0 else \
+        "back-reaming (rotating pick-up)"
+    passes = " → ".join(f"{m:.3f}" for m in trail + ([refined.mu_k] if refined.mu_k else []))
+    note = (f"{way} at {abs(data.axial_speed_m_s):.2g} m/s: F_c of the moving load case, "
+            "the model splitting each cell's friction between torque and drag (docs/theory.md "
+            "§3.3); F_c depends on μ through the drag, solved as a fixed point "
+            f"({passes or 'no μ_k'})")
+    return models, refined, note
 
 
 def evidence(settings: ChainSettings, models: SegmentModels, diag: Diagnostics,
@@ -496,7 +594,16 @@ def evidence(settings: ChainSettings, models: SegmentModels, diag: Diagnostics,
                     observer_mu_k=diag.mu_k, observer_converged=diag.converged,
                     observer_flags=tuple(Flag(f"observer_{f}") for f in diag.flags),
                     turning_s=turning_s, on_bottom=models.on_bottom,
-                    batch_mu_k_sigma=refined.details.mu_k_sigma)
+                    batch_mu_k_sigma=refined.details.mu_k_sigma,
+                    axial_speed_m_s=_axial_speed(models))
+
+
+def _axial_speed(models: SegmentModels) -> float:
+    """The pipe's axial speed while it moves [m/s] (0 in place)."""
+    if models.axial is None:
+        return 0.0
+    v = np.asarray(models.axial.values)
+    return float(v[np.flatnonzero(v)[0]])
 
 
 def seeded_pass(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
@@ -525,7 +632,8 @@ def fit_evidence(settings: ChainSettings, models: SegmentModels, verdict: Verdic
         meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
         fc_Nm_m=models.td.fc_at, settings=settings.batch,
         mu_s=mu_s if mu_s is not None else verdict.mu_s_seed, mu_k=verdict.mu_k,
-        cells=_batch_cells(settings, models.string.bit_depth_m), profile=settings.friction)
+        cells=_batch_cells(settings, models.string.bit_depth_m), profile=settings.friction,
+        axial=models.axial)
     fast = np.flatnonzero(np.abs(meas.surface_rad_s) > settings.omega_c_rad_s)
     scored = t >= (t[fast[0]] + EVIDENCE_SKIP_S if fast.size else np.inf)
     if scored.sum() < 10:
@@ -549,7 +657,7 @@ def _model_at(settings: ChainSettings, models: SegmentModels, verdict: Verdict, 
             meas.time_s, meas.surface_rad_s, meas.motor_torque_Nm, string=models.string,
             fc_Nm_m=models.td.fc_at, settings=settings.batch, mu_s=scale * mu_s,
             mu_k=scale * verdict.mu_k, cells=_batch_cells(settings, models.string.bit_depth_m),
-            profile=settings.friction, bit_torque_Nm=bit_Nm)[2]
+            profile=settings.friction, bit_torque_Nm=bit_Nm, axial=models.axial)[2]
     return model_at
 
 
@@ -594,12 +702,20 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     """
     tick = progress or (lambda amount: None)
     out_rate = output_rate_hz or settings.observer.output_rate_hz
+    data = while_moving(data)
     models = build_models(settings, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
+    moving_note = ()
+    if models.axial is not None:  # the fixed point on μ first: the observer takes its F_c
+        models, refined, note = moving_fit(settings, path, data, models, rate_hz,
+                                           torque_channel)
+        moving_note = (note,)
     starts, first, diag = starts_pass(settings, models, warm, out_rate)
     tick(0.3)
-    refined = batch_fit(settings, models)
+    if models.axial is None:
+        refined = batch_fit(settings, models)
     tick(0.5)
     verdict = decide(evidence(settings, models, diag, refined))
+    verdict = replace(verdict, messages=moving_note + verdict.messages)
     fitted_result = beside(fit_evidence, settings, models, verdict, refined.mu_s)
     final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
@@ -638,7 +754,7 @@ def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch
         windows=windows, converged=verdict.converged,
         runaway_note=_runaway_note(verdict.mu_k, kinematics) if runaway else None,
         severe_note=bit_trace.statistics_note(severity),
-        undetermined_note=undetermined))
+        undetermined_note=undetermined, moving=models.axial is not None))
     return trace, kinematics
 
 

@@ -47,6 +47,11 @@ class SegmentData:
         Downhole truth when the input has it (validation).
     torque_min_Nm, torque_max_Nm : ndarray or None
         The torque's minimum and maximum within each logged interval, when the log has them.
+    axial_speed_m_s : float
+        Of a reaming (> 0) or back-reaming (< 0) segment, the pipe's steady axial speed
+        [m/s] (0: it turns in place; :func:`drillfric.segmentation.axial_motion`).
+    axial_span_s : (float, float) or None
+        When the pipe moves at that speed [s] (at rest before and after).
     """
 
     time_s: np.ndarray
@@ -58,6 +63,8 @@ class SegmentData:
     bit_rpm: np.ndarray | None = None
     torque_min_Nm: np.ndarray | None = None
     torque_max_Nm: np.ndarray | None = None
+    axial_speed_m_s: float = 0.0
+    axial_span_s: tuple | None = None
 
 
 def check_reach(path: WellPath | None, bit_depth_m: float) -> None:

@@ -76,6 +76,9 @@ class Evidence:
     on_bottom : bool
     batch_mu_k_sigma : float or None
         Statistical 1-σ uncertainty of the batch μ_k [-] (None: not known).
+    axial_speed_m_s : float
+        The pipe's axial speed while it turns [m/s] (+ reaming, − back-reaming; 0: in
+        place).
     """
 
     batch_mu_k: float | None
@@ -90,6 +93,7 @@ class Evidence:
     turning_s: float
     on_bottom: bool
     batch_mu_k_sigma: float | None = None
+    axial_speed_m_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -138,7 +142,10 @@ def decide(ev: Evidence) -> Verdict:
     3. a μ_s lower bound is withheld on bottom (the bit drives the swings) and under the
        flags of :data:`UNRELIABLE_BOUND`;
     4. μ_k outside :data:`TYPICAL_MU` is flagged (not changed);
-    5. on bottom the friction is apparent (bit torque included).
+    5. on bottom the friction is apparent (bit torque included);
+    6. while the pipe moves axially (reaming, back-reaming: :func:`_pipe_moving`) μ_s is not
+       identifiable — no μ_s, no bound — and the observer's μ_k, from a model with no axial
+       motion, is left out of rule 2's agreement.
 
     Examples
     --------
@@ -150,6 +157,8 @@ def decide(ev: Evidence) -> Verdict:
     flags = list(ev.observer_flags) + list(ev.batch_flags)
     messages = list(ev.batch_messages)
     bound = _shown_bound(ev, messages)
+    if ev.axial_speed_m_s != 0.0:
+        bound = _pipe_moving(ev, flags, messages)
     if ev.batch_mu_k is not None:
         mu_k, method = ev.batch_mu_k, Method.BATCH
         converged = _batch_converged(ev, flags, messages)
@@ -205,9 +214,33 @@ def _bound_or_why(ev: Evidence, messages: list) -> float | None:
     return ev.mu_s_lower_bound
 
 
+def _pipe_moving(ev: Evidence, flags: list, messages: list) -> None:
+    """The rule of a segment whose pipe moves axially as it turns: μ_s is not identifiable
+    (no bound either, returned as None) and the observer's μ_k is not compared
+    (docs/theory.md §3.3: with |v| > ω_c·r_c no cell sticks in torsion, and the observer
+    models pure rotation).
+
+    >>> ev = Evidence(0.25, (), (), None, 0.6, None, 0.2, True, (), 120.0, False,
+    ...               axial_speed_m_s=-0.3)
+    >>> decide(ev).flags, decide(ev).mu_s_lower_bound, decide(ev).converged
+    ((<Flag.PIPE_MOVING: 'pipe_moving'>,), None, True)
+    """
+    flags.append(Flag.PIPE_MOVING)
+    messages[:] = [_BOUND_NOTE.sub("", m) for m in messages]
+    way = "running in" if ev.axial_speed_m_s > 0 else "pulling out"
+    messages.append(f"μ_s not identifiable: the pipe moves axially ({way} at "
+                    f"{abs(ev.axial_speed_m_s):.2g} m/s; once |v| > ω_c·r_c no point of the "
+                    "string sticks in torsion, docs/theory.md §3.3): no creep fit, no "
+                    "stick-slip onset bound")
+    messages.append(f"the observer's μ_k ({ev.observer_mu_k:.3f}) is left out: the observer "
+                    "has no axial model, its torque takes all the friction as tangential")
+    return None
+
+
 def _batch_converged(ev: Evidence, flags: list, messages: list) -> bool:
     converged = not NOT_CONVERGED.intersection(ev.batch_flags)
-    if abs(np.log(ev.batch_mu_k / max(ev.observer_mu_k, 1e-6))) > np.log(DISAGREEMENT):
+    apart = abs(np.log(ev.batch_mu_k / max(ev.observer_mu_k, 1e-6))) > np.log(DISAGREEMENT)
+    if apart and ev.axial_speed_m_s == 0.0:  # the observer has no axial model
         converged = False
         flags.append(Flag.ESTIMATORS_DISAGREE)
         messages.append(f"batch μ_k = {ev.batch_mu_k:.3f} and observer μ_k = "
@@ -284,6 +317,8 @@ class TraceEvidence:
     undetermined_note : str or None
         Why the statistics are undetermined: members that disagree, a grazing bit, or
         windows the trace withholds (None: determined).
+    moving : bool
+        The pipe moves axially as it turns (reaming, back-reaming).
     """
 
     logging: Resolution
@@ -294,6 +329,13 @@ class TraceEvidence:
     runaway_note: str | None = None
     severe_note: str | None = None
     undetermined_note: str | None = None
+    moving: bool = False
+
+
+#: Why the bit speed of a reaming / back-reaming segment is withheld.
+NO_AXIAL_OBSERVER = ("bit speed withheld: the pipe moves axially and the observer has no "
+                     "axial model (its friction is all tangential, docs/theory.md §3.3); "
+                     "the stuck fraction and severity with it")
 
 
 @dataclass(frozen=True)
@@ -336,7 +378,9 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
     4. the stuck fraction and severity are shown only where the logging resolves the
        cycle off bottom, withheld as ``stick_slip_beyond_validated`` in severe stick-slip,
        else as ``stick_slip_undetermined`` where undetermined;
-    5. a shown trace with withheld windows says which.
+    5. a shown trace with withheld windows says which;
+    6. while the pipe moves axially nothing of the trace is shown
+       (:data:`NO_AXIAL_OBSERVER`).
 
     Examples
     --------
@@ -348,6 +392,8 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
     (True, True, True, ())
     """
     claim = bit_speed_claim(ev.logging, ev.check, ev.on_bottom)
+    if ev.moving:
+        claim = replace(claim, resolved=False, reason=NO_AXIAL_OBSERVER)
     if claim.resolved and ev.windows.too_many:
         claim = replace(claim, resolved=False, reason=(
             f"bit speed withheld: {len(ev.windows.withheld)} of its {ev.windows.windows} "
@@ -360,7 +406,7 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
     if claim.resolved and ev.check.approximate:
         flags.append(Flag.BIT_SPEED_DRIFT)
         messages.append(drift_note(ev.check))
-    logged = ev.logging.resolved and not ev.on_bottom
+    logged = ev.logging.resolved and not ev.on_bottom and not ev.moving
     if logged and ev.severe_note:
         flags.append(Flag.STICK_SLIP_BEYOND_VALIDATED)
         messages.append(ev.severe_note)

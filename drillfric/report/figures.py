@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from drillfric.vocabulary import Status
+from drillfric.vocabulary import MOVING_KINDS, Status
 
 from .display import SI, Units
 from .render import is_apparent, severity_note, zone_text
@@ -169,7 +169,8 @@ def friction_log_figure(segments: pd.DataFrame,
     the stick-slip severity versus bit depth beside it.
 
     μ_k (●) is drawn for off-bottom segments only; an on-bottom segment's factor is
-    apparent (the bit torque is in it) and drawn as ▲ with its own legend entry.
+    apparent (the bit torque is in it) and drawn as ▲ with its own legend entry. Reaming
+    and back-reaming segments are not drawn for now (docs/outputs.md).
 
     Filled markers: converged; hollow: not converged. μ_s is drawn as a point only where it
     is identifiable (docs/theory.md §6); where only a lower bound is known it is drawn as a
@@ -190,6 +191,7 @@ def friction_log_figure(segments: pd.DataFrame,
     fig = _new(size[1], size[0], left_in=0.9, wspace=0.08, top_in=top_in)
     ax, ax_sev = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [2.2, 1]})
     seg = segments.assign(depth=segments["bit_depth_m"] * units.factor("length"))
+    seg = seg[~seg["kind"].isin(MOVING_KINDS)]  # reaming μ_k: not in the log for now
     ok = seg[seg["status"] == Status.OK]
     apparent = np.array([is_apparent(r) for r in ok.to_dict("records")], dtype=bool)
     for rows, color, marker, name in (

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.io.text import plural
-from drillfric.vocabulary import Status
+from drillfric.vocabulary import MOVING_KINDS, Status
 
 from .display import SI, Units, fmt
 from .figures import (
@@ -152,7 +152,8 @@ def friction_sources(segments: pd.DataFrame, units: Units = SI,
     ``whisker:mu_drag`` and ``points:mu_drag:converged`` (the drag-based μ of ``drag``,
     drag_log.parquet), ``none`` (segments without an estimate) and ``severity``. Depths in
     display ``units``."""
-    frame = _source_frame(segments[segments["bit_depth_m"].notna()], units)
+    frame = _source_frame(segments[segments["bit_depth_m"].notna()
+                                   & ~segments["kind"].isin(MOVING_KINDS)], units)  # for now
     ok = frame[frame["status"] == Status.OK]
     off = ok[~ok["apparent"]]
     out = {}

@@ -145,4 +145,12 @@ def segment_data(rows: pd.DataFrame, seg: Segment, depth: float) -> SegmentData:
                        rows["surface_torque_Nm"].to_numpy(float), float(depth), kind=seg.kind,
                        wob_N=max(wob, 0.0), bit_rpm=column("bit_rpm"),
                        torque_min_Nm=column("surface_torque_min_Nm"),
-                       torque_max_Nm=column("surface_torque_max_Nm"))
+                       torque_max_Nm=column("surface_torque_max_Nm"), **_axial(seg))
+
+
+def _axial(seg: Segment) -> dict:
+    """A reaming segment's axial speed and when the pipe moves (nothing in place)."""
+    if seg.axial_speed_m_s is None:
+        return {}
+    return {"axial_speed_m_s": float(seg.axial_speed_m_s),
+            "axial_span_s": (float(seg.axial_from_s), float(seg.axial_to_s))}

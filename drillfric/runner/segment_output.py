@@ -45,7 +45,8 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
     """A segment's :class:`SegmentRecord` (the estimate's numbers when there is one)."""
     base = dict(id=seg.id, kind=Kind(seg.kind), t_start_s=seg.t_start_s, t_end_s=seg.t_end_s,
                 bit_depth_m=depth, status=status, duration_s=seg.duration_s, message=message,
-                hookload_N=_median(rows, "hookload_N"), **_clock(rows, seg),
+                hookload_N=_median(_while_moving(rows, seg), "hookload_N"), **_clock(rows, seg),
+                axial_speed_m_s=seg.axial_speed_m_s,
                 **_drilling(seg, rows))
     if est is None:
         return SegmentRecord(**base)
@@ -61,6 +62,16 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est)))
     return withhold_friction(record, est.factors_withheld, None) if est.factors_withheld \
         else record
+
+
+def _while_moving(rows: pd.DataFrame, seg: Segment) -> pd.DataFrame:
+    """The rows of a reaming segment while the pipe moves at its speed (its hook load is
+    the moving load case's, docs/theory.md §2 steps 3–4); all rows of the other kinds."""
+    if seg.axial_speed_m_s is None or "time_s" not in rows:
+        return rows
+    t = rows["time_s"].to_numpy(float)
+    inside = (t >= seg.axial_from_s) & (t <= seg.axial_to_s)
+    return rows[inside] if inside.any() else rows
 
 
 def _drilling(seg: Segment, rows: pd.DataFrame) -> dict:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from drillfric import torsional
 from drillfric.drillstring import DrillString
 from drillfric.estimation import relaxation
 from drillfric.estimation.batch.creep_checks import CreepChecks
@@ -165,13 +166,15 @@ class BatchResult:
 def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                         settings: BatchSettings, mu_s: float, mu_k: float,
                         torque_kind: str = "motor", cells: int = 500,
-                        profile: FrictionProfile | None = None, bit_torque_Nm: float = 0.0
+                        profile: FrictionProfile | None = None, bit_torque_Nm: float = 0.0,
+                        axial: torsional.Axial | None = None
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The fitted model against the data over a whole record (the evidence of a fit).
 
     The speed-driven plant of docs/theory.md §6.4 at (μ_s, μ_k), driven by the measured
     top-drive speed from rest over the whole record, as :func:`refine`'s fits are; with
-    ``bit_torque_Nm`` > 0 a Coulomb bit of that torque [N·m] (docs/theory.md §2.3).
+    ``bit_torque_Nm`` > 0 a Coulomb bit of that torque [N·m] (docs/theory.md §2.3); with
+    ``axial`` the pipe moving at v(t) as it turns (docs/theory.md §3.3).
 
     Returns
     -------
@@ -181,7 +184,7 @@ def model_string_torque(time_s, surface_rad_s, torque_Nm, *, string: DrillString
     """
     data, _ = prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
                       settings.top_drive_inertia_kg_m2)
-    model = Model(string, as_fc_fn(fc_Nm_m), settings, data, None, profile)
+    model = Model(string, as_fc_fn(fc_Nm_m), settings, data, None, profile, axial)
     model.bit_torque_cap_Nm = max(float(bit_torque_Nm), 0.0)
     whole = Window(0, data.t.size - 1, np.arange(data.t.size))
     tau, _ = model.simulate(whole, max(mu_s, mu_k), mu_k, cells)
@@ -193,7 +196,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
            mu_s_seed: float | None = None,
            progress: Callable[[float], None] | None = None,
            profile: FrictionProfile | None = None,
-           sample_interval_s: float | None = None) -> BatchResult:
+           sample_interval_s: float | None = None,
+           axial: torsional.Axial | None = None) -> BatchResult:
     """Refine μ_k and μ_s of one record with the speed-driven model (docs/theory.md §6.4).
 
     Parameters
@@ -226,6 +230,12 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         Effective interval of the log when coarser than its spacing (means, held values;
         :mod:`drillfric.estimation.sampling`) [s]: a creep is fitted only when this, too,
         is within :data:`MIN_CREEP_RATE_HZ`.
+    axial : drillfric.torsional.Axial, optional
+        The pipe's axial speed v(t) of a reaming segment (docs/theory.md §3.3): the model
+        splits the friction at every run, and μ_s is not looked for — no creep fit, no onset
+        bound: with |v| > ω_c·r_c no cell sticks, and what sticks below that is not told
+        apart from μ_k by the mean torque (the verdict says so,
+        :func:`drillfric.estimation.verdict.decide`).
 
     Returns
     -------
@@ -233,10 +243,11 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     """
     data, messages = prepare(time_s, surface_rad_s, torque_Nm, torque_kind,
                              settings.top_drive_inertia_kg_m2)
-    model = Model(string, as_fc_fn(fc_Nm_m), settings, data, progress, profile)
+    model = Model(string, as_fc_fn(fc_Nm_m), settings, data, progress, profile, axial)
     omega_c = settings.omega_c_rad_s
-    creeps = find_creeps(data.t, data.drive, omega_c, torque_Nm=data.tau,
-                         smooth_s=TORQUE_SMOOTH_S)
+    creeps = [] if axial is not None else find_creeps(data.t, data.drive, omega_c,
+                                                       torque_Nm=data.tau,
+                                                       smooth_s=TORQUE_SMOOTH_S)
     wins, notes = rotating_windows(data, settings, *model.wind_up(cells))
     messages += notes
     flags: list[Flag] = []
@@ -261,7 +272,8 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     else:
         flags.append(Flag.NO_ROTATION)
     static = _static_stages(model, creeps, wins, kinetic, rotation, cells,
-                            rate_hz=1.0 / max(data.dt, sample_interval_s or 0.0))
+                            rate_hz=1.0 / max(data.dt, sample_interval_s or 0.0),
+                            moving=axial is not None)
     flags += static.flags
     messages += static.messages
     interval = None
@@ -322,10 +334,12 @@ class _Static:
 
 
 def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOutcome | None,
-                   rotation: _Rotation, cells: int, *, rate_hz: float) -> _Static:
+                   rotation: _Rotation, cells: int, *, rate_hz: float,
+                   moving: bool = False) -> _Static:
     """μ_s of a record: the creep fit where a creep was logged fast enough and passes its
     checks (μ_k refitted when the fitted μ_s moves the stick-slip model), else the
-    stick-slip onset bound (docs/theory.md §6.3–§6.4)."""
+    stick-slip onset bound (docs/theory.md §6.3–§6.4); none while the pipe moves axially
+    (``moving``, docs/theory.md §3.3)."""
     flags, messages = [], []
     mu_s, method, used, creep, onset = None, "none", (), None, None
     if creeps and rate_hz < MIN_CREEP_RATE_HZ:
@@ -345,12 +359,13 @@ def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOut
                 if refit is not None:
                     kinetic = refit
                     messages += refit.messages
-    if mu_s is None and kinetic is not None and rotation.stick_slip:
+    if mu_s is None and kinetic is not None and rotation.stick_slip and not moving:
         onset = onset_bound(model, wins, kinetic.mu_k, cells, bool(creeps))
         flags += onset.flags
         messages += onset.messages
         method = "stick_slip_onset" if onset.bound is not None else "none"
-    if mu_s is None and not rotation.stick_slip and kinetic is not None and not creeps:
+    if mu_s is None and not rotation.stick_slip and kinetic is not None and not creeps \
+            and not moving:
         messages.append("no stick-slip and no creep start-up: μ_s is not in the data; a creep "
                         "break-over from rest (below ω_c for 10–30 s) would make it measurable")
     return _Static(mu_s, kinetic, None if onset is None else onset.bound, method, used, creep,

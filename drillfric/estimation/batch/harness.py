@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -166,12 +166,18 @@ class Model:
     loop (``drive``, :mod:`drillfric.estimation.drive`), else follows the logged speed too.
 
     Each window starts from rest, holding the twist the measured torque says the string has
-    there (:meth:`drillfric.torsional.State.wound`; none after a released stop)."""
+    there (:meth:`drillfric.torsional.State.wound`; none after a released stop).
+
+    With ``axial`` (a reaming segment's pipe speed v(t), docs/theory.md §3.3) every run splits
+    the Coulomb force between the torque and the drag at the contact radius of each cell
+    (:func:`drillfric.torsional.contact_radius`)."""
 
     def __init__(self, string, fc_fn, settings: BatchSettings, data: FitData,
                  progress: Callable[[float], None] | None = None,
-                 profile: FrictionProfile | None = None):
+                 profile: FrictionProfile | None = None,
+                 axial: torsional.Axial | None = None):
         self.string, self.fc_fn, self.data = string, fc_fn, data
+        self.axial = axial
         self.settings = settings
         self.omega_c, self.k_t = settings.omega_c_rad_s, settings.k_t_per_s
         self.itd = settings.top_drive_inertia_kg_m2
@@ -245,6 +251,8 @@ class Model:
                                    k_t_per_s=self.k_t, top_drive_inertia_kg_m2=self.itd,
                                    bit_torque_cap_Nm=self.bit_torque_cap_Nm,
                                    cased_static=self.cased_static)
+        if self.axial is not None:
+            plant = replace(plant, contact_radius_m=torsional.contact_radius(self.string, g))
         span = slice(win.sim0, win.end + 1)
         state = self._initial(win, g, fc, mu_k)
         if win.creep or self.drive is None or not self.drive.usable:
@@ -256,7 +264,8 @@ class Model:
                                     ki_Nm_rad=self.drive.ki_Nm_rad)
             state.top[0] = d.drive[win.sim0]
         t = d.t[span]
-        rec, _ = torsional.run(plant, drive, t[-1] - t[0], 1.0 / d.dt, state)
+        rec, _ = torsional.run(plant, drive, t[-1] - t[0], 1.0 / d.dt, state,
+                               axial=self.axial)
         self.counter.tick()
         return (np.interp(t, rec.time_s, rec.string_torque_Nm),
                 np.interp(t, rec.time_s, rec.bit_rad_s))
