@@ -602,7 +602,8 @@ def judge(records: list, plateaus: list[Plateau], cfg: Config,
     summary.update(verdict=_verdict(well_problem, block, calibration),
                    withheld_segments=withheld, reason=well_problem or unverified or None)
     contradicted = [i for i in withheld if well_problem or problems.get(i)]
-    warnings = _warnings(well_problem, contradicted, problems, block, calibration, cfg)
+    warnings = _warnings(well_problem, contradicted, problems, block, calibration, cfg,
+                         summary.get("string_weight_ratio"))
     return Outcome(out, summary, warnings)
 
 
@@ -658,12 +659,17 @@ def _summary_base(cfg: Config, block: BlockWeight, calibration: Calibration | No
 
 
 def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWeight,
-              calibration: Calibration | None, cfg: Config) -> list[str]:
+              calibration: Calibration | None, cfg: Config,
+              ratio: float | None = None) -> list[str]:
     out = []
     if well_problem:
+        # calibration is advised only where it could apply (the DSATS example's 0.21× had
+        # been told to allow it, and then refused as outside the range)
+        rescalable = ratio is not None and CALIBRATION_RANGE[0] <= ratio <= CALIBRATION_RANGE[1]
         fix = ("check [[string.sections]] (linear masses, lengths), the mud density and the "
-               "hook-load channel" + ("" if cfg.hookload.calibrate_string_weight else
-                                      ", or allow hookload.calibrate_string_weight"))
+               "hook-load channel" + (", or allow hookload.calibrate_string_weight"
+                                      if rescalable and not cfg.hookload.calibrate_string_weight
+                                      else ""))
         extra = f" ({calibration.reason})" if calibration and calibration.reason else ""
         out.append(f"friction factors withheld: {well_problem}{extra}; {fix}")
     elif withheld:

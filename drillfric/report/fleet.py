@@ -16,7 +16,7 @@ from drillfric.vocabulary import Status, WellStatus
 
 from .data import segments_frame
 from .display import fmt, report_units, row_flags
-from .friction import fleet_plot
+from .friction import fleet_plot, off_bottom_mu_k
 from .interactive import Embedder
 from .render import environment, mu_s_text, now_utc
 
@@ -117,7 +117,7 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
     shown = report_units({}, units or _common_units(wells))
     embed = Embedder()
     plot_id = embed.add(fleet_plot(logs, shown), "fleet") if any(
-        ((seg["status"] == Status.OK) & seg["mu_k"].notna()).any() for _, seg in logs) else None
+        len(off_bottom_mu_k(seg)) for _, seg in logs) else None
     counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
     news = [(str(w.get("well", "?")), w["changes"]) for w in wells if w.get("changes")]
     html = environment().get_template("fleet_report.html.j2").render(

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.io.text import plural
-from drillfric.vocabulary import MOVING_KINDS, Status
+from drillfric.vocabulary import MOVING_KINDS, Kind, Status
 
 from .display import SI, Units, fmt
 from .figures import (
@@ -264,10 +264,19 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
     return gridplot([[mu, sev]], merge_tools=True, toolbar_location="right")
 
 
+def off_bottom_mu_k(seg: pd.DataFrame) -> pd.DataFrame:
+    """The segments of ``seg`` (segments.parquet's columns) that give an off-bottom μ_k at a
+    bit depth — not an on-bottom apparent μ, nor a reaming segment's (kept out of the
+    friction log until validated on field data)."""
+    return seg[(seg["status"] == Status.OK) & (seg["kind"] == Kind.OFF_BOTTOM)
+               & seg["mu_k"].notna() & seg["bit_depth_m"].notna()]
+
+
 def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
     """μ_k versus bit depth (display ``units``) of every well, a colour per well, the μ_k axis
     from 0 (an auto-scaled 0.2768–0.2798 drew three equal wells as a zigzag); legend click
-    hides a well."""
+    hides a well. Off-bottom segments only (:func:`off_bottom_mu_k`): an on-bottom apparent μ
+    has the bit torque in it — a depth log's 0.15–0.27 had been drawn here as μ_k."""
     from bokeh.models import HoverTool, Legend, LegendItem
     from bokeh.palettes import Category10, Category20
     from bokeh.plotting import figure
@@ -280,7 +289,7 @@ def fleet_plot(logs: list[tuple[str, pd.DataFrame]], units: Units = SI):
     palette = Category10[10] if len(logs) <= 10 else Category20[20]
     items, renderers = [], []
     for index, (name, seg) in enumerate(logs):
-        ok = seg[(seg["status"] == Status.OK) & seg["mu_k"].notna() & seg["bit_depth_m"].notna()]
+        ok = off_bottom_mu_k(seg)
         if not len(ok):
             continue
         color = palette[index % len(palette)]

@@ -301,7 +301,18 @@ def _broomstick(data: ResultData, units: Units) -> Broomstick:
     except DrillfricError as exc:
         return Broomstick(None, points, broom.weight_check(points, units=units),
                           f"Model lines not drawn: {exc.message}")
-    return Broomstick(table, points, broom.weight_check(points, table, units=units), None)
+    return Broomstick(table, points, broom.weight_check(_estimated(points, data), table,
+                                                        units=units), None)
+
+
+def _estimated(points: pd.DataFrame, data: ResultData) -> pd.DataFrame:
+    """The measured points of the segments the run estimated: summary.json's string-weight
+    check weighs those only (Volve F-4's report had warned of "all 8 off-bottom segments"
+    — every one skipped — where summary.json said not_checked: issue 35)."""
+    seg = data.segments
+    if "status" not in seg or "id" not in seg:
+        return points
+    return points[points["segment_id"].isin(seg.loc[seg["status"] == Status.OK, "id"])]
 
 
 def _broomstick_note(check: dict, units: Units) -> str | None:
