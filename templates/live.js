@@ -22,16 +22,25 @@
     return "withheld: " + (why || "no estimate yet");
   }
 
-  function showOpen(open, row) {
+  // A value older than this behind the newest sample [s] shows its age, greyed: it is not
+  // current (issue 35: a segment that had ended 150 s before read as the open one).
+  const OLD_S = 5;
+  const OPEN_IDS = ["open-mu-k", "open-mu-s", "open-bit-rpm", "open-severity"];
+
+  function showOpen(open, row, last) {
     if (!open) {
-      ["open-mu-k", "open-mu-s", "open-bit-rpm", "open-severity"].forEach((id) => put(id, "—"));
+      OPEN_IDS.forEach((id) => { put(id, "—"); byId(id).classList.remove("old"); });
       put("open-segment", "none");
       return;
     }
+    const age = known(last) && known(open.t_end_s) ? last - open.t_end_s : 0;
+    const old = age > OLD_S;
+    OPEN_IDS.concat(["open-segment"]).forEach((id) => byId(id).classList.toggle("old", old));
     const why = row ? row.message : "";
     const ok = open.status === "ok";  // a skipped or failed segment's numbers are withheld
     put("open-segment", "segment " + open.segment + " (" + open.kind.replace(/_/g, " ") + ", "
-        + fixed(open.t_start_s, 0) + "–" + fixed(open.t_end_s, 0) + " s, " + open.status + ")");
+        + fixed(open.t_start_s, 0) + "–" + fixed(open.t_end_s, 0) + " s, " + open.status + ")"
+        + (old ? " — as of " + age.toFixed(0) + " s before the newest sample, not current" : ""));
     put("open-mu-k", ok && known(open.mu_k)
       ? fixed(open.mu_k, 3) + (open.kind === "on_bottom_rotating" ? " apparent" : "")
       : withheld(why));
@@ -56,7 +65,8 @@
     put("rows", String(s.rows));
     put("rig-state", s.rig_state ? s.rig_state.replace(/_/g, " ") : "—");
     const open = s.open_segment;
-    showOpen(open, open ? segs.segments.find((r) => r.id === open.segment) : null);
+    showOpen(open, open ? segs.segments.find((r) => r.id === open.segment) : null,
+      s.last_sample_time_s);
     const latest = s.latest;
     put("latest", latest ? "segment " + latest.segment + ": μ_k " + fixed(latest.mu_k, 3) + ", μ_s "
       + (known(latest.mu_s) ? fixed(latest.mu_s, 3) : "not identified") : "none yet");
