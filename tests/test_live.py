@@ -183,8 +183,11 @@ def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_tren
     live.engine, now[0] = object(), 61.0  # data came once, then stopped
     assert [a["kind"] for a in live.status()["alerts"]] == ["data_stopped"]
     live.last_data = now[0]
-    live.view["open_segment"] = {"stick_slip_severity": 1.3}
-    assert [a["kind"] for a in live.status()["alerts"]] == ["severe_stick_slip"]
+    live.view["open_segment"] = {"stick_slip_severity": 1.3, "t_end_s": 672.0}
+    live.view["last_sample_time_s"] = 821.8
+    severe = live.status()["alerts"]
+    assert [a["kind"] for a in severe] == ["severe_stick_slip"]
+    assert severe[0]["time_s"] == 672.0  # the time of the rows it rests on, not the newest
     # regression: a severity withheld as beyond its validated range (≥ 2.1) silenced the
     # alert exactly where the stick-slip is worst
     live.view["open_segment"] = {"stick_slip_severity": None,

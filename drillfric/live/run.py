@@ -369,7 +369,10 @@ class LiveRun:
                                  view["last_sample_time_s"]))
         severe = severe_stick_slip(view["open_segment"] or {})
         if severe:
-            alerts.append(alert("severe_stick_slip", severe, view["last_sample_time_s"]))
+            # the time of the data it rests on, not the newest sample's (a newcomer read a
+            # 150-s-old segment's stick-slip as current)
+            alerts.append(alert("severe_stick_slip", severe,
+                                (view["open_segment"] or {}).get("t_end_s")))
         stalled = (view["open_segment"] or {}).get("bit_stalled_s")
         if stalled is not None and stalled >= BIT_STALL_S:
             alerts.append(alert("bit_stalled", f"estimated bit speed at rest for the last "
