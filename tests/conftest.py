@@ -79,7 +79,7 @@ def _kernels_compiled():
         warmup.warm_up()
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def real_data() -> Path:
     """Path of ../shared/data/real, or skip when it is not there (a user's clone)."""
     if not REAL_DATA.is_dir():

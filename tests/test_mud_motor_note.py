@@ -38,7 +38,7 @@ def test_traces_shown_with_the_pumps_on_say_so_once_for_the_well(stands, tmp_pat
     shown = result.segments[result.segments["bit_speed_resolved"].fillna(False).astype(bool)]
     assert len(shown) >= 1
     assert all(MOTOR_NOTE in m for m in shown["message"])
-    notes = [w for w in result.summary["warnings"] if "bit speed shown with the pumps on" in w]
+    notes = [w for w in result.summary["warnings"] if MOTOR_NOTE in w]
     assert len(notes) == 1
     # without the flow the same run says nothing of a motor
     assert not any(MOTOR_NOTE in (m or "") for m in whole.segments["message"])

@@ -18,14 +18,10 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def dsats_out(tmp_path_factory):
+def dsats_out(real_data, tmp_path_factory):
     """OUT/NAME of the DSATS log's run with the documented config (one run: minutes)."""
-    from tests.conftest import REAL_DATA
-
-    if not REAL_DATA.is_dir():
-        pytest.skip(f"real field data not available at {REAL_DATA}")
     out = tmp_path_factory.mktemp("dsats")
-    result = CliRunner().invoke(cli, ["-q", "run", str(REAL_DATA / "dsats_1hz" /
+    result = CliRunner().invoke(cli, ["-q", "run", str(real_data / "dsats_1hz" /
                                                         "SampleData1.csv"), "--config",
                                       str(REPO / "examples" / "dsats_1hz.toml"),
                                       "--out", str(out)])

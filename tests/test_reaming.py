@@ -143,20 +143,8 @@ def test_simulated_reaming_well_runs_through_drillfric_run(tmp_path):
     why (longer than segmentation.MAX_REAM_TRAVEL_M); the rotation in place before them is
     estimated, and the hook-load check finds the string consistent (every segment's hook
     load is the model's within 0.5 %)."""
-    import pandas as pd
 
-    (tmp_path / "ream.scenario.toml").write_text(REAMING_SCENARIO)
-    runner = CliRunner()
-    done = runner.invoke(cli, ["-q", "simulate", str(DEMO / "demo.toml"), "--scenario",
-                               str(tmp_path / "ream.scenario.toml"), "--out",
-                               str(tmp_path / "ream.csv"), "--survey",
-                               str(DEMO / "demo.survey.csv"), "--cells", "100", "--rate", "20",
-                               "--seed", "3"])
-    assert done.exit_code == 0, done.output
-    done = runner.invoke(cli, ["-q", "run", str(tmp_path / "ream.csv"), "--out",
-                               str(tmp_path / "out"), "--no-report"])
-    assert done.exit_code == 0, done.output
-    seg = pd.read_parquet(tmp_path / "out" / "ream" / "segments.parquet")
+    seg = _simulated_segments(tmp_path, REAMING_SCENARIO, cells=100, rate_hz=20)
     moving = seg[seg["kind"].isin(["reaming", "back_reaming"])]
     assert list(moving["kind"]) == ["reaming", "back_reaming"]
     assert list(moving["status"]) == ["ok", "skipped"]
@@ -167,6 +155,25 @@ def test_simulated_reaming_well_runs_through_drillfric_run(tmp_path):
     assert (in_place["status"] == "ok").all() and in_place["mu_k"].between(0.25, 0.31).all()
     ratio = seg["hookload_N"] / seg["hookload_model_N"]
     assert ratio[in_place.index].sub(1.0).abs().max() < 0.005
+
+
+def _simulated_segments(tmp_path, scenario: str, *, cells: int, rate_hz: int):
+    """segments.parquet of ``drillfric simulate`` (the demo well, ``scenario``) then
+    ``drillfric run`` on it."""
+    import pandas as pd
+
+    (tmp_path / "ream.scenario.toml").write_text(scenario)
+    runner = CliRunner()
+    done = runner.invoke(cli, ["-q", "simulate", str(DEMO / "demo.toml"), "--scenario",
+                               str(tmp_path / "ream.scenario.toml"), "--out",
+                               str(tmp_path / "ream.csv"), "--survey",
+                               str(DEMO / "demo.survey.csv"), "--cells", str(cells), "--rate",
+                               str(rate_hz), "--seed", "3"])
+    assert done.exit_code == 0, done.output
+    done = runner.invoke(cli, ["-q", "run", str(tmp_path / "ream.csv"), "--out",
+                               str(tmp_path / "out"), "--no-report"])
+    assert done.exit_code == 0, done.output
+    return pd.read_parquet(tmp_path / "out" / "ream" / "segments.parquet")
 
 
 ONE_BACK_REAM = """connection_s = 30.0
@@ -190,18 +197,7 @@ def test_a_back_reaming_segment_gives_mu_k_and_a_consistent_hook_load(tmp_path):
     simulation runs 300 cells (Δx 7.7 m; the fit's Δx ≤ 5 m) to keep the test short."""
     import pandas as pd
 
-    (tmp_path / "ream.scenario.toml").write_text(ONE_BACK_REAM)
-    runner = CliRunner()
-    done = runner.invoke(cli, ["-q", "simulate", str(DEMO / "demo.toml"), "--scenario",
-                               str(tmp_path / "ream.scenario.toml"), "--out",
-                               str(tmp_path / "ream.csv"), "--survey",
-                               str(DEMO / "demo.survey.csv"), "--cells", "300", "--rate", "10",
-                               "--seed", "3"])
-    assert done.exit_code == 0, done.output
-    done = runner.invoke(cli, ["-q", "run", str(tmp_path / "ream.csv"), "--out",
-                               str(tmp_path / "out"), "--no-report"])
-    assert done.exit_code == 0, done.output
-    seg = pd.read_parquet(tmp_path / "out" / "ream" / "segments.parquet")
+    seg = _simulated_segments(tmp_path, ONE_BACK_REAM, cells=300, rate_hz=10)
     ream = seg[seg["kind"] == "back_reaming"].iloc[0]
     assert ream["status"] == "ok" and ream["converged"]
     assert ream["mu_k"] == pytest.approx(0.28, rel=0.05)

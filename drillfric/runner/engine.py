@@ -455,10 +455,8 @@ def _motor_note(records: list[SegmentRecord]) -> str | None:
     ids = [str(r.id) for r in records if MOTOR_NOTE in (r.message or "")]
     if not ids:
         return None
-    return (f"bit speed shown with the pumps on in {plural(len(ids), 'segment')} "
-            f"({', '.join(ids[:10])}{', …' if len(ids) > 10 else ''}): it is the string's "
-            "bottom speed — with a mud motor in the BHA the bit turns faster by the motor's "
-            "speed, which drillfric does not model")
+    return (f"{plural(len(ids), 'segment')} ({', '.join(ids[:10])}"
+            f"{', …' if len(ids) > 10 else ''}): {MOTOR_NOTE}")
 
 
 def _cut_line_note(well: Well, tail: list) -> str:
