@@ -142,9 +142,11 @@ OUTPUT_CLOCK_UNIT = "us"
 def clock_at(origin: pd.Timestamp, seconds):
     """Clock time ``seconds`` [s] after ``origin``, in whole microseconds.
 
-    ``seconds`` is a float or an array of floats (NaN gives NaT); the offset is rounded to
-    the nanosecond and the sum to the microsecond, so the result fits the outputs'
-    ``timestamp[us]`` column exactly, whatever the origin's resolution.
+    ``seconds`` is a float or an array of floats (NaN gives NaT); the sum is rounded once,
+    to the microsecond (the origin's nanoseconds below its microsecond added to the offset
+    first: rounding to the nanosecond and then to the microsecond had put 41 499.7 ns at
+    42 µs), so the result fits the outputs' ``timestamp[us]`` column exactly, whatever the
+    origin's resolution.
 
     Examples
     --------
@@ -152,13 +154,15 @@ def clock_at(origin: pd.Timestamp, seconds):
     >>> clock_at(origin, 2.3116699999)
     Timestamp('2026-03-01 06:00:02.311670+0000', tz='UTC')
     """
-    offset = np.round(np.asarray(seconds, dtype=float) * 1e9)
-    if offset.ndim == 0:
-        if not np.isfinite(offset):
+    below = origin.value % 1000  # [ns]
+    base = origin - pd.Timedelta(below, unit="ns")
+    micros = np.round((below + np.asarray(seconds, dtype=float) * 1e9) / 1000.0)
+    if micros.ndim == 0:
+        if not np.isfinite(micros):
             return pd.NaT
-        return (origin + pd.Timedelta(int(offset), unit="ns")).round(OUTPUT_CLOCK_UNIT)
-    delta = pd.to_timedelta(np.where(np.isfinite(offset), offset, np.nan), unit="ns")
-    return (origin + delta).round(OUTPUT_CLOCK_UNIT)
+        return base + pd.Timedelta(int(micros), unit=OUTPUT_CLOCK_UNIT)
+    return base + pd.to_timedelta(np.where(np.isfinite(micros), micros, np.nan),
+                                  unit=OUTPUT_CLOCK_UNIT)
 
 
 def origin_of(stamp: pd.Timestamp, seconds: float) -> pd.Timestamp:
