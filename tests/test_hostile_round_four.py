@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import socket
+import stat
 import subprocess
 import threading
 from datetime import datetime, timedelta
@@ -1072,3 +1073,18 @@ id_m = 0.0714
 length_m = 200
 """)
     _strict_check(Case(["run", "w.csv", "--out", "out"], (2,), (says,)), root, capsys)
+
+
+def test_output_onto_a_device_or_fifo_is_refused_not_replaced(tmp_path):
+    """A helper's attack run as root had ``/dev/null`` replaced by a regular file: the
+    atomic writer renamed its temporary over whatever stood at the output path. A device,
+    FIFO or socket there is now refused in one line and left as it was (a FIFO stands in
+    for the device here)."""
+    from drillfric.io.atomic import replacing
+
+    fifo = tmp_path / "out.parquet"
+    os.mkfifo(fifo)
+    with pytest.raises(OutputError, match="device, FIFO or socket"), replacing(fifo) as tmp:
+        tmp.write_text("x")
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.parquet"]

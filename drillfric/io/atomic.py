@@ -87,10 +87,20 @@ def own_file(path: Path) -> Path:
 
 
 def refuse_link(path: Path) -> None:
-    """OutputError when ``path`` is a symbolic link (dangling or not)."""
+    """OutputError when ``path`` is a symbolic link (dangling or not), or a device, FIFO or
+    socket: a rename over ``/dev/null`` (``simulate --out /dev/null`` run as root) replaced
+    the device with a regular file for every program on the machine."""
     if os.path.islink(path):
         raise OutputError("cannot write results: a symbolic link stands where drillfric "
                           "writes (it writes through no link)", file=path, fix=LINK_FIX)
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise OutputError("cannot write results: a device, FIFO or socket stands where "
+                          "drillfric writes a file (it would replace it)", file=path,
+                          fix="choose a file path in a folder of your own for the output")
 
 
 @contextmanager
