@@ -34,7 +34,7 @@ from scipy.signal import lfilter
 
 from drillfric import torque_drag
 from drillfric.errors import ModelError
-from drillfric.segmentation import IDLE, TRIPPING
+from drillfric.segmentation import IDLE, TRIPPING, above_rotary
 
 if TYPE_CHECKING:
     from drillfric.config import Config
@@ -417,6 +417,8 @@ def connection_row(up: Move | None, down: Move | None, hook: HookEvidence, curve
            "t_end_s": max(m.t_end_s for m in present),
            "bit_depth_m": float(np.mean([m.bit_depth_m for m in present])),
            **_side(up, PICK_UP), **_side(down, SLACK_OFF), "block_weight_N": hook.block_N}
+    if (out := min(m.bit_depth_m for m in present)) <= 0.0:
+        return row | _verdict({}, above_rotary(out))
     slow = [m for m in present if not m.kinetic]
     if hook.contradicted or slow:
         why = (f"the hook load contradicts the configured string ({hook.contradicted})"

@@ -859,3 +859,10 @@ def _rows_done(buffer: pd.DataFrame, pending: int) -> int:
     t = buffer["time_s"].to_numpy()
     ref = t[pending] if pending < t.size else t[-1]
     return int(np.searchsorted(t[:pending], ref - PREROLL_S))
+
+
+def above_rotary(depth_m: float) -> str:
+    """Why a segment or a move with its bit at or above the rotary table is not used."""
+    return (f"the bit is at or above the rotary table (bit depth {depth_m:.1f} m): the string "
+            "is not in the hole (the BHA made up or laid out) — if it was, check the "
+            "bit-depth channel's datum")

@@ -114,6 +114,18 @@ def test_slow_move_and_contradicted_string_are_withheld():
     assert bad["status"] == "withheld" and "contradicts the configured string" in bad["reason"]
 
 
+def test_volve_f4_move_above_the_rotary_says_so():
+    """Volve F-4's drag log withheld moves at bit depths of −7.8 and −13.2 m with the model's
+    "bit depth must be positive, got -7.8": the BHA handled above the rotary table. It now
+    says what that is, and needs no model."""
+    def curves(depth):
+        raise AssertionError("no model needed")
+
+    row = drag.connection_row(_move("pick_up", -7.8, 1.66e6), None, _hook(BLOCK_N), curves)
+    assert row["status"] == "withheld" and row["mu_drag"] is None
+    assert "above the rotary table (bit depth -7.8 m)" in row["reason"]
+
+
 def test_pairing_takes_the_nearest_slack_off():
     ups = [_move("pick_up", 2000.0, 1.0, t0=0.0), _move("pick_up", 2100.0, 1.0, t0=5000.0)]
     downs = [_move("slack_off", 2010.0, 1.0, t0=100.0), _move("slack_off", 2005.0, 1.0,

@@ -62,6 +62,9 @@ def test_f9_segments_run_fails_are_failed_in_inspect(volve, tmp_path):
     failed = [g for g in doc["segments"] if g["status"] == "failed"]
     assert len(failed) == 10 and not [g for g in doc["segments"] if g["status"] == "ok"]
     assert all("string below the top section is 230.0 m long" in g["message"] for g in failed)
+    # issue 35 (F-9's geometry): segment 1 turned the BHA above the rotary, at −18.6 m
+    first = doc["segments"][0]
+    assert first["status"] == "skipped" and "above the rotary table" in first["message"]
 
 
 def test_f4_with_its_sidecars_skips_what_run_skips(volve, tmp_path):

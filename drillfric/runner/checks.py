@@ -19,7 +19,7 @@ from drillfric.errors import ConfigError, DrillfricError
 from drillfric.estimation.segment_data import SegmentData, SkipSegment, check_segment
 from drillfric.io.timebase import check_plausible_rate
 from drillfric.io.well import Well
-from drillfric.segmentation import Segment
+from drillfric.segmentation import Segment, above_rotary
 from drillfric.vocabulary import Status
 
 from .budget import check_work
@@ -102,6 +102,8 @@ def precheck(well: Well, seg: Segment, rows: pd.DataFrame,
     :func:`~drillfric.estimation.segment_data.check_segment` on its samples at its bit
     depth — the log's, else ``fallback_depth()`` [m]."""
     depth = seg.bit_depth_m if np.isfinite(seg.bit_depth_m) else fallback_depth()
+    if depth <= 0.0:
+        return Precheck(Status.SKIPPED, above_rotary(depth), depth)
     if seg.status != Status.OK:
         return Precheck(Status.SKIPPED, seg.message, depth)
     data = segment_data(rows, seg, depth)
