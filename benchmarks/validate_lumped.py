@@ -254,10 +254,12 @@ def windows(est: pd.DataFrame, truth_t: np.ndarray, truth_w: np.ndarray) -> dict
             "window_rows": rows}
 
 
-def truth_stats(t: np.ndarray, w: np.ndarray, a: float, b: float) -> dict:
-    """Stick-slip statistics of the truth over [a, b] as drillfric defines them."""
-    skip = min(30.0, 0.3 * (b - a))
-    m = (t >= a + skip) & (t <= b)
+def truth_stats(t: np.ndarray, w: np.ndarray, a: float, b: float,
+                start: float | None = None) -> dict:
+    """Stick-slip statistics of the truth over [start, b] as drillfric defines them
+    (``start``: the segment's ``stick_slip_from_s``, else 30 s or 30 % in)."""
+    start = a + min(30.0, 0.3 * (b - a)) if start is None else start
+    m = (t >= start) & (t <= b)
     if not m.any():
         return {"severity": None, "stuck": None, "max_over_mean": None}
     x = w[m]
@@ -290,12 +292,15 @@ def score(result, case: Case, rate: str, truth: dict, plant_cols: dict) -> dict:
     tt, tw = plant_cols["time_s"], plant_cols["bit_rpm"]
     traces = []
     for g in segs:
-        stats = truth_stats(tt, tw, g["t_start_s"], g["t_end_s"])
+        stats = truth_stats(tt, tw, g["t_start_s"], g["t_end_s"], g.get("stick_slip_from_s"))
+        whole = truth_stats(tt, tw, g["t_start_s"], g["t_end_s"])
         row = {"id": g["id"], "resolved": bool(g.get("bit_speed_resolved")),
                "reason": g.get("bit_speed_reason"),
                "severity": g.get("stick_slip_severity"), "stuck": g.get("stuck_fraction"),
                "severity_truth": stats["severity"], "stuck_truth": stats["stuck"],
-               "max_over_mean_truth": stats["max_over_mean"]}
+               "max_over_mean_truth": stats["max_over_mean"],
+               "stats_from_s": g.get("stick_slip_from_s"),
+               "severity_truth_whole": whole["severity"], "stuck_truth_whole": whole["stuck"]}
         if row["resolved"] and "bit_rpm_est" in est:
             rows = est[(est["segment_id"] == g["id"]) & (est["start_id"] == -1)]
             rows = rows[rows["bit_rpm_est"].notna()]

@@ -97,7 +97,7 @@ def statuses(summary: dict, rate: str, truth_mu_k: float = MU_K) -> list[dict]:
             out.append({"what": name, "status": "ok" if ok else "FALSE", "mu_k": mu,
                         "reason": ", ".join(g["quality_flags"])})
         else:
-            why = [f for f in g["quality_flags"] if f not in ("observer_not_converged",
+            why = [f for f in g["quality_flags"] if f not in ("observer_starts_disagree",
                                                       "observer_deadlock_averted")]
             out.append({"what": name, "status": "withheld", "mu_k": mu,
                         "reason": ", ".join(why) or (g["message"] or "not converged")[:90]})

@@ -76,7 +76,7 @@ def status(seg: dict, rate: str) -> tuple[str, str]:
     if seg["converged"]:
         within = abs(mu / MU_K - 1.0) <= tol
         return ("converged" if within else "FALSE"), ", ".join(seg["quality_flags"])
-    reasons = [f for f in seg["quality_flags"] if f not in ("observer_not_converged",
+    reasons = [f for f in seg["quality_flags"] if f not in ("observer_starts_disagree",
                                                     "observer_deadlock_averted")]
     return "withheld", ", ".join(reasons) or ", ".join(seg["quality_flags"])
 

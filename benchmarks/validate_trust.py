@@ -131,18 +131,20 @@ def _clean(raw: dict) -> dict:
 
 
 def truth(plant: str, est_cfg: Path) -> dict:
-    """μ_s, μ_k of the zone the estimator reports (open hole, or the effective blend)."""
+    """μ_s, μ_k of the zone the estimator reports (open hole, or the effective blend), and
+    the estimator's ω_c [RPM] (the stuck band of the statistics)."""
     sim, model, _ = PLANTS[plant]
-    if "mu_k_cased" not in sim or model is not None:
-        return {"mu_s": sim["mu_s"], "mu_k": sim["mu_k"]}
     cfg = load_config(est_cfg)
+    omega_c_rpm = cfg.model.omega_c_rad_s * 30.0 / np.pi
+    if "mu_k_cased" not in sim or model is not None:
+        return {"mu_s": sim["mu_s"], "mu_k": sim["mu_k"], "omega_c_rpm": omega_c_rpm}
     path = read_survey(est_cfg.parent / "path.survey.csv")
     td = solve_config(cfg, path, DEPTH_M)
     cased = np.clip((SHOE_M - (td.md_m[:-1] + td.md_m[1:]) / 2) / np.diff(td.md_m), 0, 1)
     share = float(np.sum(td.fc_Nm_m * np.diff(td.md_m) * cased) / td.T_N_Nm)
     return {"mu_s": share * sim["mu_s_cased"] + (1 - share) * sim["mu_s"],
             "mu_k": share * sim["mu_k_cased"] + (1 - share) * sim["mu_k"],
-            "cased_share": share}
+            "cased_share": share, "omega_c_rpm": omega_c_rpm}
 
 
 def run_logged(frame: pd.DataFrame, rate: str, name: str, folder: Path, est_cfg: Path):
@@ -188,6 +190,28 @@ def score(result, plant: str, rate: str, zone_truth: dict) -> dict:
     out["bounds"] = bounds
     out["bounds_false"] = [b for b in bounds if b >= zone_truth["mu_s"]]
     out.update(_bit(result, segs))
+    out["stats"] = _statistics(result, segs, zone_truth["omega_c_rpm"])
+    out["stats_false"] = [x for x in out["stats"] if not x["ok"]]
+    return out
+
+
+def _statistics(result, segs: list[dict], omega_c_rpm: float) -> list[dict]:
+    """Each printed stuck fraction and severity against the truth's (the simulated bit speed
+    on the estimate rows from ``stick_slip_from_s``), tolerance ±0.05 and ±12 %
+    (docs/bit_speed.md)."""
+    est, out = result.estimates, []
+    for g in segs:
+        if g.get("stuck_fraction") is None or "bit_rpm" not in est:
+            continue
+        rows = est[(est["segment_id"] == g["id"]) & (est["start_id"] == -1)]
+        bit = rows.loc[rows["time_s"] >= g["stick_slip_from_s"], "bit_rpm"].to_numpy(float)
+        lo, hi = np.percentile(bit, (1.0, 99.0))
+        stuck = float(np.mean(np.abs(bit) <= omega_c_rpm))
+        severity = float((hi - lo) / (2.0 * abs(np.mean(bit))))
+        out.append({"id": g["id"], "stuck": g["stuck_fraction"], "stuck_truth": stuck,
+                    "severity": g["stick_slip_severity"], "severity_truth": severity,
+                    "ok": abs(g["stuck_fraction"] - stuck) <= 0.05
+                    and abs(g["stick_slip_severity"] / severity - 1.0) <= 0.12})
     return out
 
 
@@ -259,7 +283,8 @@ def _line(r: dict) -> str:
     bit = ("not resolved" if not r["bit_resolved"] else
            f"{_fmt(r['bit_rms_rpm'], '.1f')} vs {_fmt(r['surface_rms_rpm'], '.1f')}")
     flags = ("" if r["mu_k_ok"] else " μ_k✗") + (" μ_s✗" if r["mu_s_false"] else "") + (
-        " bound✗" if r["bounds_false"] else "") + ("" if bit_ok(r) else " bit✗")
+        " bound✗" if r["bounds_false"] else "") + ("" if bit_ok(r) else " bit✗") + (
+        " stats✗" if r["stats_false"] else "")
     return (f"| {r['plant']} | {r['rate']} | {r['ok']}/{r['segments']} | {_fmt(r['mu_k'])} "
             f"({err}) | {claims} | {bounds} | {bit} | {_fmt(r['severity'], '.2f')} |"
             f"{flags or ' ✓'} | {r['run_s']:.0f} |")

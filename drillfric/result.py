@@ -24,7 +24,7 @@ from drillfric.vocabulary import Kind, Method, Status
 class Flag(StrEnum):
     """Conditions a reader of a segment's numbers must know (docs/outputs.md)."""
 
-    OBSERVER_NOT_CONVERGED = "observer_not_converged"
+    OBSERVER_STARTS_DISAGREE = "observer_starts_disagree"
     OBSERVER_DEADLOCK_AVERTED = "observer_deadlock_averted"
     NO_ROTATION = "no_rotation"
     ROTATION_TOO_SHORT = "rotation_too_short"
@@ -54,10 +54,16 @@ class Flag(StrEnum):
     FACTORS_RUN_AWAY = "factors_run_away"
     PIPE_MOVING = "pipe_moving"
 
+    @classmethod
+    def _missing_(cls, value):
+        """Flags renamed since results were written: ``observer_not_converged`` (until
+        0.1.0) is ``observer_starts_disagree`` — the segment may well be converged."""
+        return {"observer_not_converged": cls.OBSERVER_STARTS_DISAGREE}.get(value)
+
 
 #: What each flag means (docs/outputs.md).
 FLAG_MEANINGS = {
-    Flag.OBSERVER_NOT_CONVERGED: "the observer's starts did not agree (spread above tolerance)",
+    Flag.OBSERVER_STARTS_DISAGREE: "the observer's starts did not agree (spread above tolerance)",
     Flag.OBSERVER_DEADLOCK_AVERTED: "an observer start stuck while the top drive turned was "
                                     "released by the deadlock guard",
     Flag.NO_ROTATION: "the fit window holds no rotation above ω_c",
@@ -155,7 +161,7 @@ _VERDICT = "drillfric.estimation.verdict."
 #: the well-wide checks (string weight, torque zero, pooling) then withhold or mark. No
 #: other function raises a flag (tests/test_rule_table.py scans the code for it).
 FLAG_RAISED_BY = {
-    Flag.OBSERVER_NOT_CONVERGED: ("drillfric.estimation.chain.evidence",),
+    Flag.OBSERVER_STARTS_DISAGREE: ("drillfric.estimation.chain.evidence",),
     Flag.OBSERVER_DEADLOCK_AVERTED: ("drillfric.estimation.chain.evidence",),
     Flag.NO_ROTATION: (_FIT + "fit.refine",),
     Flag.ROTATION_TOO_SHORT: (_FIT + "fit.refine",),
@@ -249,15 +255,23 @@ class SegmentRecord:
     settling_time_s: float | None = _f("s", "time the observer starts took to settle")
     residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
     stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated bit "
-                                                "speed (ensemble members pooled; ±12 %); null "
+                                                "speed from stick_slip_from_s to t_end_s "
+                                                "(ensemble members pooled; ±12 %); null "
                                                 "where beyond its validated range (flag "
-                                                "stick_slip_beyond_validated)")
+                                                "stick_slip_beyond_validated) or not "
+                                                "determined (stick_slip_undetermined)")
     status: Status = _f("", "ok, skipped or failed", Status.OK)
     message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
     duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
-    stuck_fraction: float | None = _f("-", "share of the time the bit is stuck, |ω_bit| ≤ ω_c "
+    stuck_fraction: float | None = _f("-", "share of the time from stick_slip_from_s to "
+                                           "t_end_s the bit is stuck, |ω_bit| ≤ ω_c "
                                            "(ensemble members pooled; ±0.05); null where "
-                                           "beyond its validated range")
+                                           "beyond its validated range or not determined")
+    stick_slip_from_s: float | None = _f("s", "the stuck fraction and severity are taken "
+                                              "from this time to t_end_s: after the start-up "
+                                              "and after any creep whose break-free depends "
+                                              "on an unidentified μ_s (the rotation at its "
+                                              "set-point, not its transients)")
     mu_k_observer: float | None = _f("-", "observer consensus μ_k (first pass)")
     mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass)")
     mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")

@@ -117,7 +117,7 @@ def test_converged_header_status_and_badges_agree(evidence):
         warnings = re.findall(r'<span class="badge flag"[^>]*>([^<]*)</span>', section)
         if seg["converged"]:
             assert not any("not converged" in w for w in warnings), (seg["id"], warnings)
-        if "observer_not_converged" in seg["quality_flags"] and seg["method"] == "batch":
+        if "observer_starts_disagree" in seg["quality_flags"] and seg["method"] == "batch":
             assert "observer starts spread" in section
     cells = [r.split("</td>")[-3] for r in
              html.split('id="diagnostics-table"')[1].split("</table>")[0].split("<tr")[2:]]

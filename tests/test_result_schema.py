@@ -17,6 +17,7 @@ from drillfric.result import (
     ESTIMATE_NAMES,
     FLEET_WELL_COLUMNS,
     SEGMENT_FIELDS,
+    Flag,
     SegmentRecord,
     outputs_markdown,
     segment_arrow_types,
@@ -89,3 +90,11 @@ def test_only_the_data_layer_reads_result_files():
     others = [p.name for p in (REPO / "drillfric" / "report").glob("*.py")
               if p.name != "data.py" and readers.search(p.read_text(encoding="utf-8"))]
     assert not others, others
+
+
+def test_results_flagged_observer_not_converged_still_load():
+    """Issue 35: "converged" stood beside the flag ``observer_not_converged`` on every demo
+    segment (the batch fit's μ_k converged while the observer's starts spread). The flag is
+    now ``observer_starts_disagree``; results written before still read."""
+    assert Flag("observer_not_converged") is Flag.OBSERVER_STARTS_DISAGREE
+    assert Flag.OBSERVER_STARTS_DISAGREE.value == "observer_starts_disagree"

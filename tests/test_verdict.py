@@ -108,9 +108,9 @@ CASES = [
      dict(converged=False, flags=(Flag.PIPE_MOVING, Flag.MU_K_UNCERTAIN)),
      "…and its statistical uncertainty"),
     ("flags_ordered_and_unique",
-     dict(observer_flags=(Flag.OBSERVER_NOT_CONVERGED,),
+     dict(observer_flags=(Flag.OBSERVER_STARTS_DISAGREE,),
           batch_flags=(Flag.MU_K_NOT_CONVERGED, Flag.MU_K_NOT_CONVERGED)),
-     dict(flags=(Flag.OBSERVER_NOT_CONVERGED, Flag.MU_K_NOT_CONVERGED)),
+     dict(flags=(Flag.OBSERVER_STARTS_DISAGREE, Flag.MU_K_NOT_CONVERGED)),
      "observer flags first, then the fit's; each once"),
 ]
 

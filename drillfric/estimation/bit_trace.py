@@ -73,6 +73,10 @@ SEVERITY_VALIDATED_BELOW = 2.1
 #: (stuck 0.06 for 0.14–0.23, severity −15…−27 %), and the 100-RPM record's 0.87 too, while
 #: 0.59–0.71 (the bit well clear of rest) and 1.63 held (docs/validation.md).
 GRAZING = (0.75, 1.3)
+#: Least rotation after the transients [s] over which the stuck fraction and severity are
+#: taken (:func:`drillfric.estimation.chain.statistics_from`): several stick-slip periods
+#: (3–20 s for 1500–6000 m of pipe), so that a share of time is a statistic of the cycle.
+MIN_STATISTICS_S = 60.0
 #: The stated tolerances of the stuck fraction [-] and of the severity [share] (docs/
 #: bit_speed.md "Stuck fraction and severity").
 STUCK_TOLERANCE = 0.05
@@ -460,6 +464,32 @@ def _window_reason(a: float, b: float, gap_rad_s: float, allowed_rad_s: float) -
 def travel_time_s(string) -> float:
     """One-way torsional wave travel time along ``string`` [s]: Σ L_i/c_i."""
     return float(sum(s.length_m / s.wave_speed_m_s for s in string.sections))
+
+
+def stops_without_mu_s(severity: float, stuck: float) -> str:
+    """Why the stuck fraction and severity of a segment whose μ_s was not identified are
+    withheld ("" when the bit does not stop: severity below :data:`GRAZING` and at most
+    2×:data:`STUCK_TOLERANCE` stuck).
+
+    How long the bit sticks each cycle, and so both numbers, turns on μ_s: the torque it
+    must wind up to break free. On the lumped plant, over the rotation after their creeps,
+    82 pairs printed with μ_s unidentified were 71 within the tolerance and 11 not — stuck
+    −0.15…+0.15, severity −14…+24 % — all in stick-slip (estimated severity 1.4–1.9, or 0.69
+    with 0.11 stuck at 6000 m); the 32 without stick-slip (severity ≤ 0.59, stuck ≤ 0.05)
+    all held (docs/bit_speed.md).
+
+    Examples
+    --------
+    >>> stops_without_mu_s(0.55, 0.04)
+    ''
+    >>> stops_without_mu_s(1.7, 0.5)[:44]
+    'stuck fraction and severity withheld: the bi'
+    """
+    if severity < GRAZING[0] and stuck <= 2.0 * STUCK_TOLERANCE:
+        return ""
+    return (f"stuck fraction and severity withheld: the bit stops in the cycle (estimated "
+            f"severity {severity:.2f}), and how long it sticks turns on μ_s, which the data "
+            "did not identify (docs/bit_speed.md)")
 
 
 def members_disagree(member_bit_rad_s: np.ndarray, severity: float,

@@ -103,6 +103,8 @@ class SegmentEstimate:
         Severity of the ensemble's members pooled with their weights [-].
     stuck_fraction : float
         Share of the time the pooled members' bit turns no faster than ω_c [-].
+    stick_slip_from_s : float
+        Both taken from this time to the segment's end [s] (:func:`statistics_from`).
     mu_k_observer, mu_s_observer : float
         Observer consensus (first pass) [-].
     mu_td : float or None
@@ -167,6 +169,7 @@ class SegmentEstimate:
     residual_rms_rpm: float
     stick_slip_severity: float
     stuck_fraction: float
+    stick_slip_from_s: float
     mu_k_observer: float
     mu_s_observer: float
     mu_td: float | None
@@ -719,43 +722,80 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     fitted_result = beside(fit_evidence, settings, models, verdict, refined.mu_s)
     final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
-    trace, kinematics = trace_verdict(settings, models, refined, verdict, final, bit)
+    trace, kinematics, stats_from = trace_verdict(settings, models, refined, verdict,
+                                                  final, bit)
     fitted = fitted_result()
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
     return _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
                                                    trace, final, bit, fitted, terms,
-                                                   kinematics))
+                                                   kinematics, stats_from))
 
 
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
                   verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate
-                  ) -> tuple[TraceVerdict, bit_trace.KinematicCheck]:
+                  ) -> tuple[TraceVerdict, bit_trace.KinematicCheck, float]:
     """Step 8: the checks of the seeded trace (whole-segment kinematics, window by window,
     the members' statistics) and what of it the rules of
-    :func:`~drillfric.estimation.verdict.decide_trace` show."""
+    :func:`~drillfric.estimation.verdict.decide_trace` show; with the time from which the
+    stuck fraction and severity are taken [s] (:func:`statistics_from`)."""
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, settings.speed_noise_rad_s)
-    windows = _windows(settings, models, refined, final.time_s, bit.rad_s)
+    unknown = _unknown_spans(models, refined, final.time_s)
+    windows = _windows(settings, models, final.time_s, bit.rad_s, unknown)
     late = settled_mask(final.time_s)
     settled = final.time_s[late]
     runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
                                   if settled.size > 1 else 0.0)
-    severity = bit_trace.mixture_severity(final.bit_rad_s_est[late], bit.weights[late])
-    cut = any(np.any(late & (final.time_s >= a) & (final.time_s < b))
-              for a, b in windows.withheld)
-    undetermined = ("stuck fraction and severity withheld: the bit trace is withheld over some "
-                    "of their windows (window by window, docs/bit_speed.md)") if cut else \
-        bit_trace.members_disagree(final.bit_rad_s_est[late], severity,
-                                   settings.omega_c_rad_s)
+    start = statistics_from(final.time_s, unknown, windows.withheld)
+    span = final.time_s >= start
+    severity = bit_trace.mixture_severity(final.bit_rad_s_est[span], bit.weights[span])
     trace = decide_trace(TraceEvidence(
         logging=bit_speed_resolution(models), on_bottom=models.on_bottom, check=kinematics,
         windows=windows, converged=verdict.converged,
         runaway_note=_runaway_note(verdict.mu_k, kinematics) if runaway else None,
         severe_note=bit_trace.statistics_note(severity),
-        undetermined_note=undetermined, moving=models.axial is not None))
-    return trace, kinematics
+        undetermined_note=_undetermined(final, bit, span, windows, severity, settings,
+                                        refined.mu_s is not None),
+        moving=models.axial is not None))
+    return trace, kinematics, start
+
+
+def statistics_from(time_s: np.ndarray, unknown: tuple, withheld: tuple = ()) -> float:
+    """Time from which the stuck fraction and severity are taken [s]: after the start-up
+    (:func:`~drillfric.estimation.diagnostics.settled_mask`) and after every span whose bit
+    speed depends on a μ_s the data did not identify (``unknown``: the start-up from rest,
+    each creep with its break-free), to the end of the 30-s windows withheld over them
+    (``withheld``): the statistics of the rotation at its set-point, not of its transients
+    (docs/bit_speed.md "Stuck fraction and severity")."""
+    settled = time_s[settled_mask(time_s)]
+    first = float(settled[0]) if settled.size else float(time_s[-1])
+    over = [b for a, b in withheld if any(lo < b and hi > a for lo, hi in unknown)]
+    return max([first] + [float(b) for _, b in unknown] + [float(b) for b in over])
+
+
+def _undetermined(final: ObserverRecord, bit: BitSpeedEstimate, span: np.ndarray,
+                  windows: bit_trace.WindowVerdict, severity: float,
+                  settings: ChainSettings, mu_s_known: bool) -> str:
+    """Why the stuck fraction and severity are not determined ("" when they are): too short
+    a rotation after the transients (:data:`~drillfric.estimation.bit_trace.
+    MIN_STATISTICS_S`), a window of it withheld, stick-slip whose stuck phases rest on a μ_s
+    the data did not identify (:func:`~drillfric.estimation.bit_trace.stops_without_mu_s`),
+    or members that disagree."""
+    time_s = final.time_s
+    if not span.any() or time_s[span][-1] - time_s[span][0] < bit_trace.MIN_STATISTICS_S:
+        return ("stuck fraction and severity withheld: less than "
+                f"{bit_trace.MIN_STATISTICS_S:g} s of rotation after the start-up and the "
+                "creeps whose break-free depends on the unidentified μ_s (docs/bit_speed.md)")
+    if any(np.any(span & (time_s >= a) & (time_s < b)) for a, b in windows.withheld):
+        return ("stuck fraction and severity withheld: the bit trace is withheld over some "
+                "of their windows (window by window, docs/bit_speed.md)")
+    members, weights = final.bit_rad_s_est[span], bit.weights[span]
+    if not mu_s_known and (why := bit_trace.stops_without_mu_s(
+            severity, bit_trace.stuck_share(members, weights, settings.omega_c_rad_s))):
+        return why
+    return bit_trace.members_disagree(members, severity, settings.omega_c_rad_s)
 
 
 def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
@@ -806,21 +846,26 @@ def _runaway_note(mu_k: float, check: bit_trace.KinematicCheck) -> str:
             "string can hold: the fitted factors do not describe this record")
 
 
-def _windows(settings: ChainSettings, models: SegmentModels, refined, time_s: np.ndarray,
-             bit_rad_s: np.ndarray) -> bit_trace.WindowVerdict:
-    """The window-by-window check of the trace (docs/bit_speed.md "Window by window"); where
-    μ_s was not identified, the windows of the start-up from rest and of each creep with its
-    break-free (to a wave round trip and 10 s after its end) depend on it; windows over a
-    gap between the logged samples (``models.sample_times_s``, after the EDR defects were
-    dropped) longer than the wave travel time were not observed."""
+def _unknown_spans(models: SegmentModels, refined, time_s: np.ndarray) -> tuple:
+    """[t_from_s, t_to_s) of the spans whose bit speed depends on μ_s where it was not
+    identified: the start-up from rest and each creep with its break-free (to a wave round
+    trip and 10 s after its end); none where μ_s was identified."""
+    if refined.mu_s is not None:
+        return ()
     travel = bit_trace.travel_time_s(models.string)
-    unknown = ()
-    if refined.mu_s is None:
-        settled = time_s[settled_mask(time_s)]
-        start = ((time_s[0], settled[0] if settled.size else time_s[-1]),)
-        creeps = tuple((a, b + 2.0 * travel + 10.0) for a, b in
-                       (refined.details.creeps_found or []))
-        unknown = start + creeps
+    settled = time_s[settled_mask(time_s)]
+    start = ((time_s[0], settled[0] if settled.size else time_s[-1]),)
+    return start + tuple((a, b + 2.0 * travel + 10.0) for a, b in
+                         (refined.details.creeps_found or []))
+
+
+def _windows(settings: ChainSettings, models: SegmentModels, time_s: np.ndarray,
+             bit_rad_s: np.ndarray, unknown: tuple) -> bit_trace.WindowVerdict:
+    """The window-by-window check of the trace (docs/bit_speed.md "Window by window"); the
+    windows over ``unknown`` (:func:`_unknown_spans`) depend on the unidentified μ_s; windows
+    over a gap between the logged samples (``models.sample_times_s``, after the EDR defects
+    were dropped) longer than the wave travel time were not observed."""
+    travel = bit_trace.travel_time_s(models.string)
     meas = models.meas
     return bit_trace.window_check(time_s, bit_rad_s, meas.time_s, meas.surface_rad_s,
                                   meas.motor_torque_Nm,
@@ -844,6 +889,7 @@ class Steps:
     fitted: FitEvidence
     terms: bit_torque.TorqueTerms | None
     kinematics: bit_trace.KinematicCheck
+    stats_from_s: float
 
 
 def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
@@ -854,8 +900,8 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
     verdict, trace, refined, final, bit = (steps.verdict, steps.trace, steps.refined,
                                            steps.final, steps.bit)
     reported = diagnose(bit.record(final), settings.omega_c_rad_s)
-    late = settled_mask(final.time_s)
-    members, weights = final.bit_rad_s_est[late], bit.weights[late]
+    span = final.time_s >= steps.stats_from_s
+    members, weights = final.bit_rad_s_est[span], bit.weights[span]
     messages = list(verdict.messages)
     fits = refined.details.creep_fits
     at_top = bool(fits) and fits[-1][1] > 1.05 * verdict.mu_k  # not at μ_s = μ_k
@@ -870,11 +916,12 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         settling_time_s=steps.diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
         stick_slip_severity=bit_trace.mixture_severity(members, weights),
         stuck_fraction=bit_trace.stuck_share(members, weights, settings.omega_c_rad_s),
+        stick_slip_from_s=steps.stats_from_s,
         mu_k_observer=steps.diag.mu_k, mu_s_observer=steps.diag.mu_s,
         mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags + trace.flags,
         messages=tuple(messages) + _interval_note(refined, verdict, trace) + trace.messages
-        + _dropped_note(models),
+        + _span_note(trace, final.time_s, steps.stats_from_s) + _dropped_note(models),
         starts=steps.starts, first=steps.first, final=final, bit=bit,
         bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=models.td,
         mu_s_seed=verdict.mu_s_seed, evidence=steps.fitted, bit_speed=trace.bit_speed,
@@ -883,6 +930,16 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         friction_zone=settings.friction.zone, samples_dropped=models.dropped,
         factors_withheld=withheld_factors(verdict.method, trace.converged,
                                           verdict.flags + trace.flags))
+
+
+def _span_note(trace: TraceVerdict, time_s: np.ndarray, start_s: float) -> tuple[str, ...]:
+    """The message of statistics taken after transients the unidentified μ_s decides."""
+    settled = time_s[settled_mask(time_s)]
+    if not trace.statistics or not settled.size or start_s <= settled[0]:
+        return ()
+    return (f"stuck fraction and severity over {start_s:.0f}–{time_s[-1]:.0f} s: the start-up "
+            "and creeps before, whose break-free depends on the unidentified μ_s, are left "
+            "out (docs/bit_speed.md)",)
 
 
 def _interval_note(refined: batch.BatchResult, verdict: Verdict, trace: TraceVerdict

@@ -21,7 +21,7 @@ from drillfric.vocabulary import Kind, Method, Status
 #: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``
 #: concerns only the μ_s bound, withheld, not μ_k; ``bit_speed_drift`` and
 #: ``stick_slip_beyond_validated`` only the bit-speed trace and its statistics).
-_POOLABLE = frozenset({"too_short_to_converge", "observer_not_converged",
+_POOLABLE = frozenset({"too_short_to_converge", "observer_starts_disagree",
                        "estimators_disagree", "bit_speed_drift", "mu_k_uncertain",
                        "bistable_regime", "stick_slip_beyond_validated",
                        "stick_slip_undetermined"})

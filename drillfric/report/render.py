@@ -285,7 +285,7 @@ def _flag_items(row: dict) -> list[tuple[str, str, str]]:
 #: Flags that are notes, not warnings, where the segment's μ_k is the batch fit's: the
 #: observer's starts are a cross-check there (docs/reports.md "Converged"). Label, meaning.
 _NOTE_FLAGS = {
-    "observer_not_converged": (
+    "observer_starts_disagree": (
         "observer starts spread",
         "the observer's starts did not agree (spread above tolerance); μ_k is the batch "
         "fit's, whose convergence is judged on its own (status)"),

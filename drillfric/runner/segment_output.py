@@ -26,6 +26,9 @@ if TYPE_CHECKING:
 
 #: The note of a segment whose bit speed is shown while the pumps ran (issue 34 item 5): the
 #: trace is the string's bottom speed; a mud motor would add its own (≈ k·flow).
+#: The bit-speed columns nulled where the trace is withheld (the trace and its band).
+BIT_BAND_COLUMNS = ("bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max")
+
 MOTOR_NOTE = ("the pumps were on while the string turned: the bit speed shown is the "
               "string's bottom speed — with a mud motor the bit turns faster by the motor's "
               "speed, which drillfric does not model")
@@ -105,7 +108,8 @@ def _bit_fields(est: SegmentEstimate) -> dict:
                   interval_torque_swing=est.logged.torque_swing,
                   samples_dropped=est.samples_dropped)
     kept = dict(stick_slip_severity=est.stick_slip_severity,
-                stuck_fraction=est.stuck_fraction) if est.bit_statistics else {}
+                stuck_fraction=est.stuck_fraction,
+                stick_slip_from_s=est.stick_slip_from_s) if est.bit_statistics else {}
     if not est.bit_speed.resolved:
         return logged | kept | dict(bit_speed_resolved=False,
                                     bit_speed_reason=est.bit_speed.reason)
@@ -177,7 +181,7 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     for a, b in est.bit_windows_withheld:
         gone |= (t >= a) & (t < b)
     if gone.any():
-        frame.loc[gone, ["bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max"]] = np.nan
+        frame.loc[gone, list(BIT_BAND_COLUMNS)] = np.nan
         stuck = frame["bit_stuck"].astype("boolean")
         stuck[gone] = pd.NA
         frame["bit_stuck"] = stuck
@@ -204,8 +208,7 @@ def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentDa
         "surface_torque_Nm": at(ev.time_s, ev.measured_Nm),
         "surface_torque_est_Nm": rec.surface_torque_est_Nm.ravel(),
         "surface_torque_fit_Nm": at(ev.time_s, ev.model_Nm),
-        "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
-        "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}
+        **{c: np.full(n_t * n_s, np.nan, dtype=np.float32) for c in BIT_BAND_COLUMNS[1:]}}
     if data.bit_rpm is not None:
         cols["bit_rpm"] = at(data.time_s, data.bit_rpm)
     return pd.DataFrame(cols)
