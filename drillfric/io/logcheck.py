@@ -115,15 +115,16 @@ class LogCheck:
 
     def duplicates_note(self, duplicates: int) -> str | None:
         """A warning when more than 1 % of the rows repeated an earlier sample's time and
-        were dropped (timestamps cut to whole seconds on a 20-Hz log dropped 95 % of it,
-        silently), or None."""
+        values and were dropped (timestamps cut to whole seconds on a 20-Hz log dropped 95 %
+        of it, silently), or None. Rows repeating a time with other values are the time
+        base's :meth:`~drillfric.io.timebase.TimeTracker.conflicts_note`."""
         if duplicates <= 0.01 * (duplicates + self.rows):
             return None
         share = 100.0 * duplicates / (duplicates + self.rows)
-        return (f"{duplicates} rows ({share:.0f} % of the log) repeat an earlier row's time "
-                "and were dropped (the first row of each time kept): are the timestamps cut "
-                "to whole seconds or coarser than the logging? Log them to full resolution, "
-                "or give a time_s column")
+        return (f"{self.well.files.data}: {duplicates} rows ({share:.0f} % of the log) repeat "
+                "an earlier row's time and values and were dropped (one row of each time "
+                "kept): are the timestamps cut to whole seconds or coarser than the logging? "
+                "Log them to full resolution, or give a time_s column")
 
     def nothing_found(self, segments: int) -> str | None:
         """Why a run found no rotating segment at all (a warning), or None."""

@@ -235,11 +235,19 @@ class Well:
         tracker = tracker or self.time_tracker()
         for chunk in self.source.chunks(chunk_rows):
             yield self.canonical(chunk, tracker)
+        rest = None if tracker is None else tracker.flush()
+        if rest is not None and len(rest):
+            yield rest
 
     def canonical(self, raw: pd.DataFrame, tracker: TimeTracker | None) -> pd.DataFrame:
         """One raw chunk of the data (the source's columns) as canonical SI columns, its
-        time checked by ``tracker`` (:meth:`chunks` does this for every chunk)."""
-        return _convert(raw, self.mappings, tracker)
+        time checked by ``tracker`` (:meth:`chunks` does this for every chunk).
+
+        The rows of the chunk's last time are held back by ``tracker`` until the next
+        chunk shows whether that time repeats (:meth:`~drillfric.io.timebase.TimeTracker.
+        settle`); ``tracker.flush()`` hands them out at the end of the data."""
+        frame = _convert(raw, self.mappings, tracker)
+        return frame if tracker is None else tracker.settle(frame)
 
     def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
         """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
@@ -249,6 +257,7 @@ class Well:
         tracker = self.time_tracker()
         chunks = list(self.chunks(chunk_rows, tracker))
         surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
+        tracker.check_conflicts(len(surface))
         if surface.empty:
             raise InputError("no data rows with a time", file=self.files.data,
                              fix="give a file with data rows (and a readable time column)")
@@ -257,7 +266,8 @@ class Well:
                              max_gap_s=self.config.segmentation.max_gap_s,
                              duplicates_dropped=tracker.duplicates,
                              untimed_dropped=tracker.untimed, origin=tracker.origin,
-                             source_start_s=tracker.source_start_s)
+                             source_start_s=tracker.source_start_s,
+                             conflicts_dropped=tracker.conflicts)
         files = {k: v for k, v in (("data", self.files.data), ("config", self.files.config),
                                    ("survey", self.files.survey)) if v is not None}
         return WellData(name=self.name, surface=surface, survey=self.survey,
@@ -623,7 +633,7 @@ def _channel_infos(mappings: dict[str, Mapping], surface: pd.DataFrame,
     out = {}
     for key, m in mappings.items():
         if key == "time":
-            total = len(surface) + tracker.untimed + tracker.duplicates
+            total = len(surface) + tracker.untimed + tracker.duplicates + tracker.conflicts
             nulls = tracker.untimed / total if total else 0.0
             clock = tracker.origin is not None
             unit = CLOCK_UNIT if clock else m.unit

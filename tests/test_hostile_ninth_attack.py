@@ -1,0 +1,129 @@
+"""The ninth hostile-input attack (issue 30): its remaining findings, each a regression test
+named after the bug (lasio style), fixtures made here (tmp_path), no field data copied.
+
+The end-to-end cases use the demo's first stand (`drillfric simulate`: creep start-up and
+stick-slip at 2210 m, 20 Hz, μ_k = 0.28: examples/demo/demo.truth.json).
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from drillfric.cli.main import cli
+
+from drillfric.io.well import open_well
+from drillfric.runner import run_well
+from drillfric.runner.engine import Engine
+from tests.conftest import DEMO
+from tests.io.io_frames import surface_frame
+
+TRUTH_MU_K = 0.28
+
+
+def _stand() -> pd.DataFrame:
+    """The demo's first stand (its first 230 s)."""
+    frame = pd.read_csv(DEMO / "demo.csv")
+    return frame[frame["time_s"] < 230.0].reset_index(drop=True)
+
+
+def _well_folder(folder, frame: pd.DataFrame):
+    """``folder/demo.csv`` holding ``frame``, with the demo's configuration and survey."""
+    folder.mkdir()
+    for name in ("demo.toml", "demo.survey.csv"):
+        shutil.copy(DEMO / name, folder / name)
+    frame.to_csv(folder / "demo.csv", index=False)
+    return folder / "demo.csv"
+
+
+# ------------------------------------------------ F2: a time written twice, other values
+def _written_twice(frame: pd.DataFrame, share: float, seed: int) -> tuple[pd.DataFrame,
+                                                                         np.ndarray]:
+    """``frame`` with ``share`` of its times written twice: first a row with the torque
+    halved and the speed 30 % up, then the true row (the first row is the wrong one); the
+    positions of the doubled times in the result."""
+    rng = np.random.default_rng(seed)
+    picks = np.sort(rng.choice(len(frame), int(share * len(frame)), replace=False))
+    bad = frame.iloc[picks].assign(surface_torque_Nm=lambda f: 0.5 * f["surface_torque_Nm"],
+                                   surface_rpm=lambda f: 1.3 * f["surface_rpm"] + 1.0)
+    both = pd.concat([bad.assign(_o=0), frame.assign(_o=1)])
+    both = both.sort_values(["time_s", "_o"], kind="stable").drop(columns="_o")
+    both = both.reset_index(drop=True)
+    twice = np.flatnonzero(both["time_s"].duplicated(keep="last").to_numpy())
+    return both, twice
+
+
+def test_duplicated_timestamps_with_different_values_give_the_same_rows_in_any_chunking():
+    """Regression (issue 30, ninth attack): a repeated time's rows were settled chunk by
+    chunk (the first row kept); keeping the last or dropping both is chunk-dependent at a
+    chunk boundary. The rows of a chunk's last time are held back until the next chunk:
+    read in chunks of 1, 2, 3, 7 or 1000 rows, the log gives the rows of one read — the
+    doubled times (other values) dropped, an identical repeat kept once."""
+    frame, twice = _written_twice(surface_frame(rows=300), 0.1, seed=3)
+    once = int(np.flatnonzero(~frame["time_s"].duplicated(keep=False).to_numpy())[5])
+    frame = pd.concat([frame.iloc[:once + 1], frame.iloc[once:]],
+                      ignore_index=True)  # one identical repeat
+    twice[twice > once] += 1
+    well = open_well(frame=frame)
+    whole = well.load()
+    assert (whole.timebase.conflicts_dropped, whole.timebase.duplicates_dropped) == (60, 1)
+    assert len(whole.surface) == 300 - 30
+    assert not np.isin(whole.surface["time_s"] + frame["time_s"].iloc[0],
+                       frame["time_s"].iloc[twice]).any()
+    for rows in (1, 2, 3, 7, 1000):
+        parts = list(well.chunks(rows))
+        pd.testing.assert_frame_equal(pd.concat(parts, ignore_index=True), whole.surface)
+
+
+def test_duplicated_timestamps_with_different_values_in_most_of_the_log_are_refused(
+        tmp_path, capsys):
+    """Timestamps cut to whole seconds on a 5-Hz log: every second written five times with
+    other values. Nothing of it can be trusted: one line naming the file, the counts and the
+    fix, exit 2, nothing written."""
+    frame = surface_frame(rows=400)
+    frame["time_s"] = np.floor(frame["time_s"])
+    path = tmp_path / "coarse.csv"
+    frame.to_csv(path, index=False)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["-q", "run", str(path), "--out", str(out),
+                                      "--no-report"])
+    assert result.exit_code == 2
+    line = result.output.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert f"{path}: 80 of the log's 80 timestamps (100 %) are repeated with other values " \
+           "(400 rows, the first at 0 s in column 'time_s')" in line
+    assert "log the time at full resolution" in line
+    assert not out.exists() or not any(out.rglob("*.parquet"))
+
+
+@pytest.mark.slow
+def test_duplicated_timestamps_with_different_values_keep_mu_k_within_its_uncertainty(
+        tmp_path):
+    """Regression (issue 30, ninth attack): 9 % of a simulated stand's times written twice,
+    the first row wrong (torque halved, speed 30 % up). The first row of each time was kept:
+    μ_k 0.267 ± 0.013 for the truth 0.28 (clean stand: 0.279 ± 0.014), with a warning that
+    the repeats were dropped. All rows of a contradicted time are dropped now: μ_k within
+    its stated ± of the truth, a warning naming the file and the counts — and the stand fed
+    to the engine in chunks cut inside the doubled times (as ``drillfric live`` reads a
+    growing file) gives the run's numbers."""
+    frame, twice = _written_twice(_stand(), 0.09, seed=30)
+    path = _well_folder(tmp_path / "twice", frame)
+    whole = run_well(open_well(path))
+    mu_k, plus = whole.summary["mu_k"], whole.summary["mu_k_uncertainty"]
+    assert abs(mu_k - TRUTH_MU_K) <= plus
+    note = next(w for w in whole.summary["warnings"] if "repeated with other values" in w)
+    assert note.startswith(f"{path}: {twice.size} of the log's {len(frame) - twice.size} "
+                           f"timestamps (9.0 %) are repeated with other values "
+                           f"({2 * twice.size} rows")
+    cuts = np.unique(np.r_[0, twice[::40], twice[5::40] + 1, len(frame)])
+    engine = Engine(open_well(frame=frame.iloc[:10], config=path.with_suffix(".toml"),
+                              survey=path.with_suffix(".survey.csv"), name="demo"))
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        engine.feed(frame.iloc[a:b])
+    fed = engine.result()
+    assert fed.summary["inputs"]["rows"] == whole.summary["inputs"]["rows"]
+    assert fed.summary["mu_k"] == pytest.approx(mu_k, rel=0.005)
+    assert fed.segments["t_end_s"].tolist() == whole.segments["t_end_s"].tolist()
