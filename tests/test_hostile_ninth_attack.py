@@ -127,3 +127,26 @@ def test_duplicated_timestamps_with_different_values_keep_mu_k_within_its_uncert
     assert fed.summary["inputs"]["rows"] == whole.summary["inputs"]["rows"]
     assert fed.summary["mu_k"] == pytest.approx(mu_k, rel=0.005)
     assert fed.segments["t_end_s"].tolist() == whole.segments["t_end_s"].tolist()
+
+
+# ------------------------------------------------ F7: an absurd observer noise setting
+@pytest.mark.parametrize("value", [1000, 5.5])
+def test_observer_speed_noise_rpm_of_1000_is_refused_naming_key_value_and_range(
+        value, tmp_path, capsys):
+    """Regression (issue 30, ninth attack): ``observer.speed_noise_rpm = 1000`` was taken:
+    the observer then ignores the speed it is given, and its bit trace, shown as resolved,
+    was 54 RPM RMS from the bit. A speed sensor's noise is at most a few RPM: one line
+    naming the key, the value, the allowed range and the fix; exit 2, nothing written."""
+    frame = surface_frame(rows=50)
+    path = tmp_path / "w.csv"
+    frame.to_csv(path, index=False)
+    path.with_suffix(".toml").write_text(f"[observer]\nspeed_noise_rpm = {value}\n")
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["-q", "run", str(path), "--out", str(out),
+                                      "--no-report"])
+    assert result.exit_code == 2
+    line = result.output.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert f"key 'observer.speed_noise_rpm' = {value:g} is outside (0, 5]" in line
+    assert "fix: give a value (0, 5] [RPM]" in line
+    assert not out.exists()
