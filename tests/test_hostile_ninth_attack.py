@@ -150,3 +150,86 @@ def test_observer_speed_noise_rpm_of_1000_is_refused_naming_key_value_and_range(
     assert f"key 'observer.speed_noise_rpm' = {value:g} is outside (0, 5]" in line
     assert "fix: give a value (0, 5] [RPM]" in line
     assert not out.exists()
+
+
+# ------------------------------------------------ F5b: 10-Hz frames flushed once a second
+def _unstamped_bursts(bursts: int, per_burst: int = 10) -> list[bytes]:
+    """``bursts`` bursts of ``per_burst`` WITS0 frames without date and time (speed = the
+    frame's number)."""
+    from drillfric.io.wits0 import encode, item_map
+
+    items = item_map({})
+    return [b"".join(encode({"surface_rpm": float(b * per_burst + k)}, items)
+                     for k in range(per_burst)) for b in range(bursts)]
+
+
+def _seconds(times: pd.Series) -> np.ndarray:
+    """Recorded ISO times as seconds from the first [s]."""
+    stamps = pd.to_datetime(times)
+    return (stamps - stamps.iloc[0]).dt.total_seconds().to_numpy()
+
+
+def _receiver(tmp_path, warned: list):
+    from drillfric.io.wits0 import Row, item_map
+    from drillfric.live.wits0_receiver import Receiver, Recording, parse_address, setup
+
+    address = parse_address("wits0://127.0.0.1:5000")
+    return Receiver(address, setup(address, None, "t"),
+                    Recording(tmp_path / "t.wits0.csv", Row(item_map({})).names, False),
+                    warn=warned.append)
+
+
+def test_wits0_frames_without_time_flushed_once_a_second_are_spread_not_1_ms_apart(tmp_path):
+    """Regression (issue 30, ninth attack): a recorder flushing its 10-Hz frames once a
+    second, without their date and time, had them recorded 1 ms apart (μ_k right, the bit
+    trace withheld). A burst's frames are spread evenly over the time since the previous
+    burst — 0.1 s apart — and the burst is said once."""
+    warned: list[str] = []
+    receiver = _receiver(tmp_path, warned)
+    for k, burst in enumerate(_unstamped_bursts(4)):
+        receiver._take(burst, 100.0 + k)
+    receiver.recording.close()
+    got = pd.read_csv(tmp_path / "t.wits0.csv")
+    t = _seconds(got["time"])
+    assert got["surface_rpm"].tolist() == [float(k) for k in range(40)]
+    np.testing.assert_allclose(np.diff(t[9:]), 0.1, atol=2e-6)  # after the first burst
+    assert len(warned) == 1
+    assert "10 frames without a date and time arrived together" in warned[0]
+    assert "spread evenly over the 1 s since the previous burst, 0.1 s apart" in warned[0]
+
+
+def test_wits0_burst_cut_into_two_reads_is_one_burst(tmp_path):
+    """A burst that TCP delivers in two reads a few ms apart is gathered as one (its frames
+    spread alike), over a real socket."""
+    import socket
+    import threading
+    import time
+
+    listener = socket.create_server(("127.0.0.1", 0))
+    warned: list[str] = []
+    receiver = _receiver(tmp_path, warned)
+    receiver.address = receiver.address.__class__("127.0.0.1", listener.getsockname()[1])
+    thread = threading.Thread(target=receiver.run, daemon=True)
+    listener.settimeout(10)
+    thread.start()
+    try:
+        conn, _ = listener.accept()
+        for burst in _unstamped_bursts(3):
+            half = len(burst) // 2
+            conn.sendall(burst[:half])
+            time.sleep(0.005)
+            conn.sendall(burst[half:])
+            time.sleep(0.5)
+        deadline = time.monotonic() + 10
+        while receiver.frames < 30 and time.monotonic() < deadline:
+            time.sleep(0.02)
+        receiver.stop.set()
+        conn.close()
+    finally:
+        receiver.stop.set()
+        thread.join(5)
+        listener.close()
+    got = pd.read_csv(tmp_path / "t.wits0.csv")
+    t = _seconds(got["time"])
+    steps = np.diff(t[10:])  # the second and third bursts: ~0.5 s / 10 apart
+    assert len(got) == 30 and (steps > 0.03).all() and (steps < 0.08).all()
