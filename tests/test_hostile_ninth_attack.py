@@ -233,3 +233,40 @@ def test_wits0_burst_cut_into_two_reads_is_one_burst(tmp_path):
     t = _seconds(got["time"])
     steps = np.diff(t[10:])  # the second and third bursts: ~0.5 s / 10 apart
     assert len(got) == 30 and (steps > 0.03).all() and (steps < 0.08).all()
+
+
+# ------------------------------------------------ messages: a survey tie-in written twice
+def test_a_survey_tie_in_station_written_twice_identically_is_dropped_with_a_warning(tmp_path):
+    """Regression (issue 30, ninth attack): a tie-in station repeated exactly (same MD,
+    inclination and azimuth) refused the whole survey ("depths not increasing"). It is one
+    station written twice: dropped, with one warning naming the file and the MD."""
+    from drillfric.io.survey import SurveyWarning, read_survey
+
+    path = tmp_path / "s.csv"
+    path.write_text("MD,INC,AZI,TVD\n500,2.5,45,499.9\n500,2.5,45,499.9\n800,10,50,\n"
+                    "1100,20,55,\n")
+    with pytest.warns(SurveyWarning) as caught:
+        well_path = read_survey(path)
+    assert [str(w.message) for w in caught] == [
+        f"{path}: survey station 2 repeats station 1 exactly (MD 500 m): dropped (a tie-in "
+        "station written twice)"]
+    assert well_path.md_m.tolist() == [500.0, 800.0, 1100.0]
+
+
+def test_a_survey_station_repeated_with_other_values_is_refused_naming_the_md(tmp_path,
+                                                                             capsys):
+    """Two stations at one MD with different angles: which is the station cannot be told —
+    one line naming the file, the MD and both readings, exit 2."""
+    frame = surface_frame(rows=50)
+    path = tmp_path / "w.csv"
+    frame.to_csv(path, index=False)
+    path.with_suffix(".survey.csv").write_text("MD,INC,AZI\n0,0,0\n500,2.5,45\n500,3,45\n"
+                                               "2600,20,55\n")
+    result = CliRunner().invoke(cli, ["-q", "run", str(path), "--out", str(tmp_path / "o"),
+                                      "--no-report"])
+    assert result.exit_code == 2
+    line = result.output.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert (f"{path.with_suffix('.survey.csv')}: survey stations 2 and 3 are both at MD 500 m "
+            "with different values (inclination / azimuth 2.5° / 45° and 3° / 45°)") in line
+    assert "fix: keep one station at MD 500 m" in line
