@@ -15,6 +15,7 @@ import pytest
 from click.testing import CliRunner
 from drillfric.cli.main import cli
 
+from drillfric.errors import InputError
 from drillfric.io.well import open_well
 from drillfric.runner import run_well
 from drillfric.runner.engine import Engine
@@ -270,3 +271,70 @@ def test_a_survey_station_repeated_with_other_values_is_refused_naming_the_md(tm
     assert (f"{path.with_suffix('.survey.csv')}: survey stations 2 and 3 are both at MD 500 m "
             "with different values (inclination / azimuth 2.5° / 45° and 3° / 45°)") in line
     assert "fix: keep one station at MD 500 m" in line
+
+
+# ------------------------------------------------ messages: a clock going back
+def _clock_log(tmp_path, stamps: list[str]):
+    frame = surface_frame(rows=len(stamps))
+    frame["time_s"] = stamps
+    path = tmp_path / "clock.csv"
+    frame.rename(columns={"time_s": "time"}).to_csv(path, index=False)
+    return path
+
+
+def test_a_dst_fall_back_is_named_with_its_timestamp_and_the_fix(tmp_path):
+    """Regression (issue 30, ninth attack): a local clock's daylight-saving fall-back
+    (02:59:59 then 02:00:00, no UTC offset) refused the log as "time goes backwards" with
+    "sort the file by time" — which would scramble it. The line says where, that it is a
+    fall-back, and to export the times in UTC or with their offset."""
+    stamps = ["2026-10-25T02:59:58", "2026-10-25T02:59:59", "2026-10-25T02:00:00",
+              "2026-10-25T02:00:01"]
+    path = _clock_log(tmp_path, stamps)
+    with pytest.raises(InputError) as caught:
+        open_well(path).load()
+    assert caught.value.message == (
+        f"{path}: time goes backwards at data row 3 (2026-10-25 02:00:00 after "
+        "2026-10-25 02:59:59): back 60 min, a daylight-saving fall-back of a local clock "
+        "written without its UTC offset — fix: export the times in UTC or with their offset "
+        "(e.g. 2026-10-25T02:30:00+01:00), or give a time_s column")
+
+
+def test_a_clock_stepped_back_035_s_is_named_with_its_timestamp_and_the_fix(tmp_path):
+    """Regression (issue 30, ninth attack): a 0.35-s clock step back (a clock synchronised
+    while logging) refused the log with "sort the file by time". The line names the row and
+    the timestamps, the step, and which rows to remove."""
+    stamps = ["2026-03-01T06:00:00.00", "2026-03-01T06:00:00.50", "2026-03-01T06:00:00.15",
+              "2026-03-01T06:00:00.65"]
+    path = _clock_log(tmp_path, stamps)
+    with pytest.raises(InputError) as caught:
+        open_well(path).load()
+    assert caught.value.message == (
+        f"{path}: time goes backwards at data row 3 (2026-03-01 06:00:00.150000 after "
+        "2026-03-01 06:00:00.500000): back 0.35 s, a clock stepped back (set or synchronised "
+        "while logging) — fix: remove the rows from that one on whose time is not after "
+        "2026-03-01 06:00:00.500000 (the 0.35 s the clock logged twice), or give a time_s "
+        "column that never goes back")
+
+
+def test_overlapping_hourly_exports_name_the_two_parts_not_the_folder(tmp_path):
+    """Regression (issue 30, ninth attack): two hourly exports of a folder overlapping (the
+    second starting before the first ends) were refused naming the folder only. The line
+    names both parts and where they overlap."""
+    well = tmp_path / "A-12"
+    (well / "hourly").mkdir(parents=True)
+    (well / "well.toml").write_text('[well]\ndata = "hourly"\n')
+    frame = surface_frame(rows=60)
+    frame.iloc[:40].to_csv(well / "hourly" / "06.csv", index=False)
+    frame.iloc[30:].to_csv(well / "hourly" / "07.csv", index=False)  # 10 rows again
+    with pytest.raises(InputError) as caught:
+        open_well(well).load()
+    assert caught.value.message == (
+        f"{well / 'hourly'}: part '07.csv' starts at 6 s, before part '06.csv' ends (7.8 s): "
+        "the two parts of the log overlap — fix: remove the rows of '07.csv' up to 7.8 s (or "
+        "the part that is an export of the same hours again)")
+    (well / "hourly" / "07.csv").write_text(
+        frame.iloc[40:].assign(time_s=lambda f: f["time_s"].where(f.index != 50, 1.0))
+        .to_csv(index=False))
+    with pytest.raises(InputError, match="time goes backwards at data row 11 of part "
+                                         "'07.csv' \\(1 s after 9.8 s\\)"):
+        open_well(well).load()

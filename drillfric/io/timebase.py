@@ -224,6 +224,9 @@ class TimeTracker:
         self._last: float | None = None
         self._absolute: bool | None = None
         self._held: pd.DataFrame | None = None  # rows of the last time read (settle)
+        # the part of a log in parts read last, and the rows read before it
+        self._part: str | None = None
+        self._part_row = 0
 
     def state(self) -> dict:
         """Where the time base stands (plain values; the origin as ISO 8601 text; the rows
@@ -233,7 +236,8 @@ class TimeTracker:
                 "untimed": self.untimed, "rows_seen": self._rows_seen, "last": self._last,
                 "absolute": self._absolute, "conflicts": self.conflicts,
                 "conflict_times": self.conflict_times,
-                "first_conflict_s": self.first_conflict_s, "held": self._held}
+                "first_conflict_s": self.first_conflict_s, "held": self._held,
+                "part": self._part, "part_row": self._part_row}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -245,16 +249,24 @@ class TimeTracker:
         self.conflicts = int(state.get("conflicts", 0))
         self.conflict_times = int(state.get("conflict_times", 0))
         self.first_conflict_s = state.get("first_conflict_s")
+        self._part, self._part_row = state.get("part"), int(state.get("part_row", 0))
         held = state.get("held")
         self._held = None if held is None else held.copy()
 
     @property
     def holding(self) -> bool:
         """Whether rows are held back (:meth:`settle`) for :meth:`flush` to hand out."""
-        return self._held is not None and len(self._held) > 0
+        return self.held_rows > 0
 
-    def step(self, values: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series | None]:
-        """Check one chunk's time column.
+    @property
+    def held_rows(self) -> int:
+        """Rows held back by :meth:`settle` (read, their time not yet settled)."""
+        return 0 if self._held is None else len(self._held)
+
+    def step(self, values: pd.Series, part: str | None = None
+             ) -> tuple[np.ndarray, np.ndarray, pd.Series | None]:
+        """Check one chunk's time column (``part``: the file of a log in parts it comes
+        from, for messages).
 
         Rows repeating a time are all kept here: :meth:`settle` decides on them, with their
         values.
@@ -282,16 +294,50 @@ class TimeTracker:
         previous = np.concatenate([[self._last if self._last is not None else -np.inf], t[:-1]])
         back = np.flatnonzero(t < previous)
         if back.size:
-            i = back[0]
-            row = self._rows_seen + rows[i] + 1
-            raise InputError(f"time goes backwards at data row {row} ({self._show(t[i])} "
-                             f"after {self._show(previous[i])})", file=self.file,
-                             fix="sort the file by time or remove the out-of-order rows")
+            self._backwards(int(rows[back[0]]), float(t[back[0]]), float(previous[back[0]]),
+                            part, first=back[0] == 0 and part != self._part)
         if t.size:
             self._last = float(t[-1])
+        if part != self._part:
+            self._part, self._part_row = part, self._rows_seen
         self._rows_seen += len(seconds)
         kept = None if stamps is None else stamps[valid].reset_index(drop=True)
         return seconds[valid], valid, kept
+
+    def _backwards(self, i: int, t: float, before: float, part: str | None,
+                   first: bool) -> None:
+        """Raise the InputError of a time going back at the chunk's row ``i`` (``t`` after
+        ``before`` [s]; ``first``: the first timed row of a new part), saying where and what
+        it looks like: two overlapping parts of a log, a daylight-saving fall-back, a clock
+        stepped back."""
+        back = before - t
+        at, prev = self._show(t), self._show(before)
+        if first and part is not None and self._part is not None:
+            raise InputError(f"part '{printable(part)}' starts at {at}, before part "
+                             f"'{printable(self._part)}' ends ({prev}): the two parts of "
+                             "the log overlap", file=self.file,
+                             fix=f"remove the rows of '{printable(part)}' up to {prev} (or the "
+                                 "part that is an export of the same hours again)")
+        if part is not None and part != self._part:
+            self._part_row = self._rows_seen  # the row is in a part begun in this chunk
+        row = self._rows_seen + i + 1
+        where = f"at data row {row - self._part_row} of part '{printable(part)}'" \
+            if part is not None else f"at data row {row}"
+        problem = f"time goes backwards {where} ({at} after {prev})"
+        if abs(back - 3600.0) <= 60.0 and self.origin is not None:
+            raise InputError(f"{problem}: back {back / 60:.0f} min, a daylight-saving "
+                             "fall-back of a local clock written without its UTC offset",
+                             file=self.file,
+                             fix="export the times in UTC or with their offset (e.g. "
+                                 "2026-10-25T02:30:00+01:00), or give a time_s column")
+        if back < 60.0:
+            raise InputError(f"{problem}: back {back:.3g} s, a clock stepped back (set or "
+                             "synchronised while logging)", file=self.file,
+                             fix=f"remove the rows from that one on whose time is not after "
+                                 f"{prev} (the {back:.3g} s the clock logged twice), or give "
+                                 "a time_s column that never goes back")
+        raise InputError(problem, file=self.file,
+                         fix="sort the file by time or remove the out-of-order rows")
 
     def settle(self, rows: pd.DataFrame) -> pd.DataFrame:
         """The rows of ``rows`` (canonical: ``time_s`` from :meth:`step`, values) whose time

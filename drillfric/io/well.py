@@ -54,7 +54,7 @@ from drillfric.errors import DrillfricError, InputError
 from drillfric.files import require_file
 from drillfric.io import witsml, witsml_objects
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
-from drillfric.io.parts import open_parts
+from drillfric.io.parts import PART_ATTR, open_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import plural, printable
@@ -595,7 +595,8 @@ def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
     out: dict = {}
     keep = slice(None)
     if tracker is not None:
-        time_s, keep, stamps = tracker.step(chunk[mappings["time"].column])
+        time_s, keep, stamps = tracker.step(chunk[mappings["time"].column],
+                                            part=chunk.attrs.get(PART_ATTR))
         out["time_s"] = time_s
         if stamps is not None:
             out["timestamp"] = stamps.array
