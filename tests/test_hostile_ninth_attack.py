@@ -338,3 +338,81 @@ def test_overlapping_hourly_exports_name_the_two_parts_not_the_folder(tmp_path):
     with pytest.raises(InputError, match="time goes backwards at data row 11 of part "
                                          "'07.csv' \\(1 s after 9.8 s\\)"):
         open_well(well).load()
+
+
+# ------------------------------------------------ messages: a time or speed in another unit
+def test_date_and_hhmmss_columns_are_not_read_as_seconds(tmp_path):
+    """Regression (issue 30, ninth attack): DATE and TIME (HHMMSS) columns had the TIME read
+    as seconds — 235859 then 235900 a 41-s gap every minute, and the log refused only where
+    it crossed midnight, as "time goes backwards". One line names the columns, the rows and
+    the fix; exit 2."""
+    frame = surface_frame(rows=400, rate_hz=1.0)
+    stamps = pd.Timestamp("2026-11-27 23:58:00") + pd.to_timedelta(frame["time_s"], unit="s")
+    frame.insert(0, "DATE", stamps.dt.strftime("%Y%m%d").astype(int))
+    frame.insert(1, "TIME", stamps.dt.strftime("%H%M%S").astype(int))
+    frame = frame.drop(columns="time_s").rename(columns={"surface_rpm": "RPM"})
+    path = tmp_path / "w.csv"
+    frame.to_csv(path, index=False)
+    for rows in (1, 7, 1000):  # the same line in any chunking
+        with pytest.raises(InputError) as caught:
+            list(open_well(path).chunks(rows))
+        assert caught.value.message == (
+            f"{path}: time column 'TIME' holds times of day written as HHMMSS beside the date "
+            "column 'DATE' (235859 then 235900 at data row 61: 1 s, read as seconds 41): "
+            "drillfric reads a time column as seconds or as timestamps — fix: give one time "
+            "column of ISO 8601 timestamps, date and time together (e.g. 2026-11-27T23:59:00), "
+            "or a time_s column")
+
+
+def test_a_log_in_seconds_with_one_gap_over_60_to_99_is_not_taken_for_hhmmss():
+    """One 41-s gap skipping 60–99 s of a log in seconds looks like a minute of HHMMSS: it
+    takes two such steps to be called that."""
+    t = np.r_[np.arange(0.0, 60.0), np.arange(100.0, 160.0)]
+    frame = surface_frame(rows=t.size, rate_hz=1.0).assign(time_s=t)
+    assert len(open_well(frame=frame).load().surface) == t.size
+
+
+def _run_line(tmp_path, frame, config: str = ""):
+    path = tmp_path / "w.csv"
+    frame.to_csv(path, index=False)
+    if config:
+        path.with_suffix(".toml").write_text(config)
+    result = CliRunner().invoke(cli, ["-q", "run", str(path), "--out", str(tmp_path / "o"),
+                                      "--no-report"])
+    return path, result
+
+
+_NEUTRAL = {"surface_rpm": "RPM", "surface_torque_Nm": "TORQUE", "hookload_N": "HKLD",
+            "bit_depth_m": "BITDEPTH", "time_s": "TIME"}
+_SI = ('[channels]\nsurface_torque = { column = "TORQUE", unit = "N.m" }\n'
+       'hookload = { column = "HKLD", unit = "N" }\n')
+
+
+def test_time_in_minutes_says_every_rotation_is_short_and_how_to_say_minutes(tmp_path):
+    """Regression (issue 30, ninth attack): a 1-Hz log's time written in minutes ran to
+    "too short: 6.65 s < 30 s" for every rotation, nothing more. A warning says the samples
+    are 1/60 s apart, that in minutes the rotation would be 399 s, and the config line."""
+    frame = surface_frame(rows=400, rate_hz=1.0)
+    frame["time_s"] /= 60.0
+    path, result = _run_line(tmp_path, frame.rename(columns=_NEUTRAL), _SI)
+    assert result.exit_code == 0, result.output
+    assert (f"{path}: every rotation is too short (the longest 6.65 s < "
+            "segmentation.min_segment_s = 30 s), its samples 0.0167 s apart: if the time "
+            "column 'TIME' is in minutes (the longest 399 s, samples 1 s apart), say so: "
+            '[channels] time = { column = "TIME", unit = "min" }') in result.output
+
+
+def test_speed_in_rad_s_says_the_top_speed_and_how_to_say_rad_s(tmp_path):
+    """Regression (issue 30, ninth attack): a speed column in rad/s ran to "the top drive
+    never turns faster than ω_c". The segment's message gives ω_c and the top speed in RPM,
+    and a warning names the column, its top, the RPM it would be and the config line."""
+    frame = surface_frame(rows=400, rate_hz=1.0)
+    frame["surface_rpm"] *= 2.0 * np.pi / 60.0
+    path, result = _run_line(tmp_path, frame.rename(columns=_NEUTRAL), _SI)
+    assert result.exit_code == 0, result.output
+    top = frame["surface_rpm"].max()
+    assert (f"{path}: the surface speed column 'RPM' reads at most {top:.3g} RPM, where a top "
+            f"drive turns at 30–250: if it is in rad/s ({top:.3g} rad/s = "
+            f"{top * 60 / (2 * np.pi):.3g} RPM), say so: [channels] surface_rpm = "
+            '{ column = "RPM", unit = "rad/s" }') in result.output
+    assert f"never turns faster than ω_c (9.55 RPM): at most {top:.3g} RPM" in result.output

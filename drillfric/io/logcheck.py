@@ -36,11 +36,14 @@ class LogCheck:
         self.backwards = 0  # of those, turning backwards
         self.rpm_min = np.inf
         self.rpm_max = -np.inf
+        self.spacing_s = np.nan  # median sample spacing of the first chunk [s]
 
     def feed(self, chunk: pd.DataFrame) -> None:
         """Take in one canonical chunk (the first one also checks the sample spacing)."""
         if self.rows == 0 and len(chunk) > 1:
             self._spacing(chunk["time_s"].to_numpy(float))
+            dt = np.diff(chunk["time_s"].to_numpy(float))
+            self.spacing_s = float(np.median(dt[dt > 0])) if (dt > 0).any() else np.nan
         self.rows += len(chunk)
         for name in self.finite:
             if name in chunk:
@@ -57,7 +60,8 @@ class LogCheck:
     def state(self) -> dict:
         """The counters (plain values and arrays)."""
         return {"rows": self.rows, "finite": dict(self.finite), "turning": self.turning,
-                "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max])}
+                "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max]),
+                "spacing_s": self.spacing_s}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -65,6 +69,7 @@ class LogCheck:
         self.backwards = int(state["backwards"])
         self.finite = {k: int(v) for k, v in state["finite"].items()}
         self.rpm_min, self.rpm_max = (float(v) for v in state["rpm_range"])
+        self.spacing_s = float(state.get("spacing_s", np.nan))
 
     def _spacing(self, time_s: np.ndarray) -> None:
         """Every sample a gap: time in ms read as s, or a log slower than max_gap_s (the
@@ -126,6 +131,36 @@ class LogCheck:
                 "kept): are the timestamps cut to whole seconds or coarser than the logging? "
                 "Log them to full resolution, or give a time_s column")
 
+    def unit_hints(self, records) -> list[str]:
+        """Warnings for a log that looks read in the wrong unit though nothing refused it
+        (issue 30, ninth attack: the messages had been "the top drive never turns faster
+        than ω_c" and "too short"): a speed column that never exceeds 20 RPM (rad/s read as
+        RPM?), and rotations all too short though their samples are a whole fraction of a
+        minute apart (minutes read as seconds?)."""
+        out, file = [], self.well.files.data
+        top = max(abs(self.rpm_min), abs(self.rpm_max))
+        m = self.well.channels.get("surface_rpm")
+        if m is not None and np.isfinite(top) and 0.5 < top <= 20.0:
+            out.append(f"{file}: the surface speed column '{printable(m.column)}' reads at "
+                       f"most {top:.3g} RPM, where a top drive turns at 30–250: if it is in "
+                       f"rad/s ({top:.3g} rad/s = {top * 60.0 / (2.0 * np.pi):.3g} RPM), "
+                       + _say_unit(m, "rad/s"))
+        time = self.well.mappings.get("time")
+        short = [r for r in records if str(r.message or "").startswith("too short")]
+        dt = self.spacing_s
+        if (time is not None and time.unit != CLOCK_UNIT and short
+                and len(short) == len(records) and np.isfinite(dt)
+                and 0.01 <= 60.0 * dt <= 60.0):
+            longest = max(r.duration_s for r in short)
+            minimum = self.well.config.segmentation.min_segment_s
+            if 60.0 * longest >= minimum:
+                out.append(f"{file}: every rotation is too short (the longest {longest:.3g} "
+                           f"s < segmentation.min_segment_s = {minimum:g} s), its samples "
+                           f"{dt:.3g} s apart: if the time column '{printable(time.column)}' "
+                           f"is in minutes (the longest {60.0 * longest:.4g} s, samples "
+                           f"{60.0 * dt:.3g} s apart), " + _say_unit(time, "min"))
+        return out
+
     def nothing_found(self, segments: int) -> str | None:
         """Why a run found no rotating segment at all (a warning), or None."""
         if segments:
@@ -135,3 +170,14 @@ class LogCheck:
         return (f"no rotating segment found: the surface speed never exceeds "
                 f"segmentation.rotating_rpm = {threshold:.4g} RPM for "
                 f"segmentation.min_rotation_s (highest: {top}) — nothing was estimated")
+
+
+def _say_unit(m, unit: str) -> str:
+    """How to tell drillfric that mapping ``m``'s column is in ``unit``: the config line, or
+    — where the file states the unit (the config cannot contradict it) — the file."""
+    column = printable(m.column)
+    if m.source in ("config", "default"):
+        return (f'say so: [channels] {m.channel.key} = {{ column = "{column}", '
+                f'unit = "{unit}" }}')
+    return (f"the file's {m.source} says '{printable(m.unit)}': correct it to '{unit}' "
+            f"(then drillfric converts)")

@@ -207,12 +207,16 @@ class TimeTracker:
         Seconds per unit of a numeric time column (1 for seconds).
     file, column : str
         For messages.
+    date_column : str, optional
+        A column of the file holding dates (for messages).
     """
 
-    def __init__(self, factor: float, *, file: str | None = None, column: str = "time"):
+    def __init__(self, factor: float, *, file: str | None = None, column: str = "time",
+                 date_column: str | None = None):
         self.factor = factor
         self.file = file
         self.column = column
+        self.date_column = date_column  # a column of dates beside the time (for messages)
         self.origin: pd.Timestamp | None = None
         self.source_start_s: float | None = None
         self.duplicates = 0  # rows dropped: a repeat of their time's values
@@ -227,6 +231,11 @@ class TimeTracker:
         # the part of a log in parts read last, and the rows read before it
         self._part: str | None = None
         self._part_row = 0
+        # a numeric time that may be clock times written HHMMSS: its last value (None: no
+        # longer possible — a value no HHMMSS is, or a unit other than the second)
+        self._hhmmss: float | None = np.nan if factor == 1.0 else None
+        self._hhmmss_jumps = 0  # minutes crossed so far by such a column
+        self._hhmmss_first: list = []  # the first: value before, after, s, as s, data row
 
     def state(self) -> dict:
         """Where the time base stands (plain values; the origin as ISO 8601 text; the rows
@@ -237,7 +246,8 @@ class TimeTracker:
                 "absolute": self._absolute, "conflicts": self.conflicts,
                 "conflict_times": self.conflict_times,
                 "first_conflict_s": self.first_conflict_s, "held": self._held,
-                "part": self._part, "part_row": self._part_row}
+                "part": self._part, "part_row": self._part_row, "hhmmss": self._hhmmss,
+                "hhmmss_jumps": self._hhmmss_jumps, "hhmmss_first": self._hhmmss_first}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -250,6 +260,9 @@ class TimeTracker:
         self.conflict_times = int(state.get("conflict_times", 0))
         self.first_conflict_s = state.get("first_conflict_s")
         self._part, self._part_row = state.get("part"), int(state.get("part_row", 0))
+        self._hhmmss = state.get("hhmmss")
+        self._hhmmss_jumps = int(state.get("hhmmss_jumps", 0))
+        self._hhmmss_first = list(state.get("hhmmss_first") or [])
         held = state.get("held")
         self._held = None if held is None else held.copy()
 
@@ -291,6 +304,8 @@ class TimeTracker:
         self.untimed += int((~valid).sum())
         rows = np.flatnonzero(valid)
         t = seconds[valid]
+        if stamps is None and self._hhmmss is not None and t.size:
+            self._check_hhmmss(t + (self.source_start_s or 0.0), rows)
         previous = np.concatenate([[self._last if self._last is not None else -np.inf], t[:-1]])
         back = np.flatnonzero(t < previous)
         if back.size:
@@ -303,6 +318,43 @@ class TimeTracker:
         self._rows_seen += len(seconds)
         kept = None if stamps is None else stamps[valid].reset_index(drop=True)
         return seconds[valid], valid, kept
+
+    def _check_hhmmss(self, v: np.ndarray, rows: np.ndarray) -> None:
+        """Raise when a numeric time column holds clock times written as HHMMSS (235859,
+        235900: one second, read as seconds 41): every value a time of day so written, and
+        a step across a minute 40 s or more longer as a number than as a time of day
+        (read as seconds, every minute of the log would end in a 41-s gap) — twice, so that
+        one gap of a log in seconds skipping 60–99 is not taken for it."""
+        whole = np.floor(np.round(v, 6))
+        fits = (v >= 0) & (v < 240000) & ((whole // 100) % 100 < 60) & (whole % 100 < 60)
+        if not fits.all():
+            self._hhmmss = None
+            return
+        sod = (whole // 10000) * 3600 + (whole // 100 % 100) * 60 + v - 100 * (whole // 100)
+        prev = np.r_[self._hhmmss, v[:-1]]
+        prev_whole = np.floor(np.round(prev, 6))
+        prev_sod = (prev_whole // 10000) * 3600 + (prev_whole // 100 % 100) * 60 \
+            + prev - 100 * (prev_whole // 100)
+        step, as_time = v - prev, np.mod(sod - prev_sod, 86400.0)
+        wraps = (step < 0) & (as_time < 40)  # 235959 then 000000: midnight
+        jump = np.flatnonzero(((as_time < 40) & (step - as_time >= 40)) | wraps)
+        self._hhmmss = float(v[-1])
+        for k in jump[:2]:
+            if not self._hhmmss_first:
+                self._hhmmss_first = [float(prev[k]), float(v[k]), float(as_time[k]),
+                                      float(step[k]), self._rows_seen + int(rows[k]) + 1]
+        self._hhmmss_jumps += int(jump.size)
+        if self._hhmmss_jumps < 2:
+            return
+        before, after, as_time_s, step_s, row = self._hhmmss_first
+        date = f" beside the date column '{printable(self.date_column)}'" \
+            if self.date_column else ""
+        raise InputError(f"time column '{printable(self.column)}' holds times of day written "
+                         f"as HHMMSS{date} ({before:g} then {after:g} at data row {row:.0f}: "
+                         f"{as_time_s:g} s, read as seconds {step_s:g}): drillfric reads a "
+                         "time column as seconds or as timestamps", file=self.file,
+                         fix="give one time column of ISO 8601 timestamps, date and time "
+                             "together (e.g. 2026-11-27T23:59:00), or a time_s column")
 
     def _backwards(self, i: int, t: float, before: float, part: str | None,
                    first: bool) -> None:

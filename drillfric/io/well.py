@@ -87,6 +87,8 @@ CLOCK_UNIT = "ISO 8601"
 FRAME_NAME = "well"
 #: Fewest rows of a file whose header may be quoted as a data log's (:func:`log_shaped`).
 LOG_MIN_ROWS = 10
+#: Column names of a date beside a time column (a time of day written HHMMSS: messages).
+_DATE_NAMES = frozenset({"date", "yyyymmdd", "yymmdd", "ddmmyy", "ddmmyyyy", "day"})
 #: Rows read ahead to tell whether a time column without a stated unit holds timestamps.
 _PEEK_ROWS = 64
 
@@ -219,7 +221,10 @@ class Well:
         if self.depth_indexed:
             return None
         time = self.mappings["time"]
-        return TimeTracker(time.factor, file=str(self.files.data), column=time.column)
+        dates = [c for c in (self.source.columns if self.source is not None else [])
+                 if split_unit(str(c))[0].strip().casefold() in _DATE_NAMES]
+        return TimeTracker(time.factor, file=str(self.files.data), column=time.column,
+                           date_column=dates[0] if dates else None)
 
     def chunks(self, chunk_rows: int = CHUNK_ROWS,
                tracker: TimeTracker | None = None) -> Iterator[pd.DataFrame]:

@@ -253,7 +253,7 @@ class Engine:
             self.tracker.conflicts_note(self.check.rows),
             self.check.duplicates_note(self.tracker.duplicates),
             self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail),
-            _motor_note(self.records)) if w]
+            _motor_note(self.records)) if w] + self.check.unit_hints(self.records)
         plateaus = self.hook.close()
         calibration = None
         if self.calibration is not None:
