@@ -416,3 +416,25 @@ def test_speed_in_rad_s_says_the_top_speed_and_how_to_say_rad_s(tmp_path):
             f"{top * 60 / (2 * np.pi):.3g} RPM), say so: [channels] surface_rpm = "
             '{ column = "RPM", unit = "rad/s" }') in result.output
     assert f"never turns faster than ω_c (9.55 RPM): at most {top:.3g} RPM" in result.output
+
+
+# ------------------------------------------------ messages: WOB and hook load swapped
+def test_wob_and_hook_load_swapped_are_refused_naming_both_columns(tmp_path):
+    """Regression (issue 30, ninth attack): a log with its WOB and hook-load columns swapped
+    passed every plausibility check (every rotation then on bottom). A WOB above the hook
+    load in most rows cannot be: one line naming both columns, the share, the loads and the
+    mapping that swaps them back; exit 2."""
+    frame = surface_frame(rows=400, rate_hz=1.0)
+    rng = np.random.default_rng(4)
+    frame["wob_N"] = 80e3 + rng.normal(0.0, 5e3, len(frame))
+    frame = frame.rename(columns={"wob_N": "HKLD", "hookload_N": "WOB"})
+    frame = frame.rename(columns={"HKLD": "HKLD [N]", "WOB": "WOB [N]"})
+    path, result = _run_line(tmp_path, frame)
+    assert result.exit_code == 2, result.output
+    line = result.output.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert (f"{path}: the weight-on-bit column 'WOB [N]' reads more than the hook-load column "
+            "'HKLD [N]' in 100 % of the rows (mean 1200 kN against 8") in line
+    assert ('the two columns look swapped — fix: map them the other way round: [channels] '
+            'wob = { column = "HKLD [N]" }, hookload = { column = "WOB [N]" }') in line
+    assert not any((tmp_path / "o").rglob("*.parquet"))

@@ -18,6 +18,14 @@ from drillfric.io.text import printable
 from drillfric.io.well import CLOCK_UNIT
 from drillfric.segmentation import is_gap
 
+#: Loads below this are no reading of a string's weight [N] (zeros, noise): the WOB and
+#: hook-load comparison (:meth:`LogCheck.finish`) leaves such rows out.
+SWAP_FLOOR_N = 10e3
+#: Share of the rows with a WOB above the hook load beyond which the two columns are taken
+#: as swapped (the hook carries the block and the string; drilling puts part of the
+#: string's weight on the bit, never more than the hook holds but for moments).
+SWAP_SHARE = 0.9
+
 
 class LogCheck:
     """Accumulates what the checks need from every chunk of a run (constant memory).
@@ -37,6 +45,9 @@ class LogCheck:
         self.rpm_min = np.inf
         self.rpm_max = -np.inf
         self.spacing_s = np.nan  # median sample spacing of the first chunk [s]
+        self.loaded = 0  # rows with WOB and hook load, one of them above SWAP_FLOOR_N
+        self.wob_over = 0  # of those, WOB above the hook load
+        self.wob_sum = self.hook_sum = 0.0  # their sums [N] (for the message)
 
     def feed(self, chunk: pd.DataFrame) -> None:
         """Take in one canonical chunk (the first one also checks the sample spacing)."""
@@ -48,6 +59,14 @@ class LogCheck:
         for name in self.finite:
             if name in chunk:
                 self.finite[name] += int(np.isfinite(chunk[name].to_numpy(float)).sum())
+        if "wob_N" in chunk and "hookload_N" in chunk:
+            wob, hook = chunk["wob_N"].to_numpy(float), chunk["hookload_N"].to_numpy(float)
+            both = np.isfinite(wob) & np.isfinite(hook)
+            both[both] = np.maximum(wob[both], hook[both]) > SWAP_FLOOR_N
+            self.loaded += int(both.sum())
+            self.wob_over += int((wob[both] > hook[both]).sum())
+            self.wob_sum += float(wob[both].sum())
+            self.hook_sum += float(hook[both].sum())
         rpm = chunk["surface_rpm"].to_numpy(float)
         rpm = rpm[np.isfinite(rpm)]
         if rpm.size:
@@ -61,7 +80,8 @@ class LogCheck:
         """The counters (plain values and arrays)."""
         return {"rows": self.rows, "finite": dict(self.finite), "turning": self.turning,
                 "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max]),
-                "spacing_s": self.spacing_s}
+                "spacing_s": self.spacing_s,
+                "loads": np.array([self.loaded, self.wob_over, self.wob_sum, self.hook_sum])}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -70,6 +90,10 @@ class LogCheck:
         self.finite = {k: int(v) for k, v in state["finite"].items()}
         self.rpm_min, self.rpm_max = (float(v) for v in state["rpm_range"])
         self.spacing_s = float(state.get("spacing_s", np.nan))
+        loads = state.get("loads")
+        if loads is not None:
+            self.loaded, self.wob_over = int(loads[0]), int(loads[1])
+            self.wob_sum, self.hook_sum = float(loads[2]), float(loads[3])
 
     def _spacing(self, time_s: np.ndarray) -> None:
         """Every sample a gap: time in ms read as s, or a log slower than max_gap_s (the
@@ -109,6 +133,19 @@ class LogCheck:
                                  f"any of {self.rows} rows", file=file,
                                  fix=f"map the column that holds {m.channel.kind} in "
                                      f'[channels] {m.channel.key} = {{ column = "..." }}')
+        if self.loaded >= 10 and self.wob_over > SWAP_SHARE * self.loaded:
+            wob, hook = self.well.channels["wob_N"], self.well.channels["hookload_N"]
+            raise InputError(f"the weight-on-bit column '{printable(wob.column)}' reads more "
+                             f"than the hook-load column '{printable(hook.column)}' in "
+                             f"{100 * self.wob_over / self.loaded:.0f} % of the rows (mean "
+                             f"{self.wob_sum / self.loaded / 1e3:.4g} kN against "
+                             f"{self.hook_sum / self.loaded / 1e3:.4g} kN): the hook carries "
+                             "the block and the whole string, the bit only part of the "
+                             "string's weight: the two columns look swapped", file=file,
+                             fix=f"map them the other way round: [channels] "
+                                 f'{wob.channel.key} = {{ column = "{printable(hook.column)}" }}'
+                                 f', {hook.channel.key} = '
+                                 f'{{ column = "{printable(wob.column)}" }} (with their units)')
         if self.turning and self.backwards > 0.9 * self.turning:
             m = self.well.channels["surface_rpm"]
             raise InputError(f"surface speed column '{printable(m.column)}' turns backwards in "
