@@ -407,7 +407,7 @@ class Receiver:
             while size < NOT_WITS_BYTES and time.monotonic() < until:
                 try:
                     more = conn.recv(65536)
-                except TimeoutError:
+                except OSError:  # a timeout (the burst ended) or a drop: the next read says
                     break
                 if not more:
                     break  # closed: the next read says so again
@@ -415,7 +415,10 @@ class Receiver:
                 parts.append(more)
                 size += len(more)
         finally:
-            conn.settimeout(0.1)
+            try:
+                conn.settimeout(0.1)
+            except OSError:
+                pass
         return b"".join(parts), arrival
 
     def _take(self, data: bytes, arrival: float | None = None) -> None:
