@@ -76,7 +76,8 @@ def summarize(well, data) -> dict:
     channels = {}
     for name, info in data.channels.items():
         total = tb.rows if name != "time_s" else (tb.rows + tb.untimed_dropped
-                                                  + tb.duplicates_dropped)
+                                                  + tb.duplicates_dropped
+                                                  + tb.conflicts_dropped)
         channels[name] = _channel(name, info.column, info.unit, info.source,
                                   info.null_fraction, total, data.surface)
     assumed = data.config.assumed_with(data.survey)
@@ -87,6 +88,7 @@ def summarize(well, data) -> dict:
         "survey": _survey(data.survey),
         "well": data.name, "files": {k: str(v) for k, v in data.files.items()},
         "duplicates_dropped": tb.duplicates_dropped, "untimed_dropped": tb.untimed_dropped,
+        "conflicts_dropped": tb.conflicts_dropped,
         "origin": None if tb.origin is None else tb.origin.isoformat(),
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
@@ -219,6 +221,9 @@ def render(s: dict, units: str = "si") -> str:
     dropped = []
     if s["duplicates_dropped"]:
         dropped.append(f"{plural(s['duplicates_dropped'], 'repeated timestamp')} dropped")
+    if s.get("conflicts_dropped"):
+        dropped.append(f"{plural(s['conflicts_dropped'], 'row')} of timestamps repeated with "
+                       "other values dropped")
     if s["untimed_dropped"]:
         dropped.append(f"{plural(s['untimed_dropped'], 'row')} without a time dropped")
     lines.append(f"rows       {s['rows']}" + (f" ({'; '.join(dropped)})" if dropped else ""))

@@ -102,7 +102,9 @@ bit is at 100.0 m — fix: shorten the BHA sections or check the bit depth
     """
     if data.time_s.size < MIN_SAMPLES:
         raise SkipSegment(f"only {data.time_s.size} samples")
-    if np.nanmax(np.abs(data.surface_rpm)) * RPM_TO_RAD_S <= cfg.omega_c_rad_s:
-        raise SkipSegment("the top drive never turns faster than ω_c")
+    top = np.nanmax(np.abs(data.surface_rpm))
+    if top * RPM_TO_RAD_S <= cfg.omega_c_rad_s:
+        raise SkipSegment(f"the top drive never turns faster than ω_c "
+                          f"({cfg.omega_c_rad_s / RPM_TO_RAD_S:.3g} RPM): at most {top:.3g} RPM")
     check_reach(path, data.bit_depth_m)
     build_string(cfg.sections, data.bit_depth_m)

@@ -18,6 +18,14 @@ from drillfric.io.text import printable
 from drillfric.io.well import CLOCK_UNIT
 from drillfric.segmentation import is_gap
 
+#: Loads below this are no reading of a string's weight [N] (zeros, noise): the WOB and
+#: hook-load comparison (:meth:`LogCheck.finish`) leaves such rows out.
+SWAP_FLOOR_N = 10e3
+#: Share of the rows with a WOB above the hook load beyond which the two columns are taken
+#: as swapped (the hook carries the block and the string; drilling puts part of the
+#: string's weight on the bit, never more than the hook holds but for moments).
+SWAP_SHARE = 0.9
+
 
 class LogCheck:
     """Accumulates what the checks need from every chunk of a run (constant memory).
@@ -36,15 +44,29 @@ class LogCheck:
         self.backwards = 0  # of those, turning backwards
         self.rpm_min = np.inf
         self.rpm_max = -np.inf
+        self.spacing_s = np.nan  # median sample spacing of the first chunk [s]
+        self.loaded = 0  # rows with WOB and hook load, one of them above SWAP_FLOOR_N
+        self.wob_over = 0  # of those, WOB above the hook load
+        self.wob_sum = self.hook_sum = 0.0  # their sums [N] (for the message)
 
     def feed(self, chunk: pd.DataFrame) -> None:
         """Take in one canonical chunk (the first one also checks the sample spacing)."""
         if self.rows == 0 and len(chunk) > 1:
             self._spacing(chunk["time_s"].to_numpy(float))
+            dt = np.diff(chunk["time_s"].to_numpy(float))
+            self.spacing_s = float(np.median(dt[dt > 0])) if (dt > 0).any() else np.nan
         self.rows += len(chunk)
         for name in self.finite:
             if name in chunk:
                 self.finite[name] += int(np.isfinite(chunk[name].to_numpy(float)).sum())
+        if "wob_N" in chunk and "hookload_N" in chunk:
+            wob, hook = chunk["wob_N"].to_numpy(float), chunk["hookload_N"].to_numpy(float)
+            both = np.isfinite(wob) & np.isfinite(hook)
+            both[both] = np.maximum(wob[both], hook[both]) > SWAP_FLOOR_N
+            self.loaded += int(both.sum())
+            self.wob_over += int((wob[both] > hook[both]).sum())
+            self.wob_sum += float(wob[both].sum())
+            self.hook_sum += float(hook[both].sum())
         rpm = chunk["surface_rpm"].to_numpy(float)
         rpm = rpm[np.isfinite(rpm)]
         if rpm.size:
@@ -57,7 +79,9 @@ class LogCheck:
     def state(self) -> dict:
         """The counters (plain values and arrays)."""
         return {"rows": self.rows, "finite": dict(self.finite), "turning": self.turning,
-                "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max])}
+                "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max]),
+                "spacing_s": self.spacing_s,
+                "loads": np.array([self.loaded, self.wob_over, self.wob_sum, self.hook_sum])}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -65,6 +89,11 @@ class LogCheck:
         self.backwards = int(state["backwards"])
         self.finite = {k: int(v) for k, v in state["finite"].items()}
         self.rpm_min, self.rpm_max = (float(v) for v in state["rpm_range"])
+        self.spacing_s = float(state.get("spacing_s", np.nan))
+        loads = state.get("loads")
+        if loads is not None:
+            self.loaded, self.wob_over = int(loads[0]), int(loads[1])
+            self.wob_sum, self.hook_sum = float(loads[2]), float(loads[3])
 
     def _spacing(self, time_s: np.ndarray) -> None:
         """Every sample a gap: time in ms read as s, or a log slower than max_gap_s (the
@@ -104,6 +133,19 @@ class LogCheck:
                                  f"any of {self.rows} rows", file=file,
                                  fix=f"map the column that holds {m.channel.kind} in "
                                      f'[channels] {m.channel.key} = {{ column = "..." }}')
+        if self.loaded >= 10 and self.wob_over > SWAP_SHARE * self.loaded:
+            wob, hook = self.well.channels["wob_N"], self.well.channels["hookload_N"]
+            raise InputError(f"the weight-on-bit column '{printable(wob.column)}' reads more "
+                             f"than the hook-load column '{printable(hook.column)}' in "
+                             f"{100 * self.wob_over / self.loaded:.0f} % of the rows (mean "
+                             f"{self.wob_sum / self.loaded / 1e3:.4g} kN against "
+                             f"{self.hook_sum / self.loaded / 1e3:.4g} kN): the hook carries "
+                             "the block and the whole string, the bit only part of the "
+                             "string's weight: the two columns look swapped", file=file,
+                             fix=f"map them the other way round: [channels] "
+                                 f'{wob.channel.key} = {{ column = "{printable(hook.column)}" }}'
+                                 f', {hook.channel.key} = '
+                                 f'{{ column = "{printable(wob.column)}" }} (with their units)')
         if self.turning and self.backwards > 0.9 * self.turning:
             m = self.well.channels["surface_rpm"]
             raise InputError(f"surface speed column '{printable(m.column)}' turns backwards in "
@@ -115,15 +157,46 @@ class LogCheck:
 
     def duplicates_note(self, duplicates: int) -> str | None:
         """A warning when more than 1 % of the rows repeated an earlier sample's time and
-        were dropped (timestamps cut to whole seconds on a 20-Hz log dropped 95 % of it,
-        silently), or None."""
+        values and were dropped (timestamps cut to whole seconds on a 20-Hz log dropped 95 %
+        of it, silently), or None. Rows repeating a time with other values are the time
+        base's :meth:`~drillfric.io.timebase.TimeTracker.conflicts_note`."""
         if duplicates <= 0.01 * (duplicates + self.rows):
             return None
         share = 100.0 * duplicates / (duplicates + self.rows)
-        return (f"{duplicates} rows ({share:.0f} % of the log) repeat an earlier row's time "
-                "and were dropped (the first row of each time kept): are the timestamps cut "
-                "to whole seconds or coarser than the logging? Log them to full resolution, "
-                "or give a time_s column")
+        return (f"{self.well.files.data}: {duplicates} rows ({share:.0f} % of the log) repeat "
+                "an earlier row's time and values and were dropped (one row of each time "
+                "kept): are the timestamps cut to whole seconds or coarser than the logging? "
+                "Log them to full resolution, or give a time_s column")
+
+    def unit_hints(self, records) -> list[str]:
+        """Warnings for a log that looks read in the wrong unit though nothing refused it
+        (issue 30, ninth attack: the messages had been "the top drive never turns faster
+        than ω_c" and "too short"): a speed column that never exceeds 20 RPM (rad/s read as
+        RPM?), and rotations all too short though their samples are a whole fraction of a
+        minute apart (minutes read as seconds?)."""
+        out, file = [], self.well.files.data
+        top = max(abs(self.rpm_min), abs(self.rpm_max))
+        m = self.well.channels.get("surface_rpm")
+        if m is not None and np.isfinite(top) and 0.5 < top <= 20.0:
+            out.append(f"{file}: the surface speed column '{printable(m.column)}' reads at "
+                       f"most {top:.3g} RPM, where a top drive turns at 30–250: if it is in "
+                       f"rad/s ({top:.3g} rad/s = {top * 60.0 / (2.0 * np.pi):.3g} RPM), "
+                       + _say_unit(m, "rad/s"))
+        time = self.well.mappings.get("time")
+        short = [r for r in records if str(r.message or "").startswith("too short")]
+        dt = self.spacing_s
+        if (time is not None and time.unit != CLOCK_UNIT and short
+                and len(short) == len(records) and np.isfinite(dt)
+                and 0.01 <= 60.0 * dt <= 60.0):
+            longest = max(r.duration_s for r in short)
+            minimum = self.well.config.segmentation.min_segment_s
+            if 60.0 * longest >= minimum:
+                out.append(f"{file}: every rotation is too short (the longest {longest:.3g} "
+                           f"s < segmentation.min_segment_s = {minimum:g} s), its samples "
+                           f"{dt:.3g} s apart: if the time column '{printable(time.column)}' "
+                           f"is in minutes (the longest {60.0 * longest:.4g} s, samples "
+                           f"{60.0 * dt:.3g} s apart), " + _say_unit(time, "min"))
+        return out
 
     def nothing_found(self, segments: int) -> str | None:
         """Why a run found no rotating segment at all (a warning), or None."""
@@ -134,3 +207,14 @@ class LogCheck:
         return (f"no rotating segment found: the surface speed never exceeds "
                 f"segmentation.rotating_rpm = {threshold:.4g} RPM for "
                 f"segmentation.min_rotation_s (highest: {top}) — nothing was estimated")
+
+
+def _say_unit(m, unit: str) -> str:
+    """How to tell drillfric that mapping ``m``'s column is in ``unit``: the config line, or
+    — where the file states the unit (the config cannot contradict it) — the file."""
+    column = printable(m.column)
+    if m.source in ("config", "default"):
+        return (f'say so: [channels] {m.channel.key} = {{ column = "{column}", '
+                f'unit = "{unit}" }}')
+    return (f"the file's {m.source} says '{printable(m.unit)}': correct it to '{unit}' "
+            f"(then drillfric converts)")

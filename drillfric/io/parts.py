@@ -48,6 +48,23 @@ def folder_parts(folder: Path) -> tuple[Path, ...] | None:
     return tuple(files)
 
 
+#: ``DataFrame.attrs`` key of a part's raw chunks: the part's file name, for messages
+#: (:class:`~drillfric.io.timebase.TimeTracker`: two overlapping exports named).
+PART_ATTR = "drillfric_part"
+
+
+def _tagged(source: RawSource) -> RawSource:
+    """``source`` whose raw chunks carry its file name in ``attrs[PART_ATTR]``."""
+    read, name = source._read, source.path.name
+
+    def tagged(*args):
+        for chunk in read(*args):
+            chunk.attrs[PART_ATTR] = name
+            yield chunk
+
+    return replace(source, _read=tagged)
+
+
 def _drillfrics(name: str) -> bool:
     """A file drillfric writes in OUT (--out may be the data folder itself: the next night
     read its own fleet.html and fleet_summary.parquet as parts of the log)."""
@@ -64,7 +81,7 @@ def _format(path: Path) -> str:
 def open_parts(paths) -> RawSource:
     """One raw source from the parts of a log (each opened as the file it is; every part
     must have the first part's columns). Its ``parts`` are the parts' own sources."""
-    sources = tuple(open_source(p) for p in paths)
+    sources = tuple(_tagged(open_source(p)) for p in paths)
     first = sources[0]
     for src in sources[1:]:
         if src.columns != first.columns:

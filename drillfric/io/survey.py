@@ -25,6 +25,7 @@ Recognised layouts
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -102,15 +103,11 @@ def read_survey_table(path) -> pd.DataFrame:
     elif ext == ".xml":
         from drillfric.io.witsml_objects import trajectory_table
 
-        table = trajectory_table(path)
-        _validate(table, path)
-        return table
+        return _validate(trajectory_table(path), path)
     else:
         raise InputError(f"unknown survey file extension '{path.suffix}'", file=path,
                          fix="give a .csv, .txt, .parquet or WITSML .xml survey")
-    table = _canonical(names, units, data, path)
-    _validate(table, path)
-    return table
+    return _validate(_canonical(names, units, data, path), path)
 
 
 def _check_size(path: Path) -> None:
@@ -182,9 +179,7 @@ def survey_table_from_frame(frame: pd.DataFrame, *, file=None) -> pd.DataFrame:
     """
     names = [str(c) for c in frame.columns]
     data = [frame[c].to_numpy() for c in frame.columns]
-    table = _canonical(names, [None] * len(names), data, file)
-    _validate(table, file)
-    return table
+    return _validate(_canonical(names, [None] * len(names), data, file), file)
 
 
 def write_survey(path, well_path: WellPath) -> None:
@@ -346,7 +341,12 @@ def _factor(unit: str | None, kind: str, name: str, file) -> float:
                              "deg/100ft for DLS") from exc
 
 
-def _validate(table: pd.DataFrame, file) -> None:
+class SurveyWarning(UserWarning):
+    """Something in a survey file drillfric read past (a station written twice)."""
+
+
+def _validate(table: pd.DataFrame, file) -> pd.DataFrame:
+    """``table`` checked, a station repeating the one before exactly dropped (warned)."""
     if len(table) == 0:
         raise InputError("survey has no stations", file=file,
                          fix="export the survey with its stations under the header")
@@ -359,6 +359,7 @@ def _validate(table: pd.DataFrame, file) -> None:
             k = int(np.argmax(nan))
             raise InputError(f"survey station {k + 1} has no {col} value", file=file,
                              fix="fill or remove the incomplete station")
+    table = _repeats_dropped(table, file)
     md = table["md_m"].to_numpy()
     step = np.diff(md)
     if np.any(step <= 0):
@@ -368,6 +369,36 @@ def _validate(table: pd.DataFrame, file) -> None:
                          fix="sort the survey by MD and remove duplicate stations")
     _check_range(table["inc_deg"].to_numpy(), 180.0, "inclination", file)
     _check_range(table["azi_deg"].to_numpy(), 360.0, "azimuth", file)
+    return table
+
+
+def _repeats_dropped(table: pd.DataFrame, file) -> pd.DataFrame:
+    """``table`` without the stations that repeat the one before exactly (a tie-in station
+    written twice: one warning naming the file and the MD); a station at the MD of the one
+    before with other values is an InputError naming the MD (which is the station cannot
+    be told)."""
+    md = table["md_m"].to_numpy(float)
+    twice = np.flatnonzero(np.diff(md) == 0) + 1
+    if not twice.size:
+        return table
+    values = table.to_numpy(dtype=float, na_value=np.nan)
+    for k in twice:
+        if not np.array_equal(values[k - 1], values[k], equal_nan=True):
+            shown = [f"{table['inc_deg'].iat[i]:g}° / {table['azi_deg'].iat[i]:g}°"
+                     for i in (k - 1, k)]
+            other = "" if shown[0] != shown[1] else " (other columns differ)"
+            raise InputError(f"survey stations {k} and {k + 1} are both at MD {md[k]:g} m "
+                             f"with different values (inclination / azimuth {shown[0]} and "
+                             f"{shown[1]}{other}): which is the station cannot be told",
+                             file=file, fix=f"keep one station at MD {md[k]:g} m (the tie-in "
+                                            "or the measured one) and remove the other")
+    first = f"MD {md[twice[0]]:g} m"
+    text = (f"survey station {twice[0] + 1} repeats station {twice[0]} exactly ({first})"
+            if twice.size == 1 else f"{twice.size} survey stations repeat the station before "
+                                    f"exactly (the first at {first})")
+    warnings.warn_explicit(f"{file}: {text}: dropped (a tie-in station written twice)",
+                           SurveyWarning, __file__, 0, module=__name__, registry={})
+    return table.drop(index=table.index[twice]).reset_index(drop=True)
 
 
 def check_doglegs(path: WellPath, limit_deg_30m: float, file) -> None:

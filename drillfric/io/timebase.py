@@ -3,8 +3,16 @@
 Rig recorders log absolute timestamps (ISO 8601) or elapsed seconds, with jittered spacing,
 repeated rows and outages. Here time becomes ``time_s`` [s] from the first sample (the
 absolute time of ``time_s = 0`` is kept as ``origin`` when known); a timestamp that goes
-backwards is an error naming the row; a row repeating the previous timestamp is dropped
-(the first is kept) and counted; gaps and the nominal rate come from the sample spacing.
+backwards is an error naming the row; gaps and the nominal rate come from the sample spacing.
+
+Rows sharing a timestamp (:meth:`TimeTracker.settle`): identical ones are one sample
+written twice — one is kept, the others counted in ``duplicates``; rows of one time with
+*different* values contradict each other — which one is the sample cannot be told, so all of
+them are dropped and counted in ``conflicts`` (keeping the first had put μ_k at 0.263 for
+0.28 when 9 % of the times were written twice with other values: issue 30, ninth attack).
+The rows of a chunk's last time are held back until the next chunk (or the end of the data,
+:meth:`TimeTracker.flush`) shows whether that time repeats, so the rows kept are the same in
+any chunking — a live follower's and a run's alike.
 
 :class:`TimeTracker` carries the state across chunks so that a file read in several
 chunks gives exactly the same ``time_s`` as the file read at once.
@@ -36,7 +44,7 @@ class TimeBase:
     Attributes
     ----------
     rows : int
-        Rows kept (after dropping duplicates and rows without a time).
+        Rows kept (after dropping repeated times and rows without a time).
     t_start_s, t_end_s : float
         First and last ``time_s`` [s].
     rate_hz : float
@@ -46,13 +54,16 @@ class TimeBase:
         ``(start_s, end_s)`` of every spacing longer than ``segmentation.max_gap_s``: where
         a run ends a segment (:func:`drillfric.segmentation.is_gap`).
     duplicates_dropped : int
-        Rows dropped because they repeat the previous row's timestamp.
+        Rows dropped because they repeat the previous row's timestamp and values.
     origin : pandas.Timestamp or None
         Absolute time of ``time_s = 0`` when the file has absolute timestamps.
     untimed_dropped : int
         Rows dropped because their time was empty or a null marker.
     source_start_s : float or None
         The file's own numeric time of the first sample [s] (``time_s`` starts at 0).
+    conflicts_dropped : int
+        Rows dropped because other rows of their timestamp hold other values (every row
+        of such a time is dropped: :meth:`TimeTracker.settle`).
     """
 
     rows: int
@@ -64,6 +75,7 @@ class TimeBase:
     origin: pd.Timestamp | None
     untimed_dropped: int = 0
     source_start_s: float | None = None
+    conflicts_dropped: int = 0
 
 
 def nominal_rate_hz(time_s: np.ndarray) -> float:
@@ -123,7 +135,7 @@ def check_plausible_rate(time_s: np.ndarray, *, file=None, column: str = "time")
 
 def summarize(time_s: np.ndarray, *, max_gap_s: float, duplicates_dropped: int = 0,
               untimed_dropped: int = 0, origin: pd.Timestamp | None = None,
-              source_start_s: float | None = None) -> TimeBase:
+              source_start_s: float | None = None, conflicts_dropped: int = 0) -> TimeBase:
     """:class:`TimeBase` of an already checked, increasing ``time_s`` [s]."""
     time_s = np.asarray(time_s, dtype=float)
     rate = nominal_rate_hz(time_s)
@@ -132,7 +144,8 @@ def summarize(time_s: np.ndarray, *, max_gap_s: float, duplicates_dropped: int =
                     t_end_s=float(time_s[-1]) if time_s.size else 0.0,
                     rate_hz=rate, gaps=_spans(time_s, max_gap_s),
                     duplicates_dropped=duplicates_dropped, origin=origin,
-                    untimed_dropped=untimed_dropped, source_start_s=source_start_s)
+                    untimed_dropped=untimed_dropped, source_start_s=source_start_s,
+                    conflicts_dropped=conflicts_dropped)
 
 
 OUTPUT_CLOCK_UNIT = "us"
@@ -180,6 +193,11 @@ def origin_of(stamp: pd.Timestamp, seconds: float) -> pd.Timestamp:
     return pd.Timestamp(stamp) - pd.Timedelta(int(np.round(float(seconds) * 1e9)), unit="ns")
 
 
+#: Share of a log's timestamps that may be repeated with other values (all their rows
+#: dropped) before the log is refused (:meth:`TimeTracker.check_conflicts`).
+MAX_CONFLICT_SHARE = 0.25
+
+
 class TimeTracker:
     """Turns the time column of successive chunks into checked ``time_s`` [s].
 
@@ -189,26 +207,47 @@ class TimeTracker:
         Seconds per unit of a numeric time column (1 for seconds).
     file, column : str
         For messages.
+    date_column : str, optional
+        A column of the file holding dates (for messages).
     """
 
-    def __init__(self, factor: float, *, file: str | None = None, column: str = "time"):
+    def __init__(self, factor: float, *, file: str | None = None, column: str = "time",
+                 date_column: str | None = None):
         self.factor = factor
         self.file = file
         self.column = column
+        self.date_column = date_column  # a column of dates beside the time (for messages)
         self.origin: pd.Timestamp | None = None
         self.source_start_s: float | None = None
-        self.duplicates = 0
+        self.duplicates = 0  # rows dropped: a repeat of their time's values
         self.untimed = 0
+        self.conflicts = 0  # rows dropped: other values at their time
+        self.conflict_times = 0  # the times of those rows
+        self.first_conflict_s: float | None = None  # time_s of the first such time
         self._rows_seen = 0
         self._last: float | None = None
         self._absolute: bool | None = None
+        self._held: pd.DataFrame | None = None  # rows of the last time read (settle)
+        # the part of a log in parts read last, and the rows read before it
+        self._part: str | None = None
+        self._part_row = 0
+        # a numeric time that may be clock times written HHMMSS: its last value (None: no
+        # longer possible — a value no HHMMSS is, or a unit other than the second)
+        self._hhmmss: float | None = np.nan if factor == 1.0 else None
+        self._hhmmss_jumps = 0  # minutes crossed so far by such a column
+        self._hhmmss_first: list = []  # the first: value before, after, s, as s, data row
 
     def state(self) -> dict:
-        """Where the time base stands (plain values; the origin as ISO 8601 text)."""
+        """Where the time base stands (plain values; the origin as ISO 8601 text; the rows
+        held back as a DataFrame)."""
         return {"origin": None if self.origin is None else self.origin.isoformat(),
                 "source_start_s": self.source_start_s, "duplicates": self.duplicates,
                 "untimed": self.untimed, "rows_seen": self._rows_seen, "last": self._last,
-                "absolute": self._absolute}
+                "absolute": self._absolute, "conflicts": self.conflicts,
+                "conflict_times": self.conflict_times,
+                "first_conflict_s": self.first_conflict_s, "held": self._held,
+                "part": self._part, "part_row": self._part_row, "hhmmss": self._hhmmss,
+                "hhmmss_jumps": self._hhmmss_jumps, "hhmmss_first": self._hhmmss_first}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -217,16 +256,40 @@ class TimeTracker:
         self.duplicates, self.untimed = int(state["duplicates"]), int(state["untimed"])
         self._rows_seen, self._last = int(state["rows_seen"]), state["last"]
         self._absolute = state["absolute"]
+        self.conflicts = int(state.get("conflicts", 0))
+        self.conflict_times = int(state.get("conflict_times", 0))
+        self.first_conflict_s = state.get("first_conflict_s")
+        self._part, self._part_row = state.get("part"), int(state.get("part_row", 0))
+        self._hhmmss = state.get("hhmmss")
+        self._hhmmss_jumps = int(state.get("hhmmss_jumps", 0))
+        self._hhmmss_first = list(state.get("hhmmss_first") or [])
+        held = state.get("held")
+        self._held = None if held is None else held.copy()
 
-    def step(self, values: pd.Series) -> tuple[np.ndarray, np.ndarray, pd.Series | None]:
-        """Check one chunk's time column.
+    @property
+    def holding(self) -> bool:
+        """Whether rows are held back (:meth:`settle`) for :meth:`flush` to hand out."""
+        return self.held_rows > 0
+
+    @property
+    def held_rows(self) -> int:
+        """Rows held back by :meth:`settle` (read, their time not yet settled)."""
+        return 0 if self._held is None else len(self._held)
+
+    def step(self, values: pd.Series, part: str | None = None
+             ) -> tuple[np.ndarray, np.ndarray, pd.Series | None]:
+        """Check one chunk's time column (``part``: the file of a log in parts it comes
+        from, for messages).
+
+        Rows repeating a time are all kept here: :meth:`settle` decides on them, with their
+        values.
 
         Returns
         -------
         time_s : ndarray
             Seconds from the first sample for the rows kept.
         keep : ndarray of bool
-            Which rows of the chunk are kept (time present, not a repeat).
+            Which rows of the chunk are kept (time present).
         stamps : pandas.Series or None
             The kept rows' timestamps (UTC, nanoseconds, as parsed) when the column holds
             clock time; None for a numeric time.
@@ -241,23 +304,179 @@ class TimeTracker:
         self.untimed += int((~valid).sum())
         rows = np.flatnonzero(valid)
         t = seconds[valid]
+        if stamps is None and self._hhmmss is not None and t.size:
+            self._check_hhmmss(t + (self.source_start_s or 0.0), rows)
         previous = np.concatenate([[self._last if self._last is not None else -np.inf], t[:-1]])
         back = np.flatnonzero(t < previous)
         if back.size:
-            i = back[0]
-            row = self._rows_seen + rows[i] + 1
-            raise InputError(f"time goes backwards at data row {row} ({self._show(t[i])} "
-                             f"after {self._show(previous[i])})", file=self.file,
-                             fix="sort the file by time or remove the out-of-order rows")
-        repeat = t == previous
-        self.duplicates += int(repeat.sum())
-        keep = np.zeros(len(seconds), dtype=bool)
-        keep[rows[~repeat]] = True
+            self._backwards(int(rows[back[0]]), float(t[back[0]]), float(previous[back[0]]),
+                            part, first=back[0] == 0 and part != self._part)
         if t.size:
             self._last = float(t[-1])
+        if part != self._part:
+            self._part, self._part_row = part, self._rows_seen
         self._rows_seen += len(seconds)
-        kept = None if stamps is None else stamps[keep].reset_index(drop=True)
-        return seconds[keep], keep, kept
+        kept = None if stamps is None else stamps[valid].reset_index(drop=True)
+        return seconds[valid], valid, kept
+
+    def _check_hhmmss(self, v: np.ndarray, rows: np.ndarray) -> None:
+        """Raise when a numeric time column holds clock times written as HHMMSS (235859,
+        235900: one second, read as seconds 41): every value a time of day so written, and
+        a step across a minute 40 s or more longer as a number than as a time of day
+        (read as seconds, every minute of the log would end in a 41-s gap) — twice, so that
+        one gap of a log in seconds skipping 60–99 is not taken for it."""
+        whole = np.floor(np.round(v, 6))
+        fits = (v >= 0) & (v < 240000) & ((whole // 100) % 100 < 60) & (whole % 100 < 60)
+        if not fits.all():
+            self._hhmmss = None
+            return
+        sod = (whole // 10000) * 3600 + (whole // 100 % 100) * 60 + v - 100 * (whole // 100)
+        prev = np.r_[self._hhmmss, v[:-1]]
+        prev_whole = np.floor(np.round(prev, 6))
+        prev_sod = (prev_whole // 10000) * 3600 + (prev_whole // 100 % 100) * 60 \
+            + prev - 100 * (prev_whole // 100)
+        step, as_time = v - prev, np.mod(sod - prev_sod, 86400.0)
+        wraps = (step < 0) & (as_time < 40)  # 235959 then 000000: midnight
+        jump = np.flatnonzero(((as_time < 40) & (step - as_time >= 40)) | wraps)
+        self._hhmmss = float(v[-1])
+        for k in jump[:2]:
+            if not self._hhmmss_first:
+                self._hhmmss_first = [float(prev[k]), float(v[k]), float(as_time[k]),
+                                      float(step[k]), self._rows_seen + int(rows[k]) + 1]
+        self._hhmmss_jumps += int(jump.size)
+        if self._hhmmss_jumps < 2:
+            return
+        before, after, as_time_s, step_s, row = self._hhmmss_first
+        date = f" beside the date column '{printable(self.date_column)}'" \
+            if self.date_column else ""
+        raise InputError(f"time column '{printable(self.column)}' holds times of day written "
+                         f"as HHMMSS{date} ({before:g} then {after:g} at data row {row:.0f}: "
+                         f"{as_time_s:g} s, read as seconds {step_s:g}): drillfric reads a "
+                         "time column as seconds or as timestamps", file=self.file,
+                         fix="give one time column of ISO 8601 timestamps, date and time "
+                             "together (e.g. 2026-11-27T23:59:00), or a time_s column")
+
+    def _backwards(self, i: int, t: float, before: float, part: str | None,
+                   first: bool) -> None:
+        """Raise the InputError of a time going back at the chunk's row ``i`` (``t`` after
+        ``before`` [s]; ``first``: the first timed row of a new part), saying where and what
+        it looks like: two overlapping parts of a log, a daylight-saving fall-back, a clock
+        stepped back."""
+        back = before - t
+        at, prev = self._show(t), self._show(before)
+        if first and part is not None and self._part is not None:
+            raise InputError(f"part '{printable(part)}' starts at {at}, before part "
+                             f"'{printable(self._part)}' ends ({prev}): the two parts of "
+                             "the log overlap", file=self.file,
+                             fix=f"remove the rows of '{printable(part)}' up to {prev} (or the "
+                                 "part that is an export of the same hours again)")
+        if part is not None and part != self._part:
+            self._part_row = self._rows_seen  # the row is in a part begun in this chunk
+        row = self._rows_seen + i + 1
+        where = f"at data row {row - self._part_row} of part '{printable(part)}'" \
+            if part is not None else f"at data row {row}"
+        problem = f"time goes backwards {where} ({at} after {prev})"
+        if abs(back - 3600.0) <= 60.0 and self.origin is not None:
+            raise InputError(f"{problem}: back {back / 60:.0f} min, a daylight-saving "
+                             "fall-back of a local clock written without its UTC offset",
+                             file=self.file,
+                             fix="export the times in UTC or with their offset (e.g. "
+                                 "2026-10-25T02:30:00+01:00), or give a time_s column")
+        if back < 60.0:
+            raise InputError(f"{problem}: back {back:.3g} s, a clock stepped back (set or "
+                             "synchronised while logging)", file=self.file,
+                             fix=f"remove the rows from that one on whose time is not after "
+                                 f"{prev} (the {back:.3g} s the clock logged twice), or give "
+                                 "a time_s column that never goes back")
+        raise InputError(problem, file=self.file,
+                         fix="sort the file by time or remove the out-of-order rows")
+
+    def settle(self, rows: pd.DataFrame) -> pd.DataFrame:
+        """The rows of ``rows`` (canonical: ``time_s`` from :meth:`step`, values) whose time
+        is settled, with the rows held back from the chunk before.
+
+        The rows of the last time are held back: the next chunk may repeat it. Of rows
+        sharing a time, identical ones are kept once (the others counted in
+        :attr:`duplicates`); rows of one time holding different values are all dropped
+        (counted in :attr:`conflicts` and :attr:`conflict_times`) — the same rows in any
+        chunking.
+        """
+        if self.holding and len(rows):
+            rows = pd.concat([self._held, rows], ignore_index=True)
+        elif self.holding:
+            return rows
+        if not len(rows):
+            return rows
+        t = rows["time_s"].to_numpy(float)
+        last = t == t[-1]
+        self._held = rows[last].reset_index(drop=True)
+        return self._resolve(rows[~last].reset_index(drop=True))
+
+    def flush(self) -> pd.DataFrame | None:
+        """The rows held back by :meth:`settle` (settled: the data ended), or None."""
+        held, self._held = self._held, None
+        return None if held is None else self._resolve(held)
+
+    def _resolve(self, rows: pd.DataFrame) -> pd.DataFrame:
+        """``rows`` with each repeated time settled (:meth:`settle`)."""
+        t = rows["time_s"].to_numpy(float)
+        if t.size < 2 or not (t[1:] == t[:-1]).any():
+            return rows
+        starts = np.flatnonzero(np.r_[True, t[1:] != t[:-1]])
+        sizes = np.diff(np.r_[starts, t.size])
+        group = np.repeat(np.arange(starts.size), sizes)
+        values = rows[[c for c in rows.columns if c not in ("time_s", "timestamp")]]
+        v = values.to_numpy(dtype=float, na_value=np.nan)
+        ref = v[starts][group]
+        same = ((v == ref) | (np.isnan(v) & np.isnan(ref))).all(axis=1)
+        agree = np.logical_and.reduceat(same, starts)
+        self.duplicates += int((sizes[agree] - 1).sum())
+        self.conflicts += int(sizes[~agree].sum())
+        self.conflict_times += int((~agree).sum())
+        if self.first_conflict_s is None and not agree.all():
+            self.first_conflict_s = float(t[starts[~agree][0]])
+        keep = np.zeros(t.size, dtype=bool)
+        keep[starts[agree]] = True
+        return rows[keep].reset_index(drop=True)
+
+    def check_conflicts(self, kept: int) -> None:
+        """Raise when more than :data:`MAX_CONFLICT_SHARE` of the log's times were repeated
+        with other values (``kept``: the rows kept): the time column is not the samples'
+        time (cut to whole seconds on a faster log, two recorders interleaved), and what is
+        left of the log cannot be trusted."""
+        times = kept + self.conflict_times
+        if self.conflict_times <= MAX_CONFLICT_SHARE * times:
+            return
+        if kept == 0 and self.conflict_times == 1:
+            raise InputError(f"time column '{printable(self.column)}' holds one value for all "
+                             f"{self.conflicts} rows", file=self.file,
+                             fix="map the column that holds the sample times in [channels] "
+                                 'time = { column = "..." }')
+        raise InputError(f"{self.conflict_times} of the log's {times} timestamps "
+                         f"({100.0 * self.conflict_times / times:.0f} %) are repeated with "
+                         f"other values ({self.conflicts} rows, the first at "
+                         f"{self._show(self.first_conflict_s or 0.0)} in column "
+                         f"'{printable(self.column)}'): which row is the sample cannot be told",
+                         file=self.file,
+                         fix="log the time at full resolution (not cut to whole seconds), or "
+                             "give a time_s column; if two recorders write the file, keep one")
+
+    def conflicts_note(self, kept: int) -> str | None:
+        """A warning naming the file and the counts when rows were dropped for a timestamp
+        repeated with other values (louder from 1 % of the log's times), or None."""
+        if not self.conflicts:
+            return None
+        times = kept + self.conflict_times
+        share = 100.0 * self.conflict_times / times
+        where = f"{self.file}: " if self.file else ""
+        text = (f"{where}{self.conflict_times} of the log's {times} timestamps ({share:.1f} %) "
+                f"are repeated with other values ({self.conflicts} rows, the first at "
+                f"{self._show(self.first_conflict_s or 0.0)}): which row is the sample cannot "
+                "be told, so all of them were dropped")
+        if share >= 1.0:
+            text += (" — that many contradicting rows: check the recorder (timestamps cut "
+                     "coarser than the logging, two sources writing one log)")
+        return text
 
     def _show(self, t: float) -> str:
         if self.origin is not None:

@@ -54,7 +54,7 @@ from drillfric.errors import DrillfricError, InputError
 from drillfric.files import require_file
 from drillfric.io import witsml, witsml_objects
 from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
-from drillfric.io.parts import open_parts
+from drillfric.io.parts import PART_ATTR, open_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import plural, printable
@@ -87,6 +87,8 @@ CLOCK_UNIT = "ISO 8601"
 FRAME_NAME = "well"
 #: Fewest rows of a file whose header may be quoted as a data log's (:func:`log_shaped`).
 LOG_MIN_ROWS = 10
+#: Column names of a date beside a time column (a time of day written HHMMSS: messages).
+_DATE_NAMES = frozenset({"date", "yyyymmdd", "yymmdd", "ddmmyy", "ddmmyyyy", "day"})
 #: Rows read ahead to tell whether a time column without a stated unit holds timestamps.
 _PEEK_ROWS = 64
 
@@ -219,7 +221,10 @@ class Well:
         if self.depth_indexed:
             return None
         time = self.mappings["time"]
-        return TimeTracker(time.factor, file=str(self.files.data), column=time.column)
+        dates = [c for c in (self.source.columns if self.source is not None else [])
+                 if split_unit(str(c))[0].strip().casefold() in _DATE_NAMES]
+        return TimeTracker(time.factor, file=str(self.files.data), column=time.column,
+                           date_column=dates[0] if dates else None)
 
     def chunks(self, chunk_rows: int = CHUNK_ROWS,
                tracker: TimeTracker | None = None) -> Iterator[pd.DataFrame]:
@@ -235,11 +240,19 @@ class Well:
         tracker = tracker or self.time_tracker()
         for chunk in self.source.chunks(chunk_rows):
             yield self.canonical(chunk, tracker)
+        rest = None if tracker is None else tracker.flush()
+        if rest is not None and len(rest):
+            yield rest
 
     def canonical(self, raw: pd.DataFrame, tracker: TimeTracker | None) -> pd.DataFrame:
         """One raw chunk of the data (the source's columns) as canonical SI columns, its
-        time checked by ``tracker`` (:meth:`chunks` does this for every chunk)."""
-        return _convert(raw, self.mappings, tracker)
+        time checked by ``tracker`` (:meth:`chunks` does this for every chunk).
+
+        The rows of the chunk's last time are held back by ``tracker`` until the next
+        chunk shows whether that time repeats (:meth:`~drillfric.io.timebase.TimeTracker.
+        settle`); ``tracker.flush()`` hands them out at the end of the data."""
+        frame = _convert(raw, self.mappings, tracker)
+        return frame if tracker is None else tracker.settle(frame)
 
     def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
         """Read the whole surface log into a :class:`WellData` (SI units); a time log only."""
@@ -249,6 +262,7 @@ class Well:
         tracker = self.time_tracker()
         chunks = list(self.chunks(chunk_rows, tracker))
         surface = pd.concat(chunks, ignore_index=True) if chunks else pd.DataFrame()
+        tracker.check_conflicts(len(surface))
         if surface.empty:
             raise InputError("no data rows with a time", file=self.files.data,
                              fix="give a file with data rows (and a readable time column)")
@@ -257,7 +271,8 @@ class Well:
                              max_gap_s=self.config.segmentation.max_gap_s,
                              duplicates_dropped=tracker.duplicates,
                              untimed_dropped=tracker.untimed, origin=tracker.origin,
-                             source_start_s=tracker.source_start_s)
+                             source_start_s=tracker.source_start_s,
+                             conflicts_dropped=tracker.conflicts)
         files = {k: v for k, v in (("data", self.files.data), ("config", self.files.config),
                                    ("survey", self.files.survey)) if v is not None}
         return WellData(name=self.name, surface=surface, survey=self.survey,
@@ -585,7 +600,8 @@ def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
     out: dict = {}
     keep = slice(None)
     if tracker is not None:
-        time_s, keep, stamps = tracker.step(chunk[mappings["time"].column])
+        time_s, keep, stamps = tracker.step(chunk[mappings["time"].column],
+                                            part=chunk.attrs.get(PART_ATTR))
         out["time_s"] = time_s
         if stamps is not None:
             out["timestamp"] = stamps.array
@@ -623,7 +639,7 @@ def _channel_infos(mappings: dict[str, Mapping], surface: pd.DataFrame,
     out = {}
     for key, m in mappings.items():
         if key == "time":
-            total = len(surface) + tracker.untimed + tracker.duplicates
+            total = len(surface) + tracker.untimed + tracker.duplicates + tracker.conflicts
             nulls = tracker.untimed / total if total else 0.0
             clock = tracker.origin is not None
             unit = CLOCK_UNIT if clock else m.unit

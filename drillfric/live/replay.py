@@ -22,6 +22,8 @@ def recorded_frame(path: Path):
                          fix="replay a time log")
     tracker = well.time_tracker()
     frames = [well.canonical(raw, tracker) for raw in well.source.chunks()]
+    frames.append(tracker.flush())
+    frames = [f for f in frames if f is not None and len(f)]
     canonical = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
     if len(canonical) < 2:
         raise InputError("fewer than two timed rows", file=path, fix="replay a longer log")

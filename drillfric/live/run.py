@@ -271,7 +271,8 @@ class LiveRun:
         states = engine.stream.last_states
         with self.lock:
             self.view.update(
-                last_sample_time_s=last, rows=engine.check.rows,
+                last_sample_time_s=last,
+                rows=engine.check.rows + (engine.tracker.held_rows if engine.tracker else 0),
                 last_sample_utc=utc_at(engine.tracker.origin, last) if last is not None
                 else None,
                 rig_state=RIG_STATES[int(states[-1])] if states is not None and len(states)

@@ -38,6 +38,15 @@ NOT_WITS_BYTES = 65536
 #: spaced by their arrival, kept inside that second.
 WITHIN_SECOND_S = 0.999
 _MIN_STEP_S = 0.001
+#: Silence that ends a burst of frames [s]: reads closer together than this are one burst
+#: (a recorder's flush split by TCP into several reads), gathered for at most
+#: :data:`GATHER_MAX_S` before its frames are timed.
+BURST_GAP_S = 0.02
+GATHER_MAX_S = 0.5
+#: Longest time between bursts that frames without date and time are spread over [s]: after
+#: a longer silence the stream stalled, and when the frames it then brings were taken is not
+#: known (they are timed as they arrive).
+MAX_SPREAD_S = 5.0
 #: Furthest a frame's date and time may lie ahead of the wall clock [s] (time zones span
 #: UTC-12 to UTC+14): a frame dated later is a wrong clock, not recorded — it would make
 #: every true frame after it look "before the previous one" and be dropped for good.
@@ -137,7 +146,25 @@ class FrameClock:
         self._stamp: float | None = None
         self._first_arrival = 0.0
         self._rig_arrival: float | None = None  # arrival of the last frame on the rig clock
+        self._burst_s: float | None = None  # arrival of the last burst that brought frames
+        self._step: float | None = None  # spacing of this burst's frames without date/time
         self.out_of_order = 0
+
+    def burst(self, unstamped: int, frames: int, arrival_s: float) -> float | None:
+        """``frames`` frames arrived together at ``arrival_s`` (monotonic [s]),
+        ``unstamped`` of them without date and time: those are spread evenly over the time
+        since the previous burst — a recorder flushing 10-Hz frames once a second puts them
+        0.1 s apart, not 1 ms (issue 30, ninth attack). Returns that spacing [s], or None
+        (no earlier burst, or more than :data:`MAX_SPREAD_S` of silence before this one:
+        the frames are timed as they arrive)."""
+        self._step = None
+        if unstamped and self._burst_s is not None:
+            since = arrival_s - self._burst_s
+            if 0.0 < since <= MAX_SPREAD_S:
+                self._step = since / unstamped
+        if frames:
+            self._burst_s = arrival_s
+        return self._step
 
     def ahead(self, clock: datetime | None, wall_s: float) -> bool:
         """Whether the date/time ``clock`` lies more than :data:`MAX_AHEAD_S` after the wall
@@ -152,9 +179,15 @@ class FrameClock:
         last recorded frame (counted in :attr:`out_of_order`, not recorded). A frame without
         date/time after frames with them keeps to the rig's clock: the last recorded time
         plus the arrival time since (on the computer's UTC clock, one unstamped frame of a
-        rig clock behind UTC had put every later frame "before" it: all dropped)."""
+        rig clock behind UTC had put every later frame "before" it: all dropped). A frame
+        without date/time in a burst (:meth:`burst`) follows the last time by the burst's
+        spacing."""
         if clock is None:
-            if self._rig_arrival is not None:
+            if self._step is not None and self.last_s is not None:
+                t = self.last_s + max(self._step, _MIN_STEP_S)
+                if self._rig_arrival is not None:
+                    self._rig_arrival = arrival_s
+            elif self._rig_arrival is not None:
                 t = self.last_s + max(arrival_s - self._rig_arrival, _MIN_STEP_S)
                 self._rig_arrival = arrival_s
             else:
@@ -356,18 +389,60 @@ class Receiver:
                         continue
                     if not data:
                         break
-                    self._take(data)
+                    self._take(*self._gather(conn, data))
         except OSError:
             pass  # dropped: reconnect
         finally:
             self.decoder.reset()  # a frame the drop cut is discarded
         return self.frames > got
 
-    def _take(self, data: bytes) -> None:
-        arrival, wall = time.monotonic(), time.time()
+    def _gather(self, conn: socket.socket, data: bytes) -> tuple[bytes, float]:
+        """``data`` and the reads that follow it within :data:`BURST_GAP_S` of each other
+        (one burst, however TCP cut it; at most :data:`GATHER_MAX_S` and
+        :data:`NOT_WITS_BYTES`), and the arrival of its last read (monotonic [s])."""
+        arrival = time.monotonic()
+        parts, size, until = [data], len(data), arrival + GATHER_MAX_S
+        conn.settimeout(BURST_GAP_S)
+        try:
+            while size < NOT_WITS_BYTES and time.monotonic() < until:
+                try:
+                    more = conn.recv(65536)
+                except OSError:  # a timeout (the burst ended) or a drop: the next read says
+                    break
+                if not more:
+                    break  # closed: the next read says so again
+                arrival = time.monotonic()
+                parts.append(more)
+                size += len(more)
+        finally:
+            try:
+                conn.settimeout(0.1)
+            except OSError:
+                pass
+        return b"".join(parts), arrival
+
+    def _take(self, data: bytes, arrival: float | None = None) -> None:
+        """Record the frames of one burst of ``data`` arriving at ``arrival`` (monotonic
+        [s]; default now)."""
+        arrival, wall = time.monotonic() if arrival is None else arrival, time.time()
         self._received += len(data)
-        for frame in self.decoder.feed(data):
-            values, stamp = self.setup.row.update(frame), frame_clock(frame)
+        frames = list(self.decoder.feed(data))
+        stamps = [frame_clock(frame) for frame in frames]
+        unstamped = sum(stamp is None for stamp in stamps)
+        step = self.clock.burst(unstamped, len(frames), arrival)
+        if unstamped > 1 and (step is not None or self.frames):
+            late = step is None  # after a silence longer than MAX_SPREAD_S
+            self._once("burst-late" if late else "burst",
+                       f"{self.address}: {unstamped} frames without a date and time arrived "
+                       "together (a recorder sending in bursts): "
+                       + (f"after more than {MAX_SPREAD_S:g} s of silence, so recorded 1 ms "
+                          "apart (the bit trace over them is withheld)" if late else
+                          f"spread evenly over the {step * unstamped:.3g} s since the "
+                          f"previous burst, {step:.3g} s apart")
+                       + "; frames carrying their date and time (items 0105, 0106) are "
+                         "timed exactly")
+        for frame, stamp in zip(frames, stamps, strict=True):
+            values = self.setup.row.update(frame)
             if self.clock.ahead(stamp, wall):
                 self._once("future", f"{self.address}: a frame dated {stamp:%Y-%m-%d %H:%M:%S}"
                                      ", more than a day after this computer's clock: not "

@@ -153,7 +153,11 @@ class Engine:
         :meth:`estimate` in order (``drillfric live`` estimates them in another thread:
         this half touches only :meth:`feed_state`, that one only :meth:`fit_state`)."""
         self.raw_rows += len(raw)
-        chunk = self.last_chunk = self.well.canonical(raw, self.tracker)
+        return self._segment(self.well.canonical(raw, self.tracker))
+
+    def _segment(self, chunk: pd.DataFrame) -> list[tuple[Segment, pd.DataFrame]]:
+        """Steps 1–3 of :meth:`feed_raw` for canonical rows (time settled)."""
+        self.last_chunk = chunk
         if self.check.rows == 0 and len(chunk):
             self.estimator.rate_hz = first_chunk(self.well, chunk, self.rate_hz, self.warnings)
             self.estimator.has_truth = "bit_rpm" in chunk
@@ -228,20 +232,28 @@ class Engine:
         still being written (docs/fleet.md "Only what is new"): its rows count in these
         results and are read again, complete, by the run that continues."""
         tail = list(tail)
-        # the tail moves the accumulators on: the state before it, copied (not views of them)
-        self._before_close = copy.deepcopy(self.state()) if tail else self.state()
+        # the tail and the rows the time base held back move the accumulators on: the state
+        # before them, copied (not views of them)
+        self._before_close = copy.deepcopy(self.state()) if tail else \
+            copy.deepcopy(self.feed_state()) | self.fit_state() if self.tracker.holding \
+            else self.state()
         ended = {r.id for raw in tail for r in self.feed_raw(raw)}
+        held = self.tracker.flush()
+        if held is not None and len(held):
+            ended |= {r.id for r in self.estimate(self._segment(held))}
         done = self.stream.close()
         open_ids = {seg.id for seg, _ in done} | ended
         self._take(done)
+        self.tracker.check_conflicts(self.check.rows)
         if self.check.rows == 0:
             raise InputError("no data rows", file=self.well.files.data,
                              fix="check that the file holds samples below its header")
         self.check.finish(self.tracker.duplicates)
         warnings = self.warnings + [w for w in (
+            self.tracker.conflicts_note(self.check.rows),
             self.check.duplicates_note(self.tracker.duplicates),
             self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail),
-            _motor_note(self.records)) if w]
+            _motor_note(self.records)) if w] + self.check.unit_hints(self.records)
         plateaus = self.hook.close()
         calibration = None
         if self.calibration is not None:

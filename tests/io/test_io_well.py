@@ -143,12 +143,14 @@ def test_gaps_and_duplicates_reported(tmp_path, frame):
 def test_dsats_sample_with_documented_mapping(real_data):
     # Source: ../shared/data/real/README.md — 50 000 rows, -999.25 in 1 458 rows, spacing
     # jitters 0–2 s around 1 s, torque in ft·lbf, hook load in klbf; two rows repeat the
-    # previous timestamp (rows 23 009 and 23 341 of the file, found by reading it).
+    # previous timestamp (rows 23 009 and 23 341 of the file, found by reading it) with other
+    # values: both rows of each of those times are dropped (which is the sample is unknown).
     path = real_data / "dsats_1hz" / "SampleData1.csv"
     w = load_well(path, config=EXAMPLES / "dsats_1hz.toml")
-    raw = pd.read_csv(path, header=None).drop_duplicates(subset=0).reset_index(drop=True)
+    raw = pd.read_csv(path, header=None)
+    raw = raw[~raw.duplicated(subset=0, keep=False)].reset_index(drop=True)
     tb = w.timebase
-    assert (tb.rows, tb.duplicates_dropped, tb.gaps) == (49_998, 2, ())
+    assert (tb.rows, tb.duplicates_dropped, tb.conflicts_dropped, tb.gaps) == (49_996, 0, 4, ())
     assert tb.rate_hz == pytest.approx(1.0, abs=0.01) and tb.source_start_s == 0.97
     torque = w.channels["surface_torque_Nm"]
     assert (torque.column, torque.unit) == ("8", "ft.lbf")

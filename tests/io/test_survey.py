@@ -217,7 +217,8 @@ def test_default_tie_in_without_positions(tmp_path):
 # ----------------------------------------------------------------------------- bad input
 
 @pytest.mark.parametrize("name, content, problem", [
-    ("s.csv", "MD,INC,AZI\n0,0,0\n100,1,0\n100,2,0\n", "depths not increasing at station 3"),
+    ("s.csv", "MD,INC,AZI\n0,0,0\n100,1,0\n100,2,0\n",
+     "survey stations 2 and 3 are both at MD 100 m with different values"),
     ("s.csv", "MD,INC,AZI\n0,0,0\n100,1,0\n90,2,0\n", "depths not increasing"),
     ("s.csv", "MD,INC,AZI\n0,0,0\n100,181,0\n", "inclination 181° at station 2 is outside"),
     ("s.csv", "MD,INC,AZI\n0,0,0\n100,-1,0\n", "inclination -1°"),
