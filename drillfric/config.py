@@ -196,6 +196,19 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "sample interval it decides whether the stick-slip cycle — and so the bit "
                   "speed — is resolved (docs/bit_speed.md)."),
     ),
+    "bha": (
+        Key("motor_rev_per_litre", float, None, "rev/L", "Mud motor (positive displacement "
+            "motor) in the BHA: its no-load speed per unit of flow in, k (spec sheets: "
+            "0.03–0.3 rev/L; \"0.15 rev/gal\" accepted). With it, and the flow channel, "
+            "the bit turns at the string's bottom speed plus k·flow (docs/theory.md §2.4): "
+            "bit_rpm_est gains the motor's speed, bha_rpm_est keeps the string's. Default: "
+            "no motor.", min=0.0, min_exclusive=True, max=10.0),
+        Key("motor_speed_drop", float, 0.3, "", "Largest share of its no-load speed a "
+            "declared motor loses under the bit's load on bottom (a PDM at its full "
+            "recommended differential pressure turns 15–30 % slower): the on-bottom motor "
+            "speed is taken as the middle of k·flow·[1 − drop, 1], the MSE's speed "
+            "uncertainty spans the range (docs/theory.md §2.4).", min=0.0, max=0.9),
+    ),
     "model": (
         Key("omega_c_rad_s", float, None, "rad/s", "Static/kinetic switching speed ω_c "
             "(default 1.0 rad/s; give this or omega_c_rpm).", min=0.0, min_exclusive=True),

@@ -250,8 +250,10 @@ class Engine:
         weighed = judge(self.records, plateaus, self.well.config, calibration)
         zero = zero_check(self.rest, weighed.summary["block_weight_N"], weighed.records)
         records, pools = pool_short_segments(withhold_offset(weighed.records, zero))
-        records, friction_log = assess_bit_torque(records, pools,
-                                                  self.well.config.well.bit_diameter_m)
+        cfg = self.well.config
+        records, friction_log = assess_bit_torque(
+            records, pools, cfg.well.bit_diameter_m,
+            None if cfg.bha.motor_rev_per_litre is None else cfg.bha.motor_speed_drop)
         self._note_revisions(records)
         summary = summarise(self.well, records, pools, rows=self.check.rows,
                             assumed=self.well.assumed + self.estimator.assumed,
@@ -452,7 +454,7 @@ def _revision(old: SegmentRecord, new: SegmentRecord, why: str) -> dict:
 def _motor_note(records: list[SegmentRecord]) -> str | None:
     """The well's warning, once, where bit speeds were shown with the pumps on (issue 34
     item 5: a mud motor's speed is not in them), or None."""
-    ids = [str(r.id) for r in records if MOTOR_NOTE in (r.message or "")]
+    ids = [str(r.id) for r in records if r.bit_speed_reason == MOTOR_NOTE]
     if not ids:
         return None
     return (f"{plural(len(ids), 'segment')} ({', '.join(ids[:10])}"
