@@ -448,6 +448,17 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "the Coulomb bit.", min=1.0, max=10.0),
         _positive("bit_weakening_rpm", 10.0, "RPM", "Decay speed ω_b of the rate-weakening "
                   "bit torque (used when bit_weakening_ratio > 1).", max=1000.0),
+        Key("flow_m3_s", float, 0.0, "m³/s", "Flow in of every stand that gives none (pumps on "
+            "throughout the stand, off in connections; recorded as flow_in_m3_s when > 0).",
+            min=0.0, max=0.2),
+        Key("motor_rev_per_litre", float, None, "rev/L", "Mud motor of the simulated BHA: "
+            "its no-load speed per unit of flow, k (docs/simulator.md, Mud motor); the truth "
+            "bit_rpm is then the BHA's (bha_rpm) plus the motor's. The run's own [bha] table "
+            "declares it or not. Default: no motor.", min=0.0, min_exclusive=True, max=10.0),
+        Key("motor_stall_torque_Nm", float, None, "N·m", "Stall torque of the simulated "
+            "motor: its speed falls linearly with the bit torque, ω_m = 2π·k·Q·(1 − "
+            "τ_bit/τ_stall) (docs/theory.md eq. 2.4b). Default: no drop.", min=0.0,
+            min_exclusive=True),
         Key("off_bottom_m", float, 5.0, "m", "Distance of the bit above hole bottom in "
             "off-bottom stands (recorded hole depth = bit depth + this).", min=0.0),
         Key("friction_law", str, "step", "", "Friction law of the truth (docs/theory.md §3.2): "
