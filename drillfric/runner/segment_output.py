@@ -33,6 +33,11 @@ MOTOR_NOTE = ("the pumps were on while the string turned: the bit speed shown is
               "string's bottom speed and includes no mud motor — with a motor the bit turns "
               "faster by its speed; declare it with [bha] motor_rev_per_litre")
 
+#: The note of an on-bottom segment drilled with the pumps on and no motor declared: its MSE
+#: takes the surface speed as the bit's.
+MSE_NOTE = ("the pumps were on while drilling: mse_Pa takes the string's speed as the bit's "
+            "— with a mud motor the bit turns faster and the MSE is higher; declare it with "
+            "[bha] motor_rev_per_litre")
 #: The note of a segment whose trace is shown with a declared motor turning: the stick-slip
 #: statistics are those of the string's bottom, not of the bit the motor turns.
 BHA_STATISTICS_NOTE = ("stick_slip_severity and stuck_fraction are the BHA's (the string's "
@@ -210,14 +215,18 @@ def motor_fields(rows: pd.DataFrame, cfg: Config, on_bottom: bool, frame: pd.Dat
                  record: SegmentRecord) -> dict:
     """A segment's fields from the mud motor (issue 34 item 5): without a declared motor,
     where a trace is shown with the pumps on, :data:`MOTOR_NOTE` (message and
-    ``bit_speed_reason``); with one, ``motor_rpm_mean``, the notes that the stick-slip
-    statistics are the BHA's and where the flow is missing, and ``bit_rms_error_rpm`` of
-    the bit's speed (BHA + motor) where the input has the truth."""
+    ``bit_speed_reason``), on bottom with the pumps on :data:`MSE_NOTE`; with one,
+    ``motor_rpm_mean``, the notes that the stick-slip statistics are the BHA's and where
+    the flow is missing, and ``bit_rms_error_rpm`` of the bit's speed (BHA + motor) where
+    the input has the truth."""
     motor = row_motor(rows, cfg, on_bottom)
     if motor is None:
-        shown = record.bit_speed_resolved and pumped(rows, cfg)
+        if not pumped(rows, cfg):
+            return {}
+        if on_bottom:
+            return dict(message=_joined(record.message, MSE_NOTE))
         return dict(message=_joined(record.message, MOTOR_NOTE),
-                    bit_speed_reason=MOTOR_NOTE) if shown else {}
+                    bit_speed_reason=MOTOR_NOTE) if record.bit_speed_resolved else {}
     turning = rows["surface_rpm"].to_numpy(float) > cfg.segmentation.rotating_rpm
     mid = motor.mid[turning] / RPM_TO_RAD_S
     mean = float(np.nanmean(mid)) if np.isfinite(mid).any() else None
