@@ -19,8 +19,14 @@ docs/theory.md eq. 2.4b). Three stands: off bottom with the pumps on, on bottom 
   (the surface's where the segment says the MSE takes the string's speed): false when
   outside its stated 95 % half-width.
 
-Run: ``python benchmarks/validate_motor.py [--quick] [--json OUT]`` (a few minutes; --quick:
-k = 0.1 only).
+``false_as_bit`` counts the windows that would be false were the trace read as the bit's
+whatever its note says: the undeclared runs' numbers before issue 34 item 5.
+
+The second plant family (benchmarks/plants/lumped.py, §L6: its own motor law, independent
+of drillfric) runs the same motors on one off-bottom rotation of its 3000-m well.
+
+Run: ``python benchmarks/validate_motor.py [--quick] [--json OUT]`` (about 10 minutes;
+--quick: k = 0.1 only).
 """
 
 from __future__ import annotations
@@ -38,6 +44,8 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks import validate_lumped as VL  # noqa: E402
+from benchmarks.plants import lumped as L  # noqa: E402
 from drillfric.estimation.bit_torque import teale_mse_Pa  # noqa: E402
 from drillfric.io.well import open_well  # noqa: E402
 from drillfric.io.writers import dumps_toml  # noqa: E402
@@ -86,6 +94,22 @@ def simulate(folder: Path, k: float, q: float) -> dict:
     return {"columns": sim.columns, "truth": sim.truth(), "config": raw}
 
 
+def simulate_lumped(folder: Path, k: float, q: float) -> dict:
+    """The second plant family (benchmarks/plants/lumped.py §L6) with the motor: one
+    off-bottom rotation of 240 s at 60 RPM on the 3000-m well of validate_lumped.py,
+    μ_s/μ_k = 0.4/0.25 (stick-slip), pumps on throughout."""
+    case = VL.Case(3000.0, 0.25, 1.6, creep="ramp")
+    survey, string = VL.well(case)
+    knots = L.setpoint(60.0, 250.0)
+    rec = L.simulate(string, L.Drive(knots, 2900.0, case.kp, case.ki),
+                     L.Friction(0.4, 0.25, omega_switch_rad_s=VL.OMEGA_C), knots[-1][0],
+                     rate_hz=100.0, noise=L.Noise(rpm_sd=0.5, torque_sd_Nm=200.0,
+                                                  hookload_sd_N=2000.0, seed=1),
+                     motor=L.Motor(k, q, STALL_NM))
+    config = tomllib.loads(VL.write_config(folder, case, survey).read_text(encoding="utf-8"))
+    return {"columns": rec.columns, "truth": {"stands": []}, "config": config}
+
+
 def logged(cols: dict, rate: str) -> pd.DataFrame:
     """The 100-Hz record as logged at ``rate`` (spot values or 1-s block means)."""
     cols = {k: np.asarray(v, float) for k, v in cols.items()}
@@ -99,10 +123,14 @@ def run(folder: Path, sim: dict, rate: str, declared: bool, k: float):
     """drillfric's run of one logged record, the motor declared or not."""
     name = f"r{rate.split('-')[0]}{'m' if 'means' in rate else ''}_{'d' if declared else 'u'}"
     data = logged(sim["columns"], rate)
-    data.drop(columns=["bha_rpm", "string_torque_Nm"]).to_csv(folder / f"{name}.csv",
-                                                               index=False)
-    cfg = {t: v for t, v in sim["config"].items() if t != "simulate"}
+    truth_only = ("bha_rpm", "string_torque_Nm", "motor_torque_Nm")
+    data = data.drop(columns=[c for c in truth_only if c in data])
+    if not data["wob_N"].any():
+        data = data.drop(columns="wob_N")
+    data.to_csv(folder / f"{name}.csv", index=False)
+    cfg = {t: v for t, v in sim["config"].items() if t not in ("simulate", "well")}
     cfg["hookload"] = {"block_weight_N": 0.0}
+    cfg["well"] = {"bit_diameter_m": D_BIT}
     if declared:
         cfg["bha"] = {"motor_rev_per_litre": k}
     if rate.endswith("means"):
@@ -145,7 +173,7 @@ def grade(result, sim: dict) -> dict:
     cols, stands = sim["columns"], sim["truth"]["stands"]
     t, bit, bha = cols["time_s"], cols["bit_rpm"], cols["bha_rpm"]
     out = {"windows": 0, "false_windows": 0, "stats": 0, "false_stats": 0, "mse": 0,
-           "false_mse": 0, "bit_rms_rpm": [], "notes": 0}
+           "false_mse": 0, "notes": 0, "false_as_bit": 0, "worst_error_rpm": 0.0}
     for g in result.summary["segments"]:
         if g["status"] != "ok":
             continue
@@ -158,6 +186,10 @@ def grade(result, sim: dict) -> dict:
             w = windows(rows, t, bha if claims_bha else bit)
             out["windows"] += len(w)
             out["false_windows"] += sum(not x["ok"] for x in w)
+            out["worst_error_rpm"] = max([out["worst_error_rpm"]]
+                                         + [abs(x["est"] - x["truth"]) for x in w])
+            # the same trace read as the bit's without the note (before issue 34 item 5)
+            out["false_as_bit"] += sum(not x["ok"] for x in windows(rows, t, bit))
         _grade_stats(out, g, t, bha)
         _grade_mse(out, g, stands, t, bit, cols)
     return out
@@ -194,19 +226,21 @@ def main() -> None:
     args = parser.parse_args()
     rows, started = [], time.time()
     with tempfile.TemporaryDirectory() as tmp:
-        for k, q in MOTORS[1:2] if args.quick else MOTORS:
-            folder = Path(tmp) / f"k{k:g}"
-            folder.mkdir()
-            sim = simulate(folder, k, q)
-            for rate in RATES:
-                for declared in (True, False):
-                    result = run(folder, sim, rate, declared, k)
-                    row = {"k_rev_per_litre": k, "flow_m3_s": q, "rate": rate,
-                           "declared": declared} | grade(result, sim)
-                    rows.append(row)
-                    print(json.dumps(row), flush=True)
+        for plant, make in (("simulator", simulate), ("lumped", simulate_lumped)):
+            for k, q in MOTORS[1:2] if args.quick else MOTORS:
+                folder = Path(tmp) / f"{plant}_k{k:g}"
+                folder.mkdir()
+                sim = make(folder, k, q)
+                for rate in RATES:
+                    for declared in (True, False):
+                        result = run(folder, sim, rate, declared, k)
+                        row = {"plant": plant, "k_rev_per_litre": k, "flow_m3_s": q,
+                               "rate": rate, "declared": declared} | grade(result, sim)
+                        rows.append(row)
+                        print(json.dumps(row), flush=True)
     totals = {key: sum(r[key] for r in rows) for key in
-              ("windows", "false_windows", "stats", "false_stats", "mse", "false_mse")}
+              ("windows", "false_windows", "stats", "false_stats", "mse", "false_mse",
+               "false_as_bit")}
     print(json.dumps({"totals": totals, "runs": len(rows),
                       "wall_s": round(time.time() - started)}))
     if args.json:
