@@ -164,3 +164,32 @@ def test_simulated_motor_well_shows_the_bit_speed_or_says_it_is_the_bha(tmp_path
         assert motor == pytest.approx(0.0, abs=1e-9)
         assert seg["bit_speed_reason"] == MOTOR_NOTE
         assert sum(MOTOR_NOTE in w for w in result.summary["warnings"]) == 1
+
+
+def test_report_shows_the_bha_speed_beside_the_bit_speed_with_a_motor():
+    from drillfric.report.evidence import panel_data
+    from drillfric.report.render import _bit_speed_cell
+
+    rows = pd.DataFrame({"time_s": [0.0, 1.0], "start_id": [-1, -1],
+                         "surface_rpm": [60.0, 60.0], "surface_rpm_est": [60.0, 60.0],
+                         "bit_rpm_est": [230.0, 200.0], "bha_rpm_est": [50.0, 20.0],
+                         "bit_stuck": [False, False]})
+    assert panel_data(rows)["bit"]["bha"].tolist() == [50.0, 20.0]
+    # without a motor the two are the same numbers: one line
+    assert "bha" not in panel_data(rows.assign(bha_rpm_est=rows["bit_rpm_est"]))["bit"]
+    cell = _bit_speed_cell({"status": "ok", "bit_speed_resolved": True,
+                            "motor_rpm_mean": 180.0, "sample_interval_s": 0.01})
+    assert "BHA + motor ≈ 180 rpm" in cell
+
+
+def test_live_open_segment_gives_the_bha_speed(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from drillfric.live.alerts import bit_tail
+
+    table = pa.table({"segment_id": pa.array([3, 3], pa.int32()), "time_s": [0.0, 1.0],
+                      "surface_rpm": [60.0, 60.0], "bit_rpm_est": [230.0, 200.0],
+                      "bha_rpm_est": [50.0, 20.0], "bit_stuck": [False, False]})
+    pq.write_table(table, tmp_path / "estimates.parquet")
+    assert bit_tail(tmp_path, 3) == (200.0, 20.0, 0.0)
