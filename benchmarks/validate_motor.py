@@ -19,8 +19,9 @@ docs/theory.md eq. 2.4b). Three stands: off bottom with the pumps on, on bottom 
   (the surface's where the segment says the MSE takes the string's speed): false when
   outside its stated 95 % half-width.
 
-``false_as_bit`` counts the windows that would be false were the trace read as the bit's
-whatever its note says: the undeclared runs' numbers before issue 34 item 5.
+``false_as_bit`` and ``mse_false_as_bit`` count the windows and MSEs that would be false
+were they read as the bit's whatever the segment's note says: the undeclared runs' numbers
+before issue 34 item 5.
 
 The second plant family (benchmarks/plants/lumped.py, §L6: its own motor law, independent
 of drillfric) runs the same motors on one off-bottom rotation of its 3000-m well.
@@ -173,7 +174,8 @@ def grade(result, sim: dict) -> dict:
     cols, stands = sim["columns"], sim["truth"]["stands"]
     t, bit, bha = cols["time_s"], cols["bit_rpm"], cols["bha_rpm"]
     out = {"windows": 0, "false_windows": 0, "stats": 0, "false_stats": 0, "mse": 0,
-           "false_mse": 0, "notes": 0, "false_as_bit": 0, "worst_error_rpm": 0.0}
+           "false_mse": 0, "notes": 0, "false_as_bit": 0, "worst_error_rpm": 0.0,
+           "mse_false_as_bit": 0, "worst_mse_error": 0.0}
     for g in result.summary["segments"]:
         if g["status"] != "ok":
             continue
@@ -213,10 +215,14 @@ def _grade_mse(out: dict, g: dict, stands: list, t, bit, cols) -> None:
     stand = min(stands, key=lambda s: abs(s["bit_depth_m"] - g["bit_depth_m"]))
     m = (t >= g["t_start_s"]) & (t <= g["t_end_s"]) & (cols["surface_rpm"] > 2.0)
     says_surface = "mse_Pa takes the string's speed" in (g.get("message") or "")
-    speed = float(np.mean(cols["surface_rpm"][m] if says_surface else bit[m]))
-    truth = teale_mse_Pa(g["wob_N"], stand["bit_power_torque_Nm"], speed, g["rop_m_h"], D_BIT)
+    at = lambda rpm: teale_mse_Pa(g["wob_N"], stand["bit_power_torque_Nm"],  # noqa: E731
+                                  float(np.mean(rpm)), g["rop_m_h"], D_BIT)
+    truth, of_bit = at(cols["surface_rpm"][m] if says_surface else bit[m]), at(bit[m])
     out["mse"] += 1
     out["false_mse"] += abs(g["mse_Pa"] - truth) > g["mse_uncertainty_Pa"]
+    out["worst_mse_error"] = max(out["worst_mse_error"], abs(g["mse_Pa"] / truth - 1.0))
+    # read as the bit's MSE whatever the note says (before issue 34 item 5)
+    out["mse_false_as_bit"] += abs(g["mse_Pa"] - of_bit) > g["mse_uncertainty_Pa"]
 
 
 def main() -> None:
@@ -240,7 +246,7 @@ def main() -> None:
                         print(json.dumps(row), flush=True)
     totals = {key: sum(r[key] for r in rows) for key in
               ("windows", "false_windows", "stats", "false_stats", "mse", "false_mse",
-               "false_as_bit")}
+               "false_as_bit", "mse_false_as_bit")}
     print(json.dumps({"totals": totals, "runs": len(rows),
                       "wall_s": round(time.time() - started)}))
     if args.json:

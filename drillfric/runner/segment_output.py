@@ -221,12 +221,7 @@ def motor_fields(rows: pd.DataFrame, cfg: Config, on_bottom: bool, frame: pd.Dat
     the input has the truth."""
     motor = row_motor(rows, cfg, on_bottom)
     if motor is None:
-        if not pumped(rows, cfg):
-            return {}
-        if on_bottom:
-            return dict(message=_joined(record.message, MSE_NOTE))
-        return dict(message=_joined(record.message, MOTOR_NOTE),
-                    bit_speed_reason=MOTOR_NOTE) if record.bit_speed_resolved else {}
+        return _undeclared(rows, cfg, on_bottom, record)
     turning = rows["surface_rpm"].to_numpy(float) > cfg.segmentation.rotating_rpm
     mid = motor.mid[turning] / RPM_TO_RAD_S
     mean = float(np.nanmean(mid)) if np.isfinite(mid).any() else None
@@ -235,6 +230,19 @@ def motor_fields(rows: pd.DataFrame, cfg: Config, on_bottom: bool, frame: pd.Dat
     fields = dict(motor_rpm_mean=mean, message=_joined(record.message, *notes))
     error = _bit_error_rpm(frame) if record.bit_rms_error_rpm is not None else None
     return fields | ({"bit_rms_error_rpm": error} if error is not None else {})
+
+
+def _undeclared(rows: pd.DataFrame, cfg: Config, on_bottom: bool,
+                record: SegmentRecord) -> dict:
+    """Without a declared motor, what a pumped segment says: on bottom, that its MSE takes
+    the string's speed (:data:`MSE_NOTE`); off bottom with a trace shown, that the trace is
+    the string's bottom speed (:data:`MOTOR_NOTE`, also its ``bit_speed_reason``)."""
+    if not pumped(rows, cfg):
+        return {}
+    if on_bottom:
+        return dict(message=_joined(record.message, MSE_NOTE))
+    return dict(message=_joined(record.message, MOTOR_NOTE),
+                bit_speed_reason=MOTOR_NOTE) if record.bit_speed_resolved else {}
 
 
 def _joined(*parts: str) -> str:
