@@ -193,3 +193,46 @@ def test_live_open_segment_gives_the_bha_speed(tmp_path):
                       "bha_rpm_est": [50.0, 20.0], "bit_stuck": [False, False]})
     pq.write_table(table, tmp_path / "estimates.parquet")
     assert bit_tail(tmp_path, 3) == (200.0, 20.0, 0.0)
+
+
+def _rows(flow_m3_s) -> pd.DataFrame:
+    n = len(flow_m3_s)
+    return pd.DataFrame({"time_s": np.arange(float(n)), "surface_rpm": np.full(n, 60.0),
+                         "flow_in_m3_s": np.asarray(flow_m3_s, float)})
+
+
+@pytest.mark.parametrize("on_bottom, resolved, says", [
+    (False, True, "bit speed shown is the string's bottom speed"),
+    (True, False, "mse_Pa takes the string's speed"),
+    (False, False, None)])  # no trace shown: nothing to qualify
+def test_undeclared_motor_segments_say_what_their_speed_is(on_bottom, resolved, says):
+    from drillfric.result import SegmentRecord
+    from drillfric.runner.segment_output import motor_fields
+
+    record = SegmentRecord(id=1, bit_speed_resolved=resolved)
+    fields = motor_fields(_rows([0.03] * 10), config_from_dict({}), on_bottom, None, record)
+    if says is None:
+        assert fields == {}
+    else:
+        assert says in fields["message"]
+        assert ("bit_speed_reason" in fields) is (not on_bottom)
+
+
+def test_declared_motor_segment_gives_its_mean_speed_and_says_the_statistics_are_the_bhas():
+    from drillfric.result import SegmentRecord
+    from drillfric.runner.segment_output import (
+        BHA_STATISTICS_NOTE,
+        FLOW_MISSING_NOTE,
+        motor_fields,
+    )
+
+    cfg = config_from_dict({"bha": {"motor_rev_per_litre": 0.1}})
+    record = SegmentRecord(id=1, stuck_fraction=0.4)
+    fields = motor_fields(_rows([0.03] * 10), cfg, False, None, record)
+    assert fields["motor_rpm_mean"] == pytest.approx(180.0)
+    assert BHA_STATISTICS_NOTE in fields["message"]
+    assert FLOW_MISSING_NOTE not in fields["message"]
+    # on bottom the mean is the middle of 180·[0.7, 1]; a missing flow is said
+    fields = motor_fields(_rows([0.03] * 9 + [np.nan]), cfg, True, None, record)
+    assert fields["motor_rpm_mean"] == pytest.approx(153.0)
+    assert FLOW_MISSING_NOTE in fields["message"]

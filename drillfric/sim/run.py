@@ -335,7 +335,7 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
         columns.pop("wob_N")
     if not any(s.flow_m3_s > 0 for s in scenario.stands):
         columns.pop("flow_in_m3_s")
-    if cfg.simulate.motor_rev_per_litre is None:
+    if settings.motor_rev_per_litre is None:
         columns.pop("bha_rpm")
     block = cfg.hookload.block_weight_N
     columns["hookload_N"] = columns["hookload_N"] + (block or 0.0)
@@ -458,8 +458,8 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
     stuck = float(np.mean(np.abs(rec.bit_rad_s[rotating]) < 0.1 * settings.omega_c_rad_s)) \
         if rotating.any() else 0.0
     hookload = _hookload(cfg, path, stand, td, tds, axial, depth, rec.time_s)
-    motor = pdm_speed_rad_s(stand.flow_m3_s, cfg.simulate.motor_rev_per_litre,
-                            rec.bit_torque_Nm, cfg.simulate.motor_stall_torque_Nm)
+    motor = pdm_speed_rad_s(stand.flow_m3_s, settings.motor_rev_per_litre,
+                            rec.bit_torque_Nm, settings.motor_stall_torque_Nm)
     cols = {"time_s": rec.time_s + t0, "surface_rpm": rec.surface_rad_s / RPM_TO_RAD_S,
             "surface_torque_Nm": surface_torque, "hookload_N": hookload,
             "bit_depth_m": depth, "hole_depth_m": hole,
