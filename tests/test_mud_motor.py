@@ -236,3 +236,15 @@ def test_declared_motor_segment_gives_its_mean_speed_and_says_the_statistics_are
     fields = motor_fields(_rows([0.03] * 9 + [np.nan]), cfg, True, None, record)
     assert fields["motor_rpm_mean"] == pytest.approx(153.0)
     assert FLOW_MISSING_NOTE in fields["message"]
+
+
+def test_a_declared_motor_without_its_flow_is_said_once_for_the_well():
+    from drillfric.result import SegmentRecord
+    from drillfric.runner.engine import _flow_missing_note
+    from drillfric.runner.segment_output import FLOW_MISSING_NOTE
+
+    records = [SegmentRecord(id=i, message=FLOW_MISSING_NOTE if i != 2 else "")
+               for i in (1, 2, 3)]
+    note = _flow_missing_note(records)
+    assert note.startswith("2 segments (1, 3): ") and FLOW_MISSING_NOTE in note
+    assert _flow_missing_note(records[1:2]) is None
