@@ -267,7 +267,7 @@ class Quantity(click.ParamType):
 
     def get_metavar(self, param, ctx=None) -> str:
         """The unit as the metavar (``--bit-depth M``, ``--rate HZ``), as docs/cli.md writes."""
-        return {"N·m": "NM", "m/s": "M/S"}.get(self.unit, self.unit.upper())
+        return {"N·m": "NM", "m/s": "M/S", "m³/s": "M3/S"}.get(self.unit, self.unit.upper())
 
     def convert(self, value, param, ctx):
         if isinstance(value, int | float) and not isinstance(value, bool):

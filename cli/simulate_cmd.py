@@ -22,7 +22,9 @@ def _overrides(**options) -> dict:
             "mu_s": "simulate.mu_s", "mu_k": "simulate.mu_k",
             "bit_depth": "simulate.bit_depth_m", "rpm": "simulate.rpm", "seed": "simulate.seed",
             "rpm_noise": "simulate.rpm_noise", "torque_noise": "simulate.torque_noise_Nm",
-            "wob": "simulate.wob_N", "cells": "simulate.cells"}
+            "wob": "simulate.wob_N", "cells": "simulate.cells", "flow": "simulate.flow_m3_s",
+            "motor": "simulate.motor_rev_per_litre",
+            "motor_stall_torque": "simulate.motor_stall_torque_Nm"}
     return {keys[k]: v for k, v in options.items() if v is not None}
 
 
@@ -73,6 +75,12 @@ def _say_scenario_duration(duration: float, used: Path, plan) -> None:
               help="Surface speed set-point after the ramp [RPM].")
 @click.option("--wob", type=Quantity("N"), help="Weight on bit of a single stand [N] (> 0: on "
               "bottom), e.g. \"30 klbf\".")
+@click.option("--flow", type=Quantity("m³/s"), help="Flow in of every stand that gives none "
+              "[m³/s] (pumps on), e.g. \"1800 L/min\".")
+@click.option("--motor", type=Quantity("rev/L"), help="A mud motor in the simulated BHA: its "
+              "speed per unit of flow [rev/L], e.g. \"0.15 rev/gal\" (docs/simulator.md).")
+@click.option("--motor-stall-torque", type=Quantity("N·m"), help="The motor's stall torque "
+              "[N·m]: its speed falls linearly with the bit torque (default: no drop).")
 @click.option("--seed", type=int, help="Seed of the measurement noise.")
 @click.option("--rpm-noise", type=Quantity("RPM"), help="Gaussian surface-speed noise [RPM].")
 @click.option("--torque-noise", type=Quantity("N·m"), help="Gaussian torque noise [N·m].")
@@ -84,11 +92,13 @@ def _say_scenario_duration(duration: float, used: Path, plan) -> None:
               help="Survey file (overrides the configuration's [survey] file and a "
                    "CONFIG-stem.survey.csv beside it).")
 def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bit_depth, rpm,
-            wob, seed, rpm_noise, torque_noise, cells, scenario, survey) -> None:
+            wob, flow, motor, motor_stall_torque, seed, rpm_noise, torque_noise, cells,
+            scenario, survey) -> None:
     """Simulate surface data with ground truth from the torsional plant (docs/theory.md §3).
 
     Writes OUT with time_s, surface_rpm, surface_torque_Nm, hookload_N, bit_depth_m,
-    hole_depth_m, bit_rpm and string_torque_Nm (noise-free truth), plus OUT's sidecars
+    hole_depth_m, bit_rpm and string_torque_Nm (noise-free truth; with --flow flow_in_m3_s,
+    with --motor bha_rpm, the string's bottom, and bit_rpm adds the motor), plus OUT's sidecars
     NAME.toml, NAME.survey.csv and NAME.truth.json, so that `drillfric run OUT` reads it
     directly (NAME: OUT's stem, also the well's name in NAME.toml). The survey is --survey,
     else CONFIG's [survey] file, else CONFIG-stem.survey.csv beside CONFIG (as `run` finds
@@ -103,7 +113,8 @@ def command(config: Path, out: Path, duration, rate, mu_s, mu_k, omega_c_rpm, bi
     data_format(out)
     overrides = _overrides(duration=duration, rate=rate, mu_s=mu_s, mu_k=mu_k,
                            bit_depth=bit_depth, rpm=rpm, seed=seed, rpm_noise=rpm_noise,
-                           torque_noise=torque_noise, wob=wob, cells=cells)
+                           torque_noise=torque_noise, wob=wob, cells=cells, flow=flow,
+                           motor=motor, motor_stall_torque=motor_stall_torque)
     cfg, survey_path, well_path = _load(config, survey, overrides, omega_c_rpm)
     used, plan = sim.plan(cfg, config, well_path, scenario,
                           single=bit_depth is not None and scenario is None)

@@ -196,6 +196,19 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
                   "sample interval it decides whether the stick-slip cycle — and so the bit "
                   "speed — is resolved (docs/bit_speed.md)."),
     ),
+    "bha": (
+        Key("motor_rev_per_litre", float, None, "rev/L", "Mud motor (positive displacement "
+            "motor) in the BHA: its no-load speed per unit of flow in, k (spec sheets: "
+            "0.03–0.3 rev/L; \"0.15 rev/gal\" accepted). With it, and the flow channel, "
+            "the bit turns at the string's bottom speed plus k·flow (docs/theory.md §2.4): "
+            "bit_rpm_est gains the motor's speed, bha_rpm_est keeps the string's. Default: "
+            "no motor.", min=0.0, min_exclusive=True, max=10.0),
+        Key("motor_speed_drop", float, 0.3, "", "Largest share of its no-load speed a "
+            "declared motor loses under the bit's load on bottom (a PDM at its full "
+            "recommended differential pressure turns 15–30 % slower): the on-bottom motor "
+            "speed is taken as the middle of k·flow·[1 − drop, 1], the MSE's speed "
+            "uncertainty spans the range (docs/theory.md §2.4).", min=0.0, max=0.9),
+    ),
     "model": (
         Key("omega_c_rad_s", float, None, "rad/s", "Static/kinetic switching speed ω_c "
             "(default 1.0 rad/s; give this or omega_c_rpm).", min=0.0, min_exclusive=True),
@@ -438,6 +451,17 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "the Coulomb bit.", min=1.0, max=10.0),
         _positive("bit_weakening_rpm", 10.0, "RPM", "Decay speed ω_b of the rate-weakening "
                   "bit torque (used when bit_weakening_ratio > 1).", max=1000.0),
+        Key("flow_m3_s", float, 0.0, "m³/s", "Flow in of every stand that gives none (pumps on "
+            "throughout the stand, off in connections; recorded as flow_in_m3_s when > 0).",
+            min=0.0, max=0.2),
+        Key("motor_rev_per_litre", float, None, "rev/L", "Mud motor of the simulated BHA: "
+            "its no-load speed per unit of flow, k (docs/simulator.md, Mud motor); the truth "
+            "bit_rpm is then the BHA's (bha_rpm) plus the motor's. The run's own [bha] table "
+            "declares it or not. Default: no motor.", min=0.0, min_exclusive=True, max=10.0),
+        Key("motor_stall_torque_Nm", float, None, "N·m", "Stall torque of the simulated "
+            "motor: its speed falls linearly with the bit torque, ω_m = 2π·k·Q·(1 − "
+            "τ_bit/τ_stall) (docs/theory.md eq. 2.4b). Default: no drop.", min=0.0,
+            min_exclusive=True),
         Key("off_bottom_m", float, 5.0, "m", "Distance of the bit above hole bottom in "
             "off-bottom stands (recorded hole depth = bit depth + this).", min=0.0),
         Key("friction_law", str, "step", "", "Friction law of the truth (docs/theory.md §3.2): "

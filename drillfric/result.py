@@ -254,9 +254,10 @@ class SegmentRecord:
                              "depth-indexed log's friction log) or none", Method.NONE)
     settling_time_s: float | None = _f("s", "time the observer starts took to settle")
     residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
-    stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated bit "
-                                                "speed from stick_slip_from_s to t_end_s "
-                                                "(ensemble members pooled; ±12 %); null "
+    stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated BHA "
+                                                "speed (the bit's without a mud motor) from "
+                                                "stick_slip_from_s to t_end_s (ensemble "
+                                                "members pooled; ±12 %); null "
                                                 "where beyond its validated range (flag "
                                                 "stick_slip_beyond_validated) or not "
                                                 "determined (stick_slip_undetermined)")
@@ -264,9 +265,10 @@ class SegmentRecord:
     message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
     duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
     stuck_fraction: float | None = _f("-", "share of the time from stick_slip_from_s to "
-                                           "t_end_s the bit is stuck, |ω_bit| ≤ ω_c "
-                                           "(ensemble members pooled; ±0.05); null where "
-                                           "beyond its validated range or not determined")
+                                           "t_end_s the BHA is stuck, |ω_BHA| ≤ ω_c (the "
+                                           "bit's without a mud motor; ensemble members "
+                                           "pooled; ±0.05); null where beyond its "
+                                           "validated range or not determined")
     stick_slip_from_s: float | None = _f("s", "the stuck fraction and severity are taken "
                                               "from this time to t_end_s: after the start-up "
                                               "and after any creep whose break-free depends "
@@ -309,7 +311,13 @@ class SegmentRecord:
                                                     "window-by-window kinematic check or "
                                                     "because it depends on an unidentified "
                                                     "μ_s (docs/bit_speed.md)")
-    bit_speed_reason: str | None = _f("", "why the bit speed is not reported")
+    bit_speed_reason: str | None = _f("", "why the bit speed is not reported; of a trace "
+                                          "shown with the pumps on and no motor declared, "
+                                          "that it is the string's bottom speed")
+    motor_rpm_mean: float | None = _f("RPM", "mean speed the declared mud motor adds to the "
+                                             "BHA's over the turning rows (k·flow; on bottom "
+                                             "less the half of its largest drop, "
+                                             "docs/theory.md §2.4)")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
                                               "the spacing, the averaging interval, the "
                                               "update interval of held values and the width "
@@ -361,9 +369,10 @@ class SegmentRecord:
                                    "(well.bit_diameter_m)")
     mu_bit_uncertainty: float | None = _f("-", "95 % half-width of mu_bit (from T_bit's)")
     mse_Pa: float | None = _f("Pa", "downhole mechanical specific energy (Teale, with "
-                                    "T_bit): WOB/A + 2π·N·T_bit/(A·ROP), N the mean surface "
-                                    "speed")
-    mse_uncertainty_Pa: float | None = _f("Pa", "95 % half-width of mse_Pa (from T_bit's)")
+                                    "T_bit): WOB/A + 2π·N·T_bit/(A·ROP), N the bit's mean "
+                                    "speed: the surface's plus motor_rpm_mean")
+    mse_uncertainty_Pa: float | None = _f("Pa", "95 % half-width of mse_Pa (from T_bit's and a "
+                                                "motor's speed drop)")
     bit_torque_reason: str | None = _f("", "why bit_torque_Nm, mu_bit or mse_Pa is null")
 
     def to_json(self) -> dict:
@@ -421,8 +430,14 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("mu_k", "float64", "-", "μ̂_k of the start"),
     Column("surface_rpm", "float64", "RPM", "measured top-drive speed"),
     Column("surface_rpm_est", "float64", "RPM", "observer's top-drive speed"),
-    Column("bit_rpm_est", "float64", "RPM", "estimated bit speed"),
-    Column("bit_stuck", "bool", "", "estimated bit in the static band (ω within ±ω_c); null "
+    Column("bit_rpm_est", "float64", "RPM", "estimated bit speed: the BHA's plus a declared "
+                                            "mud motor's (docs/theory.md §2.4; null where "
+                                            "the flow is missing while the pumps may run)"),
+    Column("bha_rpm_est", "float64", "RPM", "estimated speed of the string's bottom (BHA, "
+                                            "above a mud motor): bit_rpm_est without a "
+                                            "declared motor"),
+    Column("bit_stuck", "bool", "", "estimated bit in the static band (ω within ±ω_c: the "
+                                    "BHA stuck and no declared motor turning); null "
                                     "where the bit speed is not resolved"),
     Column("residual_rpm", "float64", "RPM", "innovation ω̂₀ − ω₀"),
     Column("surface_torque_Nm", "float64", "N·m", "measured string torque at surface "
@@ -434,6 +449,12 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("bit_rpm", "float64", "RPM", "measured bit speed (synthetic truth only)"),
     Column("bit_rpm_est_min", "float32", "RPM", "ensemble band: lowest member (seeded rows)"),
     Column("bit_rpm_est_max", "float32", "RPM", "ensemble band: highest member (seeded rows)"),
+    Column("bha_rpm_est_min", "float32", "RPM", "the BHA's ensemble band: lowest member "
+                                                "(seeded rows); the bit's band adds the "
+                                                "motor's speed after its largest drop"),
+    Column("bha_rpm_est_max", "float32", "RPM", "the BHA's ensemble band: highest member; "
+                                                "the bit's band adds the motor's no-load "
+                                                "speed"),
 )
 ESTIMATE_NAMES: tuple[str, ...] = tuple(c.name for c in ESTIMATE_COLUMNS)
 #: ``start_id`` of the final observer pass seeded with the batch-refined factors.

@@ -40,6 +40,7 @@ _DEFINITIONS = (
     "kilokilogram_force = 1000 * kilogram_force = kkgf",
     "specific_gravity = 1000 * kilogram / meter ** 3 = sg",
     "pound_per_gallon = pound / gallon = ppg",
+    "@alias turn = rev",  # a mud motor's "0.15 rev/gal" ([bha] motor_rev_per_litre)
 )
 
 #: Drilling spellings pint does not know, lower-cased, mapped to pint expressions.
@@ -154,6 +155,7 @@ LABEL_UNITS = {
     "m/h": ("meter/hour", "speed"),
     "m³/s": ("meter**3/second", "flow rate"),
     "°/30 m": ("degree/(30*meter)", "dogleg severity"),
+    "rev/L": ("revolution/liter", "motor displacement"),
 }
 
 #: Units shown to people in each system (terminal summaries, report axes and tables), by
@@ -472,7 +474,8 @@ def _convert(magnitude: Decimal, spelled: str, expr: str, expected: str, what: s
 _EXAMPLE_VALUE = {"length": "8200 ft", "density": "10.5 ppg", "linear mass": "19.5 lb/ft",
                   "force": "40 klbf", "torque": "25 kft.lbf", "pressure": "3000 psi",
                   "rotary speed": "120 rpm", "time": "2 min", "moment of inertia":
-                  "2900 kg.m**2", "dogleg severity": "3 deg/(100 ft)"}
+                  "2900 kg.m**2", "dogleg severity": "3 deg/(100 ft)",
+                  "motor displacement": "0.15 rev/gal"}
 
 
 #: Further quantities named in messages (a value given in kg where a length is expected).

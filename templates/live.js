@@ -50,6 +50,8 @@
     put("open-bit-rpm", row && row.bit_speed_resolved === false
       ? withheld(row.bit_speed_reason || "bit speed not resolved")
       : ok && known(open.bit_rpm) ? fixed(open.bit_rpm, 1) + " rpm"
+        + (known(open.bha_rpm) && open.bha_rpm !== open.bit_rpm
+          ? " (BHA " + fixed(open.bha_rpm, 1) + " rpm + mud motor)" : "")
         : withheld(open.bit_rpm_reason || why));
     put("open-severity", ok && known(open.stick_slip_severity)
       ? fixed(open.stick_slip_severity, 2)
@@ -91,6 +93,7 @@
     doc.get_model_by_name("bit").data = {
       x: num(t.bit.time_s), rpm: num(t.bit.bit_rpm_est),
       low: num(t.bit.bit_rpm_est_min), high: num(t.bit.bit_rpm_est_max),
+      bha: num(t.bit.bha_rpm_est),
     };
     put("bit-withheld", t.bit.withheld.length ? "Bit speed withheld: " + t.bit.withheld
       .map((w) => "segment " + w.segment + " — " + w.reason).join("; ") : "");

@@ -1,4 +1,4 @@
-"""The independent lumped validation plant (benchmarks/plants/lumped.py, its §L1–§L5):
+"""The independent lumped validation plant (benchmarks/plants/lumped.py, its §L1–§L6):
 physics against closed forms, its compiled kernel against its NumPy twin, and its
 independence from drillfric's own model (no import of drillfric's plant, simulator, kernels,
 torque and drag or well path)."""
@@ -62,6 +62,25 @@ def test_steady_rotation_torque_is_the_sliding_capacity(string):
     expect = 0.25 * string.T_N_Nm + omega * d[1:].sum()
     assert np.mean(cols["surface_torque_Nm"][late]) == pytest.approx(expect, rel=1e-3)
     assert np.min(cols["bit_rpm"][cols["time_s"] >= 30.0]) > 1.0 / L.RPM
+
+
+def test_mud_motor_adds_its_speed_and_slows_under_the_bit_torque(string):
+    """§L6: off bottom the bit turns at ω_N + 2π·k·Q exactly (k = 0.1 rev/L, Q = 0.03 m³/s:
+    180 RPM, the motor's no-load speed); on bottom (T_bit = μ_bit·WOB·D/3 = 1295.4 N·m,
+    τ_stall = 2·T_bit) at half of it. The plant's string is not changed by the motor: the
+    same run without it gives the same ω_N (to the last bit)."""
+    fr = L.Friction(0.25, 0.25, viscous_rate_per_s=0.5)
+    drive = L.Drive(L.setpoint(60.0, 20.0, idle_s=1.0, ramp_s=5.0, stop_s=0.0,
+                               stop_hold_s=0.0), 2900.0, 38e3, 100e3)
+    bit = L.Bit(wob_N=60e3)
+    for on_bottom, motor_rpm in ((False, 180.0), (True, 90.0)):
+        motor = L.Motor(0.1, 0.03, stall_torque_Nm=2.0 * bit.torque_Nm)
+        used = bit if on_bottom else None
+        cols = L.simulate(string, drive, fr, 20.0, rate_hz=10.0, bit=used, motor=motor).columns
+        plain = L.simulate(string, drive, fr, 20.0, rate_hz=10.0, bit=used).columns
+        assert np.array_equal(cols["bha_rpm"], plain["bit_rpm"])
+        assert cols["bit_rpm"] - cols["bha_rpm"] == pytest.approx(motor_rpm, rel=1e-12)
+        assert np.all(cols["flow_in_m3_s"] == 0.03)
 
 
 def test_first_frequency_is_the_continuous_strings():

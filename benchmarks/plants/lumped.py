@@ -1,7 +1,7 @@
 r"""Lumped multi-body torsional drill string with Coulomb wall friction (validation plant).
 
 This module documents itself: it is a validation plant for drillfric and imports nothing of
-drillfric (numpy, scipy and numba only). Sections below are cited as §L1–§L5.
+drillfric (numpy, scipy and numba only). Sections below are cited as §L1–§L6.
 
 §L1 Geometry and loads
 ----------------------
@@ -115,6 +115,26 @@ sin(π/4N)/(π/4N) (uniform string, fixed top, free bit), ≈ 1 − 10⁻⁵ at 
 ``bit_rpm`` (ω_N, the truth), and the constants ``hookload_N``, ``bit_depth_m``,
 ``hole_depth_m`` (bit + ``off_bottom_m`` off bottom), ``wob_N``. :class:`Noise` adds seeded
 Gaussian noise and quantisation to the surface channels (after the truth is taken).
+
+With a :class:`Motor` (a positive displacement mud motor between the string's bottom and the
+bit, pumped at the flow Q) the log adds ``flow_in_m3_s`` (Q) and ``bha_rpm`` (ω_N, the
+string's bottom), and ``bit_rpm`` becomes the bit's: ω_N plus the motor's speed relative to
+its housing, which falls linearly with the torque it delivers to the bit (§L6).
+
+§L6 Mud motor
+-------------
+A positive displacement motor passes a fixed volume of mud per revolution: without load it
+turns at n₀ = k·Q (k [rev/m³] from ``rev_per_litre`` × 1000 L/m³), and its leakage grows with
+the differential pressure, i.e. with the torque it delivers, until it stalls at τ_stall:
+
+    ω_motor = 2π·k·Q·max(0, 1 − τ_bit/τ_stall)   [rad/s]
+
+Its housing turns with node N and carries the bit's reaction, so the string sees the bit
+torque as before (the motor's own inertia is neglected). With the motor turning, the bit
+always slides on the rock: on bottom it delivers the Coulomb bit's T_bit all the time, off
+bottom nothing, so the motor turns at n₀·(1 − T_bit/τ_stall) on bottom and n₀ off bottom.
+(Like the node-N element, the plant's bit friction still acts on ω_N: what a motor changes
+in the string's own stick-slip on bottom is not modelled.)
 
 §L5 Units
 ---------
@@ -525,6 +545,23 @@ class Bit:
 
 
 @dataclass(frozen=True)
+class Motor:
+    """A mud motor (§L6): ``rev_per_litre`` k [rev/L], ``flow_m3_s`` Q [m³/s],
+    ``stall_torque_Nm`` τ_stall [N·m] (None: no drop under load)."""
+
+    rev_per_litre: float
+    flow_m3_s: float
+    stall_torque_Nm: float | None = None
+
+    def speed_rad_s(self, bit_torque_Nm: float) -> float:
+        """The motor's speed relative to its housing at a bit torque [rad/s] (§L6)."""
+        no_load = 2.0 * np.pi * self.rev_per_litre * 1000.0 * self.flow_m3_s
+        if self.stall_torque_Nm is None:
+            return no_load
+        return no_load * max(0.0, 1.0 - bit_torque_Nm / self.stall_torque_Nm)
+
+
+@dataclass(frozen=True)
 class Noise:
     """Seeded sensor errors on the recorded surface channels (not on ``bit_rpm``)."""
 
@@ -799,7 +836,8 @@ def simulate(string: LumpedString, drive: Drive, friction: Friction, duration_s:
              noise: Noise | None = None, off_bottom_m: float = 5.0, theta: float = 0.5,
              tol_rad_s: float = 1e-10, max_sweeps: int = 500, kernel: str = "numba",
              initial_speed_rad_s: np.ndarray | None = None,
-             initial_twist_rad: np.ndarray | None = None) -> Record:
+             initial_twist_rad: np.ndarray | None = None,
+             motor: Motor | None = None) -> Record:
     """Run the plant from rest (or a given state) for ``duration_s`` and log it (§L3–§L4).
 
     Parameters
@@ -812,6 +850,8 @@ def simulate(string: LumpedString, drive: Drive, friction: Friction, duration_s:
         "numba" (compiled) or "numpy" (the twin: slow, for tests).
     initial_speed_rad_s, initial_twist_rad : ndarray, optional
         ω over nodes 0…N [rad/s], φ over segments (index 0 unused) [rad].
+    motor : Motor, optional
+        A mud motor below the string, pumped throughout (§L6).
     """
     bit = bit or Bit()
     every = int(round(1.0 / (rate_hz * dt_s)))
@@ -844,6 +884,10 @@ def simulate(string: LumpedString, drive: Drive, friction: Friction, duration_s:
             "bit_depth_m": depth,
             "hole_depth_m": depth + (0.0 if wob > 0 else off_bottom_m),
             "wob_N": np.full(rows, wob)}
+    if motor is not None:
+        cols["flow_in_m3_s"] = np.full(rows, motor.flow_m3_s)
+        cols["bha_rpm"] = cols["bit_rpm"]
+        cols["bit_rpm"] = cols["bha_rpm"] + motor.speed_rad_s(bit.torque_Nm) / RPM
     if noise is not None:
         noise.apply(cols)
     energy = {name: out[:, i].copy() for i, name in enumerate(REC[4:9], start=4)}

@@ -224,8 +224,8 @@ def _share_to(entry: dict, T_N: float) -> float:
 
 
 # --------------------------------------------------------------------- on bottom
-def assess(records: list[SegmentRecord], pools: list[dict],
-           bit_diameter_m: float | None) -> tuple[list[SegmentRecord], list[dict]]:
+def assess(records: list[SegmentRecord], pools: list[dict], bit_diameter_m: float | None,
+           motor_drop: float | None = None) -> tuple[list[SegmentRecord], list[dict]]:
     """The bit torque, μ_bit and MSE of every estimated on-bottom segment (or null with the
     reason), and the record's friction log.
 
@@ -237,19 +237,22 @@ def assess(records: list[SegmentRecord], pools: list[dict],
         The pools of short segments (summary.json ``pooled``).
     bit_diameter_m : float or None
         D_bit [m] (``well.bit_diameter_m``); None: μ_bit and MSE are null.
+    motor_drop : float or None
+        With a declared mud motor, the largest share of its speed it loses on bottom
+        (``bha.motor_speed_drop``); None: no motor, the bit turns at the surface's mean speed.
     """
     log = friction_log(records, pools)
     T_N_off = off_bottom_T_N(records)
     out = []
     for r in records:
         if r.status is Status.OK and r.kind is Kind.ON_BOTTOM:
-            r = replace(r, **on_bottom_fields(r, log, T_N_off, bit_diameter_m))
+            r = replace(r, **on_bottom_fields(r, log, T_N_off, bit_diameter_m, motor_drop))
         out.append(r)
     return out, [{k: v for k, v in e.items() if not k.startswith("T_N")} for e in log]
 
 
 def on_bottom_fields(r: SegmentRecord, log: list[dict], T_N_off,
-                     bit_diameter_m: float | None) -> dict:
+                     bit_diameter_m: float | None, motor_drop: float | None = None) -> dict:
     """The bit-torque fields of one on-bottom record (docs/theory.md §2.3)."""
     if r.surface_torque_turning_Nm is None or r.torque_per_mu_Nm is None:
         return {"bit_torque_reason": "no rotating torque to separate (too short)"}
@@ -271,7 +274,7 @@ def on_bottom_fields(r: SegmentRecord, log: list[dict], T_N_off,
             f"at μ_k = {mu:.3f} (±{u_bit:.0f} N·m): string, WOB or μ_k contradict the "
             "data")}
     fields |= {"bit_torque_Nm": float(t_bit), "bit_torque_uncertainty_Nm": u_bit}
-    return fields | _bit_measures(r, t_bit, u_bit, bit_diameter_m)
+    return fields | _bit_measures(r, t_bit, u_bit, bit_diameter_m, motor_drop)
 
 
 def _nearest(log: list[dict], T_N: float | None) -> dict | None:
@@ -283,8 +286,9 @@ def _nearest(log: list[dict], T_N: float | None) -> dict | None:
 
 
 def _bit_measures(r: SegmentRecord, t_bit: float, u_bit: float,
-                  bit_diameter_m: float | None) -> dict:
-    """μ_bit and Teale's MSE from T_bit, or the reason they are null."""
+                  bit_diameter_m: float | None, motor_drop: float | None) -> dict:
+    """μ_bit and Teale's MSE from T_bit at the bit's mean speed (:func:`bit_speed_rpm`), or
+    the reason they are null."""
     if not r.wob_N or r.wob_N <= 0:
         return {"bit_torque_reason": "no weight on bit logged: μ_bit and MSE not computed"}
     if bit_diameter_m is None:
@@ -295,10 +299,36 @@ def _bit_measures(r: SegmentRecord, t_bit: float, u_bit: float,
     if not r.rop_m_h or not r.surface_rpm_mean:
         return out | {"bit_torque_reason": "the bit did not advance (no rate of "
                                            "penetration): MSE not computed"}
-    return out | {"mse_Pa": teale_mse_Pa(r.wob_N, t_bit, r.surface_rpm_mean, r.rop_m_h,
-                                         bit_diameter_m),
-                  "mse_uncertainty_Pa": teale_mse_Pa(0.0, u_bit, r.surface_rpm_mean,
-                                                     r.rop_m_h, bit_diameter_m)}
+    speed = bit_speed_rpm(r.surface_rpm_mean, r.motor_rpm_mean, motor_drop)
+    if speed is None:
+        return out | {"bit_torque_reason": "the mud motor's speed is not known (flow "
+                                           "missing): MSE not computed"}
+    rpm, u_rpm = speed
+    mse = lambda w, t, n: teale_mse_Pa(w, t, n, r.rop_m_h, bit_diameter_m)  # noqa: E731
+    return out | {"mse_Pa": mse(r.wob_N, t_bit, rpm),
+                  "mse_uncertainty_Pa": float(np.hypot(mse(0.0, u_bit, rpm),
+                                                       mse(0.0, t_bit, u_rpm)))}
+
+
+def bit_speed_rpm(surface_rpm_mean: float, motor_rpm_mean: float | None,
+                  motor_drop: float | None) -> tuple[float, float] | None:
+    """The bit's mean speed on bottom and its 95 % half-width [RPM]: the surface's mean
+    (the BHA's, in the mean) plus a declared motor's (docs/theory.md eq. 2.4c), whose
+    on-bottom speed k·Q·(1 − drop/2) is known to ±k·Q·drop/2 (eq. 2.4b); None where a
+    motor is declared (``motor_drop`` not None) but its speed is not known.
+
+    Examples
+    --------
+    >>> bit_speed_rpm(60.0, None, None)
+    (60.0, 0.0)
+    >>> bit_speed_rpm(60.0, 153.0, 0.3)  # k·Q = 180 RPM, 126–180 on bottom
+    (213.0, 27.0)
+    """
+    if motor_drop is None:
+        return surface_rpm_mean, 0.0
+    if motor_rpm_mean is None:
+        return None
+    return surface_rpm_mean + motor_rpm_mean, motor_rpm_mean * motor_drop / (2.0 - motor_drop)
 
 
 def mu_bit(bit_torque_Nm: float, wob_N: float, bit_diameter_m: float) -> float:

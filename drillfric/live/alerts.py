@@ -29,7 +29,7 @@ def open_view(record: SegmentRecord, folder: Path) -> dict:
     """live.json ``open_segment``: the open segment's numbers as estimated so far; its bit
     speed null with ``bit_rpm_reason`` where the run withholds it (:func:`bit_speed_withheld`)."""
     why = bit_speed_withheld(record.to_json())
-    bit_rpm, stalled_s = (None, None) if why else bit_tail(folder, record.id)
+    bit_rpm, bha_rpm, stalled_s = (None, None, None) if why else bit_tail(folder, record.id)
     if bit_rpm is None and not why:
         why = ("the latest 30-s window's bit speed is withheld (window-by-window kinematic "
                "check: the segment's message says why)" if record.bit_speed_windows_withheld
@@ -37,7 +37,8 @@ def open_view(record: SegmentRecord, folder: Path) -> dict:
     return {"segment": record.id, "kind": record.kind.value, "status": record.status.value,
             "t_start_s": record.t_start_s, "t_end_s": record.t_end_s, "mu_k": record.mu_k,
             "mu_s": record.mu_s, "mu_s_lower_bound": record.mu_s_lower_bound,
-            "bit_rpm": bit_rpm, "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
+            "bit_rpm": bit_rpm, "bha_rpm": bha_rpm if bit_rpm is not None else None,
+            "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
             "stick_slip_severity": record.stick_slip_severity,
             "stick_slip_beyond_validated":
                 Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
@@ -68,22 +69,31 @@ def bit_speed_withheld(record: dict) -> str:
     return ""
 
 
-def bit_tail(folder: Path, seg_id: int) -> tuple[float | None, float | None]:
-    """The last estimated bit speed [RPM] of segment ``seg_id`` (its last row group) and how
-    long [s] the estimated bit has been stuck (``bit_stuck``) at its end while the top drive
-    turned (above :data:`STALL_SURFACE_RPM`); (None, None) without estimates."""
+def bit_tail(folder: Path, seg_id: int) -> tuple[float | None, float | None, float | None]:
+    """The last estimated bit and BHA speeds [RPM] of segment ``seg_id`` (its last row
+    group; they differ by a declared mud motor's speed) and how long [s] the estimated bit
+    has been stuck (``bit_stuck``) at its end while the top drive turned (above
+    :data:`STALL_SURFACE_RPM`); (None, None, None) without estimates."""
     path = folder / "estimates.parquet"
     if not path.is_file():
-        return None, None
+        return None, None, None
     source = pq.ParquetFile(path)
+    names = ["segment_id", "time_s", "surface_rpm", "bit_rpm_est", "bit_stuck"] + \
+        ["bha_rpm_est"] * ("bha_rpm_est" in source.schema_arrow.names)
     for i in reversed(range(source.num_row_groups)):
-        table = source.read_row_group(i, columns=["segment_id", "time_s", "surface_rpm",
-                                                  "bit_rpm_est", "bit_stuck"])
+        table = source.read_row_group(i, columns=names)
         if table.num_rows and int(table["segment_id"][0].as_py()) == seg_id:
-            value = table["bit_rpm_est"][-1].as_py()
-            last = None if value is None or not math.isfinite(value) else float(value)
-            return last, stalled_s(table.to_pandas())
-    return None, None
+            return (_last(table, "bit_rpm_est"), _last(table, "bha_rpm_est"),
+                    stalled_s(table.to_pandas()))
+    return None, None, None
+
+
+def _last(table, column: str) -> float | None:
+    """The last value of ``column`` of an Arrow table, None where null, NaN or absent."""
+    if column not in table.column_names:
+        return None
+    value = table[column][-1].as_py()
+    return None if value is None or not math.isfinite(value) else float(value)
 
 
 def stalled_s(rows: pd.DataFrame) -> float:

@@ -69,7 +69,7 @@ BIT_POINTS = 1000
 REQUEST_TIMEOUT_S = 10.0
 #: The bit-speed columns read from estimates.parquet (the band only where written).
 _BIT_COLUMNS = ("time_s", "segment_id", "start_id", "bit_rpm_est", "bit_rpm_est_min",
-                "bit_rpm_est_max")
+                "bit_rpm_est_max", "bha_rpm_est")
 _JSON = "application/json; charset=utf-8"
 _HTML = "text/html; charset=utf-8"
 #: CSP of the JSON answers and errors: nothing at all.
@@ -215,7 +215,7 @@ class LivePage:
         """The estimated bit speed of the segments after log time ``start_s`` [s], with its
         band; segments whose bit speed is not resolved are listed as withheld instead."""
         empty = {c: [] for c in ("time_s", "bit_rpm_est", "bit_rpm_est_min",
-                                 "bit_rpm_est_max")}
+                                 "bit_rpm_est_max", "bha_rpm_est")}
         if start_s is None:
             return empty | {"withheld": []}
         records = {r.get("id"): r for r in self.records()
@@ -238,7 +238,8 @@ class LivePage:
             rows = rows.iloc[extreme_rows(rows, BIT_POINTS // len(groups),
                                           ("bit_rpm_est",))]
             parts += [rows, rows.iloc[-1:].assign(bit_rpm_est=np.nan, bit_rpm_est_min=np.nan,
-                                                  bit_rpm_est_max=np.nan)]  # a gap after it
+                                                  bit_rpm_est_max=np.nan,
+                                                  bha_rpm_est=np.nan)]  # a gap after it
         if not parts:
             return empty | {"withheld": withheld}
         frame = pd.concat(parts, ignore_index=True)
@@ -246,13 +247,14 @@ class LivePage:
 
 
 def _final_bit_rows(path: Path, ids: tuple[int, ...]) -> pd.DataFrame:
-    """The final pass's bit speed and band of segments ``ids`` in estimates.parquet."""
+    """The final pass's bit speed, its band and the BHA's speed of segments ``ids`` in
+    estimates.parquet (NaN where the file has no such column)."""
     names = pq.read_schema(path).names
     table = pq.read_table(path, columns=[c for c in _BIT_COLUMNS if c in names],
                           filters=[("start_id", "=", FINAL_START_ID),
                                    ("segment_id", "in", list(ids))])
     frame = table.to_pandas()
-    for column in ("bit_rpm_est_min", "bit_rpm_est_max"):
+    for column in ("bit_rpm_est_min", "bit_rpm_est_max", "bha_rpm_est"):
         if column not in frame:
             frame[column] = np.nan
     return frame.sort_values(["segment_id", "time_s"], kind="stable")
@@ -306,14 +308,14 @@ def page_gzip() -> bytes:
 
 def _layout():
     """The figures, their ColumnDataSources named for the page's script: ``surface``
-    (x, rpm, torque_kNm, hookload_kN), ``bit`` (x, rpm, low, high) and ``segments``."""
+    (x, rpm, torque_kNm, hookload_kN), ``bit`` (x, rpm, low, high, bha) and ``segments``."""
     from bokeh.layouts import column, row
     from bokeh.models import ColumnDataSource, DataRange1d, HoverTool, Span
     from bokeh.plotting import figure
 
     surface = ColumnDataSource({k: [] for k in ("x", "rpm", "torque_kNm", "hookload_kN")},
                                name="surface")
-    bit = ColumnDataSource({k: [] for k in ("x", "rpm", "low", "high")}, name="bit")
+    bit = ColumnDataSource({k: [] for k in ("x", "rpm", "low", "high", "bha")}, name="bit")
     segs = ColumnDataSource({k: [] for k in ("id", "depth", "mu_k", "mu_app", "mu_s", "mu_s_lb",
                                              "severity", "fill")}, name="segments")
     speed = time_figure(220, "speed [rpm]")
@@ -321,6 +323,8 @@ def _layout():
                 legend_label="bit band")
     speed.line("x", "rpm", source=surface, color="#1f77b4", legend_label="surface")
     speed.line("x", "rpm", source=bit, color="#d62728", legend_label="bit (estimated)")
+    speed.line("x", "bha", source=bit, color="#d62728", line_dash="dashed",
+               legend_label="BHA (string's bottom; the bit's less a mud motor's)")
     speed.legend.location = "top_left"
     torque = time_figure(170, "torque [kN·m]", x_range=speed.x_range)
     torque.line("x", "torque_kNm", source=surface, color="#2ca02c")

@@ -10,7 +10,8 @@ unless stated):
 3. surface speed — measured and estimated;
 4. speed residual — measured − estimated;
 5. bit speed — estimated (the seeded ensemble's mean with its min–max band), stuck periods
-   shaded, the measured downhole speed where the input had one; left out where the logging
+   shaded, the measured downhole speed where the input had one, and with a declared mud
+   motor the BHA's speed beneath the bit's (docs/theory.md §2.4); left out where the logging
    rate does not resolve the stick-slip cycle (``bit_speed_resolved`` false: the report
    gives the reason instead — no trace is drawn from such data);
 6. μ_k and μ_s of every observer start (the paper's Fig. 10 view) and the final pass.
@@ -41,6 +42,7 @@ MEASURED = "#555555"
 OBSERVER = "#1f5fa8"
 FIT = "#e67e22"
 STUCK = "#f4b6b6"
+BHA = "#8e44ad"
 _PX = 150
 
 
@@ -77,7 +79,8 @@ def panel_data(est: pd.DataFrame, units: Units = SI, bit: bool = True
     Keys present only when the file has the columns: ``torque`` (``measured``,
     ``observer``, ``fit``), ``torque_residual`` (``fit``, ``observer``), ``speed``
     (``measured``, ``estimated`` [rpm]), ``speed_residual`` (``residual``), ``bit``
-    (``estimated``, ``low``, ``high``, ``measured`` [rpm]; only with ``bit`` — False where
+    (``estimated``, ``low``, ``high``, ``measured`` [rpm], ``bha`` — the string's bottom —
+    where a declared mud motor makes it differ from the bit's; only with ``bit`` — False where
     the bit speed is not resolved — and an estimated bit speed in the file). Every array
     is the file's column at the rows of ``est`` (scaled), so a figure shows the file's
     numbers.
@@ -104,6 +107,10 @@ def panel_data(est: pd.DataFrame, units: Units = SI, bit: bool = True
     if not (bit and has_column(best, "bit_rpm_est")):
         return out
     speeds = {"estimated": best["bit_rpm_est"].to_numpy(float)}
+    if has_column(best, "bha_rpm_est"):
+        bha = best["bha_rpm_est"].to_numpy(float)
+        if not np.array_equal(bha, speeds["estimated"], equal_nan=True):
+            speeds["bha"] = bha  # a declared mud motor turns the bit faster
     if has_column(best, "bit_rpm_est_min"):
         speeds["low"] = best["bit_rpm_est_min"].to_numpy(float)
         speeds["high"] = best["bit_rpm_est_max"].to_numpy(float)
@@ -124,14 +131,15 @@ def _label(key: str, units: Units) -> str:
 #: Height of a line of notes at 7 pt [in].
 _NOTE_LINE_IN = 0.13
 _STYLE = {"measured": (MEASURED, 1.0), "observer": (OBSERVER, 1.0), "fit": (FIT, 1.2),
-          "estimated": (OBSERVER, 1.0), "residual": (MEASURED, 0.8)}
+          "estimated": (OBSERVER, 1.0), "residual": (MEASURED, 0.8), "bha": (BHA, 1.0)}
 _LEGEND = {("torque", "measured"): "measured", ("torque", "observer"): "observer model",
            ("torque", "fit"): "fit model (fitted μ)",
            ("torque_residual", "fit"): "measured − fit",
            ("torque_residual", "observer"): "measured − observer",
            ("speed", "measured"): "measured", ("speed", "estimated"): "estimated",
            ("speed_residual", "residual"): "measured − estimated",
-           ("bit", "estimated"): "estimated", ("bit", "measured"): "measured downhole"}
+           ("bit", "estimated"): "estimated", ("bit", "measured"): "measured downhole",
+           ("bit", "bha"): "BHA (string's bottom, without the motor)"}
 
 
 # ------------------------------------------------------------------------------ Bokeh

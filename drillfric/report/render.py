@@ -407,9 +407,15 @@ def _torque_fit(row: dict, units: Units, quality: str | None = None) -> str:
 
 
 def _bit_speed_cell(row: dict) -> str:
-    """Resolved or not, with the logging interval that decides it."""
+    """Resolved or not, with the logging interval that decides it, and the speed a declared
+    mud motor adds (or, with the pumps on and none declared, that the trace is the BHA's)."""
     text, interval = bit_speed_text(row, reason=False), interval_text(row)
-    return f"{text} ({interval})" if interval and text != "—" else text
+    text = f"{text} ({interval})" if interval and text != "—" else text
+    motor = fmt(row.get("motor_rpm_mean"), ".0f")
+    if motor != "—":
+        return f"{text}; BHA + motor ≈ {motor} rpm"
+    return f"{text}; the BHA's, no motor" if row.get("bit_speed_reason") and \
+        not bit_speed_unresolved(row) else text
 
 
 def config_rows(config: dict) -> list[tuple[str, list[tuple[str, str]]]]:

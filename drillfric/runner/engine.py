@@ -51,7 +51,7 @@ from drillfric.vocabulary import Kind, Status
 
 from .estimator import SegmentEstimator, first_chunk
 from .finish import MemorySink, Sink, finish, summarise
-from .segment_output import MOTOR_NOTE, iso
+from .segment_output import FLOW_MISSING_NOTE, MOTOR_NOTE, iso
 from .state import read_state, write_state
 
 #: Relative change of the string-weight scale beyond which a segment estimated with the
@@ -253,7 +253,8 @@ class Engine:
             self.tracker.conflicts_note(self.check.rows),
             self.check.duplicates_note(self.tracker.duplicates),
             self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail),
-            _motor_note(self.records)) if w] + self.check.unit_hints(self.records)
+            _motor_note(self.records), _flow_missing_note(self.records)) if w] \
+            + self.check.unit_hints(self.records)
         plateaus = self.hook.close()
         calibration = None
         if self.calibration is not None:
@@ -262,8 +263,10 @@ class Engine:
         weighed = judge(self.records, plateaus, self.well.config, calibration)
         zero = zero_check(self.rest, weighed.summary["block_weight_N"], weighed.records)
         records, pools = pool_short_segments(withhold_offset(weighed.records, zero))
-        records, friction_log = assess_bit_torque(records, pools,
-                                                  self.well.config.well.bit_diameter_m)
+        cfg = self.well.config
+        records, friction_log = assess_bit_torque(
+            records, pools, cfg.well.bit_diameter_m,
+            None if cfg.bha.motor_rev_per_litre is None else cfg.bha.motor_speed_drop)
         self._note_revisions(records)
         summary = summarise(self.well, records, pools, rows=self.check.rows,
                             assumed=self.well.assumed + self.estimator.assumed,
@@ -464,11 +467,24 @@ def _revision(old: SegmentRecord, new: SegmentRecord, why: str) -> dict:
 def _motor_note(records: list[SegmentRecord]) -> str | None:
     """The well's warning, once, where bit speeds were shown with the pumps on (issue 34
     item 5: a mud motor's speed is not in them), or None."""
-    ids = [str(r.id) for r in records if MOTOR_NOTE in (r.message or "")]
+    return _segments_note([r.id for r in records if r.bit_speed_reason == MOTOR_NOTE],
+                          MOTOR_NOTE)
+
+
+def _flow_missing_note(records: list[SegmentRecord]) -> str | None:
+    """The well's warning, once, where a declared motor's flow is missing (its bit speed is
+    withheld there), or None."""
+    return _segments_note([r.id for r in records if FLOW_MISSING_NOTE in (r.message or "")],
+                          f"{FLOW_MISSING_NOTE} (a mud motor is declared, [bha] "
+                          "motor_rev_per_litre: map the flow-in channel)")
+
+
+def _segments_note(ids: list[int], text: str) -> str | None:
+    """``text`` once for the segments ``ids`` (the first ten named), or None without any."""
     if not ids:
         return None
-    return (f"{plural(len(ids), 'segment')} ({', '.join(ids[:10])}"
-            f"{', …' if len(ids) > 10 else ''}): {MOTOR_NOTE}")
+    return (f"{plural(len(ids), 'segment')} ({', '.join(map(str, ids[:10]))}"
+            f"{', …' if len(ids) > 10 else ''}): {text}")
 
 
 def _cut_line_note(well: Well, tail: list) -> str:

@@ -20,7 +20,7 @@ from drillfric.segmentation import Segment
 from drillfric.vocabulary import Kind, Status
 
 from .checks import bit_depth_default, check_first_chunk, precheck
-from .segment_output import MOTOR_NOTE, output_frames, pumped, segment_record
+from .segment_output import motor_fields, output_frames, segment_record
 
 #: Relative margin by which a requested rate may exceed the data's nominal rate (timing
 #: jitter) before it counts as upsampling.
@@ -87,10 +87,10 @@ class SegmentEstimator:
         if est.converged and seg.kind == Kind.OFF_BOTTOM:
             self.warm = (est.mu_s_seed, est.mu_k)
         record = segment_record(seg, depth, Status.OK, seg.message, rows, est)
-        if record.bit_speed_resolved and pumped(rows, self.well.config):
-            record = replace(record, message="; ".join(filter(None, [record.message,
-                                                                     MOTOR_NOTE])))
-        return (record, output_frames(seg, est, data, rows, self.settings.omega_c_rad_s))
+        cfg = self.well.config
+        frames = output_frames(seg, est, data, rows, self.settings.omega_c_rad_s, cfg)
+        return replace(record, **motor_fields(rows, cfg, seg.kind == Kind.ON_BOTTOM,
+                                              frames["estimates"], record)), frames
 
     def state(self) -> dict:
         """What passes to the next segment (plain values)."""

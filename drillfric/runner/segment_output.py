@@ -11,6 +11,8 @@ import pandas as pd
 
 from drillfric.estimation.bit_torque import rate_of_penetration_m_h
 from drillfric.estimation.chain import SegmentEstimate
+from drillfric.estimation.diagnostics import settled_mask
+from drillfric.estimation.motor import MotorSpeed, motor_speed
 from drillfric.estimation.observer import ObserverRecord
 from drillfric.estimation.segment_data import SegmentData
 from drillfric.hookload import withhold_friction
@@ -24,14 +26,30 @@ if TYPE_CHECKING:
     from drillfric.config import Config
 
 
-#: The note of a segment whose bit speed is shown while the pumps ran (issue 34 item 5): the
-#: trace is the string's bottom speed; a mud motor would add its own (≈ k·flow).
-#: The bit-speed columns nulled where the trace is withheld (the trace and its band).
-BIT_BAND_COLUMNS = ("bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max")
-
+#: The note (and ``bit_speed_reason``) of a segment whose bit speed is shown while the pumps
+#: ran and no motor is declared (issue 34 item 5): the trace is the string's bottom speed; a
+#: mud motor would add its own (≈ k·flow).
 MOTOR_NOTE = ("the pumps were on while the string turned: the bit speed shown is the "
-              "string's bottom speed — with a mud motor the bit turns faster by the motor's "
-              "speed, which drillfric does not model")
+              "string's bottom speed and includes no mud motor — with a motor the bit turns "
+              "faster by its speed; declare it with [bha] motor_rev_per_litre")
+
+#: The note of an on-bottom segment drilled with the pumps on and no motor declared: its MSE
+#: takes the surface speed as the bit's.
+MSE_NOTE = ("the pumps were on while drilling: mse_Pa takes the string's speed as the bit's "
+            "— with a mud motor the bit turns faster and the MSE is higher; declare it with "
+            "[bha] motor_rev_per_litre")
+#: The note of a segment whose trace is shown with a declared motor turning: the stick-slip
+#: statistics are those of the string's bottom, not of the bit the motor turns.
+BHA_STATISTICS_NOTE = ("stick_slip_severity and stuck_fraction are the BHA's (the string's "
+                       "bottom, bha_rpm_est): the mud motor turns the bit faster by "
+                       "motor_rpm_mean")
+#: The note of a segment with a declared motor whose flow is missing while the pumps may run.
+FLOW_MISSING_NOTE = ("the flow is missing while the pumps may run: the bit speed (BHA + "
+                     "motor) is withheld on those rows")
+
+#: Bit-speed columns of estimates.parquet that a withheld window empties.
+_SPEED_COLUMNS = ("bit_rpm_est", "bit_rpm_est_min", "bit_rpm_est_max", "bha_rpm_est",
+                  "bha_rpm_est_min", "bha_rpm_est_max")
 
 
 def pumped(rows: pd.DataFrame, cfg: Config) -> bool:
@@ -151,11 +169,97 @@ def _with_clock(frame: pd.DataFrame, rows: pd.DataFrame) -> pd.DataFrame:
 
 
 def output_frames(seg: Segment, est: SegmentEstimate, data: SegmentData, rows: pd.DataFrame,
-                  omega_c: float) -> dict[str, pd.DataFrame]:
+                  omega_c: float, cfg: Config) -> dict[str, pd.DataFrame]:
     """The output rows of an estimated segment: ``estimates`` (with clock time when the log
-    has it) and its torque-and-drag ``profile`` (``omega_c``: the static band [rad/s])."""
-    return {"estimates": _with_clock(_estimate_frame(seg.id, est, data, omega_c), rows),
-            "profile": _profile_frame(seg.id, est)}
+    has it; the bit speed with a declared motor's, :func:`with_motor`) and its
+    torque-and-drag ``profile`` (``omega_c``: the static band [rad/s])."""
+    frame = with_motor(_estimate_frame(seg.id, est, data, omega_c), rows,
+                       row_motor(rows, cfg, seg.kind == Kind.ON_BOTTOM))
+    return {"estimates": _with_clock(frame, rows), "profile": _profile_frame(seg.id, est)}
+
+
+def row_motor(rows: pd.DataFrame, cfg: Config, on_bottom: bool) -> MotorSpeed | None:
+    """The speed band a declared mud motor (``[bha] motor_rev_per_litre``) adds at each of
+    the segment's rows [rad/s] (docs/theory.md §2.4); None without a declared motor."""
+    k = cfg.bha.motor_rev_per_litre
+    if k is None:
+        return None
+    flow = rows["flow_in_m3_s"].to_numpy(float) if "flow_in_m3_s" in rows else None
+    return motor_speed(flow, pumps_on(rows, cfg), k, cfg.bha.motor_speed_drop, on_bottom)
+
+
+def with_motor(frame: pd.DataFrame, rows: pd.DataFrame,
+               motor: MotorSpeed | None) -> pd.DataFrame:
+    """estimates rows with the bit speed of the BHA plus a declared motor (eq. 2.4c):
+    ``bit_rpm_est`` = ``bha_rpm_est`` + the motor's mid speed, the band the BHA's band plus
+    the motor's low and high speeds; the bit is not stuck where the motor turns, unknown
+    where its speed is (flow missing). Without a motor the bit's columns are the BHA's."""
+    if motor is None:
+        return frame
+    at = frame["time_s"].to_numpy(float)
+    t = rows["time_s"].to_numpy(float)
+    low, mid, high = (np.interp(at, t, v) / RPM_TO_RAD_S
+                      for v in (motor.low, motor.mid, motor.high))
+    frame["bit_rpm_est"] = frame["bha_rpm_est"].to_numpy(float) + mid
+    frame["bit_rpm_est_min"] = (frame["bha_rpm_est_min"].to_numpy(float) + low
+                                ).astype(np.float32)
+    frame["bit_rpm_est_max"] = (frame["bha_rpm_est_max"].to_numpy(float) + high
+                                ).astype(np.float32)
+    stuck = frame["bit_stuck"].astype("boolean")
+    stuck[(mid > 0) & stuck.notna().to_numpy()] = False
+    stuck[np.isnan(mid)] = pd.NA
+    frame["bit_stuck"] = stuck
+    return frame
+
+
+def motor_fields(rows: pd.DataFrame, cfg: Config, on_bottom: bool, frame: pd.DataFrame | None,
+                 record: SegmentRecord) -> dict:
+    """A segment's fields from the mud motor (issue 34 item 5): without a declared motor,
+    where a trace is shown with the pumps on, :data:`MOTOR_NOTE` (message and
+    ``bit_speed_reason``), on bottom with the pumps on :data:`MSE_NOTE`; with one,
+    ``motor_rpm_mean``, the notes that the stick-slip statistics are the BHA's and where
+    the flow is missing, and ``bit_rms_error_rpm`` of the bit's speed (BHA + motor) where
+    the input has the truth."""
+    motor = row_motor(rows, cfg, on_bottom)
+    if motor is None:
+        return _undeclared(rows, cfg, on_bottom, record)
+    turning = rows["surface_rpm"].to_numpy(float) > cfg.segmentation.rotating_rpm
+    mid = motor.mid[turning] / RPM_TO_RAD_S
+    mean = float(np.nanmean(mid)) if np.isfinite(mid).any() else None
+    notes = [BHA_STATISTICS_NOTE] * bool(mean and record.stuck_fraction is not None) + \
+        [FLOW_MISSING_NOTE] * bool(np.isnan(mid).any())
+    fields = dict(motor_rpm_mean=mean, message=_joined(record.message, *notes))
+    error = _bit_error_rpm(frame) if record.bit_rms_error_rpm is not None else None
+    return fields | ({"bit_rms_error_rpm": error} if error is not None else {})
+
+
+def _undeclared(rows: pd.DataFrame, cfg: Config, on_bottom: bool,
+                record: SegmentRecord) -> dict:
+    """Without a declared motor, what a pumped segment says: on bottom, that its MSE takes
+    the string's speed (:data:`MSE_NOTE`); off bottom with a trace shown, that the trace is
+    the string's bottom speed (:data:`MOTOR_NOTE`, also its ``bit_speed_reason``)."""
+    if not pumped(rows, cfg):
+        return {}
+    if on_bottom:
+        return dict(message=_joined(record.message, MSE_NOTE))
+    return dict(message=_joined(record.message, MOTOR_NOTE),
+                bit_speed_reason=MOTOR_NOTE) if record.bit_speed_resolved else {}
+
+
+def _joined(*parts: str) -> str:
+    return "; ".join(p for p in parts if p)
+
+
+def _bit_error_rpm(frame: pd.DataFrame | None) -> float | None:
+    """RMS error of the seeded pass's bit speed (BHA + motor) against the input's truth
+    after the start-up [RPM], over the rows where both are known."""
+    if frame is None or "bit_rpm" not in frame:
+        return None
+    seeded = frame[frame["start_id"] == SEEDED_START_ID]
+    late = seeded[settled_mask(seeded["time_s"].to_numpy(float))]
+    error = (late["bit_rpm_est"] - late["bit_rpm"]).to_numpy(float)
+    error = error[np.isfinite(error)]
+    return float(np.sqrt(np.mean(error ** 2))) if error.size else None
 
 
 def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
@@ -164,9 +268,11 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): its
     ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
     carry most of the weight) with the members' min–max bit speed as
-    ``bit_rpm_est_min/max`` (NaN on the starts' rows). Where the logging does not resolve
-    the stick-slip cycle the bit columns are null: no trace is drawn from such data; so are
-    they in the 30-s windows the window-by-window check withheld (``est.bit_windows_withheld``).
+    ``bit_rpm_est_min/max`` (NaN on the starts' rows). The string's bottom speed is also
+    ``bha_rpm_est`` (``_min/_max``): the bit's until a motor's is added
+    (:func:`with_motor`). Where the logging does not resolve the stick-slip cycle the speed
+    columns are null: no trace is drawn from such data; so are they in the 30-s windows the
+    window-by-window check withheld (``est.bit_windows_withheld``).
     """
     first = _record_frame(seg_id, est.first, 0, data,
                           np.abs(est.first.bha_rad_s_est) <= omega_c, est)
@@ -175,13 +281,15 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
     frame = pd.concat([first, seeded], ignore_index=True)
+    for name in ("", "_min", "_max"):
+        frame["bha_rpm_est" + name] = frame["bit_rpm_est" + name]
     gone = np.zeros(len(frame), dtype=bool) if est.bit_speed.resolved else \
         np.ones(len(frame), dtype=bool)
     t = frame["time_s"].to_numpy(float)
     for a, b in est.bit_windows_withheld:
         gone |= (t >= a) & (t < b)
     if gone.any():
-        frame.loc[gone, list(BIT_BAND_COLUMNS)] = np.nan
+        frame.loc[gone, list(_SPEED_COLUMNS)] = np.nan
         stuck = frame["bit_stuck"].astype("boolean")
         stuck[gone] = pd.NA
         frame["bit_stuck"] = stuck
@@ -208,7 +316,8 @@ def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentDa
         "surface_torque_Nm": at(ev.time_s, ev.measured_Nm),
         "surface_torque_est_Nm": rec.surface_torque_est_Nm.ravel(),
         "surface_torque_fit_Nm": at(ev.time_s, ev.model_Nm),
-        **{c: np.full(n_t * n_s, np.nan, dtype=np.float32) for c in BIT_BAND_COLUMNS[1:]}}
+        "bit_rpm_est_min": np.full(n_t * n_s, np.nan, dtype=np.float32),
+        "bit_rpm_est_max": np.full(n_t * n_s, np.nan, dtype=np.float32)}
     if data.bit_rpm is not None:
         cols["bit_rpm"] = at(data.time_s, data.bit_rpm)
     return pd.DataFrame(cols)

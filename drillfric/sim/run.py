@@ -100,6 +100,7 @@ class StandResult:
     bit_torque_k_Nm: float = 0.0
     bit_weakening_ratio: float = 1.0
     bit_weakening_rpm: float = 10.0
+    flow_m3_s: float = 0.0
     bit_power_torque_Nm: float = 0.0
     axial_speed_m_s: float = 0.0
     axial_start_s: float | None = None
@@ -118,8 +119,10 @@ class Simulation:
     Attributes
     ----------
     columns : dict of ndarray
-        Canonical surface channels (docs/ingestion.md) plus the noise-free truth ``bit_rpm``
-        and ``string_torque_Nm`` (τ(0) = τ_m − I_TD dω₀/dt).
+        Canonical surface channels (docs/ingestion.md; ``flow_in_m3_s`` where a stand
+        pumps) plus the noise-free truth ``bit_rpm``, ``string_torque_Nm`` (τ(0) = τ_m −
+        I_TD dω₀/dt) and, with a mud motor, ``bha_rpm`` (the string's bottom; ``bit_rpm``
+        adds the motor's speed).
     stands : tuple of StandResult
     settings : PlantSettings
     noise : Noise
@@ -330,6 +333,10 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
     _check_bounded(columns, cfg)
     if not any(s.on_bottom for s in scenario.stands):
         columns.pop("wob_N")
+    if not any(s.flow_m3_s > 0 for s in scenario.stands):
+        columns.pop("flow_in_m3_s")
+    if settings.motor_rev_per_litre is None:
+        columns.pop("bha_rpm")
     block = cfg.hookload.block_weight_N
     columns["hookload_N"] = columns["hookload_N"] + (block or 0.0)
     noise.apply(columns)
@@ -451,11 +458,15 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
     stuck = float(np.mean(np.abs(rec.bit_rad_s[rotating]) < 0.1 * settings.omega_c_rad_s)) \
         if rotating.any() else 0.0
     hookload = _hookload(cfg, path, stand, td, tds, axial, depth, rec.time_s)
+    motor = pdm_speed_rad_s(stand.flow_m3_s, settings.motor_rev_per_litre,
+                            rec.bit_torque_Nm, settings.motor_stall_torque_Nm)
     cols = {"time_s": rec.time_s + t0, "surface_rpm": rec.surface_rad_s / RPM_TO_RAD_S,
             "surface_torque_Nm": surface_torque, "hookload_N": hookload,
             "bit_depth_m": depth, "hole_depth_m": hole,
-            "wob_N": np.full(n, stand.wob_N), "bit_rpm": rec.bit_rad_s / RPM_TO_RAD_S,
-            "string_torque_Nm": rec.string_torque_Nm}
+            "wob_N": np.full(n, stand.wob_N),
+            "bit_rpm": (rec.bit_rad_s + motor) / RPM_TO_RAD_S,
+            "string_torque_Nm": rec.string_torque_Nm,
+            "flow_in_m3_s": np.full(n, stand.flow_m3_s), "bha_rpm": rec.bit_rad_s / RPM_TO_RAD_S}
     grid = plant.grid
     cased_T_N = float(np.sum(settings.cased_share(grid) * td.fc_at(grid.x_m) * grid.dx_true_m))
     creep_end = (t0 + stand.idle_s + stand.creep_ramp_s + stand.creep_hold_s
@@ -473,9 +484,31 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
                          bit_power_torque_Nm=_power_bit_torque_Nm(stand, rec),
                          bit_torque_k_Nm=plant.bit_torque_cap_Nm,
                          bit_weakening_ratio=stand.bit_weakening_ratio,
-                         bit_weakening_rpm=stand.bit_weakening_rpm,
+                         bit_weakening_rpm=stand.bit_weakening_rpm, flow_m3_s=stand.flow_m3_s,
                          **_reaming_truth(stand, plants, tds, t0))
     return cols, result
+
+
+def pdm_speed_rad_s(flow_m3_s: float, rev_per_litre: float | None, bit_torque_Nm: np.ndarray,
+                    stall_torque_Nm: float | None) -> np.ndarray:
+    """Speed of the simulated mud motor's rotor relative to its housing [rad/s]: the
+    positive displacement motor's linear characteristic ω_m = 2π·k·Q·(1 − τ_bit/τ_stall),
+    clipped to [0, 2π·k·Q] (docs/theory.md eqs. 2.4a–b; k [rev/L] × 1000 L/m³); 0 without a
+    motor, no drop without a stall torque.
+
+    Examples
+    --------
+    >>> rpm = pdm_speed_rad_s(0.03, 0.1, np.array([0.0, 500.0, 4000.0]), 2000.0) * 30 / np.pi
+    >>> rpm.round(6).tolist()
+    [180.0, 135.0, 0.0]
+    """
+    torque = np.asarray(bit_torque_Nm, dtype=float)
+    if rev_per_litre is None:
+        return np.zeros(torque.size)
+    no_load = 2.0 * np.pi * rev_per_litre * 1000.0 * flow_m3_s
+    if stall_torque_Nm is None:
+        return np.full(torque.size, no_load)
+    return no_load * np.clip(1.0 - np.maximum(torque, 0.0) / stall_torque_Nm, 0.0, 1.0)
 
 
 def _reaming_truth(stand: Stand, plants, tds, t0: float) -> dict:
@@ -554,7 +587,8 @@ def _connection(t0: float, span: float, rate: float, before: Stand, after: Stand
     zero = np.zeros(t.size)
     return {"time_s": t, "surface_rpm": zero, "surface_torque_Nm": zero.copy(),
             "hookload_N": zero.copy(), "bit_depth_m": depth, "hole_depth_m": depth + off,
-            "wob_N": zero.copy(), "bit_rpm": zero.copy(), "string_torque_Nm": zero.copy()}
+            "wob_N": zero.copy(), "bit_rpm": zero.copy(), "string_torque_Nm": zero.copy(),
+            "flow_in_m3_s": zero.copy(), "bha_rpm": zero.copy()}
 
 
 def _notes(stands) -> tuple:

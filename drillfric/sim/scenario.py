@@ -44,6 +44,9 @@ class Stand:
     bit_weakening_ratio, bit_weakening_rpm : float
         Rate-weakening bit of an on-bottom stand, T_bit(ω) = T_k·(1 + (r − 1)·exp(−|ω|/ω_b)):
         r [-] (1: the Coulomb bit) and ω_b [RPM] (docs/simulator.md, Bit).
+    flow_m3_s : float
+        Flow in through the string and its mud motor [m³/s], pumps on throughout the stand
+        (idle, start-up and stop included; off in the connection after it).
     setpoint_rpm : tuple of (t_s, rpm), optional
         Explicit piecewise-linear set-point from the start of the stand (replaces the
         start-up/hold/stop shape; a repeated time makes a step).
@@ -77,6 +80,7 @@ class Stand:
     rop_m_h: float = 0.0
     bit_weakening_ratio: float = 1.0
     bit_weakening_rpm: float = 10.0
+    flow_m3_s: float = 0.0
     setpoint_rpm: tuple | None = None
     motor_torque_Nm: tuple | None = None
     stop: bool = True
@@ -232,7 +236,8 @@ def _check_stand(stand: Stand, where: str, file) -> None:
         if not getattr(stand, key) > 0:
             raise ConfigError(f"{where}.{key} must be > 0, got {getattr(stand, key)}",
                               file=file)
-    for key in ("rpm", "creep_rpm", "idle_s", "stop_s", "stop_hold_s", "wob_N", "rop_m_h"):
+    for key in ("rpm", "creep_rpm", "idle_s", "stop_s", "stop_hold_s", "wob_N", "rop_m_h",
+                "flow_m3_s"):
         if getattr(stand, key) < 0:
             raise ConfigError(f"{where}.{key} must be ≥ 0, got {getattr(stand, key)}",
                               file=file)
@@ -316,7 +321,8 @@ def base_stand(cfg: Config) -> Stand:
                  duration_s=cfg.simulate.duration_s, rpm=cfg.simulate.rpm,
                  ramp_s=cfg.simulate.ramp_s, wob_N=cfg.simulate.wob_N,
                  bit_weakening_ratio=cfg.simulate.bit_weakening_ratio,
-                 bit_weakening_rpm=cfg.simulate.bit_weakening_rpm)
+                 bit_weakening_rpm=cfg.simulate.bit_weakening_rpm,
+                 flow_m3_s=cfg.simulate.flow_m3_s)
 
 
 def single_stand(cfg: Config, bit_depth_m: float) -> Scenario:

@@ -81,6 +81,9 @@ class PlantSettings:
         Casing shoe [m]; with ``mu_s_cased``, ``mu_k_cased`` the truth above it.
     mu_s_cased, mu_k_cased : float, optional
         True friction factors above the shoe (the fixed part of the profile) [-].
+    motor_rev_per_litre, motor_stall_torque_Nm : float, optional
+        A mud motor in the BHA: k [rev/L] and its stall torque [N·m] (docs/simulator.md,
+        Mud motor); None: no motor, no drop.
     """
 
     mu_s: float
@@ -100,6 +103,8 @@ class PlantSettings:
     casing_shoe_md_m: float | None = None
     mu_s_cased: float | None = None
     mu_k_cased: float | None = None
+    motor_rev_per_litre: float | None = None
+    motor_stall_torque_Nm: float | None = None
 
     @property
     def cased(self) -> bool:
@@ -131,7 +136,9 @@ class PlantSettings:
                   stribeck_speed_rad_s=cfg.simulate.stribeck_speed_rad_s,
                   stribeck_exponent=cfg.simulate.stribeck_exponent,
                   casing_shoe_md_m=cfg.model.casing_shoe_md_m,
-                  mu_s_cased=cfg.simulate.mu_s_cased, mu_k_cased=cfg.simulate.mu_k_cased)
+                  mu_s_cased=cfg.simulate.mu_s_cased, mu_k_cased=cfg.simulate.mu_k_cased,
+                  motor_rev_per_litre=cfg.simulate.motor_rev_per_litre,
+                  motor_stall_torque_Nm=cfg.simulate.motor_stall_torque_Nm)
         for zone, mu_s, mu_k in (("", out.mu_s, out.mu_k),
                                  ("_cased", out.mu_s_cased, out.mu_k_cased)):
             if mu_k is not None and mu_s is not None and mu_k > mu_s:
