@@ -216,6 +216,11 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "(alternative to omega_c_rad_s).", min=0.0, min_exclusive=True),
         Key("k_t_per_s", float, 0.1, "1/s", "Viscous damping rate k_t of the torsional "
             "model (docs/theory.md §3, eq. 2–3).", min=0.0),
+        Key("k_t_uncertainty_factor", float, 3.0, "", "How far the true viscous damping "
+            "may lie from k_t_per_s, as a factor f (k_t/f … f·k_t; heavy mud reached 3×): "
+            "μ_k's 95 % interval carries what that range moves it by where this exceeds the "
+            "validated tolerance (docs/theory.md §6.4 \"Uncertainty of μ_k\"); 1 trusts "
+            "k_t_per_s as given.", min=1.0, max=100.0),
         Key("cells", int, 500, "", "Number of cells of the torsional model (the paper: 500).",
             min=20, max=200000),
         _positive("element_length_m", 2.0, "m", "Element length of the soft-string "

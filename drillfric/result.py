@@ -249,6 +249,11 @@ class SegmentRecord:
     mu_s_spread: float | None = _f("-", "uncertainty of μ_s (creep fit's change on grid "
                                         "refinement)")
     mu_k_spread: float | None = _f("-", "spread of the observer starts' μ_k")
+    mu_k_damping_uncertainty: float | None = _f("-", "half-width of a batch μ_k from the "
+                                                     "viscous damping assumed (k_t within "
+                                                     "model.k_t_uncertainty_factor), combined "
+                                                     "in quadrature with the tolerance in its "
+                                                     "95 % interval")
     converged: bool = _f("", "whether μ_k is converged (agreeing estimators, ≥ 90 s)", False)
     method: Method = _f("", "estimator of the numbers: batch, observer, td_backcalc (a "
                              "depth-indexed log's friction log) or none", Method.NONE)

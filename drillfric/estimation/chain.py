@@ -95,6 +95,9 @@ class SegmentEstimate:
     mu_s_lower_bound : float or None
     mu_s_spread, mu_k_spread : float or None
         Spread of the observer's starts [-].
+    mu_k_damping : float or None
+        Half-width of a batch μ_k from the viscous damping assumed [-]
+        (:func:`~drillfric.estimation.batch.fit.damping_half_width`).
     converged : bool
     method : Method
     settling_time_s : float or None
@@ -163,6 +166,7 @@ class SegmentEstimate:
     mu_s_lower_bound: float | None
     mu_s_spread: float | None
     mu_k_spread: float | None
+    mu_k_damping: float | None
     converged: bool
     method: Method
     settling_time_s: float | None
@@ -913,6 +917,7 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         mu_s_lower_bound=verdict.mu_s_lower_bound,
         mu_s_spread=_mu_s_spread(settings, refined, steps.diag),
         mu_k_spread=steps.diag.mu_k_spread, converged=trace.converged, method=verdict.method,
+        mu_k_damping=refined.details.mu_k_damping if verdict.method is Method.BATCH else None,
         settling_time_s=steps.diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
         stick_slip_severity=bit_trace.mixture_severity(members, weights),
         stuck_fraction=bit_trace.stuck_share(members, weights, settings.omega_c_rad_s),

@@ -174,10 +174,12 @@ def entry_half_width(members: list[SegmentRecord], mu_k: float) -> float:
     — [-]: the validated tolerance of its logging (:func:`mu_k_tolerance`, 5 % at ≤ 0.2 s,
     else 10 %: the model-form error found on both plant families, docs/validation.md
     "Calibrated intervals"), or where larger the scatter of a pool's pieces
-    (:func:`mean_half_width`) or half the spread of the observer's starts that gave a
-    segment's number. One rule for the headline's ū and the friction log's entries. (A
-    torque match of 2 % had been the floor; on the second plant family every headline ± so
-    made excluded the truth, errors 2–4 %.)
+    (:func:`mean_half_width`), half the spread of the observer's starts that gave a
+    segment's number; the tolerance combined in quadrature with what the assumed viscous
+    damping may move it by (``mu_k_damping_uncertainty``: independent errors). One rule for
+    the headline's ū and the friction log's entries. (A torque match of 2 % had been the
+    floor; on the second plant family every headline ± so made excluded the truth, errors
+    2–4 %.)
 
     Examples
     --------
@@ -189,7 +191,8 @@ def entry_half_width(members: list[SegmentRecord], mu_k: float) -> float:
     scatter = mean_half_width(np.array([r.mu_k for r in members]))
     observer = max(((r.mu_k_spread or 0.0) / 2.0 for r in members
                     if r.method == Method.OBSERVER), default=0.0)
-    return max(tolerance * mu_k, scatter, observer)
+    damping = max((r.mu_k_damping_uncertainty or 0.0 for r in members), default=0.0)
+    return max(float(np.hypot(tolerance * mu_k, damping)), scatter, observer)
 
 
 def uncertainty(values: list[float], own: list[float]) -> float | None:

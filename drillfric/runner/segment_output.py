@@ -76,6 +76,7 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         mu_s=est.mu_s, mu_k=est.mu_k, mu_s_identifiable=est.mu_s_identifiable,
         mu_s_lower_bound=est.mu_s_lower_bound, mu_s_spread=est.mu_s_spread,
         mu_k_spread=est.mu_k_spread, converged=est.converged, method=est.method,
+        mu_k_damping_uncertainty=est.mu_k_damping,
         settling_time_s=est.settling_time_s, residual_rms_rpm=est.residual_rms_rpm,
         mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),

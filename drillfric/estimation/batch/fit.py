@@ -94,6 +94,8 @@ class BatchDetails:
         than 3 whole cycles (docs/theory.md §6.4).
     torque_cycles : int
         Whole torque cycles the uncertainty rests on.
+    mu_k_damping : float or None
+        Half-width of μ_k [-] from the viscous damping assumed (:func:`damping_half_width`).
     """
 
     cells: int = 0
@@ -113,6 +115,7 @@ class BatchDetails:
     relaxation: relaxation.RelaxationCycles | None = None
     mu_k_sigma: float | None = None
     torque_cycles: int = 0
+    mu_k_damping: float | None = None
 
 
 @dataclass(frozen=True)
@@ -276,17 +279,19 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
                             moving=axial is not None)
     flags += static.flags
     messages += static.messages
-    interval = None
+    interval = damping = None
+    if static.kinetic is not None:
+        damping = damping_half_width(model, wins, cells)
     if static.kinetic is not None and rotation.target_error is not None:
         interval = _uncertainty_note(model, rotation, static.kinetic.mu_k, cells,
-                                     max(data.dt, sample_interval_s or 0.0))
+                                     max(data.dt, sample_interval_s or 0.0), damping)
     return BatchResult(
         mu_k=None if static.kinetic is None else static.kinetic.mu_k,
         mu_k_method="mean_torque", mu_s=static.mu_s, mu_s_identifiable=static.mu_s is not None,
         mu_s_lower_bound=static.bound, mu_s_method=static.method,
         creep_segments=static.creeps, flags=tuple(flags), runs=model.runs,
         messages=tuple(messages), interval_note=interval,
-        details=_details(model, cells, creeps, rotation, static, cycles))
+        details=_details(model, cells, creeps, rotation, static, cycles, damping))
 
 
 @dataclass(frozen=True)
@@ -382,17 +387,41 @@ def _mu_k_sigma(model: Model, rotation: _Rotation, cells: int) -> float | None:
     return float(np.sqrt(2.0) * rotation.target_error[0] / model.t_n(cells))
 
 
+def damping_half_width(model: Model, wins: list, cells: int) -> float:
+    """Half-width of μ_k [-] from the viscous damping the model assumes (docs/theory.md §6.4
+    "Uncertainty of μ_k"): the mean torque's viscous part k_t·J·ω̄ (J the string's polar
+    mass moment, ω̄ the mean speed of the rotation fitted) is taken as friction in
+    proportion where the true damping differs; with the truth within k_t/f … f·k_t
+    (``model.k_t_uncertainty_factor``) μ_k moves by up to (f − 1)·k_t·J·ω̄ / T_N (heavier
+    damping read as friction; the lighter side moves it less, (1 − 1/f)·…).
+
+    Three times the configured damping had put μ_k 9 % high at 100 Hz, outside its stated
+    5 % (issue 34); on the demo the viscous part is 1.4–1.9 % of the friction torque."""
+    used = np.concatenate([w.used for w in wins])
+    g = model.grid(cells)[0]
+    inertia = float(np.sum(g.rho_j_kg_m * g.dx_true_m))
+    viscous = model.k_t * inertia * float(np.mean(np.abs(model.data.w_bar[used])))
+    factor = model.settings.k_t_uncertainty_factor
+    return float((factor - 1.0) * viscous / model.t_parts(cells)[0])
+
+
 def _uncertainty_note(model: Model, rotation: _Rotation, mu_k: float, cells: int,
-                      sample_interval_s: float | None) -> str:
+                      sample_interval_s: float | None, damping: float | None = None) -> str:
     """The message stating μ_k's 95 % half-width — its statistical 2σ, never below the
     validated tolerance of the logging (:func:`~drillfric.estimation.batch.settings.
-    mu_k_tolerance`: model-form error included) — and the statistical part."""
+    mu_k_tolerance`: model-form error included) combined with what the assumed damping may
+    move it by (:func:`damping_half_width`; independent errors, in quadrature) — and the
+    statistical part."""
     two_sigma = 2.0 * _mu_k_sigma(model, rotation, cells)
     tolerance = mu_k_tolerance(sample_interval_s)
-    half = max(two_sigma, tolerance * mu_k)
+    floor = float(np.hypot(tolerance * mu_k, damping or 0.0))
+    half = max(two_sigma, floor)
     err, n = rotation.target_error
-    why = ("its statistical 2σ" if two_sigma >= tolerance * mu_k else
-           f"the validated {100 * tolerance:.0f} % of this logging, model-form error included")
+    factor = model.settings.k_t_uncertainty_factor
+    why = ("its statistical 2σ" if two_sigma >= floor else
+           f"the validated {100 * tolerance:.0f} % of this logging, model-form error included"
+           + (f", and ±{damping:.3f} for the viscous damping assumed (k_t within ×1/{factor:g}"
+              f"…×{factor:g}, model.k_t_uncertainty_factor)" if damping else ""))
     return (f"μ_k = {mu_k:.3f} ± {half:.3f} (95 %: {why}; statistical 2σ ± {two_sigma:.3f}, "
             f"±{100 * two_sigma / mu_k:.1f} %: the mean torque of {n} whole cycles (or "
             f"{STEADY_BLOCK_S:g}-s blocks of steady rotation) is known to ±{err:.0f} N·m (1σ), "
@@ -400,7 +429,8 @@ def _uncertainty_note(model: Model, rotation: _Rotation, mu_k: float, cells: int
 
 
 def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Static,
-             cycles: relaxation.RelaxationCycles | None) -> BatchDetails:
+             cycles: relaxation.RelaxationCycles | None,
+             damping: float | None = None) -> BatchDetails:
     """The traces of a fit from its stages' outcomes."""
     kinetic, creep = static.kinetic, static.creep
     return BatchDetails(
@@ -415,4 +445,5 @@ def _details(model: Model, cells: int, creeps, rotation: _Rotation, static: _Sta
         creep_checks=None if creep is None else creep.checks,
         onset_scan=[] if static.onset is None else static.onset.scan, drive=model.drive,
         relaxation=cycles, mu_k_sigma=_mu_k_sigma(model, rotation, cells),
-        torque_cycles=0 if rotation.target_error is None else rotation.target_error[1])
+        torque_cycles=0 if rotation.target_error is None else rotation.target_error[1],
+        mu_k_damping=damping)

@@ -27,6 +27,8 @@ class BatchSettings:
         Static/kinetic switching speed ω_c [rad/s] (``model.omega_c_rad_s``/``omega_c_rpm``).
     k_t_per_s : float
         Viscous damping rate k_t [1/s] (``model.k_t_per_s``).
+    k_t_uncertainty_factor : float
+        The true damping may lie within k_t/f … f·k_t [-] (``model.k_t_uncertainty_factor``).
     top_drive_inertia_kg_m2 : float
         I_TD [kg·m²] (``rig.top_drive_inertia_kg_m2``).
     mu_max : float
@@ -48,6 +50,7 @@ class BatchSettings:
     dip_max_s: float = default("segmentation.dip_max_s")
     dip_torque_fraction: float = default("segmentation.dip_torque_fraction")
     window_s: float = default("batch.window_s")
+    k_t_uncertainty_factor: float = default("model.k_t_uncertainty_factor")
 
     @classmethod
     def from_config(cls, cfg: Config) -> BatchSettings:
@@ -56,7 +59,8 @@ class BatchSettings:
                    top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
                    mu_max=cfg.observer.mu_max, dip_max_s=cfg.segmentation.dip_max_s,
                    dip_torque_fraction=cfg.segmentation.dip_torque_fraction,
-                   window_s=cfg.batch.window_s)
+                   window_s=cfg.batch.window_s,
+                   k_t_uncertainty_factor=cfg.model.k_t_uncertainty_factor)
 
 
 # --- the series compared (docs/theory.md §6.4) ---------------------------------------------
