@@ -1,13 +1,13 @@
 """Where a well's files are: its data, configuration, survey and string, found once.
 
 A well is given as a data file with sidecars found by name (``NAME.toml``,
-``NAME.survey.{csv,parquet,xml}``, ``NAME.tubular.xml``), a folder holding ``well.toml`` (which
-names its files), a folder or numbered parts of a WITSML log, an HDF5 bundle (``/config``,
-``/survey`` inside), or data in memory (:func:`frame_files`). :func:`resolve_files` finds them
-without reading the data (``peek=False``: not even the data file's header), so a fleet's
-parent can name its wells cheaply (docs/fleet.md); :func:`safe_name` turns a well's name into
-one safe directory name. Files found or named *for* the user must not lead out of their
-folder (docs/security.md).
+``NAME.survey.{csv,parquet,xml,txt,…}``, ``NAME.tubular.xml``), a folder holding
+``well.toml`` (which names its files), a folder or numbered parts of a WITSML log, an HDF5
+bundle (``/config``, ``/survey`` inside), or data in memory (:func:`frame_files`).
+:func:`resolve_files` finds them without reading the data (``peek=False``: not even the data
+file's header), so a fleet's parent can name its wells cheaply (docs/fleet.md);
+:func:`safe_name` turns a well's name into one safe directory name. Files found or named
+*for* the user must not lead out of their folder (docs/security.md).
 """
 
 from __future__ import annotations
@@ -34,8 +34,10 @@ from drillfric.io.text import printable
 MAX_NAME_BYTES = 100
 #: Extensions of HDF5 files (a bundle may hold /config and /survey beside /surface).
 HDF5_EXT = (".h5", ".hdf5")
-#: Extensions of survey sidecars (NAME.survey.EXT), in the order they are looked for.
-_SURVEY_EXT = (".csv", ".parquet", ".xml")
+#: Extensions of survey sidecars (NAME.survey.EXT), in the order they are looked for: every
+#: extension :func:`drillfric.io.survey.read_survey` reads (a Volve ``F-5.survey.txt`` beside
+#: its log had been passed over, and the well run as vertical, its μ 37 % high).
+SURVEY_EXT = (".csv", ".parquet", ".xml", ".txt", ".tsv", ".dat", ".prn", ".asc", ".pq")
 #: What errors name as the "file" of a well opened from a DataFrame (``open_well(frame=)``).
 FRAME_LABEL = Path("<DataFrame>")
 
@@ -329,7 +331,7 @@ def find_survey(data_path: Path, config_path: Path | None, raw: dict,
                               "survey file named by the configuration",
                               fix="give it with --survey (or the configuration with --config), "
                                   "or move it beside the configuration")
-    for ext in _SURVEY_EXT:
+    for ext in SURVEY_EXT:
         if (candidate := _sidecar(data_path, ".survey" + ext)) is not None:
             return candidate
     if peek and (_h5_has(data_path, "survey") or _witsml_has(data_path, "trajectory")):

@@ -283,3 +283,16 @@ def test_a_station_typo_bending_the_path_beyond_any_string_is_refused(tmp_path):
     assert open_config(tmp_path / "short.toml")[2] is not None
     _, _, demo = open_config(REPO / "examples/demo/demo.toml")  # 3°/30 m at most
     assert demo is not None
+
+
+def test_volve_f5_survey_txt_beside_its_log_is_its_sidecar(tmp_path):
+    """A fleet's F-5 had ``USROP_F-5.survey.txt`` beside its log (the Volve survey is .txt):
+    the sidecar finder looked for .csv/.parquet/.xml only, so the well ran as vertical and
+    its μ read 37 % high, silently. Every extension read_survey reads is a sidecar."""
+    from drillfric.io import survey as survey_io
+    from drillfric.io.wellfiles import SURVEY_EXT, resolve_well
+
+    assert set(SURVEY_EXT) == survey_io._TEXT_EXT | survey_io._PARQUET_EXT | {".xml"}
+    (tmp_path / "F-5.csv").write_text("time_s,rpm,torque\n0,60,5000\n1,60,5000\n")
+    (tmp_path / "F-5.survey.txt").write_text("md_m,inc_deg,azi_deg\n0,0,0\n1000,30,90\n")
+    assert resolve_well(tmp_path / "F-5.csv").survey == tmp_path / "F-5.survey.txt"
