@@ -115,8 +115,13 @@ _ALIASES = {
     "lb/ft": "pound/foot",
     "ppf": "pound/foot",
     "ftus": "survey_foot",
+    "usft": "survey_foot",  # not micro-survey-foot (issue 30, tenth attack)
+    "us-ft": "survey_foot",
     "hz": "hertz",
 }
+#: Units of a rotary speed that name no angle (Hz, 1/s, cps) count cycles: revolutions per
+#: time, not radians (pint's Hz = 1/s = 1 rad/s had read a speed logged in Hz 6.3× low).
+ANGLE_UNITS = frozenset({"radian", "turn", "degree", "gradian", "arcminute", "arcsecond"})
 
 #: SI target unit for each kind of quantity drillfric reads.
 SI_UNITS = {
@@ -320,11 +325,15 @@ def conversion_factor(unit: str, kind: str) -> float:
     --------
     >>> round(conversion_factor("ft.lbf", "torque"), 6)
     1.355818
+    >>> conversion_factor("Hz", "rpm")  # a rotary speed in Hz counts revolutions
+    60.0
     """
     import pint
 
     reg = registry()
     source = parse_unit(unit)
+    if kind in ("rpm", "angular_velocity") and not ANGLE_UNITS & set(source._units):
+        source = source * reg.turn  # a frequency of the rotation: cycles per time
     target = reg.parse_units(SI_UNITS[kind])
     try:
         return float(reg.Quantity(1.0, source).to(target).magnitude)

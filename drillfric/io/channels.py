@@ -25,7 +25,7 @@ from functools import lru_cache
 
 from drillfric.errors import InputError
 from drillfric.io.text import listing, printable
-from drillfric.units import parse_unit, registry
+from drillfric.units import ANGLE_UNITS, parse_unit, registry
 
 
 @dataclass(frozen=True)
@@ -185,7 +185,7 @@ _FT, _LBF, _GAL, _KGF = 0.3048, 4.4482216152605, 3.785411784e-3, 9.80665
 _COMMON = {
     "second": {"s": 1.0, "sec": 1.0, "ms": 1e-3, "min": 60.0, "h": 3600.0, "hr": 3600.0},
     "revolution/minute": {"rpm": 1.0, "rev/min": 1.0, "r/min": 1.0, "c/s": 60.0,
-                          "rev/s": 60.0, "rps": 60.0},
+                          "rev/s": 60.0, "rps": 60.0, "hz": 60.0, "1/s": 60.0, "cps": 60.0},
     "newton*meter": {"n.m": 1.0, "nm": 1.0, "n·m": 1.0, "n-m": 1.0, "n*m": 1.0,
                      "kn.m": 1e3, "knm": 1e3, "kn·m": 1e3, "kn-m": 1e3, "kn*m": 1e3,
                      "ft.lbf": _FT * _LBF, "ft-lbf": _FT * _LBF, "ft·lbf": _FT * _LBF,
@@ -223,6 +223,8 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     import pint
 
     source = _source_unit(unit, channel, file)
+    if "revolution" in channel.unit and not ANGLE_UNITS & set(source._units):
+        source = source * registry().turn  # a rotary speed in Hz counts revolutions
     try:
         return float(registry().Quantity(1.0, source).to(channel.unit).magnitude)
     except pint.errors.DimensionalityError as exc:
@@ -414,13 +416,23 @@ def find_column(columns: list[str], key: str, config_channels: dict, *,
 
 def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: dict,
               spec: dict, file: str | None) -> tuple[str, str]:
-    """Source unit of a mapped column and where it came from (precedence in module doc)."""
-    stated = name_unit or file_units.get(column)
-    stated_source = "header" if name_unit else file_units.get(("source", column), "header")
-    if stated is None and column == channel.name:
-        stated, stated_source = SUFFIX_UNITS[channel.key], "name suffix"
+    """Source unit of a mapped column and where it came from (precedence in module doc).
+
+    A file that states two different units for one column (its header name, its units row
+    or field metadata, a canonical name's suffix) is refused unless ``[channels]`` names
+    one of them: one had been taken silently, μ_k −27 % to +35 % (issue 30, tenth attack)."""
+    states = _stated_units(channel, column, name_unit, file_units)
+    stated, stated_source = states[0] if states else (None, None)
     configured = spec.get("unit")
+    if configured is None and any(_differ(u, stated, channel) for u, _ in states[1:]):
+        said = "; ".join(f"its {where} says '{printable(u)}'" for u, where in states)
+        raise InputError(f"the file states two units for {channel.name} (column "
+                         f"'{printable(column)}'): {said}", file=file,
+                         fix=f"say which in the configuration, e.g. [channels] {channel.key} = "
+                             f'{{ unit = "{printable(states[-1][0])}" }}')
     if configured is not None:
+        if any(not _differ(u, configured, channel) for u, _ in states[1:]):
+            return configured, "config"
         if stated is not None and not _same_unit(stated, configured, channel, file):
             raise InputError(f"inconsistent unit for {channel.name}: column "
                              f"'{printable(column)}' says '{printable(stated)}' but [channels] "
@@ -430,6 +442,29 @@ def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: 
     if stated is not None:
         return stated, stated_source
     return channel.default_unit, "default"
+
+
+def _stated_units(channel: Channel, column: str, name_unit: str | None,
+                  file_units: dict) -> list[tuple[str, str]]:
+    """(unit, where) of every unit the file states for ``column``, in precedence order."""
+    states = []
+    if name_unit:
+        states.append((name_unit, "header"))
+    if file_units.get(column):
+        states.append((file_units[column], file_units.get(("source", column), "header")))
+    if column == channel.name:
+        states.append((SUFFIX_UNITS[channel.key], "name suffix"))
+    return states
+
+
+def _differ(a: str, b: str, channel: Channel) -> bool:
+    """Whether two stated units of one column convert differently (a spelling neither
+    drillfric nor pint reads does not count: the one in effect is checked where it is
+    used)."""
+    try:
+        return not _same_unit(a, b, channel, None)
+    except InputError:
+        return False
 
 
 def _same_unit(a: str, b: str, channel: Channel, file: str | None) -> bool:

@@ -235,15 +235,48 @@ class LivePage:
             if why:
                 withheld.append({"segment": int(seg_id), "reason": why})
                 continue
-            rows = rows.iloc[extreme_rows(rows, BIT_POINTS // len(groups),
-                                          ("bit_rpm_est",))]
-            parts += [rows, rows.iloc[-1:].assign(bit_rpm_est=np.nan, bit_rpm_est_min=np.nan,
-                                                  bit_rpm_est_max=np.nan,
-                                                  bha_rpm_est=np.nan)]  # a gap after it
+            parts.append(band_breaks(rows.iloc[extreme_rows(rows, BIT_POINTS // len(groups),
+                                                            ("bit_rpm_est",))]))
         if not parts:
             return empty | {"withheld": withheld}
         frame = pd.concat(parts, ignore_index=True)
         return {c: frame[c].to_numpy(float) for c in empty} | {"withheld": withheld}
+
+
+def band_breaks(rows: pd.DataFrame) -> pd.DataFrame:
+    """One segment's bit rows for the page's band and lines: the area glyph skips null
+    values and so joins the band across them — over a withheld window, and from one segment
+    to the next across a connection where nothing turned (a newcomer saw a 110-RPM band
+    over 90 s in the slips) — so each stretch of the band is closed by a row of no width
+    at its first and last time (its low = high, the lines null there), and the null rows
+    leave the band: between stretches it has no area.
+
+    Examples
+    --------
+    >>> rows = pd.DataFrame({"time_s": [0.0, 1.0, 2.0, 3.0], "bit_rpm_est": [5.0, 5, np.nan, 7],
+    ...                      "bit_rpm_est_min": [4.0, 4, np.nan, 6],
+    ...                      "bit_rpm_est_max": [6.0, 6, np.nan, 8], "bha_rpm_est": np.nan})
+    >>> out = band_breaks(rows)
+    >>> out["time_s"].tolist(), out["bit_rpm_est_min"].tolist()
+    ([0.0, 0.0, 1.0, 1.0, 3.0, 3.0, 3.0], [5.0, 4.0, 4.0, 5.0, 7.0, 6.0, 7.0])
+    """
+    low, high = rows["bit_rpm_est_min"].to_numpy(float), rows["bit_rpm_est_max"].to_numpy(float)
+    valid = np.isfinite(low) & np.isfinite(high)
+    if not valid.any():
+        return rows
+    mid = (low + high) / 2.0
+    edges = np.diff(np.r_[0, valid.astype(int), 0])
+    pieces = []
+    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
+        run = rows.iloc[a:b]
+        pieces += [_closed(run.iloc[:1], mid[a]), run, _closed(run.iloc[-1:], mid[b - 1])]
+    return pd.concat(pieces, ignore_index=True)
+
+
+def _closed(row: pd.DataFrame, level: float) -> pd.DataFrame:
+    """``row`` as the band's end: no width at ``level`` [RPM], its lines null."""
+    return row.assign(bit_rpm_est=np.nan, bha_rpm_est=np.nan, bit_rpm_est_min=level,
+                      bit_rpm_est_max=level)
 
 
 def _final_bit_rows(path: Path, ids: tuple[int, ...]) -> pd.DataFrame:
