@@ -44,7 +44,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString
 from drillfric.errors import DrillfricError, ModelError
-from drillfric.estimation import batch, bit_torque, bit_trace, spikes
+from drillfric.estimation import batch, bit_torque, bit_trace, skew, spikes
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -153,6 +153,9 @@ class SegmentEstimate:
     factors_withheld : str
         Why the segment's friction factors are not shown ("" when they are:
         :func:`~drillfric.estimation.verdict.withheld_factors`).
+    skew : Skew or None
+        The torque's lag behind the speed the segment was corrected for, or why it is not
+        identified (:func:`drillfric.estimation.skew.correct`).
     """
 
     mu_s: float | None
@@ -190,6 +193,7 @@ class SegmentEstimate:
     friction_zone: str = "effective"
     samples_dropped: int = 0
     factors_withheld: str = ""
+    skew: skew.Skew | None = None
 
 
 def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
@@ -702,6 +706,7 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     """
     tick = progress or (lambda amount: None)
     out_rate = output_rate_hz or settings.observer.output_rate_hz
+    data, skewed = skew.correct(data, settings.torque_lag_s)
     data = while_moving(data)
     models = build_models(settings, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
     moving_note = ()
@@ -719,22 +724,25 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     fitted_result = beside(fit_evidence, settings, models, verdict, refined.mu_s)
     final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
-    trace, kinematics = trace_verdict(settings, models, refined, verdict, final, bit)
+    trace, kinematics = trace_verdict(settings, models, refined, verdict, final, bit, skewed)
     fitted = fitted_result()
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
-    return _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
-                                                   trace, final, bit, fitted, terms,
-                                                   kinematics))
+    estimate = _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
+                                                       trace, final, bit, fitted, terms,
+                                                       kinematics))
+    return replace(estimate, skew=skewed)
 
 
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
-                  verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate
+                  verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate,
+                  skewed: skew.Skew | None = None
                   ) -> tuple[TraceVerdict, bit_trace.KinematicCheck]:
     """Step 8: the checks of the seeded trace (whole-segment kinematics, window by window,
     the members' statistics) and what of it the rules of
-    :func:`~drillfric.estimation.verdict.decide_trace` show."""
+    :func:`~drillfric.estimation.verdict.decide_trace` show (``skewed``: the channels'
+    timing, :func:`drillfric.estimation.skew.correct`)."""
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, settings.speed_noise_rad_s)
     windows = _windows(settings, models, refined, final.time_s, bit.rad_s)
@@ -754,7 +762,8 @@ def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch
         windows=windows, converged=verdict.converged,
         runaway_note=_runaway_note(verdict.mu_k, kinematics) if runaway else None,
         severe_note=bit_trace.statistics_note(severity),
-        undetermined_note=undetermined, moving=models.axial is not None))
+        undetermined_note=undetermined, moving=models.axial is not None,
+        skew_note=None if skewed is None or skewed.known else skewed.reason))
     return trace, kinematics
 
 
