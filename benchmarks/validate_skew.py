@@ -8,7 +8,10 @@ lags the speed) at 100, 10, 5 and 1 Hz and as 1-s means, in two stands:
   time the lag;
 - ``stick-slip``: the same well's creep stand cut to its steady rotation (the log starts and
   ends while the string turns): one stick-slip frequency, where the lag is "not
-  identified".
+  identified";
+- ``soft drive``: the creep stand, whole, on a soft-torque drive (kp 900 N·m·s/rad, ki 2500
+  N·m/rad: the surface speed dips to ~0 between slips; validate_trust's ``soft-torque``):
+  a start-up, but stick-slip dominates.
 
 Every record runs through the whole pipeline (:func:`drillfric.run`) and is graded:
 
@@ -20,8 +23,12 @@ Every record runs through the whole pipeline (:func:`drillfric.run`) and is grad
 - stick-slip statistics: a stated severity within max(0.1, 15 %) of the truth's (or
   withheld).
 
-Run: ``python benchmarks/validate_skew.py [--quick] [--json FILE]`` (about 10 minutes on one
-core; ``--quick``: 10 Hz and 1-s means, lags −1, 0, 1 s).
+With ``--uncorrected`` the skewed 100/10 Hz records also run with ``[channels] lag_s = 0``:
+the lag ignored, as before issue 34 (what the check prevents).
+
+Run: ``python benchmarks/validate_skew.py [--quick] [--uncorrected] [--json FILE]`` (about 5
+minutes on one core, 8 with ``--uncorrected``; ``--quick``: 10 Hz and 1-s means, lags −1,
+0, 1 s).
 """
 
 from __future__ import annotations
@@ -55,19 +62,22 @@ SEVERITY_ABS, SEVERITY_REL = 0.1, 0.15
 MU_K = 0.25
 #: Stands: set-point steps from rest; the creep stand cut to its steady stick-slip.
 STANDS = {
-    "steps": dict(STAND, setpoint_rpm=[[0, 0], [3, 0], [3, 60], [100, 60], [100, 90],
-                                       [160, 90], [160, 50], [230, 50], [230, 70],
-                                       [300, 70]]),
-    "stick-slip": dict(STAND),
+    "steps": ("step", dict(STAND, setpoint_rpm=[[0, 0], [3, 0], [3, 60], [100, 60],
+                                                [100, 90], [160, 90], [160, 50], [230, 50],
+                                                [230, 70], [300, 70]])),
+    "stick-slip": ("step", dict(STAND)),
+    "soft drive": ("soft-torque", dict(STAND)),
 }
 #: The stick-slip stand's rows kept: after the creep and the ramp, before the stop [s].
 STEADY_S = (100.0, 340.0)
 
 
 def simulate(stand: str, folder: Path) -> tuple[pd.DataFrame, Path]:
-    """The 100 Hz simulation of ``stand`` and the estimator's configuration."""
-    folder.mkdir()
-    sim_cfg, est_cfg = _config(folder, "step", PLANTS["step"], STANDS[stand])
+    """The 100 Hz simulation of ``stand`` (its plant and stand) and the estimator's
+    configuration (without the demo's statement that the channels are in step)."""
+    folder.mkdir(parents=True)
+    plant, spec = STANDS[stand]
+    sim_cfg, est_cfg = _config(folder, plant, PLANTS[plant], spec)
     est = tomllib.loads(est_cfg.read_text(encoding="utf-8"))
     est.pop("channels", None)  # the demo states its channels in step: here they are not
     est_cfg.write_text(dumps_toml(est), encoding="utf-8")
@@ -149,10 +159,26 @@ def _severity(est: pd.DataFrame, segs: list[dict]) -> dict:
     return {"severity_stated": stated, "severity_ok": bool(ok), "severity_err": worst}
 
 
+def uncorrected(data: Path, est_cfg: Path, lag_s: float) -> dict:
+    """The record run as if its channels were in step (``[channels] lag_s = 0``): what the
+    lag does where nothing corrects or withholds it."""
+    cfg = tomllib.loads(est_cfg.read_text(encoding="utf-8"))
+    cfg["channels"] = {"surface_torque": {"lag_s": 0.0}}
+    ignored = est_cfg.with_name("ignored.toml")
+    ignored.write_text(dumps_toml(cfg), encoding="utf-8")
+    result = drillfric.run(drillfric.open_well(
+        data, config=ignored, survey=est_cfg.parent / "path.survey.csv"))
+    out = grade(result, lag_s)
+    return {k: out[k] for k in ("mu_k", "windows_shown", "windows_false", "severity_err")}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--uncorrected", action="store_true",
+                    help="also run the 100/10 Hz skewed records with [channels] lag_s = 0 "
+                         "(the lag ignored, as before issue 34)")
     args = ap.parse_args()
     rates = ("10 Hz", "1-s means") if args.quick else RATES
     lags = (-1.0, 0.0, 1.0) if args.quick else LAGS
@@ -169,6 +195,8 @@ def main() -> None:
                         data, config=est_cfg, survey=est_cfg.parent / "path.survey.csv"))
                     row = {"stand": stand, "rate": rate, "lag_s": lag,
                            **grade(result, lag), "run_s": time.perf_counter() - t0}
+                    if args.uncorrected and lag != 0.0 and rate in ("100 Hz", "10 Hz"):
+                        row["uncorrected"] = uncorrected(data, est_cfg, lag)
                     rows.append(row)
                     print(_line(row), flush=True)
     false = sum(r["false"] for r in rows)
@@ -184,7 +212,11 @@ def _line(r: dict) -> str:
     return (f"{r['stand']:<10} {r['rate']:<9} lag {r['lag_s']:+.1f} s → {lag:<28} μ_k {mu} "
             f"windows {r['windows_shown']} ({r['windows_false']} false) severity "
             f"{r['severity_stated']} (error {_fmt(r['severity_err'], '+.2f')}) "
-            f"{'FALSE' if r['false'] else 'ok'}")
+            f"{'FALSE' if r['false'] else 'ok'}" + (
+                f" | lag ignored: μ_k {_fmt(r['uncorrected']['mu_k'], '.3f')}, windows "
+                f"{r['uncorrected']['windows_shown']} ({r['uncorrected']['windows_false']} "
+                f"false), severity error {_fmt(r['uncorrected']['severity_err'], '+.2f')}"
+                if "uncorrected" in r else ""))
 
 
 def _fmt(value, spec: str) -> str:
