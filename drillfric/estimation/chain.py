@@ -4,6 +4,9 @@ The chain of docs/theory.md §5–§6 for one segment at one bit depth (the shap
 ModelChain: each step a function with typed inputs and outputs, :func:`estimate_segment`
 only wires them):
 
+0. :func:`drillfric.estimation.skew.correct` — the torque moved by its lag behind the speed,
+   configured (``[channels] lag_s``) or identified from set-point steps, start-ups and stops
+   (§5.3); a lag not identified leaves the torque as logged and withholds the trace (step 8);
 1. :func:`build_models` — torque and drag at the bit depth gives F_c(x) (§2); the string,
    the measurements on a uniform grid, and the observer (a copy of the plant, §5);
 2. :func:`starts_pass` — the adaptive observer from every configured start (plus the
