@@ -481,6 +481,10 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "truth).", min=0.0, max=2.0),
         Key("mu_k_cased", float, None, "", "True kinetic friction factor above "
             "model.casing_shoe_md_m (with mu_s_cased).", min=0.0, max=2.0),
+        Key("torque_lag_s", float, 0.0, "s", "Lag of the recorded surface torque behind the "
+            "speed (positive: logged late, as by a second acquisition device; "
+            "docs/bit_speed.md, Channel skew). The configuration written beside the data "
+            "states it as [channels] surface_torque lag_s.", min=-10.0, max=10.0),
     ),
 }
 
@@ -517,7 +521,13 @@ CHANNEL_KEYS = ("time", "measured_depth", "surface_rpm", "surface_torque", "hook
                 "bit_depth", "hole_depth", "wob", "block_position", "bit_rpm", "standpipe_pressure",
                 "flow_in", "flow_out", "pump_rate", "surface_torque_min", "surface_torque_max",
                 "surface_rpm_min", "surface_rpm_max", "hookload_min", "hookload_max")
-_CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float)}
+_CHANNEL_FIELDS = {"column": (str, int), "unit": str, "mnemonics": list, "scale": (int, float),
+                   "lag_s": (int, float, str)}
+#: Channels a ``lag_s`` may be given for: the pair whose relative timing the observer reads
+#: (docs/theory.md §5.3); the estimation corrects the torque by lag(torque) − lag(speed).
+LAG_CHANNELS = ("surface_torque", "surface_rpm")
+#: Largest ``lag_s`` magnitude accepted [s]: a recorder's skew is seconds, not minutes.
+CHANNEL_LAG_MAX_S = 10.0
 #: Magnitudes a channel's `scale` may have: a sign flip or a factor no unit conversion
 #: gives (1e300 had been taken, overflowing every value: issue 30, eighth attack).
 CHANNEL_SCALE = (1e-6, 1e6)
@@ -691,7 +701,7 @@ def _channels(raw: Any, file: str | None) -> dict:
         for key, value in spec.items():
             if key not in _CHANNEL_FIELDS:
                 raise ConfigError(f"unknown key 'channels.{name}.{key}'", file=file,
-                                  fix="use column, unit, scale or mnemonics")
+                                  fix="use column, unit, scale, lag_s or mnemonics")
             if not isinstance(value, _CHANNEL_FIELDS[key]) or isinstance(value, bool):
                 raise ConfigError(f"channels.{name}.{key} has the wrong type", file=file,
                                   fix='e.g. { column = "SRPM", unit = "rpm", scale = -1 }')
@@ -702,7 +712,47 @@ def _channels(raw: Any, file: str | None) -> dict:
                                   fix="e.g. scale = -1 for a log of opposite sign; a unit "
                                       "goes in `unit`")
         out[name] = dict(spec)
+        if "lag_s" in spec:
+            out[name]["lag_s"] = _channel_lag(name, spec["lag_s"], file)
     return out
+
+
+def _channel_lag(name: str, value: Any, file: str | None) -> float:
+    """``channels.NAME.lag_s`` in seconds (a number, or text with a time unit: "800 ms").
+
+    Raises
+    ------
+    ConfigError
+        A lag on a channel other than :data:`LAG_CHANNELS`, a unit of another quantity, or a
+        magnitude above :data:`CHANNEL_LAG_MAX_S`.
+    """
+    where = f"channels.{name}.lag_s"
+    if name not in LAG_CHANNELS:
+        raise ConfigError(f"{where}: a lag is read for {' and '.join(LAG_CHANNELS)} only",
+                          file=file, fix="give the torque's lag relative to the speed, e.g. "
+                                         "surface_torque = { column = \"STOR\", lag_s = 0.8 }")
+    if isinstance(value, str):
+        from drillfric.units import quantity_value
+        value = quantity_value(value, "second", what=f"key '{where}'", file=file)
+    if not (_is_number(value) and abs(value) <= CHANNEL_LAG_MAX_S):
+        raise ConfigError(f"{where} must be a time of magnitude ≤ {CHANNEL_LAG_MAX_S:g} s",
+                          file=file, fix="positive: the channel is logged late, e.g. 0.8")
+    return float(value)
+
+
+def torque_lag_s(channels: dict) -> float | None:
+    """The configured lag of the torque behind the speed [s]: ``lag_s`` of surface_torque
+    minus that of surface_rpm (None: neither given, the lag is identified from the data).
+
+    Examples
+    --------
+    >>> torque_lag_s({"surface_torque": {"lag_s": 0.8}}), torque_lag_s({})
+    (0.8, None)
+    """
+    lags = [channels.get(key, {}).get("lag_s") for key in LAG_CHANNELS]
+    if all(lag is None for lag in lags):
+        return None
+    return (lags[0] or 0.0) - (lags[1] or 0.0)
 
 
 def _check_hole(sections: tuple[dict, ...], bit_diameter_m: float | None,
@@ -903,7 +953,13 @@ def schema_markdown() -> str:
               '`surface_torque = { column = "STOR", unit = "kN.m" }`. A column may be a name or '
               "a 0-based index (headerless files). `mnemonics = [...]` adds names to recognise; "
               "`scale` multiplies the values after the unit conversion (`scale = -1` for a "
-              f"log of opposite sign; magnitude {CHANNEL_SCALE[0]:g}–{CHANNEL_SCALE[1]:g}).",
+              f"log of opposite sign; magnitude {CHANNEL_SCALE[0]:g}–{CHANNEL_SCALE[1]:g}). "
+              "`lag_s` (surface_torque and surface_rpm only; seconds, or text such as "
+              '`"800 ms"`; magnitude ≤ 10 s) states how late the channel is logged: positive, '
+              "the torque lags the speed, e.g. "
+              '`surface_torque = { column = "STOR", lag_s = 0.8 }`. The estimation shifts the '
+              "torque by lag(surface_torque) − lag(surface_rpm) and does not identify the lag "
+              "from the data (docs/bit_speed.md, *Channel skew*).",
               "", "Channel keys: " + ", ".join(f"`{c}`" for c in CHANNEL_KEYS), ""]
     return "\n".join(lines)
 

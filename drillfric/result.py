@@ -53,6 +53,7 @@ class Flag(StrEnum):
     MU_K_DEPENDS_ON_MU_S = "mu_k_depends_on_mu_s"
     FACTORS_RUN_AWAY = "factors_run_away"
     PIPE_MOVING = "pipe_moving"
+    CHANNEL_SKEW_UNIDENTIFIED = "channel_skew_unidentified"
 
     @classmethod
     def _missing_(cls, value):
@@ -134,6 +135,12 @@ FLAG_MEANINGS = {
                       "is not identifiable (no point sticks in torsion once |v| > ω_c·r_c), "
                       "the observer's μ_k is left out of the agreement and its bit speed "
                       "withheld (it has no axial model, docs/theory.md §3.3)",
+    Flag.CHANNEL_SKEW_UNIDENTIFIED: "the torque's lag behind the speed is neither configured "
+                                    "([channels] lag_s) nor identified from the segment's "
+                                    "set-point steps, start-ups or stops: the bit speed, "
+                                    "stuck fraction and severity, whose phase rests on the "
+                                    "channels' timing, are withheld (docs/bit_speed.md, "
+                                    "Channel skew)",
 }
 
 
@@ -190,6 +197,7 @@ FLAG_RAISED_BY = {
     Flag.MU_K_DEPENDS_ON_MU_S: (_FIT + "kinetic.fit_kinetic",),
     Flag.FACTORS_RUN_AWAY: (_VERDICT + "decide_trace",),
     Flag.PIPE_MOVING: (_VERDICT + "_pipe_moving",),
+    Flag.CHANNEL_SKEW_UNIDENTIFIED: (_VERDICT + "decide_trace",),
 }
 
 
@@ -323,6 +331,14 @@ class SegmentRecord:
                                              "BHA's over the turning rows (k·flow; on bottom "
                                              "less the half of its largest drop, "
                                              "docs/theory.md §2.4)")
+    torque_lag_s: float | None = _f("s", "lag of the logged torque behind the speed the "
+                                         "segment was corrected for (positive: the torque "
+                                         "lags); null where not identified "
+                                         "(docs/bit_speed.md, Channel skew)")
+    torque_lag_uncertainty_s: float | None = _f("s", "95 % half-width of an identified "
+                                                     "torque_lag_s (0: configured)")
+    torque_lag_source: str | None = _f("", "config ([channels] lag_s), identified, or not "
+                                           "identified (the reason in the message)")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
                                               "the spacing, the averaging interval, the "
                                               "update interval of held values and the width "

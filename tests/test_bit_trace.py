@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -166,6 +168,13 @@ def test_stick_slip_trace_drifting_under_a_third_of_its_swing_is_shown_flagged()
     assert not bit_speed_claim(Resolution(True, 20.0), steady, on_bottom=False).resolved
 
 
+def _synchronised(cfg):
+    """The chain's settings for a simulated record, whose torque and speed are logged in
+    step (``[channels] lag_s = 0``): stick-slip alone cannot time a lag, and an unknown lag
+    would withhold the statistics these tests read (docs/bit_speed.md, Channel skew)."""
+    return replace(ChainSettings.from_config(cfg), torque_lag_s=0.0)
+
+
 def test_severe_stick_slip_statistics_withheld_not_printed_low():
     """Issue 22 (benchmarks/validate_severity.py): in severe off-bottom stick-slip (sticky
     0.8/0.25 at 2000 m, 30 RPM: the truth's severity 3.9, stuck 0.73) the ensemble read the
@@ -179,8 +188,7 @@ def test_severe_stick_slip_statistics_withheld_not_printed_low():
     late = rec.time_s > 30.0
     assert stick_slip_severity(rec.bit_rad_s[late]) > 2.9  # beyond the validated 1.9–2.9
     w, q = noisy(rec)
-    est = estimate_segment(ChainSettings.from_config(cfg), path,
-                           SegmentData(rec.time_s, w / RPM, q, 2000.0))
+    est = estimate_segment(_synchronised(cfg), path, SegmentData(rec.time_s, w / RPM, q, 2000.0))
     assert est.stick_slip_severity >= SEVERITY_VALIDATED_BELOW
     assert not est.bit_statistics
     assert Flag.STICK_SLIP_BEYOND_VALIDATED in est.flags
@@ -204,8 +212,7 @@ def test_stick_slip_statistics_rest_on_mu_s_and_are_withheld_without_it():
     stuck = float(np.mean(np.abs(rec.bit_rad_s[late]) <= 1.0))
     assert 1.0 < truth < 2.0  # the bit stops, below the validated-range limit
     w, q = noisy(rec)
-    est = estimate_segment(ChainSettings.from_config(cfg), path,
-                           SegmentData(rec.time_s, w / RPM, q, 2000.0))
+    est = estimate_segment(_synchronised(cfg), path, SegmentData(rec.time_s, w / RPM, q, 2000.0))
     assert est.mu_s is None  # a ramp start: μ_s not identified
     assert est.stick_slip_severity == pytest.approx(truth, rel=0.12)
     assert est.stuck_fraction == pytest.approx(stuck, abs=0.05)

@@ -204,6 +204,16 @@ TRACE_CASES = [
      dict(shown=False, statistics=False, converged=True, flags=()),
      "issue 36 item 2: the observer has no axial model, so neither the trace of a reaming "
      "segment nor its statistics are shown (not validated); the factors stand"),
+    ("channel_skew_unidentified", dict(skew_note="channel skew not identified: rivals",
+                                       check=DRIFTING, severe_note="severe"),
+     dict(shown=False, windows=(), statistics=False, converged=True,
+          flags=(Flag.CHANNEL_SKEW_UNIDENTIFIED,)),
+     "issue 34 item 1: the trace's phase rests on the channels' timing; a lag the data "
+     "cannot fix withholds the trace and its statistics (one flag says why), the factors "
+     "stand"),
+    ("channel_skew_unresolved", dict(skew_note="why", logging=Resolution(False, 2.0)),
+     dict(shown=False, statistics=False, flags=()),
+     "a trace the logging cannot resolve is not flagged for its skew as well"),
 ]
 
 

@@ -4,6 +4,9 @@ The chain of docs/theory.md §5–§6 for one segment at one bit depth (the shap
 ModelChain: each step a function with typed inputs and outputs, :func:`estimate_segment`
 only wires them):
 
+0. :func:`drillfric.estimation.skew.correct` — the torque moved by its lag behind the speed,
+   configured (``[channels] lag_s``) or identified from set-point steps, start-ups and stops
+   (§5.3); a lag not identified leaves the torque as logged and withholds the trace (step 8);
 1. :func:`build_models` — torque and drag at the bit depth gives F_c(x) (§2); the string,
    the measurements on a uniform grid, and the observer (a copy of the plant, §5);
 2. :func:`starts_pass` — the adaptive observer from every configured start (plus the
@@ -44,7 +47,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString
 from drillfric.errors import DrillfricError, ModelError
-from drillfric.estimation import batch, bit_torque, bit_trace, spikes
+from drillfric.estimation import batch, bit_torque, bit_trace, skew, spikes
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -158,6 +161,9 @@ class SegmentEstimate:
     factors_withheld : str
         Why the segment's friction factors are not shown ("" when they are:
         :func:`~drillfric.estimation.verdict.withheld_factors`).
+    skew : Skew or None
+        The torque's lag behind the speed the segment was corrected for, or why it is not
+        identified (:func:`drillfric.estimation.skew.correct`).
     """
 
     mu_s: float | None
@@ -197,6 +203,7 @@ class SegmentEstimate:
     friction_zone: str = "effective"
     samples_dropped: int = 0
     factors_withheld: str = ""
+    skew: skew.Skew | None = None
 
 
 def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
@@ -709,6 +716,7 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     """
     tick = progress or (lambda amount: None)
     out_rate = output_rate_hz or settings.observer.output_rate_hz
+    data, skewed = skew.correct(data, settings.torque_lag_s)
     data = while_moving(data)
     models = build_models(settings, path, data, rate_hz=rate_hz, torque_channel=torque_channel)
     moving_note = ()
@@ -727,22 +735,25 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
     trace, kinematics, stats_from = trace_verdict(settings, models, refined, verdict,
-                                                  final, bit)
+                                                  final, bit, skewed)
     fitted = fitted_result()
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
-    return _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
-                                                   trace, final, bit, fitted, terms,
-                                                   kinematics, stats_from))
+    estimate = _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
+                                                       trace, final, bit, fitted, terms,
+                                                       kinematics, stats_from))
+    return replace(estimate, skew=skewed)
 
 
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
-                  verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate
+                  verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate,
+                  skewed: skew.Skew | None = None
                   ) -> tuple[TraceVerdict, bit_trace.KinematicCheck, float]:
     """Step 8: the checks of the seeded trace (whole-segment kinematics, window by window,
     the members' statistics) and what of it the rules of
-    :func:`~drillfric.estimation.verdict.decide_trace` show; with the time from which the
+    :func:`~drillfric.estimation.verdict.decide_trace` show (``skewed``: the channels'
+    timing, :func:`drillfric.estimation.skew.correct`); with the time from which the
     stuck fraction and severity are taken [s] (:func:`statistics_from`)."""
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, settings.speed_noise_rad_s)
@@ -762,7 +773,8 @@ def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch
         severe_note=bit_trace.statistics_note(severity),
         undetermined_note=_undetermined(final, bit, span, windows, severity, settings,
                                         refined.mu_s is not None),
-        moving=models.axial is not None))
+        moving=models.axial is not None,
+        skew_note=None if skewed is None or skewed.known else skewed.reason))
     return trace, kinematics, start
 
 

@@ -19,12 +19,13 @@ from drillfric.vocabulary import Kind, Method, Status
 
 #: Flags a short segment may carry and still be pooled (it is only too short: a few torque
 #: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``
-#: concerns only the μ_s bound, withheld, not μ_k; ``bit_speed_drift`` and
-#: ``stick_slip_beyond_validated`` only the bit-speed trace and its statistics).
+#: concerns only the μ_s bound, withheld, not μ_k; ``bit_speed_drift``,
+#: ``stick_slip_beyond_validated`` and ``channel_skew_unidentified`` only the bit-speed trace
+#: and its statistics).
 _POOLABLE = frozenset({"too_short_to_converge", "observer_starts_disagree",
                        "estimators_disagree", "bit_speed_drift", "mu_k_uncertain",
                        "bistable_regime", "stick_slip_beyond_validated",
-                       "stick_slip_undetermined"})
+                       "stick_slip_undetermined", "channel_skew_unidentified"})
 #: Short segments pool when the string's friction torque added between their bit depths is
 #: at most this share of the torque at the deeper one, |ΔT_N|/T_N (docs/theory.md "Pooling
 #: along depth"). The reported μ_k is the torque-weighted mean of μ(x) over the whole

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from drillfric.config import torque_lag_s
 from drillfric.estimation.batch.settings import BatchSettings
 from drillfric.estimation.gains import GainSettings
 from drillfric.friction import FrictionProfile
@@ -43,6 +44,9 @@ class ChainSettings:
         What the logged torque is: ``"motor"`` or ``"string"`` (``rig.torque_kind``).
     sample_averaging_s : float or None
         The logger's declared averaging of each sample [s] (``rig.sample_averaging_s``).
+    torque_lag_s : float or None
+        The torque's configured lag behind the speed [s] (``[channels] lag_s``,
+        :func:`drillfric.config.torque_lag_s`); None: identified from each segment.
     """
 
     td: TDSettings
@@ -53,6 +57,7 @@ class ChainSettings:
     cells: int
     torque_kind: str
     sample_averaging_s: float | None
+    torque_lag_s: float | None = None
 
     @classmethod
     def from_config(cls, cfg: Config) -> ChainSettings:
@@ -60,7 +65,7 @@ class ChainSettings:
         return cls(TDSettings.from_config(cfg), GainSettings.from_config(cfg),
                    FrictionProfile.from_config(cfg), BatchSettings.from_config(cfg),
                    cfg.observer, int(cfg.model.cells), cfg.rig.torque_kind,
-                   cfg.rig.sample_averaging_s)
+                   cfg.rig.sample_averaging_s, torque_lag_s(cfg.channels))
 
     @property
     def omega_c_rad_s(self) -> float:

@@ -319,6 +319,9 @@ class TraceEvidence:
         windows the trace withholds (None: determined).
     moving : bool
         The pipe moves axially as it turns (reaming, back-reaming).
+    skew_note : str or None
+        Why the torque's lag behind the speed is not known (None: configured or identified,
+        :mod:`drillfric.estimation.skew`).
     """
 
     logging: Resolution
@@ -330,6 +333,7 @@ class TraceEvidence:
     severe_note: str | None = None
     undetermined_note: str | None = None
     moving: bool = False
+    skew_note: str | None = None
 
 
 #: Why the bit speed of a reaming / back-reaming segment is withheld.
@@ -380,7 +384,10 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
        else as ``stick_slip_undetermined`` where undetermined;
     5. a shown trace with withheld windows says which;
     6. while the pipe moves axially nothing of the trace is shown
-       (:data:`NO_AXIAL_OBSERVER`).
+       (:data:`NO_AXIAL_OBSERVER`);
+    7. where the torque's lag behind the speed is neither configured nor identified, the
+       trace and its statistics are withheld (``channel_skew_unidentified``): the trace's
+       phase rests on the channels' timing, which the data could not fix.
 
     Examples
     --------
@@ -399,6 +406,12 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
             f"bit speed withheld: {len(ev.windows.withheld)} of its {ev.windows.windows} "
             f"30-s windows fail: {ev.windows.reason}"))
     flags, messages = [], []
+    logged = ev.logging.resolved and not ev.on_bottom and not ev.moving
+    if ev.skew_note and (claim.resolved or logged):
+        flags.append(Flag.CHANNEL_SKEW_UNIDENTIFIED)
+        messages.append(f"bit speed, stuck fraction and severity withheld: {ev.skew_note}")
+        claim = replace(claim, resolved=False, reason=f"bit speed withheld: {ev.skew_note}")
+        logged = False
     runaway = ev.converged and ev.runaway_note is not None
     if runaway:
         flags.append(Flag.FACTORS_RUN_AWAY)
@@ -406,7 +419,6 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
     if claim.resolved and ev.check.approximate:
         flags.append(Flag.BIT_SPEED_DRIFT)
         messages.append(drift_note(ev.check))
-    logged = ev.logging.resolved and not ev.on_bottom and not ev.moving
     if logged and ev.severe_note:
         flags.append(Flag.STICK_SLIP_BEYOND_VALIDATED)
         messages.append(ev.severe_note)

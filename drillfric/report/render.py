@@ -111,7 +111,8 @@ def severity_text(row: dict) -> str:
 
 #: Why a segment shows no stick-slip severity, by flag or field, in the order said.
 _NO_SEVERITY = (("stick_slip_beyond_validated", "severe (beyond the validated range)"),
-                ("stick_slip_undetermined", "undetermined"))
+                ("stick_slip_undetermined", "undetermined"),
+                ("channel_skew_unidentified", "withheld (channel skew not identified)"))
 
 
 def severity_note(segments: pd.DataFrame) -> str:

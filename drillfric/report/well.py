@@ -151,6 +151,7 @@ def _header(data: ResultData, units: Units) -> dict:
         "written": written_at(data.result_dir / "summary.json"), "built": now_utc(),
         "span": _log_span(data, units), "files": files, "rows": inputs.get("rows"),
         "rate_hz": inputs.get("resampled_rate_hz"),
+        "skew": skew_text(inputs.get("channel_skew")),
         "run_time_s": summary.get("run_time_s"),
         "mu_k": fmt(summary.get("mu_k")), "mu_k_reason": _no_mu_k_reason(data),
         "trust": headline_trust(summary),
@@ -169,6 +170,28 @@ def _header(data: ResultData, units: Units) -> dict:
         "string": (string_columns, string_rows),
         "converged_meaning": CONVERGED_MEANING,
     }
+
+
+def skew_text(skew: dict | None) -> str:
+    """The torque's lag behind the speed as the inputs section states it (summary.json
+    ``inputs.channel_skew``; docs/bit_speed.md, Channel skew).
+
+    Examples
+    --------
+    >>> skew_text({"lag_s": 0.81, "uncertainty_s": 0.05, "source": "identified",
+    ...            "segments_identified": 2})
+    '+0.81 ± 0.05 s, identified (2 segments)'
+    >>> skew_text({"lag_s": None, "source": "not identified", "reason": "why"})
+    'not identified — why'
+    """
+    if not skew:
+        return "—"
+    if skew.get("lag_s") is None:
+        return f"not identified — {skew.get('reason') or ''}".rstrip(" —")
+    if skew.get("source") == "config":
+        return f"{skew['lag_s']:+.2f} s, configured ([channels] lag_s)"
+    return (f"{skew['lag_s']:+.2f} ± {skew['uncertainty_s']:.2f} s, identified "
+            f"({skew.get('segments_identified', 0)} segments)")
 
 
 def _profile_text(summary: dict, depth_indexed: bool) -> str:
@@ -772,7 +795,8 @@ def _header_lines(report: Report) -> list[list[str]]:
              ["units", head["units"]]]
     for kind, path, sha in head["files"]:
         lines += [[f"input {kind}", f"{path}\nsha256 {sha}"]]
-    lines += [["rows", fmt(head["rows"], ",.0f")], ["resampled to [Hz]", fmt(head["rate_hz"])]]
+    lines += [["rows", fmt(head["rows"], ",.0f")], ["resampled to [Hz]", fmt(head["rate_hz"])],
+              ["torque lag behind speed", head["skew"]]]
     lines += [["ASSUMED", a] for a in head["assumed"]] or [["assumed", "nothing"]]
     lines += [["WARNING", w] for w in head["warnings"]]
     check = _broomstick_note(report.broomstick.check, report.units)

@@ -14,10 +14,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 
 from drillfric._version import __version__
+from drillfric.config import torque_lag_s
 from drillfric.errors import OutputError
 from drillfric.estimation.consensus import consensus
 from drillfric.estimation.headline import judge as judge_headline
@@ -68,7 +70,8 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, ro
     inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
               for k, p in well.files.inputs.items() if Path(p).is_file()}
     inputs.update(rows=rows, resampled_rate_hz=resampled_rate_hz,
-                  requested_rate_hz=requested_rate_hz)
+                  requested_rate_hz=requested_rate_hz,
+                  channel_skew=channel_skew(torque_lag_s(well.config.channels), records))
     count = {s: sum(r.status is s for r in records) for s in Status}
     return {"well": well.name, "drillfric_version": __version__, **consensus(records, pools),
             "friction_zone": profile.zone, "friction_profile": profile.describe(),
@@ -80,6 +83,43 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, ro
                                         for r in records),
                        "skipped": count[Status.SKIPPED], "failed": count[Status.FAILED]},
             "run_time_s": wall_s, "warnings": list(warnings)}
+
+
+#: How a segment's message states an unidentified skew (drillfric.estimation.skew).
+_UNIDENTIFIED = "channel skew not identified"
+
+
+def channel_skew(configured_s: float | None, records: list[SegmentRecord]) -> dict:
+    """summary.json ``inputs.channel_skew``: the torque's lag behind the speed [s] the well
+    was estimated with (docs/bit_speed.md, Channel skew).
+
+    The configured lag, else the inverse-variance mean of the segments' identified lags
+    (its ± the larger of the mean's 95 % half-width and the lags' spread), else "not
+    identified" with the segments' first reason.
+
+    Examples
+    --------
+    >>> channel_skew(0.8, [])["source"], channel_skew(None, [])["source"]
+    ('config', 'not identified')
+    """
+    if configured_s is not None:
+        return {"lag_s": configured_s, "uncertainty_s": 0.0, "source": "config",
+                "segments_identified": 0}
+    found = [(r.torque_lag_s, r.torque_lag_uncertainty_s) for r in records
+             if r.torque_lag_source == "identified"]
+    if not found:
+        why = next((part[part.index(_UNIDENTIFIED):] for r in records
+                    for part in (r.message or "").split("; ") if _UNIDENTIFIED in part),
+                   "channel skew not identified: no segment's set-point steps, "
+                   "start-ups or stops time it")
+        return {"lag_s": None, "uncertainty_s": None, "source": "not identified",
+                "segments_identified": 0, "reason": why}
+    lags, half = (np.array(v, dtype=float) for v in zip(*found, strict=True))
+    weights = 1.0 / np.maximum(half, 1e-3) ** 2
+    mean = float(np.sum(weights * lags) / weights.sum())
+    spread = float(lags.max() - lags.min()) / 2.0
+    return {"lag_s": mean, "uncertainty_s": max(float(1.0 / np.sqrt(weights.sum())), spread),
+            "source": "identified", "segments_identified": len(found)}
 
 
 class MemorySink:

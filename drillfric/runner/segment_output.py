@@ -81,9 +81,18 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
-        **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est)))
+        **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est), **_skew(est)))
     return withhold_friction(record, est.factors_withheld, None) if est.factors_withheld \
         else record
+
+
+def _skew(est: SegmentEstimate) -> dict:
+    """The torque's lag the segment was corrected for (docs/bit_speed.md, Channel skew)."""
+    skew = est.skew
+    if skew is None:
+        return {}
+    return dict(torque_lag_s=skew.lag_s, torque_lag_uncertainty_s=skew.uncertainty_s,
+                torque_lag_source=skew.source)
 
 
 def _while_moving(rows: pd.DataFrame, seg: Segment) -> pd.DataFrame:

@@ -39,6 +39,7 @@ from drillfric.config import Config
 from drillfric.drillstring import build_string
 from drillfric.errors import ConfigError, InputError, ModelError
 from drillfric.io.text import plural
+from drillfric.sim.recorder import lagged
 from drillfric.sim.scenario import Scenario, Stand, base_stand, load_scenario, single_stand
 from drillfric.sim.settings import Noise, PlantSettings
 from drillfric.units import RPM_TO_RAD_S
@@ -339,6 +340,8 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
         columns.pop("bha_rpm")
     block = cfg.hookload.block_weight_N
     columns["hookload_N"] = columns["hookload_N"] + (block or 0.0)
+    columns["surface_torque_Nm"] = lagged(columns["time_s"], columns["surface_torque_Nm"],
+                                          cfg.simulate.torque_lag_s)
     noise.apply(columns)
     notes = _notes(stands)
     return Simulation(columns, tuple(stands), settings, noise, rate, notes)
@@ -661,8 +664,13 @@ def written_config(cfg: Config) -> dict:
     """The simulated well's configuration as written beside it (``Config.to_dict()``), stating
     the block weight its hook load carries — the configured one, else 0 (the simulated hook
     load is then the string alone) — so that ``run`` can weigh the string without a
-    connection in the record (docs/theory.md §2.1)."""
+    connection in the record (docs/theory.md §2.1), and the torque's lag behind the speed
+    it was recorded with (``[channels] surface_torque lag_s``: the simulator knows its
+    channels' timing, which a log of stick-slip alone cannot tell; docs/bit_speed.md)."""
     config = cfg.to_dict()
     hook = dict(config.get("hookload") or {})
     hook["block_weight_N"] = hook.get("block_weight_N") or 0.0
-    return config | {"hookload": hook}
+    channels = {k: dict(v) for k, v in (config.get("channels") or {}).items()}
+    channels.setdefault("surface_torque", {})["lag_s"] = float(cfg.simulate.torque_lag_s)
+    channels.get("surface_rpm", {}).pop("lag_s", None)  # the speed is the reference
+    return config | {"hookload": hook, "channels": channels}
