@@ -425,8 +425,8 @@ def window_check(time_s, bit_rad_s, surface_time_s, surface_rad_s, torque_Nm,
 
 
 #: Why windows over a creep or over a gap of the log are withheld.
-_CREEP_REASON = ("bit speed withheld over the creep and its break-free: μ_s was not "
-                 "identified, and the bit's speed there depends on it")
+_CREEP_REASON = ("bit speed withheld over the start-up from rest or a creep, with its "
+                 "break-free: μ_s was not identified, and the bit's speed there depends on it")
 _GAP_REASON = ("bit speed withheld where the log has a gap longer than the string's wave "
                "travel time: the bit's motion there was not observed")
 
