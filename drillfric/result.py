@@ -53,6 +53,7 @@ class Flag(StrEnum):
     MU_K_DEPENDS_ON_MU_S = "mu_k_depends_on_mu_s"
     FACTORS_RUN_AWAY = "factors_run_away"
     PIPE_MOVING = "pipe_moving"
+    MU_K_DRIFT = "mu_k_drift"
 
 
 #: What each flag means (docs/outputs.md).
@@ -128,6 +129,10 @@ FLAG_MEANINGS = {
                       "is not identifiable (no point sticks in torsion once |v| > ω_c·r_c), "
                       "the observer's μ_k is left out of the agreement and its bit speed "
                       "withheld (it has no axial model, docs/theory.md §3.3)",
+    Flag.MU_K_DRIFT: "the friction moved within the segment beyond its uncertainty (windowed "
+                     "re-fits of the mean torque after torque and drag, docs/theory.md §6.6): "
+                     "mu_k_drift_per_h is its rate, μ_k the mean over the drift, "
+                     "estimates.parquet's μ_k column μ_k(t)",
 }
 
 
@@ -184,6 +189,7 @@ FLAG_RAISED_BY = {
     Flag.MU_K_DEPENDS_ON_MU_S: (_FIT + "kinetic.fit_kinetic",),
     Flag.FACTORS_RUN_AWAY: (_VERDICT + "decide_trace",),
     Flag.PIPE_MOVING: (_VERDICT + "_pipe_moving",),
+    Flag.MU_K_DRIFT: ("drillfric.estimation.friction_trend.drift_verdict",),
 }
 
 
@@ -351,6 +357,13 @@ class SegmentRecord:
                                     "speed")
     mse_uncertainty_Pa: float | None = _f("Pa", "95 % half-width of mse_Pa (from T_bit's)")
     bit_torque_reason: str | None = _f("", "why bit_torque_Nm, mu_bit or mse_Pa is null")
+    mu_k_drift_per_h: float | None = _f("1/h", "linear trend of μ_k(t) over the segment's "
+                                               "independent windows (docs/theory.md §6.6); "
+                                               "the friction moved where the flag "
+                                               "mu_k_drift says so")
+    mu_k_first: float | None = _f("-", "μ_k of the segment's first window (μ_k(t), "
+                                       "batch.trend_window_s)")
+    mu_k_last: float | None = _f("-", "μ_k of the segment's last window")
 
     def to_json(self) -> dict:
         """Plain JSON values (enums as text, NaN as None), in field order."""
@@ -404,7 +417,12 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("segment_id", "int32", "", "segment id (segments.parquet)"),
     Column("start_id", "int16", "", "observer start (0…), −1 for the seeded ensemble pass"),
     Column("mu_s", "float64", "-", "μ̂_s of the start"),
-    Column("mu_k", "float64", "-", "μ̂_k of the start"),
+    Column("mu_k", "float64", "-", "μ̂_k of the start; on the seeded rows μ_k(t): the "
+                                   "windowed re-fits of the mean torque interpolated between "
+                                   "window centres (docs/theory.md §6.6), null where withheld "
+                                   "(a change faster than the windows resolve, the ends of a "
+                                   "drifting segment)"),
+    Column("mu_k_half_width", "float64", "-", "95 % half-width of μ_k(t) (seeded rows)"),
     Column("surface_rpm", "float64", "RPM", "measured top-drive speed"),
     Column("surface_rpm_est", "float64", "RPM", "observer's top-drive speed"),
     Column("bit_rpm_est", "float64", "RPM", "estimated bit speed"),

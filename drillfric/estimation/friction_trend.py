@@ -1,0 +1,250 @@
+"""Friction that moves within a segment: μ_k(t) from windowed re-fits of the mean torque,
+and the drift test (docs/theory.md §6.6).
+
+The batch fit (§6.4) gives one μ_k from the first ``batch.window_s`` of a segment; its model,
+driven by the measured top-drive speed over the whole segment at that μ_k (the fit's evidence,
+:func:`drillfric.estimation.chain.fit_evidence`), carries the torque and drag, the viscous
+and cased torque, the stick-slip and every set-point change of the segment. Over a window of
+``batch.trend_window_s`` (50 % overlap) the measured whole-cycle mean string torque M_w and
+the model's m_w then differ only by the friction that moved (eq. 6.6a):
+
+    μ_k,w = μ_k + (M_w − m_w) / T_N,
+
+T_N = ∫F_c dx of the estimated part (the mean friction torque's slope in μ_k, §6.4: with all
+else fixed the mean torque of the model is linear in μ_k to within its jitter). Each window
+states its 95 % half-width (eq. 6.6b): the validated tolerance of the batch μ_k
+(:func:`~drillfric.estimation.batch.settings.mu_k_tolerance`) and 2σ of the window, σ = √2 ×
+the standard error of the data's whole-cycle mean over T_N (the model's mean scatters as
+much), in quadrature.
+
+The drift test (eq. 6.6c) uses the windows that do not overlap: a weighted linear trend
+of μ_k,w against time, flagged ``mu_k_drift`` when its slope is significant at 95 % (the
+residual scatter counted where it exceeds the windows' own σ) and the change over the
+windows exceeds the validated tolerance — or when two windows differ by more than the
+tolerance plus 2σ of their difference (a step up and back down). Model-form errors common to
+all windows (the batch μ_k's own bias) cancel in the test.
+
+Rows between window centres take μ_k(t) linearly interpolated (exact on a ramp: a window's
+mean of a linear change is its centre's value); a change faster than the windows resolve (a
+step) makes the window values bend: where a window's second difference exceeds
+:data:`MAX_BEND` the rows within a hop of it are withheld, as are the rows beyond the first
+and last centres of a drifting segment and the rows of windows whose own uncertainty is
+above :data:`MU_K_CLAIM` (nothing is claimed there).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from drillfric.estimation.batch.harness import cycle_mean, cycle_mean_error
+from drillfric.estimation.batch.settings import MU_K_CLAIM
+from drillfric.result import Flag
+
+#: Share of a window that must be usable rotation (after the start-up) for its μ_k [-].
+MIN_USED = 0.5
+#: Largest second difference of neighbouring window μ_k relative to μ_k [-] over which rows
+#: are interpolated: a step of Δ bends the window values by Δ/2, which is the largest error
+#: of the interpolated rows near it (module docstring).
+MAX_BEND = 0.05
+#: Independent (non-overlapping) windows the drift test needs.
+MIN_WINDOWS = 3
+#: Two-sided 95 % normal quantile of the drift test.
+Z95 = 1.96
+
+
+@dataclass(frozen=True)
+class FrictionTrend:
+    """μ_k(t) of one segment and its drift test (docs/theory.md §6.6).
+
+    Attributes
+    ----------
+    centre_s : ndarray
+        Window centres [s].
+    mu_k : ndarray
+        Window μ_k [-] (NaN: the window holds too little rotation or too few cycles).
+    half_width : ndarray
+        95 % half-width of each window's μ_k [-] (eq. 6.6b).
+    sigma : ndarray
+        1-σ statistical uncertainty of each window's μ_k [-].
+    drift : bool
+        Whether the friction moved beyond its uncertainty (eq. 6.6c).
+    rate_per_h : float or None
+        Linear trend of the independent windows' μ_k [1/h] (None with fewer than
+        :data:`MIN_WINDOWS`).
+    change : float
+        μ_k of the trend at the last independent window minus at the first [-].
+    tolerance : float
+        Relative validated tolerance the test used [-].
+    window_s : float
+        Window length [s].
+    """
+
+    centre_s: np.ndarray
+    mu_k: np.ndarray
+    half_width: np.ndarray
+    sigma: np.ndarray
+    drift: bool = False
+    rate_per_h: float | None = None
+    change: float = 0.0
+    tolerance: float = 0.0
+    window_s: float = 0.0
+
+    @property
+    def mean(self) -> float | None:
+        """Mean of the window μ_k over the segment [-] (None without windows)."""
+        ok = np.isfinite(self.mu_k)
+        return float(np.mean(self.mu_k[ok])) if ok.any() else None
+
+    def at(self, time_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """μ_k(t) [-] and its 95 % half-width [-] at ``time_s`` [s], NaN where withheld
+        (module docstring: a bend, beyond the end centres of a drift, a gap)."""
+        t = np.asarray(time_s, dtype=float)
+        ok = np.isfinite(self.mu_k) & (self.sigma * 2.0 <= MU_K_CLAIM * self.mu_k)
+        out = np.full(t.size, np.nan), np.full(t.size, np.nan)
+        if not ok.any():
+            return out
+        c, mu, hw = self.centre_s[ok], self.mu_k[ok], self.half_width[ok]
+        value, width = np.interp(t, c, mu), np.interp(t, c, hw)
+        hop = 0.5 * self.window_s
+        gone = np.zeros(t.size, dtype=bool)
+        for i in _bent(mu):
+            gone |= np.abs(t - c[i]) < hop * (1.0 + 1e-9)
+        for a, b in zip(c[:-1], c[1:], strict=True):
+            if b - a > 2.0 * hop * (1.0 + 1e-9):  # a gap: nothing known between
+                gone |= (t > a) & (t < b)
+        if self.drift:
+            gone |= (t < c[0]) | (t > c[-1])
+        return np.where(gone, np.nan, value), np.where(gone, np.nan, width)
+
+
+def _bent(mu: np.ndarray) -> np.ndarray:
+    """Indices of windows whose second difference exceeds :data:`MAX_BEND` of their μ_k."""
+    if mu.size < 3:
+        return np.array([], dtype=int)
+    bend = np.abs(mu[:-2] - 2.0 * mu[1:-1] + mu[2:])
+    return np.flatnonzero(bend > MAX_BEND * mu[1:-1]) + 1
+
+
+def windows(time_s: np.ndarray, usable: np.ndarray, window_s: float
+            ) -> list[tuple[float, float]]:
+    """Windows [a, a + ``window_s``) of hop ``window_s``/2 over the usable samples [s], the
+    last one ending at the last usable sample (so the end of the segment is covered); one
+    window over all of them when they span less than a window."""
+    t = np.asarray(time_s, dtype=float)[usable]
+    if t.size < 2:
+        return []
+    first, last = float(t[0]), float(t[-1])
+    if last - first <= window_s:
+        return [(first, last)]
+    hop = 0.5 * window_s
+    starts = list(first + hop * np.arange(int(np.floor((last - first - window_s) / hop)) + 1))
+    if last - window_s > starts[-1] + 1e-9:
+        starts.append(last - window_s)
+    return [(a, a + window_s) for a in starts]
+
+
+def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm: float,
+                   tolerance: float, window_s: float) -> FrictionTrend:
+    """μ_k of each window and the drift test of one segment (docs/theory.md §6.6).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Uniform sample times [s].
+    measured_Nm, model_Nm : array_like
+        Measured string torque and the fitted model's at ``mu_k`` [N·m].
+    usable : array_like of bool
+        Samples compared: turning, after the start-up.
+    mu_k : float
+        The segment's batch μ_k the model ran at [-].
+    T_N_Nm : float
+        ∫F_c dx of the estimated part [N·m]: the mean torque's slope in μ_k.
+    tolerance : float
+        Validated relative tolerance of μ_k at this logging [-] (the half-width's floor and
+        the smallest change the drift test calls a drift).
+    window_s : float
+        Window length [s] (``batch.trend_window_s``); windows overlap by half.
+    """
+    t = np.asarray(time_s, dtype=float)
+    meas, model = np.asarray(measured_Nm, dtype=float), np.asarray(model_Nm, dtype=float)
+    use = np.asarray(usable, dtype=bool)
+    dt = float(t[1] - t[0]) if t.size > 1 else 1.0
+    spans = windows(t, use, window_s)
+    centre, mu, sigma = (np.full(len(spans), np.nan) for _ in range(3))
+    for i, (a, b) in enumerate(spans):
+        inside = use & (t >= a) & (t <= b)
+        centre[i] = 0.5 * (a + b)
+        if inside.sum() * dt < MIN_USED * min(window_s, b - a) or T_N_Nm <= 0:
+            continue
+        error = cycle_mean_error([meas[inside]], dt)
+        if error is None:
+            continue
+        mu[i] = mu_k + (cycle_mean([meas[inside]], dt) - cycle_mean([model[inside]], dt)) \
+            / T_N_Nm
+        sigma[i] = np.sqrt(2.0) * error[0] / T_N_Nm
+    half = np.hypot(tolerance * mu, 2.0 * sigma)
+    trend = FrictionTrend(centre, mu, half, sigma, tolerance=tolerance, window_s=window_s)
+    return drift_test(trend)
+
+
+def drift_test(trend: FrictionTrend) -> FrictionTrend:
+    """The trend with its drift test (eq. 6.6c) on the windows that do not overlap (every
+    other one, from the first valid): a weighted linear trend significant at 95 % whose change
+    over them exceeds ``trend.tolerance`` of the mean μ_k, or two of them apart by more than
+    that plus 2σ of their difference."""
+    ok = np.flatnonzero(np.isfinite(trend.mu_k))
+    if ok.size == 0:
+        return trend
+    independent = _spaced(trend.centre_s, ok, trend.window_s)
+    if independent.size < MIN_WINDOWS:
+        return trend
+    t_h = trend.centre_s[independent] / 3600.0
+    mu, sig = trend.mu_k[independent], np.maximum(trend.sigma[independent], 1e-12)
+    w = 1.0 / sig**2
+    tm = np.sum(w * t_h) / np.sum(w)
+    sxx = np.sum(w * (t_h - tm) ** 2)
+    slope = float(np.sum(w * (t_h - tm) * (mu - np.sum(w * mu) / np.sum(w))) / sxx)
+    fitted = np.sum(w * mu) / np.sum(w) + slope * (t_h - tm)
+    scatter = float(np.sum(w * (mu - fitted) ** 2) / (mu.size - 2)) if mu.size > 2 else 1.0
+    slope_se = float(np.sqrt(max(scatter, 1.0) / sxx))
+    level = float(np.mean(mu))
+    change = slope * float(t_h[-1] - t_h[0])
+    trending = abs(slope) > Z95 * slope_se and abs(change) > trend.tolerance * level
+    hi, lo = int(np.argmax(mu)), int(np.argmin(mu))
+    stepped = mu[hi] - mu[lo] > trend.tolerance * level + 2.0 * Z95 * float(
+        np.hypot(sig[hi], sig[lo]))
+    return FrictionTrend(trend.centre_s, trend.mu_k, trend.half_width, trend.sigma,
+                         drift=bool(trending or stepped), rate_per_h=slope, change=change,
+                         tolerance=trend.tolerance, window_s=trend.window_s)
+
+
+def _spaced(centre_s: np.ndarray, index: np.ndarray, window_s: float) -> np.ndarray:
+    """Of ``index`` (in time order), those at least a window after the previous kept one."""
+    kept: list[int] = []
+    for i in index:
+        if not kept or centre_s[i] - centre_s[kept[-1]] >= window_s * (1.0 - 1e-9):
+            kept.append(int(i))
+    return np.asarray(kept, dtype=int)
+
+
+def drift_verdict(trend: FrictionTrend | None) -> tuple[tuple, tuple]:
+    """The flag and the sentence of a segment whose friction moved (none when it did not):
+    ``mu_k_drift``; the segment's μ_k is then the mean of the windows, a mean over the
+    drift."""
+    if trend is None or not trend.drift:
+        return (), ()
+    return (Flag.MU_K_DRIFT,), (drift_note(trend),)
+
+
+def drift_note(trend: FrictionTrend) -> str:
+    """The segment's sentence on a drift: the range of μ_k(t), its rate, and that the
+    segment's μ_k is a mean over it (no number of the segment's μ_k: it may be withheld)."""
+    ok = np.isfinite(trend.mu_k)
+    lo, hi = float(np.min(trend.mu_k[ok])), float(np.max(trend.mu_k[ok]))
+    rate = trend.rate_per_h or 0.0
+    return (f"friction moved within the segment (mu_k_drift): the {trend.window_s:g}-s "
+            f"windows' μ_k(t) ran from {lo:.3f} to {hi:.3f}, a trend of {rate:+.3f}/h "
+            f"({100 * rate / trend.mean:+.0f} %/h); the segment's μ_k is a mean over the "
+            "drift, estimates.parquet's μ_k column holds μ_k(t) (docs/theory.md §6.6)")

@@ -1,0 +1,149 @@
+"""Friction that moves within a segment (issue 34 item 6): μ_k(t) from windowed re-fits of
+the mean torque and the drift test (drillfric.estimation.friction_trend, docs/theory.md §6.6).
+
+The torques here are built from the equation the module inverts: the model's string torque
+is a stick-slip-like oscillation about a fixed part plus μ_k·T_N, the measured one the same
+with μ_k(t) in place of μ_k plus white noise. Window by window the re-fit must return the
+mean of μ_k(t) over the window; a constant friction must raise no drift; a ramp must, with
+its rate; a step must have its rows near the step withheld, not interpolated.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drillfric.estimation.friction_trend import (
+    MAX_BEND,
+    FrictionTrend,
+    drift_test,
+    drift_verdict,
+    friction_trend,
+    windows,
+)
+from drillfric.result import Flag
+
+DT = 0.1  # [s] 10 Hz
+T_N = 40e3  # [N·m] torque per unit friction factor
+MU_K = 0.25
+FIXED = 2e3  # [N·m] viscous and cased torque, not proportional to μ_k
+PERIOD = 4.0  # [s] stick-slip period
+NOISE = 300.0  # [N·m] torque noise
+
+
+def _torques(mu_of_t, duration_s=1200.0, seed=1):
+    """(t, measured, model at MU_K): a 30 % swing about the mean torque, noise on the data."""
+    t = np.arange(0.0, duration_s, DT)
+    swing = 0.3 * np.sin(2 * np.pi * t / PERIOD)
+    model = FIXED + MU_K * T_N * (1.0 + swing)
+    measured = FIXED + mu_of_t(t) * T_N * (1.0 + swing) + \
+        np.random.default_rng(seed).normal(0.0, NOISE, t.size)
+    return t, measured, model
+
+
+def _trend(mu_of_t, tolerance=0.05, window_s=120.0, **kw):
+    t, measured, model = _torques(mu_of_t, **kw)
+    usable = t >= 30.0
+    return t, friction_trend(t, measured, model, usable, mu_k=MU_K, T_N_Nm=T_N,
+                             tolerance=tolerance, window_s=window_s)
+
+
+def test_windows_overlap_by_half_and_cover_the_end():
+    """Hop of half a window; the last window ends at the last usable sample (the segment's
+    end is covered), a record shorter than a window is one window."""
+    t = np.arange(0.0, 400.0, 1.0)
+    spans = windows(t, t >= 10.0, 120.0)
+    assert spans[0] == (10.0, 130.0)
+    assert all(b - a == pytest.approx(120.0) for a, b in spans)
+    assert np.diff([a for a, _ in spans])[0] == pytest.approx(60.0)
+    assert spans[-1][1] == pytest.approx(399.0)
+    assert windows(t, t >= 350.0, 120.0) == [(350.0, 399.0)]
+
+
+def test_constant_friction_is_recovered_without_drift():
+    """Constant μ_k: every window within 1 % (noise 300 N·m over 1200 samples per window
+    gives σ ≈ 0.1 % of μ_k), no drift, the rows' μ_k(t) everywhere after the start-up."""
+    t, trend = _trend(lambda t: np.full(t.size, MU_K * 1.1))
+    ok = np.isfinite(trend.mu_k)
+    assert ok.all()
+    np.testing.assert_allclose(trend.mu_k, 1.1 * MU_K, rtol=0.01)
+    assert not trend.drift
+    assert drift_verdict(trend) == ((), ())
+    rows, width = trend.at(t[t >= 90.0])
+    assert np.isfinite(rows).all()
+    # the half-width is the validated tolerance with the statistical part in quadrature
+    assert np.all(width >= 0.05 * rows - 1e-12)
+
+
+def test_ramp_is_tracked_and_flagged_with_its_rate():
+    """μ_k rising 30 % over 20 minutes: each row within 2 % of the truth (the window mean of
+    a linear change is its centre's value; noise σ ≈ 0.1 %), flagged with the rate 0.075/h
+    (0.25 × 30 % per 1/3 h) within 5 %, and the ends beyond the first and last centres
+    withheld."""
+    truth = lambda t: MU_K * (1.0 + 0.3 * t / 1200.0)  # noqa: E731
+    t, trend = _trend(truth)
+    assert trend.drift
+    assert trend.rate_per_h == pytest.approx(MU_K * 0.3 * 3, rel=0.05)
+    flags, notes = drift_verdict(trend)
+    assert flags == (Flag.MU_K_DRIFT,) and "mean over the drift" in notes[0]
+    rows, _ = trend.at(t)
+    shown = np.isfinite(rows)
+    np.testing.assert_allclose(rows[shown], truth(t[shown]), rtol=0.02)
+    assert not shown[t < trend.centre_s[0]].any() and not shown[t > trend.centre_s[-1]].any()
+
+
+def test_step_rows_near_the_step_are_withheld():
+    """A 30 % step at 600 s: windows straddling it bend by ~15 %, beyond MAX_BEND; the rows
+    near the step are withheld, all others within 3 % of the truth (no interpolated value
+    across the step is shown)."""
+    truth = lambda t: MU_K * np.where(t < 600.0, 1.0, 1.3)  # noqa: E731
+    t, trend = _trend(truth)
+    assert trend.drift
+    rows, _ = trend.at(t)
+    shown = np.isfinite(rows)
+    assert not shown[np.abs(t - 600.0) < 30.0].any()
+    np.testing.assert_allclose(rows[shown], truth(t[shown]), rtol=0.03)
+    assert MAX_BEND < 0.15
+
+
+def test_step_up_and_back_down_is_a_drift_without_a_trend():
+    """Friction up 30 % for 6 minutes, then back (a pack-off cleared): the linear trend is
+    flat, the windows' spread is what flags it."""
+    truth = lambda t: MU_K * np.where((t > 400.0) & (t < 760.0), 1.3, 1.0)  # noqa: E731
+    _, trend = _trend(truth)
+    assert trend.drift
+
+
+def test_a_change_within_the_tolerance_is_not_a_drift():
+    """A 4 % rise over the segment is measured (slope significant: σ ≈ 0.1 %) but below the
+    5 % validated tolerance: no flag (a drift the numbers cannot be trusted to show)."""
+    _, trend = _trend(lambda t: MU_K * (1.0 + 0.04 * t / 1200.0))
+    assert trend.rate_per_h > 0
+    assert not trend.drift
+
+
+def test_noisy_windows_do_not_make_a_drift():
+    """Constant friction under heavy noise (σ of a window ≈ 2.5 % of μ_k): the trend's
+    uncertainty grows with it, no drift in 20 seeds (a false flag rate well below 5 %
+    leaves at most one); windows whose 2σ exceed 5 % show no rows."""
+    false = 0
+    for seed in range(20):
+        t, measured, model = _torques(lambda t: np.full(t.size, MU_K), seed=seed)
+        noisy = measured + np.random.default_rng(100 + seed).normal(0.0, 1.5e4, t.size)
+        trend = friction_trend(t, noisy, model, t >= 30.0, mu_k=MU_K, T_N_Nm=T_N,
+                               tolerance=0.05, window_s=120.0)
+        false += trend.drift
+        rows, _ = trend.at(t)
+        loose = 2.0 * trend.sigma > 0.05 * trend.mu_k
+        if loose.all():
+            assert not np.isfinite(rows).any()
+    assert false <= 1
+
+
+def test_too_few_windows_make_no_test():
+    """Two independent windows cannot show a trend: no rate, no flag."""
+    trend = FrictionTrend(np.array([60.0, 120.0, 180.0]), np.array([0.25, 0.3, 0.35]),
+                          np.full(3, 0.02), np.full(3, 1e-3), tolerance=0.05,
+                          window_s=120.0)
+    tested = drift_test(trend)
+    assert tested.rate_per_h is None and not tested.drift
