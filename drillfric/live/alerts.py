@@ -113,6 +113,22 @@ def trend_alert(done: list[SegmentRecord]) -> dict | None:
     return None
 
 
+def friction_rising(latest: list[SegmentRecord]) -> dict | None:
+    """The ``friction_rising`` alert: of the open segment, else the last closed one
+    (``latest``, in that order), the first whose friction moved within it (flag
+    ``mu_k_drift``, docs/theory.md §6.6) upwards (``mu_k_drift_per_h`` > 0); None when
+    neither rose (a drift down — a hole cleaned — is no alarm)."""
+    for record in latest:
+        rate = record.mu_k_drift_per_h
+        if Flag.MU_K_DRIFT in record.quality_flags and rate is not None and rate > 0:
+            span = ("" if record.mu_k_first is None or record.mu_k_last is None else
+                    f" from {record.mu_k_first:.3f} to {record.mu_k_last:.3f}")
+            return alert("friction_rising", f"friction rising within segment {record.id}: "
+                                            f"μ_k(t){span}, {rate:+.3f}/h (cuttings bed, "
+                                            "pack-off?)", record.t_end_s)
+    return None
+
+
 def ended(error: BaseException | None, done: bool, time_s: float | None) -> list[dict]:
     """The alert of a run that ended: ``run_failed`` with its one-line reason (the numbers
     shown are the last published, not current), or ``run_ended``; none while it runs."""
