@@ -246,5 +246,6 @@ def drift_note(trend: FrictionTrend) -> str:
     rate = trend.rate_per_h or 0.0
     return (f"friction moved within the segment (mu_k_drift): the {trend.window_s:g}-s "
             f"windows' μ_k(t) ran from {lo:.3f} to {hi:.3f}, a trend of {rate:+.3f}/h "
-            f"({100 * rate / trend.mean:+.0f} %/h); the segment's μ_k is a mean over the "
-            "drift, estimates.parquet's μ_k column holds μ_k(t) (docs/theory.md §6.6)")
+            f"({100 * rate / trend.mean:+.0f} %/h); the segment's μ_k, where shown, is the "
+            "mean over the drift, estimates.parquet's μ_k column holds μ_k(t) "
+            "(docs/theory.md §6.6)")
