@@ -207,3 +207,27 @@ def test_a_simulated_ramp_is_flagged_and_tracked_a_constant_stand_is_not(tmp_pat
         assert shown.mean() > 0.6
         assert np.all(np.abs(mu[shown] / truth[shown] - 1.0) <= 0.10)
         assert np.all(rows.mu_k_half_width.to_numpy(float)[shown] > 0)
+
+
+def test_rows_of_a_segment_withheld_well_wide_lose_their_mu_k_in_memory():
+    """The API without ``out`` (MemorySink): a segment whose factors the string-weight check
+    withheld gives its seeded rows without μ_k(t); the rows held keep it (a later
+    publication may judge otherwise) and the other segment's rows are untouched."""
+    import pandas as pd
+
+    from drillfric.result import SegmentRecord
+    from drillfric.runner.finish import MemorySink
+
+    sink = MemorySink()
+    for seg_id in (1, 2):
+        sink.add({"estimates": pd.DataFrame({"segment_id": seg_id, "start_id": [0, -1],
+                                             "mu_k": [0.2, 0.25],
+                                             "mu_k_half_width": [np.nan, 0.01]})}, False)
+    records = [SegmentRecord(id=1, quality_flags=(Flag.STRING_WEIGHT_UNVERIFIED,)),
+               SegmentRecord(id=2)]
+    sink.finish(None, {}, records, None, {})
+    out = sink.estimates()
+    assert np.isnan(out["mu_k"].iloc[1])
+    assert out["mu_k"].iloc[0] == 0.2 and out["mu_k"].iloc[3] == 0.25
+    assert np.isnan(out["mu_k_half_width"].iloc[1])
+    assert sink.frames["estimates"][0]["mu_k"].iloc[1] == 0.25
