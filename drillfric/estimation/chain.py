@@ -750,10 +750,13 @@ def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Ver
     speed = np.interp(fitted.time_s, meas.time_s, np.abs(meas.surface_rad_s))
     fast = np.flatnonzero(speed > settings.omega_c_rad_s)
     usable = fitted.scored & (fitted.time_s <= fitted.time_s[fast[-1]])
-    return friction_trend(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, usable,
-                          mu_k=verdict.mu_k, T_N_Nm=models.observer.plant.T_N_Nm,
-                          tolerance=mu_k_tolerance(models.logged.interval_s),
-                          window_s=settings.batch.trend_window_s)
+    trend = friction_trend(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, usable,
+                           mu_k=verdict.mu_k, T_N_Nm=models.observer.plant.T_N_Nm,
+                           tolerance=mu_k_tolerance(models.logged.interval_s),
+                           window_s=settings.batch.trend_window_s)
+    # on bottom μ_k(t) is the apparent friction: a change of the bit torque (the WOB) moves
+    # it as friction would, so it is not called a drift of the friction (§6.6)
+    return replace(trend, drift=False) if models.on_bottom else trend
 
 
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,

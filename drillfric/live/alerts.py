@@ -40,7 +40,9 @@ def open_view(record: SegmentRecord, folder: Path) -> dict:
             "bit_rpm": bit_rpm, "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
             "stick_slip_severity": record.stick_slip_severity,
             "stick_slip_beyond_validated":
-                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
+                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags,
+            "mu_k_drift": Flag.MU_K_DRIFT in record.quality_flags,
+            "mu_k_last": record.mu_k_last, "mu_k_drift_per_h": record.mu_k_drift_per_h}
 
 
 def severe_stick_slip(open_segment: dict) -> str:
