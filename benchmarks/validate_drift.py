@@ -6,9 +6,11 @@ Each record is one stand of the demo well's string and path (examples/demo) at 2
 follows a ``mu_k_schedule`` (docs/simulator.md): ramps of 10–40 % over 5–30 minutes from
 2 minutes in, steps up and down at 10 minutes, a 6-minute pack-off (+30 %) that clears, and
 constant-friction controls that could fake a drift — stick-slip, a steady rotation
-(μ_s = μ_k, 120 RPM), set-point changes (60 → 100 → 60 RPM) and drilling on bottom at
-20 m/h (the string lengthening under a 12-t Coulomb bit). Each is logged at 100, 10, 5 and
-1 Hz and as 1-s means and run through the whole pipeline (:func:`drillfric.run`).
+(μ_s = μ_k, 120 RPM), set-point changes (60 → 100 → 60 RPM), drilling on bottom at
+20 m/h (the string lengthening under a 12-t Coulomb bit), a Stribeck plant (not the model's
+law; with a ramp too) and validate_trust's sensors (lag, quantisation, dropouts). Each is
+logged at 100, 10, 5 and 1 Hz and as 1-s means and run through the whole pipeline
+(:func:`drillfric.run`).
 
 Scored, per record and rate:
 
@@ -64,6 +66,9 @@ def _step(factor: float) -> dict:
             "mu_k_schedule": [[0.0, 1.0], [600.0, 1.0], [600.0, factor]]}
 
 
+#: The Stribeck plant of validate_trust: μ falls from μ_s at rest to μ_k (v_s 0.5 rad/s).
+STRIBECK = {"friction_law": "stribeck", "stribeck_speed_rad_s": 0.5, "stribeck_exponent": 1.0}
+
 #: name → (stand keys, simulate keys, what it is); a stand without ``mu_k_schedule`` is a
 #: constant-friction control.
 CASES = {
@@ -78,7 +83,15 @@ CASES = {
     "pack-off": ({"duration_s": 1200.0, "mu_k_schedule": [
         [0.0, 1.0], [400.0, 1.0], [400.0, 1.3], [760.0, 1.3], [760.0, 1.0]]}, {},
         "μ_k +30 % for 6 min, then back"),
+    "stribeck-ramp30-20": (_ramp(30, 20), STRIBECK,
+                           "μ_k +30 % over 20 min on a Stribeck plant (not the model's law)"),
     "const": ({"duration_s": 1200.0}, {}, "constant friction, stick-slip"),
+    "const-stribeck": ({"duration_s": 1200.0}, STRIBECK,
+                       "constant friction, Stribeck law (v_s = 0.5 rad/s)"),
+    "sensors": ({"duration_s": 1200.0}, {"rpm_resolution": 1.0,
+                                         "torque_resolution_Nm": 100.0},
+                "constant friction, 0.3 s speed lag, 1 RPM / 100 N·m quantisation, dropouts "
+                "(validate_trust's sensors)"),
     "const-steady": ({"duration_s": 1200.0, "rpm": 120.0}, {"mu_s": MU_K},
                      "constant friction, steady rotation (μ_s = μ_k, 120 RPM)"),
     "const-setpoints": ({"duration_s": 1200.0, "setpoint_rpm": [

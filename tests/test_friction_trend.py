@@ -128,7 +128,8 @@ def test_a_change_within_the_tolerance_is_not_a_drift():
 def test_noisy_windows_do_not_make_a_drift():
     """Constant friction under heavy noise (σ of a window ≈ 2.5 % of μ_k): the trend's
     uncertainty grows with it, no drift in 20 seeds (a false flag rate well below 5 %
-    leaves at most one); windows whose 2σ exceed 5 % show no rows."""
+    leaves at most one); the rows show the level the windows agree on, whose σ is the
+    windows' over √(independent windows) ≈ 0.8 %: within the issue's 10 % wherever shown."""
     false = 0
     for seed in range(20):
         t, measured, model = _torques(lambda t: np.full(t.size, MU_K), seed=seed)
@@ -137,9 +138,8 @@ def test_noisy_windows_do_not_make_a_drift():
                                tolerance=0.05, window_s=120.0)
         false += trend.drift
         rows, _ = trend.at(t)
-        loose = 2.0 * trend.sigma > 0.05 * trend.mu_k
-        if loose.all():
-            assert not np.isfinite(rows).any()
+        shown = np.isfinite(rows)
+        assert np.all(np.abs(rows[shown] / MU_K - 1.0) <= 0.10)
     assert false <= 1
 
 
@@ -231,3 +231,20 @@ def test_rows_of_a_segment_withheld_well_wide_lose_their_mu_k_in_memory():
     assert out["mu_k"].iloc[0] == 0.2 and out["mu_k"].iloc[3] == 0.25
     assert np.isnan(out["mu_k_half_width"].iloc[1])
     assert sink.frames["estimates"][0]["mu_k"].iloc[1] == 0.25
+
+
+def test_windows_that_scatter_beyond_their_statistics_widen_their_uncertainty():
+    """A model that misses the record by a share that wanders from window to window
+    (±6 %, alternating, each window's own σ 0.1 %): the scatter of the windows' second
+    differences is taken as their σ (eq. 6.6b), so no drift is called from it and the rows
+    show their level, within 1 % of the truth."""
+    wander = lambda t: MU_K * (1.0 + 0.06 * np.sign(np.sin(2 * np.pi * t / 240.0)))  # noqa: E731
+    t, measured, model = _torques(lambda t: np.full(t.size, MU_K))
+    shifted = measured + (wander(t) - MU_K) * T_N
+    trend = friction_trend(t, shifted, model, t >= 30.0, mu_k=MU_K, T_N_Nm=T_N,
+                           tolerance=0.05, window_s=120.0)
+    assert np.nanmin(trend.sigma) > 0.01
+    assert not trend.drift
+    rows, _ = trend.at(t)
+    assert np.isfinite(rows).any()
+    np.testing.assert_allclose(rows[np.isfinite(rows)], MU_K, rtol=0.01)

@@ -34,7 +34,7 @@ above :data:`MU_K_CLAIM` (nothing is claimed there).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -52,6 +52,8 @@ MAX_BEND = 0.05
 MIN_WINDOWS = 3
 #: Two-sided 95 % normal quantile of the drift test.
 Z95 = 1.96
+#: Second differences of the windows that estimate their scatter beyond statistics.
+MIN_BENDS = 3
 
 
 @dataclass(frozen=True)
@@ -99,8 +101,12 @@ class FrictionTrend:
 
     def at(self, time_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """μ_k(t) [-] and its 95 % half-width [-] at ``time_s`` [s], NaN where withheld
-        (module docstring: a bend, beyond the end centres of a drift, a gap)."""
+        (module docstring): of a drifting segment the windows interpolated (withheld near a
+        bend, beyond the end centres, across a gap); else the level the windows agree on
+        (:meth:`level`)."""
         t = np.asarray(time_s, dtype=float)
+        if not self.drift:
+            return self.level(t)
         ok = np.isfinite(self.mu_k) & (self.sigma * 2.0 <= MU_K_CLAIM * self.mu_k)
         out = np.full(t.size, np.nan), np.full(t.size, np.nan)
         if not ok.any():
@@ -108,15 +114,68 @@ class FrictionTrend:
         c, mu, hw = self.centre_s[ok], self.mu_k[ok], self.half_width[ok]
         value, width = np.interp(t, c, mu), np.interp(t, c, hw)
         hop = 0.5 * self.window_s
-        gone = np.zeros(t.size, dtype=bool)
+        gone = (t < c[0]) | (t > c[-1])
         for i in _bent(mu):
             gone |= np.abs(t - c[i]) < hop * (1.0 + 1e-9)
         for a, b in zip(c[:-1], c[1:], strict=True):
             if b - a > 2.0 * hop * (1.0 + 1e-9):  # a gap: nothing known between
                 gone |= (t > a) & (t < b)
-        if self.drift:
-            gone |= (t < c[0]) | (t > c[-1])
         return np.where(gone, np.nan, value), np.where(gone, np.nan, width)
+
+    def level(self, time_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """μ_k(t) of a segment whose friction did not move beyond its uncertainty [-], and
+        its 95 % half-width [-]: the weighted linear trend of the independent windows (their
+        weighted mean with fewer than :data:`MIN_WINDOWS`), held beyond the first and last
+        centres; NaN where its 2σ exceeds :data:`MU_K_CLAIM` of it (eq. 6.6d)."""
+        t = np.asarray(time_s, dtype=float)
+        index = _spaced(self.centre_s, np.flatnonzero(np.isfinite(self.mu_k)), self.window_s)
+        if index.size == 0:
+            return np.full(t.size, np.nan), np.full(t.size, np.nan)
+        c = self.centre_s[index]
+        line = _line(c / 3600.0, self.mu_k[index], self.sigma[index],
+                     slope=index.size >= MIN_WINDOWS)
+        value, se = line.at(np.clip(t, c[0], c[-1]) / 3600.0)
+        gone = 2.0 * se > MU_K_CLAIM * value
+        width = np.hypot(self.tolerance * value, 2.0 * se)
+        return np.where(gone, np.nan, value), np.where(gone, np.nan, width)
+
+
+@dataclass(frozen=True)
+class _Line:
+    """A weighted straight line μ = level + slope·(t − t_mean) [t in h] and what its
+    standard error needs (weights 1/σ², the scale max(χ²/dof, 1))."""
+
+    level: float
+    slope: float
+    t_mean: float
+    sum_w: float
+    sxx: float
+    scale: float
+
+    def at(self, t_h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The line and its standard error at ``t_h`` [h]."""
+        dt = np.asarray(t_h, dtype=float) - self.t_mean
+        var = self.scale * (1.0 / self.sum_w + (dt**2 / self.sxx if self.sxx > 0 else 0.0))
+        return self.level + self.slope * dt, np.sqrt(var)
+
+    @property
+    def slope_se(self) -> float:
+        """Standard error of the slope [1/h] (inf without a slope)."""
+        return float(np.sqrt(self.scale / self.sxx)) if self.sxx > 0 else float("inf")
+
+
+def _line(t_h: np.ndarray, mu: np.ndarray, sigma: np.ndarray, *, slope: bool) -> _Line:
+    """Weighted least squares of ``mu`` on ``t_h`` [h] with 1-σ ``sigma`` (a constant when
+    not ``slope``); the scale of its errors is the residuals' χ² per degree of freedom where
+    it exceeds 1 (the windows scatter more than their σ say)."""
+    w = 1.0 / np.maximum(sigma, 1e-12) ** 2
+    tm = float(np.sum(w * t_h) / np.sum(w))
+    level = float(np.sum(w * mu) / np.sum(w))
+    sxx = float(np.sum(w * (t_h - tm) ** 2)) if slope else 0.0
+    b = float(np.sum(w * (t_h - tm) * (mu - level)) / sxx) if sxx > 0 else 0.0
+    dof = mu.size - (2 if slope else 1)
+    chi2 = float(np.sum(w * (mu - level - b * (t_h - tm)) ** 2))
+    return _Line(level, b, tm, float(np.sum(w)), sxx, max(chi2 / dof, 1.0) if dof > 0 else 1.0)
 
 
 def _bent(mu: np.ndarray) -> np.ndarray:
@@ -184,6 +243,7 @@ def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm
         mu[i] = mu_k + (cycle_mean([meas[inside]], dt) - cycle_mean([model[inside]], dt)) \
             / T_N_Nm
         sigma[i] = np.sqrt(2.0) * error[0] / T_N_Nm
+    sigma = np.maximum(sigma, form_scatter(mu))
     half = np.hypot(tolerance * mu, 2.0 * sigma)
     trend = FrictionTrend(centre, mu, half, sigma, tolerance=tolerance, window_s=window_s)
     return drift_test(trend)
@@ -195,29 +255,43 @@ def drift_test(trend: FrictionTrend) -> FrictionTrend:
     over them exceeds ``trend.tolerance`` of the mean μ_k, or two of them apart by more than
     that plus 2σ of their difference."""
     ok = np.flatnonzero(np.isfinite(trend.mu_k))
-    if ok.size == 0:
-        return trend
     independent = _spaced(trend.centre_s, ok, trend.window_s)
     if independent.size < MIN_WINDOWS:
         return trend
     t_h = trend.centre_s[independent] / 3600.0
-    mu, sig = trend.mu_k[independent], np.maximum(trend.sigma[independent], 1e-12)
-    w = 1.0 / sig**2
-    tm = np.sum(w * t_h) / np.sum(w)
-    sxx = np.sum(w * (t_h - tm) ** 2)
-    slope = float(np.sum(w * (t_h - tm) * (mu - np.sum(w * mu) / np.sum(w))) / sxx)
-    fitted = np.sum(w * mu) / np.sum(w) + slope * (t_h - tm)
-    scatter = float(np.sum(w * (mu - fitted) ** 2) / (mu.size - 2)) if mu.size > 2 else 1.0
-    slope_se = float(np.sqrt(max(scatter, 1.0) / sxx))
+    mu, sig = trend.mu_k[independent], trend.sigma[independent]
+    line = _line(t_h, mu, sig, slope=True)
     level = float(np.mean(mu))
-    change = slope * float(t_h[-1] - t_h[0])
-    trending = abs(slope) > Z95 * slope_se and abs(change) > trend.tolerance * level
+    change = line.slope * float(t_h[-1] - t_h[0])
+    trending = abs(line.slope) > Z95 * line.slope_se and abs(change) > trend.tolerance * level
     hi, lo = int(np.argmax(mu)), int(np.argmin(mu))
     stepped = mu[hi] - mu[lo] > trend.tolerance * level + 2.0 * Z95 * float(
         np.hypot(sig[hi], sig[lo]))
-    return FrictionTrend(trend.centre_s, trend.mu_k, trend.half_width, trend.sigma,
-                         drift=bool(trending or stepped), rate_per_h=slope, change=change,
-                         tolerance=trend.tolerance, window_s=trend.window_s)
+    return replace(trend, drift=bool(trending or stepped), rate_per_h=line.slope,
+                   change=change)
+
+
+def form_scatter(mu: np.ndarray) -> float:
+    """1-σ scatter of the window μ_k [-] that their statistics do not explain (a model that
+    misses the record by a share that wanders from window to window), eq. 6.6b: from the
+    median |second difference| of consecutive windows, which a ramp leaves at 0 and a step
+    moves at two windows only; with windows overlapping by half var(Δ²μ) = 2σ², so
+    σ = median|Δ²μ| / (0.6745·√2) (0.6745σ: the median of |N(0, σ²)|). 0 with fewer than
+    :data:`MIN_BENDS` second differences.
+
+    Examples
+    --------
+    >>> form_scatter(np.linspace(0.25, 0.35, 9)) < 1e-12  # a ramp: no scatter
+    True
+    >>> round(form_scatter(np.array([0.25, 0.27] * 4)), 3)  # windows alternating by 0.02
+    0.042
+    """
+    ok = np.asarray(mu, dtype=float)
+    ok = ok[np.isfinite(ok)]
+    if ok.size < MIN_BENDS + 2:
+        return 0.0
+    bend = np.abs(ok[:-2] - 2.0 * ok[1:-1] + ok[2:])
+    return float(np.median(bend) / (0.6745 * np.sqrt(2.0)))
 
 
 def _spaced(centre_s: np.ndarray, index: np.ndarray, window_s: float) -> np.ndarray:
