@@ -417,11 +417,12 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("segment_id", "int32", "", "segment id (segments.parquet)"),
     Column("start_id", "int16", "", "observer start (0…), −1 for the seeded ensemble pass"),
     Column("mu_s", "float64", "-", "μ̂_s of the start"),
-    Column("mu_k", "float64", "-", "μ̂_k of the start; on the seeded rows μ_k(t): the "
-                                   "windowed re-fits of the mean torque interpolated between "
-                                   "window centres (docs/theory.md §6.6), null where withheld "
-                                   "(a change faster than the windows resolve, the ends of a "
-                                   "drifting segment)"),
+    Column("mu_k", "float64", "-", "μ̂_k of the start; on the seeded rows μ_k(t) from the "
+                                   "windowed re-fits of the mean torque (docs/theory.md §6.6): "
+                                   "the level the windows agree on where the friction did not "
+                                   "move, interpolated between window centres where it did; "
+                                   "null where withheld (a change faster than the windows "
+                                   "resolve, the ends of a drifting segment)"),
     Column("mu_k_half_width", "float64", "-", "95 % half-width of μ_k(t) (seeded rows)"),
     Column("surface_rpm", "float64", "RPM", "measured top-drive speed"),
     Column("surface_rpm_est", "float64", "RPM", "observer's top-drive speed"),

@@ -24,9 +24,11 @@ windows exceeds the validated tolerance — or when two windows differ by more t
 tolerance plus 2σ of their difference (a step up and back down). Model-form errors common to
 all windows (the batch μ_k's own bias) cancel in the test.
 
-Rows between window centres take μ_k(t) linearly interpolated (exact on a ramp: a window's
-mean of a linear change is its centre's value); a change faster than the windows resolve (a
-step) makes the window values bend: where a window's second difference exceeds
+Rows of a segment whose friction did not move take the level the independent windows agree
+on (their weighted linear trend, eq. 6.6d). Of a drifting segment, rows between window
+centres take μ_k(t) linearly interpolated (exact on a ramp: a window's mean of a linear
+change is its centre's value); a change faster than the windows resolve (a step) makes the
+window values bend: where a window's second difference exceeds
 :data:`MAX_BEND` the rows within a hop of it are withheld, as are the rows beyond the first
 and last centres of a drifting segment and the rows of windows whose own uncertainty is
 above :data:`MU_K_CLAIM` (nothing is claimed there).
