@@ -753,7 +753,8 @@ def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Ver
     trend = friction_trend(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, usable,
                            mu_k=verdict.mu_k, T_N_Nm=models.observer.plant.T_N_Nm,
                            tolerance=mu_k_tolerance(models.logged.interval_s),
-                           window_s=settings.batch.trend_window_s)
+                           window_s=settings.batch.trend_window_s,
+                           anchor_end_s=meas.t0_s + settings.batch.window_s)
     # on bottom μ_k(t) is the apparent friction: a change of the bit torque (the WOB) moves
     # it as friction would, so it is not called a drift of the friction (§6.6)
     return replace(trend, drift=False) if models.on_bottom else trend

@@ -207,7 +207,8 @@ def windows(time_s: np.ndarray, usable: np.ndarray, window_s: float
 
 
 def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm: float,
-                   tolerance: float, window_s: float) -> FrictionTrend:
+                   tolerance: float, window_s: float,
+                   anchor_end_s: float | None = None) -> FrictionTrend:
     """μ_k of each window and the drift test of one segment (docs/theory.md §6.6).
 
     Parameters
@@ -227,6 +228,10 @@ def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm
         the smallest change the drift test calls a drift).
     window_s : float
         Window length [s] (``batch.trend_window_s``); windows overlap by half.
+    anchor_end_s : float, optional
+        End of the span the batch fit matched ``mu_k`` over [s]: the model's mean torque
+        misses the data's there by what the model of the evidence does not share with the
+        fit's (eq. 6.6a), taken off every window. None: no offset.
     """
     t = np.asarray(time_s, dtype=float)
     meas, model = np.asarray(measured_Nm, dtype=float), np.asarray(model_Nm, dtype=float)
@@ -234,6 +239,8 @@ def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm
     dt = float(t[1] - t[0]) if t.size > 1 else 1.0
     spans = windows(t, use, window_s)
     centre, mu, sigma = (np.full(len(spans), np.nan) for _ in range(3))
+    offset, offset_sigma = _offset(meas, model, use & (t <= (
+        np.inf if anchor_end_s is None else anchor_end_s)), dt, anchor_end_s is not None)
     for i, (a, b) in enumerate(spans):
         inside = use & (t >= a) & (t <= b)
         centre[i] = 0.5 * (a + b)
@@ -242,13 +249,27 @@ def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm
         error = cycle_mean_error([meas[inside]], dt)
         if error is None:
             continue
-        mu[i] = mu_k + (cycle_mean([meas[inside]], dt) - cycle_mean([model[inside]], dt)) \
-            / T_N_Nm
-        sigma[i] = np.sqrt(2.0) * error[0] / T_N_Nm
+        mu[i] = mu_k + (cycle_mean([meas[inside]], dt) - cycle_mean([model[inside]], dt)
+                        - offset) / T_N_Nm
+        sigma[i] = np.hypot(np.sqrt(2.0) * error[0], offset_sigma) / T_N_Nm
     sigma = np.maximum(sigma, form_scatter(mu))
     half = np.hypot(tolerance * mu, 2.0 * sigma)
     trend = FrictionTrend(centre, mu, half, sigma, tolerance=tolerance, window_s=window_s)
     return drift_test(trend)
+
+
+def _offset(measured: np.ndarray, model: np.ndarray, span: np.ndarray, dt: float,
+            anchored: bool) -> tuple[float, float]:
+    """Whole-cycle mean of measured − model torque over ``span`` [N·m] and its standard error
+    (√2 × the data's, as a window's) [N·m]; (0, 0) when not ``anchored`` or the span holds
+    too few cycles."""
+    if not anchored or span.sum() < 3:
+        return 0.0, 0.0
+    error = cycle_mean_error([measured[span]], dt)
+    if error is None:
+        return 0.0, 0.0
+    return (cycle_mean([measured[span]], dt) - cycle_mean([model[span]], dt),
+            float(np.sqrt(2.0) * error[0]))
 
 
 def drift_test(trend: FrictionTrend) -> FrictionTrend:
