@@ -266,3 +266,17 @@ def test_the_batch_span_anchors_a_model_that_misses_the_mean_by_a_constant():
     shown = np.isfinite(rows)
     np.testing.assert_allclose(rows[shown], truth(t[shown]), rtol=0.02)
     assert np.nanmin(loose.mu_k[loose.centre_s < 500.0]) > 1.12 * MU_K
+
+
+def test_a_segment_too_short_for_the_drift_test_withholds_a_change_it_cannot_test():
+    """A 6-minute segment (two independent windows: no drift test) whose friction rises
+    40 % in it: its windows differ by more than the tolerance, so no level is shown (a
+    constant there would be up to 20 % off); with constant friction its level is shown."""
+    ramp = lambda t: MU_K * (1.0 + 0.4 * t / 360.0)  # noqa: E731
+    t, trend = _trend(ramp, duration_s=360.0)
+    assert trend.rate_per_h is None and not trend.drift
+    assert not np.isfinite(trend.at(t)[0]).any()
+    t, flat = _trend(lambda t: np.full(t.size, MU_K), duration_s=360.0)
+    rows = flat.at(t)[0]
+    assert np.isfinite(rows).all()
+    np.testing.assert_allclose(rows, MU_K, rtol=0.01)

@@ -128,10 +128,16 @@ class FrictionTrend:
         """μ_k(t) of a segment whose friction did not move beyond its uncertainty [-], and
         its 95 % half-width [-]: the weighted linear trend of the independent windows (their
         weighted mean with fewer than :data:`MIN_WINDOWS`), held beyond the first and last
-        centres; NaN where its 2σ exceeds :data:`MU_K_CLAIM` of it (eq. 6.6d)."""
+        centres; NaN where its 2σ exceeds :data:`MU_K_CLAIM` of it (eq. 6.6d), and
+        everywhere when too few windows for the drift test differ by more than the
+        tolerance."""
         t = np.asarray(time_s, dtype=float)
-        index = _spaced(self.centre_s, np.flatnonzero(np.isfinite(self.mu_k)), self.window_s)
-        if index.size == 0:
+        valid = np.flatnonzero(np.isfinite(self.mu_k))
+        index = _spaced(self.centre_s, valid, self.window_s)
+        if index.size == 0 or (index.size < MIN_WINDOWS and np.ptp(self.mu_k[valid])
+                               > self.tolerance * float(np.mean(self.mu_k[valid]))):
+            # no windows, or too few to test a drift and apart by more than the tolerance:
+            # a change the test cannot see, so no level is claimed
             return np.full(t.size, np.nan), np.full(t.size, np.nan)
         c = self.centre_s[index]
         line = _line(c / 3600.0, self.mu_k[index], self.sigma[index],
