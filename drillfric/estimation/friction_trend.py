@@ -6,9 +6,11 @@ driven by the measured top-drive speed over the whole segment at that μ_k (the 
 :func:`drillfric.estimation.chain.fit_evidence`), carries the torque and drag, the viscous
 and cased torque, the stick-slip and every set-point change of the segment. Over a window of
 ``batch.trend_window_s`` (50 % overlap) the measured whole-cycle mean string torque M_w and
-the model's m_w then differ only by the friction that moved (eq. 6.6a):
+the model's m_w then differ only by the friction that moved and by what the evidence's model
+(driven by the logged speed) does not share with the fit's (the replayed drive), which the
+span B the fit matched μ_k on measures (eq. 6.6a):
 
-    μ_k,w = μ_k + (M_w − m_w) / T_N,
+    μ_k,w = μ_k + (M_w − m_w − (M_B − m_B)) / T_N,
 
 T_N = ∫F_c dx of the estimated part (the mean friction torque's slope in μ_k, §6.4: with all
 else fixed the mean torque of the model is linear in μ_k to within its jitter). Each window
