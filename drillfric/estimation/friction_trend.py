@@ -73,14 +73,13 @@ class FrictionTrend:
     half_width : ndarray
         95 % half-width of each window's μ_k [-] (eq. 6.6b).
     sigma : ndarray
-        1-σ statistical uncertainty of each window's μ_k [-].
+        1-σ uncertainty of each window's μ_k [-]: statistical, raised to the windows'
+        scatter beyond it (:func:`form_scatter`) and with the anchor's error.
     drift : bool
         Whether the friction moved beyond its uncertainty (eq. 6.6c).
     rate_per_h : float or None
         Linear trend of the independent windows' μ_k [1/h] (None with fewer than
         :data:`MIN_WINDOWS`).
-    change : float
-        μ_k of the trend at the last independent window minus at the first [-].
     tolerance : float
         Relative validated tolerance the test used [-].
     window_s : float
@@ -93,7 +92,6 @@ class FrictionTrend:
     sigma: np.ndarray
     drift: bool = False
     rate_per_h: float | None = None
-    change: float = 0.0
     tolerance: float = 0.0
     window_s: float = 0.0
 
@@ -298,8 +296,7 @@ def drift_test(trend: FrictionTrend) -> FrictionTrend:
     hi, lo = int(np.argmax(mu)), int(np.argmin(mu))
     stepped = mu[hi] - mu[lo] > trend.tolerance * level + 2.0 * Z95 * float(
         np.hypot(sig[hi], sig[lo]))
-    return replace(trend, drift=bool(trending or stepped), rate_per_h=line.slope,
-                   change=change)
+    return replace(trend, drift=bool(trending or stepped), rate_per_h=line.slope)
 
 
 def form_scatter(mu: np.ndarray) -> float:
