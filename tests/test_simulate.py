@@ -566,6 +566,8 @@ def test_friction_schedule_raises_the_torque_and_records_the_truth():
     friction = out.stands[0].T_N_Nm * 0.25
     # steady sliding: the torque rise is 0.3·μ_k·T_N within the ringing's 2 % of it
     assert after - before == pytest.approx(0.3 * friction, rel=0.02)
+    assert out.truth()["stands"][0]["mu_k_schedule"] == [
+        [0.0, 0.25], [40.0, 0.25], [40.0, pytest.approx(0.325)]]
     plain = sim.simulate(cfg, path, scenario.Scenario((replace(stand, mu_k_schedule=None),),
                                                       0.0))
     assert "mu_k_true" not in plain.columns

@@ -70,6 +70,8 @@ class StandResult:
     ``T_N_Nm`` is ∫F_c dx over the part of the string whose truth is ``mu_s``, ``mu_k``
     (the open hole with a cased truth, else the whole string), ``T_N_cased_Nm`` over the
     cased part (0 without a cased truth) [N·m per unit friction factor].
+    ``mu_k_schedule`` is the open hole's true μ_k in time of a stand whose friction follows
+    a schedule, [[t_s on the global clock, μ_k], ...] (None: constant ``mu_k``).
     ``bit_torque_time_mean_Nm`` is the time-mean of the torque the bit applied from the end of the
     start-up to the start of the stop [N·m] (0 off bottom): with a rate-weakening bit in
     stick-slip it differs from ``bit_torque_k_Nm`` = T_k = μ_bit·WOB·D_bit/3.
@@ -116,6 +118,7 @@ class StandResult:
     hookload_moving_N: float | None = None
     torque_moving_Nm: float | None = None
     T_N_moving_Nm: float | None = None
+    mu_k_schedule: list | None = None
 
 
 @dataclass(frozen=True)
@@ -518,8 +521,17 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
                          bit_torque_k_Nm=plant.bit_torque_cap_Nm,
                          bit_weakening_ratio=stand.bit_weakening_ratio,
                          bit_weakening_rpm=stand.bit_weakening_rpm,
+                         mu_k_schedule=_schedule_truth(stand, settings.mu_k, t0),
                          **_reaming_truth(stand, plants, tds, t0))
     return cols, result
+
+
+def _schedule_truth(stand: Stand, mu_k: float, t0: float) -> list | None:
+    """The stand's ``mu_k_schedule`` as the open hole's μ_k on the global clock,
+    [[t_s, μ_k], ...] (None without one)."""
+    if stand.mu_k_schedule is None:
+        return None
+    return [[t0 + stand.idle_s + t, mu_k * f] for t, f in stand.mu_k_schedule]
 
 
 def _held_factor(stand: Stand, time_s: np.ndarray) -> np.ndarray:
