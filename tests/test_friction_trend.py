@@ -280,3 +280,23 @@ def test_a_segment_too_short_for_the_drift_test_withholds_a_change_it_cannot_tes
     rows = flat.at(t)[0]
     assert np.isfinite(rows).all()
     np.testing.assert_allclose(rows, MU_K, rtol=0.01)
+
+
+def test_the_report_draws_the_seeded_rows_mu_k_t_with_its_band():
+    """The evidence's μ panel (report): the seeded pass's source carries μ_k(t) ∓ its
+    half-width as the band's edges; an observer start's rows (no half-width) carry none."""
+    import pandas as pd
+
+    from drillfric.report.evidence import evidence_sources
+
+    t = np.arange(0.0, 3.0)
+    est = pd.DataFrame({"time_s": np.r_[t, t], "start_id": [0] * 3 + [-1] * 3,
+                        "mu_k": [0.2, 0.21, 0.22, 0.25, 0.26, np.nan],
+                        "mu_s": 0.5, "mu_k_half_width": [np.nan] * 3 + [0.01, 0.02, np.nan],
+                        "surface_rpm": 60.0, "surface_rpm_est": 60.0})
+    sources = evidence_sources(est, None, bit=False)
+    seeded = sources["start:-1"]
+    np.testing.assert_allclose(seeded["low"][:2], [0.24, 0.24], rtol=1e-6)
+    np.testing.assert_allclose(seeded["high"][:2], [0.26, 0.28], rtol=1e-6)
+    assert np.isnan(seeded["low"][2])
+    assert "low" not in sources["start:0"]
