@@ -908,8 +908,9 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         mu_k_observer=steps.diag.mu_k, mu_s_observer=steps.diag.mu_s,
         mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags + trace.flags + drift_flags,
-        messages=tuple(messages) + _interval_note(refined, verdict, trace) + trace.messages
-        + drift_messages + _dropped_note(models),
+        messages=tuple(messages) + (() if drift_flags else  # the fit's ± is its window's
+                                    _interval_note(refined, verdict, trace))
+        + trace.messages + drift_messages + _dropped_note(models),
         starts=steps.starts, first=steps.first, final=final, bit=bit,
         bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=models.td,
         mu_s_seed=verdict.mu_s_seed, evidence=steps.fitted, bit_speed=trace.bit_speed,
