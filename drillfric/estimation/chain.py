@@ -749,6 +749,8 @@ def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Ver
     meas = models.meas
     speed = np.interp(fitted.time_s, meas.time_s, np.abs(meas.surface_rad_s))
     fast = np.flatnonzero(speed > settings.omega_c_rad_s)
+    if fast.size == 0:
+        return None
     usable = fitted.scored & (fitted.time_s <= fitted.time_s[fast[-1]])
     trend = friction_trend(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, usable,
                            mu_k=verdict.mu_k, T_N_Nm=models.observer.plant.T_N_Nm,

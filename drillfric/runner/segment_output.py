@@ -175,7 +175,9 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
     carry most of the weight) with the members' min–max bit speed as
     ``bit_rpm_est_min/max`` (NaN on the starts' rows) and μ_k(t) of the windowed re-fits
-    with its half-width (``est.trend``, docs/theory.md §6.6). Where the logging does not resolve
+    with its half-width (``est.trend``, docs/theory.md §6.6; null where the segment's
+    factors are withheld, unless the friction moved: a seeded trace that runs away from a
+    constant μ_k is what a drift makes). Where the logging does not resolve
     the stick-slip cycle the bit columns are null: no trace is drawn from such data; so are
     they in the 30-s windows the window-by-window check withheld (``est.bit_windows_withheld``).
     """
@@ -185,9 +187,11 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
                            est.bit.stuck(est.final, omega_c), est)
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
-    if est.trend is not None:
+    if est.trend is not None and (est.trend.drift or not est.factors_withheld):
         seeded["mu_k"], seeded["mu_k_half_width"] = est.trend.at(
             seeded["time_s"].to_numpy(float))
+    elif est.factors_withheld:  # the seed is the factor the segment's rules withheld
+        seeded["mu_k"] = np.nan
     frame = pd.concat([first, seeded], ignore_index=True)
     gone = np.zeros(len(frame), dtype=bool) if est.bit_speed.resolved else \
         np.ones(len(frame), dtype=bool)
