@@ -307,6 +307,11 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
             "the first this-many seconds of each segment (the mean-torque match needs "
             "minutes; creep start-ups are at the start). At least 10 s: a shorter window "
             "holds less than one stick-slip cycle.", min=10.0),
+        Key("trend_window_s", float, 120.0, "s", "Window of the re-fits that give μ_k(t) over "
+            "the whole segment (windows overlap by half; docs/theory.md §6.6): friction that "
+            "moves within a stand is tracked at this resolution, a change faster than it is "
+            "withheld. Shorter windows hold fewer torque cycles (a larger stated "
+            "uncertainty).", min=30.0, max=1800.0),
     ),
     "segmentation": (
         _positive("rotating_rpm", 2.0, "RPM", "Surface speed above which the string starts "

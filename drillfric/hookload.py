@@ -437,7 +437,8 @@ class Outcome:
 
 #: The friction numbers a contradicted segment withholds.
 _WITHHELD = ("mu_s", "mu_k", "mu_s_lower_bound", "mu_s_spread", "mu_k_spread",
-             "mu_k_damping_uncertainty", "mu_k_observer", "mu_s_observer", "mu_td")
+             "mu_k_damping_uncertainty", "mu_k_observer", "mu_s_observer", "mu_td",
+             "mu_k_drift_per_h", "mu_k_first", "mu_k_last")
 
 
 #: A note that states a friction factor: μ_k or μ_s, a relation and a number.

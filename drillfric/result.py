@@ -54,6 +54,7 @@ class Flag(StrEnum):
     FACTORS_RUN_AWAY = "factors_run_away"
     PIPE_MOVING = "pipe_moving"
     CHANNEL_SKEW_UNIDENTIFIED = "channel_skew_unidentified"
+    MU_K_DRIFT = "mu_k_drift"
 
     @classmethod
     def _missing_(cls, value):
@@ -141,6 +142,10 @@ FLAG_MEANINGS = {
                                     "stuck fraction and severity, whose phase rests on the "
                                     "channels' timing, are withheld (docs/bit_speed.md, "
                                     "Channel skew)",
+    Flag.MU_K_DRIFT: "the friction moved within the segment beyond its uncertainty (windowed "
+                     "re-fits of the mean torque after torque and drag, docs/theory.md §6.6): "
+                     "mu_k_drift_per_h is its rate, μ_k the mean over the drift, "
+                     "estimates.parquet's μ_k column μ_k(t)",
 }
 
 
@@ -198,6 +203,7 @@ FLAG_RAISED_BY = {
     Flag.FACTORS_RUN_AWAY: (_VERDICT + "decide_trace",),
     Flag.PIPE_MOVING: (_VERDICT + "_pipe_moving",),
     Flag.CHANNEL_SKEW_UNIDENTIFIED: (_VERDICT + "decide_trace",),
+    Flag.MU_K_DRIFT: ("drillfric.estimation.friction_trend.drift_verdict",),
 }
 
 
@@ -395,6 +401,13 @@ class SegmentRecord:
     mse_uncertainty_Pa: float | None = _f("Pa", "95 % half-width of mse_Pa (from T_bit's and a "
                                                 "motor's speed drop)")
     bit_torque_reason: str | None = _f("", "why bit_torque_Nm, mu_bit or mse_Pa is null")
+    mu_k_drift_per_h: float | None = _f("1/h", "linear trend of μ_k(t) over the segment's "
+                                               "independent windows (docs/theory.md §6.6); "
+                                               "the friction moved where the flag "
+                                               "mu_k_drift says so")
+    mu_k_first: float | None = _f("-", "μ_k of the segment's first window (μ_k(t), "
+                                       "batch.trend_window_s)")
+    mu_k_last: float | None = _f("-", "μ_k of the segment's last window")
 
     def to_json(self) -> dict:
         """Plain JSON values (enums as text, NaN as None), in field order."""
@@ -448,7 +461,13 @@ ESTIMATE_COLUMNS: tuple[Column, ...] = (
     Column("segment_id", "int32", "", "segment id (segments.parquet)"),
     Column("start_id", "int16", "", "observer start (0…), −1 for the seeded ensemble pass"),
     Column("mu_s", "float64", "-", "μ̂_s of the start"),
-    Column("mu_k", "float64", "-", "μ̂_k of the start"),
+    Column("mu_k", "float64", "-", "μ̂_k of the start; on the seeded rows μ_k(t) from the "
+                                   "windowed re-fits of the mean torque (docs/theory.md §6.6): "
+                                   "the level the windows agree on where the friction did not "
+                                   "move, interpolated between window centres where it did; "
+                                   "null where withheld (a change faster than the windows "
+                                   "resolve, the ends of a drifting segment)"),
+    Column("mu_k_half_width", "float64", "-", "95 % half-width of μ_k(t) (seeded rows)"),
     Column("surface_rpm", "float64", "RPM", "measured top-drive speed"),
     Column("surface_rpm_est", "float64", "RPM", "observer's top-drive speed"),
     Column("bit_rpm_est", "float64", "RPM", "estimated bit speed: the BHA's plus a declared "

@@ -41,9 +41,14 @@
     put("open-segment", "segment " + open.segment + " (" + open.kind.replace(/_/g, " ") + ", "
         + fixed(open.t_start_s, 0) + "–" + fixed(open.t_end_s, 0) + " s, " + open.status + ")"
         + (old ? " — as of " + age.toFixed(0) + " s before the newest sample, not current" : ""));
-    put("open-mu-k", ok && known(open.mu_k)
+    // friction that moves within the segment (flag mu_k_drift): μ_k(t) of its last window
+    const moving = ok && open.mu_k_drift && known(open.mu_k_last) && known(open.mu_k_drift_per_h)
+      ? " — friction moving: μ_k(t) " + fixed(open.mu_k_last, 3) + " at the last window, "
+        + (open.mu_k_drift_per_h > 0 ? "+" : "") + fixed(open.mu_k_drift_per_h, 3) + "/h"
+      : "";
+    put("open-mu-k", (ok && known(open.mu_k)
       ? fixed(open.mu_k, 3) + (open.kind === "on_bottom_rotating" ? " apparent" : "")
-      : withheld(why));
+      : withheld(why)) + moving);
     put("open-mu-s", ok && known(open.mu_s) ? fixed(open.mu_s, 3)
       : ok && known(open.mu_s_lower_bound) ? "≥ " + fixed(open.mu_s_lower_bound, 3) + " (not identifiable)"
         : withheld(ok ? "not identifiable from these data" : why));

@@ -357,6 +357,13 @@ def test_no_slips_is_unverified_not_consistent(hanging_stand):
         # issue 35 item 6: no friction factor printed in a withheld segment's notes
         assert not any(re.search(r"μ_[ks][^;]{0,12}?(=|≥|≤|≈)\s*\d", s["message"] or "")
                        for s in estimated), [s["message"] for s in estimated]
+        # issue 34 item 6: nor in estimates.parquet's μ_k(t) (the seeded rows); the starts'
+        # rows keep the observer's adaptation (documented as traces, not a result)
+        rows = pd.read_parquet(folder / name / "demo" / "estimates.parquet")
+        seeded = rows["start_id"] == -1
+        assert rows.loc[seeded, "mu_k"].isna().all()
+        assert rows.loc[seeded, "mu_k_half_width"].isna().all()
+        assert rows.loc[~seeded, "mu_k"].notna().any()
 
 
 def test_no_slips_configured_block_weight_catches_wrong_string(hanging_stand):

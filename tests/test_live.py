@@ -208,6 +208,30 @@ def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_tren
     assert alert["kind"] == "friction_trend" and alert["time_s"] == 400.0
 
 
+def test_friction_rising_alert_from_a_segment_whose_friction_rose(tmp_path):
+    """friction_rising (issue 34 item 6): raised by the open segment's, else the last
+    closed segment's, mu_k_drift with a rising rate, carried into live.json's alerts with
+    the segment's end as its time; a drift down (a cleaned hole) or a constant friction
+    raises none."""
+    from drillfric.live.alerts import friction_rising
+    from drillfric.live.run import LiveRun
+    from drillfric.result import Flag, SegmentRecord
+
+    def seg(i, rate, flagged=True):
+        return SegmentRecord(id=i, t_end_s=100.0 * i, mu_k_drift_per_h=rate,
+                             mu_k_first=0.25, mu_k_last=0.32,
+                             quality_flags=(Flag.MU_K_DRIFT,) if flagged else ())
+
+    assert friction_rising([seg(1, 0.2, flagged=False)]) is None  # rate within uncertainty
+    assert friction_rising([seg(1, -0.2)]) is None  # friction fell
+    rising = friction_rising([seg(2, -0.1), seg(1, 0.2)])  # the open one fell, last rose
+    assert rising["kind"] == "friction_rising" and rising["time_s"] == 100.0
+    assert "0.250 to 0.320" in rising["message"] and "+0.200/h" in rising["message"]
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: 0.0)
+    live.view["rising"] = rising
+    assert [a["kind"] for a in live.status()["alerts"]] == ["friction_rising"]
+
+
 def test_a_slow_segment_fit_does_not_hold_back_the_newest_sample(recorded, tmp_path,
                                                                  monkeypatch):
     """Regression (issue 24, lag): the fits ran in the thread that feeds the rows, so

@@ -316,6 +316,9 @@ def test_open_segment_numbers_that_are_withheld_show_as_withheld_in_the_browser(
         first = _visit(browser, server.url, shown)
         live.view["open_segment"] = opened | {"status": "skipped"}
         skipped = _visit(browser, server.url, shown)
+        live.view["open_segment"] = opened | {"mu_k_drift": True, "mu_k_last": 0.31,
+                                              "mu_k_drift_per_h": 0.2}
+        moving = _visit(browser, server.url, shown)
     finally:
         browser.close()
         server.stop()
@@ -325,3 +328,6 @@ def test_open_segment_numbers_that_are_withheld_show_as_withheld_in_the_browser(
     assert first.values["open-bit-rpm"] == f"withheld: {reason}"
     assert first.values["open-severity"] == "0.50"
     assert all(v.startswith("withheld") for k, v in skipped.values.items() if k != "polls")
+    # issue 34 item 6: friction moving within the open segment is shown beside its μ_k
+    assert moving.values["open-mu-k"] == ("0.270 — friction moving: μ_k(t) 0.310 at the last "
+                                          "window, +0.200/h")

@@ -41,3 +41,20 @@ def test_severe_stick_slip_with_statistics_withheld_is_still_noted():
     summary["segments"][1]["quality_flags"] = ["stick_slip_beyond_validated"]
     out = changes(summary, [], ran=True, data_changed_utc=None)
     assert "severe stick-slip (the bit stops) in 1 segment: 2" in out["notes"]
+
+
+def test_wells_whose_friction_rose_within_a_new_segment_are_named():
+    """Issue 34 item 6: a new segment flagged mu_k_drift with a rising rate is named with the
+    steepest rate; a drift down (a cleaned hole) and an old segment's drift are not."""
+    history = [night(_summary(0.25, [0.2]), "d1")]
+    summary = _summary(0.25, [0.2, 0.2, 0.2, 0.2])
+    for seg, rate in zip(summary["segments"], (0.3, 0.1, -0.2, 0.05), strict=True):
+        seg["quality_flags"] = ["mu_k_drift"]
+        seg["mu_k_drift_per_h"] = rate
+    out = changes(summary, history, ran=True, data_changed_utc=None)
+    assert out["notes"][-1].startswith("friction rose within 2 segments: 2, 4")
+    assert "+0.100/h" in out["notes"][-1]
+    summary["segments"][1]["quality_flags"] = []
+    summary["segments"][3]["quality_flags"] = []
+    assert not any("friction rose" in n for n in changes(summary, history, ran=True,
+                                                         data_changed_utc=None)["notes"])

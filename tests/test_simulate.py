@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import h5py
@@ -121,7 +122,7 @@ def test_explicit_setpoint_with_a_step():
     """A repeated knot time is a step; values between knots are linear."""
     t = np.array([0.0, 1.0, 1.0, 2.0])
     v = np.array([0.0, 1.0, 3.0, 3.0])
-    out = sim._interp_steps(np.array([0.5, 0.999, 1.0, 1.5, 5.0]), t, v)
+    out = sim.step_interp(np.array([0.5, 0.999, 1.0, 1.5, 5.0]), t, v)
     np.testing.assert_allclose(out, [0.5, 0.999, 3.0, 3.0, 3.0])
 
 
@@ -514,3 +515,59 @@ def test_truth_power_bit_torque_of_a_stick_slipping_coulomb_bit_is_its_sliding_t
     assert np.min(run.columns["bit_rpm"]) > -0.5  # and never turns backwards
     t_k = T.bit_torque_cap(0.3, 80e3, 0.2159)
     assert truth["bit_power_torque_Nm"] == pytest.approx(t_k, rel=1e-3)
+
+
+# ------------------------------------------------------------------ friction schedule
+
+def test_friction_pieces_follow_a_ramp_and_a_step():
+    """A schedule becomes pieces of ≤ SCHEDULE_PIECE_S, each at the factor of its middle:
+    a ramp 1 → 1.3 over 10 s is 5 pieces whose factors rise by 0.06, a repeated time a
+    step at that very time, a constant part one piece."""
+    stand = scenario.Stand(100.0, idle_s=5.0, mu_k_schedule=(
+        (0.0, 1.0), (10.0, 1.3), (20.0, 1.3), (20.0, 1.0)))
+    pieces = sim.friction_pieces(stand, 0.0, 40.0)
+    ends = [e for e, _ in pieces]
+    factors = [f for _, f in pieces]
+    assert ends[:6] == pytest.approx([5.0, 7.0, 9.0, 11.0, 13.0, 15.0])
+    assert factors[1:6] == pytest.approx([1.03, 1.09, 1.15, 1.21, 1.27])
+    assert pieces[-2] == (pytest.approx(25.0), pytest.approx(1.3))
+    assert pieces[-1] == (pytest.approx(40.0), pytest.approx(1.0))
+    assert sim.friction_pieces(scenario.Stand(100.0), 0.0, 40.0) == [(40.0, 1.0)]
+
+
+@pytest.mark.parametrize("value, word", [
+    ([[0.0, 1.0], [10.0, 0.0]], "factors"), ([[0.0, 1.0], [10.0, 9.0]], "factors"),
+    ([[5.0, 1.0], [10.0, 1.2]], "t = 0")])
+def test_friction_schedule_is_validated(tmp_path, value, word):
+    """Factors must be in (0, 8] and the series start at t = 0 (as setpoint_rpm)."""
+    with pytest.raises(ConfigError, match=word):
+        scenario._stand_from_dict({"bit_depth_m": 100.0, "mu_k_schedule": value}, {},
+                                  "stand[1]", None)
+
+
+def test_friction_schedule_raises_the_torque_and_records_the_truth():
+    """Physics: friction up 30 % halfway through a steady rotation (μ_s = μ_k, 120 RPM: no
+    stick-slip) raises the mean string torque by 30 % of its friction part (the viscous part
+    stays), and the truth column follows the factor; without a schedule there is no truth
+    column (constant friction is the truth file's μ_k)."""
+    cfg = config_from_dict({"simulate": {"rate_hz": 10.0, "mu_s": 0.25, "mu_k": 0.25,
+                                         "cells": 120, "rpm_noise": 0.0,
+                                         "torque_noise_Nm": 0.0}})
+    path = minimum_curvature([0.0, 500.0, 1000.0, 2000.0], np.radians([0, 0, 30, 30]),
+                             np.radians([0, 0, 20, 20]))
+    stand = scenario.Stand(1500.0, duration_s=80.0, rpm=120.0, idle_s=0.0, stop=False,
+                           mu_k_schedule=((0.0, 1.0), (40.0, 1.0), (40.0, 1.3)))
+    out = sim.simulate(cfg, path, scenario.Scenario((stand,), 0.0))
+    t, torque = out.columns["time_s"], out.columns["string_torque_Nm"]
+    truth = out.columns["mu_k_true"]
+    assert np.all(truth[t < 39.9] == pytest.approx(0.25))
+    assert np.all(truth[t > 40.1] == pytest.approx(0.325))
+    before, after = torque[(t > 25) & (t < 39)].mean(), torque[(t > 65) & (t < 79)].mean()
+    friction = out.stands[0].T_N_Nm * 0.25
+    # steady sliding: the torque rise is 0.3·μ_k·T_N within the ringing's 2 % of it
+    assert after - before == pytest.approx(0.3 * friction, rel=0.02)
+    assert out.truth()["stands"][0]["mu_k_schedule"] == [
+        [0.0, 0.25], [40.0, 0.25], [40.0, pytest.approx(0.325)]]
+    plain = sim.simulate(cfg, path, scenario.Scenario((replace(stand, mu_k_schedule=None),),
+                                                      0.0))
+    assert "mu_k_true" not in plain.columns

@@ -26,7 +26,9 @@ only wires them):
    measured torque (run beside step 5);
 7. :func:`bit_speed_resolution` — whether the logging resolves the stick-slip cycle;
 8. :func:`trace_verdict` — the trace's checks and
-   :func:`drillfric.estimation.verdict.decide_trace`, what of it may be shown (pure rules).
+   :func:`drillfric.estimation.verdict.decide_trace`, what of it may be shown (pure rules);
+9. :func:`moving_friction` — μ_k(t) from windowed re-fits of the mean torque over the
+   whole segment and the drift test (docs/theory.md §6.6, flag ``mu_k_drift``).
 
 The estimate is built once from what the steps gave (``_assemble``): every flag and withheld
 field comes from the two rule tables of :mod:`drillfric.estimation.verdict`. The steps take
@@ -48,9 +50,10 @@ from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString
 from drillfric.errors import DrillfricError, ModelError
 from drillfric.estimation import batch, bit_torque, bit_trace, skew, spikes
-from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S
+from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S, mu_k_tolerance
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
+from drillfric.estimation.friction_trend import FrictionTrend, drift_verdict, friction_trend
 from drillfric.estimation.gains import design_gains
 from drillfric.estimation.observer import (
     BitSpeedEstimate,
@@ -164,6 +167,9 @@ class SegmentEstimate:
     skew : Skew or None
         The torque's lag behind the speed the segment was corrected for, or why it is not
         identified (:func:`drillfric.estimation.skew.correct`).
+    trend : FrictionTrend or None
+        μ_k(t) of the windowed re-fits and the drift test (docs/theory.md §6.6); None where
+        the segment's μ_k is not a converged batch value.
     """
 
     mu_s: float | None
@@ -204,6 +210,7 @@ class SegmentEstimate:
     samples_dropped: int = 0
     factors_withheld: str = ""
     skew: skew.Skew | None = None
+    trend: FrictionTrend | None = field(default=None, repr=False)
 
 
 def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
@@ -740,10 +747,36 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
+    trend = moving_friction(settings, models, verdict, fitted)
     estimate = _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
                                                        trace, final, bit, fitted, terms,
-                                                       kinematics, stats_from))
+                                                       kinematics, stats_from, trend))
     return replace(estimate, skew=skewed)
+
+
+def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
+                    fitted: FitEvidence) -> FrictionTrend | None:
+    """Step 9: μ_k(t) of windowed re-fits over the whole segment and the drift test
+    (docs/theory.md §6.6), from the fitted model's torque of step 6 (no model run of its
+    own); None where the batch μ_k is not converged over its window (nothing to move from).
+    The seeded trace's checks do not enter: a trace that runs away from a constant μ_k is
+    what a drift makes."""
+    if verdict.method is not Method.BATCH or not verdict.converged or fitted.scored is None:
+        return None
+    meas = models.meas
+    speed = np.interp(fitted.time_s, meas.time_s, np.abs(meas.surface_rad_s))
+    fast = np.flatnonzero(speed > settings.omega_c_rad_s)
+    if fast.size == 0:
+        return None
+    usable = fitted.scored & (fitted.time_s <= fitted.time_s[fast[-1]])
+    trend = friction_trend(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, usable,
+                           mu_k=verdict.mu_k, T_N_Nm=models.observer.plant.T_N_Nm,
+                           tolerance=mu_k_tolerance(models.logged.interval_s),
+                           window_s=settings.batch.trend_window_s,
+                           anchor_end_s=meas.t0_s + settings.batch.window_s)
+    # on bottom μ_k(t) is the apparent friction: a change of the bit torque (the WOB) moves
+    # it as friction would, so it is not called a drift of the friction (§6.6)
+    return replace(trend, drift=False) if models.on_bottom else trend
 
 
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
@@ -906,6 +939,7 @@ class Steps:
     terms: bit_torque.TorqueTerms | None
     kinematics: bit_trace.KinematicCheck
     stats_from_s: float
+    trend: FrictionTrend | None = None
 
 
 def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
@@ -924,8 +958,11 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
     if Flag.CREEP_FIT_AT_BOUND in verdict.flags and at_top:
         messages.append(_creep_advice(models.string, models.td.T_N_Nm, verdict.mu_k, refined,
                                       models.meas))
+    trend = steps.trend
+    mu_k = trend.mean if trend is not None and trend.drift else verdict.mu_k
+    drift_flags, drift_messages = drift_verdict(trend)
     return SegmentEstimate(
-        mu_s=refined.mu_s, mu_k=verdict.mu_k, mu_s_identifiable=refined.mu_s_identifiable,
+        mu_s=refined.mu_s, mu_k=mu_k, mu_s_identifiable=refined.mu_s_identifiable,
         mu_s_lower_bound=verdict.mu_s_lower_bound,
         mu_s_spread=_mu_s_spread(settings, refined, steps.diag),
         mu_k_spread=steps.diag.mu_k_spread, converged=trace.converged, method=verdict.method,
@@ -936,8 +973,10 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         stick_slip_from_s=steps.stats_from_s,
         mu_k_observer=steps.diag.mu_k, mu_s_observer=steps.diag.mu_s,
         mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
-        flags=verdict.flags + trace.flags,
-        messages=tuple(messages) + _interval_note(refined, verdict, trace) + trace.messages
+        flags=verdict.flags + trace.flags + drift_flags,
+        messages=tuple(messages) + (() if drift_flags else  # the fit's ± is its window's
+                                    _interval_note(refined, verdict, trace))
+        + trace.messages + drift_messages
         + _span_note(trace, final.time_s, steps.stats_from_s) + _dropped_note(models),
         starts=steps.starts, first=steps.first, final=final, bit=bit,
         bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=models.td,
@@ -946,7 +985,7 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         bit_statistics=trace.statistics, logged=models.logged, torque_terms=steps.terms,
         friction_zone=settings.friction.zone, samples_dropped=models.dropped,
         factors_withheld=withheld_factors(verdict.method, trace.converged,
-                                          verdict.flags + trace.flags))
+                                          verdict.flags + trace.flags), trend=trend)
 
 
 def _span_note(trace: TraceVerdict, time_s: np.ndarray, start_s: float) -> tuple[str, ...]:

@@ -4,7 +4,8 @@ fleet_summary.parquet lead with it (docs/fleet.md "What changed overnight").
 Each well's manifest entry keeps the last :data:`HISTORY_NIGHTS` nights it ran (μ_k and
 segment count, :func:`night`); tonight's outcome is compared with them
 (:func:`changes`): new segments, a well μ_k beyond the well's own recent spread, severe
-stick-slip in a new segment, and wells whose data did not change (no new rows arrived).
+stick-slip in a new segment, friction that rose within a new segment (``mu_k_drift``), and
+wells whose data did not change (no new rows arrived).
 """
 
 from __future__ import annotations
@@ -66,7 +67,22 @@ def changes(summary: dict | None, history: list[dict], *, ran: bool,
     if severe:
         notes.append(f"severe stick-slip (the bit stops) in {plural(len(severe), 'segment')}: "
                      f"{', '.join(map(str, severe))}")
+    notes += _friction_rose(segments[before:])
     return {"new_segments": max(len(segments) - before, 0), "notes": notes}
+
+
+def _friction_rose(segments: list[dict]) -> list[str]:
+    """A note naming the new segments whose friction rose within them (flag ``mu_k_drift``
+    with a rising ``mu_k_drift_per_h``, docs/theory.md §6.6) and the steepest rate."""
+    rose = [(s["id"], s["mu_k_drift_per_h"]) for s in segments
+            if Flag.MU_K_DRIFT in (s.get("quality_flags") or ())
+            and (s.get("mu_k_drift_per_h") or 0.0) > 0]
+    if not rose:
+        return []
+    steepest = max(rate for _, rate in rose)
+    return [f"friction rose within {plural(len(rose), 'segment')}: "
+            f"{', '.join(str(i) for i, _ in rose)} (mu_k_drift, up to {steepest:+.3f}/h: "
+            "cuttings bed or pack-off?)"]
 
 
 def _moved(mu_k: float | None, recent: list[float]) -> list[str]:

@@ -41,7 +41,9 @@ def open_view(record: SegmentRecord, folder: Path) -> dict:
             "bit_rpm_reason": why or None, "bit_stalled_s": stalled_s,
             "stick_slip_severity": record.stick_slip_severity,
             "stick_slip_beyond_validated":
-                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
+                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags,
+            "mu_k_drift": Flag.MU_K_DRIFT in record.quality_flags,
+            "mu_k_last": record.mu_k_last, "mu_k_drift_per_h": record.mu_k_drift_per_h}
 
 
 def severe_stick_slip(open_segment: dict) -> str:
@@ -120,6 +122,22 @@ def trend_alert(done: list[SegmentRecord]) -> dict | None:
     if median > 0 and abs(done[-1].mu_k / median - 1.0) >= TREND_CHANGE:
         return alert("friction_trend", f"μ_k {done[-1].mu_k:.3f} in segment {done[-1].id} "
                       f"against {median:.3f} before", done[-1].t_end_s)
+    return None
+
+
+def friction_rising(latest: list[SegmentRecord]) -> dict | None:
+    """The ``friction_rising`` alert: of the open segment, else the last closed one
+    (``latest``, in that order), the first whose friction moved within it (flag
+    ``mu_k_drift``, docs/theory.md §6.6) upwards (``mu_k_drift_per_h`` > 0); None when
+    neither rose (a drift down — a hole cleaned — is no alarm)."""
+    for record in latest:
+        rate = record.mu_k_drift_per_h
+        if Flag.MU_K_DRIFT in record.quality_flags and rate is not None and rate > 0:
+            span = ("" if record.mu_k_first is None or record.mu_k_last is None else
+                    f" from {record.mu_k_first:.3f} to {record.mu_k_last:.3f}")
+            return alert("friction_rising", f"friction rising within segment {record.id}: "
+                                            f"μ_k(t){span}, {rate:+.3f}/h (cuttings bed, "
+                                            "pack-off?)", record.t_end_s)
     return None
 
 

@@ -44,6 +44,7 @@ from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live.alerts import (
     alert,
     ended,
+    friction_rising,
     open_view,
     severe_stick_slip,
     trend_alert,
@@ -176,8 +177,8 @@ class LiveRun:
         self.recent = RecentRows()  # the last minutes of surface rows (the live page)
         self.view: dict = {"last_sample_time_s": None, "last_sample_utc": None,
                            "rig_state": None, "open_segment": None, "latest": None,
-                           "trend_alert": None, "rows": 0, "segments_closed": 0,
-                           "resumed": None}
+                           "trend_alert": None, "rising": None, "rows": 0,
+                           "segments_closed": 0, "resumed": None}
 
     # ------------------------------------------------------------------ feed thread
     def work(self) -> None:
@@ -353,7 +354,9 @@ class LiveRun:
                              latest=None if not done else
                              {"segment": done[-1].id, "mu_k": done[-1].mu_k,
                               "mu_s": done[-1].mu_s, "t_end_s": done[-1].t_end_s},
-                             trend_alert=trend_alert(done))
+                             trend_alert=trend_alert(done),
+                             rising=friction_rising(opened[-1:] + [
+                                 r for r in closed if r.status is Status.OK][-1:]))
 
     # ------------------------------------------------------------------ live.json
     def status(self) -> dict:
@@ -381,6 +384,8 @@ class LiveRun:
                                  "turns", (view["open_segment"] or {}).get("t_end_s")))
         if view["trend_alert"] is not None:
             alerts.append(view["trend_alert"])
+        if view["rising"] is not None:
+            alerts.append(view["rising"])
         return {"source": str(self.path), "well": None if self.well is None else self.well.name,
                 "last_sample_time_s": view["last_sample_time_s"],
                 "last_sample_utc": view["last_sample_utc"],

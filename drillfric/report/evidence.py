@@ -14,7 +14,9 @@ unless stated):
    motor the BHA's speed beneath the bit's (docs/theory.md §2.4); left out where the logging
    rate does not resolve the stick-slip cycle (``bit_speed_resolved`` false: the report
    gives the reason instead — no trace is drawn from such data);
-6. μ_k and μ_s of every observer start (the paper's Fig. 10 view) and the final pass.
+6. μ_k and μ_s of every observer start (the paper's Fig. 10 view) and the final pass, whose
+   μ_k is μ_k(t) of the windowed re-fits with its 95 % band (docs/theory.md §6.6; gaps
+   where it is withheld).
 
 Torques are drawn in the report's display units (:mod:`drillfric.report.display`), speeds
 in rpm. Panels whose columns the file does not hold (results older than the torque columns)
@@ -39,6 +41,8 @@ from .interactive import (
 )
 
 MEASURED = "#555555"
+#: Legend of the seeded pass in the μ panel: its μ_k is μ_k(t), its μ_s the seed.
+FINAL_LABEL = "final pass: μ_k(t), μ_s seeded"
 OBSERVER = "#1f5fa8"
 FIT = "#e67e22"
 STUCK = "#f4b6b6"
@@ -164,8 +168,18 @@ def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | TimeAxis | None,
     for start_id, rows in est.groupby("start_id", sort=True):
         out[f"start:{int(start_id)}"] = {"x": time_values(rows["time_s"], origin),
                                          "mu_k": float32(rows["mu_k"]),
-                                         "mu_s": float32(rows["mu_s"])}
+                                         "mu_s": float32(rows["mu_s"]),
+                                         **_mu_k_band(rows)}
     return out
+
+
+def _mu_k_band(rows: pd.DataFrame) -> dict[str, np.ndarray]:
+    """``low``/``high``: μ_k(t) ∓ its 95 % half-width (the seeded rows' windowed re-fits,
+    docs/theory.md §6.6); none where the rows hold no half-width."""
+    if not has_column(rows, "mu_k_half_width") or not rows["mu_k_half_width"].notna().any():
+        return {}
+    mu, half = rows["mu_k"].to_numpy(float), rows["mu_k_half_width"].to_numpy(float)
+    return {"low": float32(mu - half), "high": float32(mu + half)}
 
 
 #: Segment flags under which the segment's friction factors are withheld although the
@@ -262,9 +276,12 @@ def _mu_plot(sources: dict[str, dict], axis: TimeAxis, x_range, note: str = ""):
         start_id = int(name.split(":", 1)[1])
         final = start_id == FINAL_START_ID
         color = "black" if final else Category10[10][start_id % 10]
-        label = "final (seeded) pass" if final else f"start {start_id}"
+        label = FINAL_LABEL if final else f"start {start_id}"
         source = ColumnDataSource(columns, name=name)
         width = 1.8 if final else 1.0
+        if "low" in columns:
+            fig.varea("x", "low", "high", source=source, color="black", alpha=0.12,
+                      legend_label="μ_k(t) 95 % band")
         lines.append(fig.line("x", "mu_k", source=source, color=color, line_width=width,
                               legend_label=label))
         fig.line("x", "mu_s", source=source, color=color, line_dash="dashed",
@@ -355,6 +372,10 @@ def _mu_axes(ax, est: pd.DataFrame, segment: dict, origin) -> None:
         final = start_id == FINAL_START_ID
         kw = {"color": "black", "linewidth": 1.4} if final else {"linewidth": 0.8}
         x = time_values(rows["time_s"], origin)
-        line, = ax.plot(x, rows["mu_k"], label="final (seeded) pass" if final
+        line, = ax.plot(x, rows["mu_k"], label=FINAL_LABEL if final
                         else start_label(segment, int(start_id)), **kw)
+        band = _mu_k_band(rows) if final else {}
+        if band:
+            ax.fill_between(x, band["low"], band["high"], color="black", alpha=0.12,
+                            linewidth=0, label="μ_k(t) 95 % band")
         ax.plot(x, rows["mu_s"], linestyle="--", **{**kw, "color": line.get_color()})

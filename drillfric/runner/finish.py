@@ -34,8 +34,32 @@ from drillfric.io.results import (
 )
 from drillfric.io.tracks import write_tracks
 from drillfric.io.well import Well
-from drillfric.result import SegmentRecord, WellResult, segments_frame
+from drillfric.result import SEEDED_START_ID, Flag, SegmentRecord, WellResult, segments_frame
 from drillfric.vocabulary import Status
+
+#: Flags of the well-wide checks that withhold a segment's friction factors after its rows
+#: were written (the string weight, the torque zero: docs/theory.md §2.1): its μ_k(t) rows
+#: (the seeded pass's ``mu_k``, ``mu_k_half_width``) are withheld with them.
+WELL_WITHHELD = (Flag.HOOKLOAD_CONTRADICTS_STRING, Flag.STRING_WEIGHT_UNVERIFIED,
+                 Flag.TORQUE_ZERO_OFFSET)
+
+
+def withheld_ids(records: list[SegmentRecord]) -> set[int]:
+    """Ids of the segments whose friction factors a well-wide check withheld
+    (:data:`WELL_WITHHELD`)."""
+    return {r.id for r in records if any(f in WELL_WITHHELD for f in r.quality_flags)}
+
+
+def without_mu_k(frame: pd.DataFrame, ids: set[int]) -> pd.DataFrame:
+    """``frame`` (estimates rows) with the seeded rows' μ_k(t) and half-width null in the
+    segments ``ids`` (a copy; ``frame`` itself when none is there)."""
+    gone = frame["segment_id"].isin(list(ids)).to_numpy() & \
+        (frame["start_id"].to_numpy() == SEEDED_START_ID)
+    if not gone.any():
+        return frame
+    out = frame.copy()
+    out.loc[gone, ["mu_k", "mu_k_half_width"]] = float("nan")
+    return out
 
 #: Writes the report of a result directory into it (``drillfric.report.write_well_report``
 #: with the options asked for); the run layer calls it and never imports the report.
@@ -127,6 +151,7 @@ class MemorySink:
 
     def __init__(self):
         self.frames: dict[str, list] = {"estimates": [], "profile": []}
+        self.withheld: set[int] = set()  # segments whose μ_k(t) rows are withheld
 
     def add(self, frames: dict[str, pd.DataFrame], with_truth: bool) -> None:
         """Keep a segment's output rows (``estimates``, ``profile``; either may be absent)."""
@@ -158,12 +183,16 @@ class MemorySink:
                        for key, frame in state.items()}
 
     def finish(self, well: Well, summary: dict, records, tracks, tables) -> None:
-        """Nothing to write."""
+        """Nothing to write; the rows of segments a well-wide check withheld are given
+        without their μ_k(t) (:func:`withheld_ids`; the rows held keep it: a later
+        publication may judge otherwise)."""
+        self.withheld = withheld_ids(records)
 
     def estimates(self) -> pd.DataFrame | None:
         """The estimates rows of the run, None when there are none."""
         parts = self.frames["estimates"]
-        return pd.concat(parts, ignore_index=True) if parts else None
+        return without_mu_k(pd.concat(parts, ignore_index=True), self.withheld) if parts \
+            else None
 
 
 class DirectorySink:
@@ -223,8 +252,9 @@ class DirectorySink:
         if self.writer is None:  # no time series: an estimates.parquet without rows
             self.writer = EstimatesWriter(self.folder / "estimates.parquet", False)
         self.writer.close()
-        if self.revised:
-            self._rewrite_revised()
+        withheld = withheld_ids(records)
+        if self.revised or withheld:
+            self._rewrite(withheld)
         write_json(self.folder / "summary.json", summary)
         write_segments(self.folder / "segments.parquet", records)
         if tracks is not None:
@@ -242,9 +272,10 @@ class DirectorySink:
         """None: read back from the file when asked (:attr:`WellResult.estimates`)."""
         return None
 
-    def _rewrite_revised(self) -> None:
+    def _rewrite(self, withheld: set[int]) -> None:
         """estimates.parquet with each revised segment's rows in place of its old ones (one
-        row group per segment, in segment order)."""
+        row group per segment, in segment order), and the μ_k(t) rows of the segments a
+        well-wide check withheld (``withheld``) null (:func:`without_mu_k`)."""
         path = self.folder / "estimates.parquet"
         old = pq.ParquetFile(path)
         with replacing(path) as fresh:
@@ -255,11 +286,13 @@ class DirectorySink:
                 table = old.read_row_group(g)
                 seg_id = int(table["segment_id"][0].as_py()) if table.num_rows else 0
                 while pending and pending[0][0] < seg_id:
-                    writer.write(pending.pop(0)[1])
-                if seg_id not in self.revised:
+                    writer.write(without_mu_k(pending.pop(0)[1], withheld))
+                if seg_id in withheld and seg_id not in self.revised:
+                    writer.write(without_mu_k(table.to_pandas(), withheld))
+                elif seg_id not in self.revised:
                     writer.write_table(table)
             for _, frame in pending:
-                writer.write(frame)
+                writer.write(without_mu_k(frame, withheld))
             writer.close()
 
 

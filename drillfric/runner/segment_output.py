@@ -4,6 +4,7 @@ SegmentRecord` and its output rows (estimates.parquet, profiles.parquet; docs/ou
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -82,8 +83,11 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
         **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est), **_skew(est)))
-    return withhold_friction(record, est.factors_withheld, None) if est.factors_withheld \
-        else record
+    if est.factors_withheld:
+        record = withhold_friction(record, est.factors_withheld, None)
+    # the windows' numbers stand where the segment's factors are withheld by its own rules:
+    # a seeded trace that runs away from a constant μ_k is what a drift makes (§6.6)
+    return replace(record, **_trend_fields(est))
 
 
 def _skew(est: SegmentEstimate) -> dict:
@@ -120,6 +124,16 @@ def _torque_terms(est: SegmentEstimate) -> dict:
                 surface_torque_turning_Nm=terms.surface_torque_turning_Nm,
                 surface_torque_sem_Nm=terms.surface_torque_sem_Nm,
                 torque_per_mu_Nm=terms.torque_per_mu_Nm, torque_fixed_Nm=terms.torque_fixed_Nm)
+
+
+def _trend_fields(est: SegmentEstimate) -> dict:
+    """μ_k's trend over the segment and its first and last window (docs/theory.md §6.6)."""
+    trend = est.trend
+    if trend is None or not np.isfinite(trend.mu_k).any():
+        return {}
+    ok = trend.mu_k[np.isfinite(trend.mu_k)]
+    rate = None if trend.rate_per_h is None else float(trend.rate_per_h)
+    return dict(mu_k_drift_per_h=rate, mu_k_first=float(ok[0]), mu_k_last=float(ok[-1]))
 
 
 def _evidence_fields(est: SegmentEstimate) -> dict:
@@ -278,11 +292,14 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
     seeded with the batch-refined factors (``start_id`` = :data:`SEEDED_START_ID`): its
     ensemble as one start (``est.bit``: weighted means, the bit stuck where stuck members
     carry most of the weight) with the members' min–max bit speed as
-    ``bit_rpm_est_min/max`` (NaN on the starts' rows). The string's bottom speed is also
-    ``bha_rpm_est`` (``_min/_max``): the bit's until a motor's is added
-    (:func:`with_motor`). Where the logging does not resolve the stick-slip cycle the speed
-    columns are null: no trace is drawn from such data; so are they in the 30-s windows the
-    window-by-window check withheld (``est.bit_windows_withheld``).
+    ``bit_rpm_est_min/max`` (NaN on the starts' rows) and μ_k(t) of the windowed re-fits
+    with its half-width (``est.trend``, docs/theory.md §6.6; null where the segment's
+    factors are withheld, unless the friction moved: a seeded trace that runs away from a
+    constant μ_k is what a drift makes). The string's bottom speed is also ``bha_rpm_est``
+    (``_min/_max``): the bit's until a motor's is added (:func:`with_motor`). Where the
+    logging does not resolve the stick-slip cycle the speed columns are null: no trace is
+    drawn from such data; so are they in the 30-s windows the window-by-window check
+    withheld (``est.bit_windows_withheld``).
     """
     first = _record_frame(seg_id, est.first, 0, data,
                           np.abs(est.first.bha_rad_s_est) <= omega_c, est)
@@ -290,6 +307,11 @@ def _estimate_frame(seg_id: int, est: SegmentEstimate, data: SegmentData,
                            est.bit.stuck(est.final, omega_c), est)
     seeded["bit_rpm_est_min"] = (est.bit.low_rad_s / RPM_TO_RAD_S).astype(np.float32)
     seeded["bit_rpm_est_max"] = (est.bit.high_rad_s / RPM_TO_RAD_S).astype(np.float32)
+    if est.trend is not None and (est.trend.drift or not est.factors_withheld):
+        seeded["mu_k"], seeded["mu_k_half_width"] = est.trend.at(
+            seeded["time_s"].to_numpy(float))
+    elif est.factors_withheld:  # the seed is the factor the segment's rules withheld
+        seeded["mu_k"] = np.nan
     frame = pd.concat([first, seeded], ignore_index=True)
     for name in ("", "_min", "_max"):
         frame["bha_rpm_est" + name] = frame["bit_rpm_est" + name]
@@ -318,6 +340,7 @@ def _record_frame(seg_id: int, rec: ObserverRecord, offset: int, data: SegmentDa
         "segment_id": np.full(n_t * n_s, seg_id, dtype=np.int32),
         "start_id": np.tile(np.arange(n_s, dtype=np.int16) + offset, n_t),
         "mu_s": rec.mu_s.ravel(), "mu_k": rec.mu_k.ravel(),
+        "mu_k_half_width": np.full(n_t * n_s, np.nan),
         "surface_rpm": at(data.time_s, data.surface_rpm),
         "surface_rpm_est": rec.surface_rad_s_est.ravel() / RPM_TO_RAD_S,
         "bit_rpm_est": rec.bit_rad_s_est.ravel() / RPM_TO_RAD_S,

@@ -28,7 +28,7 @@ A scenario file (TOML, see docs/simulator.md)::
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +40,14 @@ from drillfric.drillstring import build_string
 from drillfric.errors import ConfigError, InputError, ModelError
 from drillfric.io.text import plural
 from drillfric.sim.recorder import lagged
-from drillfric.sim.scenario import Scenario, Stand, base_stand, load_scenario, single_stand
+from drillfric.sim.scenario import (
+    Scenario,
+    Stand,
+    base_stand,
+    load_scenario,
+    single_stand,
+    step_interp,
+)
 from drillfric.sim.settings import Noise, PlantSettings
 from drillfric.units import RPM_TO_RAD_S
 from drillfric.wellpath import WellPath, no_survey_path
@@ -64,6 +71,8 @@ class StandResult:
     ``T_N_Nm`` is ∫F_c dx over the part of the string whose truth is ``mu_s``, ``mu_k``
     (the open hole with a cased truth, else the whole string), ``T_N_cased_Nm`` over the
     cased part (0 without a cased truth) [N·m per unit friction factor].
+    ``mu_k_schedule`` is the open hole's true μ_k in time of a stand whose friction follows
+    a schedule, [[t_s on the global clock, μ_k], ...] (None: constant ``mu_k``).
     ``bit_torque_time_mean_Nm`` is the time-mean of the torque the bit applied from the end of the
     start-up to the start of the stop [N·m] (0 off bottom): with a rate-weakening bit in
     stick-slip it differs from ``bit_torque_k_Nm`` = T_k = μ_bit·WOB·D_bit/3.
@@ -111,6 +120,7 @@ class StandResult:
     hookload_moving_N: float | None = None
     torque_moving_Nm: float | None = None
     T_N_moving_Nm: float | None = None
+    mu_k_schedule: list | None = None
 
 
 @dataclass(frozen=True)
@@ -228,19 +238,8 @@ def _drive(stand: Stand, settings: PlantSettings) -> torsional.Drive:
         knots = stand.knots()
         kind, t_pts, values = "pi", knots[:, 0], knots[:, 1] * RPM_TO_RAD_S
     t = np.arange(0.0, stand.total_s + _SERIES_DT_S, _SERIES_DT_S)
-    return torsional.Drive(kind, _interp_steps(t, t_pts, values), _SERIES_DT_S, 0.0,
+    return torsional.Drive(kind, step_interp(t, t_pts, values), _SERIES_DT_S, 0.0,
                            settings.kp_Nms_rad, settings.ki_Nm_rad)
-
-
-def _interp_steps(t: np.ndarray, t_pts: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Piecewise-linear interpolation where a repeated knot time is a step (right value)."""
-    idx = np.searchsorted(t_pts, t, side="right")
-    idx = np.clip(idx, 1, len(t_pts) - 1)
-    t0, t1 = t_pts[idx - 1], t_pts[idx]
-    v0, v1 = values[idx - 1], values[idx]
-    span = np.where(t1 > t0, t1 - t0, 1.0)
-    frac = np.clip((t - t0) / span, 0.0, 1.0)
-    return np.where(t >= t_pts[-1], values[-1], v0 + frac * (v1 - v0))
 
 
 def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None, stand: Stand,
@@ -268,7 +267,7 @@ def _axial(stand: Stand) -> torsional.Axial | None:
         return None
     knots = stand.axial_knots()
     t = np.arange(0.0, stand.total_s + _SERIES_DT_S, _SERIES_DT_S)
-    return torsional.Axial(_interp_steps(t, knots[:, 0], knots[:, 1]), _SERIES_DT_S, 0.0)
+    return torsional.Axial(step_interp(t, knots[:, 0], knots[:, 1]), _SERIES_DT_S, 0.0)
 
 
 def _moved_m(axial: torsional.Axial | None, time_s: np.ndarray) -> np.ndarray:
@@ -338,6 +337,8 @@ def simulate(cfg: Config, path: WellPath | None, scenario: Scenario, *,
         columns.pop("flow_in_m3_s")
     if settings.motor_rev_per_litre is None:
         columns.pop("bha_rpm")
+    if all(s.mu_k_schedule is None for s in scenario.stands):
+        columns.pop("mu_k_true")
     block = cfg.hookload.block_weight_N
     columns["hookload_N"] = columns["hookload_N"] + (block or 0.0)
     columns["surface_torque_Nm"] = lagged(columns["time_s"], columns["surface_torque_Nm"],
@@ -434,18 +435,63 @@ def _run_phases(cfg: Config, settings, path, stand: Stand, rate: float):
         plant, td = plant_for(cfg, settings, path, stand, depth, moving)
         state = torsional.State.rest(plant.grid) if state is None \
             else state.on_grid(plants[-1].grid, plant.grid)
-        start = state.t_s
-        stop = start + torsional.model_steps(end - start, plant.grid.dt_s) * plant.grid.dt_s
-        eps = 1e-9 * plant.grid.dt_s
-        mine = times[(times >= start - eps) & ((times < stop - eps) | (k == len(phases) - 1))]
-        rec, state = torsional.run(plant, drive, end - start, rate, state, times_s=mine,
-                                   axial=axial if moving else None)
-        recs.append(rec)
+        pieces = friction_pieces(stand, state.t_s, end)
+        for j, (piece_end, factor) in enumerate(pieces):
+            start = state.t_s
+            stop = start + torsional.model_steps(piece_end - start, plant.grid.dt_s) \
+                * plant.grid.dt_s
+            eps = 1e-9 * plant.grid.dt_s
+            last = k == len(phases) - 1 and j == len(pieces) - 1
+            mine = times[(times >= start - eps) & ((times < stop - eps) | last)]
+            rec, state = torsional.run(_scaled(plant, factor), drive, piece_end - start, rate,
+                                       state, times_s=mine, axial=axial if moving else None)
+            recs.append(rec)
         plants.append(plant)
         tds.append(td)
     columns = {f: np.concatenate([getattr(r, f) for r in recs])
                for f in torsional.Record.__dataclass_fields__}
     return torsional.Record(**columns), plants, tds
+
+
+#: Longest piece of a ``mu_k_schedule`` the plant holds at one friction factor [s]: a ramp
+#: becomes steps of at most this (a 40 % ramp over 5 min: steps of 0.27 %).
+SCHEDULE_PIECE_S = 2.0
+
+
+def friction_pieces(stand: Stand, start_s: float, end_s: float) -> list[tuple[float, float]]:
+    """(end [s from the stand's start], factor [-]) of the pieces of [``start_s``, ``end_s``]
+    over which the plant holds the stand's friction factor (:meth:`Stand.friction_factor`):
+    one piece at 1 without a schedule; with one, the knots cut the span and each linear part
+    is cut into pieces of at most :data:`SCHEDULE_PIECE_S`, each at the factor of its middle.
+
+    Examples
+    --------
+    >>> friction_pieces(Stand(100.0, idle_s=0.0, mu_k_schedule=((0.0, 1.0), (3.0, 1.0),
+    ...                                                          (3.0, 2.0))), 0.0, 5.0)
+    [(3.0, 1.0), (5.0, 2.0)]
+    """
+    if stand.mu_k_schedule is None:
+        return [(end_s, 1.0)]
+    knots = np.asarray(stand.mu_k_schedule, dtype=float)[:, 0] + stand.idle_s
+    cuts = np.unique(np.r_[start_s, knots[(knots > start_s) & (knots < end_s)], end_s])
+    ends = []
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        ends += list(a + (b - a) * np.arange(1, int(np.ceil((b - a) / SCHEDULE_PIECE_S
+                                                             - 1e-9)) + 1)
+                     / max(int(np.ceil((b - a) / SCHEDULE_PIECE_S - 1e-9)), 1))
+    ends = np.asarray(ends)
+    middles = 0.5 * (np.r_[start_s, ends[:-1]] + ends)
+    factors = stand.friction_factor(middles)
+    keep = np.r_[factors[1:] != factors[:-1], True]  # merge pieces at one factor
+    return [(float(e), float(f)) for e, f in zip(ends[keep], factors[keep], strict=True)]
+
+
+def _scaled(plant: torsional.Plant, factor: float) -> torsional.Plant:
+    """The plant with its open hole's μ_s and μ_k times ``factor`` (the cased part's fixed
+    friction unchanged)."""
+    if factor == 1.0:
+        return plant
+    return replace(plant, mu_s=plant.mu_s * factor, mu_k=plant.mu_k * factor)
 
 
 def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float, rate: float):
@@ -469,7 +515,8 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
             "wob_N": np.full(n, stand.wob_N),
             "bit_rpm": (rec.bit_rad_s + motor) / RPM_TO_RAD_S,
             "string_torque_Nm": rec.string_torque_Nm,
-            "flow_in_m3_s": np.full(n, stand.flow_m3_s), "bha_rpm": rec.bit_rad_s / RPM_TO_RAD_S}
+            "flow_in_m3_s": np.full(n, stand.flow_m3_s), "bha_rpm": rec.bit_rad_s / RPM_TO_RAD_S,
+            "mu_k_true": settings.mu_k * _held_factor(stand, rec.time_s)}
     grid = plant.grid
     cased_T_N = float(np.sum(settings.cased_share(grid) * td.fc_at(grid.x_m) * grid.dx_true_m))
     creep_end = (t0 + stand.idle_s + stand.creep_ramp_s + stand.creep_hold_s
@@ -488,6 +535,7 @@ def _run_stand(cfg: Config, settings, path, stand: Stand, index: int, t0: float,
                          bit_torque_k_Nm=plant.bit_torque_cap_Nm,
                          bit_weakening_ratio=stand.bit_weakening_ratio,
                          bit_weakening_rpm=stand.bit_weakening_rpm, flow_m3_s=stand.flow_m3_s,
+                         mu_k_schedule=_schedule_truth(stand, settings.mu_k, t0),
                          **_reaming_truth(stand, plants, tds, t0))
     return cols, result
 
@@ -512,6 +560,23 @@ def pdm_speed_rad_s(flow_m3_s: float, rev_per_litre: float | None, bit_torque_Nm
     if stall_torque_Nm is None:
         return np.full(torque.size, no_load)
     return no_load * np.clip(1.0 - np.maximum(torque, 0.0) / stall_torque_Nm, 0.0, 1.0)
+
+
+def _schedule_truth(stand: Stand, mu_k: float, t0: float) -> list | None:
+    """The stand's ``mu_k_schedule`` as the open hole's μ_k on the global clock,
+    [[t_s, μ_k], ...] (None without one)."""
+    if stand.mu_k_schedule is None:
+        return None
+    return [[t0 + stand.idle_s + t, mu_k * f] for t, f in stand.mu_k_schedule]
+
+
+def _held_factor(stand: Stand, time_s: np.ndarray) -> np.ndarray:
+    """The friction factor the plant held at each recorded time [-]
+    (:func:`friction_pieces`: each piece's factor up to its end)."""
+    pieces = friction_pieces(stand, 0.0, stand.total_s)
+    ends = np.array([e for e, _ in pieces])
+    idx = np.minimum(np.searchsorted(ends, time_s - 1e-9, side="left"), ends.size - 1)
+    return np.array([f for _, f in pieces])[idx]
 
 
 def _reaming_truth(stand: Stand, plants, tds, t0: float) -> dict:
@@ -591,7 +656,8 @@ def _connection(t0: float, span: float, rate: float, before: Stand, after: Stand
     return {"time_s": t, "surface_rpm": zero, "surface_torque_Nm": zero.copy(),
             "hookload_N": zero.copy(), "bit_depth_m": depth, "hole_depth_m": depth + off,
             "wob_N": zero.copy(), "bit_rpm": zero.copy(), "string_torque_Nm": zero.copy(),
-            "flow_in_m3_s": zero.copy(), "bha_rpm": zero.copy()}
+            "flow_in_m3_s": zero.copy(), "bha_rpm": zero.copy(),
+            "mu_k_true": np.full(t.size, np.nan)}
 
 
 def _notes(stands) -> tuple:

@@ -63,6 +63,11 @@ class Stand:
     axial_delay_s, axial_ramp_s : float
         Rotation in place between the end of the start-up and the start of the axial motion,
         and the block's acceleration time [s].
+    mu_k_schedule : tuple of (t_s, factor), optional
+        Friction that changes in time (a cuttings bed building up, a wiper trip clearing
+        it): piecewise-linear factor [-] on the open hole's μ_k and μ_s (their ratio kept)
+        from the start of the set-point, as ``setpoint_rpm`` (a repeated time makes a step;
+        held after the last point). None: the friction is constant.
     """
 
     bit_depth_m: float
@@ -87,6 +92,7 @@ class Stand:
     axial_speed_m_s: float = 0.0
     axial_delay_s: float = 0.0
     axial_ramp_s: float = 2.0
+    mu_k_schedule: tuple | None = None
 
     @property
     def start_up_s(self) -> float:
@@ -102,6 +108,16 @@ class Stand:
             return self.idle_s + float(series[-1][0])
         stop = self.stop_s + self.stop_hold_s if self.stop else 0.0
         return self.idle_s + self.duration_s + stop
+
+    def friction_factor(self, t_s) -> np.ndarray:
+        """The factor on μ_k and μ_s at ``t_s`` [s from the stand's start] [-] (1 without a
+        schedule): ``mu_k_schedule`` piecewise linear, a repeated time a step (the later
+        value from that time on), held before the first and after the last point."""
+        t = np.asarray(t_s, dtype=float)
+        if self.mu_k_schedule is None:
+            return np.ones(t.shape)
+        pts = np.asarray(self.mu_k_schedule, dtype=float)
+        return step_interp(t, pts[:, 0] + self.idle_s, pts[:, 1])
 
     def knots(self) -> np.ndarray:
         """Set-point (t [s] from stand start, ω_ref [RPM]) knots of the piecewise-linear shape."""
@@ -201,7 +217,7 @@ def _stand_from_dict(raw: dict, defaults: dict, where: str, file) -> Stand:
         raise ConfigError(f"{where} needs bit_depth_m", file=file)
     values = {}
     for key, value in merged.items():
-        if key in ("setpoint_rpm", "motor_torque_Nm"):
+        if key in ("setpoint_rpm", "motor_torque_Nm", "mu_k_schedule"):
             values[key] = _series(value, f"{where}.{key}", file)
         elif key == "start":
             if value not in _STARTS:
@@ -251,6 +267,38 @@ def _check_stand(stand: Stand, where: str, file) -> None:
                           fix="increase duration_s or shorten the ramp/creep")
     if stand.moving:
         _check_reaming(stand, where, file)
+    if stand.mu_k_schedule is not None:
+        factors = np.asarray(stand.mu_k_schedule)[:, 1]
+        if not np.all((factors > 0) & (factors <= MAX_FRICTION_FACTOR)):
+            raise ConfigError(f"{where}.mu_k_schedule factors must be in (0, "
+                              f"{MAX_FRICTION_FACTOR:g}], got {factors.min():g}…"
+                              f"{factors.max():g}", file=file,
+                              fix="a factor multiplies the configured μ_k and μ_s: 1 keeps "
+                                  "them, 1.3 is 30 % more friction")
+
+
+#: Largest factor a ``mu_k_schedule`` may put on the configured friction [-] (μ up to 8× is
+#: beyond any hole; the friction search stops at ``observer.mu_max``).
+MAX_FRICTION_FACTOR = 8.0
+
+
+def step_interp(t: np.ndarray, t_pts: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Piecewise-linear interpolation where a repeated knot time is a step (right value),
+    held outside the knots.
+
+    Examples
+    --------
+    >>> step_interp(np.array([0.0, 1.0, 1.5, 2.0, 9.0]), np.array([0.0, 1.0, 1.0, 3.0]),
+    ...             np.array([1.0, 1.0, 2.0, 3.0])).tolist()
+    [1.0, 2.0, 2.25, 2.5, 3.0]
+    """
+    idx = np.searchsorted(t_pts, t, side="right")
+    idx = np.clip(idx, 1, len(t_pts) - 1)
+    t0, t1 = t_pts[idx - 1], t_pts[idx]
+    v0, v1 = values[idx - 1], values[idx]
+    span = np.where(t1 > t0, t1 - t0, 1.0)
+    frac = np.clip((t - t0) / span, 0.0, 1.0)
+    return np.where(t >= t_pts[-1], values[-1], v0 + frac * (v1 - v0))
 
 
 #: Fastest axial pipe speed a stand may ream at [m/s] (trips run at up to ~1.5 m/s).

@@ -41,6 +41,9 @@ class BatchSettings:
         ``segmentation.dip_torque_fraction``).
     window_s : float
         The fit uses the first this-many seconds of a segment [s] (``batch.window_s``).
+    trend_window_s : float
+        Window of the re-fits of μ_k(t) over the whole segment, overlapping by half [s]
+        (``batch.trend_window_s``, docs/theory.md §6.6).
     """
 
     omega_c_rad_s: float
@@ -51,6 +54,7 @@ class BatchSettings:
     dip_torque_fraction: float = default("segmentation.dip_torque_fraction")
     window_s: float = default("batch.window_s")
     k_t_uncertainty_factor: float = default("model.k_t_uncertainty_factor")
+    trend_window_s: float = default("batch.trend_window_s")
 
     @classmethod
     def from_config(cls, cfg: Config) -> BatchSettings:
@@ -59,7 +63,7 @@ class BatchSettings:
                    top_drive_inertia_kg_m2=cfg.rig.top_drive_inertia_kg_m2,
                    mu_max=cfg.observer.mu_max, dip_max_s=cfg.segmentation.dip_max_s,
                    dip_torque_fraction=cfg.segmentation.dip_torque_fraction,
-                   window_s=cfg.batch.window_s,
+                   window_s=cfg.batch.window_s, trend_window_s=cfg.batch.trend_window_s,
                    k_t_uncertainty_factor=cfg.model.k_t_uncertainty_factor)
 
 
