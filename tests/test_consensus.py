@@ -94,3 +94,18 @@ def test_mu_s_plus_minus_holds_its_validated_tolerance():
     assert found["mu_s"] == pytest.approx(0.585)
     assert found["mu_s_uncertainty"] == pytest.approx(0.0585)
     assert abs(0.600 - found["mu_s"]) <= found["mu_s_uncertainty"]
+
+
+def test_the_run_line_states_mu_s_with_its_interval():
+    """Newcomer retry (issue 35): summary.json carried μ_s's ± (0.059 on the demo) but the
+    terminal printed "μ_s = 0.585" bare — the one number without its stated tolerance."""
+    from types import SimpleNamespace
+
+    from cli.run_cmd import _describe
+
+    summary = {"counts": {"segments": 4, "estimated": 4, "converged": 4, "skipped": 0,
+                          "failed": 0}, "segments": [], "mu_k": 0.279,
+               "mu_k_uncertainty": 0.017, "mu_s": 0.585, "mu_s_uncertainty": 0.0585,
+               "mu_s_lower_bound": None}
+    line = _describe(SimpleNamespace(well="demo", summary=summary))
+    assert line.endswith("μ_k = 0.279 ± 0.017, μ_s = 0.585 ± 0.059")
