@@ -432,15 +432,17 @@ def test_batch_settings_take_every_key_from_the_configuration():
     """Regression: ``segmentation.dip_max_s``, ``dip_torque_fraction`` and ``observer.mu_max``
     were bound to the schema defaults at import; every field must come from the file."""
     from drillfric.config import config_from_dict
-    cfg = config_from_dict({"model": {"omega_c_rpm": 6.0, "k_t_per_s": 0.3},
+    cfg = config_from_dict({"model": {"omega_c_rpm": 6.0, "k_t_per_s": 0.3,
+                                      "k_t_uncertainty_factor": 2.0},
                             "rig": {"top_drive_inertia_kg_m2": 1500.0},
                             "observer": {"mu_max": 0.95},
                             "segmentation": {"dip_max_s": 25.0, "dip_torque_fraction": 0.3},
-                            "batch": {"window_s": 300.0}})
+                            "batch": {"window_s": 300.0, "trend_window_s": 90.0}})
     got = batch.BatchSettings.from_config(cfg)
     assert got == batch.BatchSettings(omega_c_rad_s=6.0 * RPM, k_t_per_s=0.3,
                                       top_drive_inertia_kg_m2=1500.0, mu_max=0.95,
-                                      dip_max_s=25.0, dip_torque_fraction=0.3, window_s=300.0)
+                                      dip_max_s=25.0, dip_torque_fraction=0.3, window_s=300.0,
+                                      trend_window_s=90.0, k_t_uncertainty_factor=2.0)
     defaults = batch.BatchSettings.from_config(config_from_dict({}))
     assert all(getattr(got, f) != getattr(defaults, f) for f in got.__dataclass_fields__)
 
