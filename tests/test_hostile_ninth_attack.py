@@ -21,6 +21,7 @@ from drillfric.runner import run_well
 from drillfric.runner.engine import Engine
 from tests.conftest import DEMO
 from tests.io.io_frames import surface_frame
+from tests.test_live import _wait_for
 
 TRUTH_MU_K = 0.28
 
@@ -221,9 +222,7 @@ def test_wits0_burst_cut_into_two_reads_is_one_burst(tmp_path):
             time.sleep(0.005)
             conn.sendall(burst[half:])
             time.sleep(0.5)
-        deadline = time.monotonic() + 10
-        while receiver.frames < 30 and time.monotonic() < deadline:
-            time.sleep(0.02)
+        _wait_for(lambda: receiver.frames >= 30, 10)
         receiver.stop.set()
         conn.close()
     finally:

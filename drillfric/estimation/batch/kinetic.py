@@ -183,16 +183,22 @@ class KineticOutcome:
     messages: tuple[str, ...] = ()
 
 
+def viscous_torque_Nm(model: Model, wins: list[Window], cells: int) -> float:
+    """The viscous part of the model's mean torque over the rotation fitted [N·m]:
+    k_t·J·ω̄, J = ∫ρJ dx the string's polar mass moment, ω̄ the mean speed over ``wins``
+    (docs/theory.md §3 eq. 2–3, §6.4)."""
+    used = np.concatenate([w.used for w in wins])
+    g = model.grid(cells)[0]
+    inertia = float(np.sum(g.rho_j_kg_m * g.dx_true_m))
+    return model.k_t * inertia * float(np.mean(model.data.w_bar[used]))
+
+
 def fit_kinetic(model: Model, wins: list[Window], target_Nm: float, stick_slip: bool,
                 mu_s_seed: float | None, cells: int) -> KineticOutcome:
     """μ_k by mean-torque matching with the model in the data's regime (docs/theory.md §6.4):
     stick-slip data are fitted with μ_s = :data:`PROVISIONAL_RATIO`·μ_k (then 4·μ_k if the
     model does not stick), steady data with μ_s = μ_k."""
-    d = model.data
-    used = np.concatenate([w.used for w in wins])
-    g = model.grid(cells)[0]
-    string_inertia = float(np.sum(g.rho_j_kg_m * g.dx_true_m))
-    viscous = model.k_t * string_inertia * float(np.mean(d.w_bar[used]))
+    viscous = viscous_torque_Nm(model, wins, cells)
     t_est, t_fixed = model.t_parts(cells)
     top = model.settings.mu_max
     x0 = float(np.clip((target_Nm - viscous - t_fixed) / t_est, min(0.01, top), min(1.0, top)))
