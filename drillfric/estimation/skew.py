@@ -152,16 +152,44 @@ def lag_profile(time_s: np.ndarray, rpm: np.ndarray, torque_Nm: np.ndarray, *,
     rows = np.arange(hp + shifts[-1], grid.size - hp - shifts[-1])
     if rows.size < 10 * hp:
         return None
-    r2 = np.array([_r2(torque[rows + s], speed[rows], accel[rows]) if torque_on_speed
-                   else _r2(accel[rows], speed[rows], torque[rows + s]) for s in shifts])
+    r2 = _r2_by_shift(accel[rows], speed[rows], torque, rows[0] + shifts, torque_on_speed)
     return LagProfile(shifts * dt, r2, rows.size * dt / max(SMOOTH_S, dt), logged_dt)
 
 
-def _r2(y: np.ndarray, *regressors: np.ndarray) -> float:
-    """R² of the least-squares fit of ``y`` on ``regressors`` (no intercept: high-passed)."""
-    X = np.column_stack(regressors)
-    v = X.T @ y
-    return float(v @ np.linalg.pinv(X.T @ X) @ v) / max(float(y @ y), 1e-300)
+def _r2_by_shift(accel: np.ndarray, speed: np.ndarray, torque: np.ndarray,
+                 starts: np.ndarray, torque_on_speed: bool) -> np.ndarray:
+    """R² of the two-regressor fit at every shift at once (no intercept: high-passed).
+
+    ``accel`` and ``speed`` are the fixed rows; the torque enters as
+    ``torque[start:start + n]`` for each of ``starts`` (consecutive). Each fit needs only
+    inner products, and the ones with the shifted torque are cross-correlations — one pass
+    each instead of a regression per lag. The normal equations are solved with a
+    pseudo-inverse, as a least-squares fit with a zero regressor would be. BLAS on one
+    thread: numpy's correlate is a dot product per lag, and OpenBLAS's idle threads spin —
+    on a 100-Hz stand beside the observer's kernels they cost 4–8× the work.
+    """
+    from threadpoolctl import threadpool_limits
+
+    n = accel.size
+    window = torque[starts[0]:starts[-1] + n]
+    with threadpool_limits(limits=1):
+        speed_torque = np.correlate(window, speed, mode="valid")
+        accel_torque = np.correlate(window, accel, mode="valid")
+    cumulative = np.concatenate(([0.0], np.cumsum(window * window)))
+    torque_torque = cumulative[n:] - cumulative[:-n]
+    speed_speed, speed_accel, accel_accel = speed @ speed, speed @ accel, accel @ accel
+    if torque_on_speed:  # torque on [speed, accel]
+        gram = np.broadcast_to([[speed_speed, speed_accel], [speed_accel, accel_accel]],
+                               (starts.size, 2, 2))
+        moment, response = np.stack([speed_torque, accel_torque], axis=1), torque_torque
+    else:  # accel on [speed, torque]
+        gram = np.empty((starts.size, 2, 2))
+        gram[:, 0, 0], gram[:, 1, 1] = speed_speed, torque_torque
+        gram[:, 0, 1] = gram[:, 1, 0] = speed_torque
+        moment = np.stack([np.full(starts.size, speed_accel), accel_torque], axis=1)
+        response = np.full(starts.size, accel_accel)
+    explained = np.einsum("ki,kij,kj->k", moment, np.linalg.pinv(gram), moment)
+    return explained / np.maximum(response, 1e-300)
 
 
 def judge_profile(profile: LagProfile) -> Skew:
