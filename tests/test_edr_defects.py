@@ -139,3 +139,44 @@ def test_gaps_shorter_than_max_gap_are_not_drawn_through(tmp_path):
     assert seg["mu_k"] == pytest.approx(0.28, rel=0.05)
     assert seg["bit_speed_resolved"] is False
     assert "gap longer than the string's wave travel time" in seg["bit_speed_reason"]
+
+
+def test_held_values_are_found_quantised_and_slow_channels_are_not():
+    """A reading held for 1–10 s in a noisy channel is found (the run's first sample is the
+    real reading); a channel written coarser than its noise (long repeats everywhere), a
+    slower log forward-filled (docs/bit_speed.md "Logging rate") and a stopped top drive's
+    zeros are not defects."""
+    rng = np.random.default_rng(5)
+    t = np.arange(6000) * 0.05
+    x = 60.0 + 20.0 * np.sin(2 * np.pi * t / 4.0) + rng.normal(0.0, 0.5, t.size)
+    assert not spikes.held_values(t, x).any()
+    for start, length_s in ((1000, 1.0), (3000, 10.0)):
+        x[start:start + int(length_s / 0.05) + 1] = x[start]
+    held = spikes.held_values(t, x)
+    assert held.sum() == 20 + 200 and not held[1000] and held[1001:1021].all()
+    quantised = np.round(60.0 + rng.normal(0.0, 0.2, t.size))  # 1-RPM steps, 0.2 RPM noise
+    assert not spikes.held_values(t, quantised).any()
+    forward_filled = np.repeat(x[::40], 40)[:t.size]  # a 2-s log written at 20 Hz
+    assert not spikes.held_values(t, forward_filled).any()
+    stopped = np.r_[np.zeros(3000), x[3000:]]
+    assert not spikes.held_values(t, stopped)[:3000].any()
+
+
+@pytest.mark.slow
+def test_held_speed_and_torque_change_no_number(tmp_path):
+    """Issue 34 item 4: the speed and the torque each held for 1, 4 and 10 s in the demo's
+    first stand (a device that stops updating). Found and counted (600 samples at 20 Hz);
+    kept for μ_k, which stays the clean stand's within 1.5 % (the held torque is 5 % of the
+    stand's samples, its level that of the hold's start) and converged."""
+    frame = pd.read_csv(DEMO / "demo.csv")
+    frame = frame[frame["time_s"] < 230.0].reset_index(drop=True)
+    clean = _run(tmp_path / "clean", frame, tmp_path)
+    t = frame["time_s"].to_numpy()
+    for column, starts in (("surface_rpm", (60, 110, 170)), ("surface_torque_Nm", (80, 140, 200))):
+        for start, length_s in zip(starts, (1.0, 4.0, 10.0), strict=True):
+            first = int(np.flatnonzero(t >= start)[0])
+            frame.loc[(t > start) & (t <= start + length_s), column] = frame.loc[first, column]
+    dirty = _run(tmp_path / "dirty", frame, tmp_path)
+    assert clean["samples_held"] == 0 and 590 <= dirty["samples_held"] <= 610
+    assert "held an earlier reading" in dirty["message"]
+    assert dirty["converged"] and dirty["mu_k"] == pytest.approx(clean["mu_k"], rel=0.015)

@@ -161,6 +161,8 @@ class SegmentEstimate:
         (torque-weighted over the whole string).
     samples_dropped : int
         Speed or torque samples dropped as isolated spikes or drop-outs.
+    samples_held : int
+        Speed or torque samples that held an earlier reading (kept for μ_k).
     factors_withheld : str
         Why the segment's friction factors are not shown ("" when they are:
         :func:`~drillfric.estimation.verdict.withheld_factors`).
@@ -208,6 +210,7 @@ class SegmentEstimate:
     torque_terms: bit_torque.TorqueTerms | None = None
     friction_zone: str = "effective"
     samples_dropped: int = 0
+    samples_held: int = 0
     factors_withheld: str = ""
     skew: skew.Skew | None = None
     trend: FrictionTrend | None = field(default=None, repr=False)
@@ -397,9 +400,12 @@ class SegmentModels:
         The log's effective sample interval (docs/bit_speed.md "Logging rate").
     sample_times_s : ndarray
         Times of the logged samples the measurements rest on [s]: the segment's, without
-        the EDR defects :mod:`drillfric.estimation.spikes` dropped.
+        the EDR defects :mod:`drillfric.estimation.spikes` dropped and without the held
+        values (kept for μ_k; the bit's motion over them was not observed).
     dropped : int
         How many samples were so dropped.
+    held : int
+        How many samples held an earlier reading (:func:`~drillfric.estimation.spikes.held_values`).
     axial : drillfric.torsional.Axial or None
         The pipe's axial speed on the measurements' grid while it reams (None: in place).
     """
@@ -414,6 +420,7 @@ class SegmentModels:
     sample_times_s: np.ndarray = field(repr=False)
     dropped: int = 0
     axial: torsional.Axial | None = field(default=None, repr=False)
+    held: int = 0
 
 
 def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentData, *,
@@ -464,8 +471,11 @@ def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentDa
                               torque_min_Nm=data.torque_min_Nm,
                               torque_max_Nm=data.torque_max_Nm,
                               echo_s=2.0 * bit_trace.travel_time_s(string))
-    return SegmentModels(path, string, td, meas, observer, on_bottom, logged, data.time_s,
-                         int(bad.sum()), axial_series(data, meas))
+    held = (spikes.held_values(data.time_s, data.surface_rpm)
+            | spikes.held_values(data.time_s, data.surface_torque_Nm))
+    return SegmentModels(path, string, td, meas, observer, on_bottom, logged,
+                         data.time_s[~held], int(bad.sum()), axial_series(data, meas),
+                         int(held.sum()))
 
 
 def _moving_case(settings: ChainSettings, data: SegmentData, mu: float | None) -> dict:
@@ -848,12 +858,19 @@ def _undetermined(final: ObserverRecord, bit: BitSpeedEstimate, span: np.ndarray
 
 
 def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
-    """The message of a segment whose log had isolated spikes or drop-outs."""
-    if not models.dropped:
-        return ()
-    return (f"{plural(models.dropped, 'speed or torque sample')} dropped as spikes, drop-outs or "
-            "samples lost while turning (values no motion of the string or the top drive can "
-            "take; bridged by interpolation, docs/ingestion.md \"EDR defects\")",)
+    """The message of a segment whose log had isolated spikes, drop-outs or held values."""
+    notes = ()
+    if models.dropped:
+        notes += (f"{plural(models.dropped, 'speed or torque sample')} dropped as spikes, "
+                  "drop-outs or samples lost while turning (values no motion of the string or "
+                  "the top drive can take; bridged by interpolation, docs/ingestion.md \"EDR "
+                  "defects\")",)
+    if models.held:
+        notes += (f"{plural(models.held, 'speed or torque sample')} held an earlier reading "
+                  f"for {spikes.HOLD_MIN_S:g} s or more (a device that stopped updating): kept "
+                  "for μ_k, the bit's motion over them not observed (docs/ingestion.md \"EDR "
+                  "defects\")",)
+    return notes
 
 
 def beside(work, *args):
@@ -984,6 +1001,7 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         kinematics=steps.kinematics, bit_windows_withheld=trace.windows_withheld,
         bit_statistics=trace.statistics, logged=models.logged, torque_terms=steps.terms,
         friction_zone=settings.friction.zone, samples_dropped=models.dropped,
+        samples_held=models.held,
         factors_withheld=withheld_factors(verdict.method, trace.converged,
                                           verdict.flags + trace.flags), trend=trend)
 

@@ -51,6 +51,20 @@ DROP_SHARE = 0.1
 #: is under a thirtieth of the string's fastest motion (a soft drive's speed dips to near 0
 #: for about a tenth of its cycle: 3 samples or more).
 MIN_SAMPLES_PER_CYCLE = 32
+#: Shortest held value: one reading repeated exactly for this long [s] (issue 34: a device
+#: that stops updating holds its last value for 1–10 s)...
+HOLD_MIN_S = 1.0
+#: ...and over at least this many samples (a value read twice in a row is common in a log
+#: written to one decimal)...
+HOLD_MIN_SAMPLES = 3
+#: ...and so long that the log would show one that long by chance fewer than this many
+#: times: n_pairs · p^(samples − 1), p the share of consecutive samples that repeat outside
+#: such runs (a channel written coarser than its noise repeats often, and is left alone)...
+HOLD_CHANCE = 0.01
+#: ...in a channel where such runs cover at most this share of the samples (beyond, the
+#: channel is steady below its resolution or forward-filled at a slower rate: "Logging
+#: rate" in docs/bit_speed.md, not a defect).
+HOLD_MAX_SHARE = 0.2
 
 
 def isolated_spikes(x) -> np.ndarray:
@@ -138,6 +152,40 @@ def _zeros_between(x: np.ndarray, candidate: np.ndarray, beyond: float) -> np.nd
         if first > 0 and last + 1 < x.size and min(abs(x[first - 1]), abs(x[last + 1])) > beyond:
             lost[first:last + 1] = True
     return lost
+
+
+def held_values(time_s, x) -> np.ndarray:
+    """Samples that repeat an earlier reading of ``x`` exactly, in runs no chance repeat
+    explains (a boolean mask; the run's first sample, the real reading, is not in it): runs
+    of one non-zero value lasting :data:`HOLD_MIN_S` and :data:`HOLD_MIN_SAMPLES`, rarer by
+    chance than :data:`HOLD_CHANCE` given the channel's own repeat rate, in a channel where
+    they cover at most :data:`HOLD_MAX_SHARE` (module constants). A value of 0 is left to
+    :func:`lost_torque` and :func:`lost_speed` (a stopped top drive reads 0 for minutes).
+
+    Examples
+    --------
+    >>> t = np.arange(100) * 0.1
+    >>> x = 60.0 + np.sin(t)
+    >>> x[40:60] = x[40]  # held for 2 s
+    >>> np.flatnonzero(held_values(t, x)).tolist() == list(range(41, 60))
+    True
+    """
+    t = np.asarray(time_s, dtype=float)
+    x = np.asarray(x, dtype=float)
+    held = np.zeros(x.size, dtype=bool)
+    if x.size < HOLD_MIN_SAMPLES:
+        return held
+    same = x[1:] == x[:-1]
+    runs = [(i, j + 1) for i, j in true_runs(same)
+            if j + 2 - i >= HOLD_MIN_SAMPLES and t[j + 1] - t[i] >= HOLD_MIN_S and x[i] != 0]
+    pairs_in_runs = sum(last - first for first, last in runs)
+    if pairs_in_runs > HOLD_MAX_SHARE * same.size:
+        return held
+    chance = max(float(same.sum()) - pairs_in_runs, 1.0) / same.size
+    for first, last in runs:
+        if same.size * chance ** (last - first) < HOLD_CHANCE:
+            held[first + 1:last + 1] = True
+    return held
 
 
 def defects(time_s, cycle_s: float, surface_rpm, torque_Nm,

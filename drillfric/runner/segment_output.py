@@ -148,7 +148,7 @@ def _bit_fields(est: SegmentEstimate) -> dict:
     null where the stick-slip is beyond their validated range, the reason in the message)."""
     logged = dict(sample_interval_s=est.logged.interval_s,
                   interval_torque_swing=est.logged.torque_swing,
-                  samples_dropped=est.samples_dropped)
+                  samples_dropped=est.samples_dropped, samples_held=est.samples_held)
     kept = dict(stick_slip_severity=est.stick_slip_severity,
                 stuck_fraction=est.stuck_fraction,
                 stick_slip_from_s=est.stick_slip_from_s) if est.bit_statistics else {}
