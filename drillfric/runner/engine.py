@@ -274,7 +274,9 @@ class Engine:
                             wall_s=time.perf_counter() - self.t_wall,
                             profile=self.estimator.settings.friction,
                             resampled_rate_hz=self.estimator.rate_hz,
-                            requested_rate_hz=self.rate_hz)
+                            requested_rate_hz=self.rate_hz,
+                            duplicates_dropped=self.tracker.duplicates,
+                            conflicts_dropped=self.tracker.conflicts)
         summary.update(hookload=weighed.summary, torque_zero=zero.summary(),
                        mu_k_reason=weighed.mu_k_reason(summary["mu_k"])
                        or zero.mu_k_reason(summary["mu_k"]),

@@ -70,7 +70,8 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, ro
               assumed: list[str], warnings: list[str], wall_s: float,
               profile: FrictionProfile,
               resampled_rate_hz: float | None = None,
-              requested_rate_hz: float | None = None) -> dict:
+              requested_rate_hz: float | None = None,
+              duplicates_dropped: int = 0, conflicts_dropped: int = 0) -> dict:
     """summary.json (docs/outputs.md) from what a run found.
 
     Parameters
@@ -90,10 +91,14 @@ def summarise(well: Well, records: list[SegmentRecord], pools: list[dict], *, ro
         The well's friction zones and law (the estimation's own, built once per well).
     resampled_rate_hz, requested_rate_hz : float, optional
         The rate the estimation resampled to and the rate asked for [Hz].
+    duplicates_dropped, conflicts_dropped : int
+        Rows dropped for repeating an earlier row's time and values, and for repeating a
+        time with other values (the time base's counts, docs/ingestion.md "EDR defects").
     """
     inputs = {k: {"path": str(Path(p).resolve()), "sha256": file_sha256(p)}
               for k, p in well.files.inputs.items() if Path(p).is_file()}
-    inputs.update(rows=rows, resampled_rate_hz=resampled_rate_hz,
+    inputs.update(rows=rows, duplicates_dropped=duplicates_dropped,
+                  conflicts_dropped=conflicts_dropped, resampled_rate_hz=resampled_rate_hz,
                   requested_rate_hz=requested_rate_hz,
                   channel_skew=channel_skew(torque_lag_s(well.config.channels), records))
     count = {s: sum(r.status is s for r in records) for s in Status}
