@@ -380,14 +380,44 @@ _VULGAR = {"½": " 1/2", "¼": " 1/4", "¾": " 3/4", "⅛": " 1/8", "⅜": " 3/8
 _DIGITS = 50
 
 
-def _magnitude(match: re.Match) -> Decimal:
-    """The number of a :data:`_QUANTITY` match, exactly (``5 1/2`` → 5.5)."""
+def _magnitude(match: re.Match) -> Decimal | None:
+    """The number of a :data:`_QUANTITY` match, exactly (``5 1/2`` → 5.5); None for a
+    fraction over 0."""
     if match["whole"] is not None:
+        if int(match["den"]) == 0:
+            return None
         whole, frac = Decimal(match["whole"]), Decimal(match["num"]) / Decimal(match["den"])
         return whole - frac if match["whole"].startswith("-") else whole + frac
     if match["fnum"] is not None:
-        return Decimal(match["fnum"]) / Decimal(match["fden"])
+        return None if int(match["fden"]) == 0 else Decimal(match["fnum"]) / Decimal(
+            match["fden"])
     return Decimal(match["number"])
+
+
+#: A number inside a unit as written: digits (with separators), and what comes before them.
+_UNIT_NUMBER = re.compile(r"(?P<before>\S?)\s*(?P<digits>[\d.,][\d.,]*)")
+
+
+def _number_in_unit(spelled: str) -> bool:
+    """Whether the unit part of a quantity holds a number of its own: ``",300 m"`` of
+    ``"2,300 m"``, ``"300 m"`` of ``"2 300 m"`` (pint would multiply it in: 600 m; the
+    eleventh attack of issue 30). A unit's own digits are allowed: an exponent (``m2``,
+    ``m**3``, ``ft^3``), a scale after ``/`` or ``(`` (``deg/100ft``, ``deg/(30 m)``) and
+    a leading ``1/`` (``1/s``).
+
+    Examples
+    --------
+    >>> [_number_in_unit(u) for u in (",300 m", "300 m", "kg.m**2", "deg/(100 ft)", "1/s")]
+    [True, True, False, False, False]
+    """
+    if re.match(r"\s*1\s*/", spelled):
+        spelled = spelled[spelled.index("/"):]
+    for m in _UNIT_NUMBER.finditer(spelled):
+        before, start = m["before"], m.start("digits")
+        attached = bool(before) and start == m.end("before") and before.isalpha()
+        if not (before in ("/", "(", "*", "^") or attached):
+            return True
+    return False
 
 
 def quantity_value(text: str, unit: str, *, what: str = "", file=None,
@@ -440,14 +470,22 @@ def quantity_value(text: str, unit: str, *, what: str = "", file=None,
         problem = (f"{what} must be a number or a number with a unit, got "
                    f"'{_shown(text.strip())}'" if what else f"{given} is not a number")
         raise ConfigError(problem, file=file, fix=f"write e.g. {example}")
-    if not match["unit"]:
+    if not match["unit"] and _magnitude(match) is not None:
         if bare:
             return float(_magnitude(match))
         raise ConfigError(f"{given} has no unit", file=file,
                           fix=f"write the number without quotes (in {unit}) or with its unit, "
                               f"e.g. {example}")
+    magnitude = _magnitude(match)
+    if magnitude is None:
+        raise ConfigError(f"{given} divides by 0", file=file, fix=f"write e.g. {example}")
+    if _number_in_unit(match["unit"]):
+        raise ConfigError(f"{given} has a number in its unit part ('{_shown(match['unit'])}'): "
+                          "a thousands separator or a decimal comma is not read", file=file,
+                          fix=f"write the number with digits and a decimal point only, e.g. "
+                              f"{example}")
     expected = f"{name} ({unit})" if name else unit
-    return _convert(_magnitude(match), match["unit"], expr, expected, given, file, example)
+    return _convert(magnitude, match["unit"], expr, expected, given, file, example)
 
 
 def _convert(magnitude: Decimal, spelled: str, expr: str, expected: str, what: str, file,

@@ -16,6 +16,7 @@ from drillfric.io.atomic import OUT_FILES, RECORDING_SUFFIX
 from drillfric.io.readers import data_format, open_source
 from drillfric.io.source import RawSource
 from drillfric.io.text import printable
+from drillfric.units import parse_unit
 
 #: Formats whose files a folder may hold as parts of one log.
 PART_FORMATS = ("csv", "parquet")
@@ -78,6 +79,31 @@ def _format(path: Path) -> str:
         return f"'{printable(path.suffix or path.name)}'"
 
 
+def _unit_clash(first: dict, other: dict) -> tuple[str, str, str] | None:
+    """The first column whose stated unit differs between two parts (column, the first
+    part's unit, the other's), or None: spellings of one unit (``N.m``, ``N·m``) agree; a
+    unit stated in one part only is not a clash (it is read as the first part states)."""
+    for column, unit in other.items():
+        theirs = first.get(column)
+        if isinstance(column, str) and unit and theirs and not _same(theirs, unit):
+            return column, theirs, unit
+    return None
+
+
+def _same(a: str, b: str) -> bool:
+    """Whether two unit spellings are one unit (text that is no unit compares as text)."""
+    if a.strip().lower() == b.strip().lower():
+        return True
+    try:
+        ua, ub = parse_unit(a), parse_unit(b)
+    except InputError:
+        return False
+    try:
+        return abs((1.0 * ua).to(ub).magnitude - 1.0) <= 1e-9
+    except Exception:  # noqa: BLE001 — pint's DimensionalityError and kin: not one unit
+        return False
+
+
 def open_parts(paths) -> RawSource:
     """One raw source from the parts of a log (each opened as the file it is; every part
     must have the first part's columns). Its ``parts`` are the parts' own sources."""
@@ -87,6 +113,15 @@ def open_parts(paths) -> RawSource:
         if src.columns != first.columns:
             raise InputError(f"columns differ from those of {printable(first.path.name)}",
                              file=src.path, fix="give every part of the log the same columns")
+        clash = _unit_clash(first.units, src.units)
+        if clash:
+            column, theirs, mine = clash
+            raise InputError(f"column '{printable(column)}' is in '{printable(mine)}' here and "
+                             f"in '{printable(theirs)}' in {printable(first.path.name)}: the "
+                             "parts would be read in the first part's unit",
+                             file=src.path, fix="write every part of the log in the same units "
+                                                "(convert this part), or run it as a well of "
+                                                "its own")
     rows = None if any(s.rows is None for s in sources) else sum(s.rows for s in sources)
 
     def read(chunk_rows: int) -> Iterator[pd.DataFrame]:

@@ -1,0 +1,79 @@
+"""Regression tests of the eleventh hostile-input attack (issue 30): numbers written the way
+people write them, and parts of one log in different units. Each test is named after what
+the attack did."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from drillfric.errors import ConfigError, InputError
+from drillfric.io.parts import open_parts
+from drillfric.units import quantity_value
+
+
+@pytest.mark.parametrize("text, unit", [
+    ("2,300 m", "m"), ("2 300 m", "m"), ("2\u00a0300 m", "m"), ("2\u202f300 m", "m"),
+    ("7,546.5 ft", "m"), ("2.300,5 m", "m"), ("1,2 sg", "kg/m³"), ("35,5 klbf", "N"),
+    ("2 900 kg.m**2", "kg*m**2"), ("8200 ft 2", "m"),
+])
+def test_a_thousands_separator_or_decimal_comma_in_a_quantity_is_refused(text, unit):
+    """``"2,300 m"`` read as 600 m and ``mud_density_kg_m3 = "1,2 sg"`` as 2000 kg/m³ (μ_k
+    0.312 for 0.28, exit 0): the number was cut at the separator and pint multiplied the rest
+    of it in as part of the unit. A number inside the unit part is refused, naming it."""
+    with pytest.raises(ConfigError, match="has a number in its unit part"):
+        quantity_value(text, unit, what="key 'x'", file="w.toml")
+
+
+@pytest.mark.parametrize("text, unit, expected", [
+    ("2300 m", "m", 2300.0), ("5 1/2 in", "m", 0.1397), ("2 deg/(30 m)", "rad/m", None),
+    ("0.15 rev/gal", "rev/L", None), ("2900 kg.m**2", "kg*m**2", 2900.0),
+])
+def test_a_units_own_digits_are_still_read(text, unit, expected):
+    """Exponents, a scale after '/' or '(' and whole fractions are a unit's own digits."""
+    value = quantity_value(text, unit, what="key 'x'")
+    assert expected is None or value == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("text", ["8 1/0 in", "1/0 m"])
+def test_a_fraction_over_zero_is_one_line(text):
+    """``"8 1/0 in"`` ended in 'internal error: DivisionByZero' naming no file."""
+    with pytest.raises(ConfigError, match="divides by 0"):
+        quantity_value(text, "m", what="key 'x'", file="w.toml")
+
+
+def _frame():
+    return pd.DataFrame({"TIME": [0.0, 1.0], "RPM": [60.0, 61.0], "TORQUE": [9e3, 9.1e3]})
+
+
+def test_csv_parts_with_different_units_rows_are_refused(tmp_path):
+    """h00.csv's units row said N.m, h01.csv's ft.lbf, the same column names: h01 was read in
+    N·m (μ_k 0.203 for 0.279, exit 0). The part whose units differ is refused, naming both."""
+    for name, torque_unit in (("h00.csv", "N.m"), ("h01.csv", "ft.lbf")):
+        body = _frame().to_csv(index=False).splitlines()
+        lines = [body[0], f"s,rpm,{torque_unit}", *body[1:]]
+        (tmp_path / name).write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match="'TORQUE' is in 'ft.lbf' here and in 'N.m' in h00"):
+        open_parts(sorted(tmp_path.glob("*.csv")))
+
+
+def test_parquet_parts_with_different_unit_metadata_are_refused(tmp_path):
+    """The same with Parquet parts whose field metadata ``unit`` differs."""
+    for name, torque_unit in (("h00.parquet", "N.m"), ("h01.parquet", "ft.lbf")):
+        table = pa.Table.from_pandas(_frame(), preserve_index=False)
+        fields = [f.with_metadata({"unit": torque_unit}) if f.name == "TORQUE" else f
+                  for f in table.schema]
+        pq.write_table(table.cast(pa.schema(fields)), tmp_path / name)
+    with pytest.raises(InputError, match="'TORQUE' is in 'ft.lbf' here"):
+        open_parts(sorted(tmp_path.glob("*.parquet")))
+
+
+def test_parts_spelling_one_unit_two_ways_are_one_log(tmp_path):
+    """``N.m`` and ``N·m`` are one unit: no refusal."""
+    for name, torque_unit in (("h00.csv", "N.m"), ("h01.csv", "N·m")):
+        body = _frame().to_csv(index=False).splitlines()
+        (tmp_path / name).write_text("\n".join([body[0], f"s,rpm,{torque_unit}", *body[1:]])
+                                     + "\n", encoding="utf-8")
+    assert open_parts(sorted(tmp_path.glob("*.csv"))).columns == ["TIME", "RPM", "TORQUE"]
