@@ -77,3 +77,52 @@ def test_parts_spelling_one_unit_two_ways_are_one_log(tmp_path):
         (tmp_path / name).write_text("\n".join([body[0], f"s,rpm,{torque_unit}", *body[1:]])
                                      + "\n", encoding="utf-8")
     assert open_parts(sorted(tmp_path.glob("*.csv"))).columns == ["TIME", "RPM", "TORQUE"]
+
+
+def test_a_manifest_saved_as_csv_utf8_by_excel_keeps_its_well_column(tmp_path):
+    """Excel's "CSV UTF-8" starts with a byte-order mark: the first column read as
+    '\\ufeffwell', so every well was named after its file (OUT/x1 for ALPHA), silently."""
+    from drillfric.fleet.discovery import _read_manifest
+
+    manifest = tmp_path / "wells.csv"
+    manifest.write_text("well,data,config\nALPHA,x1.csv,  \n", encoding="utf-8-sig")
+    spec, = _read_manifest(manifest)
+    assert spec.name == "ALPHA" and spec.data == tmp_path / "x1.csv"
+    assert spec.config is None  # a cell of blanks is empty, not the folder '  '
+
+
+def test_a_json_manifest_entry_naming_a_key_twice_is_refused(tmp_path):
+    """``{"data": "a.csv", "data": "b.csv"}`` ran b.csv silently."""
+    from drillfric.fleet.discovery import _read_manifest
+
+    manifest = tmp_path / "wells.json"
+    manifest.write_text('[{"well": "A", "data": "a.csv", "data": "b.csv"}]')
+    with pytest.raises(InputError, match="key 'data' written twice"):
+        _read_manifest(manifest)
+
+
+def test_one_column_configured_for_two_channels_is_refused():
+    """``surface_torque = { column = "surface_rpm" }`` ran with the speed read as the torque
+    (exit 0, caught only by the μ-range warning)."""
+    from drillfric.io.channels import map_channels
+
+    with pytest.raises(InputError, match="'surface_rpm' is taken for both surface_rpm and "
+                                         "surface_torque"):
+        map_channels(["time_s", "surface_rpm", "surface_torque_Nm"], {},
+                     {"surface_torque": {"column": "surface_rpm"}}, file="w.csv")
+
+
+def test_iso_times_that_lose_their_utc_offset_midway_are_refused(tmp_path):
+    """``+02:00`` dropped from row 2001 on: the rest was read as UTC, a silent 2-h jump and
+    clock times 2 h off (exit 0). One line naming the row."""
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    stamps = pd.date_range("2024-05-01T12:00:00", periods=40, freq="50ms")
+    text = [s.isoformat() + ("+02:00" if i < 20 else "") for i, s in enumerate(stamps)]
+    data = tmp_path / "tz.csv"
+    pd.DataFrame({"TIME": text, "RPM": 60.0, "TORQUE": 9e3}).to_csv(data, index=False)
+    result = CliRunner().invoke(cli, ["-q", "run", str(data), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2, result.output
+    assert "data row 21" in result.output and "has no UTC offset" in result.output
+    assert not (tmp_path / "o").exists()

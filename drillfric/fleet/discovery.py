@@ -115,10 +115,11 @@ def _read_manifest(path: Path) -> list[WellSpec]:
     suffix = path.suffix.lower()
     try:
         if suffix == ".csv":
-            with open(path, newline="", encoding="utf-8") as fh:
+            with open(path, newline="", encoding="utf-8-sig") as fh:
                 rows = list(csv.DictReader(fh))
         elif suffix == ".json":
-            rows = json.loads(path.read_text(encoding="utf-8"))
+            rows = json.loads(path.read_text(encoding="utf-8-sig"),
+                              object_pairs_hook=_no_repeated_keys)
             rows = rows.get("wells", rows) if isinstance(rows, dict) else rows
         else:
             raise InputError("a fleet manifest must be .csv or .json", file=path,
@@ -131,16 +132,27 @@ def _read_manifest(path: Path) -> list[WellSpec]:
         raise InputError("unreadable manifest (nested too deep)", file=path,
                          fix="write a CSV/JSON list with columns well, data, config, "
                              "survey") from None
-    if not isinstance(rows, list) or any(not isinstance(r, dict) or not r.get("data")
+    if not isinstance(rows, list) or any(not isinstance(r, dict)
+                                         or not str(r.get("data") or "").strip()
                                          for r in rows):
         raise InputError("every manifest entry needs a 'data' path", file=path,
                          fix=f"use columns {', '.join(_MANIFEST_COLUMNS)} (data required)")
 
     def where(value) -> Path | None:
-        if value and "\x00" in str(value):  # no path holds NUL: the OS refuses it
+        value = str(value or "").strip()  # a cell of blanks is an empty cell
+        if "\x00" in value:  # no path holds NUL: the OS refuses it
             raise InputError("a manifest path holds a NUL character", file=path,
                              fix="write each path as plain text")
-        return None if not value else (path.parent / str(value)).resolve()
+        return None if not value else (path.parent / value).resolve()
 
-    return [WellSpec(where(r["data"]), r.get("well") or None, where(r.get("config")),
-                     where(r.get("survey"))) for r in rows]
+    return [WellSpec(where(r["data"]), str(r.get("well") or "").strip() or None,
+                     where(r.get("config")), where(r.get("survey"))) for r in rows]
+
+
+def _no_repeated_keys(pairs: list) -> dict:
+    """A JSON object, refusing a key written twice (the last had been used silently)."""
+    keys = [k for k, _ in pairs]
+    twice = sorted({k for k in keys if keys.count(k) > 1})
+    if twice:
+        raise json.JSONDecodeError(f"key '{twice[0]}' written twice in one entry", "", 0)
+    return dict(pairs)

@@ -472,6 +472,18 @@ def _same_unit(a: str, b: str, channel: Channel, file: str | None) -> bool:
     return abs(fa - fb) <= 1e-9 * max(abs(fa), abs(fb))
 
 
+def _claimed_twice(found: dict, channel: Channel, column: str, config_channels: dict,
+                   file: str | None) -> None:
+    """Refuse one column configured for two channels (the eleventh attack of issue 30:
+    ``surface_torque = { column = "surface_rpm" }`` ran, the speed read as the torque)."""
+    for key, other in found.items():
+        configured = any("column" in (config_channels.get(k) or {}) for k in (key, channel.key))
+        if other.column == column and configured:
+            raise InputError(f"column '{printable(str(column))}' is taken for both {key} and "
+                             f"{channel.key}", file=file,
+                             fix=f"give [channels] {channel.key} and {key} a column each")
+
+
 def log_index(columns: list[str], config_channels: dict, *, depth_index: str | None = None,
               file: str | None = None) -> str:
     """Whether a log is indexed by ``"time"`` or by ``"depth"`` (docs/ingestion.md).
@@ -552,6 +564,7 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
                 raise _missing(channel, columns, file_units, config_channels, out, file,
                                log_shaped)
             continue
+        _claimed_twice(out, channel, column, config_channels, file)
         unit, source = _unit_for(channel, column, name_unit, file_units, spec, file)
         try:
             scale = factor(unit, channel, file=file)

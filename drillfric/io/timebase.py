@@ -227,6 +227,7 @@ class TimeTracker:
         self._rows_seen = 0
         self._last: float | None = None
         self._absolute: bool | None = None
+        self._zoned: bool | None = None  # whether the text timestamps carry a UTC offset
         self._held: pd.DataFrame | None = None  # rows of the last time read (settle)
         # the part of a log in parts read last, and the rows read before it
         self._part: str | None = None
@@ -522,6 +523,7 @@ class TimeTracker:
         if pd.api.types.is_datetime64_any_dtype(values):
             return self._nanoseconds(values.reset_index(drop=True))
         text = values.astype("string").str.strip()
+        self._same_zoning(text)
         for utc in (False, True):  # several UTC offsets (a daylight-saving change): to UTC
             try:
                 stamps = pd.to_datetime(text, format="ISO8601", utc=utc)
@@ -536,6 +538,27 @@ class TimeTracker:
                          f"data row "
                          f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
                          fix="write times as seconds or like 2024-05-01T12:00:00")
+
+    def _same_zoning(self, text: pd.Series) -> None:
+        """Refuse text timestamps some of which state a UTC offset and some not (the
+        eleventh attack of issue 30: ``+02:00`` lost from row 2001 on read the rest as UTC,
+        a silent 2-h jump and clock times 2 h off)."""
+        present = _present(text)
+        zoned = text.str.contains(_OFFSET, regex=True, na=False).to_numpy(dtype=bool)
+        if not present.any():
+            return
+        first = bool(zoned[present][0]) if self._zoned is None else self._zoned
+        odd = np.flatnonzero(present & (zoned != first))
+        if odd.size:
+            row = self._rows_seen + int(odd[0]) + 1
+            raise InputError(f"time column '{printable(self.column)}': the timestamp at data "
+                             f"row {row} ('{printable(text.iloc[odd[0]], 30)}') "
+                             f"{'has no' if first else 'has a'} UTC offset, the earlier ones "
+                             f"{'have one' if first else 'none'}: its clock time cannot be "
+                             "placed", file=self.file,
+                             fix="write every time with its UTC offset (or every time in UTC, "
+                                 "ending in Z)")
+        self._zoned = first
 
     def _nanoseconds(self, stamps: pd.Series) -> pd.Series:
         """``stamps`` at nanosecond resolution, the one times are computed in; a date
@@ -554,6 +577,10 @@ class TimeTracker:
                          f"{row} lies outside the years 1677–2262 drillfric computes in",
                          file=self.file, fix="check the dates of the time column (a clock "
                                              "that was never set, a placeholder date)")
+
+
+#: A UTC offset (or ``Z``) after a time of day, as ISO 8601 writes it.
+_OFFSET = r"\d{2}:\d{2}(?::\d{2}(?:[.,]\d*)?)?\s*(?:[Zz]|UTC|[+-]\d{2}(?::?\d{2})?)$"
 
 
 def holds_timestamps(values: pd.Series) -> bool:
