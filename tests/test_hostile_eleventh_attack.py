@@ -126,3 +126,23 @@ def test_iso_times_that_lose_their_utc_offset_midway_are_refused(tmp_path):
     assert result.exit_code == 2, result.output
     assert "data row 21" in result.output and "has no UTC offset" in result.output
     assert not (tmp_path / "o").exists()
+
+
+def test_one_torque_sample_of_1e30_does_not_fail_the_stand_as_a_unit():
+    """One torque sample of 1e30 N·m failed the whole stand ('4e+25x the top … is the torque
+    channel in another unit?'): the scale check took the mean. A unit scales every sample,
+    so it takes the median; the spike is left to the EDR-defect step, which drops it."""
+    import numpy as np
+
+    from drillfric.errors import DrillfricError
+    from drillfric.estimation.segment_data import SegmentData
+    from drillfric.estimation.torque_scale import check_torque_scale
+
+    t = np.arange(0.0, 60.0, 0.05)
+    torque = np.full(t.size, 15e3)
+    torque[300] = 1e30
+    data = SegmentData(t, np.full(t.size, 60.0), torque, 2210.0)
+    check_torque_scale(data, 55e3, 0.1)  # T_N of the demo's stand, order of magnitude
+    with pytest.raises(DrillfricError, match="the top of the torque-and-drag range"):
+        check_torque_scale(SegmentData(t, np.full(t.size, 60.0), torque * 1e3, 2210.0),
+                           55e3, 0.1)

@@ -61,10 +61,12 @@ def plausible_torque_range(T_N_Nm: float, kind: str, wob_N: float = 0.0) -> tupl
 
 def check_torque_scale(data, T_N_Nm: float, omega_c_rad_s: float, *,
                        torque_channel=None) -> None:
-    """Fail a segment whose mean rotating torque no plausible friction can explain.
+    """Fail a segment whose rotating torque no plausible friction can explain.
 
-    The mean surface torque [N·m] while the top drive turns faster than 2ω_c [rad/s] is
-    compared with :func:`plausible_torque_range`; more than :data:`TORQUE_SCALE_LIMIT`
+    The median surface torque [N·m] while the top drive turns faster than 2ω_c [rad/s] (a
+    unit scales every sample, a spike of 1e30 N·m one: the eleventh attack of issue 30 had
+    failed a stand on one such sample, blaming the unit) is compared with
+    :func:`plausible_torque_range`; more than :data:`TORQUE_SCALE_LIMIT`
     times above its top or below its bottom means the torque channel is in another unit
     (a factor 1000: N·m and kN·m), a wrong column, or a wrong sign.
 
@@ -86,10 +88,10 @@ def check_torque_scale(data, T_N_Nm: float, omega_c_rad_s: float, *,
     rotating = np.abs(data.surface_rpm) * RPM_TO_RAD_S > 2.0 * omega_c_rad_s
     if rotating.sum() < 10:
         return
-    mean = float(np.mean(data.surface_torque_Nm[rotating]))
+    mean = float(np.median(data.surface_torque_Nm[rotating]))
     lo, hi = plausible_torque_range(T_N_Nm, data.kind, data.wob_N)
     bit = " plus bit torque" if data.kind == Kind.ON_BOTTOM else ""
-    where = (f"the torque-and-drag range at {data.bit_depth_m:.0f} m (mean {_kNm(mean)} kN·m "
+    where = (f"the torque-and-drag range at {data.bit_depth_m:.0f} m (median {_kNm(mean)} kN·m "
              f"while rotating; range {_kNm(lo)}–{_kNm(hi)} kN·m for μ {PLAUSIBLE_MU[0]}–"
              f"{PLAUSIBLE_MU[1]}{bit})")
     if mean <= 0.0:
