@@ -146,3 +146,31 @@ def test_one_torque_sample_of_1e30_does_not_fail_the_stand_as_a_unit():
     with pytest.raises(DrillfricError, match="the top of the torque-and-drag range"):
         check_torque_scale(SegmentData(t, np.full(t.size, 60.0), torque * 1e3, 2210.0),
                            55e3, 0.1)
+
+
+@pytest.mark.slow
+def test_a_well_deleted_between_nights_is_not_reported_ok_again(tmp_path):
+    """Night 2 after B.csv was deleted read 'all 1 well ok', manifest.json kept B 'ok' and
+    OUT/B unmarked, night after night. The fleet says which wells it no longer finds, their
+    results stay, marked stale, and manifest.json says since when."""
+    import json
+
+    import numpy as np
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    wells = tmp_path / "wells"
+    wells.mkdir()
+    t = np.arange(0.0, 20.0, 0.1)
+    for name in "AB":
+        pd.DataFrame({"time_s": t, "surface_rpm": 0.0, "surface_torque_Nm": 0.0}).to_csv(
+            wells / f"{name}.csv", index=False)
+    out = tmp_path / "out"
+    command = ["-q", "fleet", str(wells), "--out", str(out), "--no-report", "--workers", "1"]
+    CliRunner().invoke(cli, command)
+    (wells / "B.csv").unlink()
+    result = CliRunner().invoke(cli, command)
+    assert "1 well of earlier runs not found this time (B)" in result.output
+    entry = json.loads((out / "manifest.json").read_text())["wells"]["B"]
+    assert entry["missing_since_utc"] and (out / "B" / "STALE.json").is_file()
+    assert "stale" in json.loads((out / "B" / "summary.json").read_text())

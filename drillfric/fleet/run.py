@@ -51,6 +51,7 @@ from drillfric.io.results import (
     remove_stale,
     write_json,
 )
+from drillfric.io.text import plural
 from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS
 from drillfric.vocabulary import WellStatus
 
@@ -337,6 +338,7 @@ class _Manifest:
         self.data["wells"] = {name: entry for name, entry in self.data["wells"].items()
                               if _sound(entry, out_root)}  # a bad entry: that well runs again
         self._saved = 0.0
+        self.gone: tuple[str, ...] = ()  # wells of earlier nights not found this time
 
     @property
     def wells(self) -> dict:
@@ -414,6 +416,7 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
             if fleet_files:
                 summary_path = _write_summary(out_root, outcomes)
                 report_path, notes = _write_report(out_root, outcomes)
+                notes = tuple(notes) + _gone_notes(manifest.gone)
     except DrillfricError:
         if created and fleet_files and not any(p.is_dir() for p in out_root.iterdir()):
             for name in (MANIFEST, _LOCK):  # failed before any well ran: no OUT left behind
@@ -468,7 +471,45 @@ def _run_jobs(jobs: list[_Job], out_root: Path, run: str, *, workers: int,
         if scheduler is None:  # local workers are gone: what they left is stale
             for dir_name in {j.dir_name for j in jobs} | set(written):
                 remove_stale(out_root, dir_name)
+    if fleet_files:
+        manifest.gone = _gone(manifest, {o.well for o in outcomes.values()})
+        manifest.save()
     return tuple(outcomes[j.index] for j in jobs), manifest
+
+
+def _gone_notes(gone: tuple[str, ...]) -> tuple[str, ...]:
+    """The fleet's note on the wells no longer found (none: no note)."""
+    if not gone:
+        return ()
+    shown = ", ".join(gone[:5]) + (f" and {len(gone) - 5} more" if len(gone) > 5 else "")
+    return (f"{plural(len(gone), 'well')} of earlier runs not found this time ({shown}): "
+            "their results are kept in OUT, marked stale (STALE.json); manifest.json says "
+            "since when (missing_since_utc)",)
+
+
+def _gone(manifest: _Manifest, present: set) -> tuple[str, ...]:
+    """The wells of earlier nights whose data this run did not find: each entry gets
+    ``missing_since_utc`` and its results in OUT are marked stale (they stay, and no longer
+    read as this night's: the eleventh attack of issue 30 found a deleted well reported
+    'ok' night after night). A well whose data returns runs again (its summary changed)."""
+    out_root = manifest.path.parent.resolve()
+    gone = []
+    for name, entry in manifest.wells.items():
+        if name in present or not isinstance(entry, dict):
+            continue
+        gone.append(name)
+        if entry.get("missing_since_utc"):
+            continue
+        entry["missing_since_utc"] = now_utc()
+        folder = Path(entry.get("outputs", {}).get("dir") or out_root / name)
+        try:
+            if folder.resolve().parent == out_root and mark_stale(
+                    folder, "its data was not among the wells of a later fleet run",
+                    entry["missing_since_utc"]):
+                entry["stale_outputs"] = str(folder)
+        except OSError:
+            continue
+    return tuple(sorted(gone))
 
 
 def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
