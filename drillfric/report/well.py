@@ -360,7 +360,7 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
                                "torque", ".1f")
     row["quality"] = quality_text(row, fit)
     row["fit_sentence"] = fit.sentence(_when(fit.t_half_s, origin), units) if fit else ""
-    row["fit_mismatch"] = fit is not None and not fit.regime_reproduced
+    row["fit_mismatch"] = fit is not None and not fit.reproduced
     row["mu_name"] = mu_name(row)
     row["status_word"] = status_word(row)
     row["note_flags"] = note_flags(row)
@@ -420,7 +420,7 @@ def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
             if (found := reproduction(rows)) is not None}
     rows = data.segments.set_index("id", drop=False)
     texts = {i: (quality_text(rows.loc[i].to_dict(), fit),
-                 "" if fit.regime_reproduced else
+                 "" if fit.reproduced else
                  fit.sentence(_when(fit.t_half_s, data.time_origin), shown))
              for i, fit in fits.items()}
     diag = diagnostic_rows(data.segments, shown, data.time_origin, texts)
