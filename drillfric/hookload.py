@@ -110,6 +110,22 @@ class BlockWeight:
     plateaus: tuple = ()
     reason: str = ""
 
+    def text(self, slips_N: float | None = None) -> str:
+        """The block weight as messages state it: the number summary.json
+        ``hookload.block_weight_N`` holds (kN, 3 significant figures) and where it comes
+        from, told apart from the slips threshold it is found under (issue 35: "block weight
+        147 kN from slips_hookload_N" read as the configured 177.9 kN)."""
+        value = f"block weight {_kN(self.weight_N)} kN"
+        if self.source == "slips_hookload_N":
+            below = "" if slips_N is None else f" = {_kN(slips_N)} kN"
+            return (f"{value}: median hook load of the in-slips plateaus, those below "
+                    f"segmentation.slips_hookload_N{below}")
+        if self.source == "log":
+            return f"{value}: median hook load of the lowest quiet plateaus (the slips)"
+        if self.source == "config":
+            return f"{value}: hookload.block_weight_N"
+        return value
+
     def evidence(self) -> dict:
         """summary.json ``hookload.block_weight_evidence``: rows, seconds, time span and
         the longest plateaus as [t_start_s, t_end_s, level_N]."""
@@ -122,6 +138,12 @@ class BlockWeight:
                 "last_s": float(max(p.t_end_s for p in self.plateaus)),
                 "plateaus": [[p.t_start_s, p.t_end_s, p.level_N]
                              for p in sorted(longest, key=lambda p: p.t_start_s)]}
+
+
+def _kN(force_N: float) -> str:
+    """A force in kN to 3 significant figures (147 kN, 178 kN, 1.52e+03 → 1520 kN)."""
+    value = force_N / 1e3
+    return f"{value:.0f}" if abs(value) >= 100 else f"{value:.3g}"
 
 
 # --------------------------------------------------------------------------- physics
@@ -579,8 +601,8 @@ def judge(records: list, plateaus: list[Plateau], cfg: Config,
         if abs(ratio - 1.0) > tol:
             well_problem = (f"the hook load contradicts the configured string: the string "
                             f"weight it measures is {ratio:.2f}× the modelled one (median of "
-                            f"{plural(len(points), 'off-bottom segment')}, block weight "
-                            f"{block.weight_N / 1e3:.0f} kN from {block.source}), beyond "
+                            f"{plural(len(points), 'off-bottom segment')}; "
+                            f"{block.text(cfg.segmentation.slips_hookload_N)}), beyond "
                             f"±{tol:.0%}")
     else:
         bad = [i for i, why in problems.items() if why]
@@ -679,8 +701,8 @@ def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWei
                    f"({problems[withheld[0]]})")
     if calibration is not None and calibration.scale is not None:
         out.append(f"string weight calibrated from the hook load: buoyed weight × "
-                   f"{calibration.scale:.3f} (block weight {block.weight_N / 1e3:.0f} kN from "
-                   f"{block.source}, {calibration.segments} off-bottom segments)")
+                   f"{calibration.scale:.3f} ({calibration.segments} off-bottom segments; "
+                   f"{block.text(cfg.segmentation.slips_hookload_N)})")
     if block.weight_N is None and not well_problem:
         out.append(f"friction factors withheld: {_unverified(block)}; give "
                    "hookload.block_weight_N (the rig's block, hook and top drive; 0 for a hook "

@@ -185,6 +185,30 @@ def test_judge_withholds_every_segment_when_the_string_is_contradicted():
     assert "withheld" in out.mu_k_reason(None) and out.warnings
 
 
+@pytest.mark.parametrize("level_N, slips_N", [(147295.2, 177929.0), (62e3, 80e3),
+                                               (1.52e6, 2e6)])
+def test_block_weight_message_states_the_summary_value_and_its_source(level_N, slips_N):
+    """Issue 35 (DSATS): the message said "block weight 147 kN from slips_hookload_N" while
+    the configuration showed slips_hookload_N 177.9 kN — two numbers for one name. The
+    message states summary.json's block_weight_N (same number) and where it comes from (the
+    in-slips plateaus), telling the threshold apart by its own value."""
+    plateaus = [hookload.Plateau(0.0, 60.0, 61, level_N)]
+    records = [_record(1, level_N + 100e3, 400e3), _record(2, level_N + 110e3, 400e3)]
+    cfg = load_config(overrides={"segmentation.slips_hookload_N": slips_N})
+    out = hookload.judge(records, plateaus, cfg)
+    assert out.summary["block_weight_N"] == level_N
+    assert out.summary["block_weight_source"] == "slips_hookload_N"
+    said = " ".join([out.summary["reason"], *out.warnings])
+    stated = re.findall(r"block weight ([0-9.]+) kN", said)
+    assert stated and {float(x) for x in stated} == {float(f"{level_N / 1e3:.3g}")
+                                                     if level_N < 1e5 else
+                                                     round(level_N / 1e3)}
+    assert "from slips_hookload_N" not in said
+    assert "in-slips plateaus, those below segmentation.slips_hookload_N = " in said
+    threshold = re.search(r"slips_hookload_N = ([0-9.]+) kN", said).group(1)
+    assert float(threshold) != float(stated[0])
+
+
 def test_judge_keeps_a_consistent_string_and_withholds_a_lone_outlier():
     plateaus = [hookload.Plateau(0.0, 60.0, 61, 150e3)]
     records = [_record(1, 400e3, 250e3), _record(2, 405e3, 252e3), _record(3, 150e3, 250e3)]
