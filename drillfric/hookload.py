@@ -569,6 +569,45 @@ def _unverified(block: BlockWeight) -> str:
             "weight) — a string 40 % off the configured one would pass")
 
 
+def in_slips_reason(hookload_N, bit_depth_m, plateaus: list[Plateau]) -> str:
+    """Why an off-bottom rotating segment is a rotation in the slips ("" when it is not):
+    its hook load lies above the log's lowest quiet plateau (the block alone) by less than
+    the lightest plausible string at its bit depth (:data:`MIN_STRING_WEIGHT_N_M`) while the
+    plateaus of the string hanging (their 90th percentile) are heavier than it by at least
+    that much. Volve F-4 (issue 35):
+    eight top-drive make-up/break-out bursts at 0.63–0.67 MN against 1.3–1.7 MN hanging,
+    labelled off-bottom rotation for want of ``segmentation.slips_hookload_N``."""
+    if not plateaus or hookload_N is None or bit_depth_m is None \
+            or not np.isfinite(hookload_N) or not np.isfinite(bit_depth_m):
+        return ""
+    levels = [p.level_N for p in plateaus]
+    lowest, hanging = min(levels), float(np.percentile(levels, 90.0))
+    lightest = MIN_STRING_WEIGHT_N_M * max(bit_depth_m, 0.0)
+    if hookload_N - lowest >= lightest or hanging - hookload_N < lightest:
+        return ""
+    return (f"rotation in the slips: its hook load {hookload_N / 1e3:.0f} kN is at the "
+            f"block's level (the lowest quiet plateau, {lowest / 1e3:.0f} kN), "
+            f"{(hanging - hookload_N) / 1e3:.0f} kN below the string hanging "
+            f"({hanging / 1e3:.0f} kN): the top drive turned a "
+            "connection being made up or broken out, not the string in the hole — not an "
+            "off-bottom rotation, skipped (set segmentation.slips_hookload_N between the two "
+            "to label such rows in_slips)")
+
+
+def _in_slips(records: list, plateaus: list[Plateau]) -> list:
+    """``records`` with the off-bottom rotations that are in the slips skipped, saying so
+    (:func:`in_slips_reason`)."""
+    out = []
+    for r in records:
+        why = in_slips_reason(r.hookload_N, r.bit_depth_m, plateaus) \
+            if r.kind is Kind.OFF_BOTTOM and r.status is not Status.FAILED else ""
+        if why:
+            r = replace(r, **{name: None for name in _WITHHELD}, status=Status.SKIPPED,
+                        message="; ".join(filter(None, [why, r.message])))
+        out.append(r)
+    return out
+
+
 def judge(records: list, plateaus: list[Plateau], cfg: Config,
           calibration: Calibration | None = None) -> Outcome:
     """Check the configured string against the hook load; withhold what it contradicts.
@@ -583,6 +622,8 @@ def judge(records: list, plateaus: list[Plateau], cfg: Config,
     flagged ``string_weight_calibrated``.
     """
     tol = cfg.hookload.tolerance
+    if cfg.segmentation.slips_hookload_N is None:  # else the slips are a rig state already
+        records = _in_slips(records, plateaus)
     points = off_bottom_points(records)
     block = calibration.block if calibration is not None and calibration.scale is not None \
         else block_weight_of(plateaus, points, cfg)
