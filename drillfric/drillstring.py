@@ -206,7 +206,9 @@ def build_string(entries, bit_depth_m: float) -> DrillString:
     lower = [float(e["length_m"]) for e in entries[1:]]
     pipe = bit_depth_m - sum(lower)
     if pipe <= 0:
-        default = all(str(e.get("name", "")).endswith("(assumed)") for e in entries)
+        from drillfric.config import DEFAULT_SECTIONS  # config does not import this module
+
+        default = [e.get("name") for e in entries] == [d["name"] for d in DEFAULT_SECTIONS]
         # issue 35 (F-9): "shorten the BHA sections" did not say that no string was given
         parts = " + ".join((f"{float(e['length_m']):g} m " if e.get("length_m") else "")
                            + str(e.get("name")).removesuffix(" (assumed)") for e in entries)
