@@ -54,9 +54,10 @@ _DEPTH_CHANNEL, _DEPTH_BLOCK, _DEPTH_NONE = 0, 1, 2
 _SPEED_TAU_S = 5.0
 #: Travel the bit must make for the pipe to count as moving along the hole while it turns
 #: [m]: reaming needs the bit to have moved this far within the time it takes at
-#: ``ream_speed_m_s`` (or since the previous sample), besides a smoothed speed above the
-#: gate. Without it the smoothed speed of the trip before a stand carried "reaming" into
-#: the first ~6 s of rotation with the bit at rest (issue 35, the demo's stand starts).
+#: ``ream_speed_m_s`` (on a coarse log: within the last two sample intervals), besides a
+#: smoothed speed above the gate. Without it the smoothed speed of the trip before a stand
+#: carried "reaming" into the first ~6 s of rotation with the bit at rest (issue 35, the
+#: demo's stand starts).
 REAM_MIN_TRAVEL_M = 0.1
 
 
@@ -193,8 +194,10 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
                 anchor_bit = bit  # where the record starts is no move
             elif abs(bit - anchor_bit) >= REAM_MIN_TRAVEL_M:
                 anchor_bit, anchor_t = bit, time_s[i]
-        moving = not np.isnan(anchor_t) and \
-            time_s[i] - anchor_t <= REAM_MIN_TRAVEL_M / ream_m_s
+        window = REAM_MIN_TRAVEL_M / ream_m_s
+        if have_prev > 0 and dt > 0.0 and 2.0 * dt > window:
+            window = 2.0 * dt  # a coarse log: the travel since the sample before last
+        moving = not np.isnan(anchor_t) and time_s[i] - anchor_t <= window
         weighted = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
         if depth_mode != _DEPTH_NONE and not np.isnan(bit):
             # going down faster than any drilling: running into hole that was already there
