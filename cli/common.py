@@ -193,7 +193,7 @@ def compile_kernels_once() -> None:
     quiet, tty = context().quiet, sys.stderr.isatty()
     if not quiet:
         click.echo("first run of this installation: compiling the numerical kernels once "
-                   f"(about 10–20 s; kept in {cache_dir()})", err=True)
+                   f"(15–60 s, longer on a busy machine; kept in {cache_dir()})", err=True)
     t0 = time.monotonic()
     if quiet or not tty:
         ok = warmup.warm_up()

@@ -206,9 +206,19 @@ def build_string(entries, bit_depth_m: float) -> DrillString:
     lower = [float(e["length_m"]) for e in entries[1:]]
     pipe = bit_depth_m - sum(lower)
     if pipe <= 0:
+        from drillfric.config import DEFAULT_SECTIONS  # config does not import this module
+
+        default = [e.get("name") for e in entries] == [d["name"] for d in DEFAULT_SECTIONS]
+        # issue 35 (F-9): "shorten the BHA sections" did not say that no string was given
+        parts = " + ".join((f"{float(e['length_m']):g} m " if e.get("length_m") else "")
+                           + str(e.get("name")).removesuffix(" (assumed)") for e in entries)
+        fix = ("no [[string.sections]] was given, so the built-in default string is used "
+               f"({parts}); give the well's string "
+               "as [[string.sections]] in the configuration (docs/configuration.md), or "
+               "check the bit depth") if default else \
+            "shorten the BHA sections ([[string.sections]] length_m) or check the bit depth"
         raise ModelError(f"the string below the top section is {sum(lower):.1f} m long but the "
-                         f"bit is at {bit_depth_m:.1f} m",
-                         fix="shorten the BHA sections or check the bit depth")
+                         f"bit is at {bit_depth_m:.1f} m", fix=fix)
     for e in entries:
         if e["od_m"] <= 0 or e["id_m"] < 0 or e["id_m"] >= e["od_m"]:
             raise ModelError(f"section '{e.get('name')}': need 0 ≤ id_m < od_m, got "

@@ -110,6 +110,22 @@ class BlockWeight:
     plateaus: tuple = ()
     reason: str = ""
 
+    def text(self, slips_N: float | None = None) -> str:
+        """The block weight as messages state it: the number summary.json
+        ``hookload.block_weight_N`` holds (kN, 3 significant figures) and where it comes
+        from, told apart from the slips threshold it is found under (issue 35: "block weight
+        147 kN from slips_hookload_N" read as the configured 177.9 kN)."""
+        value = f"block weight {_kN(self.weight_N)} kN"
+        if self.source == "slips_hookload_N":
+            below = "" if slips_N is None else f" = {_kN(slips_N)} kN"
+            return (f"{value}: median hook load of the in-slips plateaus, those below "
+                    f"segmentation.slips_hookload_N{below}")
+        if self.source == "log":
+            return f"{value}: median hook load of the lowest quiet plateaus (the slips)"
+        if self.source == "config":
+            return f"{value}: hookload.block_weight_N"
+        return value
+
     def evidence(self) -> dict:
         """summary.json ``hookload.block_weight_evidence``: rows, seconds, time span and
         the longest plateaus as [t_start_s, t_end_s, level_N]."""
@@ -122,6 +138,12 @@ class BlockWeight:
                 "last_s": float(max(p.t_end_s for p in self.plateaus)),
                 "plateaus": [[p.t_start_s, p.t_end_s, p.level_N]
                              for p in sorted(longest, key=lambda p: p.t_start_s)]}
+
+
+def _kN(force_N: float) -> str:
+    """A force in kN to 3 significant figures (147 kN, 178 kN, 1.52e+03 → 1520 kN)."""
+    value = force_N / 1e3
+    return f"{value:.0f}" if abs(value) >= 100 else f"{value:.3g}"
 
 
 # --------------------------------------------------------------------------- physics
@@ -547,6 +569,45 @@ def _unverified(block: BlockWeight) -> str:
             "weight) — a string 40 % off the configured one would pass")
 
 
+def in_slips_reason(hookload_N, bit_depth_m, plateaus: list[Plateau]) -> str:
+    """Why an off-bottom rotating segment is a rotation in the slips ("" when it is not):
+    its hook load lies above the log's lowest quiet plateau (the block alone) by less than
+    the lightest plausible string at its bit depth (:data:`MIN_STRING_WEIGHT_N_M`) while the
+    plateaus of the string hanging (their 90th percentile) are heavier than it by at least
+    that much. Volve F-4 (issue 35):
+    eight top-drive make-up/break-out bursts at 0.63–0.67 MN against 1.3–1.7 MN hanging,
+    labelled off-bottom rotation for want of ``segmentation.slips_hookload_N``."""
+    if not plateaus or hookload_N is None or bit_depth_m is None \
+            or not np.isfinite(hookload_N) or not np.isfinite(bit_depth_m):
+        return ""
+    levels = [p.level_N for p in plateaus]
+    lowest, hanging = min(levels), float(np.percentile(levels, 90.0))
+    lightest = MIN_STRING_WEIGHT_N_M * max(bit_depth_m, 0.0)
+    if hookload_N - lowest >= lightest or hanging - hookload_N < lightest:
+        return ""
+    return (f"rotation in the slips: its hook load {hookload_N / 1e3:.0f} kN is at the "
+            f"block's level (the lowest quiet plateau, {lowest / 1e3:.0f} kN), "
+            f"{(hanging - hookload_N) / 1e3:.0f} kN below the string hanging "
+            f"({hanging / 1e3:.0f} kN): the top drive turned a "
+            "connection being made up or broken out, not the string in the hole — not an "
+            "off-bottom rotation, skipped (set segmentation.slips_hookload_N between the two "
+            "to label such rows in_slips)")
+
+
+def _in_slips(records: list, plateaus: list[Plateau]) -> list:
+    """``records`` with the off-bottom rotations that are in the slips skipped, saying so
+    (:func:`in_slips_reason`)."""
+    out = []
+    for r in records:
+        why = in_slips_reason(r.hookload_N, r.bit_depth_m, plateaus) \
+            if r.kind is Kind.OFF_BOTTOM and r.status is not Status.FAILED else ""
+        if why:
+            r = replace(r, **{name: None for name in _WITHHELD}, status=Status.SKIPPED,
+                        message="; ".join(filter(None, [why, r.message])))
+        out.append(r)
+    return out
+
+
 def judge(records: list, plateaus: list[Plateau], cfg: Config,
           calibration: Calibration | None = None) -> Outcome:
     """Check the configured string against the hook load; withhold what it contradicts.
@@ -561,6 +622,8 @@ def judge(records: list, plateaus: list[Plateau], cfg: Config,
     flagged ``string_weight_calibrated``.
     """
     tol = cfg.hookload.tolerance
+    if cfg.segmentation.slips_hookload_N is None:  # else the slips are a rig state already
+        records = _in_slips(records, plateaus)
     points = off_bottom_points(records)
     block = calibration.block if calibration is not None and calibration.scale is not None \
         else block_weight_of(plateaus, points, cfg)
@@ -579,8 +642,8 @@ def judge(records: list, plateaus: list[Plateau], cfg: Config,
         if abs(ratio - 1.0) > tol:
             well_problem = (f"the hook load contradicts the configured string: the string "
                             f"weight it measures is {ratio:.2f}× the modelled one (median of "
-                            f"{plural(len(points), 'off-bottom segment')}, block weight "
-                            f"{block.weight_N / 1e3:.0f} kN from {block.source}), beyond "
+                            f"{plural(len(points), 'off-bottom segment')}; "
+                            f"{block.text(cfg.segmentation.slips_hookload_N)}), beyond "
                             f"±{tol:.0%}")
     else:
         bad = [i for i, why in problems.items() if why]
@@ -679,8 +742,8 @@ def _warnings(well_problem: str, withheld: list, problems: dict, block: BlockWei
                    f"({problems[withheld[0]]})")
     if calibration is not None and calibration.scale is not None:
         out.append(f"string weight calibrated from the hook load: buoyed weight × "
-                   f"{calibration.scale:.3f} (block weight {block.weight_N / 1e3:.0f} kN from "
-                   f"{block.source}, {calibration.segments} off-bottom segments)")
+                   f"{calibration.scale:.3f} ({calibration.segments} off-bottom segments; "
+                   f"{block.text(cfg.segmentation.slips_hookload_N)})")
     if block.weight_N is None and not well_problem:
         out.append(f"friction factors withheld: {_unverified(block)}; give "
                    "hookload.block_weight_N (the rig's block, hook and top drive; 0 for a hook "

@@ -506,9 +506,40 @@ SEEDED_START_ID = -1
 
 
 #: Well-level columns of fleet_summary.parquet (before the segment fields).
-FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "well_new_segments",
-                      "well_changes", "result_dir", "stale_result_dir", "well_mu_s",
-                      "well_mu_k", "well_mu_s_lower_bound", "drillfric_version", "segment_id")
+FLEET_WELL_COLUMNS = ("well", "well_status", "well_message", "well_failed_segments",
+                      "well_first_run", "well_new_segments", "well_changes", "result_dir",
+                      "stale_result_dir", "well_mu_s", "well_mu_k", "well_mu_s_lower_bound",
+                      "well_mu_apparent", "well_mu_apparent_segments", "well_mu_drag",
+                      "well_mu_drag_connections", "drillfric_version", "segment_id")
+#: Segment columns fleet_summary.parquet adds after the segment fields: the apparent μ of an
+#: on-bottom segment, kept out of its ``mu_k`` (issue 35: one column mixed the two).
+FLEET_SEGMENT_EXTRA = ("mu_apparent",)
+
+
+def segment_is_apparent(row: dict) -> bool:
+    """Whether a segment's μ (summary.json ``mu_k``) is apparent: on bottom, or flagged
+    ``bit_torque_in_friction`` — the bit torque is in it."""
+    flags = row.get("quality_flags")
+    return row.get("kind") == Kind.ON_BOTTOM or (
+        isinstance(flags, list | tuple) and Flag.BIT_TORQUE_IN_FRICTION in flags)
+
+
+def well_friction_columns(summary: dict | None) -> dict:
+    """The friction factors of a well besides its μ_k, as fleet_summary.parquet and
+    fleet.html state them: the median apparent μ of its ok on-bottom segments (with their
+    count) and the median drag-based μ of its connections (``drag.log`` ``mu_drag``, with
+    their count); None where there are none."""
+    summary = summary or {}
+    apparent = [float(s["mu_k"]) for s in summary.get("segments") or []
+                if s.get("status") == Status.OK and segment_is_apparent(s)
+                and isinstance(s.get("mu_k"), int | float) and np.isfinite(s["mu_k"])]
+    drag = [float(r["mu_drag"]) for r in ((summary.get("drag") or {}).get("log") or [])
+            if isinstance(r, dict) and isinstance(r.get("mu_drag"), int | float)
+            and np.isfinite(r["mu_drag"])]
+    return {"well_mu_apparent": float(np.median(apparent)) if apparent else None,
+            "well_mu_apparent_segments": len(apparent),
+            "well_mu_drag": float(np.median(drag)) if drag else None,
+            "well_mu_drag_connections": len(drag)}
 
 
 def _plain(value):

@@ -52,6 +52,13 @@ COMBINED_MOTION_KINDS = (Kind.REAMING, Kind.BACK_REAMING)
 _DEPTH_CHANNEL, _DEPTH_BLOCK, _DEPTH_NONE = 0, 1, 2
 #: Time constant of the first-order smoothing of the bit speed [s].
 _SPEED_TAU_S = 5.0
+#: Travel the bit must make for the pipe to count as moving along the hole while it turns
+#: [m]: reaming needs the bit to have moved this far within the time it takes at
+#: ``ream_speed_m_s`` (on a coarse log: within the last two sample intervals), besides a
+#: smoothed speed above the gate. Without it the smoothed speed of the trip before a stand
+#: carried "reaming" into the first ~6 s of rotation with the bit at rest (issue 35, the
+#: demo's stand starts).
+REAM_MIN_TRAVEL_M = 0.1
 
 
 @dataclass(frozen=True)
@@ -146,7 +153,8 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
 
     ``carry`` = [previous time, previous block position, previous bit depth, hole depth,
     started flag, smoothed downward bit speed, rotating latch, rotating torque level,
-    start of the current speed dip]; ``pumps`` is 1 on, 0 off, -1 unknown. Rotation has
+    start of the current speed dip, bit depth and time at its last move by
+    :data:`REAM_MIN_TRAVEL_M`]; ``pumps`` is 1 on, 0 off, -1 unknown. Rotation has
     hysteresis (:func:`_still_turning`): it starts above ``rotating_rpm`` and lasts until
     the speed drops below ``stop_rpm`` and the string is unloaded (speed noise at standstill
     does not chatter, a slow creep start-up stays inside its segment, and so do the brief
@@ -159,6 +167,7 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
     hole, have_prev, v_down = carry[3], carry[4], carry[5]
     turning = carry[6] > 0
     level, dip_start = carry[7], carry[8]
+    anchor_bit, anchor_t = carry[9], carry[10]
     for i in range(n):
         in_slips = hookload_N[i] < slips_N  # False for NaN hook load or no threshold (NaN)
         bit = bit_prev
@@ -180,6 +189,15 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
                 hole = hole_in_m[i]
             elif np.isnan(hole) or bit > hole:
                 hole = bit
+        if not np.isnan(bit) and not np.isnan(time_s[i]):
+            if np.isnan(anchor_bit):
+                anchor_bit = bit  # where the record starts is no move
+            elif abs(bit - anchor_bit) >= REAM_MIN_TRAVEL_M:
+                anchor_bit, anchor_t = bit, time_s[i]
+        window = REAM_MIN_TRAVEL_M / ream_m_s
+        if have_prev > 0 and dt > 0.0 and 2.0 * dt > window:
+            window = 2.0 * dt  # a coarse log: the travel since the sample before last
+        moving = not np.isnan(anchor_t) and time_s[i] - anchor_t <= window
         weighted = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
         if depth_mode != _DEPTH_NONE and not np.isnan(bit):
             # going down faster than any drilling: running into hole that was already there
@@ -208,7 +226,7 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
             state = IN_SLIPS
         elif turning and on_bottom:
             state = ROTATING_ON_BOTTOM
-        elif turning and abs(v_down) > ream_m_s:
+        elif turning and abs(v_down) > ream_m_s and moving:
             state = REAMING if v_down > 0.0 else BACK_REAMING
         elif turning:
             state = ROTATING_OFF_BOTTOM
@@ -228,6 +246,7 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
     carry[3], carry[4], carry[5] = hole, have_prev, v_down
     carry[6] = 1.0 if turning else 0.0
     carry[7], carry[8] = level, dip_start
+    carry[9], carry[10] = anchor_bit, anchor_t
     return states, bit_out
 
 
@@ -273,7 +292,7 @@ def _new_carry(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
     bit0 = 0.0 if _depth_mode(frame) == _DEPTH_BLOCK else np.nan
     if start is not None and _depth_mode(frame) == _DEPTH_BLOCK:
         bit0 = start
-    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan])
+    return np.array([np.nan, np.nan, bit0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan])
 
 
 def _classify(frame: pd.DataFrame, cfg: Config, carry: np.ndarray):
@@ -720,6 +739,8 @@ class Segmenter:
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
         self._carry = None if state["carry"] is None else np.array(state["carry"], float)
+        if self._carry is not None and self._carry.size < 11:  # saved before issue 35
+            self._carry = np.concatenate([self._carry, np.full(11 - self._carry.size, np.nan)])
         self._buffer = {k: np.asarray(v) for k, v in state["buffer"].items()}
         self._offset, self._next_id = int(state["offset"]), int(state["next_id"])
 

@@ -75,16 +75,26 @@
     showOpen(open, open ? segs.segments.find((r) => r.id === open.segment) : null,
       s.last_sample_time_s);
     const latest = s.latest;
+    const latestOld = !!(latest && latest.old);
     put("latest", latest ? "segment " + latest.segment + ": μ_k " + fixed(latest.mu_k, 3) + ", μ_s "
-      + (known(latest.mu_s) ? fixed(latest.mu_s, 3) : "not identified") : "none yet");
+      + (known(latest.mu_s) ? fixed(latest.mu_s, 3) : "not identified")
+      + (latestOld ? " — as of " + fixed(latest.age_s, 0) + " s before the newest sample" : "")
+      : "none yet");
+    byId("latest").classList.toggle("old", latestOld);
     put("updated", s.updated_utc);
     const list = byId("alerts");
     list.replaceChildren();
     for (const alert of s.alerts) {
       const item = document.createElement("li");
-      item.className = alert.kind;
+      // an alert resting on rows older than OLD_S behind the newest sample says how old
+      // and is greyed: it is not about now (issue 35)
+      const old = alert.old || (known(alert.time_s) && known(s.last_sample_time_s)
+        && s.last_sample_time_s - alert.time_s > OLD_S);
+      item.className = alert.kind + (old ? " old" : "");
       item.textContent = alert.kind.replace(/_/g, " ") + ": " + alert.message
-        + (known(alert.time_s) ? " (log time " + fixed(alert.time_s, 1) + " s)" : "");
+        + (known(alert.time_s) ? " (log time " + fixed(alert.time_s, 1) + " s"
+          + (old ? ", " + fixed(s.last_sample_time_s - alert.time_s, 0)
+            + " s before the newest sample, not current" : "") + ")" : "");
       list.appendChild(item);
     }
     if (!s.alerts.length) list.appendChild(Object.assign(document.createElement("li"), { textContent: "none" }));

@@ -70,3 +70,16 @@ def test_the_guard_catches_a_stale_name(code):
     option, key, name = "--no-such-" + "option", "frob" + "nicate_s", "stale_" + "kernel_name"
     text = f"`{option}`, `[model] {key}`, `{name}`, `--out`, `[well] bit_depth_m`"
     assert _missing(text, *code) == sorted([option, f"[model] {key}", name])
+
+
+def test_examples_readme_names_configurations_that_load():
+    """Issue 35 item 6: examples/README.md shows how to run the real-log kinds; every
+    configuration its commands and manifest name exists and loads."""
+    from drillfric.config import load_config
+
+    text = (REPO / "examples" / "README.md").read_text(encoding="utf-8")
+    named = set(re.findall(r"examples/[\w./-]+\.toml", text))
+    assert {"examples/dsats_1hz.toml", "examples/volve_f4.toml",
+            "examples/usrop_f5.toml"} <= named
+    for name in named:
+        load_config(REPO / name)

@@ -77,3 +77,19 @@ def test_section_index_at_boundaries():
     a, b = Section("a", .2, .1, 10., .1, 50.), Section("b", .3, .1, 5., .15, 90.)
     s = DrillString((a, b))
     assert s.section_index([0.0, 9.999, 10.0, 15.0]).tolist() == [0, 0, 1, 1]
+
+
+def test_string_longer_than_the_bit_depth_says_when_the_string_is_the_default():
+    """Issue 35 (Volve F-9, bit at ~150 m, no [string] given): "fix: shorten the BHA
+    sections" did not say the string was the built-in default; the fix names the key to
+    give. A configured string keeps the advice to shorten its sections."""
+    entries = [dict(s) for s in load_config().sections]
+    with pytest.raises(ModelError) as default:
+        build_string(entries, 150.0)
+    said = str(default.value)
+    assert "no [[string.sections]] was given, so the built-in default string is used" in said
+    assert "110 m 5in HWDP + 120 m 8in collars" in said and "shorten" not in said
+    # a configured string, even one whose sections say "(assumed)" (examples/usrop_f5.toml)
+    mine = [{**e, "name": e["name"].replace("5in HWDP", "5in HWDP, 2 joints")} for e in entries]
+    with pytest.raises(ModelError, match=r"shorten the BHA sections \(\[\[string.sections\]\]"):
+        build_string(mine, 150.0)

@@ -276,3 +276,31 @@ def test_failed_well_marks_last_nights_results_stale_and_unchanged_wells_are_ok(
     assert fleet(source, "--out", out, "--workers", "1").exit_code == 0
     assert not (out / "w2" / "STALE.json").exists()
     assert "stale" not in json.loads((out / "w2" / "summary.json").read_text())
+
+
+def test_linked_sidecars_get_a_fix_a_fleet_can_follow(tmp_path):
+    """Issue 35: a well whose sidecars are symbolic links to files elsewhere failed with
+    "fix: give the file with --config/--survey" — `fleet` has no --survey and its --config
+    applies to every well. The fix now names a manifest's config/survey columns, and a
+    manifest naming the linked files runs the well."""
+    make_wells(tmp_path / "sim", corrupt=False)
+    elsewhere, wells = tmp_path / "elsewhere", tmp_path / "wells"
+    elsewhere.mkdir()
+    wells.mkdir()
+    shutil.copy(tmp_path / "sim" / "w1.csv", wells / "w1.csv")
+    shutil.copy(tmp_path / "sim.sim.toml", elsewhere / "w1.toml")
+    shutil.copy(tmp_path / "demo.survey.csv", elsewhere / "w1.survey.csv")
+    (wells / "w1.toml").symlink_to(elsewhere / "w1.toml")
+    (wells / "w1.survey.csv").symlink_to(elsewhere / "w1.survey.csv")
+    result = fleet(wells, "--out", tmp_path / "out1", "--workers", "1")
+    assert result.exit_code == 2
+    assert "leads outside wells/" in result.output
+    assert "config/survey columns of a `drillfric fleet` manifest" in result.output
+    assert "--survey, or copy" not in result.output
+    (tmp_path / "m.csv").write_text(
+        "well,data,config,survey\n"
+        f"w1,{wells / 'w1.csv'},{wells / 'w1.toml'},{wells / 'w1.survey.csv'}\n",
+        encoding="utf-8")
+    result = fleet(tmp_path / "m.csv", "--out", tmp_path / "out2", "--workers", "1")
+    assert result.exit_code == 0, result.output
+    assert manifest(tmp_path / "out2")["w1"]["status"] == "ok"

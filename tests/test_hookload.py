@@ -185,6 +185,71 @@ def test_judge_withholds_every_segment_when_the_string_is_contradicted():
     assert "withheld" in out.mu_k_reason(None) and out.warnings
 
 
+@pytest.mark.parametrize("level_N, slips_N", [(147295.2, 177929.0), (62e3, 80e3),
+                                               (1.52e6, 2e6)])
+def test_block_weight_message_states_the_summary_value_and_its_source(level_N, slips_N):
+    """Issue 35 (DSATS): the message said "block weight 147 kN from slips_hookload_N" while
+    the configuration showed slips_hookload_N 177.9 kN — two numbers for one name. The
+    message states summary.json's block_weight_N (same number) and where it comes from (the
+    in-slips plateaus), telling the threshold apart by its own value."""
+    plateaus = [hookload.Plateau(0.0, 60.0, 61, level_N)]
+    records = [_record(1, level_N + 100e3, 400e3), _record(2, level_N + 110e3, 400e3)]
+    cfg = load_config(overrides={"segmentation.slips_hookload_N": slips_N})
+    out = hookload.judge(records, plateaus, cfg)
+    assert out.summary["block_weight_N"] == level_N
+    assert out.summary["block_weight_source"] == "slips_hookload_N"
+    said = " ".join([out.summary["reason"], *out.warnings])
+    stated = re.findall(r"block weight ([0-9.]+) kN", said)
+    assert stated and {float(x) for x in stated} == {float(f"{level_N / 1e3:.3g}")
+                                                     if level_N < 1e5 else
+                                                     round(level_N / 1e3)}
+    assert "from slips_hookload_N" not in said
+    assert "in-slips plateaus, those below segmentation.slips_hookload_N = " in said
+    threshold = re.search(r"slips_hookload_N = ([0-9.]+) kN", said).group(1)
+    assert float(threshold) != float(stated[0])
+
+
+def test_rotation_in_the_slips_is_skipped_as_such_not_off_bottom():
+    """Issue 35 (Volve F-4): top-drive make-up/break-out bursts with the string in the slips
+    (hook load at the block's, 0.63 MN, against 1.5 MN hanging) were off-bottom rotations.
+    Without segmentation.slips_hookload_N they are skipped, saying they are in the slips; a
+    rotation with the string hanging, and the slips threshold configured, are left alone."""
+    plateaus = [hookload.Plateau(0.0, 60.0, 5, 585e3), hookload.Plateau(100.0, 200.0, 8, 1.5e6),
+                hookload.Plateau(300.0, 400.0, 8, 1.52e6)]
+    records = [_record(1, 633e3, 1.2e6), _record(2, 1.48e6, 0.9e6)]
+    out = hookload.judge(records, plateaus, load_config())
+    slips, hanging = out.records
+    assert slips.status is Status.SKIPPED and slips.mu_k is None
+    assert slips.message.startswith("rotation in the slips: its hook load 633 kN")
+    assert "not an off-bottom rotation" in slips.message
+    assert hanging.status is Status.OK and "slips" not in (hanging.message or "")
+    configured = hookload.judge(records, plateaus, load_config(
+        overrides={"segmentation.slips_hookload_N": 1e6}))
+    assert "rotation in the slips" not in (configured.records[0].message or "")
+    # a shallow string hanging 20 kN above the block is no slips (lighter than any string)
+    assert hookload.in_slips_reason(605e3, 300.0, plateaus) == ""
+    assert hookload.in_slips_reason(600e3, 2600.0, plateaus) != ""
+
+
+def test_volve_f4_make_up_rotations_are_in_the_slips(real_data, tmp_path):
+    """Issue 35 on the real log: F-4's eight rotations (RigActivityCode 114, rotating in
+    slips) are skipped as rotations in the slips, none left as a plain off-bottom stand."""
+    witsml = real_data / "volve_witsml"
+    config = tmp_path / "f4.toml"
+    config.write_text('[well]\nname = "F-4"\n[segmentation]\nmax_gap_s = 60\n',
+                      encoding="utf-8")
+    result = CliRunner().invoke(cli, ["-q", "run", str(witsml / "F-4_time_log_1.xml"),
+                                      "--config", str(config), "--survey",
+                                      str(witsml / "F-4_trajectory.xml"), "--no-report",
+                                      "--out", str(tmp_path / "out")])
+    assert result.exit_code in (0, 1), result.output
+    summary = json.loads((tmp_path / "out" / "F-4" / "summary.json").read_text())
+    assert len(summary["segments"]) == 8
+    for seg in summary["segments"]:
+        assert seg["status"] == "skipped" and seg["mu_k"] is None
+        assert seg["message"].startswith("rotation in the slips"), seg["message"]
+
+
 def test_judge_keeps_a_consistent_string_and_withholds_a_lone_outlier():
     plateaus = [hookload.Plateau(0.0, 60.0, 61, 150e3)]
     records = [_record(1, 400e3, 250e3), _record(2, 405e3, 252e3), _record(3, 150e3, 250e3)]

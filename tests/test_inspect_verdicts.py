@@ -69,7 +69,8 @@ def test_f9_segments_run_fails_are_failed_in_inspect(volve, tmp_path):
 
 def test_f4_with_its_sidecars_skips_what_run_skips(volve, tmp_path):
     """F-4 with its trajectory and tubular beside it and max_gap_s above its 15-s spacing:
-    eight rotation bursts of ≤ 1 min, each too few samples for the estimator."""
+    eight rotation bursts of ≤ 1 min, each too few samples for the estimator — and in the
+    slips (issue 35: top-drive make-up, not off-bottom rotation), in inspect as in run."""
     well = tmp_path / "well"
     well.mkdir()
     for source, name in (("F-4_time_log_1.xml", "F-4.xml"), ("F-4_trajectory.xml",
@@ -83,7 +84,7 @@ def test_f4_with_its_sidecars_skips_what_run_skips(volve, tmp_path):
     assert {g["status"] for g in doc["segments"]} == {"skipped"}
     shown = CliRunner().invoke(cli, ["inspect", str(well / "F-4.xml")]).output
     assert "segments   8 rotating: 0 usable, 8 skipped" in shown
-    assert "7 skipped like segment 1: only 7 samples" in shown
+    assert "7 skipped like segment 1: rotation in the slips: its hook load 633 kN" in shown
 
 
 def test_f4_without_max_gap_is_refused_by_both_over_one_gap_rule(volve, tmp_path):

@@ -331,3 +331,99 @@ def test_open_segment_numbers_that_are_withheld_show_as_withheld_in_the_browser(
     # issue 34 item 6: friction moving within the open segment is shown beside its μ_k
     assert moving.values["open-mu-k"] == ("0.270 — friction moving: μ_k(t) 0.310 at the last "
                                           "window, +0.200/h")
+
+
+def test_live_values_older_than_five_seconds_say_their_age(tmp_path):
+    """Issue 35: open_segment, the latest segment and the alerts resting on rows that ended
+    150 s before the newest sample read as current. live.json gives each its age behind the
+    newest sample (age_s) and old (beyond OLD_S, the page's constant too)."""
+    import re
+
+    from drillfric.live.alerts import OLD_S
+
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: 0.0)
+    live.last_data = 0.0
+    live.view.update(last_sample_time_s=821.8, latest={"segment": 3, "mu_k": 0.27,
+                                                       "mu_s": None, "t_end_s": 819.0},
+                     open_segment={"segment": 4, "stick_slip_severity": 1.3,
+                                   "t_end_s": 672.0})
+    status = live.status()
+    assert status["open_segment"]["age_s"] == 149.8 and status["open_segment"]["old"]
+    assert status["latest"]["age_s"] == 2.8 and not status["latest"]["old"]
+    (severe,) = status["alerts"]
+    assert severe["kind"] == "severe_stick_slip" and severe["age_s"] == 149.8 and severe["old"]
+    assert live.view["open_segment"].keys() == {"segment", "stick_slip_severity", "t_end_s"}
+    js = (Path(__file__).resolve().parents[1] / "templates" / "live.js").read_text()
+    assert float(re.search(r"const OLD_S = ([0-9.]+);", js).group(1)) == OLD_S
+
+
+def test_old_alerts_and_latest_are_greyed_with_their_age_in_the_browser(tmp_path):
+    """The page greys an alert and the latest segment older than OLD_S behind the newest
+    sample and says how old they are; a current alert stays as it is."""
+    exe = _chromium()
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: 0.0)
+    live.last_data = 0.0
+    live.view.update(last_sample_time_s=821.8,
+                     latest={"segment": 3, "mu_k": 0.27, "mu_s": None, "t_end_s": 700.0},
+                     open_segment={"segment": 4, "kind": "off_bottom_rotating",
+                                   "status": "ok", "t_start_s": 600.0, "t_end_s": 672.0,
+                                   "mu_k": 0.27, "stick_slip_severity": 1.3},
+                     rising={"kind": "friction_rising", "message": "now", "time_s": 820.0})
+    server = LiveServer("127.0.0.1", 0)
+    server.start(live)
+    shown = {"alerts": "Array.from(document.querySelectorAll('#alerts li'))"
+                       ".map(li => li.className + '|' + li.textContent)",
+             "latest": "document.getElementById('latest').className + '|' + "
+                       "document.getElementById('latest').textContent"}
+    browser = Browser(exe, tmp_path / "profile", tmp_path / "chromium.log")
+    try:
+        visit = _visit(browser, server.url, shown)
+    finally:
+        browser.close()
+        server.stop()
+    assert visit.console_errors == []
+    severe, rising = visit.values["alerts"]
+    assert severe.startswith("severe_stick_slip old|")
+    assert "150 s before the newest sample, not current" in severe
+    assert rising.startswith("friction_rising|") and "not current" not in rising
+    assert visit.values["latest"].startswith("old|segment 3")
+    assert "122 s before the newest sample" in visit.values["latest"]
+
+
+def test_live_json_open_segment_is_the_newest_or_says_its_age(stands, tmp_path):
+    """Over real TCP while `drillfric replay` grows the file (first of the served tests, while
+    the replay runs): when live.json has an open segment, it is the newest segment of
+    /segments.json, or live.json says it is older than the newest sample (old, its age).
+    Its own live run and replay: the module's served run is kept for the others."""
+    target = _feed_folder((stands[0], None), tmp_path)
+    live = _drillfric("live", target, "--out", tmp_path / "out", "--serve", 0,
+                      "--until-idle", 2, "--no-report")
+    replay = _drillfric("replay", stands[0], "--to", target, "--speed", SPEED)
+    try:
+        line = live.stdout.readline()
+        assert line.startswith("live page: http://127.0.0.1:"), line + live.stderr.read()
+        _check_open_segment(line.split(": ", 1)[1].strip())
+    finally:
+        for proc in (replay, live):
+            if proc.poll() is None:
+                proc.kill()
+            proc.communicate()
+
+
+def _check_open_segment(url: str) -> None:
+    seen = []
+
+    def check() -> bool:
+        status, segs = _json(url + "live.json"), _json(url + "segments.json")
+        opened = status["open_segment"]
+        if opened is None or not segs["segments"]:
+            return False
+        newest = max(r["id"] for r in segs["segments"])
+        age = status["last_sample_time_s"] - opened["t_end_s"]
+        assert opened["age_s"] == pytest.approx(age, abs=0.06)
+        assert opened["segment"] >= newest - 1
+        assert opened["segment"] == newest or opened["old"] or age <= 5.0, (opened, newest)
+        seen.append(opened["segment"])
+        return len(seen) >= 1
+
+    _wait_for(check, 60)

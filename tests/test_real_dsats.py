@@ -46,6 +46,11 @@ def test_dsats_runs_end_to_end(dsats_out):
     assert check["verdict"] == "contradicted" and check["string_weight_ratio"] < 0.5
     assert check["block_weight_source"] == "slips_hookload_N"
     assert check["block_weight_evidence"]["rows"] > 100
+    # issue 35: the block weight the messages state is summary.json's, and the slips
+    # threshold (177.9 kN) is named as the threshold, not as the block weight
+    stated = f"block weight {check['block_weight_N'] / 1e3:.0f} kN: median hook load of the " \
+        "in-slips plateaus, those below segmentation.slips_hookload_N = 178 kN"
+    assert stated in check["reason"] and "from slips_hookload_N" not in summary["mu_k_reason"]
     for seg in summary["segments"]:
         assert seg["mu_k"] is None and seg["mu_s_lower_bound"] is None, seg
         if seg["status"] == "ok":

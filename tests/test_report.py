@@ -449,6 +449,64 @@ def test_fleet_friction_axis_starts_at_zero(tmp_path):
     assert mu[0]["attributes"]["start"] == 0.0
 
 
+def test_fleet_report_partial_wells_apparent_and_drag_mu_and_first_night(tmp_path):
+    """Issue 35 (a newcomer's fleet of demo, F-9 and F-5): F-9 showed "ok" with 9 of its 23
+    segments failed; the μ_k of the summary mixed F-5's apparent μ with the demo's μ_k and
+    the drag μ was nowhere; the first night said "What changed since the last night". Now:
+    "partial: 9 of 23 segments failed" (not the green ok), apparent μ and μ drag in their
+    own columns (μ_k stays the consensus), and a first night says so."""
+    demo = [{"id": i + 1, "kind": "off_bottom_rotating", "status": "ok", "mu_k": 0.28,
+             "bit_depth_m": 2000.0 + 30 * i, "converged": True} for i in range(4)]
+    f9 = [{"id": i + 1, "kind": "off_bottom_rotating", "status": "failed" if i < 9 else
+           "skipped", "mu_k": None, "bit_depth_m": 150.0} for i in range(23)]
+    f5 = [{"id": i + 1, "kind": "on_bottom_rotating", "status": "ok", "mu_k": mu,
+           "bit_depth_m": 3000.0 + 30 * i, "converged": True}
+          for i, mu in enumerate((0.15, 0.17, 0.19))]
+    drag = {"log": [{"mu_drag": 0.21}, {"mu_drag": None}, {"mu_drag": 0.25}]}
+    wells = [
+        {"well": "demo", "status": "ok", "result_dir": Path("demo"), "first_run": True,
+         "summary": {"mu_k": 0.28, "segments": demo, "counts": {"segments": 4},
+                     "drag": drag}, "changes": ["4 new segments"]},
+        {"well": "F-9", "status": "ok", "result_dir": Path("F-9"), "failed_segments": 9,
+         "first_run": True, "summary": {"mu_k": None, "segments": f9,
+                                        "counts": {"segments": 23}}},
+        {"well": "F-5", "status": "ok", "result_dir": Path("F-5"), "first_run": True,
+         "summary": {"mu_k": None, "segments": f5, "counts": {"segments": 3}}}]
+    html = write_fleet_report(tmp_path, wells).read_text(encoding="utf-8")
+    assert "What changed since the last night" not in html
+    assert '<h2 class="first" id="overnight">First run</h2>' in html
+    table = html.split('id="wells-table"')[1].split("</table>")[0]
+    rows = {r.split("<b>")[1].split("</b>")[0]: r for r in table.split("<tr")[2:]}
+    assert "partial: 9 of 23 segments failed" in rows["F-9"]
+    assert 'badge ok"' not in rows["F-9"]
+    assert "1 partial (some segments failed)" in html
+    assert re.search(r'mu-apparent">0\.170 \(3\)', rows["F-5"])
+    assert re.search(r'mu-drag">0\.230 \(2\)', rows["demo"])
+    assert re.search(r'mu-apparent">—', rows["demo"])
+    wells[1]["first_run"] = False
+    html = write_fleet_report(tmp_path, wells).read_text(encoding="utf-8")
+    assert "What changed since the last night" in html
+    assert "first run (nothing to compare with): demo, F-5" in html
+
+
+def test_fleet_summary_keeps_apparent_mu_out_of_mu_k():
+    """Issue 35: fleet_summary.parquet's mu_k held a depth log's apparent μ beside other wells'
+    μ_k; apparent μ is in mu_apparent, and the well's failed segments and drag μ are columns."""
+    from drillfric.fleet.run import WellOutcome, summary_frame
+
+    seg = [{"id": 1, "kind": "on_bottom_rotating", "status": "ok", "mu_k": 0.18},
+           {"id": 2, "kind": "off_bottom_rotating", "status": "ok", "mu_k": 0.27},
+           {"id": 3, "kind": "off_bottom_rotating", "status": "failed", "mu_k": None}]
+    frame = summary_frame([WellOutcome("A", "ok", summary={
+        "mu_k": 0.27, "segments": seg, "drag": {"log": [{"mu_drag": 0.3}]}},
+        failed_segments=1, first_run=True)])
+    assert pd.isna(frame["mu_k"].iloc[0])
+    assert frame["mu_apparent"].iloc[0] == 0.18 and pd.isna(frame["mu_apparent"].iloc[1])
+    assert frame["mu_k"].iloc[1] == 0.27
+    assert (frame["well_failed_segments"] == 1).all() and frame["well_first_run"].all()
+    assert (frame["well_mu_apparent"] == 0.18).all() and (frame["well_mu_drag"] == 0.3).all()
+
+
 def test_fleet_link_is_relative_and_encoded(tmp_path, monkeypatch):
     """Absolute result directories become relative links; odd characters are encoded (a
     directory called "javascript:x" must not become a javascript: link); a directory relative

@@ -60,8 +60,9 @@ def test_pdf_headline_keeps_a_long_withheld_reason_whole(demo, tmp_path):
     "none", not "— —" (the HTML's headline too)."""
     reason = ("withheld by the hook-load check (docs/theory.md §2.1): the hook load "
               "contradicts the configured string: the string weight it measures is 0.21× "
-              "the modelled one (median of 16 off-bottom segments, block weight 147 kN "
-              "from slips_hookload_N), beyond ±5%")
+              "the modelled one (median of 16 off-bottom segments; block weight 147 kN: "
+              "median hook load of the in-slips plateaus, those below "
+              "segmentation.slips_hookload_N = 178 kN), beyond ±5%")
 
     def withhold(summary):
         summary.update(mu_k=None, mu_k_uncertainty=None, mu_k_reason=reason,

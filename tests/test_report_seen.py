@@ -347,3 +347,42 @@ def test_friction_log_figure_has_no_mu_k_for_on_bottom_rows():
     lines = {ln.get_marker(): len(ln.get_xdata()) for ln in fig.axes[0].get_lines()
              if ln.get_marker() in ("o", "^", "x")}
     assert lines == {"o": 1, "^": 1, "x": 1}
+
+
+def test_fit_overshooting_the_torque_by_38_percent_is_not_said_to_reproduce_it():
+    """Issue 35: the report said "The fit reproduces the steady rotation … mean torque
+    within 38.0 %". "Reproduces" now follows the stated criterion (mean within
+    MEAN_TOLERANCE, same regime, swings within SWING_RATIO); else it says it does not."""
+    from drillfric.report.reproduction import MEAN_TOLERANCE, reproduction
+
+    t = np.arange(6000) / 10.0
+    steady = np.full(t.size, 20e3)
+    found = reproduction(_torques(steady, steady * 1.38))
+    assert found.regime_reproduced and not found.mean_reproduced and not found.reproduced
+    said = found.sentence("x")
+    assert said.startswith("The fit does not reproduce the steady rotation")
+    assert "38 % above the measured" in said and f"tolerance {100 * MEAN_TOLERANCE:g} %" in said
+    cycle = 10e3 * np.sin(2 * np.pi * t / 5.0)
+    found = reproduction(_torques(steady + cycle, 1.38 * steady + cycle))
+    assert "does not reproduce its mean torque" in found.sentence("x")
+    found = reproduction(_torques(steady * (t < 300) + steady + cycle * (t < 300),
+                                  1.5 * steady + cycle))
+    assert "neither the regime nor the mean torque" in found.sentence("x")
+
+
+def test_reproduces_is_said_exactly_when_the_criterion_holds():
+    """A property over scaled and stick-slipping pairs: the sentence claims reproduction
+    (no "not", "neither") exactly when Reproduction.reproduced."""
+    from drillfric.report.reproduction import reproduction
+
+    t = np.arange(6000) / 10.0
+    steady = np.full(t.size, 20e3)
+    cycle = 10e3 * np.sin(2 * np.pi * t / 5.0)
+    for scale in (0.5, 0.85, 0.95, 1.0, 1.05, 1.09, 1.11, 1.2, 1.38):
+        for m_cycle, f_cycle in ((0, 0), (1, 1), (1, 0.3), (1, 0), (0, 1)):
+            found = reproduction(_torques(steady + m_cycle * cycle,
+                                          scale * steady + f_cycle * cycle))
+            said = found.sentence("x")
+            claims = said.startswith("The fit reproduces") and " but not " not in said \
+                and "neither" not in said
+            assert claims == found.reproduced, (scale, m_cycle, f_cycle, said)

@@ -274,3 +274,31 @@ def test_run_progress_lines_without_a_terminal_and_quiet(tmp_path):
     assert quiet.returncode == 0, quiet.stderr
     assert " % (" not in quiet.stderr
     assert quiet.stdout.splitlines()[0].split("μ_k")[0] == result_line.split("μ_k")[0]
+
+
+def test_run_messages_follow_the_report_units():
+    """Issue 35 (F-5, a field-units report): messages printed "2804–2835 m window", "WOB ≤
+    10 kN" in a report in ft and klbf. Each SI quantity of a message now has its field value
+    beside it, in brackets; key names (wob_on_bottom_N) and SI reports are left alone."""
+    from drillfric.report.display import Units, message_in
+
+    field = Units("field")
+    said = message_in("2804–2835 m window; WOB ≤ 10 kN (segmentation.wob_on_bottom_N); "
+                      "torque 25.9 kN·m at 0.2 m/s; block weight 147 kN; mud 1250 kg/m³", field)
+    assert "2804–2835 m [9199–9301 ft] window" in said
+    assert "10 kN [2.25 klbf] (segmentation.wob_on_bottom_N)" in said
+    assert "25.9 kN·m [19.1 kft·lbf]" in said and "0.2 m/s [0.656 ft/s]" in said
+    assert "147 kN [33 klbf]" in said and "1250 kg/m³ [10.4 ppg]" in said
+    assert message_in("2804–2835 m window", Units("si")) == "2804–2835 m window"
+
+
+def test_field_report_messages_carry_field_values(field_copy):
+    """A property over the field report's diagnostics: every SI quantity a message states
+    is followed by its field value (no bare m or kN in a report in ft and klbf)."""
+    from drillfric.report.display import _QUANTITY
+
+    _, _, html = field_copy
+    for cells in _diagnostic_cells(html):
+        text = cells[-1]
+        for match in _QUANTITY.finditer(text):
+            assert text[match.end():].startswith(" ["), (match.group(0), text[:300])

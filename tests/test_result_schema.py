@@ -63,7 +63,7 @@ def test_fleet_summary_columns_are_the_schema():
     frame = summary_frame([WellOutcome("A", "ok", summary={"mu_k": 0.2, "segments": [seg]}),
                            WellOutcome("B", "failed", "unreadable")])
     assert list(frame.columns) == list(FLEET_WELL_COLUMNS) + [f for f in SEGMENT_FIELDS
-                                                               if f != "id"]
+                                                               if f != "id"] + ["mu_apparent"]
     assert frame["segment_id"].tolist()[0] == 3 and pd.isna(frame["segment_id"].iloc[1])
 
 

@@ -121,6 +121,29 @@ def test_back_reaming_at_0_2_m_s_is_its_own_state_not_pure_rotation():
     assert np.all(slow == ROTATING_OFF_BOTTOM)
 
 
+def test_trip_before_a_stand_does_not_label_its_first_seconds_reaming():
+    """Issue 35: the demo's rig state read "reaming" for ~6 s at each stand start: the bit
+    ran in at 0.5 m/s, stopped, and rotation started 6 s later while the 5-s smoothed bit
+    speed still exceeded ream_speed_m_s. Reaming now needs the bit to have moved
+    REAM_MIN_TRAVEL_M within that travel's time at the gate speed; a bit at rest (depth
+    jitter of a few cm included) turning after a trip is rotating off bottom."""
+    t = np.arange(0.0, 120.0, 0.1)
+    bit = 2200.0 + 0.5 * np.clip(t, 0.0, 40.0)  # runs in 20 m, stops at 40 s
+    jitter = 0.02 * np.sin(2 * np.pi * t / 0.7)
+    rpm = np.where(t >= 46.0, 60.0, 0.0)
+    for depth in (bit, bit + jitter):
+        f = pd.DataFrame({"time_s": t, "surface_rpm": rpm, "surface_torque_Nm": 100.0 * rpm,
+                          "bit_depth_m": depth, "hole_depth_m": np.full(t.size, 2300.0)})
+        states = classify(f, cfg())
+        assert np.all(states[(t > 5.0) & (t < 40.0)] == TRIPPING)
+        assert np.all(states[t >= 46.0] == ROTATING_OFF_BOTTOM), RIG_STATES[states[460]]
+    # turning while it still moves is reaming, from the first samples
+    moving = 2200.0 + 0.2 * t
+    states = classify(frame(np.full(t.size, 60.0)).assign(
+        time_s=t, bit_depth_m=moving, hole_depth_m=np.full(t.size, 2300.0)), cfg())
+    assert np.all(states[t >= 30.0] == REAMING)
+
+
 def test_back_reaming_segment_carries_its_axial_speed():
     """Issue 22, issue 36 item 2: a back-reaming stretch is a segment of its own, cut from
     the rotation before it, and carries the pipe's steady speed (signed, − pulling out) and
@@ -181,11 +204,14 @@ def test_fast_advance_below_the_known_hole_is_not_drilling():
     at the running maximum, yet is off bottom — turning while running in: reaming; once
     stopped it is on bottom after the smoothed speed (time constant 5 s, factor 0.8 per 1 s
     sample) has decayed below max_rop_m_h = 0.083 m/s: 0.8^12 = 0.069 (0.8^11 = 0.086),
-    i.e. from row 72.
+    i.e. from row 72. Reaming lasts while the bit moves (issue 35: REAM_MIN_TRAVEL_M within
+    its time at ream_speed_m_s, 2 s after the last move at row 60); between, the bit at rest
+    turns off bottom (the smoothed speed still above max_rop_m_h).
     """
     bit = np.concatenate((np.arange(500.0, 560.0), np.full(30, 560.0)))
     states = classify(frame(np.full(bit.size, 60.0), bit_depth_m=bit), cfg())
-    assert np.all(states[2:72] == REAMING)
+    assert np.all(states[2:63] == REAMING)
+    assert np.all(states[63:72] == ROTATING_OFF_BOTTOM)
     assert np.all(states[72:] == ROTATING_ON_BOTTOM)
     faster = classify(frame(np.full(bit.size, 60.0), bit_depth_m=bit), cfg(max_rop_m_h=4000.0))
     assert np.all(faster[1:] == ROTATING_ON_BOTTOM)
@@ -212,10 +238,11 @@ def test_block_position_reckoning_ignores_block_travel_in_slips():
     assert np.all(states[89:99] == TRIPPING)
     assert np.all(states[110:] == ROTATING_ON_BOTTOM)
     no_slips = classify(data, cfg())
-    # 27 m too high, still running in: reaming until the smoothed speed (0.89 m/s at the end
-    # of the lowering, row 98) falls below ream_speed_m_s = 0.05 m/s: 0.89·0.8^13 = 0.049
-    assert np.all(no_slips[99:111] == REAMING)
-    assert np.all(no_slips[111:] == ROTATING_OFF_BOTTOM)
+    # 27 m too high, still running in: reaming while the bit moves (the lowering ends at row
+    # 98; issue 35: 2 s after the last 0.1-m move), not until the smoothed speed (0.89 m/s
+    # there) has decayed below ream_speed_m_s, which labelled 12 s at rest as reaming
+    assert np.all(no_slips[99:101] == REAMING)
+    assert np.all(no_slips[101:] == ROTATING_OFF_BOTTOM)
 
 
 def test_block_reckoning_reports_depth_only_from_a_start_depth():
@@ -417,7 +444,7 @@ def test_compiled_kernel_matches_its_python_source():
                                         "block_position_m", "wob_N")]
     args += [pumps_on(data, cfg()), 1, 5.0, 2.5, 10.0, 0.5, 300e3, 0.5, 10e3, 0.1, 300.0 / 3600.0,
              0.05]
-    carry = [np.nan, np.nan, 0.0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan]
+    carry = [np.nan, np.nan, 0.0, np.nan, 0.0, 0.0, 0.0, 0.0, np.nan, np.nan, np.nan]
     fast = _compiled_kernel()(*args, np.array(carry))
     slow = _classify_kernel(*args, np.array(carry))
     np.testing.assert_array_equal(fast[0], slow[0])

@@ -98,7 +98,9 @@ def check_segment(data: SegmentData, cfg: Config, path: WellPath | None) -> None
     Traceback (most recent call last):
     ...
     drillfric.errors.ModelError: the string below the top section is 230.0 m long but the \
-bit is at 100.0 m — fix: shorten the BHA sections or check the bit depth
+bit is at 100.0 m — fix: no [[string.sections]] was given, so the built-in default string is \
+used (5 7/8in DP + 110 m 5in HWDP + 120 m 8in collars); give the well's string as \
+[[string.sections]] in the configuration (docs/configuration.md), or check the bit depth
     """
     if data.time_s.size < MIN_SAMPLES:
         raise SkipSegment(f"only {data.time_s.size} samples")

@@ -52,7 +52,13 @@ from drillfric.io.results import (
     write_json,
 )
 from drillfric.io.text import plural
-from drillfric.result import FLEET_WELL_COLUMNS, SEGMENT_FIELDS
+from drillfric.result import (
+    FLEET_SEGMENT_EXTRA,
+    FLEET_WELL_COLUMNS,
+    SEGMENT_FIELDS,
+    segment_is_apparent,
+    well_friction_columns,
+)
 from drillfric.vocabulary import WellStatus
 
 MANIFEST = "manifest.json"
@@ -224,6 +230,8 @@ class WellOutcome:
         Segments new since the last night (None: the well failed).
     changes : tuple of str
         What changed since the last night (:func:`drillfric.fleet.overnight.changes`).
+    first_run : bool
+        Processed with no earlier night of this well in the manifest: nothing to compare.
     """
 
     well: str
@@ -237,6 +245,7 @@ class WellOutcome:
     stale_dir: Path | None = None
     new_segments: int | None = None
     changes: tuple[str, ...] = ()
+    first_run: bool = False
 
 
 @dataclass(frozen=True)
@@ -560,7 +569,8 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
                        Path(rec["out_dir"]) if entry["status"] == WellStatus.OK else None,
                        summary, entry["failed_segments"], rec.get("task_s", 0.0), attempts,
                        stale_dir=stale, new_segments=changed["new_segments"],
-                       changes=tuple(changed["notes"]))
+                       changes=tuple(changed["notes"]),
+                       first_run=summary is not None and not history)
 
 
 def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
@@ -721,17 +731,22 @@ def summary_frame(outcomes) -> pd.DataFrame:
     for o in _changed_first(outcomes):
         s = o.summary or {}
         base = {"well": o.well, "well_status": o.status, "well_message": o.message,
+                "well_failed_segments": int(o.failed_segments or 0),
+                "well_first_run": bool(o.first_run),
                 "well_new_segments": o.new_segments, "well_changes": "; ".join(o.changes),
                 "result_dir": None if o.result_dir is None else str(o.result_dir),
                 "stale_result_dir": None if o.stale_dir is None else str(o.stale_dir),
                 "well_mu_s": s.get("mu_s"), "well_mu_k": s.get("mu_k"),
                 "well_mu_s_lower_bound": s.get("mu_s_lower_bound"),
-                "drillfric_version": s.get("drillfric_version")}
+                "drillfric_version": s.get("drillfric_version")} | well_friction_columns(s)
         for seg in s.get("segments") or [{}]:
             row = base | {"segment_id": seg.get("id")}
             row |= {f: seg.get(f) for f in seg_fields}
+            if seg and segment_is_apparent(seg):  # apparent μ: its own column, not μ_k
+                row["mu_apparent"], row["mu_k"] = row["mu_k"], None
             rows.append(row)
-    frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields)
+    frame = pd.DataFrame(rows, columns=list(FLEET_WELL_COLUMNS) + seg_fields
+                         + list(FLEET_SEGMENT_EXTRA))
     frame["segment_id"] = frame["segment_id"].astype("Int64")
     return frame
 
@@ -757,7 +772,8 @@ def _write_report(out_root: Path, outcomes) -> tuple[Path | None, tuple[str, ...
         return None, ("fleet.html not written: this version has no fleet report",)
     items = [{"well": o.well, "status": o.status, "message": o.message,
               "result_dir": o.result_dir, "summary": o.summary, "stale_dir": o.stale_dir,
-              "changes": list(o.changes)}
+              "changes": list(o.changes), "failed_segments": o.failed_segments,
+              "first_run": o.first_run}
              for o in _changed_first(outcomes)]
     try:
         return report.write_fleet_report(out_root, items), ()

@@ -265,7 +265,10 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
         folder, parts = split
         for part in parts:
             require_inside(part, part.parent, "part of the log",
-                           fix="copy the parts into the log's folder")
+                           fix="copy the parts into the log's folder (a link out of it is not "
+                               "followed), or name one part itself as the data: `drillfric "
+                               "run PART.xml`, or the data column of a `drillfric fleet` "
+                               "manifest (docs/fleet.md)")
         return split
     parts = folder_parts(path)
     if parts is not None:
@@ -275,6 +278,14 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
         return path, parts
     data_format(path)
     return path, ()
+
+
+#: What to do about a sidecar that is a link out of the data's folder — valid for `run` and
+#: for `fleet` alike (issue 35: "give the file with --config/--survey" does not work for a
+#: fleet, which has no --survey and whose --config applies to every well).
+LINKED_FILE_FIX = ("copy it beside the data (a link out of the folder is not followed), or "
+                   "name it: `drillfric run --config/--survey`, or the config/survey columns "
+                   "of a `drillfric fleet` manifest (docs/fleet.md)")
 
 
 def _sidecar(data_path: Path, suffix: str) -> Path | None:
@@ -288,7 +299,7 @@ def _sidecar(data_path: Path, suffix: str) -> Path | None:
     if not candidate.is_file():
         return None
     return require_inside(candidate, data_path.parent, "sidecar",
-                          fix="give the file with --config/--survey, or copy it beside the data")
+                          fix=LINKED_FILE_FIX)
 
 
 def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:

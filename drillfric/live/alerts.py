@@ -23,6 +23,30 @@ SEVERE_STICK_SLIP = 1.0
 TREND_CHANGE = 0.25
 #: Surface speed above which the top drive counts as turning for a stall [RPM].
 STALL_SURFACE_RPM = 5.0
+#: Log seconds behind the newest sample beyond which a live value is not current: live.json
+#: gives it ``old`` true beside its ``age_s`` and the page greys it, saying how old it is
+#: (issue 35: an open segment, a stick-slip alert 150 s old read as current). The page's
+#: OLD_S (templates/live.js) is the same.
+OLD_S = 5.0
+
+
+def aged(item: dict | None, time_s, newest_s) -> dict | None:
+    """``item`` (a live.json value resting on the rows up to log time ``time_s``) with
+    ``age_s`` — log seconds behind the newest sample ``newest_s`` — and ``old`` (beyond
+    :data:`OLD_S`); a copy, null ages where either time is unknown.
+
+    >>> aged({"kind": "severe_stick_slip", "time_s": 672.0}, 672.0, 821.8)
+    {'kind': 'severe_stick_slip', 'time_s': 672.0, 'age_s': 149.8, 'old': True}
+    """
+    if item is None:
+        return None
+    try:
+        age = round(max(float(newest_s) - float(time_s), 0.0), 1)
+    except (TypeError, ValueError):
+        return item | {"age_s": None, "old": False}
+    if not math.isfinite(age):
+        return item | {"age_s": None, "old": False}
+    return item | {"age_s": age, "old": age > OLD_S}
 
 
 def open_view(record: SegmentRecord, folder: Path) -> dict:

@@ -42,6 +42,7 @@ from drillfric.io.atomic import replacing
 from drillfric.io.results import write_json
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live.alerts import (
+    aged,
     alert,
     ended,
     friction_rising,
@@ -386,12 +387,19 @@ class LiveRun:
             alerts.append(view["trend_alert"])
         if view["rising"] is not None:
             alerts.append(view["rising"])
+        newest = view["last_sample_time_s"]
+        # every value resting on older rows says how old (issue 35: open_segment and the
+        # alerts of a segment that had ended read as current)
+        alerts = [aged(a, a.get("time_s"), newest) for a in alerts]
+        opened = aged(view["open_segment"], (view["open_segment"] or {}).get("t_end_s"),
+                      newest)
+        latest = aged(view["latest"], (view["latest"] or {}).get("t_end_s"), newest)
         return {"source": str(self.path), "well": None if self.well is None else self.well.name,
-                "last_sample_time_s": view["last_sample_time_s"],
+                "last_sample_time_s": newest,
                 "last_sample_utc": view["last_sample_utc"],
                 "updated_utc": datetime.now(UTC).isoformat(timespec="milliseconds"),
-                "rig_state": view["rig_state"], "open_segment": view["open_segment"],
-                "latest": view["latest"], "alerts": alerts, "rows": view["rows"],
+                "rig_state": view["rig_state"], "open_segment": opened,
+                "latest": latest, "alerts": alerts, "rows": view["rows"],
                 "running": not self.done.is_set(),
                 "segments_closed": view["segments_closed"], "resumed": view["resumed"],
                 "idle_s": round(idle, 3), "max_update_gap_s": round(self.max_gap_s, 3)}

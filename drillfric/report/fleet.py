@@ -11,7 +11,8 @@ from urllib.parse import quote
 
 from drillfric._version import __version__
 from drillfric.io.atomic import write_text_replacing
-from drillfric.result import Flag
+from drillfric.io.text import plural
+from drillfric.result import Flag, well_friction_columns
 from drillfric.vocabulary import Status, WellStatus
 
 from .data import segments_frame
@@ -61,6 +62,9 @@ def _link(out_dir: Path, result_dir) -> str | None:
 
 #: How a well's status is shown: an unchanged well's results are ok, from an earlier run.
 STATUS_TEXT = {"ok": "ok", "skipped": "ok (unchanged)", "failed": "failed"}
+#: Badge of a well that ran but some of whose segments failed ("partial: N of M segments
+#: failed"): not the green "ok" (issue 35).
+PARTIAL = "unconverged"
 
 
 def _row(out_dir: Path, well: dict) -> dict:
@@ -72,9 +76,23 @@ def _row(out_dir: Path, well: dict) -> dict:
     if stale is not None:
         message += (f" — the results in {Path(stale).name}/ are an earlier run's, marked "
                     "stale (STALE.json, summary.json stale)")
+    worst = _worst(summary.get("segments") or [])
+    failed = int(well.get("failed_segments") or worst["failed"] or 0)
+    text = STATUS_TEXT.get(status, status)
+    badge = WellStatus.OK if status == WellStatus.SKIPPED else status
+    if status != WellStatus.FAILED and failed:
+        # issue 35: F-9 showed "ok" with 9 of its 23 segments failed
+        text = (f"{text.replace('ok', 'partial', 1)}: "
+                f"{failed} of {plural(counts.get('segments', failed), 'segment')} failed")
+        badge = PARTIAL
+    friction = well_friction_columns(summary)
     return {"well": str(well.get("well", "?")), "status": status,
-            "status_text": STATUS_TEXT.get(status, status),
-            "badge": WellStatus.OK if status == WellStatus.SKIPPED else status,
+            "status_text": text, "partial": badge == PARTIAL,
+            "badge": badge,
+            "mu_apparent": fmt(friction["well_mu_apparent"]),
+            "mu_apparent_n": friction["well_mu_apparent_segments"],
+            "mu_drag": fmt(friction["well_mu_drag"]),
+            "mu_drag_n": friction["well_mu_drag_connections"],
             "message": message,
             "stale_link": _link(out_dir, stale) if stale is not None else None,
             "segments": counts.get("segments", "—"), "estimated": counts.get("estimated", "—"),
@@ -84,7 +102,7 @@ def _row(out_dir: Path, well: dict) -> dict:
             "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
                               summary.get("mu_s_lower_bound")) if summary else "—",
             "indicative": bool(summary.get("indicative")),
-            "worst": _worst(summary.get("segments") or []),
+            "worst": worst,
             "link": _link(out_dir, well.get("result_dir")) if summary else None}
 
 
@@ -118,11 +136,16 @@ def write_fleet_report(out_dir: Path, wells: list[dict], units: str | None = Non
     embed = Embedder()
     plot_id = embed.add(fleet_plot(logs, shown), "fleet") if any(
         len(off_bottom_mu_k(seg)) for _, seg in logs) else None
-    counts = {k: sum(r["status"] == k for r in rows) for k in ("ok", "failed", "skipped")}
-    news = [(str(w.get("well", "?")), w["changes"]) for w in wells if w.get("changes")]
+    counts = {k: sum(r["status"] == k and not r["partial"] for r in rows)
+              for k in ("ok", "failed", "skipped")}
+    counts["partial"] = sum(r["partial"] for r in rows)
+    # a well's first night has nothing to compare with: named as such, not as news
+    first = [str(w.get("well", "?")) for w in wells if w.get("first_run")]
+    news = [(str(w.get("well", "?")), w["changes"]) for w in wells
+            if w.get("changes") and not w.get("first_run")]
     html = environment().get_template("fleet_report.html.j2").render(
         rows=rows, failed=[r for r in rows if r["status"] == WellStatus.FAILED], counts=counts,
-        news=news,
+        news=news, first=first, everyone_first=len(first) == len(wells),
         plot_id=plot_id, bokeh=embed.head, version=__version__, built=now_utc())
     out = out_dir / "fleet.html"
     write_text_replacing(out, html)

@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 
 from drillfric.io.text import plural
 from drillfric.io.timebase import clock_at
-from drillfric.result import Flag
+from drillfric.result import Flag, segment_is_apparent
 from drillfric.vocabulary import Kind, Method, Status
 
 from .display import Units, fmt, row_flags
@@ -313,9 +313,7 @@ CONVERGED_MEANING = (
 
 def is_apparent(row: dict) -> bool:
     """Whether the segment's μ is apparent: on bottom, the bit torque is in it."""
-    flags = row.get("quality_flags")
-    return row.get("kind") == Kind.ON_BOTTOM or (
-        isinstance(flags, list | tuple) and Flag.BIT_TORQUE_IN_FRICTION in flags)
+    return segment_is_apparent(row)
 
 
 def mu_name(row: dict) -> str:

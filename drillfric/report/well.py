@@ -25,7 +25,7 @@ from drillfric.vocabulary import Status
 from . import broomstick as broom
 from . import figures
 from .data import ResultData, final_torques, load_result, segment_estimates
-from .display import Units, fmt, report_units
+from .display import Units, fmt, message_in, report_units
 from .evidence import (
     evidence_figure,
     evidence_plot,
@@ -360,7 +360,7 @@ def _segment_head(row: dict, origin, units: Units, fit: Reproduction | None = No
                                "torque", ".1f")
     row["quality"] = quality_text(row, fit)
     row["fit_sentence"] = fit.sentence(_when(fit.t_half_s, origin), units) if fit else ""
-    row["fit_mismatch"] = fit is not None and not fit.regime_reproduced
+    row["fit_mismatch"] = fit is not None and not fit.reproduced
     row["mu_name"] = mu_name(row)
     row["status_word"] = status_word(row)
     row["note_flags"] = note_flags(row)
@@ -406,6 +406,28 @@ class Report:
         return tracks is not None and len(tracks) > 0 and bool(panels_present(tracks))
 
 
+def _messages_in(data, shown: Units) -> None:
+    """The run's messages (SI, summary.json) in the report's units (:func:`message_in`):
+    warnings, the reasons of a withheld μ_k and of the hook-load check, each segment's
+    message and bit-speed reason (issue 35: a field-units report printed m and kN)."""
+    if shown.system == "si":
+        return
+    summary = data.summary
+    for key in ("warnings", "assumed"):
+        if isinstance(summary.get(key), list):
+            summary[key] = [message_in(w, shown) if isinstance(w, str) else w
+                            for w in summary[key]]
+    for table in (summary, summary.get("friction_log"), summary.get("hookload")):
+        if isinstance(table, dict):
+            for key in ("mu_k_reason", "reason"):
+                if isinstance(table.get(key), str):
+                    table[key] = message_in(table[key], shown)
+    for column in ("message", "bit_speed_reason"):
+        if column in data.segments:
+            data.segments[column] = [message_in(m, shown) if isinstance(m, str) else m
+                                     for m in data.segments[column]]
+
+
 def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
                  units: str | None = None) -> Report:
     """Read a result directory and prepare the report (no figure drawn yet); ``units``:
@@ -413,6 +435,7 @@ def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
     limit = segment_limit(segments)
     data = load_result(Path(result_dir))
     shown = report_units(data.summary, units)
+    _messages_in(data, shown)
     drawn = select_segments(data.segments, limit)
     estimates = segment_estimates(data.result_dir, drawn)
     ok = [int(i) for i in data.segments.loc[data.segments["status"] == Status.OK, "id"]]
@@ -420,7 +443,7 @@ def build_report(result_dir: Path, segments: int | str = MAX_SEGMENT_FIGURES,
             if (found := reproduction(rows)) is not None}
     rows = data.segments.set_index("id", drop=False)
     texts = {i: (quality_text(rows.loc[i].to_dict(), fit),
-                 "" if fit.regime_reproduced else
+                 "" if fit.reproduced else
                  fit.sentence(_when(fit.t_half_s, data.time_origin), shown))
              for i, fit in fits.items()}
     diag = diagnostic_rows(data.segments, shown, data.time_origin, texts)

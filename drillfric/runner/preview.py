@@ -24,13 +24,17 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Iterator
+from dataclasses import replace
 
+import numpy as np
 import pandas as pd
 
+from drillfric import hookload
 from drillfric.errors import DrillfricError
 from drillfric.io.logcheck import LogCheck
 from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.segmentation import Segment, SegmentStream
+from drillfric.vocabulary import Kind, Status
 
 from .checks import Precheck, bit_depth_default, check_first_chunk, precheck
 
@@ -69,7 +73,26 @@ def segment_verdicts(well: Well, surface: pd.DataFrame, assumed: list[str],
     stream = SegmentStream(well.config)
     done = [pair for chunk in _chunks(surface, chunk_rows) for pair in stream.feed(chunk)]
     fallback = functools.cache(lambda: bit_depth_default(well, assumed))
-    return [(seg, precheck(well, seg, rows, fallback)) for seg, rows in done + stream.close()]
+    verdicts = [(seg, rows, precheck(well, seg, rows, fallback))
+                for seg, rows in done + stream.close()]
+    if well.config.segmentation.slips_hookload_N is not None:  # the slips are a rig state
+        return [(seg, pre) for seg, _, pre in verdicts]
+    plateaus = functools.cache(lambda: hookload.find_plateaus(surface, well.config))
+    return [(seg, _in_slips(seg, rows, pre, plateaus)) for seg, rows, pre in verdicts]
+
+
+def _in_slips(seg: Segment, rows: pd.DataFrame, pre: Precheck, plateaus) -> Precheck:
+    """``pre`` skipped as run's hook-load check skips a rotation in the slips (issue 35,
+    :func:`drillfric.hookload.in_slips_reason`; only without ``slips_hookload_N``)."""
+    if seg.kind != Kind.OFF_BOTTOM or pre.status is Status.FAILED \
+            or "hookload_N" not in rows or not rows["hookload_N"].notna().any():
+        return pre
+    why = hookload.in_slips_reason(float(np.nanmedian(rows["hookload_N"].to_numpy(float))),
+                                   pre.bit_depth_m, plateaus())
+    if not why:
+        return pre
+    return replace(pre, status=Status.SKIPPED, data=None,
+                   message="; ".join(filter(None, [why, pre.message])))
 
 
 def _chunks(surface: pd.DataFrame, chunk_rows: int) -> Iterator[pd.DataFrame]:
