@@ -81,9 +81,14 @@ class Inertia:
 
 
 def _moving_mean(values: np.ndarray, width: int) -> np.ndarray:
+    """Centred moving mean over ``width`` samples, zeros beyond the ends (as
+    ``np.convolve(values, ones(width)/width, "same")``) by a running sum: O(n) at any width."""
     if width <= 1:
         return values
-    return np.convolve(values, np.ones(width) / width, mode="same")
+    lead = (width - 1) // 2
+    padded = np.concatenate((np.zeros(width - lead), values, np.zeros(lead)))
+    total = np.cumsum(padded)
+    return (total[width:] - total[:-width]) / width
 
 
 def _high_pass(values: np.ndarray, width: int) -> np.ndarray:
