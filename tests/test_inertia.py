@@ -66,3 +66,42 @@ def test_a_short_segment_says_nothing():
     t = T[:300]
     rig = inertia.assess(t, 6.0 + np.sin(t), 8e3 + np.cos(t), 8e3 + 0 * t, 2900.0)
     assert rig.source == "immaterial" and rig.identified_kg_m2 is None
+
+
+@pytest.mark.slow
+def test_a_gear_change_between_stands_withholds_the_trace_that_rests_on_it(tmp_path):
+    """End to end (issue 34 item 2): the configured 2900 kg·m², a stiff-drive stick-slip
+    stand at that inertia and a stand of set-point steps after a gear change to 2.5×. The
+    first stand's trace does not rest on the inertia (share < 0.2) and is shown; the second
+    one's does and the data do not identify it: trace and statistics withheld with the flag;
+    μ_k stands in both."""
+    import tomllib
+    from pathlib import Path
+
+    import drillfric
+    from drillfric.io.writers import dumps_toml
+
+    demo = Path(__file__).resolve().parents[1] / "examples" / "demo"
+    steps = [[0, 0], [3, 0], [3, 60], [80, 60], [80, 90], [140, 90], [140, 50], [200, 50]]
+    (tmp_path / "stands.toml").write_text(dumps_toml({"stand": [
+        {"bit_depth_m": 2300.0, "duration_s": 200.0, "start": "creep", "creep_hold_s": 60.0},
+        {"bit_depth_m": 2330.0, "duration_s": 200.0, "setpoint_rpm": steps,
+         "top_drive_inertia_kg_m2": 2.5 * 2900.0}]}), encoding="utf-8")
+    cfg = tomllib.loads((demo / "demo.toml").read_text(encoding="utf-8"))
+    cfg["simulate"].update(scenario="stands.toml", rate_hz=10.0, cells=1000, mu_s=0.6,
+                           mu_k=0.25)
+    cfg["survey"] = {"file": str(demo / "demo.survey.csv")}
+    (tmp_path / "sim.toml").write_text(dumps_toml(cfg), encoding="utf-8")
+    data = tmp_path / "well.parquet"
+    drillfric.simulate(tmp_path / "sim.toml", out=data)
+    result = drillfric.run(drillfric.open_well(data))
+    segs = [g for g in result.summary["segments"] if g["status"] == "ok"]
+    assert len(segs) == 2
+    stiff, geared = segs
+    assert stiff["top_drive_inertia_source"] == "immaterial" and stiff["bit_speed_resolved"]
+    assert geared["top_drive_inertia_source"] == "not identified"
+    assert "top_drive_inertia_unconfirmed" in geared["quality_flags"]
+    assert not geared["bit_speed_resolved"] and geared["stick_slip_severity"] is None
+    assert "top-drive inertia not identified" in geared["message"]
+    for seg in segs:
+        assert seg["mu_k"] == pytest.approx(0.25, rel=0.05)

@@ -12,7 +12,8 @@ vectorised NumPy over the segment's grid):
 
 1. the **share**: the RMS of the inertia correction I_TD·dω₀/dt against the RMS of the
    torque's own variation (both smoothed over :data:`SMOOTH_S` and high-passed over
-   :data:`HIGH_PASS_S`). Below :data:`MATERIAL_SHARE` the trace does not rest on the inertia
+   :data:`HIGH_PASS_S`; the variation taken as at least :data:`VARIATION_FLOOR` of the mean
+   torque). Below :data:`MATERIAL_SHARE` the trace does not rest on the inertia
    (a stiff drive holds ω₀ through stick-slip): 0.4–2.5× the configured value left the
    validation sweep's windows and severities within tolerance;
 2. the **identification**: the top-drive equation τ_m − τ̂(0) = I_TD·dω₀/dt with τ̂(0) the
@@ -36,14 +37,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Smoothing of both sides before the fit [s] (sensor noise; the accelerations stay).
-SMOOTH_S = 0.5
+#: Smoothing of both sides before the fit [s] (sensor noise, which the derivative
+#: amplifies; the accelerations of set-point steps, start-ups and a soft drive stay).
+SMOOTH_S = 1.0
 #: High-pass window: the moving mean removed (the friction level, the slow set-point) [s].
 HIGH_PASS_S = 4.0
 #: Share of the torque's variation the inertia correction may reach before the trace rests
-#: on the inertia (the validation's stiff stick-slip stands 0.12–0.16, the demo 0.17–0.18;
-#: set-point steps 0.24–0.51, a soft-torque drive 1.0–2.1).
+#: on the inertia (the validation's stiff stick-slip stands 0.09–0.10; set-point steps
+#: 0.24–0.32 at 5–100 Hz, a soft-torque drive 1.9).
 MATERIAL_SHARE = 0.2
+#: The torque's variation is taken as at least this share of its mean level: in steady
+#: rotation (no stick-slip) the speed noise's derivative against the torque's noise is no
+#: measure of what the trace rests on (the steady plant read 1.0 without it, 0.14 with).
+VARIATION_FLOOR = 0.15
 #: Largest relative uncertainty of an inertia stated as identified, and the largest
 #: departure from the configured value it confirms (issue 34: ±25 % at 10–100 Hz).
 TOLERANCE = 0.25
@@ -104,8 +110,9 @@ def identify(time_s: np.ndarray, surface_rad_s: np.ndarray, motor_torque_Nm: np.
     (I, half_width, I_reverse, r2, rms_accel_over_torque) or None
         Slope [kg·m²], its profile-likelihood 95 % half-width [kg·m²], the reverse
         regression's slope [kg·m²], the share of the filtered torque difference explained
-        [-], and RMS(dω₀/dt)/RMS(τ_m) of the filtered sides [s²·... : kg⁻¹·m⁻²]; None when
-        the segment is shorter than a few high-pass windows or has no acceleration.
+        [-], and RMS(dω₀/dt)/max(RMS(τ_m), :data:`VARIATION_FLOOR`·|mean τ_m|) of the
+        filtered sides [1/(kg·m²)]; None when the segment is shorter than a few high-pass
+        windows or has no acceleration.
     """
     t = np.asarray(time_s, dtype=float)
     if t.size < 3:
@@ -119,7 +126,8 @@ def identify(time_s: np.ndarray, surface_rad_s: np.ndarray, motor_torque_Nm: np.
     torque = _high_pass(_moving_mean(motor_torque_Nm, k), hp)[rows]
     diff = _high_pass(_moving_mean(motor_torque_Nm - model_torque_Nm, k), hp)[rows]
     xx, xy, yy = float(accel @ accel), float(accel @ diff), float(diff @ diff)
-    tt = float(torque @ torque)
+    level = VARIATION_FLOOR * abs(float(np.mean(motor_torque_Nm[rows])))
+    tt = max(float(torque @ torque), accel.size * level ** 2)
     if xx <= 0.0 or tt <= 0.0 or yy <= 0.0:
         return None
     slope = xy / xx
