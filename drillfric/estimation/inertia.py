@@ -15,7 +15,7 @@ vectorised NumPy over the segment's grid):
    :data:`HIGH_PASS_S`; the variation taken as at least :data:`VARIATION_FLOOR` of the mean
    torque). Below :data:`MATERIAL_SHARE` the trace does not rest on the inertia
    (a stiff drive holds ω₀ through stick-slip): 0.4–2.5× the configured value left the
-   validation sweep's windows and severities within tolerance;
+   validation sweep's windows and severities within tolerance there;
 2. the **identification**: the top-drive equation τ_m − τ̂(0) = I_TD·dω₀/dt with τ̂(0) the
    fitted model's string torque, I_TD the slope of a least-squares fit of the filtered
    sides. Identified only where the fit's profile-likelihood 95 % interval (n_eff = the
