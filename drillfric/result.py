@@ -55,6 +55,8 @@ class Flag(StrEnum):
     PIPE_MOVING = "pipe_moving"
     CHANNEL_SKEW_UNIDENTIFIED = "channel_skew_unidentified"
     MU_K_DRIFT = "mu_k_drift"
+    TOP_DRIVE_INERTIA_UNCONFIRMED = "top_drive_inertia_unconfirmed"
+    TOP_DRIVE_INERTIA_CONTRADICTED = "top_drive_inertia_contradicted"
 
     @classmethod
     def _missing_(cls, value):
@@ -146,6 +148,17 @@ FLAG_MEANINGS = {
                      "re-fits of the mean torque after torque and drag, docs/theory.md §6.6): "
                      "mu_k_drift_per_h is its rate, μ_k the mean over the drift, "
                      "estimates.parquet's μ_k column μ_k(t)",
+    Flag.TOP_DRIVE_INERTIA_UNCONFIRMED: "the inertia correction I_TD·dω₀/dt of the logged "
+                                        "motor torque is a material share of the torque's "
+                                        "variation and the segment's data do not identify "
+                                        "I_TD: the bit speed, stuck fraction and severity, "
+                                        "which rest on rig.top_drive_inertia_kg_m2, are "
+                                        "withheld (docs/bit_speed.md, Top-drive inertia)",
+    Flag.TOP_DRIVE_INERTIA_CONTRADICTED: "the segment's data identify a top-drive inertia "
+                                         "beyond ±25 % of rig.top_drive_inertia_kg_m2 (a gear "
+                                         "change?): the bit speed, stuck fraction and "
+                                         "severity are withheld (docs/bit_speed.md, Top-drive "
+                                         "inertia)",
 }
 
 
@@ -204,6 +217,8 @@ FLAG_RAISED_BY = {
     Flag.PIPE_MOVING: (_VERDICT + "_pipe_moving",),
     Flag.CHANNEL_SKEW_UNIDENTIFIED: (_VERDICT + "decide_trace",),
     Flag.MU_K_DRIFT: ("drillfric.estimation.friction_trend.drift_verdict",),
+    Flag.TOP_DRIVE_INERTIA_UNCONFIRMED: (_VERDICT + "decide_trace",),
+    Flag.TOP_DRIVE_INERTIA_CONTRADICTED: (_VERDICT + "decide_trace",),
 }
 
 
@@ -345,6 +360,18 @@ class SegmentRecord:
                                                      "torque_lag_s (0: configured)")
     torque_lag_source: str | None = _f("", "config ([channels] lag_s), identified, or not "
                                            "identified (the reason in the message)")
+    top_drive_inertia_share: float | None = _f("", "RMS of the inertia correction "
+                                                   "I_TD·dω₀/dt against the RMS of the "
+                                                   "torque's variation (docs/bit_speed.md, "
+                                                   "Top-drive inertia); null for a string "
+                                                   "torque")
+    top_drive_inertia_kg_m2_identified: float | None = _f(
+        "kg·m²", "top-drive inertia the segment's data identify (null: not identified)")
+    top_drive_inertia_uncertainty_kg_m2: float | None = _f(
+        "kg·m²", "95 % half-width of top_drive_inertia_kg_m2_identified")
+    top_drive_inertia_source: str | None = _f(
+        "", "not used (string torque), immaterial, confirmed, contradicted or not identified "
+            "(the reason in the message)")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
                                               "the spacing, the averaging interval, the "
                                               "update interval of held values and the width "

@@ -110,6 +110,8 @@ def test_scenario_file_defaults_and_overrides(well):
     ("[[stand]]\nbit_depth_m = 1000.0\nsetpoint_rpm = [[1, 2]]\n", "setpoint_rpm"),
     ("[[stand]]\nbit_depth_m = 1000.0\nbit_weakening_ratio = 0.5\n", "bit_weakening_ratio"),
     ("[[stand]]\nbit_depth_m = 1000.0\nbit_weakening_rpm = 0.0\n", "bit_weakening_rpm"),
+    ("[[stand]]\nbit_depth_m = 1000.0\ntop_drive_inertia_kg_m2 = 0.0\n",
+     "top_drive_inertia_kg_m2"),
 ])
 def test_bad_scenarios_name_the_problem(tmp_path, text, word):
     path = tmp_path / "bad.toml"
@@ -154,6 +156,24 @@ def test_columns_time_base_and_connection(two_stands):
     assert np.all(c["hookload_N"][conn] == 0)
     assert np.all(np.diff(c["bit_depth_m"][conn]) > 0)
     np.testing.assert_allclose(c["hole_depth_m"] - c["bit_depth_m"], 5.0)
+
+
+def test_a_gear_change_between_stands_changes_the_inertia_of_that_stand(two_stands):
+    """Issue 34 item 2 (inertia per stand): the motor torque less the string's is
+    I_TD·dω₀/dt with the stand's own inertia; the stand before keeps the rig's."""
+    cfg, path, scen, result = two_stands
+    geared = scenario.Scenario((scen.stands[0], replace(scen.stands[1],
+                                                        top_drive_inertia_kg_m2=3 * 2900.0)),
+                               scen.connection_s)
+    other = sim.simulate(cfg, path, geared)
+    t = result.columns["time_s"]
+    first = t <= result.stands[0].t_end_s
+    for key in ("surface_torque_Nm", "bit_rpm"):
+        np.testing.assert_array_equal(other.columns[key][first], result.columns[key][first])
+    second = t >= result.stands[1].t_start_s
+    inertia_term = [np.std((r.columns["surface_torque_Nm"] - r.columns["string_torque_Nm"])
+                           [second]) for r in (result, other)]
+    assert inertia_term[1] > 1.5 * inertia_term[0]
 
 
 def test_creep_hold_and_stick_slip_truth(two_stands):

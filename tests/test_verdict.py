@@ -214,6 +214,19 @@ TRACE_CASES = [
     ("channel_skew_unresolved", dict(skew_note="why", logging=Resolution(False, 2.0)),
      dict(shown=False, statistics=False, flags=()),
      "a trace the logging cannot resolve is not flagged for its skew as well"),
+    ("top_drive_inertia_unconfirmed", dict(inertia_note="top-drive inertia not identified"),
+     dict(shown=False, windows=(), statistics=False, converged=True,
+          flags=(Flag.TOP_DRIVE_INERTIA_UNCONFIRMED,)),
+     "issue 34 item 2: a gear change (true inertia 2.5x the configured) put 5-6 of 7 30-s "
+     "windows off on a soft drive: where the inertia correction is material and the data "
+     "do not confirm the inertia, the trace and its statistics are withheld"),
+    ("top_drive_inertia_contradicted",
+     dict(inertia_note="contradicted", inertia_contradicted=True),
+     dict(shown=False, statistics=False, flags=(Flag.TOP_DRIVE_INERTIA_CONTRADICTED,)),
+     "an inertia the data identify beyond ±25 % of the configured withholds the trace"),
+    ("top_drive_inertia_after_skew", dict(skew_note="why", inertia_note="why"),
+     dict(shown=False, statistics=False, flags=(Flag.CHANNEL_SKEW_UNIDENTIFIED,)),
+     "one reason is enough: the skew is said, the inertia not again"),
 ]
 
 

@@ -49,7 +49,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString
 from drillfric.errors import DrillfricError, ModelError
-from drillfric.estimation import batch, bit_torque, bit_trace, skew, spikes
+from drillfric.estimation import batch, bit_torque, bit_trace, inertia, skew, spikes
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S, mu_k_tolerance
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -172,6 +172,8 @@ class SegmentEstimate:
     trend : FrictionTrend or None
         μ_k(t) of the windowed re-fits and the drift test (docs/theory.md §6.6); None where
         the segment's μ_k is not a converged batch value.
+    inertia : Inertia or None
+        What the data say of the top-drive inertia (:func:`top_drive_inertia`).
     """
 
     mu_s: float | None
@@ -214,6 +216,7 @@ class SegmentEstimate:
     factors_withheld: str = ""
     skew: skew.Skew | None = None
     trend: FrictionTrend | None = field(default=None, repr=False)
+    inertia: inertia.Inertia | None = None
 
 
 def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
@@ -751,9 +754,10 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     fitted_result = beside(fit_evidence, settings, models, verdict, refined.mu_s)
     final, bit = seeded_pass(settings, models, verdict, out_rate)
     tick(0.2)
-    trace, kinematics, stats_from = trace_verdict(settings, models, refined, verdict,
-                                                  final, bit, skewed)
     fitted = fitted_result()
+    rig = top_drive_inertia(settings, models, fitted)
+    trace, kinematics, stats_from = trace_verdict(settings, models, refined, verdict,
+                                                  final, bit, skewed, rig)
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
@@ -761,7 +765,7 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     estimate = _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
                                                        trace, final, bit, fitted, terms,
                                                        kinematics, stats_from, trend))
-    return replace(estimate, skew=skewed)
+    return replace(estimate, skew=skewed, inertia=rig)
 
 
 def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
@@ -791,7 +795,7 @@ def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Ver
 
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
                   verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate,
-                  skewed: skew.Skew | None = None
+                  skewed: skew.Skew | None = None, rig: inertia.Inertia | None = None
                   ) -> tuple[TraceVerdict, bit_trace.KinematicCheck, float]:
     """Step 8: the checks of the seeded trace (whole-segment kinematics, window by window,
     the members' statistics) and what of it the rules of
@@ -817,8 +821,23 @@ def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch
         undetermined_note=_undetermined(final, bit, span, windows, severity, settings,
                                         refined.mu_s is not None),
         moving=models.axial is not None,
-        skew_note=None if skewed is None or skewed.known else skewed.reason))
+        skew_note=None if skewed is None or skewed.known else skewed.reason,
+        inertia_note=None if rig is None else rig.reason,
+        inertia_contradicted=rig is not None and rig.source == "contradicted"))
     return trace, kinematics, start
+
+
+def top_drive_inertia(settings: ChainSettings, models: SegmentModels,
+                      fitted: FitEvidence) -> inertia.Inertia:
+    """Step 7b: what the segment's data say of the top-drive inertia the motor torque is
+    corrected with, from the fitted model's string torque of step 6 (no model run of its
+    own; :func:`drillfric.estimation.inertia.assess`, docs/theory.md §5.4)."""
+    meas = models.meas
+    return inertia.assess(fitted.time_s, np.interp(fitted.time_s, meas.time_s,
+                                                   meas.surface_rad_s),
+                          np.interp(fitted.time_s, meas.time_s, meas.motor_torque_Nm),
+                          fitted.model_Nm, settings.top_drive_inertia_kg_m2,
+                          settings.torque_kind)
 
 
 def statistics_from(time_s: np.ndarray, unknown: tuple, withheld: tuple = ()) -> float:

@@ -322,6 +322,12 @@ class TraceEvidence:
     skew_note : str or None
         Why the torque's lag behind the speed is not known (None: configured or identified,
         :mod:`drillfric.estimation.skew`).
+    inertia_note : str or None
+        Why the trace may not rest on the configured top-drive inertia (None: it may,
+        :mod:`drillfric.estimation.inertia`).
+    inertia_contradicted : bool
+        The data identify an inertia the configured one is beyond ±25 % of (flagged
+        ``top_drive_inertia_contradicted``, else ``top_drive_inertia_unconfirmed``).
     """
 
     logging: Resolution
@@ -334,6 +340,8 @@ class TraceEvidence:
     undetermined_note: str | None = None
     moving: bool = False
     skew_note: str | None = None
+    inertia_note: str | None = None
+    inertia_contradicted: bool = False
 
 
 #: Why the bit speed of a reaming / back-reaming segment is withheld.
@@ -387,7 +395,11 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
        (:data:`NO_AXIAL_OBSERVER`);
     7. where the torque's lag behind the speed is neither configured nor identified, the
        trace and its statistics are withheld (``channel_skew_unidentified``): the trace's
-       phase rests on the channels' timing, which the data could not fix.
+       phase rests on the channels' timing, which the data could not fix;
+    8. where the top-drive inertia correction of a motor torque is material and the data do
+       not identify the inertia, or identify one beyond ±25 % of the configured, the trace
+       and its statistics are withheld (``top_drive_inertia_unconfirmed`` /
+       ``top_drive_inertia_contradicted``, :mod:`drillfric.estimation.inertia`).
 
     Examples
     --------
@@ -411,6 +423,12 @@ def decide_trace(ev: TraceEvidence) -> TraceVerdict:
         flags.append(Flag.CHANNEL_SKEW_UNIDENTIFIED)
         messages.append(f"bit speed, stuck fraction and severity withheld: {ev.skew_note}")
         claim = replace(claim, resolved=False, reason=f"bit speed withheld: {ev.skew_note}")
+        logged = False
+    if ev.inertia_note and (claim.resolved or logged):
+        flags.append(Flag.TOP_DRIVE_INERTIA_CONTRADICTED if ev.inertia_contradicted
+                     else Flag.TOP_DRIVE_INERTIA_UNCONFIRMED)
+        messages.append(f"bit speed, stuck fraction and severity withheld: {ev.inertia_note}")
+        claim = replace(claim, resolved=False, reason=f"bit speed withheld: {ev.inertia_note}")
         logged = False
     runaway = ev.converged and ev.runaway_note is not None
     if runaway:

@@ -82,12 +82,24 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
-        **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est), **_skew(est)))
+        **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est), **_skew(est),
+        **_inertia(est)))
     if est.factors_withheld:
         record = withhold_friction(record, est.factors_withheld, None)
     # the windows' numbers stand where the segment's factors are withheld by its own rules:
     # a seeded trace that runs away from a constant μ_k is what a drift makes (§6.6)
     return replace(record, **_trend_fields(est))
+
+
+def _inertia(est: SegmentEstimate) -> dict:
+    """What the data say of the top-drive inertia (docs/bit_speed.md, Top-drive inertia)."""
+    rig = est.inertia
+    if rig is None:
+        return {}
+    return dict(top_drive_inertia_share=rig.share,
+                top_drive_inertia_kg_m2_identified=rig.identified_kg_m2,
+                top_drive_inertia_uncertainty_kg_m2=rig.uncertainty_kg_m2,
+                top_drive_inertia_source=rig.source)
 
 
 def _skew(est: SegmentEstimate) -> dict:

@@ -258,6 +258,8 @@ def plant_for(cfg: Config, settings: PlantSettings, path: WellPath | None, stand
     cap = torsional.bit_torque_cap(settings.bit_mu, stand.wob_N, settings.bit_diameter_m)
     plant = settings.plant(grid, td.fc_at(grid.x_m), cap, stand.bit_weakening_ratio,
                            stand.bit_weakening_rpm, torsional.contact_radius(string, grid))
+    if stand.top_drive_inertia_kg_m2 is not None:  # a gear change between stands
+        plant = replace(plant, top_drive_inertia_kg_m2=stand.top_drive_inertia_kg_m2)
     return plant, td
 
 

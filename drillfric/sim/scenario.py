@@ -68,6 +68,9 @@ class Stand:
         it): piecewise-linear factor [-] on the open hole's μ_k and μ_s (their ratio kept)
         from the start of the set-point, as ``setpoint_rpm`` (a repeated time makes a step;
         held after the last point). None: the friction is constant.
+    top_drive_inertia_kg_m2 : float, optional
+        The top drive's inertia during this stand [kg·m²] (a gear change between stands,
+        issue 34 item 2); None: ``rig.top_drive_inertia_kg_m2``.
     """
 
     bit_depth_m: float
@@ -93,6 +96,7 @@ class Stand:
     axial_delay_s: float = 0.0
     axial_ramp_s: float = 2.0
     mu_k_schedule: tuple | None = None
+    top_drive_inertia_kg_m2: float | None = None
 
     @property
     def start_up_s(self) -> float:
@@ -257,6 +261,10 @@ def _check_stand(stand: Stand, where: str, file) -> None:
         if getattr(stand, key) < 0:
             raise ConfigError(f"{where}.{key} must be ≥ 0, got {getattr(stand, key)}",
                               file=file)
+    inertia = stand.top_drive_inertia_kg_m2
+    if inertia is not None and not (np.isfinite(inertia) and inertia > 0):
+        raise ConfigError(f"{where}.top_drive_inertia_kg_m2 must be > 0, got {inertia}",
+                          file=file, fix="leave it out to use rig.top_drive_inertia_kg_m2")
     if not 1.0 <= stand.bit_weakening_ratio <= 10.0:
         raise ConfigError(f"{where}.bit_weakening_ratio must be in [1, 10], got "
                           f"{stand.bit_weakening_ratio}", file=file,
