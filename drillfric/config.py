@@ -799,7 +799,8 @@ def _check_observer_lists(observer: dict, file: str | None) -> None:
     highest = max(pair[0] for pair in starts)
     if highest > observer["mu_max"]:
         raise ConfigError(f"observer.mu_max = {observer['mu_max']:g} is below the observer "
-                          f"starts (μ_s up to {highest:g}), which must lie within the clamp",
+                          f"starts (observer.starts: μ_s up to {highest:g}), which must lie "
+                          "within the clamp",
                           file=file, fix="raise observer.mu_max or give observer.starts "
                                          "within it")
     poles = observer["poles_per_s"]
@@ -884,12 +885,42 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
         sections = _sections([dict(s) for s in DEFAULT_SECTIONS], "built-in default")
         assumed.append("drill string: typical 5 7/8in DP + 110 m 5in HWDP + 120 m 8in collars")
     channels = _channels(raw.get("channels", {}), fname)
+    given = []
     for dotted, value in (overrides or {}).items():
         if value is None:
             continue
         table, key = dotted.split(".")
         spec = {k.name: k for k in SCHEMA[table]}[key]
         values[table][key] = spec.validate(value, dotted, "command line")
+        given.append(dotted)
+    try:
+        _check_together(values, sections, fname)
+    except ConfigError as exc:
+        said = [d for d in given if d in exc.problem]
+        if not said:
+            raise
+        # a value the command line gave is at fault, not the file (an invalid --starts was
+        # blamed on the TOML: issue 30, tenth attack)
+        options = ", ".join(f"{OPTION_NAMES[d]} ({d})" if d in OPTION_NAMES else d
+                            for d in said)
+        rest = f"; the other keys from {fname}" if fname else ""
+        raise ConfigError(f"{exc.problem}{rest}", file=f"command line {options}",
+                          fix=f"correct {options.split(' (')[0] if len(said) == 1 else 'them'}"
+                              + (f" (or {exc.fix})" if exc.fix else "")) from exc
+    if raw.get("rig", {}).get("top_drive_inertia_kg_m2") is None:
+        assumed.append(TOP_DRIVE_INERTIA_ASSUMED)
+    if "fluid" not in raw:
+        assumed.append("mud density 1200 kg/m³")
+    return Config(values=values, sections=sections, channels=channels,
+                  source=None if file is None else Path(file), assumed=tuple(assumed))
+
+
+#: The command-line options that set configuration keys (for messages about their values).
+OPTION_NAMES = {"observer.starts": "--starts", "well.units": "--units"}
+
+
+def _check_together(values: dict, sections, fname: str | None) -> None:
+    """The checks of keys that must go together, after the command line's overrides."""
     _check_observer_lists(values["observer"], fname)
     if values["segmentation"]["rotating_stop_rpm"] > values["segmentation"]["rotating_rpm"]:
         raise ConfigError("segmentation.rotating_stop_rpm must not exceed rotating_rpm "
@@ -900,12 +931,6 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
     if values["model"]["omega_c_rad_s"] is not None and values["model"]["omega_c_rpm"] is not None:
         raise ConfigError("give either model.omega_c_rad_s or model.omega_c_rpm, not both",
                           file=fname)
-    if raw.get("rig", {}).get("top_drive_inertia_kg_m2") is None:
-        assumed.append(TOP_DRIVE_INERTIA_ASSUMED)
-    if "fluid" not in raw:
-        assumed.append("mud density 1200 kg/m³")
-    return Config(values=values, sections=sections, channels=channels,
-                  source=None if file is None else Path(file), assumed=tuple(assumed))
 
 
 def load_config(path: str | Path | None = None, *,

@@ -308,10 +308,12 @@ class PlateauFinder:
         standing on bottom hangs lighter by the weight set on the bit, so a stop there is
         neither the slips nor the string hanging free (a 12-t WOB held through a stop after
         drilling was taken for the slips: docs/validation.md)."""
+        by_wob = _column(chunk, "wob_N") > self._seg.wob_on_bottom_N
         if "bit_depth_m" in chunk and "hole_depth_m" in chunk:
             gap = _column(chunk, "hole_depth_m") - _column(chunk, "bit_depth_m")
-            return gap <= self._seg.on_bottom_m
-        return _column(chunk, "wob_N") > self._seg.wob_on_bottom_N
+            # the hole depth above the bit cannot be: there the WOB decides (segmentation)
+            return np.where(gap < -self._seg.on_bottom_m, by_wob, gap <= self._seg.on_bottom_m)
+        return by_wob
 
     def feed(self, chunk: pd.DataFrame, states=None) -> None:
         """Consume the next rows (canonical SI columns; ``states``, the rig states, are

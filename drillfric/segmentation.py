@@ -199,7 +199,11 @@ def _classify_kernel(time_s, rpm, torque_Nm, hookload_N, bit_in_m, hole_in_m, bl
             window = 2.0 * dt  # a coarse log: the travel since the sample before last
         moving = not np.isnan(anchor_t) and time_s[i] - anchor_t <= window
         weighted = wob_N[i] > wob_on_N  # False when WOB is not recorded (NaN)
-        if depth_mode != _DEPTH_NONE and not np.isnan(bit):
+        # the bit below the hole's bottom cannot be: the hole-depth channel is wrong or
+        # lagging, so the depths tell nothing here and the WOB alone decides (a hole depth
+        # 20 m above the bit put every rotation on bottom: issue 30, tenth attack)
+        below_hole = depth_mode == _DEPTH_CHANNEL and bit - hole > on_bottom_m
+        if depth_mode != _DEPTH_NONE and not np.isnan(bit) and not below_hole:
             # going down faster than any drilling: running into hole that was already there
             on_bottom = hole - bit <= on_bottom_m and v_down <= max_rop_m_s
             near = hole - bit <= WOB_NEAR_BOTTOM_M
@@ -339,7 +343,10 @@ def classify(frame: pd.DataFrame, cfg: Config) -> np.ndarray:
 
     On bottom means hole depth − bit depth ≤ ``on_bottom_m`` while the bit does not go down
     faster than ``max_rop_m_h`` (bit speed smoothed to first order, time constant
-    :data:`_SPEED_TAU_S`). The bit depth is the
+    :data:`_SPEED_TAU_S`). Where the hole-depth channel reads more than ``on_bottom_m``
+    above the bit (which cannot be: the channel is wrong or lagging) the depths decide
+    nothing: on bottom means ``wob_N`` > ``wob_on_bottom_N`` there (the run warns,
+    :meth:`drillfric.io.logcheck.LogCheck.hole_above_note`). The bit depth is the
     ``bit_depth_m`` channel, else it is reckoned from ``block_position_m`` (the bit moves
     with the block except while in the slips); the hole depth is ``hole_depth_m``, else
     the running maximum of the bit depth. Without either depth channel, on bottom means

@@ -22,6 +22,7 @@ pint is imported and its registry built on first use (:func:`registry`), not at 
 
 from __future__ import annotations
 
+import math
 import re
 from decimal import Decimal, InvalidOperation, localcontext
 from functools import cache, lru_cache
@@ -122,6 +123,28 @@ _ALIASES = {
 #: Units of a rotary speed that name no angle (Hz, 1/s, cps) count cycles: revolutions per
 #: time, not radians (pint's Hz = 1/s = 1 rad/s had read a speed logged in Hz 6.3× low).
 ANGLE_UNITS = frozenset({"radian", "turn", "degree", "gradian", "arcminute", "arcsecond"})
+
+
+def names_angle(unit) -> bool:
+    """Whether a parsed pint unit holds an angle unit — by what it is, not by its name (pint
+    names gradians ``grade`` and prefixed ones ``milliradian``: a speed in ``gon/s`` or
+    ``mrad/s`` was taken for cycles per time, 2π too fast: issue 30, tenth attack).
+
+    Examples
+    --------
+    >>> names_angle(parse_unit("mrad/s")), names_angle(parse_unit("gon")), names_angle(
+    ...     parse_unit("Hz"))
+    (True, True, False)
+    """
+    reg = registry()
+    return any(_angle_name(reg, name) for name in unit._units)
+
+
+def _angle_name(reg, name: str) -> bool:
+    try:
+        return "radian" in reg.get_root_units(name)[1]._units
+    except Exception:  # noqa: BLE001 — a name pint cannot reduce is no angle
+        return False
 
 #: SI target unit for each kind of quantity drillfric reads.
 SI_UNITS = {
@@ -299,10 +322,18 @@ def parse_unit(text: str) -> pint.Unit:
     >>> str(parse_unit("kN.m"))
     'kilonewton * meter'
     """
-    unit = _parse(registry(), text)
+    reg = registry()
+    unit = _parse(reg, text)
     if unit is None:
         raise InputError(f"unknown unit '{text}'",
                          fix="use a unit such as rpm, kN.m, ft.lbf, klbf, m, ft")
+    for name in unit._units:
+        size = reg.get_root_units(name)[0] if _angle_name(reg, name) else 0.0
+        if size > 2.0 * math.pi * (1.0 + 1e-9):
+            raise InputError(f"unit '{text}' reads as {name}s ({size:.4g} rad each: a "
+                             "capital letter is an SI prefix, G giga, M mega): no angle is "
+                             "logged in those", fix="write 'gon' for gradians (400 per turn), "
+                             "'deg' for degrees (the German 'Grad'), 'rad' for radians")
     return unit
 
 
@@ -332,7 +363,7 @@ def conversion_factor(unit: str, kind: str) -> float:
 
     reg = registry()
     source = parse_unit(unit)
-    if kind in ("rpm", "angular_velocity") and not ANGLE_UNITS & set(source._units):
+    if kind in ("rpm", "angular_velocity") and not names_angle(source):
         source = source * reg.turn  # a frequency of the rotation: cycles per time
     target = reg.parse_units(SI_UNITS[kind])
     try:

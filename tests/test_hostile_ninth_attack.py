@@ -329,8 +329,10 @@ def test_overlapping_hourly_exports_name_the_two_parts_not_the_folder(tmp_path):
         open_well(well).load()
     assert caught.value.message == (
         f"{well / 'hourly'}: part '07.csv' starts at 6 s, before part '06.csv' ends (7.8 s): "
-        "the two parts of the log overlap — fix: remove the rows of '07.csv' up to 7.8 s (or "
-        "the part that is an export of the same hours again)")
+        "the two parts of the log overlap — fix: the parts are read in name order (numbers by "
+        "value), the files are never changed: if the names do not sort in time order, copy the "
+        "parts into a new folder under names that do; if '07.csv' exports hours already logged "
+        "again, move it into a sub-folder (not read)")  # no fix that edits a file: tenth attack
     (well / "hourly" / "07.csv").write_text(
         frame.iloc[40:].assign(time_s=lambda f: f["time_s"].where(f.index != 50, 1.0))
         .to_csv(index=False))

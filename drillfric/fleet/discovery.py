@@ -17,6 +17,7 @@ from pathlib import Path
 from drillfric.errors import InputError
 from drillfric.io import witsml
 from drillfric.io.atomic import OUT_FILES
+from drillfric.io.text import printable
 
 _DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las", ".xml", ".dlis",
              ".xlsx")
@@ -138,6 +139,9 @@ def _read_manifest(path: Path) -> list[WellSpec]:
         raise InputError("every manifest entry needs a 'data' path", file=path,
                          fix=f"use columns {', '.join(_MANIFEST_COLUMNS)} (data required)")
 
+    for i, row in enumerate(rows, start=1):
+        _check_entry(row, i, path)
+
     def where(value) -> Path | None:
         value = str(value or "").strip()  # a cell of blanks is an empty cell
         if "\x00" in value:  # no path holds NUL: the OS refuses it
@@ -145,8 +149,39 @@ def _read_manifest(path: Path) -> list[WellSpec]:
                              fix="write each path as plain text")
         return None if not value else (path.parent / value).resolve()
 
-    return [WellSpec(where(r["data"]), str(r.get("well") or "").strip() or None,
-                     where(r.get("config")), where(r.get("survey"))) for r in rows]
+    return [WellSpec(where(r["data"]), _name(r.get("well")), where(r.get("config")),
+                     where(r.get("survey"))) for r in rows]
+
+
+def _check_entry(row: dict, i: int, path: Path) -> None:
+    """A manifest entry holds only the columns drillfric reads, each a text (a well's name
+    may be a number): a declared ``type`` or a well name given as a list was ignored in
+    silence — the well ran as its file stem, as whatever its data are (issue 30, tenth
+    attack)."""
+    unknown = [str(k) for k, v in row.items() if k not in _MANIFEST_COLUMNS and k is not None
+               and not (k == "" and not v)]  # a trailing comma's empty column
+    if unknown or None in row:  # None: a CSV row with more fields than the header
+        what = (f"column '{printable(unknown[0])}'" if unknown
+                else "more fields than the header has columns")
+        raise InputError(f"manifest entry {i} has {what}, which drillfric does not read (a "
+                         "well's kind and settings come from its data and configuration)",
+                         file=path, fix=f"keep only the columns {', '.join(_MANIFEST_COLUMNS)}"
+                                        "; set anything else in the well's configuration")
+    for key in _MANIFEST_COLUMNS:
+        value = row.get(key)
+        number = key == "well" and isinstance(value, int | float) and not isinstance(value, bool)
+        if value is not None and not isinstance(value, str) and not number:
+            raise InputError(f"manifest entry {i}: {key} is a {type(value).__name__}, not a "
+                             "text", file=path, fix=f'write {key} as a text, e.g. "{key}": '
+                             + ('"A-1"' if key == "well" else '"wells/a.csv"'))
+
+
+def _name(value) -> str | None:
+    """A manifest's well name (a number as written), None when not given (a cell of
+    blanks too)."""
+    if value is None or not str(value).strip():
+        return None
+    return value.strip() if isinstance(value, str) else format(value, "g")
 
 
 def _no_repeated_keys(pairs: list) -> dict:

@@ -106,8 +106,7 @@ def _open_job(index: int, spec: WellSpec, out_root: Path, overrides: dict,
     except DrillfricError as exc:
         return _Job(index, fallback, fallback, None, {}, exc.message)
     except OSError as exc:
-        return _Job(index, fallback, fallback, None, {},
-                    f"{exc.filename}: cannot read ({exc.strerror})")
+        return _Job(index, fallback, fallback, None, {}, _os_line(exc, spec.data))
     # the configuration files are inputs (hashed); defaults change with the version only
     effective = json.dumps(jsonable({"overrides": overrides, "options": options}),
                            sort_keys=True, default=str)
@@ -128,9 +127,21 @@ def _hashed(job: _Job, known: dict) -> _Job:
         return job
     try:
         inputs = {role: _file_stamp(p, known) for role, p in job.fingerprint["inputs"].items()}
+    except DrillfricError as exc:
+        return replace(job, task=None, error=exc.message)
     except OSError as exc:
-        return replace(job, task=None, error=f"{exc.filename}: cannot read ({exc.strerror})")
+        return replace(job, task=None, error=_os_line(exc, job.task.data))
     return replace(job, fingerprint=job.fingerprint | {"inputs": inputs})
+
+
+def _os_line(exc: OSError, path) -> str:
+    """One line for an OSError that names the file and the problem even when the error
+    carries neither (a FIFO among the wells gave "None: cannot read (None)", issue 30)."""
+    from drillfric.io.text import one_line, printable
+
+    where = printable(str(exc.filename if exc.filename is not None else path), 4096)
+    problem = exc.strerror or str(exc) or type(exc).__name__
+    return one_line(f"{where}: cannot read ({problem})")
 
 
 def _abs(path) -> str | None:
@@ -139,9 +150,12 @@ def _abs(path) -> str | None:
 
 def _file_stamp(path: Path, known: dict) -> dict:
     """Size, modification time and SHA-256 of an input file (hashed again only when size or
-    time changed). OSError for anything but a regular file: a FIFO would hang the hash."""
-    if not path.is_file():
-        raise FileNotFoundError(f"not a regular file: {path}")
+    time changed). InputError for anything but a regular file, naming it: a FIFO would hang
+    the hash."""
+    from drillfric.files import require_file
+
+    require_file(Path(path), "input file", fix="keep only the wells' files in the folder, "
+                 "or list the wells in a manifest")
     stat = path.stat()
     key = str(path.resolve())
     stamp = {"path": key, "size": stat.st_size, "mtime_ns": stat.st_mtime_ns}

@@ -25,7 +25,7 @@ from functools import lru_cache
 
 from drillfric.errors import InputError
 from drillfric.io.text import listing, printable
-from drillfric.units import ANGLE_UNITS, parse_unit, registry
+from drillfric.units import names_angle, parse_unit, registry
 
 
 @dataclass(frozen=True)
@@ -223,7 +223,7 @@ def factor(unit: str, channel: Channel, *, file: str | None = None) -> float:
     import pint
 
     source = _source_unit(unit, channel, file)
-    if "revolution" in channel.unit and not ANGLE_UNITS & set(source._units):
+    if "revolution" in channel.unit and not names_angle(source):
         source = source * registry().turn  # a rotary speed in Hz counts revolutions
     try:
         return float(registry().Quantity(1.0, source).to(channel.unit).magnitude)
@@ -244,6 +244,9 @@ def _source_unit(unit: str, channel: Channel, file: str | None):
     try:
         return parse_unit(spelled)
     except InputError as exc:
+        if " reads as " in exc.problem:  # a unit pint reads, as nothing a rig logs
+            raise InputError(f"{channel.name}: {printable(exc.problem, 200)}", file=file,
+                             fix=exc.fix) from exc
         raise InputError(f"unknown unit '{printable(unit)}' for {channel.name}: no {channel.kind} "
                          f"unit is spelled so (nor any unit pint knows)", file=file,
                          fix=f"write a {channel.kind} unit drillfric reads — "
@@ -305,6 +308,9 @@ class Mapping:
         ``"config"``, ``"header"``, ``"units row"``, ``"name suffix"`` or ``"default"``.
     factor : float
         Multiplier from the source unit to the canonical unit.
+    note : str or None
+        Why this column was taken over one the mnemonic table prefers (that one holds no
+        changing value: :func:`drillfric.io.well.prefer_live`), for the run's warnings.
     """
 
     channel: Channel
@@ -312,6 +318,7 @@ class Mapping:
     unit: str
     source: str
     factor: float
+    note: str | None = None
 
 
 def _rank(column: str, channel: Channel, extra: tuple[str, ...]) -> tuple[tuple, str | None]:
@@ -345,7 +352,8 @@ def _normalised(mnemonics: tuple[str, ...]) -> list[str]:
 
 
 def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | None,
-                 file_units: dict | None = None) -> tuple[str | None, str | None]:
+                 file_units: dict | None = None,
+                 passed_over: frozenset = frozenset()) -> tuple[str | None, str | None]:
     """The column a channel maps to (from ``[channels]`` or mnemonics) and the unit in its name.
 
     A column found by mnemonic whose stated unit measures another quantity (``FLOWOUT`` in
@@ -369,12 +377,8 @@ def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | N
                          f"columns are: {listing(columns, recognised=_recognisable(columns))}",
                          file=file,
                          fix="use one of the listed column names (or a 0-based index)")
-    extra = tuple(spec.get("mnemonics", ()))
-    ranked = [(rank, col, unit) for col in columns
-              for rank, unit in [_rank(col, channel, extra)] if rank]
-    fitting = [r for r in ranked if _unit_agrees(r[1], r[2], channel, file_units or {}, spec)]
-    if fitting or not channel.required:
-        ranked = fitting
+    ranked = _candidates(columns, channel, spec, file_units)
+    ranked = [r for r in ranked if r[1] not in passed_over]
     if not ranked:
         return None, None
     best = max(r[0] for r in ranked)
@@ -385,6 +389,37 @@ def _find_column(columns: list[str], channel: Channel, spec: dict, file: str | N
                          fix=f'choose one in [channels], e.g. {channel.key} = '
                              f'{{ column = "{printable(top[0][1])}" }}')
     return top[0][1], top[0][2]
+
+
+def _candidates(columns: list[str], channel: Channel, spec: dict,
+                file_units: dict | None) -> list[tuple[tuple, str, str | None]]:
+    """(rank, column, unit in its name) of every column the mnemonics match for ``channel``,
+    best first (a column whose stated unit measures another quantity only when none fits)."""
+    extra = tuple(spec.get("mnemonics", ()))
+    ranked = [(rank, col, unit) for col in columns
+              for rank, unit in [_rank(col, channel, extra)] if rank]
+    fitting = [r for r in ranked if _unit_agrees(r[1], r[2], channel, file_units or {}, spec)]
+    if fitting or not channel.required:
+        ranked = fitting
+    return sorted(ranked, key=lambda r: r[0], reverse=True)
+
+
+def candidate_columns(columns: list[str], key: str, config_channels: dict,
+                      file_units: dict | None = None) -> list[str]:
+    """Every column that could be channel ``key`` by its name, the mnemonic table's choice
+    first; none when ``[channels]`` names the column (the user chose).
+
+    Examples
+    --------
+    >>> candidate_columns(["time_s", "TDRPM", "RPM"], "surface_rpm", {})
+    ['RPM', 'TDRPM']
+    >>> candidate_columns(["TDRPM", "RPM"], "surface_rpm", {"surface_rpm": {"column": "RPM"}})
+    []
+    """
+    spec = config_channels.get(key, {})
+    if spec.get("column") is not None:
+        return []
+    return [r[1] for r in _candidates(columns, BY_KEY[key], spec, file_units)]
 
 
 def _unit_agrees(column: str, name_unit: str | None, channel: Channel, file_units: dict,
@@ -452,6 +487,8 @@ def _stated_units(channel: Channel, column: str, name_unit: str | None,
         states.append((name_unit, "header"))
     if file_units.get(column):
         states.append((file_units[column], file_units.get(("source", column), "header")))
+    if file_units.get(("also", column)):  # a format stating it twice (WITSML)
+        states.append(tuple(file_units[("also", column)]))
     if column == channel.name:
         states.append((SUFFIX_UNITS[channel.key], "name suffix"))
     return states
@@ -520,7 +557,8 @@ def log_index(columns: list[str], config_channels: dict, *, depth_index: str | N
 
 def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
                  file: str | None = None, index: str = "time",
-                 log_shaped: Callable[[], bool] | None = None) -> dict[str, Mapping]:
+                 log_shaped: Callable[[], bool] | None = None,
+                 passed_over: dict | None = None) -> dict[str, Mapping]:
     """Match source columns to canonical channels.
 
     Parameters
@@ -540,6 +578,9 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
     log_shaped : callable, optional
         Asked only when a required channel is missing and no column name is known: whether
         the file is recognisably a data log all the same (its header is then listed).
+    passed_over : dict, optional
+        ``{channel key: set of columns}`` not to take for that channel by mnemonic (columns
+        holding no changing value while another candidate does).
 
     Returns
     -------
@@ -558,7 +599,8 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
         if channel.index not in (None, index):
             continue
         spec = config_channels.get(channel.key, {})
-        column, name_unit = _find_column(columns, channel, spec, file, file_units)
+        column, name_unit = _find_column(columns, channel, spec, file, file_units,
+                                         frozenset((passed_over or {}).get(channel.key, ())))
         if column is None:
             if channel.required:
                 raise _missing(channel, columns, file_units, config_channels, out, file,

@@ -33,6 +33,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.source import RawSource
+from drillfric.io.text import printable
 
 #: Largest uncompressed size a workbook may declare [bytes] (Excel's own limit of
 #: 1 048 576 rows of a rig log's few dozen columns stays well below).
@@ -46,6 +47,9 @@ MAX_RATIO = 200
 MAX_CELLS = 1 << 25
 #: Words in a sheet name that mark the sheet holding the log.
 SHEET_WORDS = ("surface", "log", "data")
+#: Words in a sheet name that mark a sheet holding something else (a survey's "Survey data"
+#: was taken for the log by its word "data": issue 30, tenth attack).
+NOT_LOG_WORDS = ("survey", "trajectory", "deviation", "directional", "notes", "bha")
 _HEAD_ROWS = 50
 _NUMBER = re.compile(r"^\s*[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?\s*$")
 _FIX = "save the workbook again from Excel (.xlsx), or export the sheet as CSV"
@@ -105,12 +109,44 @@ def check_workbook(path: Path) -> None:
     with zipfile.ZipFile(path) as archive:
         for member in archive.infolist():
             if re.fullmatch(r"xl/worksheets/[^/]+\.xml", member.filename):
-                _check_sheet(archive, member, path)
+                span = _check_sheet(archive, member, path)
+                if span.uncached:
+                    sheet = _sheet_names(archive).get(member.filename, member.filename)
+                    raise InputError(
+                        f"sheet '{printable(sheet)}' holds {span.uncached} formula cells "
+                        f"without their computed values (the first at {span.first_uncached}): "
+                        "the workbook was written by a program that does not calculate, so "
+                        "those cells read empty", file=path,
+                        fix="open the workbook in Excel or LibreOffice and save it (the values "
+                            "are then stored), or export the sheet as CSV")
 
 
-def _check_sheet(archive: zipfile.ZipFile, member: zipfile.ZipInfo, path: Path) -> None:
+def _sheet_names(archive: zipfile.ZipFile) -> dict[str, str]:
+    """``{worksheet member: sheet name}`` from ``xl/workbook.xml`` and its relationships
+    (empty when they cannot be read: the member's name is shown instead)."""
+    from defusedxml.ElementTree import fromstring
+
+    try:
+        book = fromstring(archive.read("xl/workbook.xml"), forbid_dtd=True)
+        rels = fromstring(archive.read("xl/_rels/workbook.xml.rels"), forbid_dtd=True)
+    except Exception:  # noqa: BLE001 — a name is only for the message
+        return {}
+    targets = {r.get("Id"): r.get("Target", "") for r in rels}
+    out = {}
+    for elem in book.iter():
+        if elem.tag.rpartition("}")[2] != "sheet":
+            continue
+        rid = next((v for k, v in elem.attrib.items() if k.rpartition("}")[2] == "id"), None)
+        target = targets.get(rid, "").lstrip("/")
+        member = target if target.startswith("xl/") else f"xl/{target}"
+        out[member] = elem.get("name", member)
+    return out
+
+
+def _check_sheet(archive: zipfile.ZipFile, member: zipfile.ZipInfo, path: Path) -> _Span:
     """InputError when a worksheet declares or fills more than :data:`MAX_CELLS` cells
-    (the XML streamed in blocks into a parser target: no element tree is built)."""
+    (the XML streamed in blocks into a parser target: no element tree is built); else what
+    the stream saw (:class:`_Span`: its formula cells without a stored value too)."""
     from xml.etree.ElementTree import ParseError
 
     from defusedxml import DefusedXmlException
@@ -128,6 +164,7 @@ def _check_sheet(archive: zipfile.ZipFile, member: zipfile.ZipInfo, path: Path) 
     except (ParseError, DefusedXmlException, zipfile.BadZipFile, OSError, ValueError) as exc:
         raise InputError(f"not a readable Excel workbook (sheet XML {member.filename}: "
                          f"{type(exc).__name__})", file=path, fix=_FIX) from None
+    return span
 
 
 def _too_big(member: zipfile.ZipInfo, span: _Span, path: Path) -> InputError:
@@ -151,17 +188,45 @@ class _Span:
         self._row = 0
         self._col = 0
         self._declared = 0
+        # formula cells without a stored value (<c><f>…</f></c>, no <v>): calamine reads
+        # them empty (a time column of formulas gave "no data rows": issue 30, tenth attack)
+        self.uncached = 0
+        self.first_uncached = ""
+        self._formula = self._value = self._in_value = False
+
+    def data(self, text: str) -> None:
+        if self._in_value and text.strip():
+            self._value = True
+
+    def end(self, tag: str) -> None:
+        if self._in_value and tag.rpartition("}")[2] == "v":
+            self._in_value = False
 
     def start(self, tag: str, attrib: dict) -> None:
         name = tag.rpartition("}")[2]
         if name == "c":
+            self._cell_done()
             self.cell(attrib.get("r"))
+        elif name == "f":
+            self._formula = True
+        elif name == "is":  # an inline string
+            self._value = True
+        elif name == "v":  # a stored value when it holds text (openpyxl writes <v />)
+            self._in_value = True
         elif name == "row":
+            self._cell_done()
             self.row(attrib.get("r"))
         elif name == "dimension":
             self.declared(attrib.get("ref", ""))
 
+    def _cell_done(self) -> None:
+        if self._formula and not self._value:
+            self.uncached += 1
+            self.first_uncached = self.first_uncached or f"{_letters(self._col)}{self._row}"
+        self._formula = self._value = False
+
     def close(self) -> None:
+        self._cell_done()
         return None
 
     def declared(self, ref: str) -> None:
@@ -260,11 +325,16 @@ def pick_sheet(names: list[str], heights: list[int]) -> int:
     1
     >>> pick_sheet(["Sheet1", "Sheet2"], [0, 10])
     1
+    >>> pick_sheet(["Survey data", "Surface log"], [3, 100])  # a survey is no log
+    1
     """
-    for i, name in enumerate(names):
-        if heights[i] and any(w in name.lower() for w in SHEET_WORDS):
+    likely = [i for i in range(len(names)) if heights[i]
+              and not any(w in names[i].lower() for w in NOT_LOG_WORDS)]
+    for i in likely:
+        if any(w in names[i].lower() for w in SHEET_WORDS):
             return i
-    return next((i for i, h in enumerate(heights) if h), 0)
+    order = likely + [i for i in range(len(names)) if heights[i] and i not in likely]
+    return order[0] if order else 0
 
 
 def sheet_layout(path: Path, sheet: str) -> SheetLayout:
@@ -274,7 +344,11 @@ def sheet_layout(path: Path, sheet: str) -> SheetLayout:
         head.append(row)
         if len(head) >= _HEAD_ROWS:
             break
-    start = next((i for i, row in enumerate(head) if len(_filled(row)) >= 2), None)
+    # the header is the first row about as wide as the table: a title row above it (a
+    # merged "Torque & drag" over three columns, a rig name) holds fewer cells (issue 30)
+    widest = max((len(_filled(row)) for row in head), default=0)
+    start = next((i for i, row in enumerate(head)
+                  if len(_filled(row)) >= max(2, (widest + 1) // 2)), None)
     if start is None:
         raise InputError(f"sheet '{sheet}' holds no table (no row with two or more cells)",
                          file=path, fix="put the log in the first sheet, one column per "
@@ -298,6 +372,13 @@ def sheet_layout(path: Path, sheet: str) -> SheetLayout:
                 units[column] = unit
                 units[("source", column)] = "units row"
     return SheetLayout(sheet, columns, units, start + 1 + units_row)
+
+
+def _log_header(columns: list[str]) -> bool:
+    """Whether a sheet's header names a speed or a torque column (a log's, not a survey's)."""
+    from drillfric.io.channels import find_column
+
+    return any(find_column(columns, key, {}) for key in ("surface_rpm", "surface_torque"))
 
 
 def _cell_seconds(cell):
@@ -354,6 +435,15 @@ def open_excel(path) -> RawSource:
                          "whose first sheet holds the log")
     at = pick_sheet(names, heights)
     layout = sheet_layout(path, names[at])
+    if not _log_header(layout.columns):  # another filled sheet's header may be the log's
+        for i in (i for i in range(len(names)) if heights[i] and i != at):
+            try:
+                other = sheet_layout(path, names[i])
+            except InputError:
+                continue
+            if _log_header(other.columns):
+                at, layout = i, other
+                break
     rows = heights[at] - layout.data_row
 
     def read(chunk_rows: int) -> Iterator[pd.DataFrame]:
@@ -368,4 +458,5 @@ def open_excel(path) -> RawSource:
         if block:
             yield _block(block, layout.columns)
 
-    return RawSource(path, "excel", layout.columns, layout.units, rows, read)
+    return RawSource(path, "excel", layout.columns, layout.units, rows, read,
+                     where=f"sheet '{printable(layout.sheet)}'")

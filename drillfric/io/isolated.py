@@ -171,7 +171,7 @@ def _source(path: Path, fmt: str, payload: bytes, name: str) -> RawSource:
             yield frame
 
     return RawSource(path, fmt, columns, units, head["rows"], read,
-                     depth_index=head["depth_index"])
+                     depth_index=head["depth_index"], where=head.get("where"))
 
 
 # --------------------------------------------------------------------------- child side
@@ -209,7 +209,7 @@ def _table(source: RawSource):
     head = {"columns": [str(c) for c in frame.columns], "rows": source.rows,
             "units": [[list(k) if isinstance(k, tuple) else k, v]
                       for k, v in source.units.items()],
-            "depth_index": source.depth_index}
+            "depth_index": source.depth_index, "where": source.where}
     table = pa.table(arrays) if arrays else pa.table({})
     return table.replace_schema_metadata({_HEADER: json.dumps(head).encode()})
 

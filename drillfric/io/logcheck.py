@@ -48,6 +48,9 @@ class LogCheck:
         self.loaded = 0  # rows with WOB and hook load, one of them above SWAP_FLOOR_N
         self.wob_over = 0  # of those, WOB above the hook load
         self.wob_sum = self.hook_sum = 0.0  # their sums [N] (for the message)
+        # rows whose hole depth reads above the bit depth by more than on_bottom_m, the
+        # most it does [m] and the first such row's time [s]
+        self.above, self.above_max_m, self.above_first_s = 0, 0.0, np.nan
 
     def feed(self, chunk: pd.DataFrame) -> None:
         """Take in one canonical chunk (the first one also checks the sample spacing)."""
@@ -67,6 +70,14 @@ class LogCheck:
             self.wob_over += int((wob[both] > hook[both]).sum())
             self.wob_sum += float(wob[both].sum())
             self.hook_sum += float(hook[both].sum())
+        if "bit_depth_m" in chunk and "hole_depth_m" in chunk:
+            excess = chunk["bit_depth_m"].to_numpy(float) - chunk["hole_depth_m"].to_numpy(float)
+            over = np.flatnonzero(excess > self.well.config.segmentation.on_bottom_m)
+            if over.size:
+                if not self.above:
+                    self.above_first_s = float(chunk["time_s"].to_numpy(float)[over[0]])
+                self.above += int(over.size)
+                self.above_max_m = max(self.above_max_m, float(excess[over].max()))
         rpm = chunk["surface_rpm"].to_numpy(float)
         rpm = rpm[np.isfinite(rpm)]
         if rpm.size:
@@ -81,7 +92,8 @@ class LogCheck:
         return {"rows": self.rows, "finite": dict(self.finite), "turning": self.turning,
                 "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max]),
                 "spacing_s": self.spacing_s,
-                "loads": np.array([self.loaded, self.wob_over, self.wob_sum, self.hook_sum])}
+                "loads": np.array([self.loaded, self.wob_over, self.wob_sum, self.hook_sum]),
+                "hole_above": np.array([self.above, self.above_max_m, self.above_first_s])}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -90,6 +102,10 @@ class LogCheck:
         self.finite = {k: int(v) for k, v in state["finite"].items()}
         self.rpm_min, self.rpm_max = (float(v) for v in state["rpm_range"])
         self.spacing_s = float(state.get("spacing_s", np.nan))
+        above = state.get("hole_above")
+        if above is not None:
+            self.above, self.above_max_m = int(above[0]), float(above[1])
+            self.above_first_s = float(above[2])
         loads = state.get("loads")
         if loads is not None:
             self.loaded, self.wob_over = int(loads[0]), int(loads[1])
@@ -197,6 +213,27 @@ class LogCheck:
                            f"is in minutes (the longest {60.0 * longest:.4g} s, samples "
                            f"{60.0 * dt:.3g} s apart), " + _say_unit(time, "min"))
         return out
+
+    def hole_above_note(self) -> str | None:
+        """A warning when the hole depth read above the bit depth (by more than
+        ``segmentation.on_bottom_m``), which cannot be: the bit is never below the hole's
+        bottom. Those rows were on or off bottom by their WOB alone (not by the depths,
+        which put every rotation on bottom: issue 30, tenth attack), or None."""
+        if not self.above:
+            return None
+        bit, hole = self.well.channels["bit_depth_m"], self.well.channels["hole_depth_m"]
+        share = 100.0 * self.above / max(self.rows, 1)
+        wob = "wob_N" in self.well.channels
+        return (f"{self.well.files.data}: the hole depth (column '{printable(hole.column)}') "
+                f"reads above the bit depth (column '{printable(bit.column)}') in "
+                f"{self.above} rows ({share:.3g} % of the log, by up to "
+                f"{self.above_max_m:.4g} m, the first at {self.above_first_s:.6g} s): the "
+                "bit cannot be below the hole, so the hole-depth channel is wrong or lagging "
+                "there and on or off bottom was "
+                + ("judged from the WOB alone in those rows" if wob else
+                   "not known in those rows (no WOB channel: rotation counted as off "
+                   "bottom; drilling would put its bit torque into μ_k)")
+                + " — check the hole-depth channel (its datum, its unit, whether it updates)")
 
     def nothing_found(self, segments: int) -> str | None:
         """Why a run found no rotating segment at all (a warning), or None."""

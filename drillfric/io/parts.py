@@ -1,10 +1,12 @@
 """A well's log split over several files of one format in a folder — the hourly or daily
-CSV or Parquet exports of a rig recorder — read as one log, its files in name order
-(docs/ingestion.md "A well on disk", docs/fleet.md "Only what is new").
+CSV or Parquet exports of a rig recorder — read as one log, its files in name order, numbers
+in names by value (``p9`` before ``p10``; docs/ingestion.md "A well on disk", docs/fleet.md
+"Only what is new").
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
@@ -24,9 +26,12 @@ PART_FORMATS = ("csv", "parquet")
 _SIDECAR_TAGS = (".survey.", ".truth.", ".tubular.")
 
 
-def folder_parts(folder: Path) -> tuple[Path, ...] | None:
+def folder_parts(folder: Path, named=()) -> tuple[Path, ...] | None:
     """The data files of a folder holding one log in parts (name order), or None when it
-    holds none. Hidden files and sidecars are not parts.
+    holds none. Hidden files and sidecars are not parts, nor any file in ``named`` — the
+    files the well's configuration names as something else (its ``[survey] file``, a
+    survey or configuration given on the command line): a survey ``deviation.csv`` beside
+    the hourly parts was read as a part of the log (issue 30, tenth attack).
 
     Raises
     ------
@@ -35,10 +40,12 @@ def folder_parts(folder: Path) -> tuple[Path, ...] | None:
     """
     if not folder.is_dir():
         return None
-    files = sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")
+    others = {_identity(Path(p)) for p in named if p is not None} - {None}
+    files = sorted((p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")
                    and not any(tag in p.name for tag in _SIDECAR_TAGS)
                    and p.suffix.lower() not in (".toml", ".json", ".md")
-                   and not _drillfrics(p.name))
+                   and not _drillfrics(p.name) and _identity(p) not in others),
+                   key=lambda p: natural_key(p.name))
     if not files:
         return None
     formats = {_format(p) for p in files}
@@ -64,6 +71,32 @@ def _tagged(source: RawSource) -> RawSource:
             yield chunk
 
     return replace(source, _read=tagged)
+
+
+def natural_key(name: str) -> tuple:
+    """Sort key of a part's name with its numbers compared by value: the hourly parts
+    ``p9``, ``p10``, ``p11`` of a recorder that does not pad its numbers sorted as
+    ``p10, p11, p9`` and were refused as overlapping (issue 30, tenth attack).
+
+    Examples
+    --------
+    >>> sorted(["p10.csv", "p9.csv", "p11.csv"], key=natural_key)
+    ['p9.csv', 'p10.csv', 'p11.csv']
+    >>> sorted(["2026-11-27_10.csv", "2026-11-27_09.csv"], key=natural_key)[0]
+    '2026-11-27_09.csv'
+    """
+    runs = re.split(r"(\d+)", name)
+    return tuple(int(r) if i % 2 else r for i, r in enumerate(runs)), name
+
+
+def _identity(path: Path):
+    """What tells two names of one file apart from two files (device and inode, else the
+    resolved path); None for a file that is not there."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino)
 
 
 def _drillfrics(name: str) -> bool:

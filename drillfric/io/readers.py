@@ -104,7 +104,36 @@ def _open_parquet(path: Path) -> RawSource:
             raise corrupt from exc
 
     return RawSource(path, "parquet", list(schema.names), units, meta.metadata.num_rows, read,
-                     seek="row")
+                     seek="row", narrow=_narrow_floats(schema, meta.metadata))
+
+
+def _narrow_floats(schema, metadata) -> dict:
+    """``{column: (type, largest magnitude)}`` of the float32/float16 columns, the
+    magnitude from the row groups' statistics (NaN when they give none): read before any
+    data, so that a time column too coarse for its samples is one clear line (issue 30, tenth
+    attack), not every timestamp "repeated with other values"."""
+    import numpy as np
+    import pyarrow.types as pt
+
+    out = {}
+    for j, fld in enumerate(schema):
+        if not (pt.is_float16(fld.type) or pt.is_float32(fld.type)):
+            continue
+        dtype = np.float16 if pt.is_float16(fld.type) else np.float32
+        largest = 0.0
+        try:
+            for g in range(metadata.num_row_groups):
+                stats = metadata.row_group(g).column(j).statistics
+                if stats is None or not stats.has_min_max:
+                    raise ValueError("no statistics")
+                for v in (stats.min, stats.max):
+                    value = (float(np.frombuffer(v, "<f2")[0]) if isinstance(v, bytes)
+                             else float(v))
+                    largest = max(largest, abs(value))
+        except (ValueError, TypeError, IndexError):
+            largest = float("nan")
+        out[fld.name] = (dtype.__name__, largest)
+    return out
 
 
 def _groups_from(metadata, start: int) -> tuple[list[int], int]:

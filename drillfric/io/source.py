@@ -54,6 +54,14 @@ class RawSource:
         growth is recognised by its rows' content rather than its bytes (a WITSML log
         rewritten with more rows, an HDF5 table, a LAS file: docs/fleet.md "Only what is
         new"); None for the others.
+    narrow : dict
+        Columns stored in fewer bits than a float64 (Parquet float32, float16):
+        ``{column: (type name, largest magnitude from the file's statistics, NaN when
+        unknown)}``; they are read widened to float64 (:func:`drillfric.io.well.check_narrow`
+        says where the narrow type lost what a run needs).
+    where : str or None
+        Which part of the file was read, for messages (an Excel workbook's sheet:
+        ``"sheet 'Surface log'"``); None when the file is one table.
     """
 
     path: Path
@@ -67,6 +75,8 @@ class RawSource:
     parts: tuple = ()
     digest: Callable[[int | None], str] | None = field(default=None, repr=False,
                                                        compare=False)
+    narrow: dict = field(default_factory=dict, repr=False, compare=False)
+    where: str | None = None
 
     def chunks(self, chunk_rows: int = 200_000) -> Iterator[pd.DataFrame]:
         """Yield the raw data in blocks of at most ``chunk_rows`` rows, labelled by column."""

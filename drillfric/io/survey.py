@@ -337,8 +337,9 @@ def _factor(unit: str | None, kind: str, name: str, file) -> float:
         return float(np.degrees(conversion_factor(m.group(1), "angle"))) * 30.0 / per
     except InputError as exc:
         raise InputError(f"column '{printable(name)}': {exc.problem}", file=file,
-                         fix="use m or ft for depths, deg or rad for angles, deg/30m or "
-                             "deg/100ft for DLS") from exc
+                         fix=exc.fix if " reads as " in exc.problem else
+                         "use m or ft for depths, deg or rad for angles, deg/30m or "
+                         "deg/100ft for DLS") from exc
 
 
 class SurveyWarning(UserWarning):

@@ -369,8 +369,11 @@ class TimeTracker:
             raise InputError(f"part '{printable(part)}' starts at {at}, before part "
                              f"'{printable(self._part)}' ends ({prev}): the two parts of "
                              "the log overlap", file=self.file,
-                             fix=f"remove the rows of '{printable(part)}' up to {prev} (or the "
-                                 "part that is an export of the same hours again)")
+                             fix="the parts are read in name order (numbers by value), "
+                                 "the files are never changed: if the names do not sort in "
+                                 "time order, copy the parts into a new folder under names "
+                                 f"that do; if '{printable(part)}' exports hours already "
+                                 "logged again, move it into a sub-folder (not read)")
         if part is not None and part != self._part:
             self._part_row = self._rows_seen  # the row is in a part begun in this chunk
         row = self._rows_seen + i + 1

@@ -53,7 +53,7 @@ from drillfric.config import Config, config_from_dict, read_toml
 from drillfric.errors import DrillfricError, InputError
 from drillfric.files import require_file
 from drillfric.io import witsml, witsml_objects
-from drillfric.io.channels import Mapping, log_index, map_channels, split_unit
+from drillfric.io.channels import Mapping, candidate_columns, log_index, map_channels, split_unit
 from drillfric.io.parts import PART_ATTR, open_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
@@ -213,7 +213,8 @@ class Well:
         units = [f"unit of {m.channel.name} (column {printable(m.column)}): {m.unit}, the "
                  "default — nothing in the file or the config says"
                  for m in self.mappings.values() if m.source == "default"]
-        return self.config.assumed_with(self.survey) + units
+        chosen = [m.note for m in self.mappings.values() if m.note]
+        return self.config.assumed_with(self.survey) + chosen + units
 
     def time_tracker(self) -> TimeTracker | None:
         """A fresh time-base tracker for one pass over the data (origin, duplicates); None
@@ -471,14 +472,113 @@ def _open(files: WellFiles, cfg: Config,
            open_parts(files.parts) if files.parts and files.parts[0].suffix.lower() != ".xml"
            else witsml.open_witsml_parts(files.parts) if files.parts
            else open_source(files.data))
-    file = str(files.data)
+    file = str(files.data) + (f" ({raw.where})" if raw.where else "")
     index = log_index(raw.columns, cfg.channels, depth_index=raw.depth_index, file=file)
     channels = cfg.channels
     if index == "depth" and raw.depth_index is not None and "measured_depth" not in channels:
         channels = channels | {"measured_depth": {"column": split_unit(raw.depth_index)[0]}}
     mappings = map_channels(raw.columns, raw.units, channels, file=file, index=index,
                             log_shaped=lambda: log_shaped(raw))
-    return raw, _clock_time(raw, mappings)
+    mappings = prefer_live(raw, mappings, channels, file=file, index=index)
+    return raw, check_narrow(raw, _clock_time(raw, mappings), file=file)
+
+
+#: Finest time step a log needs its time column to resolve [s] (a 100-Hz log).
+TIME_RESOLUTION_S = 0.01
+
+
+def check_narrow(raw: RawSource, mappings: dict[str, Mapping], *,
+                 file: str) -> dict[str, Mapping]:
+    """The mappings once the columns stored narrower than float64 (Parquet float32,
+    float16: :attr:`RawSource.narrow`) are known to hold what a run needs. They are read
+    widened; but a float32 time resolves only 0.25 s at 2×10⁶ s (every 20-Hz sample then
+    repeats a time: the run failed blaming the recorder), a float16 time only 2 s at 2048 s,
+    and a float16 value beyond ±65 504 is written as infinity (read as missing: a hook load
+    in N was lost in silence).
+
+    Raises
+    ------
+    InputError
+        A mapped time column whose type cannot resolve :data:`TIME_RESOLUTION_S` at the
+        largest time it holds (a float16 time always).
+    """
+    out = dict(mappings)
+    for key, m in mappings.items():
+        if m.column not in raw.narrow:
+            continue
+        kind, largest = raw.narrow[m.column]
+        step = float(np.spacing(getattr(np, kind)(largest))) * abs(m.factor) \
+            if np.isfinite(largest) else np.nan
+        if key == "time" and (kind == "float16" or step > TIME_RESOLUTION_S):
+            at = f": at {largest * abs(m.factor):.4g} s it resolves only {step:.3g} s" \
+                if np.isfinite(step) else ""
+            raise InputError(f"time column '{printable(m.column)}' is stored as {kind} "
+                             f"({'half' if kind == 'float16' else 'single'} precision){at}, "
+                             "so samples closer than that share one time", file=file,
+                             fix="write the time column as float64 (double) or as "
+                                 "timestamps")
+        if kind == "float16" and key != "time":
+            lost = (" — its largest values overflowed to infinity when written and are "
+                    "read as missing" if not np.isfinite(largest) else "")
+            out[key] = replace(m, note=(m.note or "") + (
+                f"{m.channel.kind} from a half-precision (float16) column "
+                f"'{printable(m.column)}': 3 significant digits, nothing beyond ±65 504"
+                f"{lost} — write it as float32 or float64"))
+    return out
+
+
+def prefer_live(raw: RawSource, mappings: dict[str, Mapping], channels: dict, *,
+                file: str, index: str = "time") -> dict[str, Mapping]:
+    """The mappings with a channel that several columns could be (``RPM`` and ``TDRPM``,
+    ``Rotary Speed`` and ``Top Drive Speed``) read from a column whose values change when the
+    mnemonic table's choice holds none (empty, or one constant value over the whole log).
+
+    A dead rotary-table speed preferred over the live top-drive speed made a run find nothing
+    rotating and exit 0 having estimated nothing (issue 30, tenth attack). The data is read
+    only when a channel has several candidates, and only until each chosen column has shown
+    two different values (the first block, for a live log). The switch is a note naming both
+    columns (:attr:`Well.assumed`); a channel ``[channels]`` names a column for is never
+    switched.
+    """
+    keys = {k: cols for k, m in mappings.items() if k not in ("time", "measured_depth")
+            and len(cols := candidate_columns(raw.columns, k, channels, raw.units)) > 1
+            and m.column in cols}
+    if not keys:
+        return mappings
+    wanted = sorted({c for cols in keys.values() for c in cols})
+    first: dict[str, float] = {}
+    live: set[str] = set()
+    for chunk in raw.chunks(CHUNK_ROWS):
+        for col in wanted:
+            if col in live or col not in chunk.columns:
+                continue
+            values = _numeric(chunk[col])
+            values = values[np.isfinite(values)]
+            if values.size:
+                ref = first.setdefault(col, float(values[0]))
+                if np.any(values != ref):
+                    live.add(col)
+        if all(mappings[k].column in live for k in keys):
+            return mappings
+    passed: dict[str, set[str]] = {}
+    for key, cols in keys.items():
+        if mappings[key].column not in live and any(c in live for c in cols):
+            passed[key] = {c for c in cols if c not in live}
+    if not passed:
+        return mappings
+    remapped = map_channels(raw.columns, raw.units, channels, file=file, index=index,
+                            passed_over=passed)
+    out = dict(mappings)
+    for key in passed:
+        dead, new = mappings[key], remapped[key]
+        held = ("no number" if dead.column not in first else
+                f"the one value {first[dead.column]:.4g} throughout")
+        out[key] = replace(new, note=(
+            f"{dead.channel.kind} from column '{printable(new.column)}': column "
+            f"'{printable(dead.column)}', which the mnemonic table prefers, holds {held} — "
+            f"to read that one anyway: [channels] {key} = "
+            f"{{ column = \"{printable(dead.column)}\" }}"))
+    return out
 
 
 def log_shaped(raw: RawSource, rows: int = 50) -> bool:

@@ -175,15 +175,18 @@ def resolve_files(path, config, survey, peek: bool = True) -> tuple[WellFiles, d
     config_path = given_file(config)
     raw = _mapping(config)
     look = config is None  # find the configuration beside the data (none given)
+    if raw is None and config_path is not None and config_path.is_file():
+        raw = raw_config(config_path)
+    given = config_named(config_path, raw or {}, given_file(survey))
     if path.is_dir() and not (path / "well.toml").is_file() and witsml.split_log(path):
         data_path, parts = _data(path)
         config_path = _sidecar(data_path, ".toml") if look else config_path
     elif path.is_dir():
-        data_path, parts, dir_config, dir_raw = _directory_data(path)
+        data_path, parts, dir_config, dir_raw = _directory_data(path, given)
         if look:
             config_path, raw = dir_config, dir_raw
     else:
-        data_path, parts = _data(path)
+        data_path, parts = _data(path, given)
         config_path = _sidecar(data_path, ".toml") if look else config_path
     if config_path is not None:
         require_file(config_path, "config file")
@@ -256,10 +259,11 @@ def _mapping(config) -> dict | None:
     return config
 
 
-def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
+def _data(path: Path, named=()) -> tuple[Path, tuple[Path, ...]]:
     """The data of a well given as ``path``: a data file, or the folder and numbered files
     of a WITSML log split over parts (``path`` the folder or one of its parts; the name
-    :func:`drillfric.io.witsml.split_log` gives the log and its parts)."""
+    :func:`drillfric.io.witsml.split_log` gives the log and its parts). ``named``: files the
+    configuration or the command line names as something else, never parts of the log."""
     split = witsml.split_log(path)
     if split is not None:
         folder, parts = split
@@ -270,7 +274,7 @@ def _data(path: Path) -> tuple[Path, tuple[Path, ...]]:
                                "run PART.xml`, or the data column of a `drillfric fleet` "
                                "manifest (docs/fleet.md)")
         return split
-    parts = folder_parts(path)
+    parts = folder_parts(path, named)
     if parts is not None:
         for part in parts:
             require_inside(part, path, "file of the data folder",
@@ -302,7 +306,7 @@ def _sidecar(data_path: Path, suffix: str) -> Path | None:
                           fix=LINKED_FILE_FIX)
 
 
-def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
+def _directory_data(folder: Path, given=()) -> tuple[Path, tuple[Path, ...], Path, dict]:
     well_toml = folder / "well.toml"
     if special(well_toml):
         require_file(well_toml, "well.toml")
@@ -313,18 +317,30 @@ def _directory_data(folder: Path) -> tuple[Path, tuple[Path, ...], Path, dict]:
                              + (f" (data files here: {', '.join(found)})" if found else ""))
     raw = read_toml(well_toml)
     data = raw.get("well", {}).get("data")
+    named = config_named(well_toml, raw) + tuple(given)
     if data is None and witsml.split_log(folder):
-        return *_data(folder), well_toml, raw
+        return *_data(folder, named), well_toml, raw
     if not isinstance(data, str):
         raise ConfigError("well.toml does not name its data file", file=well_toml,
                           fix='add [well] data = "surface.parquet" (relative to the folder)')
     data_path = require_inside(folder / data, folder, "data file named by well.toml",
                                fix="give the data file on the command line instead")
     if not data_path.exists() or (data_path.is_dir() and not witsml.split_log(data_path)
-                                  and not folder_parts(data_path)):
+                                  and not folder_parts(data_path, named)):
         raise InputError("data file named by well.toml not found", file=data_path,
                          fix=f"fix [well] data in {well_toml}")
-    return *_data(data_path), well_toml, raw
+    return *_data(data_path, named), well_toml, raw
+
+
+def config_named(config_path: Path | None, raw: dict, *given) -> tuple[Path, ...]:
+    """The files a configuration names as something other than the log (its ``[survey]
+    file``), the configuration itself and the files ``given`` (``--config``, ``--survey``):
+    none of them is ever a part of a folder's log."""
+    named = raw.get("survey", {}).get("file") if isinstance(raw.get("survey"), dict) else None
+    out = [p for p in (config_path, *given) if p is not None]
+    if isinstance(named, str) and config_path is not None:
+        out.append(config_path.parent / named)
+    return tuple(out)
 
 
 def find_survey(data_path: Path, config_path: Path | None, raw: dict,

@@ -72,6 +72,10 @@ NULL_TEXT = "-999.25"
 
 _CODE = re.compile(r"^\d{4}$")
 _STAMP = re.compile(r"^\d{1,6}(\.0*)?$")
+#: An item's value as WITS writes a number: ASCII digits, an optional sign, decimal point
+#: and exponent. Python's ``float`` reads more — ``1_0`` as 10, ``nan``, ``infinity``,
+#: non-ASCII digits — none of which a recorder sends as a reading (issue 30, tenth attack).
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 
 @dataclass(frozen=True)
@@ -152,7 +156,9 @@ class Decoder:
 
     Tolerates blank lines, ``\\n``, ``\\r\\n`` or bare ``\\r`` line ends, lines outside a
     frame and lines that are no item (counted in :attr:`ignored`); a frame left open by a
-    new ``&&`` is discarded (:attr:`discarded`). Nothing grows without bound: a line longer than
+    new ``&&`` is discarded (:attr:`discarded`), and so is a frame giving one item twice with
+    two different values (which is the reading cannot be told; the same value twice is read
+    once). A discarded frame's items are never read. Nothing grows without bound: a line longer than
     :data:`MAX_LINE` or a frame of more than :data:`MAX_ITEMS` items is dropped.
     """
 
@@ -211,23 +217,29 @@ class Decoder:
                 return frame
         elif self._items is not None and len(line) > 4 and line[:4].isdigit() \
                 and line.isascii():
-            if len(self._items) >= MAX_ITEMS:
+            code, value = line[:4].decode(), line[4:].decode().strip()
+            if len(self._items) >= MAX_ITEMS or self._items.get(code, value) != value:
                 self._items, self.discarded = None, self.discarded + 1
             else:
-                self._items[line[:4].decode()] = line[4:].decode().strip()
+                self._items[code] = value
         elif line:
             self.ignored += 1
         return None
 
 
 def number(text: str) -> float:
-    """An item's value as a float (NaN when it is no finite number or a null marker).
+    """An item's value as a float (NaN when it is no finite number as WITS writes one — an
+    ASCII decimal with optional sign and exponent — or a null marker).
 
     Examples
     --------
-    >>> number("18.42"), number("-999.25"), number("abc")
-    (18.42, nan, nan)
+    >>> number("18.42"), number("-999.25"), number("abc"), number("1.5E+02")
+    (18.42, nan, nan, 150.0)
+    >>> number("1_0"), number("nan"), number("inf"), number("\u0661\u0660")
+    (nan, nan, nan, nan)
     """
+    if not _NUMBER.fullmatch(text):
+        return math.nan
     try:
         value = float(text)
     except ValueError:

@@ -230,6 +230,10 @@ class LogHeader:
         ``nameWellbore`` of the log, else its ``nameWell`` (``""`` when neither).
     rows_sha256 : str
         SHA-256 (hex) of the ``data`` rows' texts (each stripped, followed by a newline).
+    curve_units : tuple of str
+        The unit each column's ``logCurveInfo`` states when :attr:`units` are the
+        ``unitList``'s (``""`` where none or the same): a second statement of the unit, which
+        must agree (:func:`drillfric.io.channels.map_channels` refuses two).
     """
 
     position: int
@@ -247,6 +251,7 @@ class LogHeader:
     last_index: str | None
     wellbore: str = ""
     rows_sha256: str = ""
+    curve_units: tuple[str, ...] = ()
 
     @property
     def depth_indexed(self) -> bool:
@@ -295,6 +300,8 @@ class _LogScan:
     def header(self, path: Path) -> LogHeader:
         names, units = self._columns(path)
         curves = {c.get("mnemonic", ""): c for c in self.curves}
+        stated = tuple(curves.get(n, {}).get("unit", "") if self.unit_list is not None
+                       and self.mnemonic_list is not None else "" for n in names)
         index_type = self.fields.get("indexType", "").lower()
         index_curve = self.fields.get("indexCurve") or names[0]
         if index_curve not in names:
@@ -312,7 +319,7 @@ class _LogScan:
                          tuple(names), tuple(units), nulls, text, self.rows,
                          _field(self.first_row, at), _field(self.last_row, at),
                          self.fields.get("nameWellbore") or self.fields.get("nameWell", ""),
-                         self.rows_sha256.hexdigest())
+                         self.rows_sha256.hexdigest(), stated)
 
     def _columns(self, path: Path) -> tuple[list[str], list[str]]:
         """Column names in data order and their units (mnemonicList, else logCurveInfo)."""
@@ -484,11 +491,26 @@ def _chunks(path: Path, header: LogHeader, chunk_rows: int, start: int = 0,
 
 
 def _units(header: LogHeader) -> dict:
+    """The units the log states per column (its ``unitList``, else its ``logCurveInfo``),
+    and ``("also", column)`` → (unit, where) for a column whose ``logCurveInfo`` states
+    another spelling than the ``unitList``: :func:`drillfric.io.channels.map_channels`
+    refuses the two when they differ (a log saying kft·lbf in one and kN·m in the other was
+    read in the ``unitList``'s unit in silence, μ_k 0.203 for 0.28: issue 30, tenth attack)."""
     units: dict = {}
-    for column, unit in zip(header.mnemonics, header.units, strict=True):
+    curve_units = header.curve_units or ("",) * len(header.mnemonics)
+    for column, unit, curve in zip(header.mnemonics, header.units, curve_units, strict=True):
         if unit.strip().lower() not in _NO_UNIT and column not in header.text_columns:
             units[column] = unit.strip()
             units[("source", column)] = "header"
+        curve = curve.strip()
+        if not curve or curve.lower() in _NO_UNIT or column in header.text_columns \
+                or curve == unit.strip():
+            continue
+        if column in units:
+            units[("source", column)] = "unitList"
+            units[("also", column)] = (curve, "logCurveInfo")
+        else:  # the unitList leaves it blank
+            units[column], units[("source", column)] = curve, "logCurveInfo"
     return units
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
+from drillfric.config import read_toml
 from drillfric.errors import InputError
 from drillfric.files import require_inside
 from drillfric.io.digest import sha256_prefix
@@ -25,7 +26,7 @@ from drillfric.io.readers import open_source
 from drillfric.io.source import FORMATS
 from drillfric.io.text import plural, printable
 from drillfric.io.well import Well, open_well, with_parts
-from drillfric.io.wellfiles import arriving_data
+from drillfric.io.wellfiles import arriving_data, config_named
 from drillfric.runner.resume import csv_mark, parquet_mark, parts_mark
 
 #: Complete data lines wanted before a CSV file's layout is sniffed (header + rows).
@@ -51,7 +52,8 @@ def follow(path: Path) -> Tail | PartsTail:
         return Tail(path)
     data = arriving_data(path)
     if data.is_dir() or data.suffix.lower() not in FORMATS:
-        return PartsTail(data)
+        well_toml = path / "well.toml"
+        return PartsTail(data, config_named(well_toml, read_toml(well_toml)))
     return Tail(data)
 
 
@@ -217,10 +219,13 @@ class PartsTail:
     ----------
     folder : Path
         The folder the log's files arrive in.
+    named : tuple of Path
+        Files the configuration names as something else (its survey): never parts.
     """
 
-    def __init__(self, folder: Path):
+    def __init__(self, folder: Path, named=()):
         self.folder = Path(folder)
+        self.named = tuple(named)
         self.paths: tuple[Path, ...] = ()  # the parts read, in order
         self.end = 0
         self._done: list[dict] = []  # marks of the complete parts (name first)
@@ -237,7 +242,7 @@ class PartsTail:
             A file out of order, removed or changed after it was read; files of several
             formats; at the ``final`` poll, a Parquet file still unreadable.
         """
-        listed = folder_parts(self.folder) if self.folder.is_dir() else None
+        listed = folder_parts(self.folder, self.named) if self.folder.is_dir() else None
         listed = listed or ()
         self._check(listed)
         if self._last is not None:

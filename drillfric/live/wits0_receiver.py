@@ -442,7 +442,8 @@ class Receiver:
                        + "; frames carrying their date and time (items 0105, 0106) are "
                          "timed exactly")
         for frame, stamp in zip(frames, stamps, strict=True):
-            values = self.setup.row.update(frame)
+            # the row takes a frame's items only once the frame is recorded: a frame refused
+            # for its clock gave its values to the next frame (issue 30, tenth attack)
             if self.clock.ahead(stamp, wall):
                 self._once("future", f"{self.address}: a frame dated {stamp:%Y-%m-%d %H:%M:%S}"
                                      ", more than a day after this computer's clock: not "
@@ -453,7 +454,7 @@ class Receiver:
                 self._once("order", f"{self.address}: a frame's date and time lie before the "
                                     "previous frame's: not recorded (see the rig clock)")
                 continue
-            self.recording.write(t, values)
+            self.recording.write(t, self.setup.row.update(frame))
             self.frames += 1
         if not self.frames and self._received > NOT_WITS_BYTES:
             self._once("garbage", f"{self.address}: {self._received} bytes without one WITS "

@@ -252,7 +252,8 @@ class Engine:
         warnings = self.warnings + [w for w in (
             self.tracker.conflicts_note(self.check.rows),
             self.check.duplicates_note(self.tracker.duplicates),
-            self.check.nothing_found(len(self.records)), _cut_line_note(self.well, tail),
+            self.check.nothing_found(len(self.records)), self.check.hole_above_note(),
+            _cut_line_note(self.well, tail),
             _motor_note(self.records), _flow_missing_note(self.records)) if w] \
             + self.check.unit_hints(self.records)
         plateaus = self.hook.close()
