@@ -381,8 +381,9 @@ class SegmentRecord:
                                          "docs/ingestion.md)")
     samples_held: int | None = _f("", "speed or torque samples that repeated an earlier "
                                       "reading for 1 s or more beyond chance (a device that "
-                                      "stopped updating): kept for μ_k, the bit trace's "
-                                      "windows over them withheld (docs/ingestion.md)")
+                                      "stopped updating): left out of μ_k's cycle "
+                                      "statistics, the bit trace's windows over them "
+                                      "withheld (docs/ingestion.md)")
     interval_torque_swing: float | None = _f("-", "median (max − min)/|mean| of the torque "
                                                   "within each logged interval (min/max "
                                                   "channels; > 0.3: stick-slip)")

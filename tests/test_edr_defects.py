@@ -181,9 +181,10 @@ def test_held_values_are_found_quantised_and_slow_channels_are_not():
 @pytest.mark.slow
 def test_held_speed_and_torque_change_no_number(clean, tmp_path):
     """Issue 34 item 4: the speed and the torque each held for 1, 4 and 10 s in the demo's
-    first stand (a device that stops updating). Found and counted (600 samples at 20 Hz);
-    kept for μ_k, which stays the clean stand's within 1.5 % (the held torque is 5 % of the
-    stand's samples, its level that of the hold's start) and converged."""
+    first stand (a device that stops updating). Found and counted (600 samples at 20 Hz); the
+    whole-cycle mean torque leaves the holds out (a 10-s hold had been one "cycle" of another
+    mean: μ_k 2σ 7 %, unconverged, on validate_edr's stands), so μ_k is the clean stand's
+    within 1 % and converged."""
     frame = _first_stand()
     t = frame["time_s"].to_numpy()
     for column, starts in (("surface_rpm", (60, 110, 170)), ("surface_torque_Nm", (80, 140, 200))):
@@ -193,7 +194,7 @@ def test_held_speed_and_torque_change_no_number(clean, tmp_path):
     dirty = _run(tmp_path / "dirty", frame, tmp_path)
     assert clean["samples_held"] == 0 and 590 <= dirty["samples_held"] <= 610
     assert "held an earlier reading" in dirty["message"]
-    assert dirty["converged"] and dirty["mu_k"] == pytest.approx(clean["mu_k"], rel=0.015)
+    assert dirty["converged"] and dirty["mu_k"] == pytest.approx(clean["mu_k"], rel=0.01)
 
 
 @pytest.mark.slow

@@ -162,7 +162,7 @@ class SegmentEstimate:
     samples_dropped : int
         Speed or torque samples dropped as isolated spikes or drop-outs.
     samples_held : int
-        Speed or torque samples that held an earlier reading (kept for μ_k).
+        Speed or torque samples that held an earlier reading.
     factors_withheld : str
         Why the segment's friction factors are not shown ("" when they are:
         :func:`~drillfric.estimation.verdict.withheld_factors`).
@@ -404,11 +404,14 @@ class SegmentModels:
     sample_times_s : ndarray
         Times of the logged samples the measurements rest on [s]: the segment's, without
         the EDR defects :mod:`drillfric.estimation.spikes` dropped and without the held
-        values (kept for μ_k; the bit's motion over them was not observed).
+        values (the bit's motion over them was not observed).
     dropped : int
         How many samples were so dropped.
     held : int
         How many samples held an earlier reading (:func:`~drillfric.estimation.spikes.held_values`).
+    held_spans_s : tuple of (float, float)
+        [s] From the last real reading before each run of held samples to the first after
+        it: the batch fit's torque statistics leave them out.
     axial : drillfric.torsional.Axial or None
         The pipe's axial speed on the measurements' grid while it reams (None: in place).
     """
@@ -424,6 +427,7 @@ class SegmentModels:
     dropped: int = 0
     axial: torsional.Axial | None = field(default=None, repr=False)
     held: int = 0
+    held_spans_s: tuple = ()
 
 
 def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentData, *,
@@ -478,7 +482,7 @@ def build_models(settings: ChainSettings, path: WellPath | None, data: SegmentDa
             | spikes.held_values(data.time_s, data.surface_torque_Nm))
     return SegmentModels(path, string, td, meas, observer, on_bottom, logged,
                          data.time_s[~held], int(bad.sum()), axial_series(data, meas),
-                         int(held.sum()))
+                         int(held.sum()), spikes.spans_s(data.time_s, held))
 
 
 def _moving_case(settings: ChainSettings, data: SegmentData, mu: float | None) -> dict:
@@ -576,7 +580,7 @@ def batch_fit(settings: ChainSettings, models: SegmentModels) -> batch.BatchResu
                         fc_Nm_m=models.td.fc_at, settings=settings.batch, torque_kind="motor",
                         cells=_batch_cells(settings, models.string.bit_depth_m),
                         profile=settings.friction, sample_interval_s=models.logged.interval_s,
-                        axial=models.axial)
+                        axial=models.axial, unobserved_s=models.held_spans_s)
 
 
 #: Passes of the moving load case's fixed point (docs/theory.md §3.3): F_c at μ, fit μ_k,
@@ -886,9 +890,9 @@ def _dropped_note(models: SegmentModels) -> tuple[str, ...]:
                   "defects\")",)
     if models.held:
         notes += (f"{plural(models.held, 'speed or torque sample')} held an earlier reading "
-                  f"for {spikes.HOLD_MIN_S:g} s or more (a device that stopped updating): kept "
-                  "for μ_k, the bit's motion over them not observed (docs/ingestion.md \"EDR "
-                  "defects\")",)
+                  f"for {spikes.HOLD_MIN_S:g} s or more (a device that stopped updating): left "
+                  "out of μ_k's cycle statistics and of the bit trace (docs/ingestion.md "
+                  "\"EDR defects\")",)
     return notes
 
 

@@ -198,6 +198,20 @@ def held_values(time_s, x) -> np.ndarray:
     return held
 
 
+def spans_s(time_s, mask) -> tuple[tuple[float, float], ...]:
+    """[s] From the sample before each run of ``mask`` to the sample after it (the run's
+    ends where it starts or ends the record).
+
+    Examples
+    --------
+    >>> spans_s(np.arange(6.0), np.array([0, 1, 1, 0, 0, 1], dtype=bool))
+    ((0.0, 3.0), (4.0, 5.0))
+    """
+    t = np.asarray(time_s, dtype=float)
+    return tuple((float(t[max(a - 1, 0)]), float(t[min(b + 1, t.size - 1)]))
+                 for a, b in true_runs(np.asarray(mask, dtype=bool)))
+
+
 def defects(time_s, cycle_s: float, surface_rpm, torque_Nm,
             top_drive_inertia_kg_m2: float) -> np.ndarray:
     """Samples to drop (a boolean mask): torque or speed lost while turning

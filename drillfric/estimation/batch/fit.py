@@ -44,7 +44,7 @@ from drillfric.estimation.batch.settings import (
     BatchSettings,
     mu_k_tolerance,
 )
-from drillfric.estimation.creep import find_creeps, rotating_runs
+from drillfric.estimation.creep import find_creeps, rotating_runs, true_runs
 from drillfric.estimation.drive import DriveModel
 from drillfric.estimation.drive import identify as identify_drive
 from drillfric.friction import FrictionProfile
@@ -201,7 +201,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
            progress: Callable[[float], None] | None = None,
            profile: FrictionProfile | None = None,
            sample_interval_s: float | None = None,
-           axial: torsional.Axial | None = None) -> BatchResult:
+           axial: torsional.Axial | None = None, unobserved_s: tuple = ()) -> BatchResult:
     """Refine μ_k and μ_s of one record with the speed-driven model (docs/theory.md §6.4).
 
     Parameters
@@ -240,6 +240,10 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
         bound: with |v| > ω_c·r_c no cell sticks, and what sticks below that is not told
         apart from μ_k by the mean torque (the verdict says so,
         :func:`drillfric.estimation.verdict.decide`).
+    unobserved_s : tuple of (float, float)
+        [s] Spans whose samples held an earlier reading (EDR defects): the whole-cycle mean
+        torque and its error are taken from the cycles outside them (a 10-s hold in
+        stick-slip is one "cycle" of another mean, which had left μ_k unconverged).
 
     Returns
     -------
@@ -255,7 +259,7 @@ def refine(time_s, surface_rad_s, torque_Nm, *, string: DrillString, fc_Nm_m,
     wins, notes = rotating_windows(data, settings, *model.wind_up(cells))
     messages += notes
     flags: list[Flag] = []
-    rotation = _Rotation.of(model, wins)
+    rotation = _Rotation.of(model, wins, unobserved_s)
     kinetic = cycles = None
     if wins:
         cycles = relaxation.find(data.t, data.speed, data.tau_bar, omega_c, rotation.target_Nm,
@@ -309,7 +313,7 @@ class _Rotation:
     target_error: tuple[float, int] | None = None  # (standard error [N·m], whole cycles)
 
     @classmethod
-    def of(cls, model: Model, wins: list[Window]) -> _Rotation:
+    def of(cls, model: Model, wins: list[Window], unobserved_s: tuple = ()) -> _Rotation:
         if not wins:
             return cls()
         d = model.data
@@ -318,9 +322,20 @@ class _Rotation:
         # window (a steady rotation's release still rings early on, docs/theory.md §6.4)
         fluct = fluctuation(d.tau_bar[np.concatenate([w.used[w.used.size // 2:]
                                                       for w in wins])])
-        series = [d.tau[w.used] for w in wins]
+        series = [d.tau[piece] for w in wins for piece in _observed(d.t, w.used, unobserved_s)]
         return cls(cycle_mean(series, d.dt), fluct, fluct > STICK_SLIP_FLUCTUATION,
                    float(np.mean(d.speed[used])), cycle_mean_error(series, d.dt))
+
+
+def _observed(t: np.ndarray, used: np.ndarray, unobserved_s: tuple) -> list[np.ndarray]:
+    """``used`` (sample indices) cut where their times ``t`` [s] fall in an ``unobserved_s``
+    span, those samples left out: the contiguous pieces."""
+    if not unobserved_s:
+        return [used]
+    out = np.zeros(used.size, dtype=bool)
+    for a, b in unobserved_s:
+        out |= (t[used] >= a) & (t[used] <= b)
+    return [used[i0:i1 + 1] for i0, i1 in true_runs(~out)]
 
 
 @dataclass(frozen=True)
