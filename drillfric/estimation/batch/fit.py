@@ -322,9 +322,11 @@ class _Rotation:
         # window (a steady rotation's release still rings early on, docs/theory.md §6.4)
         fluct = fluctuation(d.tau_bar[np.concatenate([w.used[w.used.size // 2:]
                                                       for w in wins])])
-        series = [d.tau[piece] for w in wins for piece in _observed(d.t, w.used, unobserved_s)]
-        return cls(cycle_mean(series, d.dt), fluct, fluct > STICK_SLIP_FLUCTUATION,
-                   float(np.mean(d.speed[used])), cycle_mean_error(series, d.dt))
+        parts = [[d.tau[piece] for piece in _observed(d.t, w.used, unobserved_s)]
+                 for w in wins]
+        return cls(cycle_mean([x for p in parts for x in p], d.dt), fluct,
+                   fluct > STICK_SLIP_FLUCTUATION, float(np.mean(d.speed[used])),
+                   cycle_mean_error(parts, d.dt))
 
 
 def _observed(t: np.ndarray, used: np.ndarray, unobserved_s: tuple) -> list[np.ndarray]:

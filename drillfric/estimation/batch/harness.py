@@ -395,16 +395,19 @@ def cycle_mean(series: list[np.ndarray], dt_s: float) -> float:
     return float(np.mean(np.concatenate([x[whole_cycles(x, dt_s)] for x in series])))
 
 
-def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int] | None:
+def cycle_mean_error(series: list, dt_s: float) -> tuple[float, int] | None:
     """Standard error of :func:`cycle_mean` from the scatter of its cycles [N·m], and the
     number of whole cycles; None with fewer than :data:`MIN_CYCLES` (docs/theory.md §6.4
     "Uncertainty of μ_k").
 
-    Each whole torque cycle (between upward crossings of the 1-s smoothed torque through its
-    mean) gives one mean; the pooled mean is their length-weighted average, and its standard
-    error the ratio estimator's, √Σ(Lᵢ(mᵢ − m))² / ΣLᵢ. A steady series cut in blocks
-    (:func:`torque_pieces`) adds its drift in quadrature — the difference of its halves'
-    means: blocks of a torque still settling are not independent samples of its level.
+    ``series`` holds each window's torque, or a list of its parts where samples were left
+    out (held readings): the parts' cycles pool, and a steady window's drift is taken over
+    its parts together. Each whole torque cycle (between upward crossings of the 1-s
+    smoothed torque through its mean) gives one mean; the pooled mean is their
+    length-weighted average, and its standard error the ratio estimator's,
+    √Σ(Lᵢ(mᵢ − m))² / ΣLᵢ. A steady series cut in blocks (:func:`torque_pieces`) adds its
+    drift in quadrature — the difference of its halves' means: blocks of a torque still
+    settling are not independent samples of its level.
 
     Examples
     --------
@@ -415,12 +418,17 @@ def cycle_mean_error(series: list[np.ndarray], dt_s: float) -> tuple[float, int]
     (True, 18)
     """
     means, lengths, drift = [], [], 0.0
-    for x in series:
-        x = np.asarray(x, dtype=float)
-        pieces, steady = torque_pieces(x, dt_s)
-        means += [float(np.mean(x[a:b])) for a, b in pieces]
-        lengths += [float(b - a) for a, b in pieces]
-        if steady:
+    for window in series:
+        parts = [np.asarray(x, dtype=float) for x in
+                 (window if isinstance(window, list) else [window])]
+        steady = False
+        for x in parts:
+            pieces, part_steady = torque_pieces(x, dt_s)
+            means += [float(np.mean(x[a:b])) for a, b in pieces]
+            lengths += [float(b - a) for a, b in pieces]
+            steady |= part_steady
+        if steady:  # the settling of the window's level, over all its parts
+            x = np.concatenate(parts)
             half = x.size // 2
             drift = max(drift, abs(float(np.mean(x[:half]) - np.mean(x[half:]))))
     if len(means) < MIN_CYCLES:
