@@ -52,7 +52,7 @@ def test_pdf_holds_every_note_of_every_segment_whole(demo):
         assert detail.startswith(f"Segment {seg['id']} — ") and ": detail" in detail
         for note in split_notes(seg["message"]):
             assert squeeze(note) in detail, (seg["id"], note)
-    assert "μ_s = 0.605 of the creep fit not reported" in " ".join(pages)
+    assert "the creep fit's μ_s is not reported" in " ".join(pages)
 
 
 def test_pdf_headline_keeps_a_long_withheld_reason_whole(demo, tmp_path):
@@ -97,4 +97,5 @@ def test_html_segment_leads_with_found_and_withheld_and_folds_the_rest(demo):
         for item in lead.withheld:
             assert str(escape(item)) in section[:detail]
     one = html[html.index('id="segment-1"'):]
-    assert "μ_s = 0.605 of the creep fit not reported" in one[:one.index("seg-detail")]
+    assert str(escape("the creep fit's μ_s is not reported")) in one[:one.index("seg-detail")]
+    assert "0.605" not in one[:one.index('id="segment-2"')]  # a μ_s not reported is not printed

@@ -57,11 +57,11 @@ def segment_lead(row: dict) -> Lead:
     --------
     >>> lead = segment_lead({"status": "ok", "kind": "off_bottom_rotating", "mu_k": 0.2785,
     ...     "converged": True, "method": "batch", "mu_s": None, "mu_s_identifiable": False,
-    ...     "mu_s_lower_bound": 0.3026, "message": "fit note; μ_s = 0.605 of the creep fit "
-    ...     "not reported: the halves cannot be compared: noise ±15 % > 6 %"})
+    ...     "mu_s_lower_bound": 0.3026, "message": "fit note; the creep fit's μ_s is not "
+    ...     "reported: the halves cannot be compared: noise ±15 % > 6 %"})
     >>> print("\\n".join(lead.lines()))
     Found: μ_k 0.279, converged (batch fit); μ_s ≥ 0.303 (a lower bound)
-    Withheld: μ_s = 0.605 of the creep fit not reported: the halves cannot be compared …
+    Withheld: the creep fit's μ_s is not reported: the halves cannot be compared …
     """
     withheld = [short_reason(note) for note in withheld_notes(row)]
     if bit_speed_unresolved(row) and row.get("status") == Status.OK:

@@ -277,14 +277,17 @@ def halves_noise(c: CreepChecks) -> float:
                                                            c.halves_twist_noise)))
 
 
-def checks_text(c: CreepChecks) -> str:
-    """The checks as one message (the evidence beside a μ_s)."""
+def checks_text(c: CreepChecks, *, values: bool = True) -> str:
+    """The checks as one message (the evidence beside a μ_s); without ``values`` the
+    halves' μ_s are given only by their difference (a μ_s not reported is not printed)."""
     swing = "—" if c.swing_ratio is None else f"{c.swing_ratio:.2f}"
+    apart = abs(c.halves[0] - c.halves[1]) / max(abs(c.halves[1]), 1e-12)
+    halves = (f"halves {c.halves[0]:.3f} / {c.halves[1]:.3f}" if values
+              else f"halves {100 * apart:.1f} % apart")
     return (f"creep checks: misfit {100 * c.misfit:.1f} %, sensitivity {c.sensitivity:.0f}, "
             f"twist noise ±{100 * c.twist_noise:.1f} %, "
-            f"string engaged {100 * min(c.engaged, 1.0):.0f} %, halves {c.halves[0]:.3f} / "
-            f"{c.halves[1]:.3f} (noise ±{100 * halves_noise(c):.1f} %), "
-            f"model/data stick-slip {swing}")
+            f"string engaged {100 * min(c.engaged, 1.0):.0f} %, {halves} "
+            f"(noise ±{100 * halves_noise(c):.1f} %), model/data stick-slip {swing}")
 
 
 def smoothed_noise_Nm(d: FitData, samples: np.ndarray) -> float:

@@ -156,11 +156,11 @@ def fit_creeps(model: Model, creeps, mu_k: float, cells: int, rotating: list[Win
     fits = [(model.grid(n)[0].n_cells, mu, runs)]
     if mu - lo < 0.01 * (hi - lo):
         return CreepOutcome(None, fits=fits, flags=(Flag.CREEP_FIT_AT_BOUND,), messages=(
-            f"creep fit ran to its lower bound μ_s = {mu:.3f}: the break-over shows no static "
-            "friction above the kinetic (μ_s ≈ μ_k), not reported as identified",))
+            "creep fit ran to its lower bound (μ_s = μ_k): the break-over shows no static "
+            "friction above the kinetic, not reported as identified",))
     if hi - mu < 0.01 * (hi - lo):
         return CreepOutcome(None, fits=fits, flags=(Flag.CREEP_FIT_AT_BOUND,), messages=(
-            f"creep fit ran to its search bound (μ_s = {mu:.3f}): not reported",))
+            f"creep fit ran to its search bound (observer.mu_max = {hi:g}): not reported",))
     move = None
     for _ in range(CREEP_LEVELS - 1):
         n *= 2
@@ -168,8 +168,8 @@ def fit_creeps(model: Model, creeps, mu_k: float, cells: int, rotating: list[Win
         fits.append((model.grid(n)[0].n_cells, new, runs))
         move, mu = abs(new - mu) / new, new
         if move < CREEP_CONVERGENCE:
-            found = (f"μ_s = {mu:.3f} from {plural(len(creeps), 'creep start-up')} ({fits[-1][0]} "
-                     f"cells; {100 * move:.1f} % change from {fits[-2][0]})")
+            found = (f"from {plural(len(creeps), 'creep start-up')} ({fits[-1][0]} cells; "
+                     f"{100 * move:.1f} % change from {fits[-2][0]})")
             checks = measure(model, wins, mu, mu_k, n, rotating, stick_slip, cells)
             if not model.profile.static_known:
                 other, _ = refit_creep(model.assuming(CASED_STATIC[1]), wins, mu_k, n, mu, lo,
@@ -178,17 +178,18 @@ def fit_creeps(model: Model, creeps, mu_k: float, cells: int, rotating: list[Win
             return _judged(mu, tuple(creeps), fits, move, checks, found)
     return CreepOutcome(None, fits=fits, grid_move=move,
                         flags=(Flag.CREEP_NOT_GRID_CONVERGED,),
-                        messages=("creep μ_s not grid-converged (" + ", ".join(
-                            f"{m:.3f} at {c} cells" for c, m, _ in fits) + "): not reported",))
+                        messages=("creep μ_s not grid-converged (it moved "
+                                  f"{100 * (move or 0.0):.1f} % between {fits[-2][0]} and "
+                                  f"{fits[-1][0]} cells): not reported",))
 
 
 def _judged(mu: float, creeps: tuple, fits: list, move: float, checks: CreepChecks,
             found: str) -> CreepOutcome:
     """The grid-converged fit ``mu``, claimed only when its checks find no problem."""
     failed = problems(mu, checks)
-    messages = (found, checks_text(checks))
     if failed:
         return CreepOutcome(None, (), fits, move, checks, (Flag.MU_S_NOT_EXPLAINED,),
-                            messages + (f"μ_s = {mu:.3f} of the creep fit not reported: "
-                                        + "; ".join(failed),))
-    return CreepOutcome(mu, creeps, fits, move, checks, (), messages)
+                            (f"creep fit {found}", checks_text(checks, values=False),
+                             "the creep fit's μ_s is not reported: " + "; ".join(failed)))
+    return CreepOutcome(mu, creeps, fits, move, checks, (),
+                        (f"μ_s = {mu:.3f} {found}", checks_text(checks)))
