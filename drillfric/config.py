@@ -510,6 +510,8 @@ SECTION_KEYS: tuple[Key, ...] = (
 
 #: Documented default drill string, used (and reported as assumed) when a config has none:
 #: the A&S 2018 drill pipe, 5in heavy-weight and 8in collars (docs/reference_cases.md).
+#: How the assumed list names the built-in default string (its start: the sections follow).
+STRING_ASSUMED = "drill string: typical"
 DEFAULT_SECTIONS: tuple[dict, ...] = (
     {"name": "5 7/8in DP (assumed)", "od_m": 0.146529, "id_m": 0.123024,
      "tool_joint_od_m": 0.1778, "linear_mass_kg_m": 41.41},
@@ -883,7 +885,7 @@ def config_from_dict(raw: dict, *, file: str | Path | None = None,
         sections = _sections(string["sections"], fname)
     else:
         sections = _sections([dict(s) for s in DEFAULT_SECTIONS], "built-in default")
-        assumed.append("drill string: typical 5 7/8in DP + 110 m 5in HWDP + 120 m 8in collars")
+        assumed.append(f"{STRING_ASSUMED} 5 7/8in DP + 110 m 5in HWDP + 120 m 8in collars")
     channels = _channels(raw.get("channels", {}), fname)
     given = []
     for dotted, value in (overrides or {}).items():

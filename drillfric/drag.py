@@ -25,7 +25,7 @@ the log, withholding with the reason what the data cannot give.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -323,12 +323,16 @@ class HookEvidence:
         where it could not be measured.
     contradicted : str
         Why the configured string is contradicted ("" when it is not).
+    unweighed : str
+        Why the string's weight is unknown beyond its uncertainty ("" when it is not): the
+        built-in default string, which the hook load could not weigh.
     """
 
     block_N: float | None
     block_uncertainty_N: float
     string_uncertainty: float
     contradicted: str = ""
+    unweighed: str = ""
 
     @classmethod
     def from_summary(cls, hook: dict) -> HookEvidence:
@@ -420,9 +424,9 @@ def connection_row(up: Move | None, down: Move | None, hook: HookEvidence, curve
     if (out := min(m.bit_depth_m for m in present)) <= 0.0:
         return row | _verdict({}, above_rotary(out))
     slow = [m for m in present if not m.kinetic]
-    if hook.contradicted or slow:
+    if hook.contradicted or hook.unweighed or slow:
         why = (f"the hook load contradicts the configured string ({hook.contradicted})"
-               if hook.contradicted else
+               if hook.contradicted else hook.unweighed or
                f"{slow[0].direction.replace('_', '-')} at {slow[0].speed_m_s:.3f} m/s is too "
                f"slow for kinetic friction (below {KINETIC_MIN_M_S:g} m/s)")
         return row | _verdict({}, why)
@@ -501,7 +505,8 @@ def _verdict(found: dict[str, Estimate], why: str) -> dict:
 
 
 def drag_log(moves: list[Move], too_short: int, td: torque_drag.TDSettings, path,
-             hookload_summary: dict) -> tuple[dict, pd.DataFrame]:
+             hookload_summary: dict, *, string_assumed: bool = False
+             ) -> tuple[dict, pd.DataFrame]:
     """summary.json ``drag`` and drag_log.parquet (:data:`DRAG_COLUMNS`) of a well.
 
     Parameters
@@ -514,8 +519,17 @@ def drag_log(moves: list[Move], too_short: int, td: torque_drag.TDSettings, path
     path : WellPath or None
     hookload_summary : dict
         summary.json ``hookload`` (:func:`drillfric.hookload.judge`).
+    string_assumed : bool
+        Whether the string is the built-in default (no ``[[string.sections]]``, no WITSML
+        tubular): where the hook load could not weigh it, its weight is unknown beyond the
+        ± a drag μ carries, and every connection is withheld (the fourth newcomer's Volve
+        F-4: 0.180 ± 0.011 on the default drill pipe, 0.270 ± 0.016 on the well's tubular).
     """
     hook = HookEvidence.from_summary(hookload_summary)
+    if string_assumed and hookload_summary.get("string_weight_ratio") is None:
+        hook = replace(hook, unweighed=(
+            "the string is the built-in default (no [[string.sections]] or WITSML tubular) "
+            "and the hook load could not weigh it: a drag μ rests on the string's weight"))
     cache: dict[float, tuple] = {}
 
     def curves(depth: float):

@@ -114,6 +114,22 @@ def test_slow_move_and_contradicted_string_are_withheld():
     assert bad["status"] == "withheld" and "contradicts the configured string" in bad["reason"]
 
 
+def test_a_drag_mu_on_the_default_string_the_hook_load_could_not_weigh_is_withheld():
+    """Regression (the fourth newcomer, Volve F-4): with no [[string.sections]] and the hook
+    load unable to weigh the string, drag μ 0.180 ± 0.011 was published from the built-in
+    5 7/8in drill pipe — 0.270 ± 0.016 on the well's own tubular. Every connection is
+    withheld then, saying why; a weighed default string (a string-weight ratio) is not."""
+    moves = [_move("pick_up", 2000.0, 500e3), _move("slack_off", 2000.0, 400e3, t0=60.0)]
+    hook = {"block_weight_N": BLOCK_N, "tolerance": 0.05, "string_weight_ratio": None}
+    td = TDSettings.from_config(load_config(DEMO / "demo.toml"))
+    summary, log = drag.drag_log(moves, 0, td, None, hook, string_assumed=True)
+    assert summary["estimated"] == 0 and log["status"].eq("withheld").all()
+    assert log["reason"].str.contains("the string is the built-in default").all()
+    _, weighed = drag.drag_log(moves, 0, td, None,
+                               hook | {"string_weight_ratio": 1.01}, string_assumed=True)
+    assert not weighed["reason"].fillna("").str.contains("built-in default").any()
+
+
 def test_volve_f4_move_above_the_rotary_says_so():
     """Volve F-4's drag log withheld moves at bit depths of −7.8 and −13.2 m with the model's
     "bit depth must be positive, got -7.8": the BHA handled above the rotary table. It now

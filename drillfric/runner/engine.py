@@ -34,6 +34,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric._version import __version__
+from drillfric.config import STRING_ASSUMED
 from drillfric.drag import MoveFinder, drag_log
 from drillfric.errors import InputError
 from drillfric.estimation.bit_torque import assess as assess_bit_torque
@@ -284,9 +285,10 @@ class Engine:
                        off_bottom_friction_log=friction_log,
                        time_origin_utc=iso(self.tracker.origin), revisions=self.revisions,
                        resumed=self.resumed)
-        summary["drag"], drag_table = drag_log(self.moves.close(), self.moves.too_short,
-                                               TDSettings.from_config(self.well.config),
-                                               self.well.survey, weighed.summary)
+        summary["drag"], drag_table = drag_log(
+            self.moves.close(), self.moves.too_short, TDSettings.from_config(self.well.config),
+            self.well.survey, weighed.summary,
+            string_assumed=any(n.startswith(STRING_ASSUMED) for n in self.well.assumed))
         self.published = {r.id: _published(r) for r in records}
         self._open_ids = open_ids
         return finish(self.sink, self.well, summary, records, tracks=self.tracks.result(),
