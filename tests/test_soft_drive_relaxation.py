@@ -140,3 +140,14 @@ def test_soft_drive_ki300_crawl_above_omega_c_mu_k_not_false(crawling_above_omeg
     ev = Evidence(res.mu_k, tuple(res.flags), tuple(res.messages), 0.3, 0.5, None,
                   res.mu_k, True, (), 240.0, False)
     assert not decide(ev).converged
+
+
+def test_a_drive_fit_with_negative_gains_prints_no_gains():
+    """Regression (the fourth newcomer, DSATS): "best PI speed control, k_p = -296 N·m·s/rad,
+    k_i = -13.4 N·m/rad" — negative gains are no controller, and printing them reads as a
+    finding. The note says no PI law fits."""
+    from drillfric.estimation.drive import DriveModel
+
+    text = DriveModel(-296.0, -13.4, 0.02).describe()
+    assert "no PI speed control fits" in text and "-296" not in text
+    assert "k_p = 900" in DriveModel(900.0, 2500.0, 0.01).describe()

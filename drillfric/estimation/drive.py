@@ -80,6 +80,9 @@ class DriveModel:
                "motor torque's fluctuation")
         if self.usable:
             return f"top drive identified from the log as {law}: the model replays it"
+        if self.kp_Nms_rad <= 0.0 or self.ki_Nm_rad < 0.0:  # no PI law: its gains mean nothing
+            return ("top drive not identified (no PI speed control fits the log: the best "
+                    "fit's gains are negative): the model follows the logged speed")
         return (f"top drive not identified (best {law}): the model follows the logged "
                 "speed")
 
