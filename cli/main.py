@@ -77,7 +77,22 @@ def _register() -> None:
 
     for module in (run_cmd, simulate_cmd, td_cmd, inspect_cmd, fleet_cmd, report_cmd, live_cmd,
                    replay_cmd):
+        module.command.params += [_global_flag("--quiet", "-q", "quiet"),
+                                  _global_flag("--debug", None, "debug")]
         cli.add_command(module.command)
+
+
+def _global_flag(name: str, short: str | None, field: str) -> click.Option:
+    """The group's ``--quiet``/``--debug`` accepted after the command too (``drillfric run
+    W -q`` had failed: "No such option '-q'")."""
+
+    def set_flag(ctx: click.Context, _param, value: bool) -> None:
+        obj = ctx.find_object(RunContext)
+        if value and obj is not None:
+            setattr(obj, field, True)
+
+    return click.Option([name] + ([short] if short else []), is_flag=True, expose_value=False,
+                        callback=set_flag, help="As before the command.")
 
 
 _register()

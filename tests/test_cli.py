@@ -33,3 +33,14 @@ def test_cli_reference_is_current():
 def test_unknown_command_is_usage_error():
     result = CliRunner().invoke(cli, ["frobnicate"])
     assert result.exit_code == 2 and "Traceback" not in result.output
+
+
+def test_quiet_and_debug_are_accepted_after_the_command(tmp_path):
+    """Regression (the fourth newcomer): ``drillfric run W -q`` failed with "No such option
+    '-q'" — the nightly-job flag worked only before the command. Both places work."""
+    demo = tmp_path / "missing.csv"
+    after = CliRunner().invoke(cli, ["run", str(demo), "--out", str(tmp_path / "o"), "-q"])
+    assert "No such option" not in after.output and after.exit_code == 2
+    assert "not found" in after.output
+    helped = CliRunner().invoke(cli, ["td", "--help"])
+    assert "--quiet" in helped.output and "--debug" in helped.output
