@@ -81,3 +81,19 @@ def test_segments_outside_the_typical_range_count_only_where_their_mu_is_shown()
     shown = judge(base | {"segments": [seg(1, 0.9), seg(2, None)]})
     assert "segments_outside_typical_range" in shown["quality_flags"]
     assert any("1 segment outside the typical μ range" in w for w in shown["warnings"])
+
+
+def test_failed_segments_warning_says_why_the_first_failed():
+    """Regression (the fourth newcomer, Volve F-9): "10 segments failed … their messages say
+    why" and the terminal said nothing of why; the warning now quotes the first failed
+    segment's reason (the first clause of its message)."""
+    from drillfric.estimation.headline import judge
+
+    why = "string below the top section is 230.0 m long but the bit is at 154.4 m"
+    segs = [{"id": i, "kind": "off_bottom_rotating", "status": "failed", "mu_k": None,
+             "quality_flags": [], "message": f"{why}; more detail"} for i in (3, 4)]
+    summary = {"counts": {"estimated": 0}, "mu_k": None, "warnings": [], "assumed": [],
+               "segments": segs}
+    text = " | ".join(judge(summary)["warnings"])
+    assert f"2 segments failed (segments 3, 4): their messages say why (segment 3: {why})" \
+        in text

@@ -139,10 +139,12 @@ def _flags(summary: dict) -> list[tuple[WellFlag, str]]:
         found.append((WellFlag.STRING_WEIGHT_UNVERIFIED, ""))  # the check's own warning
     elif hook.get("verdict") == "contradicted" or hook.get("withheld_segments"):
         found.append((WellFlag.HOOKLOAD_CONTRADICTS_STRING, ""))  # the check's own warning
-    failed = [s["id"] for s in segments if s.get("status") == Status.FAILED]
+    failed = [s for s in segments if s.get("status") == Status.FAILED]
     if failed:
+        first = str(failed[0].get("message") or "").split("; ")[0]
         found.append((WellFlag.SEGMENTS_FAILED, f"{plural(len(failed), 'segment')} failed "
-                      f"({_ids(failed)}): their messages say why"))
+                      f"({_ids([s['id'] for s in failed])}): their messages say why (segment "
+                      f"{failed[0]['id']}: {first})"))
     return found
 
 
