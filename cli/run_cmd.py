@@ -70,9 +70,10 @@ def _describe(result, units: str = "si") -> str:
     c = s["counts"]
     if s.get("index") == "depth":
         return _describe_depth_log(result, units)
-    u_s = s.get("mu_s_uncertainty")
-    mu_s = _fmt(s["mu_s"]) + (f" ± {_fmt(u_s)}" if u_s is not None else "") \
-        if s["mu_s"] is not None else (
+    u_s, support = s.get("mu_s_uncertainty"), s.get("mu_s_support") or {}
+    mu_s = _fmt(s["mu_s"]) + (f" ± {_fmt(u_s)}" if u_s is not None else "") + (
+        f" ({share(support['segments'], support['of'], 'segment')})" if "of" in support
+        else "") if s["mu_s"] is not None else (
         f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
         else "not identifiable")
     return (f"{result.well}: {plural(c['segments'], 'segment')} "

@@ -156,8 +156,7 @@ def _header(data: ResultData, units: Units) -> dict:
         "mu_k": fmt(summary.get("mu_k")), "mu_k_reason": _no_mu_k_reason(data),
         "trust": headline_trust(summary),
         "apparent": _apparent(data),
-        "mu_s": mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
-                          summary.get("mu_s_lower_bound")),
+        "mu_s": _mu_s_headline(summary),
         "mu_s_identified": summary.get("mu_s") is not None,
         "zone": zone, "profile": _profile_text(summary, data.depth_indexed),
         "units": units.system, "depth_indexed": data.depth_indexed,
@@ -240,6 +239,21 @@ def _log_span(data: ResultData, units: Units) -> tuple[str, str] | None:
     spec = "%Y-%m-%d %H:%M" if span[1] - span[0] > LONG_LOG_S else "%Y-%m-%d %H:%M:%S"
     a, b = (clock_at(origin, t) for t in span)
     return what, f"{a:{spec}} – {b:{spec}} UTC"
+
+
+def _mu_s_headline(summary: dict) -> str:
+    """The well μ_s as the run's terminal line gives it: its ± and how many segments it
+    rests on (the report had shown "0.585" where the terminal said "0.585 ± 0.059": the
+    consensus of one stand of four, without its uncertainty)."""
+    text = mu_s_text(summary.get("mu_s"), summary.get("mu_s") is not None,
+                     summary.get("mu_s_lower_bound"))
+    if summary.get("mu_s") is None:
+        return text
+    u, support = summary.get("mu_s_uncertainty"), summary.get("mu_s_support") or {}
+    text += f" ± {fmt(u)}" if u is not None else ""
+    if "of" in support:
+        text += f" ({share(support['segments'], support['of'], 'segment')})"
+    return text
 
 
 def _no_mu_k_reason(data: ResultData) -> str:
