@@ -174,3 +174,59 @@ def test_a_well_deleted_between_nights_is_not_reported_ok_again(tmp_path):
     entry = json.loads((out / "manifest.json").read_text())["wells"]["B"]
     assert entry["missing_since_utc"] and (out / "B" / "STALE.json").is_file()
     assert "stale" in json.loads((out / "B" / "summary.json").read_text())
+
+
+# ---------------------------------------------------------------- F8 WITS0 midnight
+def test_wits0_recorder_whose_date_does_not_roll_over_at_midnight_loses_no_frame(tmp_path):
+    """A recorder sending 23:59:50 … 00:00:09 all dated 2024-12-01: one warning, then every
+    frame after midnight dropped as 'before the previous one' (no count), exit 0. Over real
+    TCP: all 20 frames are recorded, those after midnight dated 2024-12-02, one warning says
+    so; a frame truly dated before the previous one is counted at the end."""
+    import socket
+    import threading
+    from datetime import datetime, timedelta
+
+    from drillfric.io.wits0 import Row, encode, item_map
+    from drillfric.live.wits0_receiver import Receiver, Recording, parse_address, setup
+
+    listener = socket.create_server(("127.0.0.1", 0))
+    address = parse_address(f"wits0://127.0.0.1:{listener.getsockname()[1]}")
+    start = datetime(2024, 12, 1, 23, 59, 50)
+    frames = b""
+    for k in range(20):
+        true = start + timedelta(seconds=k)
+        sent = true.replace(day=1)  # the recorder's date stays 2024-12-01
+        frames += encode({"surface_rpm": float(k)}, item_map({}), sent)
+    frames += encode({"surface_rpm": 99.0}, item_map({}), datetime(2024, 12, 1, 0, 0, 5))
+    warnings = []
+    receiver = Receiver(address, setup(address, None, "t"),
+                        Recording(tmp_path / "t.wits0.csv", Row(item_map({})).names, False),
+                        warn=warnings.append)
+    thread = threading.Thread(target=receiver.run, daemon=True)
+    listener.settimeout(10)
+    thread.start()
+    try:
+        conn, _ = listener.accept()
+        conn.sendall(frames)
+        deadline = threading.Event()
+        for _ in range(200):
+            if receiver.frames + sum(receiver.dropped.values()) >= 21:
+                break
+            deadline.wait(0.05)
+        receiver.stop.set()
+        conn.close()
+    finally:
+        receiver.stop.set()
+        thread.join(5)
+        listener.close()
+    got = pd.read_csv(tmp_path / "t.wits0.csv")
+    assert got["surface_rpm"].tolist() == [float(k) for k in range(20)]
+    expected = [(start + timedelta(seconds=k)).isoformat(timespec="microseconds")
+                for k in range(20)]
+    assert got["time"].tolist() == expected
+    midnight = [w for w in warnings if "does not roll over at midnight" in w]
+    assert len(midnight) == 1 and "23:59:59 to 00:00:00" in midnight[0]
+    assert "recorded as 2024-12-02" in midnight[0]
+    assert receiver.dropped == {"order": 1}
+    assert "1 of 21 frames not recorded (1 dated before the previous frame)" in \
+        receiver.dropped_note()
