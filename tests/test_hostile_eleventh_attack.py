@@ -230,3 +230,39 @@ def test_wits0_recorder_whose_date_does_not_roll_over_at_midnight_loses_no_frame
     assert receiver.dropped == {"order": 1}
     assert "1 of 21 frames not recorded (1 dated before the previous frame)" in \
         receiver.dropped_note()
+
+
+# ---------------------------------------------------------------- F20 time in hours
+def test_a_one_hz_log_with_its_time_in_hours_is_refused_naming_the_unit(tmp_path):
+    """A 1-Hz log whose unlabelled time column is in hours: 'the surface speed never exceeds
+    2 RPM … (highest: 62.2 RPM)' — a warning that contradicts itself — and exit 0 with
+    nothing, though 4 stands were there. One line: samples 0.000278 s apart, is it in
+    hours? and the [channels] line."""
+    import numpy as np
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    k = np.arange(300)
+    rpm = np.where((k > 20) & (k < 260), 60.0, 0.0)
+    data = tmp_path / "hours.csv"
+    pd.DataFrame({"TIME": k / 3600.0, "surface_rpm": rpm,
+                  "surface_torque_Nm": 9e3 * (rpm > 0)}).to_csv(data, index=False)
+    result = CliRunner().invoke(cli, ["-q", "run", str(data), "--out", str(tmp_path / "o"),
+                                      "--no-report"])
+    assert result.exit_code == 2, result.output
+    assert "samples 0.000278 s apart" in result.output and "is it in hours?" in result.output
+    assert '[channels] time = { column = "TIME", unit = "h" }' in result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_turning_runs_are_counted_across_chunks():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from drillfric.io.logcheck import LogCheck
+
+    check = LogCheck(SimpleNamespace())
+    for chunk in ([0, 1, 1], [1, 1, 0, 1], [1, 1, 1, 1, 1], [0]):
+        check._runs(np.array(chunk, bool))
+    assert check.turn_longest == 6 and check.turn_run == 0
