@@ -266,3 +266,39 @@ def test_turning_runs_are_counted_across_chunks():
     for chunk in ([0, 1, 1], [1, 1, 0, 1], [1, 1, 1, 1, 1], [0]):
         check._runs(np.array(chunk, bool))
     assert check.turn_longest == 6 and check.turn_run == 0
+
+
+# ---------------------------------------------------------------- F12 decimal mark
+def test_a_remark_column_of_1_5_does_not_make_a_dot_decimal_file_decimal_comma(tmp_path):
+    """A semicolon CSV with dot decimals and a text column holding '1,5' every 50 rows: the
+    file was read with a decimal comma, the dot grouping thousands — every value 1000×
+    (time 50 s apart, and the error advised milliseconds). The mark is decided column by
+    column; one column does not outvote six."""
+    from drillfric.io.delimited import open_delimited, sniff_csv
+
+    path = tmp_path / "semidot_remark.csv"
+    lines = ["TIME;RPM;TORQUE;Remark"] + [
+        f"{0.05 * k:.3f};{0.5 * k:.3f};12.420;{'1,5' if k % 50 == 0 else ''}"
+        for k in range(120)]
+    path.write_text("\n".join(lines) + "\n")
+    assert sniff_csv(path).decimal == "."
+    frame = next(open_delimited(path).chunks(1000))
+    assert frame["TIME"].iloc[1] == pytest.approx(0.05)
+    assert frame["RPM"].iloc[3] == pytest.approx(1.5)
+    assert frame["TORQUE"].iloc[0] == pytest.approx(12.42)
+
+
+@pytest.mark.parametrize("rows, mark", [
+    (["12,5;17.240;0,05"], ","),  # 17.240 may group thousands: a comma file
+    (["12,5;0.050"], None),  # one column each way: refused
+])
+def test_the_decimal_mark_is_decided_by_the_numeric_columns(tmp_path, rows, mark):
+    from drillfric.io.delimited import sniff_csv
+
+    path = tmp_path / "x.csv"
+    path.write_text("\n".join(["A;B;C"[:len(rows[0].split(";")) * 2 - 1], *rows]) + "\n")
+    if mark is None:
+        with pytest.raises(InputError, match="the decimal mark cannot be told"):
+            sniff_csv(path)
+    else:
+        assert sniff_csv(path).decimal == mark

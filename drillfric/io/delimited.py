@@ -132,11 +132,10 @@ def sniff_csv(path: Path) -> CsvLayout:
     units_row = header and len(rows) > 1 and any(f for f in rows[1]) and not any(
         f and _is_value(f) for f in rows[1])
     body = rows[(1 + units_row) if header else 0:]
-    decimal = "," if delimiter != "," and any(
-        re.fullmatch(r"[-+]?\d*,\d+", f) for row in body for f in row) else "."
     n = len(rows[0])
     columns = [c or f"column {i}" for i, c in enumerate(rows[0])] if header else [
         str(i) for i in range(max(len(r) for r in rows))]
+    decimal = "." if delimiter == "," else _decimal_mark(body, columns, path)
     if header and len(set(columns)) < n:
         raise InputError("duplicate column names in the header", file=path,
                          fix="give every column a distinct name")
@@ -147,6 +146,50 @@ def sniff_csv(path: Path) -> CsvLayout:
                 units[col] = unit.strip("[]()")
                 units[("source", col)] = "units row"
     return CsvLayout(delimiter, decimal, header, units_row, columns, units, encoding)
+
+
+#: A value only a decimal comma writes (``12,5``), and one only a decimal dot writes — a
+#: dot that cannot group thousands (``0.050``, ``2210.000``, ``12.5``; ``17.240`` can).
+_COMMA_DECIMAL = re.compile(r"[-+]?\d*,\d+")
+_DOT_DECIMAL = re.compile(r"[-+]?\d*\.\d+")
+_DOT_GROUPED = re.compile(r"[-+]?[1-9]\d{0,2}(\.\d{3})+")
+
+
+def _decimal_mark(body: list[list[str]], columns: list[str], path: Path) -> str:
+    """The decimal mark of a file not delimited by commas, decided column by column: a
+    column with values like ``12,5`` votes for the comma, one with values only a dot writes
+    (``0.050``) for the dot. One column of the other kind — a remark of ``1,5`` beside
+    dot-decimal numbers — does not decide the file (issue 30, eleventh attack: every value
+    read 1000× as a dot grouping thousands); as many of each is refused.
+
+    Raises
+    ------
+    InputError
+        As many columns write a decimal comma as a decimal dot.
+    """
+    comma, dot = {}, {}
+    for row in body:
+        for i, f in enumerate(row):
+            if _COMMA_DECIMAL.fullmatch(f):
+                comma.setdefault(i, f)
+            elif _DOT_DECIMAL.fullmatch(f) and not _DOT_GROUPED.fullmatch(f):
+                dot.setdefault(i, f)
+    comma = {i: f for i, f in comma.items() if i not in dot}  # "1.5" and "1,5": no vote
+    if not comma:
+        return "."
+    if len(comma) > len(dot):
+        return ","
+    if len(comma) < len(dot):
+        return "."
+
+    def name(i: int) -> str:
+        return f"'{columns[i]}'" if i < len(columns) else f"column {i}"
+
+    c, d = next(iter(comma)), next(iter(dot))
+    raise InputError(f"the decimal mark cannot be told: column {name(c)} writes "
+                     f"'{comma[c]}' (a decimal comma), column {name(d)} '{dot[d]}' (a "
+                     "decimal dot), as many columns each way", file=path,
+                     fix="export the log with one decimal mark throughout")
 
 
 def _is_comment(line: str) -> bool:
