@@ -302,3 +302,38 @@ def test_the_decimal_mark_is_decided_by_the_numeric_columns(tmp_path, rows, mark
             sniff_csv(path)
     else:
         assert sniff_csv(path).decimal == mark
+
+
+# ---------------------------------------------------------------- F17 fleet names
+def test_mass_with_eszett_and_mass_in_capitals_are_two_wells():
+    """'Maß.csv' and 'MASS.csv' in one fleet folder stopped the whole fleet ("would both
+    write OUT/Maß"): casefold turns ß into ss, which no file system does. Names are compared
+    as case-insensitive file systems compare them (one character to one)."""
+    from drillfric.io.results import check_distinct, name_key
+
+    check_distinct([("Maß", "a"), ("MASS", "b")])
+    assert name_key("Well") == name_key("WELL") and name_key("Maß") != name_key("MASS")
+    with pytest.raises(InputError, match="would both write OUT/WELL and OUT/Well"):
+        check_distinct([("Well", "a"), ("WELL", "b")])
+
+
+def test_one_clashing_pair_does_not_stop_the_whole_fleet(tmp_path):
+    """A true clash ('well.csv' and 'WELL.csv', one directory on a case-insensitive file
+    system) fails the later well naming both; the other wells run."""
+    import numpy as np
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    wells = tmp_path / "wells"
+    wells.mkdir()
+    t = np.arange(0.0, 20.0, 0.1)
+    for name in ("Maß", "MASS", "well", "WELL"):
+        pd.DataFrame({"time_s": t, "surface_rpm": 0.0, "surface_torque_Nm": 0.0}).to_csv(
+            wells / f"{name}.csv", index=False)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["-q", "fleet", str(wells), "--out", str(out),
+                                      "--no-report", "--workers", "1"])
+    assert result.exit_code == 1, result.output
+    assert "would both write OUT/" in result.output and "WELL.csv" in result.output
+    dirs = {p.name for p in out.iterdir() if p.is_dir()}
+    assert {"Maß", "MASS"} <= dirs and len(dirs & {"well", "WELL"}) == 1
