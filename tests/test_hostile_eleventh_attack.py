@@ -337,3 +337,27 @@ def test_one_clashing_pair_does_not_stop_the_whole_fleet(tmp_path):
     assert "would both write OUT/" in result.output and "WELL.csv" in result.output
     dirs = {p.name for p in out.iterdir() if p.is_dir()}
     assert {"Maß", "MASS"} <= dirs and len(dirs & {"well", "WELL"}) == 1
+
+
+# ---------------------------------------------------------------- F9 one Latin-1 byte
+def test_a_utf8_log_with_one_latin1_byte_at_row_3000_is_read_as_the_docs_promise(tmp_path):
+    """A UTF-8 log with an operator's note '60°C' in Latin-1 at row 3000: 'cannot parse as
+    delimited text (UnicodeDecodeError) — fix: check that every row has the same number of
+    fields'. docs/ingestion.md promises UTF-8 or Latin-1 text: the byte is read as Latin-1,
+    one warning names the byte and the line."""
+    import warnings
+
+    from drillfric.io.delimited import TextWarning, open_delimited
+
+    lines = ["TIME,RPM,TORQUE,Note"] + [f"{0.05 * k:.2f},60.5,12000,ok (beyond the sniff)"
+                                        for k in range(3500)]
+    raw = ("\n".join(lines[:3000]) + "\n").encode() + b"# operator note: temp 60\xb0C\n" + \
+        ("\n".join(lines[3000:]) + "\n").encode() + b"174.95,60.5,12000,caf\xe9\n"
+    path = tmp_path / "latin1mid.csv"
+    path.write_bytes(raw)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        frame = pd.concat(open_delimited(path).chunks(1000))
+    assert len(frame) == 3501 and frame["Note"].iloc[-1] == "café"
+    said = [str(w.message) for w in caught if w.category is TextWarning]
+    assert len(said) == 1 and "byte 0xB0 is not UTF-8" in said[0] and "60°C" in said[0]
