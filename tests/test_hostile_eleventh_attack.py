@@ -361,3 +361,35 @@ def test_a_utf8_log_with_one_latin1_byte_at_row_3000_is_read_as_the_docs_promise
     assert len(frame) == 3501 and frame["Note"].iloc[-1] == "café"
     said = [str(w.message) for w in caught if w.category is TextWarning]
     assert len(said) == 1 and "byte 0xB0 is not UTF-8" in said[0] and "60°C" in said[0]
+
+
+# ---------------------------------------------------------------- F11 ISO 8601 corners
+def _iso_log(tmp_path, stamps):
+    data = tmp_path / "iso.csv"
+    pd.DataFrame({"TIMESTAMP": stamps, "surface_rpm": 60.0,
+                  "surface_torque_Nm": 9e3}).to_csv(data, index=False)
+    return data
+
+
+def test_iso_8601_comma_fraction_is_read():
+    """'2024-05-01T12:00:00,05Z' (ISO 8601's decimal comma) was refused as no ISO 8601."""
+    import numpy as np
+
+    from drillfric.io.timebase import TimeTracker
+
+    stamps = [f"2024-05-01T12:00:{k // 20:02d},{5 * (k % 20):02d}Z" for k in range(60)]
+    tracker = TimeTracker(1.0, file="iso.csv", column="TIMESTAMP")
+    seconds, _ = tracker._seconds(pd.Series(stamps))
+    assert np.allclose(seconds, np.arange(60) * 0.05)
+
+
+def test_iso_8601_leap_second_is_refused_saying_why(tmp_path):
+    """'2016-12-31T23:59:60.000000Z' was 'cannot read … as an ISO 8601 timestamp'. It is
+    valid ISO 8601; the line says it is a leap second, which the time axis cannot hold."""
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    stamps = [f"2016-12-31T23:59:{s:02d}.{ms:03d}Z" for s in (58, 59, 60) for ms in (0, 500)]
+    result = CliRunner().invoke(cli, ["inspect", str(_iso_log(tmp_path, stamps))])
+    assert result.exit_code == 2, result.output
+    assert "'2016-12-31T23:59:60.000Z' at data row 5 is a leap second" in result.output
