@@ -393,3 +393,15 @@ def test_iso_8601_leap_second_is_refused_saying_why(tmp_path):
     result = CliRunner().invoke(cli, ["inspect", str(_iso_log(tmp_path, stamps))])
     assert result.exit_code == 2, result.output
     assert "'2016-12-31T23:59:60.000Z' at data row 5 is a leap second" in result.output
+
+
+# ---------------------------------------------------------------- F19 a word after the unit
+@pytest.mark.parametrize("text, word", [("8200 ft MD", "MD"), ("2300 m RKB", "RKB"),
+                                        ("5 1/2 in TVD", "TVD")])
+def test_a_depth_reference_after_the_unit_is_named_as_an_unknown_word(text, word):
+    """bit_depth_m = "8200 ft MD": 'is of dimension [length] ** 2 * [time] * [current], not
+    a length' (pint read MD as mega-darcies). The word after the unit is named."""
+    with pytest.raises(ConfigError, match=f"has an unknown word '{word}' after its unit"):
+        quantity_value(text, "m", what="key 'well.bit_depth_m'", file="w.toml")
+    assert quantity_value("25 kft lbf", "N*m", what="key 'x'") == pytest.approx(33895.44,
+                                                                                rel=1e-6)
