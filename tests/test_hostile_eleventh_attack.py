@@ -405,3 +405,30 @@ def test_a_depth_reference_after_the_unit_is_named_as_an_unknown_word(text, word
         quantity_value(text, "m", what="key 'well.bit_depth_m'", file="w.toml")
     assert quantity_value("25 kft lbf", "N*m", what="key 'x'") == pytest.approx(33895.44,
                                                                                 rel=1e-6)
+
+
+# ---------------------------------------------------------------- F15 qualifier as a unit
+@pytest.mark.parametrize("columns, key, chosen", [
+    (["TIME [s]", "RPM (setpoint)", "SRPM [rpm]", "TORQUE [kN.m]"], "surface_rpm",
+     "SRPM [rpm]"),
+    (["TIME [s]", "SRPM [rpm]", "TORQUE (max)", "STOR [kN.m]"], "surface_torque",
+     "STOR [kN.m]"),
+])
+def test_a_qualifier_in_parentheses_gives_way_to_a_column_with_a_real_unit(columns, key,
+                                                                           chosen):
+    """'RPM (setpoint)' beside 'SRPM [rpm]': "unknown unit 'setpoint'" refused the log
+    (likewise 'TORQUE (max)' beside 'STOR [kN.m]'). The column whose unit is one is taken."""
+    from drillfric.io.channels import map_channels
+
+    assert map_channels(columns, {}, {}, file="w.csv")[key].column == chosen
+
+
+def test_a_lone_column_with_a_qualifier_is_named_and_can_be_given_its_unit():
+    from drillfric.io.channels import map_channels
+
+    columns = ["TIME [s]", "RPM [rpm]", "TORQUE (max)"]
+    with pytest.raises(InputError, match="'max' in its name is read as its unit, and is no "
+                                         "torque unit"):
+        map_channels(columns, {}, {}, file="w.csv")
+    given = {"surface_torque": {"column": "TORQUE (max)", "unit": "kN.m"}}
+    assert map_channels(columns, {}, given, file="w.csv")["surface_torque"].factor == 1e3
