@@ -432,3 +432,42 @@ def test_a_lone_column_with_a_qualifier_is_named_and_can_be_given_its_unit():
         map_channels(columns, {}, {}, file="w.csv")
     given = {"surface_torque": {"column": "TORQUE (max)", "unit": "kN.m"}}
     assert map_channels(columns, {}, given, file="w.csv")["surface_torque"].factor == 1e3
+
+
+# ---------------------------------------------------------------- F16 HDF5 shapes, complex
+def _h5(path, rpm, torque, notes=True):
+    import h5py
+    import numpy as np
+
+    with h5py.File(path, "w") as h5:
+        group = h5.create_group("surface")
+        group["time_s"] = np.arange(100) * 0.05
+        group["surface_rpm"] = rpm
+        group["surface_torque_Nm"] = torque
+        if notes:
+            group["notes"] = np.zeros((100, 3))
+    return path
+
+
+def test_hdf5_n_by_1_dataset_is_a_column_and_a_complex_one_is_named(tmp_path):
+    """An (N,1) surface_rpm was left out in silence ('required channel surface_rpm not
+    found'); a complex torque cast to real with numpy's ComplexWarning. The (N,1) dataset
+    is read squeezed (a dataset of another shape is named in a warning); the complex one is
+    one line naming it."""
+    import warnings
+
+    import numpy as np
+
+    from drillfric.io.hdf5 import Hdf5Warning, open_hdf5
+
+    path = _h5(tmp_path / "twod.h5", np.full((100, 1), 60.0), np.full(100, 9e3))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        source = open_hdf5(path, "surface")
+    frame = pd.concat(source.chunks(1000))
+    assert frame["surface_rpm"].tolist() == [60.0] * 100 and "notes" not in frame
+    said = [str(w.message) for w in caught if w.category is Hdf5Warning]
+    assert len(said) == 1 and "'/surface/notes' has shape (100, 3)" in said[0]
+    path = _h5(tmp_path / "complex.h5", np.full(100, 60.0), np.full(100, 9e3 + 1j), False)
+    with pytest.raises(InputError, match="'/surface/surface_torque_Nm' holds complex"):
+        open_hdf5(path, "surface")
