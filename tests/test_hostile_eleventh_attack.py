@@ -427,8 +427,7 @@ def test_a_lone_column_with_a_qualifier_is_named_and_can_be_given_its_unit():
     from drillfric.io.channels import map_channels
 
     columns = ["TIME [s]", "RPM [rpm]", "TORQUE (max)"]
-    with pytest.raises(InputError, match="'max' in its name is read as its unit, and is no "
-                                         "torque unit"):
+    with pytest.raises(InputError, match="unknown unit 'max' in its name: no torque unit"):
         map_channels(columns, {}, {}, file="w.csv")
     given = {"surface_torque": {"column": "TORQUE (max)", "unit": "kN.m"}}
     assert map_channels(columns, {}, given, file="w.csv")["surface_torque"].factor == 1e3

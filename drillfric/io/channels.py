@@ -631,9 +631,9 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
             if channel.key != "time":
                 if source == "header" and unit_fits(unit, channel) is None:
                     raise InputError(  # 'TORQUE (max)': a qualifier, not a unit
-                        f"column '{printable(column)}' ({channel.name}): "
-                        f"'{printable(unit)}' in its name is read as its unit, and is no "
-                        f"{channel.kind} unit (a qualifier such as max or setpoint?)",
+                        f"column '{printable(column)}' ({channel.name}): unknown unit "
+                        f"'{printable(unit)}' in its name: no {channel.kind} unit is spelled "
+                        "so (a qualifier such as max or setpoint?)",
                         file=file, fix=f"give the unit in [channels], e.g. {channel.key} = "
                                        f'{{ column = "{printable(column)}", unit = '
                                        f'"{channel.default_unit}" }}, or map another '
