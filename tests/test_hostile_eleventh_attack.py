@@ -225,8 +225,9 @@ def test_wits0_recorder_whose_date_does_not_roll_over_at_midnight_loses_no_frame
                 for k in range(20)]
     assert got["time"].tolist() == expected
     midnight = [w for w in warnings if "does not roll over at midnight" in w]
-    assert len(midnight) == 1 and "23:59:59 to 00:00:00" in midnight[0]
-    assert "recorded as 2024-12-02" in midnight[0]
+    assert len(midnight) == 1 and "a frame dated 2024-12-01 00:00:00 follows one of " \
+        "2024-12-01 23:59:59" in midnight[0]
+    assert "recorded as 2024-12-02 from here" in midnight[0]
     assert receiver.dropped == {"order": 1}
     assert "1 of 21 frames not recorded (1 dated before the previous frame)" in \
         receiver.dropped_note()
@@ -470,3 +471,21 @@ def test_hdf5_n_by_1_dataset_is_a_column_and_a_complex_one_is_named(tmp_path):
     path = _h5(tmp_path / "complex.h5", np.full(100, 60.0), np.full(100, 9e3 + 1j), False)
     with pytest.raises(InputError, match="'/surface/surface_torque_Nm' holds complex"):
         open_hdf5(path, "surface")
+
+
+def test_wits0_live_restarted_after_a_date_that_did_not_roll_over_continues_the_day():
+    """Restarted after such a midnight, the recording's last line (2024-12-02 00:04:59)
+    follows frames still dated 2024-12-01: each one 'before the previous', all dropped."""
+    from datetime import UTC, datetime
+
+    from drillfric.live.wits0_receiver import FrameClock
+
+    last = datetime(2024, 12, 2, 0, 4, 59, tzinfo=UTC).timestamp()
+    clock = FrameClock(None, last)
+    stamp, previous = clock.rolled(datetime(2024, 12, 1, 0, 5, 0))
+    assert stamp == datetime(2024, 12, 2, 0, 5, 0) and previous is not None
+    assert clock.time_s(stamp, 0.0, last) == last + 1.0
+    assert clock.rolled(datetime(2024, 12, 1, 0, 5, 1)) == (datetime(2024, 12, 2, 0, 5, 1), None)
+    fresh = FrameClock(None, datetime(2024, 12, 1, 12, 0, 0, tzinfo=UTC).timestamp())
+    assert fresh.rolled(datetime(2024, 12, 1, 12, 0, 1)) == (datetime(2024, 12, 1, 12, 0, 1),
+                                                            None)

@@ -178,8 +178,8 @@ class FrameClock:
         if clock is None:
             return None, None
         sent, self._sent = self._sent, clock
-        if sent is None:
-            return clock, None
+        if sent is None:  # a continued recording: its last line is the previous frame
+            return self._continued(clock)
         if clock.date() != sent.date():
             self._days = 0  # the recorder's own date moved: it is right again
             return clock, None
@@ -191,6 +191,22 @@ class FrameClock:
         elif before < early and after >= late and self._days:
             self._days -= 1  # back before midnight: that day's frames, sent again
         return clock + timedelta(days=self._days), sent if midnight else None
+
+    def _continued(self, clock: datetime) -> tuple[datetime, datetime | None]:
+        """The first frame of a continued recording: a time of day in the first
+        :data:`MIDNIGHT_WINDOW_S` of the day before the recording's last line, which lies
+        in the first minutes of its day, is a recorder whose date did not roll over (live
+        restarted after such a midnight had dropped every frame)."""
+        if self.last_s is None:
+            return clock, None
+        last = datetime.fromtimestamp(self.last_s + self.offset_s, UTC).replace(tzinfo=None)
+        early = MIDNIGHT_WINDOW_S
+        if (clock + timedelta(days=1)).date() == last.date() and \
+                3600 * clock.hour + 60 * clock.minute + clock.second < early and \
+                3600 * last.hour + 60 * last.minute + last.second < early:
+            self._days = 1
+            return clock + timedelta(days=1), last
+        return clock, None
 
     def burst(self, unstamped: int, frames: int, arrival_s: float) -> float | None:
         """``frames`` frames arrived together at ``arrival_s`` (monotonic [s]),
@@ -492,11 +508,10 @@ class Receiver:
             stamp, previous = self.clock.rolled(sent)
             if previous is not None:  # once a night (a frame sent again repeats no midnight)
                 self._once(f"midnight {stamp:%Y-%m-%d}",
-                           f"{self.address}: the frames' time of day went from "
-                           f"{previous:%H:%M:%S} to {sent:%H:%M:%S} with their date (item "
-                           f"0105) still {sent:%Y-%m-%d}: a recorder whose date does not roll "
-                           f"over at midnight; recorded as {stamp:%Y-%m-%d} (set the "
-                           "recorder's date)")
+                           f"{self.address}: a frame dated {sent:%Y-%m-%d %H:%M:%S} follows "
+                           f"one of {previous:%Y-%m-%d %H:%M:%S}: a recorder whose date (item "
+                           f"0105) does not roll over at midnight; recorded as "
+                           f"{stamp:%Y-%m-%d} from here (set the recorder's date)")
             if self.clock.ahead(stamp, wall):
                 self._drop("future", f"{self.address}: a frame dated "
                                      f"{stamp:%Y-%m-%d %H:%M:%S}, more than a day after this "
