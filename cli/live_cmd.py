@@ -70,6 +70,8 @@ def command(source: str, out: Path, config: Path | None, name: str | None,
     finally:
         if receiver is not None:
             receiver.stop.set()
+            if (note := receiver.dropped_note()) is not None:
+                receiver.warn(note)  # never a frame dropped without its count
         if server is not None:
             server.stop()
     from .run_cmd import _print

@@ -516,7 +516,32 @@ def quantity_value(text: str, unit: str, *, what: str = "", file=None,
                           fix=f"write the number with digits and a decimal point only, e.g. "
                               f"{example}")
     expected = f"{name} ({unit})" if name else unit
-    return _convert(magnitude, match["unit"], expr, expected, given, file, example)
+    try:
+        return _convert(magnitude, match["unit"], expr, expected, given, file, example)
+    except ConfigError:
+        _trailing_word(text[:match.start("unit")].strip(), match["unit"], expr, given, file)
+        raise
+
+
+def _trailing_word(number: str, spelled: str, expr: str, given: str, file) -> None:
+    """Raise for a unit followed by words that are no part of it (``"8200 ft MD"``: pint
+    read ``ft MD`` as feet × mega-darcies, "of dimension [length] ** 2 * [time] *
+    [current]" — issue 30, eleventh attack), naming the word; return when the unit's
+    leading words are no unit of the expected kind either."""
+    words = spelled.split()
+    reg = _exact_registry()
+    target = reg.parse_expression(expr)
+    for k in range(len(words) - 1, 0, -1):
+        head = " ".join(words[:k])
+        unit = _parse(reg, head, scaled=True)
+        if isinstance(unit, reg.Quantity) and unit.dimensionality == target.dimensionality:
+            rest = " ".join(words[k:])
+            raise ConfigError(f"{given} has an unknown word '{_shown(rest)}' after its unit "
+                              f"'{_shown(head)}' (a depth reference such as MD or TVD, a "
+                              "note?)", file=file,
+                              fix=f"write the number and the unit only, e.g. "
+                                  f"\"{_shown(number)} {_shown(head)}\" (a note goes in a "
+                                  "# comment)")
 
 
 def _convert(magnitude: Decimal, spelled: str, expr: str, expected: str, what: str, file,

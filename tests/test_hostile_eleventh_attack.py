@@ -174,3 +174,318 @@ def test_a_well_deleted_between_nights_is_not_reported_ok_again(tmp_path):
     entry = json.loads((out / "manifest.json").read_text())["wells"]["B"]
     assert entry["missing_since_utc"] and (out / "B" / "STALE.json").is_file()
     assert "stale" in json.loads((out / "B" / "summary.json").read_text())
+
+
+# ---------------------------------------------------------------- F8 WITS0 midnight
+def test_wits0_recorder_whose_date_does_not_roll_over_at_midnight_loses_no_frame(tmp_path):
+    """A recorder sending 23:59:50 … 00:00:09 all dated 2024-12-01: one warning, then every
+    frame after midnight dropped as 'before the previous one' (no count), exit 0. Over real
+    TCP: all 20 frames are recorded, those after midnight dated 2024-12-02, one warning says
+    so; a frame truly dated before the previous one is counted at the end."""
+    import socket
+    import threading
+    from datetime import datetime, timedelta
+
+    from drillfric.io.wits0 import Row, encode, item_map
+    from drillfric.live.wits0_receiver import Receiver, Recording, parse_address, setup
+
+    listener = socket.create_server(("127.0.0.1", 0))
+    address = parse_address(f"wits0://127.0.0.1:{listener.getsockname()[1]}")
+    start = datetime(2024, 12, 1, 23, 59, 50)
+    frames = b""
+    for k in range(20):
+        true = start + timedelta(seconds=k)
+        sent = true.replace(day=1)  # the recorder's date stays 2024-12-01
+        frames += encode({"surface_rpm": float(k)}, item_map({}), sent)
+    frames += encode({"surface_rpm": 99.0}, item_map({}), datetime(2024, 12, 1, 0, 0, 5))
+    warnings = []
+    receiver = Receiver(address, setup(address, None, "t"),
+                        Recording(tmp_path / "t.wits0.csv", Row(item_map({})).names, False),
+                        warn=warnings.append)
+    thread = threading.Thread(target=receiver.run, daemon=True)
+    listener.settimeout(10)
+    thread.start()
+    try:
+        conn, _ = listener.accept()
+        conn.sendall(frames)
+        deadline = threading.Event()
+        for _ in range(200):
+            if receiver.frames + sum(receiver.dropped.values()) >= 21:
+                break
+            deadline.wait(0.05)
+        receiver.stop.set()
+        conn.close()
+    finally:
+        receiver.stop.set()
+        thread.join(5)
+        listener.close()
+    got = pd.read_csv(tmp_path / "t.wits0.csv")
+    assert got["surface_rpm"].tolist() == [float(k) for k in range(20)]
+    expected = [(start + timedelta(seconds=k)).isoformat(timespec="microseconds")
+                for k in range(20)]
+    assert got["time"].tolist() == expected
+    midnight = [w for w in warnings if "does not roll over at midnight" in w]
+    assert len(midnight) == 1 and "a frame dated 2024-12-01 00:00:00 follows one of " \
+        "2024-12-01 23:59:59" in midnight[0]
+    assert "recorded as 2024-12-02 from here" in midnight[0]
+    assert receiver.dropped == {"order": 1}
+    assert "1 of 21 frames not recorded (1 dated before the previous frame)" in \
+        receiver.dropped_note()
+
+
+# ---------------------------------------------------------------- F20 time in hours
+def test_a_one_hz_log_with_its_time_in_hours_is_refused_naming_the_unit(tmp_path):
+    """A 1-Hz log whose unlabelled time column is in hours: 'the surface speed never exceeds
+    2 RPM … (highest: 62.2 RPM)' — a warning that contradicts itself — and exit 0 with
+    nothing, though 4 stands were there. One line: samples 0.000278 s apart, is it in
+    hours? and the [channels] line."""
+    import numpy as np
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    k = np.arange(300)
+    rpm = np.where((k > 20) & (k < 260), 60.0, 0.0)
+    data = tmp_path / "hours.csv"
+    pd.DataFrame({"TIME": k / 3600.0, "surface_rpm": rpm,
+                  "surface_torque_Nm": 9e3 * (rpm > 0)}).to_csv(data, index=False)
+    result = CliRunner().invoke(cli, ["-q", "run", str(data), "--out", str(tmp_path / "o"),
+                                      "--no-report"])
+    assert result.exit_code == 2, result.output
+    assert "samples 0.000278 s apart" in result.output and "is it in hours?" in result.output
+    assert '[channels] time = { column = "TIME", unit = "h" }' in result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_turning_runs_are_counted_across_chunks():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from drillfric.io.logcheck import LogCheck
+
+    check = LogCheck(SimpleNamespace())
+    for chunk in ([0, 1, 1], [1, 1, 0, 1], [1, 1, 1, 1, 1], [0]):
+        check._runs(np.array(chunk, bool))
+    assert check.turn_longest == 6 and check.turn_run == 0
+
+
+# ---------------------------------------------------------------- F12 decimal mark
+def test_a_remark_column_of_1_5_does_not_make_a_dot_decimal_file_decimal_comma(tmp_path):
+    """A semicolon CSV with dot decimals and a text column holding '1,5' every 50 rows: the
+    file was read with a decimal comma, the dot grouping thousands — every value 1000×
+    (time 50 s apart, and the error advised milliseconds). The mark is decided column by
+    column; one column does not outvote six."""
+    from drillfric.io.delimited import open_delimited, sniff_csv
+
+    path = tmp_path / "semidot_remark.csv"
+    lines = ["TIME;RPM;TORQUE;Remark"] + [
+        f"{0.05 * k:.3f};{0.5 * k:.3f};12.420;{'1,5' if k % 50 == 0 else ''}"
+        for k in range(120)]
+    path.write_text("\n".join(lines) + "\n")
+    assert sniff_csv(path).decimal == "."
+    frame = next(open_delimited(path).chunks(1000))
+    assert frame["TIME"].iloc[1] == pytest.approx(0.05)
+    assert frame["RPM"].iloc[3] == pytest.approx(1.5)
+    assert frame["TORQUE"].iloc[0] == pytest.approx(12.42)
+
+
+@pytest.mark.parametrize("rows, mark", [
+    (["12,5;17.240;0,05"], ","),  # 17.240 may group thousands: a comma file
+    (["12,5;0.050"], None),  # one column each way: refused
+])
+def test_the_decimal_mark_is_decided_by_the_numeric_columns(tmp_path, rows, mark):
+    from drillfric.io.delimited import sniff_csv
+
+    path = tmp_path / "x.csv"
+    path.write_text("\n".join(["A;B;C"[:len(rows[0].split(";")) * 2 - 1], *rows]) + "\n")
+    if mark is None:
+        with pytest.raises(InputError, match="the decimal mark cannot be told"):
+            sniff_csv(path)
+    else:
+        assert sniff_csv(path).decimal == mark
+
+
+# ---------------------------------------------------------------- F17 fleet names
+def test_mass_with_eszett_and_mass_in_capitals_are_two_wells():
+    """'Maß.csv' and 'MASS.csv' in one fleet folder stopped the whole fleet ("would both
+    write OUT/Maß"): casefold turns ß into ss, which no file system does. Names are compared
+    as case-insensitive file systems compare them (one character to one)."""
+    from drillfric.io.results import check_distinct, name_key
+
+    check_distinct([("Maß", "a"), ("MASS", "b")])
+    assert name_key("Well") == name_key("WELL") and name_key("Maß") != name_key("MASS")
+    with pytest.raises(InputError, match="would both write OUT/WELL and OUT/Well"):
+        check_distinct([("Well", "a"), ("WELL", "b")])
+
+
+def test_one_clashing_pair_does_not_stop_the_whole_fleet(tmp_path):
+    """A true clash ('well.csv' and 'WELL.csv', one directory on a case-insensitive file
+    system) fails the later well naming both; the other wells run."""
+    import numpy as np
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    wells = tmp_path / "wells"
+    wells.mkdir()
+    t = np.arange(0.0, 20.0, 0.1)
+    for name in ("Maß", "MASS", "well", "WELL"):
+        pd.DataFrame({"time_s": t, "surface_rpm": 0.0, "surface_torque_Nm": 0.0}).to_csv(
+            wells / f"{name}.csv", index=False)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["-q", "fleet", str(wells), "--out", str(out),
+                                      "--no-report", "--workers", "1"])
+    assert result.exit_code == 1, result.output
+    assert "would both write OUT/" in result.output and "WELL.csv" in result.output
+    dirs = {p.name for p in out.iterdir() if p.is_dir()}
+    assert {"Maß", "MASS"} <= dirs and len(dirs & {"well", "WELL"}) == 1
+
+
+# ---------------------------------------------------------------- F9 one Latin-1 byte
+def test_a_utf8_log_with_one_latin1_byte_at_row_3000_is_read_as_the_docs_promise(tmp_path):
+    """A UTF-8 log with an operator's note '60°C' in Latin-1 at row 3000: 'cannot parse as
+    delimited text (UnicodeDecodeError) — fix: check that every row has the same number of
+    fields'. docs/ingestion.md promises UTF-8 or Latin-1 text: the byte is read as Latin-1,
+    one warning names the byte and the line."""
+    import warnings
+
+    from drillfric.io.delimited import TextWarning, open_delimited
+
+    lines = ["TIME,RPM,TORQUE,Note"] + [f"{0.05 * k:.2f},60.5,12000,ok (beyond the sniff)"
+                                        for k in range(3500)]
+    raw = ("\n".join(lines[:3000]) + "\n").encode() + b"# operator note: temp 60\xb0C\n" + \
+        ("\n".join(lines[3000:]) + "\n").encode() + b"174.95,60.5,12000,caf\xe9\n"
+    path = tmp_path / "latin1mid.csv"
+    path.write_bytes(raw)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        frame = pd.concat(open_delimited(path).chunks(1000))
+    assert len(frame) == 3501 and frame["Note"].iloc[-1] == "café"
+    said = [str(w.message) for w in caught if w.category is TextWarning]
+    assert len(said) == 1 and "byte 0xB0 is not UTF-8" in said[0] and "60°C" in said[0]
+
+
+# ---------------------------------------------------------------- F11 ISO 8601 corners
+def _iso_log(tmp_path, stamps):
+    data = tmp_path / "iso.csv"
+    pd.DataFrame({"TIMESTAMP": stamps, "surface_rpm": 60.0,
+                  "surface_torque_Nm": 9e3}).to_csv(data, index=False)
+    return data
+
+
+def test_iso_8601_comma_fraction_is_read():
+    """'2024-05-01T12:00:00,05Z' (ISO 8601's decimal comma) was refused as no ISO 8601."""
+    import numpy as np
+
+    from drillfric.io.timebase import TimeTracker
+
+    stamps = [f"2024-05-01T12:00:{k // 20:02d},{5 * (k % 20):02d}Z" for k in range(60)]
+    tracker = TimeTracker(1.0, file="iso.csv", column="TIMESTAMP")
+    seconds, _ = tracker._seconds(pd.Series(stamps))
+    assert np.allclose(seconds, np.arange(60) * 0.05)
+
+
+def test_iso_8601_leap_second_is_refused_saying_why(tmp_path):
+    """'2016-12-31T23:59:60.000000Z' was 'cannot read … as an ISO 8601 timestamp'. It is
+    valid ISO 8601; the line says it is a leap second, which the time axis cannot hold."""
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    stamps = [f"2016-12-31T23:59:{s:02d}.{ms:03d}Z" for s in (58, 59, 60) for ms in (0, 500)]
+    result = CliRunner().invoke(cli, ["inspect", str(_iso_log(tmp_path, stamps))])
+    assert result.exit_code == 2, result.output
+    assert "'2016-12-31T23:59:60.000Z' at data row 5 is a leap second" in result.output
+
+
+# ---------------------------------------------------------------- F19 a word after the unit
+@pytest.mark.parametrize("text, word", [("8200 ft MD", "MD"), ("2300 m RKB", "RKB"),
+                                        ("5 1/2 in TVD", "TVD")])
+def test_a_depth_reference_after_the_unit_is_named_as_an_unknown_word(text, word):
+    """bit_depth_m = "8200 ft MD": 'is of dimension [length] ** 2 * [time] * [current], not
+    a length' (pint read MD as mega-darcies). The word after the unit is named."""
+    with pytest.raises(ConfigError, match=f"has an unknown word '{word}' after its unit"):
+        quantity_value(text, "m", what="key 'well.bit_depth_m'", file="w.toml")
+    assert quantity_value("25 kft lbf", "N*m", what="key 'x'") == pytest.approx(33895.44,
+                                                                                rel=1e-6)
+
+
+# ---------------------------------------------------------------- F15 qualifier as a unit
+@pytest.mark.parametrize("columns, key, chosen", [
+    (["TIME [s]", "RPM (setpoint)", "SRPM [rpm]", "TORQUE [kN.m]"], "surface_rpm",
+     "SRPM [rpm]"),
+    (["TIME [s]", "SRPM [rpm]", "TORQUE (max)", "STOR [kN.m]"], "surface_torque",
+     "STOR [kN.m]"),
+])
+def test_a_qualifier_in_parentheses_gives_way_to_a_column_with_a_real_unit(columns, key,
+                                                                           chosen):
+    """'RPM (setpoint)' beside 'SRPM [rpm]': "unknown unit 'setpoint'" refused the log
+    (likewise 'TORQUE (max)' beside 'STOR [kN.m]'). The column whose unit is one is taken."""
+    from drillfric.io.channels import map_channels
+
+    assert map_channels(columns, {}, {}, file="w.csv")[key].column == chosen
+
+
+def test_a_lone_column_with_a_qualifier_is_named_and_can_be_given_its_unit():
+    from drillfric.io.channels import map_channels
+
+    columns = ["TIME [s]", "RPM [rpm]", "TORQUE (max)"]
+    with pytest.raises(InputError, match="unknown unit 'max' in its name: no torque unit"):
+        map_channels(columns, {}, {}, file="w.csv")
+    given = {"surface_torque": {"column": "TORQUE (max)", "unit": "kN.m"}}
+    assert map_channels(columns, {}, given, file="w.csv")["surface_torque"].factor == 1e3
+
+
+# ---------------------------------------------------------------- F16 HDF5 shapes, complex
+def _h5(path, rpm, torque, notes=True):
+    import h5py
+    import numpy as np
+
+    with h5py.File(path, "w") as h5:
+        group = h5.create_group("surface")
+        group["time_s"] = np.arange(100) * 0.05
+        group["surface_rpm"] = rpm
+        group["surface_torque_Nm"] = torque
+        if notes:
+            group["notes"] = np.zeros((100, 3))
+    return path
+
+
+def test_hdf5_n_by_1_dataset_is_a_column_and_a_complex_one_is_named(tmp_path):
+    """An (N,1) surface_rpm was left out in silence ('required channel surface_rpm not
+    found'); a complex torque cast to real with numpy's ComplexWarning. The (N,1) dataset
+    is read squeezed (a dataset of another shape is named in a warning); the complex one is
+    one line naming it."""
+    import warnings
+
+    import numpy as np
+
+    from drillfric.io.hdf5 import Hdf5Warning, open_hdf5
+
+    path = _h5(tmp_path / "twod.h5", np.full((100, 1), 60.0), np.full(100, 9e3))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        source = open_hdf5(path, "surface")
+    frame = pd.concat(source.chunks(1000))
+    assert frame["surface_rpm"].tolist() == [60.0] * 100 and "notes" not in frame
+    said = [str(w.message) for w in caught if w.category is Hdf5Warning]
+    assert len(said) == 1 and "'/surface/notes' has shape (100, 3)" in said[0]
+    path = _h5(tmp_path / "complex.h5", np.full(100, 60.0), np.full(100, 9e3 + 1j), False)
+    with pytest.raises(InputError, match="'/surface/surface_torque_Nm' holds complex"):
+        open_hdf5(path, "surface")
+
+
+def test_wits0_live_restarted_after_a_date_that_did_not_roll_over_continues_the_day():
+    """Restarted after such a midnight, the recording's last line (2024-12-02 00:04:59)
+    follows frames still dated 2024-12-01: each one 'before the previous', all dropped."""
+    from datetime import UTC, datetime
+
+    from drillfric.live.wits0_receiver import FrameClock
+
+    last = datetime(2024, 12, 2, 0, 4, 59, tzinfo=UTC).timestamp()
+    clock = FrameClock(None, last)
+    stamp, previous = clock.rolled(datetime(2024, 12, 1, 0, 5, 0))
+    assert stamp == datetime(2024, 12, 2, 0, 5, 0) and previous is not None
+    assert clock.time_s(stamp, 0.0, last) == last + 1.0
+    assert clock.rolled(datetime(2024, 12, 1, 0, 5, 1)) == (datetime(2024, 12, 2, 0, 5, 1), None)
+    fresh = FrameClock(None, datetime(2024, 12, 1, 12, 0, 0, tzinfo=UTC).timestamp())
+    assert fresh.rolled(datetime(2024, 12, 1, 12, 0, 1)) == (datetime(2024, 12, 1, 12, 0, 1),
+                                                            None)

@@ -41,11 +41,13 @@ from drillfric.fleet.task import WellTask, now_utc, process_well
 from drillfric.io.atomic import own_file, refuse_link, replacing
 from drillfric.io.locks import Busy, lock_file
 from drillfric.io.results import (
-    check_distinct,
+    DISTINCT_FIX,
+    collisions,
     file_sha256,
     jsonable,
     mark_stale,
     missing_dirs,
+    name_key,
     read_json,
     remove_empty,
     remove_stale,
@@ -89,6 +91,29 @@ class _Job:
     fingerprint: dict
     error: str = ""
     named: bool = True
+
+
+def _distinct(jobs: list[_Job], wells: list[WellSpec]) -> list[_Job]:
+    """The jobs, a well that would write the ``OUT/NAME`` of an earlier one under another
+    spelling (``well``, ``WELL``) failed with a line naming both — the others run: one such
+    pair had stopped the whole fleet. Two wells of one name are refused (before anything
+    is written): manifest.json could record only one of them.
+
+    Raises
+    ------
+    InputError
+        Two wells of one name.
+    """
+    runnable = [(k, j) for k, j in enumerate(jobs) if j.task is not None and j.named]
+    clash = collisions([(j.dir_name, f"well '{j.name}' ({wells[k].data})")
+                        for k, j in runnable])
+    jobs = list(jobs)
+    for i, (first, line) in clash.items():
+        k, job = runnable[i]
+        if job.name == runnable[first][1].name or job.dir_name == runnable[first][1].dir_name:
+            raise InputError(line, fix=DISTINCT_FIX)
+        jobs[k] = replace(job, task=None, error=f"{line} — fix: {DISTINCT_FIX}")
+    return jobs
 
 
 def _open_job(index: int, spec: WellSpec, out_root: Path, overrides: dict,
@@ -426,8 +451,7 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
     advance = progress or (lambda amount=1.0: None)
     options = {"rate_hz": rate_hz, "pdf": pdf, "report": report}
     jobs = [_open_job(i, s, out_root, overrides or {}, options) for i, s in enumerate(wells)]
-    check_distinct([(j.dir_name, f"well '{j.name}' ({spec.data})")
-                    for j, spec in zip(jobs, wells, strict=True) if j.task is not None and j.named])
+    jobs = _distinct(jobs, wells)
     created = missing_dirs(out_root)  # removed again when nothing is left in them
     run = uuid.uuid4().hex[:8]
     try:
@@ -476,8 +500,8 @@ def _run_jobs(jobs: list[_Job], out_root: Path, run: str, *, workers: int,
         else:
             todo.append(replace(job, task=replace(job.task, resume=not force)))
     if any(not j.named for j in todo):  # their names are resolved (and claimed) by workers
-        taken = frozenset({j.dir_name.casefold() for j in jobs if j.named and j.task}
-                          | {Path(o.result_dir).name.casefold() for o in outcomes.values()
+        taken = frozenset({name_key(j.dir_name) for j in jobs if j.named and j.task}
+                          | {name_key(Path(o.result_dir).name) for o in outcomes.values()
                              if o.result_dir is not None})
         todo = [j if j.named else replace(j, task=replace(j.task, taken=taken, run=run))
                 for j in todo]

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from drillfric import __version__
 from drillfric.errors import DrillfricError, InputError
-from drillfric.io.results import jsonable
+from drillfric.io.results import jsonable, name_key
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,7 @@ def process_well(task: WellTask) -> dict:
 
 def _claim(task: WellTask, dir_name: str) -> None:
     """Claim OUT/``dir_name`` for a well whose name was resolved on this worker."""
-    key = dir_name.casefold()
+    key = name_key(dir_name)
     digest = hashlib.sha256(key.encode()).hexdigest()[:20]
     claim = Path(task.out_root) / f".claim-{task.run}-{digest}"
     try:

@@ -401,7 +401,21 @@ def _candidates(columns: list[str], channel: Channel, spec: dict,
     fitting = [r for r in ranked if _unit_agrees(r[1], r[2], channel, file_units or {}, spec)]
     if fitting or not channel.required:
         ranked = fitting
+    # a qualifier read as a unit ('RPM (setpoint)', 'TORQUE (max)') gives way to a column
+    # whose unit is one ('SRPM [rpm]'): it had refused the log "unknown unit 'setpoint'"
+    # (issue 30, eleventh attack); alone, it stays, and the unit error names it
+    known = [r for r in ranked if _unit_known(r[1], r[2], channel, file_units or {}, spec)]
+    if known:
+        ranked = known
     return sorted(ranked, key=lambda r: r[0], reverse=True)
+
+
+def _unit_known(column: str, name_unit: str | None, channel: Channel, file_units: dict,
+                spec: dict) -> bool:
+    """False when the unit stated for ``column`` is no unit drillfric knows (a qualifier
+    such as ``setpoint`` or ``max`` in parentheses)."""
+    unit = spec.get("unit") or name_unit or file_units.get(column)
+    return channel.key == "time" or not unit or unit_fits(unit, channel) is not None
 
 
 def candidate_columns(columns: list[str], key: str, config_channels: dict,
@@ -468,6 +482,9 @@ def _unit_for(channel: Channel, column: str, name_unit: str | None, file_units: 
     if configured is not None:
         if any(not _differ(u, configured, channel) for u, _ in states[1:]):
             return configured, "config"
+        if stated_source == "header" and len(states) == 1 and \
+                unit_fits(stated, channel) is None:
+            return configured, "config"  # a qualifier in the name ('TORQUE (max)'), no unit
         if stated is not None and not _same_unit(stated, configured, channel, file):
             raise InputError(f"inconsistent unit for {channel.name}: column "
                              f"'{printable(column)}' says '{printable(stated)}' but [channels] "
@@ -610,8 +627,17 @@ def map_channels(columns: list[str], file_units: dict, config_channels: dict, *,
         unit, source = _unit_for(channel, column, name_unit, file_units, spec, file)
         try:
             scale = factor(unit, channel, file=file)
-        except InputError:
+        except InputError as exc:
             if channel.key != "time":
+                if source == "header" and unit_fits(unit, channel) is None:
+                    raise InputError(  # 'TORQUE (max)': a qualifier, not a unit
+                        f"column '{printable(column)}' ({channel.name}): unknown unit "
+                        f"'{printable(unit)}' in its name: no {channel.kind} unit is spelled "
+                        "so (a qualifier such as max or setpoint?)",
+                        file=file, fix=f"give the unit in [channels], e.g. {channel.key} = "
+                                       f'{{ column = "{printable(column)}", unit = '
+                                       f'"{channel.default_unit}" }}, or map another '
+                                       "column") from exc
                 raise
             scale = float("nan")  # e.g. "yyyy-mm-dd hh:mm:ss" over a timestamp column
         out[channel.key] = Mapping(channel, column, unit, source,

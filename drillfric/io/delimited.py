@@ -15,6 +15,7 @@ from __future__ import annotations
 import codecs
 import io
 import re
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +24,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.io.source import NULL_VALUES, RawSource
+from drillfric.io.text import printable
 
 #: Longest line read [characters] (documented in docs/ingestion.md): rig exports with a few
 #: hundred channels have lines of a few kB.
@@ -132,11 +134,10 @@ def sniff_csv(path: Path) -> CsvLayout:
     units_row = header and len(rows) > 1 and any(f for f in rows[1]) and not any(
         f and _is_value(f) for f in rows[1])
     body = rows[(1 + units_row) if header else 0:]
-    decimal = "," if delimiter != "," and any(
-        re.fullmatch(r"[-+]?\d*,\d+", f) for row in body for f in row) else "."
     n = len(rows[0])
     columns = [c or f"column {i}" for i, c in enumerate(rows[0])] if header else [
         str(i) for i in range(max(len(r) for r in rows))]
+    decimal = "." if delimiter == "," else _decimal_mark(body, columns, path)
     if header and len(set(columns)) < n:
         raise InputError("duplicate column names in the header", file=path,
                          fix="give every column a distinct name")
@@ -147,6 +148,50 @@ def sniff_csv(path: Path) -> CsvLayout:
                 units[col] = unit.strip("[]()")
                 units[("source", col)] = "units row"
     return CsvLayout(delimiter, decimal, header, units_row, columns, units, encoding)
+
+
+#: A value only a decimal comma writes (``12,5``), and one only a decimal dot writes — a
+#: dot that cannot group thousands (``0.050``, ``2210.000``, ``12.5``; ``17.240`` can).
+_COMMA_DECIMAL = re.compile(r"[-+]?\d*,\d+")
+_DOT_DECIMAL = re.compile(r"[-+]?\d*\.\d+")
+_DOT_GROUPED = re.compile(r"[-+]?[1-9]\d{0,2}(\.\d{3})+")
+
+
+def _decimal_mark(body: list[list[str]], columns: list[str], path: Path) -> str:
+    """The decimal mark of a file not delimited by commas, decided column by column: a
+    column with values like ``12,5`` votes for the comma, one with values only a dot writes
+    (``0.050``) for the dot. One column of the other kind — a remark of ``1,5`` beside
+    dot-decimal numbers — does not decide the file (issue 30, eleventh attack: every value
+    read 1000× as a dot grouping thousands); as many of each is refused.
+
+    Raises
+    ------
+    InputError
+        As many columns write a decimal comma as a decimal dot.
+    """
+    comma, dot = {}, {}
+    for row in body:
+        for i, f in enumerate(row):
+            if _COMMA_DECIMAL.fullmatch(f):
+                comma.setdefault(i, f)
+            elif _DOT_DECIMAL.fullmatch(f) and not _DOT_GROUPED.fullmatch(f):
+                dot.setdefault(i, f)
+    comma = {i: f for i, f in comma.items() if i not in dot}  # "1.5" and "1,5": no vote
+    if not comma:
+        return "."
+    if len(comma) > len(dot):
+        return ","
+    if len(comma) < len(dot):
+        return "."
+
+    def name(i: int) -> str:
+        return f"'{columns[i]}'" if i < len(columns) else f"column {i}"
+
+    c, d = next(iter(comma)), next(iter(dot))
+    raise InputError(f"the decimal mark cannot be told: column {name(c)} writes "
+                     f"'{comma[c]}' (a decimal comma), column {name(d)} '{dot[d]}' (a "
+                     "decimal dot), as many columns each way", file=path,
+                     fix="export the log with one decimal mark throughout")
 
 
 def _is_comment(line: str) -> bool:
@@ -161,6 +206,37 @@ def _is_comment(line: str) -> bool:
 
 
 _LINE_END = re.compile(r"(?<=\n)|(?<=\r)(?!\n)")
+
+
+class TextWarning(UserWarning):
+    """A delimited text file read with a repair (bytes that are not UTF-8 read as Latin-1)."""
+
+
+#: Bytes that are not UTF-8, as ``surrogateescape`` decodes them (U+DC80–U+DCFF).
+_NOT_UTF8 = re.compile("[\udc80-\udcff]")
+#: Files whose stray Latin-1 bytes were said (once a file in a process).
+_LATIN1_SAID: set[str] = set()
+
+
+def _latin1(text: str, path: Path | None) -> str:
+    """``text`` decoded as UTF-8 with ``surrogateescape``, its bytes that are not UTF-8
+    read as Latin-1 (the docs promise UTF-8 or Latin-1 text: a UTF-8 log with one Latin-1
+    ``°`` in an operator's note at row 3000 had been refused blaming its field counts —
+    issue 30, eleventh attack), and said once in a warning quoting the line."""
+    if not _NOT_UTF8.search(text):
+        return text
+    fixed = _NOT_UTF8.sub(lambda m: chr(ord(m[0]) - 0xDC00), text)
+    key = str(path)
+    if key not in _LATIN1_SAID:
+        _LATIN1_SAID.add(key)
+        at = _NOT_UTF8.search(text).start()
+        start = max(text.rfind("\n", 0, at), text.rfind("\r", 0, at)) + 1
+        line = re.split(r"\r|\n", fixed[start:], maxsplit=1)[0]
+        warnings.warn_explicit(
+            f"{path}: byte 0x{ord(text[at]) - 0xDC00:02X} is not UTF-8, which the file's top "
+            f"is: read as Latin-1, in the line '{printable(line, 60)}' (save the file as "
+            "UTF-8 to silence this)", TextWarning, __file__, 0, module=__name__, registry={})
+    return fixed
 
 
 class _CommentFree(io.TextIOBase):
@@ -193,7 +269,7 @@ class _CommentFree(io.TextIOBase):
                 text, self._tail = text[:cut], text[cut:]
                 if len(self._tail) > MAX_LINE_CHARS:
                     raise _too_long(self._path)
-            text = self._clean(text)
+            text = self._clean(_latin1(text, self._path))
             if text or not block:
                 return text
 
@@ -233,11 +309,18 @@ def open_delimited(path: Path) -> RawSource:
         try:
             with open(path, "rb") as raw:
                 raw.seek(start)
+                # a UTF-8 file's stray non-UTF-8 bytes: read as Latin-1 (_latin1)
                 fh = io.TextIOWrapper(io.BufferedReader(_Window(raw, stop)),
-                                      encoding=layout.encoding, newline="")
+                                      encoding=layout.encoding, newline="",
+                                      errors="surrogateescape"
+                                      if layout.encoding.startswith("utf-8") else "strict")
                 with pd.read_csv(_CommentFree(fh, path), chunksize=chunk_rows, **args) as reader:
                     yield from reader
-        except (pd.errors.ParserError, ValueError, UnicodeDecodeError) as exc:
+        except UnicodeDecodeError as exc:
+            raise InputError(f"bytes that are not {layout.encoding.upper()} text "
+                             f"({printable(str(exc), 80)})", file=path,
+                             fix="save the file as UTF-8") from exc
+        except (pd.errors.ParserError, ValueError) as exc:
             raise InputError(f"cannot parse as delimited text ({_parser_problem(exc)})",
                              file=path,
                              fix="check that every row has the same number of fields") from exc

@@ -28,6 +28,7 @@ Every failure is an :class:`~drillfric.errors.InputError` naming the file.
 from __future__ import annotations
 
 import codecs
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -336,7 +337,8 @@ def _plain_layout(node, path: Path):
 
     if isinstance(node, h5py.Dataset) and node.dtype.names:
         columns = list(node.dtype.names)
-        _refuse_objects(path, [node.dtype[c] for c in columns])
+        _refuse_objects(path, [node.dtype[c] for c in columns],
+                        [f"{node.name}: field {c}" for c in columns])
 
         def read(ds, a, b):
             block = ds[a:b]
@@ -346,20 +348,32 @@ def _plain_layout(node, path: Path):
     if not isinstance(node, h5py.Group):
         raise InputError(f"HDF5 node '{_printable(node.name)}' is not a table", file=path,
                          fix="store a group of 1-D datasets or a pandas table")
-    datasets = {k: v for k, v in members(node, path).items()
-                if isinstance(v, h5py.Dataset) and v.ndim == 1}
+    found = {k: v for k, v in members(node, path).items() if isinstance(v, h5py.Dataset)}
+    # an (N, 1) dataset is a column (MATLAB and some writers store vectors so); it had been
+    # left out in silence: "required channel surface_rpm not found" (issue 30, eleventh
+    # attack). A dataset of another shape is no column, and a warning names it.
+    datasets = {k: v for k, v in found.items()
+                if v.ndim == 1 or v.ndim == 2 and v.shape[1] == 1}
+    for k, v in found.items():
+        if k not in datasets:
+            warnings.warn_explicit(
+                f"{path}: HDF5 dataset '{_printable(v.name)}' has shape {v.shape}, not one "
+                "value per row (N or N×1): not read as a column", Hdf5Warning, __file__, 0,
+                module=__name__, registry={})
     lengths = {len(v) for v in datasets.values()}
     if not datasets or len(lengths) != 1:
         raise InputError(f"HDF5 group '{_printable(node.name)}' needs 1-D datasets of equal "
                          "length (one per channel)", file=path,
                          fix="write one dataset per column, all with the same length")
-    _refuse_objects(path, [v.dtype for v in datasets.values()])
+    _refuse_objects(path, [v.dtype for v in datasets.values()],
+                    [v.name for v in datasets.values()])
     columns = list(datasets)
     units = {k: _attr_text(v.attrs.get("unit", v.attrs.get("units")))
              for k, v in datasets.items()}
 
     def read(group, a, b):
-        return pd.DataFrame({c: _decoded(_member(group, c, path)[a:b]) for c in columns})
+        return pd.DataFrame({c: _decoded(_member(group, c, path)[a:b].reshape(-1))
+                             for c in columns})
 
     return columns, {k: u for k, u in units.items() if u}, lengths.pop(), read
 
@@ -381,7 +395,8 @@ def _pandas_table_layout(node, path: Path):
         names = _block_names(kind, path) if kind is not None else [field]
         fields.append((field, names, _attr_text(table.attrs.get(f"{field}_dtype")) or ""))
         columns += names
-    _refuse_objects(path, [table.dtype[f] for f, _, _ in fields])
+    _refuse_objects(path, [table.dtype[f] for f, _, _ in fields],
+                    [f"{table.name}: field {f}" for f, _, _ in fields])
     index_kind = _attr_text(table.attrs.get("index_kind")) or ""
     index_name = None
     if index_kind.startswith("datetime64"):
@@ -417,7 +432,7 @@ def _pandas_fixed_layout(node, path: Path, kind: str):
         if not isinstance(values, h5py.Dataset) or _attr_text(
                 values.attrs.get("CLASS")) != "ARRAY":
             raise InputError(_PICKLED, file=path, fix=_PICKLE_FIX)
-        _refuse_objects(path, [values.dtype])
+        _refuse_objects(path, [values.dtype], [values.name])
         names = [_decoded_text(n) for n in _member(node, f"block{k}_items", path)[()]]
         blocks.append((k, names))
     columns = [_decoded_text(n) for n in _member(node, "axis0", path)[()]]
@@ -454,12 +469,24 @@ def _block_names(kind, path: Path) -> list[str]:
     return names
 
 
-def _refuse_objects(path: Path, dtypes) -> None:
-    """Object (``O``) and variable-length fields hold pickles or references: refused."""
-    for dtype in dtypes:
+class Hdf5Warning(UserWarning):
+    """Something of an HDF5 file not read (a dataset that is no column)."""
+
+
+def _refuse_objects(path: Path, dtypes, names=None) -> None:
+    """Object (``O``) and variable-length fields hold pickles or references: refused; so
+    are complex numbers (no reading is complex: they had been cast to real with numpy's
+    ComplexWarning, the imaginary part dropped — issue 30, eleventh attack), naming the
+    dataset."""
+    for k, dtype in enumerate(dtypes):
         base = dtype.base if dtype.subdtype else dtype
         if base.kind == "O" or base.kind == "V" and not base.names:
             raise InputError(_PICKLED, file=path, fix=_PICKLE_FIX)
+        if base.kind == "c":
+            name = _printable(names[k]) if names is not None else "a dataset"
+            raise InputError(f"HDF5 dataset '{name}' holds complex numbers ({base}): no "
+                             "channel of a surface log is complex", file=path,
+                             fix="store the readings as real numbers (float64)")
 
 
 # --------------------------------------------------------------------------- values

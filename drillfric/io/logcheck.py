@@ -25,6 +25,9 @@ SWAP_FLOOR_N = 10e3
 #: as swapped (the hook carries the block and the string; drilling puts part of the
 #: string's weight on the bit, never more than the hook holds but for moments).
 SWAP_SHARE = 0.9
+#: Sample spacing [s] below which a time column that gives nothing to estimate is suspected
+#: of being in minutes or hours read as seconds (above 250 Hz: faster than rig surface logs).
+FAST_SPACING_S = 1.0 / 250.0
 
 
 class LogCheck:
@@ -51,6 +54,8 @@ class LogCheck:
         # rows whose hole depth reads above the bit depth by more than on_bottom_m, the
         # most it does [m] and the first such row's time [s]
         self.above, self.above_max_m, self.above_first_s = 0, 0.0, np.nan
+        # consecutive samples turning above the rotation threshold: now, and the most so far
+        self.turn_run = self.turn_longest = 0
 
     def feed(self, chunk: pd.DataFrame) -> None:
         """Take in one canonical chunk (the first one also checks the sample spacing)."""
@@ -79,6 +84,7 @@ class LogCheck:
                 self.above += int(over.size)
                 self.above_max_m = max(self.above_max_m, float(excess[over].max()))
         rpm = chunk["surface_rpm"].to_numpy(float)
+        self._runs(np.abs(rpm) > self.well.config.segmentation.rotating_rpm)
         rpm = rpm[np.isfinite(rpm)]
         if rpm.size:
             fast = np.abs(rpm) > self.well.config.segmentation.rotating_rpm
@@ -87,13 +93,28 @@ class LogCheck:
             self.rpm_min = min(self.rpm_min, float(rpm.min()))
             self.rpm_max = max(self.rpm_max, float(rpm.max()))
 
+    def _runs(self, fast: np.ndarray) -> None:
+        """Carry the longest run of consecutive turning samples across chunks."""
+        if not fast.size:
+            return
+        if fast.all():
+            self.turn_run += fast.size
+        else:
+            stops = np.flatnonzero(~fast)
+            head = int(stops[0])  # turning samples continuing the last chunk's run
+            edges = np.diff(np.concatenate(([-1], stops, [fast.size]))) - 1
+            self.turn_longest = max(self.turn_longest, self.turn_run + head, int(edges.max()))
+            self.turn_run = int(fast.size - 1 - stops[-1])
+        self.turn_longest = max(self.turn_longest, self.turn_run)
+
     def state(self) -> dict:
         """The counters (plain values and arrays)."""
         return {"rows": self.rows, "finite": dict(self.finite), "turning": self.turning,
                 "backwards": self.backwards, "rpm_range": np.array([self.rpm_min, self.rpm_max]),
                 "spacing_s": self.spacing_s,
                 "loads": np.array([self.loaded, self.wob_over, self.wob_sum, self.hook_sum]),
-                "hole_above": np.array([self.above, self.above_max_m, self.above_first_s])}
+                "hole_above": np.array([self.above, self.above_max_m, self.above_first_s]),
+                "turn_runs": np.array([self.turn_run, self.turn_longest])}
 
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state`."""
@@ -106,6 +127,9 @@ class LogCheck:
         if above is not None:
             self.above, self.above_max_m = int(above[0]), float(above[1])
             self.above_first_s = float(above[2])
+        runs = state.get("turn_runs")
+        if runs is not None:
+            self.turn_run, self.turn_longest = int(runs[0]), int(runs[1])
         loads = state.get("loads")
         if loads is not None:
             self.loaded, self.wob_over = int(loads[0]), int(loads[1])
@@ -214,6 +238,34 @@ class LogCheck:
                            f"{60.0 * dt:.3g} s apart), " + _say_unit(time, "min"))
         return out
 
+    def time_unit_check(self, records) -> None:
+        """Refuse a run that estimated nothing because its time column, unlabelled or
+        labelled seconds, is in minutes or hours: samples less than
+        :data:`FAST_SPACING_S` apart, no rotation long enough, and the unit in which the
+        samples are 0.01–60 s apart and the longest turning stretch lasts
+        ``segmentation.min_segment_s`` (issue 30, eleventh attack: a 1-Hz log in hours ended
+        "the surface speed never exceeds 2 RPM … (highest: 62.2 RPM)", exit 0)."""
+        time = self.well.mappings.get("time")
+        dt = self.spacing_s
+        if (time is None or time.unit == CLOCK_UNIT or not np.isfinite(dt)
+                or not 0.0 < dt < FAST_SPACING_S or not self.turn_longest
+                or any(not str(r.message or "").startswith("too short") for r in records)):
+            return
+        minimum = self.well.config.segmentation.min_segment_s
+        for unit, name, scale in (("min", "minutes", 60.0), ("h", "hours", 3600.0)):
+            spacing, longest = dt * scale, self.turn_longest * dt * scale
+            if 0.01 <= spacing <= 60.0 and longest >= minimum:
+                said = ("nothing in the file or the configuration says" if
+                        time.source == "default" else f"from the {time.source}")
+                raise InputError(
+                    f"time column '{printable(time.column)}' read in "
+                    f"'{printable(time.unit)}' ({said}) has samples {dt:.3g} s apart "
+                    f"({1.0 / dt:.4g} Hz) and turns for {self.turn_longest * dt:.3g} s at "
+                    f"most, so nothing could be estimated: is it in {name}? (samples "
+                    f"{spacing:.3g} s apart, the longest rotation {longest:.4g} s)",
+                    file=self.well.files.data,
+                    fix=f"if the time is in {name}, " + _say_unit(time, unit))
+
     def hole_above_note(self) -> str | None:
         """A warning when the hole depth read above the bit depth (by more than
         ``segmentation.on_bottom_m``), which cannot be: the bit is never below the hole's
@@ -241,6 +293,13 @@ class LogCheck:
             return None
         threshold = self.well.config.segmentation.rotating_rpm
         top = f"{self.rpm_max:.4g} RPM" if np.isfinite(self.rpm_max) else "no value"
+        if self.turn_longest:  # it does exceed it, never for long enough
+            dt = self.spacing_s
+            lasted = f" (at most {self.turn_longest * dt:.3g} s)" if np.isfinite(dt) else ""
+            return (f"no rotating segment found: the surface speed exceeds "
+                    f"segmentation.rotating_rpm = {threshold:.4g} RPM (highest: {top}) only "
+                    f"for less than segmentation.min_rotation_s{lasted} — check the time "
+                    "column's unit; nothing was estimated")
         return (f"no rotating segment found: the surface speed never exceeds "
                 f"segmentation.rotating_rpm = {threshold:.4g} RPM for "
                 f"segmentation.min_rotation_s (highest: {top}) — nothing was estimated")

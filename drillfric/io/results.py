@@ -263,11 +263,57 @@ def remove_empty(folders: list[Path]) -> None:
             return
 
 
-def check_distinct(outputs: list[tuple[str, str]]) -> None:
-    """Refuse wells of one run or fleet that would write the same ``OUT/NAME``.
+def name_key(name: str) -> str:
+    """``name`` as a file system compares it: NFC (macOS folds NFD into it) and each
+    character's simple case mapping — one character to one character, as NTFS's upcase
+    table and APFS's case folding do. ``casefold`` expands ``ß`` to ``ss`` and had taken
+    ``Maß`` and ``MASS`` for one directory, which no file system does (issue 30, eleventh
+    attack).
 
-    ``outputs`` are (dir_name, what names it: the well's file or manifest row). Names are
-    compared case-insensitively (OUT may be on a case-insensitive file system).
+    Examples
+    --------
+    >>> name_key("Maß") == name_key("MASS"), name_key("WELL") == name_key("well")
+    (False, True)
+    >>> name_key("Ma\u1e9e") == name_key("Maß"), name_key("ΟΔΟΣ") == name_key("οδος")
+    (True, True)
+    """
+    import unicodedata
+
+    def simple(c: str, how) -> str:
+        mapped = how(c)
+        return mapped if len(mapped) == 1 else c
+
+    return "".join(simple(simple(c, str.upper), str.lower)
+                   for c in unicodedata.normalize("NFC", name))
+
+
+def collisions(outputs: list[tuple[str, str]]) -> dict[int, tuple[int, str]]:
+    """Of ``outputs`` — (dir_name, what names it: the well's file or manifest row) — those
+    that would write the ``OUT/NAME`` of an earlier one: by index, the earlier one's index
+    and a line naming both. Names are compared as a case-insensitive file system compares
+    them (:func:`name_key`: OUT may be on one)."""
+    seen: dict[str, int] = {}
+    clash: dict[int, tuple[int, str]] = {}
+    for i, (dir_name, source) in enumerate(outputs):
+        key = name_key(dir_name)
+        if key not in seen:
+            seen[key] = i
+            continue
+        first, where = seen[key], ""
+        if outputs[first][0] != dir_name:
+            where = (f" and OUT/{outputs[first][0]} (one directory on a case-insensitive "
+                     "file system)")
+        clash[i] = first, (f"{outputs[first][1]} and {source} would both write "
+                           f"OUT/{dir_name}{where}: one well's results would be lost")
+    return clash
+
+
+#: How a clash of two wells' output directories is fixed.
+DISTINCT_FIX = "give each well its own [well] name (or 'well' column in a manifest)"
+
+
+def check_distinct(outputs: list[tuple[str, str]]) -> None:
+    """Refuse wells of one run that would write the same ``OUT/NAME`` (:func:`collisions`).
 
     Raises
     ------
@@ -276,14 +322,8 @@ def check_distinct(outputs: list[tuple[str, str]]) -> None:
     """
     from drillfric.errors import InputError
 
-    seen: dict[str, str] = {}
-    for dir_name, source in outputs:
-        key = dir_name.casefold()
-        if key in seen:
-            raise InputError(f"{seen[key]} and {source} would both write OUT/{dir_name}: one "
-                             "well's results would be lost", fix="give each well its own "
-                             "[well] name (or 'well' column in a manifest)")
-        seen[key] = source
+    for _, line in collisions(outputs).values():
+        raise InputError(line, fix=DISTINCT_FIX)
 
 
 #: The file that marks a result directory as stale: a later run of its well failed.

@@ -26,6 +26,7 @@ nanoseconds that a microsecond column cannot hold.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -526,6 +527,8 @@ class TimeTracker:
         if pd.api.types.is_datetime64_any_dtype(values):
             return self._nanoseconds(values.reset_index(drop=True))
         text = values.astype("string").str.strip()
+        if text.str.contains(",", regex=False).any():  # ISO 8601's decimal comma: 12:00:00,05
+            text = text.str.replace(_COMMA_FRACTION, r"\1.\2", regex=True)
         self._same_zoning(text)
         for utc in (False, True):  # several UTC offsets (a daylight-saving change): to UTC
             try:
@@ -537,6 +540,13 @@ class TimeTracker:
         bad = np.flatnonzero(stamps.isna().to_numpy() & _present(text))
         row = self._rows_seen + (bad[0] if bad.size else 0) + 1
         shown = printable(text.iloc[bad[0]], 30) if bad.size else ""
+        if bad.size and _LEAP_SECOND.search(str(text.iloc[bad[0]])):
+            raise InputError(f"time column '{printable(self.column)}': '{shown}' at data row "
+                             f"{row} is a leap second (23:59:60): drillfric's time axis counts "
+                             "UTC as POSIX does, without leap seconds, so its samples would "
+                             "overlay the next second's", file=self.file,
+                             fix="export the time as seconds (a time_s column) or with the "
+                                 "leap second smeared (as NTP servers of Google and AWS do)")
         raise InputError(f"time column '{printable(self.column)}': cannot read '{shown}' at "
                          f"data row "
                          f"{row} as seconds or an ISO 8601 timestamp", file=self.file,
@@ -584,6 +594,10 @@ class TimeTracker:
 
 #: A UTC offset (or ``Z``) after a time of day, as ISO 8601 writes it.
 _OFFSET = r"\d{2}:\d{2}(?::\d{2}(?:[.,]\d*)?)?\s*(?:[Zz]|UTC|[+-]\d{2}(?::?\d{2})?)$"
+#: ISO 8601's decimal comma in the seconds (``12:00:00,05``), read as a point.
+_COMMA_FRACTION = r"(\d{2}:\d{2}:\d{2}),(\d)"
+#: A leap second's time of day (``23:59:60``, ``23:59:60.5``).
+_LEAP_SECOND = re.compile(r"\d{2}:\d{2}:60(?:[.,]\d*)?(?:Z|[+-]\d{2}:?\d{2})?$")
 
 
 def holds_timestamps(values: pd.Series) -> bool:

@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 from dataclasses import dataclass, replace
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from drillfric.config import read_toml
@@ -51,6 +51,11 @@ MAX_SPREAD_S = 5.0
 #: UTC-12 to UTC+14): a frame dated later is a wrong clock, not recorded — it would make
 #: every true frame after it look "before the previous one" and be dropped for good.
 MAX_AHEAD_S = 86400.0
+#: A frame's time of day within this of midnight on either side [s]: a time of day that
+#: wraps from the last to the first :data:`MIDNIGHT_WINDOW_S` of a day under an unchanged
+#: date is midnight passing on a recorder whose DATE item does not roll over (issue 30,
+#: eleventh attack: every frame after midnight had been dropped as "before" the previous).
+MIDNIGHT_WINDOW_S = 600.0
 
 
 @dataclass(frozen=True)
@@ -149,6 +154,59 @@ class FrameClock:
         self._burst_s: float | None = None  # arrival of the last burst that brought frames
         self._step: float | None = None  # spacing of this burst's frames without date/time
         self.out_of_order = 0
+        self._sent: datetime | None = None  # the last date/time as the recorder sent it
+        self._days = 0  # days added to the recorder's date (a DATE that did not roll over)
+
+    def rolled(self, clock: datetime | None) -> tuple[datetime | None, datetime | None]:
+        """``clock`` as the recorder sent it, with the days its DATE item failed to roll
+        over at midnight added; and, when this frame is such a midnight, the date and time
+        sent before it (else None). A time of day wrapping from the day's last
+        :data:`MIDNIGHT_WINDOW_S` to its first under one date is the next day (and back
+        again, a frame sent anew from before midnight, the day before); the recorder's date
+        moving on its own ends the correction.
+
+        Examples
+        --------
+        >>> fc = FrameClock(None)
+        >>> fc.rolled(datetime(2024, 12, 1, 23, 59, 59))[1] is None
+        True
+        >>> fc.rolled(datetime(2024, 12, 1, 0, 0, 0))[0]
+        datetime.datetime(2024, 12, 2, 0, 0)
+        >>> fc.rolled(datetime(2024, 12, 1, 0, 0, 1))
+        (datetime.datetime(2024, 12, 2, 0, 0, 1), None)
+        """
+        if clock is None:
+            return None, None
+        sent, self._sent = self._sent, clock
+        if sent is None:  # a continued recording: its last line is the previous frame
+            return self._continued(clock)
+        if clock.date() != sent.date():
+            self._days = 0  # the recorder's own date moved: it is right again
+            return clock, None
+        before, after = (3600 * c.hour + 60 * c.minute + c.second for c in (sent, clock))
+        late, early = 86400.0 - MIDNIGHT_WINDOW_S, MIDNIGHT_WINDOW_S
+        midnight = before >= late and after < early
+        if midnight:
+            self._days += 1
+        elif before < early and after >= late and self._days:
+            self._days -= 1  # back before midnight: that day's frames, sent again
+        return clock + timedelta(days=self._days), sent if midnight else None
+
+    def _continued(self, clock: datetime) -> tuple[datetime, datetime | None]:
+        """The first frame of a continued recording: a time of day in the first
+        :data:`MIDNIGHT_WINDOW_S` of the day before the recording's last line, which lies
+        in the first minutes of its day, is a recorder whose date did not roll over (live
+        restarted after such a midnight had dropped every frame)."""
+        if self.last_s is None:
+            return clock, None
+        last = datetime.fromtimestamp(self.last_s + self.offset_s, UTC).replace(tzinfo=None)
+        early = MIDNIGHT_WINDOW_S
+        if (clock + timedelta(days=1)).date() == last.date() and \
+                3600 * clock.hour + 60 * clock.minute + clock.second < early and \
+                3600 * last.hour + 60 * last.minute + last.second < early:
+            self._days = 1
+            return clock + timedelta(days=1), last
+        return clock, None
 
     def burst(self, unstamped: int, frames: int, arrival_s: float) -> float | None:
         """``frames`` frames arrived together at ``arrival_s`` (monotonic [s]),
@@ -340,6 +398,9 @@ class Receiver:
         self.warn = warn or (lambda text: print(f"warning: {text}", file=sys.stderr))
         self._received = 0
         self._warned: set[str] = set()
+        #: Frames not recorded, by why (``"order"``, ``"future"``): said in one warning
+        #: line each as they start and counted by :meth:`dropped_note` at the end.
+        self.dropped: dict[str, int] = {}
 
     def run(self) -> None:
         """Connect, record, reconnect (waiting 0.2 s, doubling to ``reconnect_max_s``)
@@ -441,24 +502,48 @@ class Receiver:
                           f"previous burst, {step:.3g} s apart")
                        + "; frames carrying their date and time (items 0105, 0106) are "
                          "timed exactly")
-        for frame, stamp in zip(frames, stamps, strict=True):
+        for frame, sent in zip(frames, stamps, strict=True):
             # the row takes a frame's items only once the frame is recorded: a frame refused
             # for its clock gave its values to the next frame (issue 30, tenth attack)
+            stamp, previous = self.clock.rolled(sent)
+            if previous is not None:  # once a night (a frame sent again repeats no midnight)
+                self._once(f"midnight {stamp:%Y-%m-%d}",
+                           f"{self.address}: a frame dated {sent:%Y-%m-%d %H:%M:%S} follows "
+                           f"one of {previous:%Y-%m-%d %H:%M:%S}: a recorder whose date (item "
+                           f"0105) does not roll over at midnight; recorded as "
+                           f"{stamp:%Y-%m-%d} from here (set the recorder's date)")
             if self.clock.ahead(stamp, wall):
-                self._once("future", f"{self.address}: a frame dated {stamp:%Y-%m-%d %H:%M:%S}"
-                                     ", more than a day after this computer's clock: not "
-                                     "recorded (see the rig clock)")
+                self._drop("future", f"{self.address}: a frame dated "
+                                     f"{stamp:%Y-%m-%d %H:%M:%S}, more than a day after this "
+                                     "computer's clock: not recorded (see the rig clock)")
                 continue
             t = self.clock.time_s(stamp, arrival, wall)
             if t is None:
-                self._once("order", f"{self.address}: a frame's date and time lie before the "
-                                    "previous frame's: not recorded (see the rig clock)")
+                self._drop("order", f"{self.address}: a frame dated "
+                                    f"{stamp:%Y-%m-%d %H:%M:%S} lies before the previous "
+                                    "frame's date and time: not recorded (see the rig clock; "
+                                    "the count follows at the end)")
                 continue
             self.recording.write(t, self.setup.row.update(frame))
             self.frames += 1
         if not self.frames and self._received > NOT_WITS_BYTES:
             self._once("garbage", f"{self.address}: {self._received} bytes without one WITS "
                                   "level 0 frame ('&&' … '!!'): is this a WITS0 port?")
+
+    def _drop(self, kind: str, text: str) -> None:
+        self.dropped[kind] = self.dropped.get(kind, 0) + 1
+        self._once(kind, text)
+
+    def dropped_note(self) -> str | None:
+        """One line counting the frames not recorded for their date and time, or None."""
+        if not self.dropped:
+            return None
+        why = {"order": "dated before the previous frame",
+               "future": "dated more than a day after this computer's clock"}
+        parts = [f"{n} {why[kind]}" for kind, n in sorted(self.dropped.items())]
+        total = sum(self.dropped.values())
+        return (f"{self.address}: {total} of {total + self.frames} frames not recorded ("
+                + "; ".join(parts) + "): see the rig clock")
 
     def _once(self, kind: str, text: str) -> None:
         if kind not in self._warned:

@@ -250,6 +250,7 @@ class Engine:
             raise InputError("no data rows", file=self.well.files.data,
                              fix="check that the file holds samples below its header")
         self.check.finish(self.tracker.duplicates)
+        self.check.time_unit_check(self.records)
         warnings = self.warnings + [w for w in (
             self.tracker.conflicts_note(self.check.rows),
             self.check.duplicates_note(self.tracker.duplicates),
