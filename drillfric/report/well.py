@@ -141,8 +141,8 @@ class Broomstick:
 def _header(data: ResultData, units: Units) -> dict:
     summary, seg = data.summary, data.segments
     inputs = summary.get("inputs") or {}
-    files = [(kind, str(v.get("path", "—")), str(v.get("sha256", "—")))
-             for kind, v in inputs.items() if isinstance(v, dict)]
+    files = [(kind, str(v["path"]), str(v.get("sha256", "—")))
+             for kind, v in inputs.items() if isinstance(v, dict) and "path" in v]
     string_columns, string_rows = string_table(summary.get("config") or {}, units)
     zone = str(summary.get("friction_zone") or "").replace("_", " ") or zone_text(seg)
     return {
@@ -191,6 +191,23 @@ def skew_text(skew: dict | None) -> str:
         return f"{skew['lag_s']:+.2f} s, configured ([channels] lag_s)"
     return (f"{skew['lag_s']:+.2f} ± {skew['uncertainty_s']:.2f} s, identified "
             f"({skew.get('segments_identified', 0)} segments)")
+
+
+def _zone_line(head: dict) -> str:
+    """The friction zone and profile in one line, the zone left out where the profile
+    starts by naming it ("effective — effective friction factor over …").
+
+    Examples
+    --------
+    >>> _zone_line({"zone": "effective", "profile": "effective friction factor; step law"})
+    'effective friction factor; step law'
+    >>> _zone_line({"zone": "open hole", "profile": "cased = 0.8 × open"})
+    'open hole — cased = 0.8 × open'
+    """
+    zone, profile = head["zone"], head["profile"]
+    if zone and profile.startswith(zone):
+        return profile
+    return " — ".join(x for x in (zone, profile) if x)
 
 
 def _profile_text(summary: dict, depth_indexed: bool) -> str:
@@ -733,7 +750,7 @@ def headline_lines(head: dict) -> list[tuple[str, bool]]:
                       f"{plural(head['apparent']['count'], 'converged on-bottom ' + what)})",
                       True))
     lines.append((f"μ_s (consensus): {head['mu_s']}", True))
-    zone = " — ".join(x for x in (head["zone"], head["profile"]) if x)
+    zone = _zone_line(head)
     if zone:
         lines.append((f"friction zone: {zone}", False))
     counts = head["counts"]
@@ -826,7 +843,7 @@ def _header_lines(report: Report) -> list[list[str]]:
              ["apparent μ on bottom", head["apparent"]["value"] + " (bit torque included)"
               if head["apparent"] else "—"],
              ["μ_s (consensus)", head["mu_s"]],
-             ["friction zone", " — ".join(x for x in (head["zone"], head["profile"]) if x)
+             ["friction zone", _zone_line(head)
               or "—"],
              ["segments", ", ".join(f"{k} {v}" for k, v in counts.items())],
              ["units", head["units"]]]
