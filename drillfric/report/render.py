@@ -450,8 +450,10 @@ def string_table(config: dict, units: Units) -> tuple[list[str], list[list[str]]
     """The drill string of a configuration as ``(headings, rows)`` in display ``units``,
     top section first.
 
-    A missing length is the top section's "to the bit"; other missing values are the
-    defaults the run computed (steel area, OD/2 contact), shown as "default".
+    A missing length is the top section's "the rest, to the surface" (it fills the string
+    above the sections below it; "to the bit" had read as if it reached the bit); other
+    missing values are the defaults the run computed (steel area, OD/2 contact), shown as
+    "default".
     """
     sections = ((config.get("string") or {}).get("sections")) or []
     rows = []
@@ -460,7 +462,8 @@ def string_table(config: dict, units: Units) -> tuple[list[str], list[list[str]]
         for key, _, quantity, scale, spec in STRING_COLUMNS:
             value = section.get(key) if isinstance(section, dict) else None
             if value is None:
-                row.append("to the bit" if key == "length_m" and index == 0 else "default")
+                row.append("the rest, to the surface" if key == "length_m" and index == 0
+                           else "default")
             elif not spec:
                 row.append(str(value))
             elif quantity:
