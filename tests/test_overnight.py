@@ -58,3 +58,19 @@ def test_wells_whose_friction_rose_within_a_new_segment_are_named():
     summary["segments"][3]["quality_flags"] = []
     assert not any("friction rose" in n for n in changes(summary, history, ran=True,
                                                          data_changed_utc=None)["notes"])
+
+
+def test_a_well_re_run_for_its_configuration_is_listed_though_nothing_moved():
+    """Regression (the fourth newcomer): demo3, re-run after its mud density changed (μ_k
+    0.279 → 0.281, within its spread, no new segment), was left out of "What changed" while
+    the two unchanged wells were listed. A re-run says why; a first night says nothing."""
+    from drillfric.fleet.run import _rerun_reason
+
+    history = [night(_summary(0.279, [0.2]), "d1")]
+    before = {"config_sha256": "a", "drillfric_version": "1"}
+    why = _rerun_reason(before, {"config_sha256": "b", "drillfric_version": "1"})
+    out = changes(_summary(0.281, [0.2]), history, ran=True, data_changed_utc=None, rerun=why)
+    assert out["notes"] == ["re-run: its configuration changed"]
+    assert _rerun_reason(before, {"config_sha256": "a", "drillfric_version": "1"}) is None
+    first = changes(_summary(0.281, [0.2]), [], ran=True, data_changed_utc=None, rerun=why)
+    assert not any(n.startswith("re-run") for n in first["notes"])

@@ -32,7 +32,7 @@ def night(summary: dict, utc: str) -> dict:
 
 
 def changes(summary: dict | None, history: list[dict], *, ran: bool,
-            data_changed_utc: str | None) -> dict:
+            data_changed_utc: str | None, rerun: str | None = None) -> dict:
     """What changed for one well tonight.
 
     Parameters
@@ -45,6 +45,11 @@ def changes(summary: dict | None, history: list[dict], *, ran: bool,
         Whether the well was processed tonight (else its data had not changed).
     data_changed_utc : str or None
         When its data last changed (for a well that did not run).
+    rerun : str or None
+        Why a well with earlier nights ran again though its data had not grown ("its
+        configuration changed", "drillfric changed"): the first note, so the well is listed
+        even when nothing else moved (the fourth newcomer's demo3, re-run for its mud density,
+        was left out of "What changed").
 
     Returns
     -------
@@ -58,7 +63,8 @@ def changes(summary: dict | None, history: list[dict], *, ran: bool,
         return {"new_segments": None, "notes": []}
     segments = summary.get("segments") or []
     before = history[-1]["segments"] if history else 0
-    notes = [plural(len(segments) - before, "new segment")] if len(segments) > before else []
+    notes = [f"re-run: {rerun}"] if rerun and history else []
+    notes += [plural(len(segments) - before, "new segment")] if len(segments) > before else []
     notes += _moved(summary.get("mu_k"), [h["mu_k"] for h in history[-HISTORY_NIGHTS:]
                                           if h.get("mu_k") is not None])
     severe = [s["id"] for s in segments[before:] if (s.get("stick_slip_severity") or 0.0)

@@ -595,7 +595,8 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
     before = manifest.wells.get(name) or {}
     history = list(before.get("history", [])) if isinstance(before, dict) else []
     summary = rec.get("summary") if entry["status"] == WellStatus.OK else None
-    changed = overnight.changes(summary, history, ran=True, data_changed_utc=None)
+    changed = overnight.changes(summary, history, ran=True, data_changed_utc=None,
+                                rerun=_rerun_reason(before, job.fingerprint))
     if summary is not None:
         entry["history"] = (history + [overnight.night(summary, now_utc())])[
             -overnight.HISTORY_NIGHTS:]
@@ -609,6 +610,18 @@ def _record(manifest: _Manifest, job: _Job, rec: dict, attempts: int,
                        stale_dir=stale, new_segments=changed["new_segments"],
                        changes=tuple(changed["notes"]),
                        first_run=summary is not None and not history)
+
+
+def _rerun_reason(before: dict, fingerprint: dict) -> str | None:
+    """Why a well of earlier nights ran again when not for new data (None: new data, or no
+    earlier night)."""
+    if not isinstance(before, dict) or not before:
+        return None
+    if before.get("config_sha256") != fingerprint.get("config_sha256"):
+        return "its configuration changed"
+    if before.get("drillfric_version") != fingerprint.get("drillfric_version"):
+        return "drillfric changed"
+    return None
 
 
 def _mark_stale(manifest: _Manifest, name: str, job: _Job, rec: dict,
