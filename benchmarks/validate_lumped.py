@@ -257,7 +257,8 @@ def windows(est: pd.DataFrame, truth_t: np.ndarray, truth_w: np.ndarray) -> dict
 def truth_stats(t: np.ndarray, w: np.ndarray, a: float, b: float,
                 start: float | None = None) -> dict:
     """Stick-slip statistics of the truth over [start, b] as drillfric defines them
-    (``start``: the segment's ``stick_slip_from_s``, else 30 s or 30 % in)."""
+    (``start``: the segment's ``stick_slip_from_s``, else 30 s or 30 % in; ``b`` its
+    ``stick_slip_to_s``, else its end)."""
     start = a + min(30.0, 0.3 * (b - a)) if start is None else start
     m = (t >= start) & (t <= b)
     if not m.any():
@@ -292,7 +293,8 @@ def score(result, case: Case, rate: str, truth: dict, plant_cols: dict) -> dict:
     tt, tw = plant_cols["time_s"], plant_cols["bit_rpm"]
     traces = []
     for g in segs:
-        stats = truth_stats(tt, tw, g["t_start_s"], g["t_end_s"], g.get("stick_slip_from_s"))
+        stats = truth_stats(tt, tw, g["t_start_s"], g.get("stick_slip_to_s") or g["t_end_s"],
+                            g.get("stick_slip_from_s"))
         whole = truth_stats(tt, tw, g["t_start_s"], g["t_end_s"])
         row = {"id": g["id"], "resolved": bool(g.get("bit_speed_resolved")),
                "reason": g.get("bit_speed_reason"),

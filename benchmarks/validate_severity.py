@@ -73,11 +73,13 @@ def configs(folder: Path, name: str) -> tuple[Path, Path]:
 
 def truth(frame: pd.DataFrame, seg: dict, omega_c_rad_s: float) -> tuple[float, float]:
     """Stuck share and severity of the true bit speed on the segment's rows from
-    ``stick_slip_from_s`` (else after its start-up): the reported statistics' definitions."""
+    ``stick_slip_from_s`` (else after its start-up) to ``stick_slip_to_s``: the reported
+    statistics' definitions."""
     t = frame["time_s"].to_numpy(float)
     t0, t1 = seg["t_start_s"], seg["t_end_s"]
     start = seg.get("stick_slip_from_s") or t0 + min(STARTUP_S, 0.3 * (t1 - t0))
-    bit = frame["bit_rpm"].to_numpy(float)[(t >= start) & (t <= t1)] * RPM_TO_RAD_S
+    end = seg.get("stick_slip_to_s") or t1
+    bit = frame["bit_rpm"].to_numpy(float)[(t >= start) & (t <= end)] * RPM_TO_RAD_S
     stuck = float(np.mean(np.abs(bit) <= omega_c_rad_s))
     lo, hi = np.percentile(bit, (1.0, 99.0))
     return stuck, float((hi - lo) / (2.0 * abs(np.mean(bit))))

@@ -290,24 +290,29 @@ class SegmentRecord:
     residual_rms_rpm: float | None = _f("RPM", "RMS innovation of the reported observer pass")
     stick_slip_severity: float | None = _f("-", "(max − min)/(2·mean) of the estimated BHA "
                                                 "speed (the bit's without a mud motor) from "
-                                                "stick_slip_from_s to t_end_s (ensemble "
+                                                "stick_slip_from_s to stick_slip_to_s (ensemble "
                                                 "members pooled; ±12 %); null "
                                                 "where beyond its validated range (flag "
-                                                "stick_slip_beyond_validated) or not "
-                                                "determined (stick_slip_undetermined)")
+                                                "stick_slip_beyond_validated), not "
+                                                "determined (stick_slip_undetermined) or "
+                                                "below 0.1 (no stick-slip: not stated)")
     status: Status = _f("", "ok, skipped or failed", Status.OK)
     message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
     duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
     stuck_fraction: float | None = _f("-", "share of the time from stick_slip_from_s to "
-                                           "t_end_s the BHA is stuck, |ω_BHA| ≤ ω_c (the "
+                                           "stick_slip_to_s the BHA is stuck, |ω_BHA| ≤ ω_c (the "
                                            "bit's without a mud motor; ensemble members "
                                            "pooled; ±0.05); null where beyond its "
                                            "validated range or not determined")
     stick_slip_from_s: float | None = _f("s", "the stuck fraction and severity are taken "
-                                              "from this time to t_end_s: after the start-up "
-                                              "and after any creep whose break-free depends "
-                                              "on an unidentified μ_s (the rotation at its "
-                                              "set-point, not its transients)")
+                                              "from this time to stick_slip_to_s: after the "
+                                              "start-up and after any creep whose break-free "
+                                              "depends on an unidentified μ_s (the rotation at "
+                                              "its set-point, not its transients)")
+    stick_slip_to_s: float | None = _f("s", "...to this time: the last at which the top "
+                                            "drive's speed (1-s mean) was at 90 % of its "
+                                            "level, before the ramp to rest that ends the "
+                                            "rotation (a stop is not stick-slip)")
     mu_k_observer: float | None = _f("-", "observer consensus μ_k (first pass)")
     mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass)")
     mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")

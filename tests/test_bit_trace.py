@@ -327,3 +327,41 @@ def test_statistics_are_taken_after_the_transients_an_unidentified_mu_s_decides(
     assert statistics_from(t, ((0.0, 30.0),), ((120.0, 150.0),)) == pytest.approx(30.0, abs=.1)
     short = np.arange(0.0, 50.0, 0.1)
     assert statistics_from(short, ()) == pytest.approx(15.0, abs=0.1)
+
+
+STEADY_SCENARIO = """connection_s = 20.0
+[defaults]
+duration_s = 150.0
+rpm = 120.0
+ramp_s = 10.0
+[[stand]]
+bit_depth_m = 2210.0
+"""
+
+
+@pytest.mark.slow
+def test_a_steady_stands_stop_is_not_stick_slip(tmp_path):
+    """Regression (issue 34, validate_edr): a steady 120-RPM stand (μ_s = μ_k) had its
+    stick-slip statistics taken to the segment's end, through the ramp to rest: a severity
+    of 0.62 on this stand (validate_trust's steady plant 0.55), its truth graded over the
+    same span agreeing. They end where the set-point does (`stick_slip_to_s`, before the
+    stop): here the bit's own torsional swing, 0.14, read within ±12 % of the truth."""
+    from drillfric.io.well import open_well
+    from drillfric.runner import run_well
+    from tests.conftest import DEMO, _simulated
+
+    (tmp_path / "demo.survey.csv").write_bytes((DEMO / "demo.survey.csv").read_bytes())
+    config = tmp_path / "steady.toml"
+    config.write_text((DEMO / "demo.toml").read_text().replace("mu_s = 0.6", "mu_s = 0.28"))
+    path = _simulated(tmp_path, "steady", config, STEADY_SCENARIO, seed=3)
+    result = run_well(open_well(path))
+    seg = result.summary["segments"][0]
+    assert seg["stick_slip_to_s"] < seg["t_end_s"] - 5.0  # before the 10-s stop
+    rows = result.estimates[(result.estimates["segment_id"] == 1)
+                            & (result.estimates["start_id"] == -1)]
+    bit = rows.loc[rows["time_s"].between(seg["stick_slip_from_s"], seg["stick_slip_to_s"]),
+                   "bit_rpm"].to_numpy(float)
+    assert seg["stuck_fraction"] == pytest.approx(np.mean(np.abs(bit) <= 30.0 / np.pi),
+                                                  abs=0.05)
+    assert seg["stick_slip_severity"] == pytest.approx(stick_slip_severity(bit), rel=0.12)
+    assert seg["stick_slip_severity"] < 0.3

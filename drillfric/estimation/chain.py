@@ -112,8 +112,8 @@ class SegmentEstimate:
         Severity of the ensemble's members pooled with their weights [-].
     stuck_fraction : float
         Share of the time the pooled members' bit turns no faster than ω_c [-].
-    stick_slip_from_s : float
-        Both taken from this time to the segment's end [s] (:func:`statistics_from`).
+    stick_slip_from_s, stick_slip_to_s : float
+        Both taken over this span [s] (:func:`statistics_from`, :func:`statistics_to`).
     mu_k_observer, mu_s_observer : float
         Observer consensus (first pass) [-].
     mu_td : float or None
@@ -190,6 +190,7 @@ class SegmentEstimate:
     stick_slip_severity: float
     stuck_fraction: float
     stick_slip_from_s: float
+    stick_slip_to_s: float
     mu_k_observer: float
     mu_s_observer: float
     mu_td: float | None
@@ -760,15 +761,16 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     tick(0.2)
     fitted = fitted_result()
     rig = top_drive_inertia(settings, models, fitted)
-    trace, kinematics, stats_from = trace_verdict(settings, models, refined, verdict,
-                                                  final, bit, skewed, rig)
+    trace, kinematics, (stats_from, stats_to) = trace_verdict(settings, models, refined,
+                                                              verdict, final, bit, skewed, rig)
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
     trend = moving_friction(settings, models, verdict, fitted)
     estimate = _assemble(settings, models, data, Steps(starts, first, diag, refined, verdict,
                                                        trace, final, bit, fitted, terms,
-                                                       kinematics, stats_from, trend))
+                                                       kinematics, stats_from, trend,
+                                                       stats_to))
     return replace(estimate, skew=skewed, inertia=rig)
 
 
@@ -800,12 +802,13 @@ def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Ver
 def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch.BatchResult,
                   verdict: Verdict, final: ObserverRecord, bit: BitSpeedEstimate,
                   skewed: skew.Skew | None = None, rig: inertia.Inertia | None = None
-                  ) -> tuple[TraceVerdict, bit_trace.KinematicCheck, float]:
+                  ) -> tuple[TraceVerdict, bit_trace.KinematicCheck, tuple[float, float]]:
     """Step 8: the checks of the seeded trace (whole-segment kinematics, window by window,
     the members' statistics) and what of it the rules of
     :func:`~drillfric.estimation.verdict.decide_trace` show (``skewed``: the channels'
-    timing, :func:`drillfric.estimation.skew.correct`); with the time from which the
-    stuck fraction and severity are taken [s] (:func:`statistics_from`)."""
+    timing, :func:`drillfric.estimation.skew.correct`); with the span over which the
+    stuck fraction and severity are taken [s] (:func:`statistics_from`,
+    :func:`statistics_to`)."""
     kinematics = bit_trace.check_segment_trace(models.string, models.meas, final.time_s,
                                                bit.rad_s, settings.speed_noise_rad_s)
     unknown = _unknown_spans(models, refined, final.time_s)
@@ -815,7 +818,8 @@ def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch
     runaway = bit_trace.runs_away(kinematics, float(settled[-1] - settled[0])
                                   if settled.size > 1 else 0.0)
     start = statistics_from(final.time_s, unknown, windows.withheld)
-    span = final.time_s >= start
+    end = statistics_to(models.meas.time_s, models.meas.surface_rad_s, start)
+    span = (final.time_s >= start) & (final.time_s <= end)
     severity = bit_trace.mixture_severity(final.bit_rad_s_est[span], bit.weights[span])
     trace = decide_trace(TraceEvidence(
         logging=bit_speed_resolution(models), on_bottom=models.on_bottom, check=kinematics,
@@ -828,7 +832,7 @@ def trace_verdict(settings: ChainSettings, models: SegmentModels, refined: batch
         skew_note=None if skewed is None or skewed.known else skewed.reason,
         inertia_note=None if rig is None else rig.reason,
         inertia_contradicted=rig is not None and rig.source == "contradicted"))
-    return trace, kinematics, start
+    return trace, kinematics, (start, end)
 
 
 def top_drive_inertia(settings: ChainSettings, models: SegmentModels,
@@ -855,6 +859,39 @@ def statistics_from(time_s: np.ndarray, unknown: tuple, withheld: tuple = ()) ->
     first = float(settled[0]) if settled.size else float(time_s[-1])
     over = [b for a, b in withheld if any(lo < b and hi > a for lo, hi in unknown)]
     return max([first] + [float(b) for _, b in unknown] + [float(b) for b in over])
+
+
+#: The rotation's set-point ends where the top drive's speed, averaged over
+#: :data:`SET_POINT_SMOOTH_S`, was last at this share of its level (its median over the
+#: statistics' span): the stop that ends a rotation — a ramp to rest — is not stick-slip.
+SET_POINT_SHARE = 0.9
+SET_POINT_SMOOTH_S = 1.0
+
+
+def statistics_to(time_s: np.ndarray, surface_rad_s: np.ndarray, start_s: float) -> float:
+    """Time to which the stuck fraction and severity are taken [s]: the last time the top
+    drive's speed (its :data:`SET_POINT_SMOOTH_S` mean) was at :data:`SET_POINT_SHARE` of
+    its level after ``start_s`` — the set-point's end, before the ramp to rest that ends
+    a rotation (a steady 120-RPM stand's 5-s stop had read a severity of 0.55, "moderate
+    stick-slip", and cut at a speed drop-out 0.05; docs/bit_speed.md "Stuck fraction and
+    severity").
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 100.0, 0.1)
+    >>> w = np.where(t < 90.0, 12.0, np.maximum(12.0 - 2.4 * (t - 90.0), 0.0))
+    >>> round(statistics_to(t, w, 10.0), 1)
+    90.5
+    """
+    span = time_s >= start_s
+    if span.sum() < 3:
+        return float(time_s[-1])
+    dt = float(np.median(np.diff(time_s)))
+    width = max(int(round(SET_POINT_SMOOTH_S / dt)), 1)
+    speed = np.convolve(np.abs(surface_rad_s), np.ones(width) / width, mode="same")
+    level = float(np.median(speed[span]))
+    at = np.flatnonzero(span & (speed >= SET_POINT_SHARE * level))
+    return float(time_s[at[-1]]) if at.size else float(time_s[-1])
 
 
 def _undetermined(final: ObserverRecord, bit: BitSpeedEstimate, span: np.ndarray,
@@ -980,6 +1017,7 @@ class Steps:
     kinematics: bit_trace.KinematicCheck
     stats_from_s: float
     trend: FrictionTrend | None = None
+    stats_to_s: float = float("inf")
 
 
 def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
@@ -990,7 +1028,7 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
     verdict, trace, refined, final, bit = (steps.verdict, steps.trace, steps.refined,
                                            steps.final, steps.bit)
     reported = diagnose(bit.record(final), settings.omega_c_rad_s)
-    span = final.time_s >= steps.stats_from_s
+    span = (final.time_s >= steps.stats_from_s) & (final.time_s <= steps.stats_to_s)
     members, weights = final.bit_rad_s_est[span], bit.weights[span]
     messages = list(verdict.messages)
     fits = refined.details.creep_fits
@@ -1001,6 +1039,8 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
     trend = steps.trend
     mu_k = trend.mean if trend is not None and trend.drift else verdict.mu_k
     drift_flags, drift_messages = drift_verdict(trend)
+    severity = bit_trace.mixture_severity(members, weights)
+    quiet = trace.statistics and bool(bit_trace.quiet_note(severity))
     return SegmentEstimate(
         mu_s=refined.mu_s, mu_k=mu_k, mu_s_identifiable=refined.mu_s_identifiable,
         mu_s_lower_bound=verdict.mu_s_lower_bound,
@@ -1008,16 +1048,18 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
         mu_k_spread=steps.diag.mu_k_spread, converged=trace.converged, method=verdict.method,
         mu_k_damping=refined.details.mu_k_damping if verdict.method is Method.BATCH else None,
         settling_time_s=steps.diag.settling_time_s, residual_rms_rpm=reported.residual_rms_rpm,
-        stick_slip_severity=bit_trace.mixture_severity(members, weights),
+        stick_slip_severity=None if quiet else severity,
         stuck_fraction=bit_trace.stuck_share(members, weights, settings.omega_c_rad_s),
         stick_slip_from_s=steps.stats_from_s,
+        stick_slip_to_s=min(steps.stats_to_s, float(final.time_s[-1])),
         mu_k_observer=steps.diag.mu_k, mu_s_observer=steps.diag.mu_s,
         mu_td=_td_cross_check(models, settings), T_N_Nm=models.observer.plant.T_N_Nm,
         flags=verdict.flags + trace.flags + drift_flags,
         messages=tuple(messages) + (() if drift_flags else  # the fit's ± is its window's
                                     _interval_note(refined, verdict, trace))
         + trace.messages + drift_messages
-        + _span_note(trace, final.time_s, steps.stats_from_s) + _dropped_note(models),
+        + _span_note(trace, final.time_s, steps.stats_from_s, steps.stats_to_s)
+        + ((bit_trace.quiet_note(severity),) if quiet else ()) + _dropped_note(models),
         starts=steps.starts, first=steps.first, final=final, bit=bit,
         bit_rms_error_rpm=_bit_error(final.time_s, bit, data), td=models.td,
         mu_s_seed=verdict.mu_s_seed, evidence=steps.fitted, bit_speed=trace.bit_speed,
@@ -1029,12 +1071,14 @@ def _assemble(settings: ChainSettings, models: SegmentModels, data: SegmentData,
                                           verdict.flags + trace.flags), trend=trend)
 
 
-def _span_note(trace: TraceVerdict, time_s: np.ndarray, start_s: float) -> tuple[str, ...]:
+def _span_note(trace: TraceVerdict, time_s: np.ndarray, start_s: float,
+               end_s: float) -> tuple[str, ...]:
     """The message of statistics taken after transients the unidentified μ_s decides."""
     settled = time_s[settled_mask(time_s)]
     if not trace.statistics or not settled.size or start_s <= settled[0]:
         return ()
-    return (f"stuck fraction and severity over {start_s:.0f}–{time_s[-1]:.0f} s: the start-up "
+    return (f"stuck fraction and severity over {start_s:.0f}–{min(end_s, time_s[-1]):.0f} s: "
+            "the start-up "
             "and creeps before, whose break-free depends on the unidentified μ_s, are left "
             "out (docs/bit_speed.md)",)
 

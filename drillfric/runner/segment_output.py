@@ -163,7 +163,8 @@ def _bit_fields(est: SegmentEstimate) -> dict:
                   samples_dropped=est.samples_dropped, samples_held=est.samples_held)
     kept = dict(stick_slip_severity=est.stick_slip_severity,
                 stuck_fraction=est.stuck_fraction,
-                stick_slip_from_s=est.stick_slip_from_s) if est.bit_statistics else {}
+                stick_slip_from_s=est.stick_slip_from_s,
+                stick_slip_to_s=est.stick_slip_to_s) if est.bit_statistics else {}
     if not est.bit_speed.resolved:
         return logged | kept | dict(bit_speed_resolved=False,
                                     bit_speed_reason=est.bit_speed.reason)
