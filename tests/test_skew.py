@@ -243,15 +243,21 @@ def _stand_run(tmp_path: Path, lag_s: float, configured: float | None):
 @pytest.mark.slow
 def test_a_skewed_stand_is_corrected_and_mu_k_barely_moves(tmp_path):
     """End to end (issue 34 item 1): a torque logged 1 s late is identified within ±0.2 s
-    from the stand's set-point steps, reported in summary.json inputs, and the trace shown;
-    μ_k, a mean-torque fit, moves by < 2 % whether the lag is corrected or not (the means
-    of a shifted torque differ by its change over the lag at the ends only)."""
+    from the stand's set-point steps, reported in summary.json inputs, and the trace no
+    longer withheld for the skew (the top-drive inertia check, issue 34 item 2, withholds
+    it here: the steps that time the lag make the inertia correction 29 % of the torque's
+    variation, and the data do not confirm I_TD); μ_k, a mean-torque fit, moves by < 2 %
+    whether the lag is corrected or not (the means of a shifted torque differ by its change
+    over the lag at the ends only)."""
     found = _stand_run(tmp_path / "found", 1.0, None)
     skew_in = found.summary["inputs"]["channel_skew"]
     assert skew_in["source"] == "identified"
     assert abs(skew_in["lag_s"] - 1.0) <= skew.TOLERANCE_S
     seg = [g for g in found.summary["segments"] if g["status"] == "ok"][0]
-    assert seg["torque_lag_source"] == "identified" and seg["bit_speed_resolved"]
+    assert seg["torque_lag_source"] == "identified"
+    assert seg["bit_speed_resolved"] or (
+        "top-drive inertia" in seg["bit_speed_reason"]
+        and "skew" not in seg["bit_speed_reason"])
     ignored = _stand_run(tmp_path / "ignored", 1.0, 0.0)
     assert ignored.summary["inputs"]["channel_skew"]["source"] == "config"
     assert ignored.summary["mu_k"] == pytest.approx(found.summary["mu_k"], rel=0.02)
