@@ -295,7 +295,7 @@ class SegmentRecord:
                                                 "where beyond its validated range (flag "
                                                 "stick_slip_beyond_validated), not "
                                                 "determined (stick_slip_undetermined) or "
-                                                "below 0.1 (no stick-slip: not stated)")
+                                                "below 0.2 (no stick-slip: not stated)")
     status: Status = _f("", "ok, skipped or failed", Status.OK)
     message: str = _f("", "why skipped/failed, and what to know about the numbers", "")
     duration_s: float = _f("s", "t_end_s − t_start_s", 0.0)
