@@ -603,8 +603,10 @@ def axial_motion(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> AxialMot
     way = "running in" if sign > 0 else "pulling out"
     if p10 < (1.0 - AXIAL_STEADY) * speed or p90 > (1.0 + AXIAL_STEADY) * speed:
         return replace(motion, withheld=(
-            f"{name} at an unsteady speed: the pipe is {way} at {p10:.2g}–{p90:.2g} m/s "
-            f"(10th–90th percentile; median {speed:.2g} m/s), more than ±"
+            f"{name} at an unsteady speed: the pipe moves at {min(sign * p10, sign * p90):+.2f}"
+            f" to {max(sign * p10, sign * p90):+.2f} m/s (10th and 90th percentile, + down; "
+            f"{way} at a median "
+            f"{speed:.2f} m/s), more than ±"
             f"{100 * AXIAL_STEADY:.0f} % apart: one axial speed does not stand for the "
             "motion, μ and the bit speed are withheld (docs/segmentation.md)"))
     travel = speed * (motion.to_s - motion.from_s)
