@@ -12,6 +12,7 @@ import pytest
 from drillfric.errors import ConfigError, InputError
 from drillfric.io.parts import open_parts
 from drillfric.units import quantity_value
+from tests.test_live import _wait_for
 
 
 @pytest.mark.parametrize("text, unit", [
@@ -208,11 +209,7 @@ def test_wits0_recorder_whose_date_does_not_roll_over_at_midnight_loses_no_frame
     try:
         conn, _ = listener.accept()
         conn.sendall(frames)
-        deadline = threading.Event()
-        for _ in range(200):
-            if receiver.frames + sum(receiver.dropped.values()) >= 21:
-                break
-            deadline.wait(0.05)
+        _wait_for(lambda: receiver.frames + sum(receiver.dropped.values()) >= 21, 10)
         receiver.stop.set()
         conn.close()
     finally:
