@@ -109,9 +109,9 @@ def test_the_profile_equals_one_regression_per_lag(torque_on_speed, period_s):
     dt = max(float(np.median(np.diff(t))), skew.PROFILE_STEP_S)  # the profile's own grid
     grid = np.arange(t[0], t[-1], dt)
     k, hp = round(skew.SMOOTH_S / dt), round(skew.HIGH_PASS_S / dt)
-    omega = np.interp(grid, t, skew._moving_mean(rpm * RPM_TO_RAD_S, k))
-    speed, accel = skew._high_pass(omega, hp), skew._high_pass(np.gradient(omega, dt), hp)
-    tau = skew._high_pass(np.interp(grid, t, skew._moving_mean(torque, k)), hp)
+    omega = np.interp(grid, t, skew.moving_mean(rpm * RPM_TO_RAD_S, k))
+    speed, accel = skew.high_pass(omega, hp), skew.high_pass(np.gradient(omega, dt), hp)
+    tau = skew.high_pass(np.interp(grid, t, skew.moving_mean(torque, k)), hp)
     shifts = np.rint(profile.lags_s / dt).astype(int)
     rows = np.arange(hp + shifts[-1], grid.size - hp - shifts[-1])
     naive = [_naive_r2(tau[rows + s], speed[rows], accel[rows]) if torque_on_speed

@@ -886,9 +886,8 @@ def statistics_to(time_s: np.ndarray, surface_rad_s: np.ndarray, start_s: float)
     span = time_s >= start_s
     if span.sum() < 3:
         return float(time_s[-1])
-    dt = float(np.median(np.diff(time_s)))
-    width = max(int(round(SET_POINT_SMOOTH_S / dt)), 1)
-    speed = np.convolve(np.abs(surface_rad_s), np.ones(width) / width, mode="same")
+    speed = smooth(np.abs(surface_rad_s), float(np.median(np.diff(time_s))),
+                   SET_POINT_SMOOTH_S)
     level = float(np.median(speed[span]))
     at = np.flatnonzero(span & (speed >= SET_POINT_SHARE * level))
     return float(time_s[at[-1]]) if at.size else float(time_s[-1])

@@ -37,6 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drillfric.estimation.skew import high_pass, moving_mean
+
 #: Smoothing of both sides before the fit [s] (sensor noise, which the derivative
 #: amplifies; the accelerations of set-point steps, start-ups and a soft drive stay).
 SMOOTH_S = 1.0
@@ -86,21 +88,6 @@ class Inertia:
     reason: str | None = None
 
 
-def _moving_mean(values: np.ndarray, width: int) -> np.ndarray:
-    """Centred moving mean over ``width`` samples, zeros beyond the ends (as
-    ``np.convolve(values, ones(width)/width, "same")``) by a running sum: O(n) at any width."""
-    if width <= 1:
-        return values
-    lead = (width - 1) // 2
-    padded = np.concatenate((np.zeros(width - lead), values, np.zeros(lead)))
-    total = np.cumsum(padded)
-    return (total[width:] - total[:-width]) / width
-
-
-def _high_pass(values: np.ndarray, width: int) -> np.ndarray:
-    return values - _moving_mean(values, width)
-
-
 def identify(time_s: np.ndarray, surface_rad_s: np.ndarray, motor_torque_Nm: np.ndarray,
              model_torque_Nm: np.ndarray) -> tuple[float, float, float, float, float] | None:
     """The fit of the top-drive equation (docs/theory.md §5.4, eq. 5.4a) on a uniform grid.
@@ -122,9 +109,9 @@ def identify(time_s: np.ndarray, surface_rad_s: np.ndarray, motor_torque_Nm: np.
     rows = slice(hp + k, t.size - hp - k)
     if t.size - 2 * (hp + k) < 3 * hp:
         return None
-    accel = _high_pass(np.gradient(_moving_mean(surface_rad_s, k), dt), hp)[rows]
-    torque = _high_pass(_moving_mean(motor_torque_Nm, k), hp)[rows]
-    diff = _high_pass(_moving_mean(motor_torque_Nm - model_torque_Nm, k), hp)[rows]
+    accel = high_pass(np.gradient(moving_mean(surface_rad_s, k), dt), hp)[rows]
+    torque = high_pass(moving_mean(motor_torque_Nm, k), hp)[rows]
+    diff = high_pass(moving_mean(motor_torque_Nm - model_torque_Nm, k), hp)[rows]
     xx, xy, yy = float(accel @ accel), float(accel @ diff), float(diff @ diff)
     level = VARIATION_FLOOR * abs(float(np.mean(motor_torque_Nm[rows])))
     tt = max(float(torque @ torque), accel.size * level ** 2)

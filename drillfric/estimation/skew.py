@@ -98,17 +98,28 @@ class LagProfile:
     interval_s: float
 
 
-def _moving_mean(values: np.ndarray, width: int) -> np.ndarray:
-    """Centred moving mean over ``width`` samples (1: the values)."""
+def moving_mean(values: np.ndarray, width: int) -> np.ndarray:
+    """Centred moving mean over ``width`` samples, zeros beyond the ends (the values of
+    ``np.convolve(values, ones(width)/width, "same")``) by a running sum: O(n) at any width
+    (1: the values).
+
+    Examples
+    --------
+    >>> x = np.arange(10.0)
+    >>> bool(np.allclose(moving_mean(x, 4), np.convolve(x, np.ones(4) / 4, mode="same")))
+    True
+    """
     if width <= 1:
         return values
-    return np.convolve(values, np.ones(width) / width, mode="same")
+    lead = (width - 1) // 2
+    total = np.cumsum(np.concatenate((np.zeros(width - lead), values, np.zeros(lead))))
+    return (total[width:] - total[:-width]) / width
 
 
-def _high_pass(values: np.ndarray, width: int) -> np.ndarray:
+def high_pass(values: np.ndarray, width: int) -> np.ndarray:
     """The values less their centred moving mean over ``width`` samples: the same linear
     filter on both sides of τ_m = I_TD·dω₀/dt + Z·ω₀ keeps the equation (and its timing)."""
-    return values - _moving_mean(values, width)
+    return values - moving_mean(values, width)
 
 
 def lag_profile(time_s: np.ndarray, rpm: np.ndarray, torque_Nm: np.ndarray, *,
@@ -144,9 +155,9 @@ def lag_profile(time_s: np.ndarray, rpm: np.ndarray, torque_Nm: np.ndarray, *,
     dt = max(logged_dt, PROFILE_STEP_S)
     grid = np.arange(time_s[0], time_s[-1], dt)
     k, hp = max(1, round(SMOOTH_S / logged_dt)), max(3, round(HIGH_PASS_S / dt))
-    omega = np.interp(grid, time_s, _moving_mean(rpm * RPM_TO_RAD_S, k))
-    speed, accel = _high_pass(omega, hp), _high_pass(np.gradient(omega, dt), hp)
-    torque = _high_pass(np.interp(grid, time_s, _moving_mean(torque_Nm, k)), hp)
+    omega = np.interp(grid, time_s, moving_mean(rpm * RPM_TO_RAD_S, k))
+    speed, accel = high_pass(omega, hp), high_pass(np.gradient(omega, dt), hp)
+    torque = high_pass(np.interp(grid, time_s, moving_mean(torque_Nm, k)), hp)
     shifts = np.arange(-round((SEARCH_S + RIVAL_SPAN_S) / dt),
                        round((SEARCH_S + RIVAL_SPAN_S) / dt) + 1)
     rows = np.arange(hp + shifts[-1], grid.size - hp - shifts[-1])
