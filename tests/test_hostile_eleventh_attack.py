@@ -337,6 +337,34 @@ def test_one_clashing_pair_does_not_stop_the_whole_fleet(tmp_path):
     assert {"Maß", "MASS"} <= dirs and len(dirs & {"well", "WELL"}) == 1
 
 
+def test_two_wells_of_one_name_fail_and_the_fleet_carries_on(tmp_path):
+    """'A.csv' and 'A.parquet' in one fleet folder stopped the whole fleet (exit 2, no well
+    run; noticed after the eleventh attack). Both fail naming each other — neither is the
+    well 'A' that manifest.json can record — and 'B' runs."""
+    import json
+
+    import numpy as np
+    from click.testing import CliRunner
+    from drillfric.cli.main import cli
+
+    wells = tmp_path / "wells"
+    wells.mkdir()
+    t = np.arange(0.0, 20.0, 0.1)
+    frame = pd.DataFrame({"time_s": t, "surface_rpm": 0.0, "surface_torque_Nm": 0.0})
+    frame.to_csv(wells / "A.csv", index=False)
+    frame.to_parquet(wells / "A.parquet")
+    frame.to_csv(wells / "B.csv", index=False)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["-q", "fleet", str(wells), "--out", str(out),
+                                      "--no-report", "--workers", "1"])
+    assert result.exit_code == 1, result.output
+    assert "would both write OUT/A" in result.output, result.output
+    assert {p.name for p in out.iterdir() if p.is_dir()} == {"B"}
+    manifest = json.loads((out / "manifest.json").read_text())["wells"]
+    assert manifest["A"]["status"] == "failed" and "would both write" in manifest["A"]["message"]
+    assert manifest["B"]["status"] != "failed"
+
+
 # ---------------------------------------------------------------- F9 one Latin-1 byte
 def test_a_utf8_log_with_one_latin1_byte_at_row_3000_is_read_as_the_docs_promise(tmp_path):
     """A UTF-8 log with an operator's note '60°C' in Latin-1 at row 3000: 'cannot parse as
@@ -359,6 +387,41 @@ def test_a_utf8_log_with_one_latin1_byte_at_row_3000_is_read_as_the_docs_promise
     assert len(frame) == 3501 and frame["Note"].iloc[-1] == "café"
     said = [str(w.message) for w in caught if w.category is TextWarning]
     assert len(said) == 1 and "byte 0xB0 is not UTF-8" in said[0] and "60°C" in said[0]
+
+
+def test_a_utf8_log_with_a_latin1_byte_near_its_top_keeps_its_utf8_units(tmp_path):
+    """A UTF-8 log (units row 'kN·m', 'µs') with one Latin-1 byte in an operator's note in
+    its first 64 KiB was read wholly as Latin-1: 'kN·m' became 'kNÂ·m' (noticed after the
+    eleventh attack). UTF-8 characters beside the stray byte make it a UTF-8 file: the
+    units stay, the byte alone is read as Latin-1, with one warning."""
+    import warnings
+
+    from drillfric.io.delimited import TextWarning, open_delimited, sniff_csv
+
+    raw = ("TIME,RPM,TORQUE,Note\ns,rpm,kN·m,\n".encode()
+           + b"0.00,60.5,12.0,temp 60\xb0C\n"
+           + "".join(f"{0.05 * k:.2f},60.5,12.0,ok µ\n" for k in range(1, 50)).encode())
+    path = tmp_path / "utf8_with_latin1.csv"
+    path.write_bytes(raw)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        layout = sniff_csv(path)
+        frame = pd.concat(open_delimited(path).chunks(1000))
+    assert layout.encoding == "utf-8-sig" and layout.units["TORQUE"] == "kN·m"
+    assert frame["Note"].iloc[0] == "temp 60°C" and frame["Note"].iloc[1] == "ok µ"
+    said = [str(w.message) for w in caught if w.category is TextWarning]
+    assert len(said) == 1 and "byte 0xB0 is not UTF-8" in said[0]
+
+
+def test_a_latin1_log_stays_latin1(tmp_path):
+    """A wholly Latin-1 log (no UTF-8 character anywhere) is read as Latin-1, unchanged."""
+    from drillfric.io.delimited import sniff_csv
+
+    path = tmp_path / "latin1.csv"
+    path.write_bytes(b"TIME,RPM,TORQUE,Note\ns,rpm,kN\xb7m,\n0.0,60.5,12.0,caf\xe9\n"
+                     b"0.1,60.5,12.0,ok\n")
+    layout = sniff_csv(path)
+    assert layout.encoding == "latin-1" and layout.units["TORQUE"] == "kN·m"
 
 
 # ---------------------------------------------------------------- F11 ISO 8601 corners

@@ -198,12 +198,13 @@ def case_symlink_at_out_name_is_not_followed(root):
     return [Case(["run", "w.csv", "--out", "out"], (2,), ("not written by drillfric",))]
 
 
-def case_manifest_rows_sharing_a_stem_are_refused(root):
-    """Two manifest rows whose files share a stem wrote one directory, both "ok"."""
-    for d in ("a", "b"):
-        _config(_log(root / d / "x.csv").with_suffix(".toml"))
-    (root / "wells.csv").write_text("data\na/x.csv\nb/x.csv\n")
-    return [Case(["fleet", "wells.csv", "--out", "out", "--workers", "1"], (2,),
+def case_manifest_rows_sharing_a_stem_both_fail(root):
+    """Two manifest rows whose files share a stem wrote one directory, both "ok"; then
+    they stopped the whole fleet. Both fail now, naming each other; the other wells run."""
+    for d in ("a", "b", "c"):
+        _config(_log(root / d / ("y.csv" if d == "c" else "x.csv")).with_suffix(".toml"))
+    (root / "wells.csv").write_text("data\na/x.csv\nb/x.csv\nc/y.csv\n")
+    return [Case(["fleet", "wells.csv", "--out", "out", "--workers", "1"], (1,),
                  ("would both write",))]
 
 

@@ -93,26 +93,32 @@ class _Job:
     named: bool = True
 
 
-def _distinct(jobs: list[_Job], wells: list[WellSpec]) -> list[_Job]:
-    """The jobs, a well that would write the ``OUT/NAME`` of an earlier one under another
-    spelling (``well``, ``WELL``) failed with a line naming both — the others run: one such
-    pair had stopped the whole fleet. Two wells of one name are refused (before anything
-    is written): manifest.json could record only one of them.
+def _distinct(jobs: list[_Job], wells: list[WellSpec], *, refuse: bool) -> list[_Job]:
+    """The jobs, a well that would write the ``OUT/NAME`` of an earlier one failed with a
+    line naming both, the others run: one such pair had stopped the whole fleet. A well
+    whose name is another's under another spelling (``well``, ``WELL``) fails alone; two
+    wells of one name (``A.csv``, ``A.parquet``) both fail, since manifest.json keeps one
+    record a name and neither is the well's. With ``refuse`` (``drillfric run``, whose
+    wells the user named one by one) any clash is refused before anything is written.
 
     Raises
     ------
     InputError
-        Two wells of one name.
+        ``refuse`` and two wells would write one directory.
     """
     runnable = [(k, j) for k, j in enumerate(jobs) if j.task is not None and j.named]
     clash = collisions([(j.dir_name, f"well '{j.name}' ({wells[k].data})")
                         for k, j in runnable])
     jobs = list(jobs)
     for i, (first, line) in clash.items():
-        k, job = runnable[i]
-        if job.name == runnable[first][1].name or job.dir_name == runnable[first][1].dir_name:
+        if refuse:
             raise InputError(line, fix=DISTINCT_FIX)
-        jobs[k] = replace(job, task=None, error=f"{line} — fix: {DISTINCT_FIX}")
+        k, job = runnable[i]
+        failed = [k]
+        if job.name == runnable[first][1].name or job.dir_name == runnable[first][1].dir_name:
+            failed.append(runnable[first][0])
+        for f in failed:
+            jobs[f] = replace(jobs[f], task=None, error=f"{line} — fix: {DISTINCT_FIX}")
     return jobs
 
 
@@ -451,7 +457,7 @@ def run_many(wells: list[WellSpec], out_root, *, workers: int, scheduler: str | 
     advance = progress or (lambda amount=1.0: None)
     options = {"rate_hz": rate_hz, "pdf": pdf, "report": report}
     jobs = [_open_job(i, s, out_root, overrides or {}, options) for i, s in enumerate(wells)]
-    jobs = _distinct(jobs, wells)
+    jobs = _distinct(jobs, wells, refuse=not fleet_files)
     created = missing_dirs(out_root)  # removed again when nothing is left in them
     run = uuid.uuid4().hex[:8]
     try:

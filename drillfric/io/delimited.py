@@ -73,14 +73,23 @@ class CsvLayout:
 
 
 def _encoding(head: bytes) -> str:
-    """Text encoding from the first bytes: a BOM, else UTF-8 when it decodes, else Latin-1."""
+    """Text encoding from the first bytes: a BOM, else UTF-8 when it decodes or when it
+    holds UTF-8 characters beside its stray bytes (those are read as Latin-1,
+    :func:`_latin1`), else Latin-1.
+
+    A UTF-8 log with one Latin-1 byte near its top had been read wholly as Latin-1: its
+    ``°`` and ``µ`` turned into ``Â°`` and ``Âµ`` (issue 30, noticed after the eleventh attack).
+    """
     for bom, codec in _BOMS:
         if head.startswith(bom):
             return codec
     try:
         head.decode("utf-8")
     except UnicodeDecodeError as exc:
-        if exc.start < len(head) - 3:  # not merely a character cut by the sniff window
+        if exc.start >= len(head) - 3:  # merely a character cut by the sniff window
+            return "utf-8-sig"
+        text = head.decode("utf-8", errors="surrogateescape")
+        if not any(c >= "\x80" and not _NOT_UTF8.match(c) for c in text):
             return "latin-1"  # old rig exports: Windows/Latin-1 text
     return "utf-8-sig"
 
@@ -88,7 +97,11 @@ def _encoding(head: bytes) -> str:
 def _decode(raw: bytes, path: Path) -> tuple[str, str]:
     """The text at the top of a file and its encoding; InputError when it is not text."""
     codec = _encoding(raw)
-    text = codecs.getincrementaldecoder(codec)(errors="replace").decode(raw)
+    if codec.startswith("utf-8"):
+        decoder = codecs.getincrementaldecoder(codec)(errors="surrogateescape")
+        text = _latin1(decoder.decode(raw), path)
+    else:
+        text = codecs.getincrementaldecoder(codec)(errors="replace").decode(raw)
     control = sum(1 for c in text if c < " " and c not in "\t\r\n")
     if "\x00" in text or control > _MAX_CONTROL_SHARE * max(len(text), 1):
         raise InputError("not a text file (binary data where delimited text was expected)",
