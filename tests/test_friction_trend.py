@@ -78,6 +78,23 @@ def test_constant_friction_is_recovered_without_drift():
     assert np.all(width >= 0.05 * rows - 1e-12)
 
 
+def test_held_readings_left_out_do_not_move_a_window():
+    """A torque held at one reading for 10 s (an EDR defect, docs/theory.md §6.6) inside a
+    window: left out of ``usable``, the window's μ_k is the constant friction's within
+    1 % (as without the hold), its cycles not pieced together across the hold; left in,
+    the held reading (the torque's peak, 1.3× its mean) moves the window by ~2 %."""
+    t, measured, model = _torques(lambda t: np.full(t.size, MU_K))
+    held = (t >= 300.0) & (t < 310.0)
+    measured = np.where(held, FIXED + MU_K * T_N * 1.3, measured)
+    kwargs = dict(mu_k=MU_K, T_N_Nm=T_N, tolerance=0.05, window_s=120.0)
+    left_out = friction_trend(t, measured, model, (t >= 30.0) & ~held, **kwargs)
+    left_in = friction_trend(t, measured, model, t >= 30.0, **kwargs)
+    over = np.abs(left_out.centre_s - 305.0) < 60.0
+    np.testing.assert_allclose(left_out.mu_k[over], MU_K, rtol=0.01)
+    assert np.max(np.abs(left_in.mu_k[over] / MU_K - 1.0)) > 0.015
+    assert not left_out.drift
+
+
 def test_ramp_is_tracked_and_flagged_with_its_rate():
     """μ_k rising 30 % over 20 minutes: each row within 2 % of the truth (the window mean of
     a linear change is its centre's value; noise σ ≈ 0.1 %), flagged with the rate 0.075/h

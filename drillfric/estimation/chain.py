@@ -789,6 +789,8 @@ def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Ver
     if fast.size == 0:
         return None
     usable = fitted.scored & (fitted.time_s <= fitted.time_s[fast[-1]])
+    for a, b in models.held_spans_s:  # held readings: not evidence of the friction (§6.6)
+        usable &= (fitted.time_s < a) | (fitted.time_s > b)
     trend = friction_trend(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, usable,
                            mu_k=verdict.mu_k, T_N_Nm=models.observer.plant.T_N_Nm,
                            tolerance=mu_k_tolerance(models.logged.interval_s),

@@ -44,6 +44,7 @@ import numpy as np
 
 from drillfric.estimation.batch.harness import cycle_mean, cycle_mean_error
 from drillfric.estimation.batch.settings import MU_K_CLAIM
+from drillfric.estimation.creep import true_runs
 from drillfric.result import Flag
 
 #: Share of a window that must be usable rotation (after the start-up) for its μ_k [-].
@@ -252,11 +253,12 @@ def friction_trend(time_s, measured_Nm, model_Nm, usable, *, mu_k: float, T_N_Nm
         centre[i] = 0.5 * (a + b)
         if inside.sum() * dt < MIN_USED * min(window_s, b - a) or T_N_Nm <= 0:
             continue
-        error = cycle_mean_error([meas[inside]], dt)
+        parts = _runs(inside)
+        error = cycle_mean_error([[meas[r] for r in parts]], dt)
         if error is None:
             continue
-        mu[i] = mu_k + (cycle_mean([meas[inside]], dt) - cycle_mean([model[inside]], dt)
-                        - offset) / T_N_Nm
+        mu[i] = mu_k + (cycle_mean([meas[r] for r in parts], dt)
+                        - cycle_mean([model[r] for r in parts], dt) - offset) / T_N_Nm
         sigma[i] = np.hypot(np.sqrt(2.0) * error[0], offset_sigma) / T_N_Nm
     sigma = np.maximum(sigma, form_scatter(mu))
     half = np.hypot(tolerance * mu, 2.0 * sigma)
@@ -271,11 +273,19 @@ def _offset(measured: np.ndarray, model: np.ndarray, span: np.ndarray, dt: float
     too few cycles."""
     if not anchored or span.sum() < 3:
         return 0.0, 0.0
-    error = cycle_mean_error([measured[span]], dt)
+    parts = _runs(span)
+    error = cycle_mean_error([[measured[r] for r in parts]], dt)
     if error is None:
         return 0.0, 0.0
-    return (cycle_mean([measured[span]], dt) - cycle_mean([model[span]], dt),
-            float(np.sqrt(2.0) * error[0]))
+    return (cycle_mean([measured[r] for r in parts], dt)
+            - cycle_mean([model[r] for r in parts], dt), float(np.sqrt(2.0) * error[0]))
+
+
+def _runs(mask: np.ndarray) -> list[slice]:
+    """The runs of consecutive True samples of ``mask``, as slices: the parts of a window
+    whose samples between (held readings, docs/theory.md §6.6) are left out, so that no
+    torque cycle is pieced together across them."""
+    return [slice(a, b + 1) for a, b in true_runs(mask)]
 
 
 def drift_test(trend: FrictionTrend) -> FrictionTrend:
