@@ -151,6 +151,13 @@ class DrillString:
         return float(sum(s.steel_density_kg_m3 * s.polar_moment_m4 * s.length_m
                          for s in self.sections[1:]))
 
+    @property
+    def polar_mass_moment_kg_m2(self) -> float:
+        """J = ∫ρJ dx over the whole string [kg·m²]: its viscous torque is k_t·J·ω̄ in the
+        mean (docs/theory.md §3 eq. 2–3, §6.4)."""
+        return float(sum(s.steel_density_kg_m3 * s.polar_moment_m4 * s.length_m
+                         for s in self.sections))
+
     def section_index(self, md_m) -> np.ndarray:
         """Index of the section containing each measured depth (bit depth → last section)."""
         md = np.atleast_1d(np.asarray(md_m, dtype=float))

@@ -377,6 +377,12 @@ class SegmentRecord:
     top_drive_inertia_source: str | None = _f(
         "", "not used (string torque), immaterial, confirmed, contradicted or not identified "
             "(the reason in the message)")
+    k_t_identified_per_s: float | None = _f(
+        "1/s", "apparent viscous damping rate the segment's steady set-points identify (the "
+               "mud's damping and any rate dependence of the friction; μ_k is then corrected "
+               "for it, docs/theory.md §6.4); null: not identified or not tried")
+    k_t_identified_uncertainty_per_s: float | None = _f(
+        "1/s", "95 % half-width of k_t_identified_per_s")
     sample_interval_s: float | None = _f("s", "effective interval of the log: the largest of "
                                               "the spacing, the averaging interval, the "
                                               "update interval of held values and the width "

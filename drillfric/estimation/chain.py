@@ -49,7 +49,7 @@ import numpy as np
 from drillfric import torque_drag, torsional
 from drillfric.drillstring import DrillString
 from drillfric.errors import DrillfricError, ModelError
-from drillfric.estimation import batch, bit_torque, bit_trace, inertia, skew, spikes
+from drillfric.estimation import batch, bit_torque, bit_trace, damping, inertia, skew, spikes
 from drillfric.estimation.batch.settings import TORQUE_SMOOTH_S, mu_k_tolerance
 from drillfric.estimation.creep import smooth
 from drillfric.estimation.diagnostics import Diagnostics, diagnose, settled_mask
@@ -174,6 +174,8 @@ class SegmentEstimate:
         the segment's μ_k is not a converged batch value.
     inertia : Inertia or None
         What the data say of the top-drive inertia (:func:`top_drive_inertia`).
+    viscous : ViscousSlope or None
+        The viscous damping the set-points identify (:func:`viscous_damping`).
     """
 
     mu_s: float | None
@@ -218,6 +220,7 @@ class SegmentEstimate:
     skew: skew.Skew | None = None
     trend: FrictionTrend | None = field(default=None, repr=False)
     inertia: inertia.Inertia | None = None
+    viscous: damping.ViscousSlope | None = None
 
 
 def _path_for(settings: ChainSettings, path: WellPath | None, bit_depth_m: float
@@ -763,6 +766,8 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
     rig = top_drive_inertia(settings, models, fitted)
     trace, kinematics, (stats_from, stats_to) = trace_verdict(settings, models, refined,
                                                               verdict, final, bit, skewed, rig)
+    viscous = viscous_damping(settings, models, verdict, fitted)
+    fitted, verdict, refined = with_damping(settings, models, verdict, refined, fitted, viscous)
     terms = bit_torque.torque_terms(models.meas, fitted, _model_at(settings, models, verdict,
                                                                  refined.mu_s)
                                     if models.on_bottom else None, verdict.mu_k)
@@ -771,7 +776,58 @@ def estimate_segment(settings: ChainSettings, path: WellPath | None, data: Segme
                                                        trace, final, bit, fitted, terms,
                                                        kinematics, stats_from, trend,
                                                        stats_to))
-    return replace(estimate, skew=skewed, inertia=rig)
+    return replace(estimate, skew=skewed, inertia=rig, viscous=viscous)
+
+
+def viscous_damping(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
+                    fitted: FitEvidence) -> damping.ViscousSlope | None:
+    """Step 7b: the viscous damping a segment's steady set-points identify (docs/theory.md
+    §6.4 "The damping identified", eq. 6.4k), from the fitted model's torque of step 6 (no
+    model run of its own); None where there is no converged batch μ_k off bottom in place."""
+    if (verdict.method is not Method.BATCH or not verdict.converged or fitted.scored is None
+            or models.on_bottom or models.axial is not None):
+        return None
+    usable = fitted.scored.copy()
+    for a, b in models.held_spans_s:
+        usable &= (fitted.time_s < a) | (fitted.time_s > b)
+    speed = np.interp(fitted.time_s, models.meas.time_s, models.meas.surface_rad_s)
+    return damping.identify(fitted.time_s, fitted.measured_Nm, fitted.model_Nm, speed, usable,
+                            inertia_kg_m2=models.string.polar_mass_moment_kg_m2,
+                            k_t_per_s=settings.batch.k_t_per_s)
+
+
+def with_damping(settings: ChainSettings, models: SegmentModels, verdict: Verdict,
+                 refined: batch.BatchResult, fitted: FitEvidence,
+                 viscous: damping.ViscousSlope | None
+                 ) -> tuple[FitEvidence, Verdict, batch.BatchResult]:
+    """The evidence, verdict and fit with an identified damping in place of the configured
+    one (eq. 6.4k): the model's torque gains Δk·J·ω(t), μ_k loses Δk·J·ω̄_B/T_N (ω̄_B the
+    top drive's mean speed over the batch window the fit matched), and μ_k's interval
+    carries the identified damping's half-width instead of the assumed range."""
+    if viscous is None or not viscous.identified:
+        return fitted, verdict, refined
+    J = models.string.polar_mass_moment_kg_m2
+    delta = (viscous.k_t_per_s - settings.batch.k_t_per_s) * J  # [N·m·s/rad]
+    speed = np.abs(np.interp(fitted.time_s, models.meas.time_s, models.meas.surface_rad_s))
+    window = fitted.scored & (fitted.time_s <= models.meas.t0_s + settings.batch.window_s)
+    mean_speed = float(np.mean(speed[window])) if window.any() else float(np.mean(speed))
+    T_N = models.observer.plant.T_N_Nm
+    mu_k = verdict.mu_k - delta * mean_speed / T_N
+    spread = viscous.uncertainty_per_s * J * mean_speed / T_N
+    details = replace(refined.details, mu_k_damping=spread)
+    note = refined.interval_note
+    if note is not None:
+        sigma = 2.0 * (refined.details.mu_k_sigma or 0.0)
+        tolerance = mu_k_tolerance(models.logged.interval_s)
+        half = max(sigma, float(np.hypot(tolerance * mu_k, spread)))
+        note = (f"μ_k = {mu_k:.3f} ± {half:.3f} (95 %: the validated {100 * tolerance:.0f} % "
+                f"of this logging and ±{spread:.3f} for the viscous damping identified; "
+                f"statistical 2σ ± {sigma:.3f}) — {verdict.mu_k:.3f} at the configured "
+                f"k_t = {settings.batch.k_t_per_s:g} 1/s, less {delta * mean_speed:.0f} N·m "
+                "of viscous torque the set-points show")
+    fitted = replace(fitted, model_Nm=fitted.model_Nm + delta * speed)
+    return (fitted, replace(verdict, mu_k=mu_k, messages=verdict.messages + (viscous.note,)),
+            replace(refined, mu_k=mu_k, details=details, interval_note=note))
 
 
 def moving_friction(settings: ChainSettings, models: SegmentModels, verdict: Verdict,

@@ -83,7 +83,7 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
         **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est), **_skew(est),
-        **_inertia(est)))
+        **_inertia(est), **_viscous(est)))
     if est.factors_withheld:
         record = withhold_friction(record, est.factors_withheld, None)
     # the windows' numbers stand where the segment's factors are withheld by its own rules:
@@ -100,6 +100,15 @@ def _inertia(est: SegmentEstimate) -> dict:
                 top_drive_inertia_kg_m2_identified=rig.identified_kg_m2,
                 top_drive_inertia_uncertainty_kg_m2=rig.uncertainty_kg_m2,
                 top_drive_inertia_source=rig.source)
+
+
+def _viscous(est: SegmentEstimate) -> dict:
+    """The viscous damping the set-points identify (docs/theory.md §6.4)."""
+    slope = est.viscous
+    if slope is None:
+        return {}
+    return dict(k_t_identified_per_s=slope.k_t_per_s,
+                k_t_identified_uncertainty_per_s=slope.uncertainty_per_s)
 
 
 def _skew(est: SegmentEstimate) -> dict:
