@@ -146,8 +146,9 @@ def wind_up_rad(string: L.LumpedString, torque_Nm: float) -> float:
     return float(np.sum(tau / string.stiffness_Nm_rad[1:]))
 
 
-def simulate_case(case: Case):
-    """100-Hz record of a case (with noise) and its plant, survey and set-point."""
+def simulate_case(case: Case, top_drive_inertia_kg_m2: float = 2900.0):
+    """100-Hz record of a case (with noise) and its plant, survey and set-point (the top
+    drive's inertia may differ from the 2900 kg·m² drillfric is configured with)."""
     survey, string = well(case)
     mu_s = case.mu_k * case.ratio
     creep_rpm = 5.0
@@ -161,7 +162,7 @@ def simulate_case(case: Case):
     start_up = (5.0 + creep["creep_hold_s"] if creep else 0.0) + 10.0
     knots = L.setpoint(case.rpm, start_up + case.rotation_s, **creep)
     total = knots[-1][0]
-    drive = L.Drive(knots, 2900.0, case.kp, case.ki)
+    drive = L.Drive(knots, top_drive_inertia_kg_m2, case.kp, case.ki)
     friction = L.Friction(mu_s, case.mu_k, omega_switch_rad_s=case.omega_sw)
     noise = L.Noise(rpm_sd=0.5, torque_sd_Nm=200.0, hookload_sd_N=2000.0, seed=case.seed)
     rec = L.simulate(string, drive, friction, total, rate_hz=100.0, noise=noise)

@@ -25,6 +25,7 @@ from drillfric.estimation.batch.harness import (
     cycle_mean,
     cycle_mean_error,
     fluctuation,
+    fluctuation_range,
     prepare,
 )
 from drillfric.estimation.batch.kinetic import (
@@ -36,6 +37,7 @@ from drillfric.estimation.batch.kinetic import (
 )
 from drillfric.estimation.batch.onset import BoundOutcome, onset_bound
 from drillfric.estimation.batch.settings import (
+    GEAR_RANGE,
     MIN_CREEP_RATE_HZ,
     MU_K_REFIT_MOVE,
     STEADY_BLOCK_S,
@@ -329,6 +331,13 @@ class _Rotation:
                    cycle_mean_error(parts, d.dt))
 
 
+def _later_fluctuation_range(model: Model, wins: list[Window]) -> tuple[float, float]:
+    """:func:`~.harness.fluctuation_range` over the later half of each window (where
+    :meth:`_Rotation.of` judges the regime) and the inertia range of a gear change."""
+    later = np.concatenate([w.used[w.used.size // 2:] for w in wins])
+    return fluctuation_range(model.data, later, GEAR_RANGE)
+
+
 def _observed(t: np.ndarray, used: np.ndarray, unobserved_s: tuple) -> list[np.ndarray]:
     """``used`` (sample indices) cut where their times ``t`` [s] fall in an ``unobserved_s``
     span, those samples left out: the contiguous pieces."""
@@ -383,10 +392,19 @@ def _static_stages(model: Model, creeps, wins: list[Window], kinetic: KineticOut
                     kinetic = refit
                     messages += refit.messages
     if mu_s is None and kinetic is not None and rotation.stick_slip and not moving:
-        onset = onset_bound(model, wins, kinetic.mu_k, cells, bool(creeps))
-        flags += onset.flags
-        messages += onset.messages
-        method = "stick_slip_onset" if onset.bound is not None else "none"
+        low, high = _later_fluctuation_range(model, wins)
+        if low > STICK_SLIP_FLUCTUATION:
+            onset = onset_bound(model, wins, kinetic.mu_k, cells, bool(creeps))
+            flags += onset.flags
+            messages += onset.messages
+            method = "stick_slip_onset" if onset.bound is not None else "none"
+        else:
+            messages.append(
+                "no μ_s bound from the stick-slip onset: the motor torque's swing, "
+                f"{low:.2f}–{high:.2f} of its mean with the top-drive inertia "
+                f"{GEAR_RANGE[0]:g}–{GEAR_RANGE[1]:g}× rig.top_drive_inertia_kg_m2 (a gear "
+                "change), rests on the inertia subtracted: the string may not stick-slip at "
+                "all (docs/theory.md §6.4)")
     if mu_s is None and not rotation.stick_slip and kinetic is not None and not creeps \
             and not moving:
         messages.append("no stick-slip and no creep start-up: μ_s is not in the data; a creep "

@@ -92,6 +92,8 @@ class FitData:
     tau: np.ndarray  # measured string torque [N·m]
     tau_bar: np.ndarray  # smoothed string torque [N·m]
     speed: np.ndarray  # logged ω₀ on the uniform time base, unsmoothed [rad/s]
+    # I_TD·dω̄₀/dt taken off a motor torque, smoothed as tau_bar (0: a string torque) [N·m]
+    inertia_bar: np.ndarray | None = None
 
     def index(self, t_s: float) -> int:
         """The first sample at or after ``t_s`` [s] (clipped to the record)."""
@@ -133,7 +135,9 @@ def prepare(time_s, surface_rad_s, torque_Nm, torque_kind: str,
                    motor=smooth(tau_m, dt, DRIVE_SMOOTH_S),
                    creep_drive=smooth(w, dt, CREEP_DRIVE_SMOOTH_S),
                    w_bar=smooth(w, dt, max(TORQUE_SMOOTH_S, 3 * dt)), tau=tau_s,
-                   tau_bar=smooth(tau_s, dt, TORQUE_SMOOTH_S), speed=w)
+                   tau_bar=smooth(tau_s, dt, TORQUE_SMOOTH_S), speed=w,
+                   inertia_bar=smooth(tau - tau_s, dt, TORQUE_SMOOTH_S)
+                   if torque_kind == "motor" else None)
     return data, notes
 
 
@@ -283,6 +287,21 @@ def fluctuation(tau_bar: np.ndarray) -> float:
     """std/|mean| of a smoothed torque: the stick-slip measure of the data [-]."""
     mean = abs(float(np.mean(tau_bar)))
     return float(np.std(tau_bar)) / mean if mean > 0 else 0.0
+
+
+def fluctuation_range(data: FitData, used: np.ndarray,
+                      inertia_factors: tuple[float, float]) -> tuple[float, float]:
+    """The smoothed string torque's :func:`fluctuation` over the samples ``used`` with the
+    top-drive inertia taken ``inertia_factors`` × the configured — (least, most) [-]. A
+    motor torque's stick-slip swing partly rests on the inertia subtracted (eq. 7 of the
+    paper): with the gear's inertia unknown, a swing that vanishes at either end of the
+    range is no evidence of stick-slip. A string torque has one value."""
+    if data.inertia_bar is None:
+        value = fluctuation(data.tau_bar[used])
+        return value, value
+    values = [fluctuation(data.tau_bar[used] + (1.0 - f) * data.inertia_bar[used])
+              for f in (1.0, *inertia_factors)]
+    return min(values), max(values)
 
 
 def sticks(bit_rad_s: np.ndarray, omega_c: float) -> bool:

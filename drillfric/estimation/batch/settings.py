@@ -81,6 +81,11 @@ MIN_CYCLES = 3
 #: A steady rotation (no stick-slip) has no torque cycles: its mean torque's error comes from
 #: the scatter of blocks this long instead, MIN_CYCLES of them at least (§6.4) [s].
 STEADY_BLOCK_S = 5.0
+#: A gear change puts the top drive's inertia at 0.4–2.5× the configured (issue 34): a motor
+#: torque's stick-slip swing must hold over that range to count as evidence of stick-slip
+#: for the onset bound on μ_s (on a steady lumped plant under set-point steps, 2.5× the
+#: inertia made a swing of 0.13 of the mean and a bound of 0.19 over a true μ_s of 0.157).
+GEAR_RANGE = (0.4, 2.5)
 STICK_SLIP_FLUCTUATION = 0.1  #: data stick-slip when std/mean of the smoothed torque exceeds
 PROVISIONAL_RATIO = 2.5  #: μ_s/μ_k of the model during the μ_k fit of stick-slip data
 MU_K_MAX_RUNS = 8  #: model runs allowed to the μ_k root find
