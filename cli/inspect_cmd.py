@@ -8,7 +8,7 @@ import re
 import click
 import numpy as np
 
-from drillfric.io.text import plural, terminal_text
+from drillfric.io.text import number, plural, terminal_text
 from drillfric.vocabulary import Status
 
 from .common import unit_system, units_option
@@ -169,34 +169,39 @@ def _segment(seg, pre) -> dict:
             "message": pre.message}
 
 
-def _num(value: float | None) -> str:
-    """A table value: 4 significant digits, whole numbers without an exponent up to 1e9.
+def _num(value: float | None, resolution: float | None = None) -> str:
+    """A table value (:func:`drillfric.io.text.number`): 4 significant digits, never finer
+    than ``resolution``, a numerical zero as 0, no exponent below 1e9.
 
     Examples
     --------
-    >>> _num(24999.4), _num(254.93), _num(None), _num(3e12)
-    ('24999', '254.9', '—', '3e+12')
+    >>> _num(24999.4), _num(254.93), _num(None), _num(3e12), _num(1.173e-34, 0.1)
+    ('24999', '254.9', '—', '3e+12', '0')
     """
-    if value is None:
-        return "—"
-    return f"{value:.0f}" if 1e4 <= abs(value) < 1e9 else f"{value:.4g}"
+    return number(value, resolution)
+
+
+#: Resolution of the channels shown in their own unit (not a display quantity).
+_RESOLUTION = {"time": 1e-3, "percentage": 0.1, "pump rate": 0.1}
 
 
 def _channel_table(s: dict, units: str) -> list[str]:
     """The channel table: source column and unit, nulls, min/median/max in the display unit
     of ``units`` (kN, not 2.549e+05 N), else the unit of the canonical column."""
     from drillfric.io.channels import BY_NAME
-    from drillfric.units import display_factor, display_unit
+    from drillfric.units import display_factor, display_resolution, display_unit
 
     head = ("channel", "column", "unit", "from", "shown in", "nulls", "min", "median", "max")
     rows = [head]
     for name, c in s["channels"].items():
-        quantity = _SHOWN.get(BY_NAME[name].kind)
-        shown, scale = ((display_unit(quantity, units), display_factor(quantity, units))
-                        if quantity else (c["si_unit"], 1.0))
+        kind = BY_NAME[name].kind
+        quantity = _SHOWN.get(kind)
+        shown, scale, step = ((display_unit(quantity, units), display_factor(quantity, units),
+                               display_resolution(quantity, units))
+                              if quantity else (c["si_unit"], 1.0, _RESOLUTION.get(kind)))
         rows.append((name, c["column"], c["unit"], c["unit_source"], shown,
                      f"{c['null_count']} ({100 * c['null_fraction']:.1f}%)",
-                     *(_num(None if c[k] is None else c[k] * scale)
+                     *(_num(None if c[k] is None else c[k] * scale, step)
                        for k in ("min", "median", "max"))))
     widths = [max(len(str(r[i])) for r in rows) for i in range(len(head))]
     return ["  ".join(str(v).ljust(w) for v, w in zip(r, widths, strict=True)).rstrip()

@@ -659,6 +659,45 @@ def to_display(values, quantity: str, system: str | None = "si"):
     return float(scaled) if scaled.ndim == 0 else scaled
 
 
+#: Resolution of each display quantity in its stored SI unit (:data:`_STORED`): what a rig
+#: sensor resolves at best — finer digits are noise, and a value below half of it is zero
+#: (issue 35: a bit speed of 1.173e-34 RPM). :func:`display_resolution` gives it in the unit
+#: shown.
+RESOLUTION_SI = {"length": 1e-3, "diameter": 1e-4, "force": 10.0, "torque": 0.1,
+                 "side force": 0.1, "density": 0.1, "linear mass": 0.01, "pressure": 100.0,
+                 "rotary speed": 0.1, "flow rate": 1e-6, "speed": 1e-5, "time": 1e-3,
+                 "moment of inertia": 0.1, "dogleg severity": 0.01}
+
+
+def display_resolution(quantity: str, system: str | None = "si") -> float:
+    """:data:`RESOLUTION_SI` of ``quantity`` in its display unit, down to a power of ten.
+
+    Examples
+    --------
+    >>> display_resolution("rotary speed"), display_resolution("force", "field")
+    (0.1, 0.001)
+    """
+    shown = RESOLUTION_SI[quantity] * display_factor(quantity, system)
+    return float(10.0 ** math.floor(math.log10(shown) + 1e-9))
+
+
+def format_number(value, quantity: str, system: str | None = "si") -> str:
+    """An SI value of ``quantity`` as a number in its display unit, at its resolution
+    (:func:`drillfric.io.text.number`: a numerical zero is 0, no exponent), e.g. in
+    inspect's channel table.
+
+    Examples
+    --------
+    >>> format_number(1.173e-34, "rotary speed"), format_number(254900.0, "force")
+    ('0', '254.9')
+    """
+    from drillfric.io.text import number
+
+    if value is None:
+        return "—"
+    return number(to_display(value, quantity, system), display_resolution(quantity, system))
+
+
 def format_value(value, quantity: str, system: str | None = "si", spec: str = ".1f") -> str:
     """An SI value as text in the display unit, e.g. ``"8202.1 ft"`` (``"—"`` for None/NaN).
 

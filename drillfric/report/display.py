@@ -14,7 +14,8 @@ import math
 import re
 from dataclasses import dataclass
 
-from drillfric.units import UNIT_SYSTEMS, display_factor, display_unit
+from drillfric.io.text import number
+from drillfric.units import UNIT_SYSTEMS, display_factor, display_resolution, display_unit
 
 #: Display units of quantities the terminal never shows (so not in DISPLAY_UNITS):
 #: ``(label, pint expression of the display unit, pint expression of the stored SI unit)``.
@@ -111,9 +112,9 @@ def message_in(text: str, units: Units) -> str:
         return text
     per = {u: (q, f) for u, q, f in _MESSAGE_UNITS}
 
-    def field(number: str, factor: float, quantity: str) -> str:
-        value = units.value(float(number.replace("−", "-")) * factor, quantity)
-        return f"{value:.0f}" if abs(value) >= 100 else f"{value:.3g}"
+    def field(text: str, factor: float, quantity: str) -> str:
+        value = units.value(float(text.replace("−", "-")) * factor, quantity)
+        return number(value, display_resolution(quantity, units.system), digits=3)
 
     def convert(match: re.Match) -> str:
         first, dash, second, unit = match.groups()
