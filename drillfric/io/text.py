@@ -105,10 +105,10 @@ MAX_DECIMALS = 6
 
 def number(value, resolution: float | None = None, digits: int = 4) -> str:
     """A physical value as people read it: ``digits`` significant digits (trailing zeros
-    dropped), never finer than ``resolution`` (the quantity's resolution in the unit shown,
-    e.g. 0.1 for RPM), a value below half the resolution as ``0`` (a numerical zero such as
-    1.173e-34 RPM is 0), and no exponent below :data:`PLAIN_LIMIT` (issue 35: an inspect median printed as
-    "1.173e-34"); "—" for None or NaN.
+    dropped), never finer than ``resolution`` (the quantity's resolution in the unit
+    shown, e.g. 0.1 for RPM), a value below half the resolution as ``0`` (a numerical zero
+    such as 1.173e-34 RPM is 0), and no exponent below :data:`PLAIN_LIMIT` (issue 35: an
+    inspect median printed as "1.173e-34"); "—" for None or NaN.
 
     Examples
     --------
