@@ -250,18 +250,18 @@ def render(s: dict, units: str = "si") -> str:
         lines.append(f"segments   {len(s['segments'])} rotating, none estimated: run refuses "
                      "the log (the error below)")
     else:
-        lines += _segments_lines(s["segments"])
+        lines += _segments_lines(s["segments"], units)
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
-def _segments_lines(segments: list[dict]) -> list[str]:
+def _segments_lines(segments: list[dict], units: str = "si") -> list[str]:
     """What run does with the segments: how many it estimates (the usable ones), skips and
     fails, and why (:func:`_reasons`)."""
     ok = [g for g in segments if g["status"] == Status.OK]
     seconds = sum(g["duration_s"] or 0.0 for g in ok)
     return [f"segments   {len(segments)} rotating: {len(ok)} usable"
             + (f" ({_kinds(ok)}; {seconds / 3600:.2f} h)" if ok else "")
-            + _counts(segments)] + _reasons(segments)
+            + _counts(segments)] + _reasons(segments, units)
 
 
 def _kinds(ok: list[dict]) -> str:
@@ -277,15 +277,19 @@ def _counts(items: list[dict]) -> str:
     return f", {skipped} skipped" + (f", {failed} failed" if failed else "")
 
 
-def _reasons(items: list[dict]) -> list[str]:
+def _reasons(items: list[dict], units: str = "si") -> list[str]:
     """One line per reason run does not estimate segments (windows) for, whatever its
-    numbers: how many, skipped or failed, and the first one's message."""
+    numbers: how many, skipped or failed, and the first one's message (its quantities in
+    ``units``)."""
+    from drillfric.units import message_text
+
     groups: dict[tuple[str, str], list[dict]] = {}
     for g in items:
         if g["status"] != Status.OK:
             groups.setdefault((g["status"], re.sub(r"\d+(\.\d+)?", "#", g["message"])),
                               []).append(g)
-    return [f"{'':10} {len(group)} {status} like segment {group[0]['id']}: {group[0]['message']}"
+    return [f"{'':10} {len(group)} {status} like segment {group[0]['id']}: "
+            f"{message_text(group[0]['message'], units)}"
             for (status, _), group in groups.items()]
 
 
@@ -309,12 +313,13 @@ def render_depth_log(s: dict, units: str = "si") -> str:
     lines.append(f"windows    {len(s['segments'])} of "
                  f"{format_value(s['window_m'], 'length', units, '.0f')}: {len(ok)} usable"
                  + (f" ({_kinds(ok)})" if ok else "") + _counts(s["segments"]))
-    lines += _reasons(s["segments"])
+    lines += _reasons(s["segments"], units)
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
 def _assumed_lines(notes: list[str], units: str) -> list[str]:
-    """What was assumed, its quantities in the display units of ``units``."""
-    from drillfric.units import display_text
+    """What was assumed, its quantities in the display units of ``units`` (issue 35: "WOB
+    ≤ 10 kN" of a field-units inspect reads "WOB ≤ 2.25 klbf")."""
+    from drillfric.units import display_text, message_text
 
-    return [f"assumed    {display_text(note, units)}" for note in notes]
+    return [f"assumed    {message_text(display_text(note, units), units)}" for note in notes]

@@ -711,6 +711,57 @@ def format_value(value, quantity: str, system: str | None = "si", spec: str = ".
     return f"{format(to_display(value, quantity, system), spec)} {display_unit(quantity, system)}"
 
 
+#: SI quantities written in run messages (summary.json is SI): unit as written, the
+#: quantity it is, and the factor to that quantity's stored unit — longest units first.
+_MESSAGE_UNITS = (("kN·m", "torque", 1e3), ("N·m", "torque", 1.0), ("kg/m³", "density", 1.0),
+                  ("m/s", "length", 1.0), ("m/h", "length", 1.0), ("MN", "force", 1e6),
+                  ("kN", "force", 1e3), ("N", "force", 1.0), ("m", "length", 1.0))
+_MESSAGE_NUMBER = r"[-−+]?\d+(?:\.\d+)?"
+_MESSAGE_QUANTITY = re.compile(
+    rf"(?<![\w.])({_MESSAGE_NUMBER})(?:\s?([–-]|to)\s?({_MESSAGE_NUMBER}))?\s?"
+    rf"({'|'.join(re.escape(u) for u, _, _ in _MESSAGE_UNITS)})(?![\w/·³²])")
+
+
+def message_text(text: str, system: str | None = "si", *, inline: bool = True) -> str:
+    """A message drillfric wrote in SI (a segment's reason, what was assumed, a warning)
+    with its quantities — m, m/s, m/h, N, kN, MN, N·m, kN·m, kg/m³ — in the display units
+    of ``system``: ``inline`` in place of the SI ones ("WOB ≤ 2.25 klbf", as inspect's
+    lines read in field units), else after them in brackets ("WOB ≤ 10 kN [2.25 klbf]", the
+    report, which keeps summary.json's SI words). Unchanged in ``"si"``.
+
+    Examples
+    --------
+    >>> message_text("rows that log WOB ≤ 10 kN, +0.05 to +0.15 m/s", "field")
+    'rows that log WOB ≤ 2.25 klbf, +0.164 to +0.492 ft/s'
+    >>> message_text("a 2804–2835 m window", "field", inline=False)
+    'a 2804–2835 m [9199–9301 ft] window'
+    """
+    if (system or "si") == "si" or not text:
+        return text
+    per = {u: (q, f) for u, q, f in _MESSAGE_UNITS}
+
+    def shown(written: str, factor: float, quantity: str) -> str:
+        value = float(written.replace("−", "-")) * factor * display_factor(quantity, system)
+        from drillfric.io.text import number
+
+        text = number(value, display_resolution(quantity, system), digits=3)
+        return ("+" + text) if written.startswith("+") and not text.startswith("-") else text
+
+    def convert(match: re.Match) -> str:
+        first, dash, second, unit = match.groups()
+        quantity, factor = per[unit]
+        label = display_unit(quantity, system)
+        if unit in ("m/s", "m/h"):
+            label += unit[1:]
+        value = shown(first, factor, quantity)
+        if second is not None:
+            gap = " " if dash == "to" else ""
+            value += gap + dash + gap + shown(second, factor, quantity)
+        return f"{value} {label}" if inline else f"{match.group(0)} [{value} {label}]"
+
+    return _MESSAGE_QUANTITY.sub(convert, text)
+
+
 #: Quantities drillfric's own notes (what was assumed) write in SI, by their spelling after
 #: the number ("1200 kg/m³", "1.0°/30 m"), for :func:`display_text`.
 _NOTE_UNITS = {"°/30 m": "dogleg severity", " kg/m³": "density",
