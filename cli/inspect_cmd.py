@@ -8,7 +8,8 @@ import re
 import click
 import numpy as np
 
-from drillfric.io.text import number, plural, terminal_text
+from drillfric.io.text import plural, terminal_text
+from drillfric.units import number
 from drillfric.vocabulary import Status
 
 from .common import unit_system, units_option
@@ -170,7 +171,7 @@ def _segment(seg, pre) -> dict:
 
 
 def _num(value: float | None, resolution: float | None = None) -> str:
-    """A table value (:func:`drillfric.io.text.number`): 4 significant digits, never finer
+    """A table value (:func:`drillfric.units.number`): 4 significant digits, never finer
     than ``resolution``, a numerical zero as 0, no exponent below 1e9.
 
     Examples

@@ -659,6 +659,50 @@ def to_display(values, quantity: str, system: str | None = "si"):
     return float(scaled) if scaled.ndim == 0 else scaled
 
 
+#: Largest magnitude written without an exponent (a 1e308 from a broken log must not print
+#: as a 309-digit number; no physical quantity drillfric shows comes near it).
+PLAIN_LIMIT = 1e9
+#: Most decimals a number without a stated resolution is written with.
+MAX_DECIMALS = 6
+
+
+def number(value, resolution: float | None = None, digits: int = 4) -> str:
+    """A physical value as people read it: ``digits`` significant digits (trailing zeros
+    dropped), never finer than ``resolution`` (the quantity's resolution in the unit
+    shown, e.g. 0.1 for RPM), a value below half the resolution as ``0`` (a numerical zero
+    such as 1.173e-34 RPM is 0), and no exponent below :data:`PLAIN_LIMIT` (issue 35: an
+    inspect median printed as "1.173e-34"); "—" for None or NaN.
+
+    Examples
+    --------
+    >>> number(24999.4), number(254.93), number(None), number(3e12)
+    ('24999', '254.9', '—', '3e+12')
+    >>> number(1.173e-34, 0.1), number(-0.04, 0.1), number(0.2312, 0.1), number(0.0035)
+    ('0', '0', '0.2', '0.0035')
+    >>> number(1e-34), number(float("inf"))
+    ('0', 'inf')
+    """
+    if value is None:
+        return "—"
+    value = float(value)
+    if value != value:
+        return "—"
+    if abs(value) == float("inf"):
+        return "inf" if value > 0 else "-inf"
+    if abs(value) >= PLAIN_LIMIT:
+        return f"{value:.{digits}g}"
+    step = MAX_DECIMALS if not resolution or resolution <= 0 else max(
+        0, -math.floor(math.log10(resolution) + 1e-9))
+    if resolution and resolution > 0 and abs(value) < resolution / 2:
+        return "0"
+    magnitude = math.floor(math.log10(abs(value))) if value else 0
+    decimals = max(0, min(digits - 1 - magnitude, step, MAX_DECIMALS))
+    text = f"{value:.{decimals}f}"
+    if "." in text:  # as .4g writes it: 254.9, not 254.90
+        text = text.rstrip("0").rstrip(".")
+    return "0" if float(text) == 0 else text
+
+
 #: Resolution of each display quantity in its stored SI unit (:data:`_STORED`): what a rig
 #: sensor resolves at best — finer digits are noise, and a value below half of it is zero
 #: (issue 35: a bit speed of 1.173e-34 RPM). :func:`display_resolution` gives it in the unit
@@ -683,7 +727,7 @@ def display_resolution(quantity: str, system: str | None = "si") -> float:
 
 def format_number(value, quantity: str, system: str | None = "si") -> str:
     """An SI value of ``quantity`` as a number in its display unit, at its resolution
-    (:func:`drillfric.io.text.number`: a numerical zero is 0, no exponent), e.g. in
+    (:func:`number`: a numerical zero is 0, no exponent), e.g. in
     inspect's channel table.
 
     Examples
@@ -691,8 +735,6 @@ def format_number(value, quantity: str, system: str | None = "si") -> str:
     >>> format_number(1.173e-34, "rotary speed"), format_number(254900.0, "force")
     ('0', '254.9')
     """
-    from drillfric.io.text import number
-
     if value is None:
         return "—"
     return number(to_display(value, quantity, system), display_resolution(quantity, system))
@@ -742,8 +784,6 @@ def message_text(text: str, system: str | None = "si", *, inline: bool = True) -
 
     def shown(written: str, factor: float, quantity: str) -> str:
         value = float(written.replace("−", "-")) * factor * display_factor(quantity, system)
-        from drillfric.io.text import number
-
         text = number(value, display_resolution(quantity, system), digits=3)
         return ("+" + text) if written.startswith("+") and not text.startswith("-") else text
 

@@ -14,7 +14,6 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from drillfric.errors import ConfigError, InputError
-from drillfric.io.text import number
 from drillfric.units import (
     RESOLUTION_SI,
     conversion_factor,
@@ -24,6 +23,7 @@ from drillfric.units import (
     format_number,
     format_value,
     from_si,
+    number,
     quantity_value,
     to_display,
     to_si,

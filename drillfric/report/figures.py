@@ -31,7 +31,7 @@ TD_COLOR = "#222222"
 #: The drag-based friction factors (pick-up / slack-off hook loads, docs/theory.md §2.2).
 DRAG_COLOR = "#16a085"
 #: Legend of the drag-based points, in the static and the interactive friction log.
-DRAG_LABEL = "drag-based μ (pick-up/slack-off hook load)"
+DRAG_LABEL = "drag-based μ of the connections (pick-up/slack-off hook loads)"
 #: Legends of the segments without an estimate and of the μ_s lower bounds, likewise.
 NONE_LABEL = "no estimate (skipped/failed)"
 BOUND_LABEL = "μ_s ≥ lower bound"
