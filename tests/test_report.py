@@ -936,6 +936,9 @@ def test_empty_friction_log_names_estimated_but_withheld_segments():
     assert "withheld by the hook-load check" in note and "1 skipped" in note
     skipped = no_friction_note(seg.assign(status=["skipped"] * 3))
     assert "no segment was estimated with a bit depth (3 segments: 3 skipped)" in skipped
+    from drillfric.report.display import Units
+
+    assert "estimated at 3064–3675 ft" in no_friction_note(seg, Units("field"))  # not m
 
 
 def test_an_empty_severity_panel_says_why():
