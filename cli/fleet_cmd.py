@@ -27,20 +27,29 @@ def _default_workers() -> int:
 
 
 def _closing_line(result) -> str:
+    """The last line of ``drillfric fleet``: in every outcome — all ok, some unchanged,
+    partial, every well failed, nothing estimated — the same words in the same order and
+    the same path, OUT/manifest.json (which lists every well; issue 35, fourth newcomer:
+    an all-unchanged run named the folder, the others the manifest).
+
+    ``fleet: 3 wells — 2 ok (1 processed, 1 unchanged), 1 failed in 4.2 s — OUT/manifest.json``
+    """
     ok, skipped, failed = (result.count(s) for s in ("ok", "skipped", "failed"))
     total = len(result.wells)
-    if skipped == total:
-        return (f"fleet: all {plural(total, 'well')} ok (unchanged since the last run; --force to "
-                f"redo them) — {result.out_root}")
-    parts = [f"{ok + skipped} ok ({ok} processed, {skipped} unchanged)", f"{failed} failed"]
+    redo = "; --force redoes them" if skipped and skipped == total else ""
+    parts = [f"{ok + skipped} ok ({ok} processed, {skipped} unchanged{redo})", f"{failed} failed"]
+    empty = len(getattr(result, "nothing_estimated", ()))
+    if empty:
+        parts.append(f"{empty} with nothing estimated")
     stale = sum(w.stale_dir is not None for w in result.wells)
     if stale:
         parts.append(f"{plural(stale, 'failed well')} {'keeps' if stale == 1 else 'keep'} an "
                      "earlier run's results, marked stale")
     if result.failed_segments:
         parts.append(f"{plural(result.failed_segments, 'segment')} failed")
+    manifest = result.manifest or Path(result.out_root) / "manifest.json"
     return (f"fleet: {plural(total, 'well')} — {', '.join(parts)} in {result.wall_s:.1f} s — "
-            f"{result.manifest}")
+            f"{manifest}")
 
 
 @click.command("fleet")

@@ -9,6 +9,7 @@ import click
 import numpy as np
 
 from drillfric.io.text import plural, terminal_text
+from drillfric.units import number
 from drillfric.vocabulary import Status
 
 from .common import unit_system, units_option
@@ -169,34 +170,39 @@ def _segment(seg, pre) -> dict:
             "message": pre.message}
 
 
-def _num(value: float | None) -> str:
-    """A table value: 4 significant digits, whole numbers without an exponent up to 1e9.
+def _num(value: float | None, resolution: float | None = None) -> str:
+    """A table value (:func:`drillfric.units.number`): 4 significant digits, never finer
+    than ``resolution``, a numerical zero as 0, no exponent below 1e9.
 
     Examples
     --------
-    >>> _num(24999.4), _num(254.93), _num(None), _num(3e12)
-    ('24999', '254.9', '—', '3e+12')
+    >>> _num(24999.4), _num(254.93), _num(None), _num(3e12), _num(1.173e-34, 0.1)
+    ('24999', '254.9', '—', '3e+12', '0')
     """
-    if value is None:
-        return "—"
-    return f"{value:.0f}" if 1e4 <= abs(value) < 1e9 else f"{value:.4g}"
+    return number(value, resolution)
+
+
+#: Resolution of the channels shown in their own unit (not a display quantity).
+_RESOLUTION = {"time": 1e-3, "percentage": 0.1, "pump rate": 0.1}
 
 
 def _channel_table(s: dict, units: str) -> list[str]:
     """The channel table: source column and unit, nulls, min/median/max in the display unit
     of ``units`` (kN, not 2.549e+05 N), else the unit of the canonical column."""
     from drillfric.io.channels import BY_NAME
-    from drillfric.units import display_factor, display_unit
+    from drillfric.units import display_factor, display_resolution, display_unit
 
     head = ("channel", "column", "unit", "from", "shown in", "nulls", "min", "median", "max")
     rows = [head]
     for name, c in s["channels"].items():
-        quantity = _SHOWN.get(BY_NAME[name].kind)
-        shown, scale = ((display_unit(quantity, units), display_factor(quantity, units))
-                        if quantity else (c["si_unit"], 1.0))
+        kind = BY_NAME[name].kind
+        quantity = _SHOWN.get(kind)
+        shown, scale, step = ((display_unit(quantity, units), display_factor(quantity, units),
+                               display_resolution(quantity, units))
+                              if quantity else (c["si_unit"], 1.0, _RESOLUTION.get(kind)))
         rows.append((name, c["column"], c["unit"], c["unit_source"], shown,
                      f"{c['null_count']} ({100 * c['null_fraction']:.1f}%)",
-                     *(_num(None if c[k] is None else c[k] * scale)
+                     *(_num(None if c[k] is None else c[k] * scale, step)
                        for k in ("min", "median", "max"))))
     widths = [max(len(str(r[i])) for r in rows) for i in range(len(head))]
     return ["  ".join(str(v).ljust(w) for v, w in zip(r, widths, strict=True)).rstrip()
@@ -245,18 +251,18 @@ def render(s: dict, units: str = "si") -> str:
         lines.append(f"segments   {len(s['segments'])} rotating, none estimated: run refuses "
                      "the log (the error below)")
     else:
-        lines += _segments_lines(s["segments"])
+        lines += _segments_lines(s["segments"], units)
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
-def _segments_lines(segments: list[dict]) -> list[str]:
+def _segments_lines(segments: list[dict], units: str = "si") -> list[str]:
     """What run does with the segments: how many it estimates (the usable ones), skips and
     fails, and why (:func:`_reasons`)."""
     ok = [g for g in segments if g["status"] == Status.OK]
     seconds = sum(g["duration_s"] or 0.0 for g in ok)
     return [f"segments   {len(segments)} rotating: {len(ok)} usable"
             + (f" ({_kinds(ok)}; {seconds / 3600:.2f} h)" if ok else "")
-            + _counts(segments)] + _reasons(segments)
+            + _counts(segments)] + _reasons(segments, units)
 
 
 def _kinds(ok: list[dict]) -> str:
@@ -272,15 +278,19 @@ def _counts(items: list[dict]) -> str:
     return f", {skipped} skipped" + (f", {failed} failed" if failed else "")
 
 
-def _reasons(items: list[dict]) -> list[str]:
+def _reasons(items: list[dict], units: str = "si") -> list[str]:
     """One line per reason run does not estimate segments (windows) for, whatever its
-    numbers: how many, skipped or failed, and the first one's message."""
+    numbers: how many, skipped or failed, and the first one's message (its quantities in
+    ``units``)."""
+    from drillfric.units import message_text
+
     groups: dict[tuple[str, str], list[dict]] = {}
     for g in items:
         if g["status"] != Status.OK:
             groups.setdefault((g["status"], re.sub(r"\d+(\.\d+)?", "#", g["message"])),
                               []).append(g)
-    return [f"{'':10} {len(group)} {status} like segment {group[0]['id']}: {group[0]['message']}"
+    return [f"{'':10} {len(group)} {status} like segment {group[0]['id']}: "
+            f"{message_text(group[0]['message'], units)}"
             for (status, _), group in groups.items()]
 
 
@@ -304,12 +314,13 @@ def render_depth_log(s: dict, units: str = "si") -> str:
     lines.append(f"windows    {len(s['segments'])} of "
                  f"{format_value(s['window_m'], 'length', units, '.0f')}: {len(ok)} usable"
                  + (f" ({_kinds(ok)})" if ok else "") + _counts(s["segments"]))
-    lines += _reasons(s["segments"])
+    lines += _reasons(s["segments"], units)
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
 def _assumed_lines(notes: list[str], units: str) -> list[str]:
-    """What was assumed, its quantities in the display units of ``units``."""
-    from drillfric.units import display_text
+    """What was assumed, its quantities in the display units of ``units`` (issue 35: "WOB
+    ≤ 10 kN" of a field-units inspect reads "WOB ≤ 2.25 klbf")."""
+    from drillfric.units import display_text, message_text
 
-    return [f"assumed    {display_text(note, units)}" for note in notes]
+    return [f"assumed    {message_text(display_text(note, units), units)}" for note in notes]

@@ -76,10 +76,14 @@ def _describe(result, units: str = "si") -> str:
         else "") if s["mu_s"] is not None else (
         f"not identifiable (≥ {s['mu_s_lower_bound']:.2f})" if s["mu_s_lower_bound"]
         else "not identifiable")
+    from drillfric.report.render import drag_text
+
+    drag = drag_text(s.get("drag"))
     return (f"{result.well}: {plural(c['segments'], 'segment')} "
             f"({c['estimated']} estimated, "
             f"{c['converged']} converged, {c['skipped']} skipped, {c['failed']} failed"
-            f"{_depths(s['segments'], units)}); {_mu_k_text(s)}, μ_s = {mu_s}")
+            f"{_depths(s['segments'], units)}); {_mu_k_text(s)}, μ_s = {mu_s}"
+            + (f"; {drag}" if drag else ""))
 
 
 def _mu_k_text(summary: dict) -> str:

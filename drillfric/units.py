@@ -659,6 +659,87 @@ def to_display(values, quantity: str, system: str | None = "si"):
     return float(scaled) if scaled.ndim == 0 else scaled
 
 
+#: Largest magnitude written without an exponent (a 1e308 from a broken log must not print
+#: as a 309-digit number; no physical quantity drillfric shows comes near it).
+PLAIN_LIMIT = 1e9
+#: Most decimals a number without a stated resolution is written with.
+MAX_DECIMALS = 6
+
+
+def number(value, resolution: float | None = None, digits: int = 4) -> str:
+    """A physical value as people read it: ``digits`` significant digits (trailing zeros
+    dropped), never finer than ``resolution`` (the quantity's resolution in the unit
+    shown, e.g. 0.1 for RPM), a value below half the resolution as ``0`` (a numerical zero
+    such as 1.173e-34 RPM is 0), and no exponent below :data:`PLAIN_LIMIT` (issue 35: an
+    inspect median printed as "1.173e-34"); "—" for None or NaN.
+
+    Examples
+    --------
+    >>> number(24999.4), number(254.93), number(None), number(3e12)
+    ('24999', '254.9', '—', '3e+12')
+    >>> number(1.173e-34, 0.1), number(-0.04, 0.1), number(0.2312, 0.1), number(0.0035)
+    ('0', '0', '0.2', '0.0035')
+    >>> number(1e-34), number(float("inf"))
+    ('0', 'inf')
+    """
+    if value is None:
+        return "—"
+    value = float(value)
+    if value != value:
+        return "—"
+    if abs(value) == float("inf"):
+        return "inf" if value > 0 else "-inf"
+    if abs(value) >= PLAIN_LIMIT:
+        return f"{value:.{digits}g}"
+    step = MAX_DECIMALS if not resolution or resolution <= 0 else max(
+        0, -math.floor(math.log10(resolution) + 1e-9))
+    if resolution and resolution > 0 and abs(value) < resolution / 2:
+        return "0"
+    magnitude = math.floor(math.log10(abs(value))) if value else 0
+    decimals = max(0, min(digits - 1 - magnitude, step, MAX_DECIMALS))
+    text = f"{value:.{decimals}f}"
+    if "." in text:  # as .4g writes it: 254.9, not 254.90
+        text = text.rstrip("0").rstrip(".")
+    return "0" if float(text) == 0 else text
+
+
+#: Resolution of each display quantity in its stored SI unit (:data:`_STORED`): what a rig
+#: sensor resolves at best — finer digits are noise, and a value below half of it is zero
+#: (issue 35: a bit speed of 1.173e-34 RPM). :func:`display_resolution` gives it in the unit
+#: shown.
+RESOLUTION_SI = {"length": 1e-3, "diameter": 1e-4, "force": 10.0, "torque": 0.1,
+                 "side force": 0.1, "density": 0.1, "linear mass": 0.01, "pressure": 100.0,
+                 "rotary speed": 0.1, "flow rate": 1e-6, "speed": 1e-5, "time": 1e-3,
+                 "moment of inertia": 0.1, "dogleg severity": 0.01}
+
+
+def display_resolution(quantity: str, system: str | None = "si") -> float:
+    """:data:`RESOLUTION_SI` of ``quantity`` in its display unit, down to a power of ten.
+
+    Examples
+    --------
+    >>> display_resolution("rotary speed"), display_resolution("force", "field")
+    (0.1, 0.001)
+    """
+    shown = RESOLUTION_SI[quantity] * display_factor(quantity, system)
+    return float(10.0 ** math.floor(math.log10(shown) + 1e-9))
+
+
+def format_number(value, quantity: str, system: str | None = "si") -> str:
+    """An SI value of ``quantity`` as a number in its display unit, at its resolution
+    (:func:`number`: a numerical zero is 0, no exponent), e.g. in
+    inspect's channel table.
+
+    Examples
+    --------
+    >>> format_number(1.173e-34, "rotary speed"), format_number(254900.0, "force")
+    ('0', '254.9')
+    """
+    if value is None:
+        return "—"
+    return number(to_display(value, quantity, system), display_resolution(quantity, system))
+
+
 def format_value(value, quantity: str, system: str | None = "si", spec: str = ".1f") -> str:
     """An SI value as text in the display unit, e.g. ``"8202.1 ft"`` (``"—"`` for None/NaN).
 
@@ -670,6 +751,55 @@ def format_value(value, quantity: str, system: str | None = "si", spec: str = ".
     if value is None or not np.isfinite(value):
         return "—"
     return f"{format(to_display(value, quantity, system), spec)} {display_unit(quantity, system)}"
+
+
+#: SI quantities written in run messages (summary.json is SI): unit as written, the
+#: quantity it is, and the factor to that quantity's stored unit — longest units first.
+_MESSAGE_UNITS = (("kN·m", "torque", 1e3), ("N·m", "torque", 1.0), ("kg/m³", "density", 1.0),
+                  ("m/s", "length", 1.0), ("m/h", "length", 1.0), ("MN", "force", 1e6),
+                  ("kN", "force", 1e3), ("N", "force", 1.0), ("m", "length", 1.0))
+_MESSAGE_NUMBER = r"[-−+]?\d+(?:\.\d+)?"
+_MESSAGE_QUANTITY = re.compile(
+    rf"(?<![\w.])({_MESSAGE_NUMBER})(?:\s?([–-]|to)\s?({_MESSAGE_NUMBER}))?\s?"
+    rf"({'|'.join(re.escape(u) for u, _, _ in _MESSAGE_UNITS)})(?![\w/·³²])")
+
+
+def message_text(text: str, system: str | None = "si", *, inline: bool = True) -> str:
+    """A message drillfric wrote in SI (a segment's reason, what was assumed, a warning)
+    with its quantities — m, m/s, m/h, N, kN, MN, N·m, kN·m, kg/m³ — in the display units
+    of ``system``: ``inline`` in place of the SI ones ("WOB ≤ 2.25 klbf", as inspect's
+    lines read in field units), else after them in brackets ("WOB ≤ 10 kN [2.25 klbf]", the
+    report, which keeps summary.json's SI words). Unchanged in ``"si"``.
+
+    Examples
+    --------
+    >>> message_text("rows that log WOB ≤ 10 kN, +0.05 to +0.15 m/s", "field")
+    'rows that log WOB ≤ 2.25 klbf, +0.164 to +0.492 ft/s'
+    >>> message_text("a 2804–2835 m window", "field", inline=False)
+    'a 2804–2835 m [9199–9301 ft] window'
+    """
+    if (system or "si") == "si" or not text:
+        return text
+    per = {u: (q, f) for u, q, f in _MESSAGE_UNITS}
+
+    def shown(written: str, factor: float, quantity: str) -> str:
+        value = float(written.replace("−", "-")) * factor * display_factor(quantity, system)
+        text = number(value, display_resolution(quantity, system), digits=3)
+        return ("+" + text) if written.startswith("+") and not text.startswith("-") else text
+
+    def convert(match: re.Match) -> str:
+        first, dash, second, unit = match.groups()
+        quantity, factor = per[unit]
+        label = display_unit(quantity, system)
+        if unit in ("m/s", "m/h"):
+            label += unit[1:]
+        value = shown(first, factor, quantity)
+        if second is not None:
+            gap = " " if dash == "to" else ""
+            value += gap + dash + gap + shown(second, factor, quantity)
+        return f"{value} {label}" if inline else f"{match.group(0)} [{value} {label}]"
+
+    return _MESSAGE_QUANTITY.sub(convert, text)
 
 
 #: Quantities drillfric's own notes (what was assumed) write in SI, by their spelling after

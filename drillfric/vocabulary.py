@@ -26,6 +26,14 @@ class WellStatus(StrEnum):
     FAILED = "failed"  #: could not be processed (its message says why)
 
 
+#: What drillfric calls the stop of rotation to add (or break out) a stand — the string set
+#: in the slips (rig state ``in_slips``) with the pick-up before it and the slack-off after
+#: it (drag_log.parquet's rows, summary.json ``drag.connections``). The report, the terminal
+#: and the fleet name these periods with this word and no other (issue 35, fourth newcomer:
+#: "in slips", "tripping" and "slack-offs" had each named them somewhere).
+CONNECTION = "connection"
+
+
 class Kind(StrEnum):
     """The load case of a rotating segment (docs/theory.md §2 item 5)."""
 

@@ -351,3 +351,30 @@ def test_a_string_in_the_slips_while_the_bit_depth_moves_is_no_drag(stands):
     info = whole.summary["drag"]
     assert info["connections"] >= 2 and info["estimated"] == 0, info
     assert all("not hanging" in row["reason"] for row in info["log"]), info["log"]
+
+
+def test_connections_labelled_three_ways(tmp_path, demo_cfg):
+    """Issue 35 (fourth newcomer): the connections were "in slips", "tripping" and
+    "slack-offs" in different places, and neither the terminal nor the report counted them.
+    Both now state the drag-based μ with the count of summary.json ``drag.connections``, in
+    the one word of drillfric.vocabulary.CONNECTION."""
+    import html
+
+    from drillfric.report.render import drag_text
+    from drillfric.vocabulary import CONNECTION
+
+    cfg, path = demo_cfg
+    summary, _ = _run(tmp_path, _connections_log(cfg, path, [2210.0, 2240.0]))
+    said = drag_text(summary["drag"])
+    total = summary["drag"]["connections"]
+    assert total == 2 and f"{total} {CONNECTION}s)" in said and said.startswith("μ drag")
+    ran = CliRunner().invoke(cli, ["run", str(tmp_path / "well.csv"), "--config",
+                                   str(tmp_path / "well.toml"), "--out",
+                                   str(tmp_path / "again")])
+    assert ran.exit_code == 0, ran.output
+    line = [x for x in ran.output.splitlines() if x.startswith("demo: ")][-1]
+    assert line.endswith(f"; {said}"), line
+    page = (tmp_path / "again" / "demo" / "report.html").read_text(encoding="utf-8")
+    assert f"Drag: {html.escape(said)}" in page
+    for other in ("slack-offs", "in-slips period", "tripping period"):
+        assert other not in line and other not in page.split("<script")[0]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -165,7 +166,7 @@ def test_incremental_skip_append_and_force(good_wells, tmp_path):
 
     second = fleet(source, "--out", out, "--workers", "1")
     assert second.exit_code == 0
-    assert "all 3 wells ok (unchanged" in second.output
+    assert "3 ok (0 processed, 3 unchanged; --force redoes them), 0 failed" in second.output
     assert stamps == {n: (out / n / "summary.json").stat().st_mtime_ns for n in TRUTH}
 
     data = good_wells / "w2.csv"
@@ -304,3 +305,29 @@ def test_linked_sidecars_get_a_fix_a_fleet_can_follow(tmp_path):
     result = fleet(tmp_path / "m.csv", "--out", tmp_path / "out2", "--workers", "1")
     assert result.exit_code == 0, result.output
     assert manifest(tmp_path / "out2")["w1"]["status"] == "ok"
+
+
+@pytest.mark.parametrize("outcome", ["all ok", "all unchanged", "partial", "some failed",
+                                     "all failed", "nothing estimated"])
+def test_fleet_last_line_names_manifest_or_folder_inconsistently(outcome):
+    """Issue 35 (fourth newcomer): the fleet's last line named the folder when every well
+    was unchanged and manifest.json otherwise. Every outcome now ends with the same path,
+    OUT/manifest.json, after the same words in the same order."""
+    from types import SimpleNamespace
+
+    from drillfric.cli.fleet_cmd import _closing_line
+
+    status = {"all ok": ["ok"] * 3, "all unchanged": ["skipped"] * 3,
+              "partial": ["ok", "ok", "skipped"], "some failed": ["ok", "failed", "skipped"],
+              "all failed": ["failed"] * 3, "nothing estimated": ["ok", "ok", "ok"]}[outcome]
+    wells = [SimpleNamespace(status=s, stale_dir=None) for s in status]
+    result = SimpleNamespace(
+        wells=wells, wall_s=2.0, manifest=Path("OUT/manifest.json"), out_root=Path("OUT"),
+        count=lambda s: status.count(s), failed_segments=2 if outcome == "partial" else 0,
+        nothing_estimated=("a", "b") if outcome == "nothing estimated" else ())
+    line = _closing_line(result)
+    assert re.fullmatch(r"fleet: 3 wells — \d ok \(\d processed, \d unchanged"
+                        r"(; --force redoes them)?\), \d failed(, [^—]+)? in 2\.0 s — "
+                        + re.escape(str(Path("OUT/manifest.json"))), line), line
+    result.manifest = None  # not recorded: the same path all the same
+    assert _closing_line(result) == line

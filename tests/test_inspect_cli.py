@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import h5py
@@ -238,3 +239,23 @@ def test_inspect_notes_the_bit_depth_run_assumes(tmp_path):
     doc = json.loads(_inspect(tmp_path / "w.csv", "--json").output)
     assert [g["bit_depth_m"] for g in doc["segments"]] == [DEFAULT_BIT_DEPTH_M]
     assert "bit depth 2500 m: neither the log nor a survey gives one" in doc["assumed"]
+
+
+def test_inspect_wob_threshold_stays_si_in_field_mode():
+    """Issue 35 (fourth newcomer, F-5 in ft): inspect's assumed line "rows that log WOB ≤ 10
+    kN" stayed SI in field units, as did the skip reasons' m/s and m; in field units every
+    inspect line gives its quantities in field units (klbf, ft/s, ft), in SI unchanged."""
+    from drillfric.cli.inspect_cmd import _assumed_lines, _reasons
+
+    note = ("on bottom in 731 of 18548 rows that log WOB ≤ 10 kN (segmentation.wob_on_bottom_N)"
+            " while the hole advanced (ROP > 0)")
+    [line] = _assumed_lines([note], "field")
+    assert "WOB ≤ 2.25 klbf (segmentation.wob_on_bottom_N)" in line and " kN" not in line
+    assert _assumed_lines([note], "si") == [f"assumed    {note}"]
+    skipped = [{"id": 7, "status": "skipped", "message": "reaming at an unsteady speed: the "
+                "pipe moves at +0.05 to +0.15 m/s; the bit depth jumps by 0.1 m; hook load "
+                "633 kN at the block's level (585 kN)"}]
+    [line] = _reasons(skipped, "field")
+    assert "+0.164 to +0.492 ft/s" in line and "0.328 ft" in line and "142 klbf" in line
+    assert not re.search(r"\d (m|kN|m/s)\b", line), line
+    assert _reasons(skipped, "si")[0].endswith(skipped[0]["message"])

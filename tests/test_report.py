@@ -936,6 +936,9 @@ def test_empty_friction_log_names_estimated_but_withheld_segments():
     assert "withheld by the hook-load check" in note and "1 skipped" in note
     skipped = no_friction_note(seg.assign(status=["skipped"] * 3))
     assert "no segment was estimated with a bit depth (3 segments: 3 skipped)" in skipped
+    from drillfric.report.display import Units
+
+    assert "estimated at 3064–3675 ft" in no_friction_note(seg, Units("field"))  # not m
 
 
 def test_an_empty_severity_panel_says_why():
@@ -953,3 +956,49 @@ def test_an_empty_severity_panel_says_why():
     assert severity_note(seg) == (
         "no severity shown: 1 severe (beyond the validated range), 1 undetermined, "
         "1 bit speed not resolved or withheld, 1 on bottom")
+
+
+def test_mu_s_mark_on_axis_edge_in_friction_log():
+    """Issue 35 (fourth newcomer): the friction log drew its largest μ_s on the axis edge
+    (half cut) and the μ = 0 diamonds of segments without an estimate on the spine. The
+    limits now hold every drawn mark — points, spread bars, bound tails — with a margin."""
+    seg = _segments([{"bit_depth_m": 1000.0, "mu_s": 0.9, "mu_s_spread": 0.1},
+                     {"bit_depth_m": 1030.0, "mu_s_identifiable": False, "mu_s": None,
+                      "mu_s_lower_bound": 0.85},
+                     {"bit_depth_m": 1090.0, "status": "failed", "mu_k": None, "mu_s": None,
+                      "mu_td": None}])
+    ax = figures.friction_log_figure(seg).axes[0]
+    (x0, x1), (y_low, y_high) = ax.get_xlim(), sorted(ax.get_ylim())
+    xs = [x for line in ax.get_lines() for x in np.asarray(line.get_xdata(), float)]
+    ys = [y for line in ax.get_lines() for y in np.asarray(line.get_ydata(), float)]
+    for collection in ax.collections:  # the spread bars
+        for path in collection.get_segments():
+            xs += list(np.asarray(path)[:, 0])
+            ys += list(np.asarray(path)[:, 1])
+    pad_x, pad_y = 0.02 * (x1 - x0), 0.02 * (y_high - y_low)
+    assert x0 + pad_x < min(xs) and max(xs) < x1 - pad_x, (x0, x1, min(xs), max(xs))
+    assert y_low + pad_y < min(ys) and max(ys) < y_high - pad_y, (y_low, y_high)
+    assert ax.yaxis_inverted()
+
+
+@pytest.mark.parametrize("stuck", [True, False])
+def test_pdf_legend_lacks_estimated_stuck(stuck):
+    """Issue 35 (fourth newcomer): the bit-speed panel's stuck shading had a legend entry
+    in the HTML ("estimated stuck") and none in the PDF. Both name it when it is drawn,
+    and neither when no period is stuck."""
+    from matplotlib.figure import Figure
+
+    from drillfric.report.evidence import STUCK_LABEL, _series_axes, evidence_sources, panel_data
+
+    t = np.arange(0.0, 20.0, 0.5)
+    bit_rpm = np.where((t > 5) & (t < 8), 0.0, 60.0) if stuck else np.full(t.size, 60.0)
+    est = pd.DataFrame({"time_s": t, "start_id": -1, "surface_rpm": 60.0,
+                        "surface_rpm_est": 60.0, "bit_rpm_est": bit_rpm,
+                        "bit_stuck": bit_rpm < 1.0, "mu_k": 0.3, "mu_s": 0.5})
+    ax = Figure().subplots()
+    data = panel_data(est)
+    _series_axes(ax, "bit", data["bit"], t, t, est, None)
+    labels = ax.get_legend_handles_labels()[1]
+    sources = evidence_sources(est, None)
+    assert (STUCK_LABEL in labels) is stuck and labels.count(STUCK_LABEL) <= 1
+    assert ("stuck" in sources) is stuck

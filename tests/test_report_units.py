@@ -295,7 +295,7 @@ def test_run_messages_follow_the_report_units():
 def test_field_report_messages_carry_field_values(field_copy):
     """A property over the field report's diagnostics: every SI quantity a message states
     is followed by its field value (no bare m or kN in a report in ft and klbf)."""
-    from drillfric.report.display import _QUANTITY
+    from drillfric.units import _MESSAGE_QUANTITY as _QUANTITY
 
     _, _, html = field_copy
     for cells in _diagnostic_cells(html):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import subprocess
 import sys
@@ -9,17 +10,22 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from drillfric.errors import ConfigError, InputError
 from drillfric.units import (
+    RESOLUTION_SI,
     conversion_factor,
     display_factor,
+    display_resolution,
     display_unit,
+    format_number,
     format_value,
     from_si,
+    number,
     quantity_value,
+    to_display,
     to_si,
 )
 
@@ -139,3 +145,38 @@ def test_pint_is_not_imported_with_the_configuration():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "False"
+
+
+# --------------------------------------------------------------------------- number text
+_QUANTITIES = sorted(RESOLUTION_SI)
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e8, max_value=1e8),
+       st.sampled_from(_QUANTITIES), st.sampled_from(["si", "field"]))
+def test_bit_rpm_median_printed_as_1e_34(value, quantity, system):
+    """Issue 35 (fourth newcomer): inspect printed a bit_rpm median as "1.173e-34". A value
+    of an ordinary quantity is written without an exponent, a value below half its
+    resolution as 0, never finer than the resolution, and reads back within it."""
+    shown = to_display(value, quantity, system)
+    assume(abs(shown) < 1e9)  # beyond: an exponent (a broken log's 1e308)
+    text = format_number(value, quantity, system)
+    step = display_resolution(quantity, system)
+    assert "e" not in text.lower() and text != "-0"
+    if abs(shown) < step / 2:
+        assert text == "0"
+    if "." in text:
+        assert len(text.split(".")[1]) <= round(-math.log10(step))
+    # 4 significant digits at most, or the resolution: within either of the two
+    assert abs(float(text) - shown) <= max(step / 2, 5e-4 * abs(shown)) * (1 + 1e-9) + 1e-12
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e-3, max_value=1e-3))
+def test_tiny_rpm_is_zero(value):
+    """A numerical zero of a speed (within 0.05 RPM) prints as 0, whatever its sign."""
+    assert number(value, 0.1) == "0"
+
+
+def test_number_text_cases():
+    assert [number(v, r) for v, r in ((1.173e-34, 0.1), (40.1, 0.1), (-13.49, 0.1),
+                                      (2.549e5, None), (3e12, None), (None, 0.1))] == [
+        "0", "40.1", "-13.5", "254900", "3e+12", "—"]

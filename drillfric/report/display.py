@@ -11,10 +11,9 @@ and the notes of the HTML and the PDF all go through one :class:`Units`.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
-from drillfric.units import UNIT_SYSTEMS, display_factor, display_unit
+from drillfric.units import UNIT_SYSTEMS, display_factor, display_unit, message_text
 
 #: Display units of quantities the terminal never shows (so not in DISPLAY_UNITS):
 #: ``(label, pint expression of the display unit, pint expression of the stored SI unit)``.
@@ -87,46 +86,17 @@ class Units:
         return "—" if left == right == "—" else f"{left} / {right}"
 
 
-#: SI quantities written in run messages (summary.json is SI): unit as written, the
-#: quantity it is, and the factor to that quantity's stored unit — longest units first.
-_MESSAGE_UNITS = (("kN·m", "torque", 1e3), ("N·m", "torque", 1.0), ("kg/m³", "density", 1.0),
-                  ("m/s", "length", 1.0), ("m/h", "length", 1.0), ("MN", "force", 1e6),
-                  ("kN", "force", 1e3), ("N", "force", 1.0), ("m", "length", 1.0))
-_NUMBER = r"[-−]?\d+(?:\.\d+)?"
-_QUANTITY = re.compile(
-    rf"(?<![\w.])({_NUMBER})(?:\s?([–-])\s?({_NUMBER}))?\s?"
-    rf"({'|'.join(re.escape(u) for u, _, _ in _MESSAGE_UNITS)})(?![\w/·³²])")
-
-
 def message_in(text: str, units: Units) -> str:
     """A run message (written in SI) for a report in ``units``: in field units each SI
     quantity keeps its value and gets the field one after it in brackets — "2804–2835 m
     [9199–9301 ft]", "WOB ≤ 10 kN [2.2 klbf]" (issue 35: an F-5 report in ft and klbf
-    printed its messages in m and kN alone). SI reports: the text unchanged.
+    printed its messages in m and kN alone). SI reports: the text unchanged
+    (:func:`drillfric.units.message_text`).
 
     >>> message_in("a 2804–2835 m window, WOB ≤ 10 kN", Units("field"))
     'a 2804–2835 m [9199–9301 ft] window, WOB ≤ 10 kN [2.25 klbf]'
     """
-    if units.system == "si" or not text:
-        return text
-    per = {u: (q, f) for u, q, f in _MESSAGE_UNITS}
-
-    def field(number: str, factor: float, quantity: str) -> str:
-        value = units.value(float(number.replace("−", "-")) * factor, quantity)
-        return f"{value:.0f}" if abs(value) >= 100 else f"{value:.3g}"
-
-    def convert(match: re.Match) -> str:
-        first, dash, second, unit = match.groups()
-        quantity, factor = per[unit]
-        label = units.label(quantity)
-        if unit in ("m/s", "m/h"):
-            label += unit[1:]
-        shown = field(first, factor, quantity)
-        if second is not None:
-            shown += dash + field(second, factor, quantity)
-        return f"{match.group(0)} [{shown} {label}]"
-
-    return _QUANTITY.sub(convert, text)
+    return message_text(text, units.system, inline=False)
 
 
 #: The default: SI display units (m, kN, kN·m, bar, L/min).

@@ -46,6 +46,8 @@ FINAL_LABEL = "final pass: μ_k(t), μ_s seeded"
 OBSERVER = "#1f5fa8"
 FIT = "#e67e22"
 STUCK = "#f4b6b6"
+#: Legend of the stuck periods, in the HTML's and the PDF's bit-speed panel alike.
+STUCK_LABEL = "estimated stuck"
 BHA = "#8e44ad"
 _PX = 150
 
@@ -153,16 +155,18 @@ def evidence_sources(est: pd.DataFrame, origin: pd.Timestamp | TimeAxis | None,
     """The data of every Bokeh source of a segment's evidence, by source name.
 
     ``panel:KEY`` (``x`` and the series of :func:`panel_data`, float32), ``stuck``
-    (``x0``, ``x1``: stuck periods, with the bit panel), ``start:ID`` (``x``, ``mu_k``,
-    ``mu_s`` of one observer start; ``start:-1`` the final pass).
+    (``x0``, ``x1``: stuck periods, with the bit panel; absent when there are none),
+    ``start:ID`` (``x``, ``mu_k``, ``mu_s`` of one observer start; ``start:-1`` the final
+    pass).
     """
     data = panel_data(est, units, bit)
     t = data.pop("time_s")["t"]
     x = time_values(t, origin)
     out = {f"panel:{key}": {"x": x, **{k: float32(v) for k, v in series.items()}}
            for key, series in data.items()}
-    if "bit" in data:
-        runs = np.array(stuck_runs(t, stuck_flags(final_pass(est)))).reshape(-1, 2)
+    runs = np.array(stuck_runs(t, stuck_flags(final_pass(est))) if "bit" in data
+                    else []).reshape(-1, 2)
+    if len(runs):  # none: no "estimated stuck" legend entry, as in the PDF
         out["stuck"] = {"x0": time_values(runs[:, 0], origin),
                         "x1": time_values(runs[:, 1], origin)}
     for start_id, rows in est.groupby("start_id", sort=True):
@@ -222,10 +226,10 @@ def evidence_plot(sources: dict[str, dict], axis: TimeAxis, units: Units = SI,
                           x_range=x_range, axis=axis)
         x_range = fig.x_range
         source = ColumnDataSource(columns, name=name)
-        if key == "bit":
+        if key == "bit" and "stuck" in sources:
             fig.vstrip(x0="x0", x1="x1", source=ColumnDataSource(sources["stuck"],
                                                                    name="stuck"),
-                       color=STUCK, alpha=0.6, line_alpha=0, legend_label="estimated stuck")
+                       color=STUCK, alpha=0.6, line_alpha=0, legend_label=STUCK_LABEL)
             if "low" in columns:
                 fig.varea("x", "low", "high", source=source, color=OBSERVER, alpha=0.18,
                           legend_label="ensemble band (min–max)")
@@ -345,9 +349,10 @@ def evidence_figure(est: pd.DataFrame, segment: dict,
 
 def _series_axes(ax, key: str, series: dict, x, t, est, origin) -> None:
     if key == "bit":
-        for t0, t1 in stuck_runs(t, stuck_flags(final_pass(est))):
-            left, right = time_values([t0, t1], origin)
-            ax.axvspan(left, right, color=STUCK, linewidth=0)
+        for index, (t0, t1) in enumerate(stuck_runs(t, stuck_flags(final_pass(est)))):
+            left, right = time_values([t0, t1], origin)  # one legend entry, as the HTML's
+            ax.axvspan(left, right, color=STUCK, linewidth=0,
+                       label=STUCK_LABEL if index == 0 else None)
         if "low" in series:
             ax.fill_between(x, series["low"], series["high"], color=OBSERVER, alpha=0.18,
                             linewidth=0, label="ensemble band (min–max)")

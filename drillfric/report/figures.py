@@ -31,7 +31,10 @@ TD_COLOR = "#222222"
 #: The drag-based friction factors (pick-up / slack-off hook loads, docs/theory.md §2.2).
 DRAG_COLOR = "#16a085"
 #: Legend of the drag-based points, in the static and the interactive friction log.
-DRAG_LABEL = "drag-based μ (pick-up/slack-off hook load)"
+DRAG_LABEL = "drag-based μ of the connections (pick-up/slack-off hook loads)"
+#: Legends of the segments without an estimate and of the μ_s lower bounds, likewise.
+NONE_LABEL = "no estimate (skipped/failed)"
+BOUND_LABEL = "μ_s ≥ lower bound"
 SEVERITY_COLOR = "#8e44ad"
 _WIDTH_IN = 9.0
 
@@ -205,7 +208,7 @@ def friction_log_figure(segments: pd.DataFrame,
     bound = ok[~ok["mu_s_identifiable"] & ok["mu_s_lower_bound"].notna()]
     if len(bound):
         ax.plot(bound["mu_s_lower_bound"], bound["depth"], ">", color=MU_S_COLOR,
-                markerfacecolor="none", label="μ_s ≥ lower bound", clip_on=False)
+                markerfacecolor="none", label=BOUND_LABEL, clip_on=False)
         for x, y in zip(bound["mu_s_lower_bound"], bound["depth"], strict=True):
             ax.plot([x, x + 0.08], [y, y], ":", color=MU_S_COLOR, linewidth=1.2)
     td = ok[~apparent & ok["mu_td"].notna()]
@@ -222,12 +225,10 @@ def friction_log_figure(segments: pd.DataFrame,
         return fig
     if len(none):
         ax.plot(np.zeros(len(none)), none["depth"], "d", color="#888888",
-                markerfacecolor="none", clip_on=False, label="no estimate (skipped/failed)")
+                markerfacecolor="none", clip_on=False, label=NONE_LABEL)
     zone = zone_text(segments)
     ax.set(xlabel=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
            ylabel=units.axis("bit depth", "length"))
-    ax.margins(x=0.08, y=0.08)
-    ax.set_xlim(left=0.0)
     _depth_axis(ax)
     ax.legend(fontsize="small", loc="best")
     sev = ok[ok["stick_slip_severity"].notna()]
@@ -240,7 +241,22 @@ def friction_log_figure(segments: pd.DataFrame,
     ax_sev.set_xlim(left=0.0, right=max(1.2, 1.1 * float(sev["stick_slip_severity"].max()))
                     if len(sev) else 1.2)
     ax_sev.grid(True, color="#dddddd", linewidth=0.6)
+    _around_every_mark(ax)
     return fig
+
+
+def _around_every_mark(ax, margin: float = 0.08) -> None:
+    """Limits of the friction log that hold every mark drawn — points, spread bars, bound
+    tails, the μ = 0 diamonds — with ``margin`` of the span around them (issue 35: a μ_s
+    mark sat on the axis edge, half cut); μ from a little below 0, depth inverted."""
+    x0, x1 = ax.dataLim.intervalx
+    y0, y1 = ax.dataLim.intervaly
+    x0, x1 = min(0.0, x0), max(x1, 0.1)
+    pad = margin * (x1 - x0)
+    ax.set_xlim(x0 - pad / 2, x1 + pad)
+    span = y1 - y0 if y1 > y0 else max(abs(y0) * 0.01, 10.0)
+    ax.set_ylim(y1 + margin * span, y0 - margin * span)  # depth down
+
 
 
 def drag_rows(drag: pd.DataFrame | None) -> pd.DataFrame:

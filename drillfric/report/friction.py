@@ -23,10 +23,12 @@ from drillfric.vocabulary import MOVING_KINDS, Kind, Status
 from .display import SI, Units, fmt
 from .figures import (
     APPARENT_COLOR,
+    BOUND_LABEL,
     DRAG_COLOR,
     DRAG_LABEL,
     MU_K_COLOR,
     MU_S_COLOR,
+    NONE_LABEL,
     TD_COLOR,
     drag_rows,
 )
@@ -214,7 +216,9 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
                 x_axis_label=f"friction factor μ{f' ({zone})' if zone else ''} [-]",
                 y_axis_label=units.axis("bit depth", "length"))
     mu.y_range.flipped = True
-    mu.x_range.start = 0.0  # a friction factor is ≥ 0: the axis never runs into negatives
+    # a friction factor is ≥ 0: the axis starts just below 0, so that the μ = 0 diamonds
+    # (no estimate) are drawn whole, not cut in half by the frame (issue 35)
+    mu.x_range.start = -0.03
     cds = {name: ColumnDataSource(columns, name=name) for name, columns in sources.items()}
     renderers, drag_renderers = [], []
     for name, source in cds.items():
@@ -237,11 +241,11 @@ def friction_plot(segments: pd.DataFrame, sources: dict[str, dict], units: Units
             renderers.append(mu.scatter("mu_s_lower_bound", "depth", source=source,
                                         marker="triangle", angle=-np.pi / 2, size=10,
                                         line_color=MU_S_COLOR, fill_color="white",
-                                        legend_label="μ_s ≥ lower bound"))
+                                        legend_label=BOUND_LABEL))
         elif mark == "none":
             renderers.append(mu.scatter("zero", "depth", source=source, marker="diamond",
                                         size=10, color="#888888", fill_color="white",
-                                        legend_label="no estimate"))
+                                        legend_label=NONE_LABEL))
     mu.add_tools(HoverTool(renderers=renderers, tooltips=_tips(units)))
     if drag_renderers:
         mu.add_tools(HoverTool(renderers=drag_renderers, tooltips=_drag_tips(units)))

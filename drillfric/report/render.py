@@ -20,10 +20,10 @@ import pandas as pd
 from jinja2 import Environment, FileSystemLoader, select_autoescape
 from matplotlib.figure import Figure
 
-from drillfric.io.text import plural
+from drillfric.io.text import plural, share
 from drillfric.io.timebase import clock_at
-from drillfric.result import Flag, segment_is_apparent
-from drillfric.vocabulary import Kind, Method, Status
+from drillfric.result import Flag, segment_is_apparent, well_friction_columns
+from drillfric.vocabulary import CONNECTION, Kind, Method, Status
 
 from .display import Units, fmt, row_flags
 
@@ -531,3 +531,27 @@ def written_at(path) -> str:
 def now_utc() -> str:
     """The current time as ``YYYY-MM-DD HH:MM UTC``."""
     return datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
+
+
+def drag_text(drag: dict | None) -> str:
+    """The drag-based friction of a well in words, as the terminal's result line and the
+    report's friction log state it, counting its connections (:data:`~drillfric.vocabulary.
+    CONNECTION`) as summary.json ``drag.connections`` does: ``"μ drag = 0.251 (3 of 5
+    connections)"``, ``"μ drag withheld (0 of 16 connections)"``; "" for a log without a
+    connection.
+
+    Examples
+    --------
+    >>> drag_text({"connections": 2, "estimated": 2, "log": [{"mu_drag": 0.2},
+    ...                                                       {"mu_drag": 0.3}]})
+    'μ drag = 0.250 (all 2 connections)'
+    >>> drag_text({"connections": 16, "estimated": 0, "log": []}), drag_text(None)
+    ('μ drag withheld (0 of 16 connections)', '')
+    """
+    drag = drag or {}
+    total = drag.get("connections") or 0
+    if not total:
+        return ""
+    mu = well_friction_columns({"drag": drag})["well_mu_drag"]
+    counted = share(int(drag.get("estimated") or 0), int(total), CONNECTION)
+    return f"μ drag withheld ({counted})" if mu is None else f"μ drag = {mu:.3f} ({counted})"

@@ -49,6 +49,7 @@ from .render import (
     config_rows,
     diagnostic_columns,
     diagnostic_rows,
+    drag_text,
     environment,
     figure_uri,
     flag_items,
@@ -558,7 +559,8 @@ def _html(report: Report) -> str:
     return environment().get_template("well_report.html.j2").render(
         head=report.head, bokeh=embed.head, tracks_id=tracks_id,
         no_tracks=_DEPTH_TRACKS if data.depth_indexed else _NO_TRACKS,
-        friction_id=friction_id, no_friction=no_friction_note(data.segments),
+        friction_id=friction_id, no_friction=no_friction_note(data.segments, units),
+        drag_line=drag_text(data.summary.get("drag")),
         sections=sections, segments=segments,
         broomstick_check=_broomstick_note(report.broomstick.check, units),
         broomstick_warning=bool(report.broomstick.check["warning"]),
@@ -575,8 +577,10 @@ def has_friction(segments: pd.DataFrame) -> bool:
                  & segments["mu_k"].notna()).any())
 
 
-def no_friction_note(segments: pd.DataFrame) -> str:
-    """Why the friction log is empty, with the counts."""
+def no_friction_note(segments: pd.DataFrame, units: Units | None = None) -> str:
+    """Why the friction log is empty, with the counts; depths in the report's ``units``
+    (a field report said "934–1120 m")."""
+    units = units or Units()
     if not len(segments):
         return "No friction log: the run found no rotating segment."
     status = segments["status"].value_counts()
@@ -587,7 +591,8 @@ def no_friction_note(segments: pd.DataFrame) -> str:
         verb = "was" if len(estimated) == 1 else "were"
         return (f"No friction factor to draw: {share(len(estimated), len(segments), 'segment')} "
                 f"{verb} estimated at "
-                f"{estimated['bit_depth_m'].min():.0f}–{estimated['bit_depth_m'].max():.0f} m "
+                f"{units.text(estimated['bit_depth_m'].min(), 'length')}–"
+                f"{units.text(estimated['bit_depth_m'].max(), 'length')} {units.label('length')} "
                 f"and their friction factors withheld{why}" + (f" ({parts})" if parts else "")
                 + "; their reasons are in the diagnostics table.")
     return (f"No friction factor to draw: no segment was estimated with a bit depth "
@@ -720,7 +725,7 @@ def _first_page(report: Report, size):
     data = report.data
     fig = figures.friction_log_figure(
         data.segments, size, report.units, top_in=top, drag=data.drag_log,
-        empty_note=no_friction_note(data.segments))
+        empty_note=no_friction_note(data.segments, report.units))
     for index, (text, strong, warning) in enumerate(lines):
         fig.text(0.45 / size[0], 1 - (_HEADLINE_TOP_IN + _HEADLINE_LINE_IN * index) / size[1],
                  text, fontsize=_HEADLINE_PT[strong], va="top", parse_math=False,
