@@ -31,8 +31,11 @@ and its final ensemble re-run with a bit cap:
   same static and kinetic, so the string's excess is what the apparent fit saw);
 - ``est±``: three caps T_bit − u, T_bit, T_bit + u (u its 95 % half-width) × the five μ_s
   members: one ensemble of 15 members, band over all of them;
-- rate-weakening record only: ``T_k``, ``r·T_k`` (the law's bounds, truth μ) and
-  ``T_k..r·T_k``: both as one ensemble of 10 members.
+- rate-weakening record only: ``T_k``, ``r·T_k`` (the law's bounds, truth μ),
+  ``T_k..r·T_k``: both as one ensemble of 10 members, and ``T_k±30 %``: caps 0.7, 1 and
+  1.3 × T_k as one ensemble of 15 (what members over T_bit ± its half-width would be where
+  T_bit is right; drillfric's 95 % half-width was 14–67 % of T_bit on the Coulomb-and-r = 2
+  records with T_bit ≥ 2 kN·m).
 
 With ``--mu-s 0.25`` the string has no static excess (μ_s = μ_k): whatever stick-slip
 there is, the bit drives it.
@@ -188,6 +191,8 @@ def probe_segment(settings, well, logged, g, frame, truth: dict, out_rate: float
             mu=mu_true)
         add("T_k..r·T_k", *capped_trace(settings, models, [t_k, r * t_k], *mu_true,
                                         out_rate), mu=mu_true)
+        add("T_k±30 %", *capped_trace(settings, models, [0.7 * t_k, t_k, 1.3 * t_k],
+                                      *mu_true, out_rate), mu=mu_true)
     if g["bit_torque_Nm"] is None:
         return out
     mu_k = g["bit_torque_mu_k"]
