@@ -11,7 +11,8 @@ draws a trace that passes the window rule of docs/bit_speed.md ("Window by windo
   otherwise it is FALSE, and how far outside the band it lies is its "outside" error;
 - "shown" windows are those the pipeline's own kinematic window check would not withhold
   (:func:`drillfric.estimation.chain._windows`, with the start-up withheld where μ_s was
-  not identified);
+  not identified); a trace is "kept" where the whole-segment kinematic check passes (or
+  flags the phase approximate) and at most half its windows are withheld, as off bottom;
 - the trace's RMS error after the start-up against the surface speed's taken as the bit's.
 
 Records: :mod:`validate_drilling`'s drilling records (demo string and path, five stands
@@ -41,8 +42,9 @@ With ``--mu-s 0.25`` the string has no static excess (μ_s = μ_k): whatever sti
 there is, the bit drives it.
 
 Run: ``NUMBA_NUM_THREADS=1 python benchmarks/probe_on_bottom_trace.py [--laws 12:0.6]
-[--rates '100 Hz,5 Hz'] [--mu-s 0.25] [--json FILE]`` (the default grid, 4 laws × 4
-rates, 80 on-bottom segments, took 5 min 19 s on one shared core, 8 Dec 2026).
+[--rates '100 Hz,5 Hz'] [--mu-s 0.25] [--rotation 60] [--json FILE]`` (the four laws at
+100 and 5 Hz, 40 on-bottom segments, took 5 min 20 s on one shared core, 8 Dec 2026;
+docs/bit_speed.md "On bottom: feasibility" has the results).
 """
 
 from __future__ import annotations
@@ -65,7 +67,7 @@ import validate_drilling as vd  # noqa: E402
 import validate_trust as trust  # noqa: E402
 
 import drillfric  # noqa: E402
-from drillfric.estimation import chain, skew  # noqa: E402
+from drillfric.estimation import bit_trace, chain, skew  # noqa: E402
 from drillfric.estimation.bit_trace import window_grid  # noqa: E402
 from drillfric.estimation.diagnostics import settled_mask  # noqa: E402
 from drillfric.estimation.observer import ObserverRecord, ensemble_bit_speed  # noqa: E402
@@ -174,7 +176,11 @@ def probe_segment(settings, well, logged, g, frame, truth: dict, out_rate: float
 
     def add(source, time_s, rad_s, low, high, **extra):
         shown = shown_windows(settings, models, time_s, rad_s, unknown)
-        out.append(common | {"source": source} | extra
+        kin = bit_trace.check_segment_trace(models.string, models.meas, time_s, rad_s,
+                                            settings.speed_noise_rad_s)
+        whole = (kin.passed or kin.approximate) and sum(shown) >= (
+            1.0 - bit_trace.MAX_WITHHELD_SHARE) * len(shown)
+        out.append(common | {"source": source, "trace_kept": bool(whole)} | extra
                    | grade(time_s, rad_s, low, high, truth_t, truth_rpm, surface_rpm
                            if time_s is t_rec else np.interp(time_s, t_rec, surface_rpm),
                            shown))
