@@ -109,3 +109,15 @@ def test_the_run_line_states_mu_s_with_its_interval():
                "mu_s_lower_bound": None}
     line = _describe(SimpleNamespace(well="demo", summary=summary))
     assert line.endswith("μ_k = 0.279 ± 0.017, μ_s = 0.585 ± 0.059")
+
+
+def test_short_steady_rotations_whose_observer_start_was_released_pool():
+    """Regression (issue 36 feasibility probe): on a string that does not stick-slip off
+    bottom (μ_s = μ_k) the 30- and 60-s connection rotations carried
+    ``observer_deadlock_averted`` — an observer start the guard released, nothing of the
+    batch μ_k — and made no friction-log entry, so every on-bottom T_bit was withheld
+    ("no off-bottom μ_k within reach") although they read μ_k 0.249–0.251."""
+    records = [_seg(i, 0.249 + 0.001 * (i % 3), flags=(Flag.TOO_SHORT_TO_CONVERGE,
+                                                      Flag.OBSERVER_DEADLOCK_AVERTED))
+               for i in range(1, 6)]
+    assert pool_short_segments(records)[1][0]["segment_ids"] == [1, 2, 3, 4, 5]

@@ -21,11 +21,14 @@ from drillfric.vocabulary import Kind, Method, Status
 #: cycles leave its own μ_k uncertain, which is what pooling answers; ``bistable_regime``
 #: concerns only the μ_s bound, withheld, not μ_k; ``bit_speed_drift``,
 #: ``stick_slip_beyond_validated`` and ``channel_skew_unidentified`` only the bit-speed trace
-#: and its statistics).
+#: and its statistics; ``observer_deadlock_averted`` an observer start the guard released,
+#: not the batch μ_k pooled — it had kept every 30–60-s rotation of a string that does not
+#: stick-slip out of the friction log, and with it every on-bottom T_bit nearby).
 _POOLABLE = frozenset({"too_short_to_converge", "observer_starts_disagree",
                        "estimators_disagree", "bit_speed_drift", "mu_k_uncertain",
                        "bistable_regime", "stick_slip_beyond_validated",
-                       "stick_slip_undetermined", "channel_skew_unidentified"})
+                       "stick_slip_undetermined", "channel_skew_unidentified",
+                       "observer_deadlock_averted"})
 #: Short segments pool when the string's friction torque added between their bit depths is
 #: at most this share of the torque at the deeper one, |ΔT_N|/T_N (docs/theory.md "Pooling
 #: along depth"). The reported μ_k is the torque-weighted mean of μ(x) over the whole
