@@ -39,7 +39,8 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
 
     Ends with what 'drillfric run' will do, from run's own checks before it estimates: the
     segments (windows) it estimates (usable), skips and fails, with the reasons, or the
-    error it would stop the log with (exit code 2).
+    error it would stop the log with (exit code 2); and whether run's hook-load check will
+    withhold their friction factors (the string against the measured hook load).
     """
     from drillfric.io.well import open_well
 
@@ -70,7 +71,7 @@ def summarize(well, data) -> dict:
     ``well`` and its loaded ``data``; its segments are those run cuts, each with what run
     does with it before estimating (:func:`drillfric.runner.preview.segment_verdicts`)."""
     from drillfric.io.timebase import spacing_summary
-    from drillfric.runner.preview import segment_verdicts
+    from drillfric.runner.preview import segment_rows, string_weight_check
 
     tb = data.timebase
     channels = {}
@@ -81,7 +82,9 @@ def summarize(well, data) -> dict:
         channels[name] = _channel(name, info.column, info.unit, info.source,
                                   info.null_fraction, total, data.surface)
     assumed = data.config.assumed_with(data.survey)
-    segments = [_segment(seg, pre) for seg, pre in segment_verdicts(well, data.surface, assumed)]
+    verdicts = segment_rows(well, data.surface, assumed)
+    segments = [_segment(seg, pre) for seg, _, pre in verdicts]
+    string_check = string_weight_check(well, data.surface, verdicts)
     return {
         "channels": channels, "rows": tb.rows, "t_start_s": tb.t_start_s,
         "t_end_s": tb.t_end_s, "rate_hz": tb.rate_hz, "gaps": [list(g) for g in tb.gaps],
@@ -93,7 +96,7 @@ def summarize(well, data) -> dict:
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
         "max_gap_s": data.config.segmentation.max_gap_s,
-        "assumed": assumed, "segments": segments,
+        "assumed": assumed, "segments": segments, "string_check": string_check,
     }
 
 
@@ -246,6 +249,8 @@ def render(s: dict, units: str = "si") -> str:
                      "the log (the error below)")
     else:
         lines += _segments_lines(s["segments"])
+        if (s.get("string_check") or {}).get("line"):
+            lines.append(f"string     {s['string_check']['line']}")
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 
