@@ -26,10 +26,13 @@ _SHOWN = {"length": "length", "force": "force", "torque": "torque",
               help="Well configuration TOML (overrides the NAME.toml sidecar).")
 @click.option("--survey", "survey_file", type=click.Path(path_type=str),
               help="Survey file (overrides the NAME.survey.* sidecar).")
+@click.option("--string", "string_file", type=click.Path(path_type=str),
+              help="WITSML tubular file read as the drill string (overrides the "
+                   "NAME.tubular.xml sidecar; for a configuration without [[string.sections]]).")
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON (SI).")
 @units_option
-def command(well: str, config_file: str | None, survey_file: str | None, as_json: bool,
-            units: str | None) -> None:
+def command(well: str, config_file: str | None, survey_file: str | None,
+            string_file: str | None, as_json: bool, units: str | None) -> None:
     """Show the channels, units, rate, gaps, time span and survey recognised in WELL.
 
     WELL is a data file (.parquet, .csv, .h5, .las, .xml, .dlis, .xlsx) with optional
@@ -44,7 +47,7 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
     """
     from drillfric.io.well import open_well
 
-    opened = open_well(well, config=config_file, survey=survey_file)
+    opened = open_well(well, config=config_file, survey=survey_file, string=string_file)
     refused = None
     if opened.depth_indexed:
         summary = summarize_depth_log(opened)
