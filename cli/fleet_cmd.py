@@ -69,7 +69,7 @@ def _closing_line(result) -> str:
                    "(not a config a manifest names).")
 def command(source: Path, out: Path, scheduler, workers, force, report, config) -> None:
     """Run every well of DIR_OR_MANIFEST (a directory of wells, or a .csv/.json manifest
-    with columns well, data, config, survey), skipping wells unchanged since their last run.
+    with columns well, data, config, survey, string), skipping wells unchanged since their last run.
     """
     from drillfric.fleet.discovery import discover
     from drillfric.fleet.run import run_many

@@ -27,10 +27,13 @@ _SHOWN = {"length": "length", "force": "force", "torque": "torque",
               help="Well configuration TOML (overrides the NAME.toml sidecar).")
 @click.option("--survey", "survey_file", type=click.Path(path_type=str),
               help="Survey file (overrides the NAME.survey.* sidecar).")
+@click.option("--string", "string_file", type=click.Path(path_type=str),
+              help="WITSML tubular file read as the drill string (overrides the "
+                   "NAME.tubular.xml sidecar; for a configuration without [[string.sections]]).")
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON (SI).")
 @units_option
-def command(well: str, config_file: str | None, survey_file: str | None, as_json: bool,
-            units: str | None) -> None:
+def command(well: str, config_file: str | None, survey_file: str | None,
+            string_file: str | None, as_json: bool, units: str | None) -> None:
     """Show the channels, units, rate, gaps, time span and survey recognised in WELL.
 
     WELL is a data file (.parquet, .csv, .h5, .las, .xml, .dlis, .xlsx) with optional
@@ -40,11 +43,12 @@ def command(well: str, config_file: str | None, survey_file: str | None, as_json
 
     Ends with what 'drillfric run' will do, from run's own checks before it estimates: the
     segments (windows) it estimates (usable), skips and fails, with the reasons, or the
-    error it would stop the log with (exit code 2).
+    error it would stop the log with (exit code 2); and whether run's hook-load check will
+    withhold their friction factors (the string against the measured hook load).
     """
     from drillfric.io.well import open_well
 
-    opened = open_well(well, config=config_file, survey=survey_file)
+    opened = open_well(well, config=config_file, survey=survey_file, string=string_file)
     refused = None
     if opened.depth_indexed:
         summary = summarize_depth_log(opened)
@@ -71,7 +75,7 @@ def summarize(well, data) -> dict:
     ``well`` and its loaded ``data``; its segments are those run cuts, each with what run
     does with it before estimating (:func:`drillfric.runner.preview.segment_verdicts`)."""
     from drillfric.io.timebase import spacing_summary
-    from drillfric.runner.preview import segment_verdicts
+    from drillfric.runner.preview import segment_rows, string_weight_check
 
     tb = data.timebase
     channels = {}
@@ -82,7 +86,9 @@ def summarize(well, data) -> dict:
         channels[name] = _channel(name, info.column, info.unit, info.source,
                                   info.null_fraction, total, data.surface)
     assumed = data.config.assumed_with(data.survey)
-    segments = [_segment(seg, pre) for seg, pre in segment_verdicts(well, data.surface, assumed)]
+    verdicts = segment_rows(well, data.surface, assumed)
+    segments = [_segment(seg, pre) for seg, _, pre in verdicts]
+    string_check = string_weight_check(well, data.surface, verdicts)
     return {
         "channels": channels, "rows": tb.rows, "t_start_s": tb.t_start_s,
         "t_end_s": tb.t_end_s, "rate_hz": tb.rate_hz, "gaps": [list(g) for g in tb.gaps],
@@ -94,7 +100,7 @@ def summarize(well, data) -> dict:
         "source_start_s": tb.source_start_s,
         "spacing_s": spacing_summary(data.surface["time_s"].to_numpy()),
         "max_gap_s": data.config.segmentation.max_gap_s,
-        "assumed": assumed, "segments": segments,
+        "assumed": assumed, "segments": segments, "string_check": string_check,
     }
 
 
@@ -252,6 +258,8 @@ def render(s: dict, units: str = "si") -> str:
                      "the log (the error below)")
     else:
         lines += _segments_lines(s["segments"], units)
+        if (s.get("string_check") or {}).get("line"):
+            lines.append(f"string     {s['string_check']['line']}")
     return "\n".join(lines + _assumed_lines(s["assumed"], units))
 
 

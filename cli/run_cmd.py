@@ -123,6 +123,9 @@ def _describe_depth_log(result, units: str) -> str:
               "overrides the NAME.toml sidecar.")
 @click.option("--survey", type=click.Path(path_type=Path), help="Survey file, overrides the "
               "NAME.survey.* sidecar.")
+@click.option("--string", "string", type=click.Path(path_type=Path),
+              help="WITSML tubular file read as the drill string (overrides the "
+                   "NAME.tubular.xml sidecar; for a configuration without [[string.sections]]).")
 @click.option("--rate", "rate", type=Quantity("Hz"), help="Resample the input to HZ before "
               "estimation (not above the data's own rate: a higher HZ is ignored with a "
               "warning).")
@@ -136,7 +139,8 @@ def _describe_depth_log(result, units: str) -> str:
               help="Units of the printed summary and of the report's axes and tables: si (m, "
                    "kN, kN·m) or field (ft, klbf, kft·lbf, ppg). Default: the configuration's "
                    "[well] units, else si. JSON and result files stay SI.")
-def command(wells, out, config, survey, rate, starts, pdf, report, workers, units) -> None:
+def command(wells, out, config, survey, string, rate, starts, pdf, report, workers,
+            units) -> None:
     """Estimate friction factors (μ_s, μ_k) and bit speed, stand by stand, for each WELL.
 
     WELL is a data file (.parquet, .csv, .h5, .las, .xml, .dlis, .xlsx) with optional
@@ -154,9 +158,10 @@ def command(wells, out, config, survey, rate, starts, pdf, report, workers, unit
         overrides["well.units"] = units
     if workers > 1 and len(wells) > 1:
         compile_kernels_once()
-        _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers)
+        _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers,
+                      string)
         return
-    opened, unreadable = _open_all(wells, config, survey, overrides)
+    opened, unreadable = _open_all(wells, config, survey, overrides, string)
     compile_kernels_once()
     failures = 0
     for well in opened:
@@ -177,7 +182,7 @@ def command(wells, out, config, survey, rate, starts, pdf, report, workers, unit
         raise SystemExit(1)
 
 
-def _open_all(wells, config, survey, overrides) -> tuple[list, int]:
+def _open_all(wells, config, survey, overrides, string=None) -> tuple[list, int]:
     """Open every well once and refuse, before anything is written, two that would write
     the same OUT/NAME; returns the opened wells and how many could not be read."""
     from drillfric.io.results import check_distinct
@@ -186,7 +191,8 @@ def _open_all(wells, config, survey, overrides) -> tuple[list, int]:
     opened, unreadable = [], 0
     for path in wells:
         try:
-            opened.append(open_well(path, config=config, survey=survey, overrides=overrides))
+            opened.append(open_well(path, config=config, survey=survey, overrides=overrides,
+                                    string=string))
         except DrillfricError as exc:
             if context().debug or len(wells) == 1:
                 raise
@@ -224,7 +230,8 @@ def _print(result, units: str | None = None) -> None:
         echo(f"results: {result.out_dir}")
 
 
-def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers) -> None:
+def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, workers,
+                  string=None) -> None:
     """Several wells on local worker processes, through the fleet executor (always redone;
     OUT gets the wells' directories only, none of the fleet files)."""
     from drillfric.fleet.discovery import WellSpec
@@ -232,7 +239,7 @@ def _run_parallel(wells, out, config, survey, rate, overrides, pdf, report, work
 
     from .common import progress
 
-    specs = [WellSpec(Path(w), config=config, survey=survey) for w in wells]
+    specs = [WellSpec(Path(w), config=config, survey=survey, string=string) for w in wells]
     with progress(f"run ({plural(len(specs), 'well')})", total=len(specs)) as advance:
         result = run_many(specs, out, workers=workers, force=True, progress=advance,
                           overrides=overrides, rate_hz=rate, pdf=pdf, report=report,

@@ -622,20 +622,33 @@ def axial_motion(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> AxialMot
 #: at up to ~1.5 m/s): a depth reset or a re-zeroed block [m/s].
 DEPTH_JUMP_M_S = 5.0
 
+#: A depth reset is a jump of at least this many metres in one sample: a smaller change is
+#: read noise or timestamp jitter however short the sample's time step (issue 35: DSATS
+#: segment 70, 0.14 m in 0.02 s, read as a "jump" at 7 m/s) [m].
+DEPTH_JUMP_MIN_M = 1.0
+
 
 def _depth_jump(kind: str, depth_m: np.ndarray, time_s: np.ndarray) -> str:
     """Why a reaming / back-reaming segment is no pipe motion: the jump of the depth channel
     that made it look like reaming (a depth reset 127 → 168 m in 2 s had read "running in
     at 0 m/s": issue 35 item 7); "" when the depth moves no faster than a trip.
 
+    A jump is judged by its size: more than :data:`DEPTH_JUMP_MIN_M` and more than a trip
+    at :data:`DEPTH_JUMP_M_S` travels in the sample's time step. A speed over a jittery
+    time step alone is no jump (0.14 m in 0.02 s is 7 m/s, but no reset).
+
     >>> _depth_jump("reaming", np.r_[np.full(5, 127.0), np.full(5, 168.2)],
     ...             np.arange(10.0)).split(" (")[0]
     'reaming? the bit depth jumps by 41.2 m within one sample'
+    >>> _depth_jump("reaming", np.r_[np.full(5, 127.0), np.full(5, 127.14)],
+    ...             np.r_[np.arange(5.0), 4.02 + np.arange(5.0)])
+    ''
     """
     step = np.abs(np.diff(depth_m))
-    rate = step / np.maximum(np.diff(time_s), 1e-9)
-    if rate.size and rate.max() > DEPTH_JUMP_M_S:
-        return (f"{kind.replace('_', '-')}? the bit depth jumps by {step[rate.argmax()]:.1f} m "
+    reach = np.maximum(DEPTH_JUMP_MIN_M, DEPTH_JUMP_M_S * np.diff(time_s))
+    over = step - reach
+    if over.size and over.max() > 0:
+        return (f"{kind.replace('_', '-')}? the bit depth jumps by {step[over.argmax()]:.1f} m "
                 "within one sample (a depth reset or a re-zeroed block, not pipe motion): "
                 "μ and the bit speed are withheld; check the depth channel")
     return ""

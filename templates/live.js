@@ -27,10 +27,15 @@
   const OLD_S = 5;
   const OPEN_IDS = ["open-mu-k", "open-mu-s", "open-bit-rpm", "open-severity"];
 
-  function showOpen(open, row, last) {
+  function showOpen(open, row, last, behindS) {
     if (!open) {
       OPEN_IDS.forEach((id) => { put(id, "—"); byId(id).classList.remove("old"); });
-      put("open-segment", "none");
+      // the estimates lagging the data: an open segment may not be published yet, so
+      // "none" would read as current (issue 35)
+      const late = known(behindS) && behindS > OLD_S;
+      put("open-segment", late ? "not known yet: the estimates are " + fixed(behindS, 0)
+        + " s behind the newest sample" : "none");
+      byId("open-segment").classList.toggle("old", late);
       return;
     }
     const age = known(last) && known(open.t_end_s) ? last - open.t_end_s : 0;
@@ -73,7 +78,7 @@
     put("rig-state", s.rig_state ? s.rig_state.replace(/_/g, " ") : "—");
     const open = s.open_segment;
     showOpen(open, open ? segs.segments.find((r) => r.id === open.segment) : null,
-      s.last_sample_time_s);
+      s.last_sample_time_s, s.behind_s);
     const latest = s.latest;
     const latestOld = !!(latest && latest.old);
     put("latest", latest ? "segment " + latest.segment + ": μ_k " + fixed(latest.mu_k, 3) + ", μ_s "
@@ -98,6 +103,8 @@
       list.appendChild(item);
     }
     if (!s.alerts.length) list.appendChild(Object.assign(document.createElement("li"), { textContent: "none" }));
+    put("behind", known(s.behind_s) ? fixed(s.behind_s, 0) + " s" : "—");
+    byId("behind").classList.toggle("old", known(s.behind_s) && s.behind_s > OLD_S);
   }
 
   function showTracks(t) {

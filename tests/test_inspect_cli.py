@@ -259,3 +259,66 @@ def test_inspect_wob_threshold_stays_si_in_field_mode():
     assert "+0.164 to +0.492 ft/s" in line and "0.328 ft" in line and "142 klbf" in line
     assert not re.search(r"\d (m|kN|m/s)\b", line), line
     assert _reasons(skipped, "si")[0].endswith(skipped[0]["message"])
+
+
+def _hooked_log(tmp_path, hookload_kN: float) -> Path:
+    """A 1-Hz log rotating off bottom at 80 RPM for 130 s with the bit at 2000 m (hole at
+    2100 m), the hook load ``hookload_kN`` and a configured block weight of 300 kN."""
+    t = np.arange(0.0, 200.0)
+    rpm = np.where((t > 20) & (t < 150), 80.0, 0.0)
+    pd.DataFrame({"TIME": t, "SRPM": rpm, "STOR [kN.m]": rpm / 8.0, "HKLD [kN]": hookload_kN,
+                  "BITDEP [m]": 2000.0, "DMEA [m]": 2100.0}).to_csv(tmp_path / "w.csv",
+                                                                      index=False)
+    (tmp_path / "w.toml").write_text("[hookload]\nblock_weight_N = 300000.0\n")
+    return tmp_path / "w.csv"
+
+
+def test_inspect_says_run_withholds_by_the_hookload_check(tmp_path):
+    """Issue 35 (fourth newcomer): inspect said "30 usable" on DSATS and run then withheld
+    all 30 μ_k by the hook-load check (the assumed default string weighs far more than the
+    hook load measures). inspect applies run's check (hookload.judge on the soft-string
+    model's off-bottom hook load) and says so in one line."""
+    from drillfric import hookload
+    from drillfric.io.well import open_well
+    from drillfric.torque_drag import TDSettings
+
+    path = _hooked_log(tmp_path, 400.0)
+    well = open_well(path)
+    td = TDSettings.from_config(well.config)
+    model = hookload.modelled_string_weight_N(td, td.path_to(None, 2000.0), 2000.0)
+    doc = json.loads(_inspect(path, "--json").output)
+    check = doc["string_check"]
+    assert check["string_weight_ratio"] == pytest.approx(100e3 / model, rel=1e-6)
+    assert check["withheld_segments"] == [1] and check["verdict"] == "contradicted"
+    out = _inspect(path).output
+    line = next(ln for ln in out.splitlines() if ln.startswith("string "))
+    assert f"measures {100e3 / model:.2f}× the modelled weight of the string (assumed " \
+           "default): run will withhold the friction factors of 1 of 1 segments" in line
+    assert "configure [[string]]" in line
+
+
+def test_inspect_is_silent_when_the_hookload_weighs_the_string(tmp_path):
+    """The hook load less the block is the model's off-bottom hook load: no line."""
+    from drillfric import hookload
+    from drillfric.io.well import open_well
+    from drillfric.torque_drag import TDSettings
+
+    well = open_well(_hooked_log(tmp_path, 400.0))
+    td = TDSettings.from_config(well.config)
+    model = hookload.modelled_string_weight_N(td, td.path_to(None, 2000.0), 2000.0)
+    path = _hooked_log(tmp_path, 300.0 + model / 1e3)
+    doc = json.loads(_inspect(path, "--json").output)
+    assert doc["string_check"]["withheld_segments"] == []
+    assert doc["string_check"]["string_weight_ratio"] == pytest.approx(1.0, rel=1e-6)
+    assert "\nstring " not in _inspect(path).output
+
+
+def test_dsats_inspect_says_run_withholds_by_the_hookload_check(real_data):
+    """Issue 35 (fourth newcomer) on the real DSATS file, read in place: the 30 usable
+    segments are all withheld by run's hook-load check (the assumed default string against
+    the hook load), and inspect says so."""
+    path = real_data / "dsats_1hz" / "SampleData1.csv"
+    out = _inspect(path, "--config", EXAMPLES / "dsats_1hz.toml").output
+    line = next(ln for ln in out.splitlines() if ln.startswith("string "))
+    assert "the modelled weight of the string (assumed default): run will withhold the " \
+           "friction factors of 30 of 30 segments" in line

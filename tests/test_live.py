@@ -122,6 +122,9 @@ def test_replay_cutting_lines_while_live_tails_gives_the_run_of_the_whole_file(r
     assert LIVE_KEYS <= set(status)
     assert status["rows"] == 44001 and status["last_sample_time_s"] == pytest.approx(440.0)
     assert status["open_segment"] is None and status["latest"]["mu_k"] is not None
+    # the final results rest on every row: the estimates are not behind (issue 35)
+    assert status["estimated_through_s"] == status["last_sample_time_s"]
+    assert status["behind_s"] == 0.0
     # how long live.json waits between writes is measured by benchmarks/bench_live_lag.py
     # (no test asserts a wall-clock time: it failed at 0.577 s on a loaded machine)
     assert status["max_update_gap_s"] is not None
@@ -206,6 +209,47 @@ def test_alerts_for_stale_and_stopped_data_severe_stick_slip_and_a_friction_tren
     assert trend_alert(done(0.25, 0.26, 0.25, 0.27)) is None  # within 25 % of the median
     alert = trend_alert(done(0.25, 0.26, 0.25, 0.34))
     assert alert["kind"] == "friction_trend" and alert["time_s"] == 400.0
+
+
+def test_live_on_a_loaded_machine_says_how_far_the_estimates_are_behind(tmp_path):
+    """Issue 35 (fourth newcomer): replaying at 20× on a loaded machine, live.json showed open
+    segment "none" and no alerts while stands 1–3 stick-slipped, and severe_stick_slip came
+    after the data had ended. live.json now says how many log seconds the published
+    estimates are behind the newest sample (``behind_s``, from data times only — the wall
+    clock does not enter), raises ``estimates_behind`` beyond OLD_S, and a closed segment's
+    severe stick-slip raises its alert (aged) when no open segment was published after it."""
+    from types import SimpleNamespace
+
+    from drillfric.live.alerts import OLD_S
+    from drillfric.live.run import LiveRun
+
+    now = [0.0]
+    live = LiveRun(tmp_path / "w.csv", tmp_path / "out", clock=lambda: now[0])
+    live.view.update(first_sample_time_s=0.0, last_sample_time_s=300.0, estimated_at=0.0)
+    status = live.status()  # nothing published yet: behind from the first sample
+    assert status["behind_s"] == 300.0 and status["estimated_through_s"] is None
+    assert status["open_segment"] is None and status["alerts"] == []  # not overdue yet
+    now[0] = live.last_data = 2.0 * live.open_every_s() + 1.0  # publications overdue
+    status = live.status()
+    assert status["behind_s"] == 300.0  # from data times: the wall clock does not enter
+    assert [a["kind"] for a in status["alerts"]] == ["estimates_behind"]
+    assert status["alerts"][0]["old"] and status["alerts"][0]["age_s"] == 300.0
+    # the publication handed rests on the newest sample fed at that moment
+    live.engine = SimpleNamespace(feed_state=lambda: {})
+    live._hand_publication()
+    assert live.jobs.get_nowait()[3] == (300.0, now[0])
+    live.view.update(estimated_through_s=300.0 - OLD_S + 1.0)
+    assert live.status()["behind_s"] == OLD_S - 1.0 and live.status()["alerts"] == []
+    live.view.update(estimated_through_s=200.0, closed={
+        "segment": 3, "t_end_s": 190.0, "stick_slip_severity": 1.4,
+        "stick_slip_beyond_validated": False})
+    status = live.status()
+    assert status["behind_s"] == 100.0
+    assert [a["kind"] for a in status["alerts"]] == ["estimates_behind", "severe_stick_slip"]
+    late, severe = status["alerts"]
+    assert "100 s of log behind" in late["message"] and late["time_s"] == 200.0
+    assert "segment 3, closed" in severe["message"] and severe["time_s"] == 190.0
+    assert severe["old"] and severe["age_s"] == 110.0
 
 
 def test_friction_rising_alert_from_a_segment_whose_friction_rose(tmp_path):

@@ -619,3 +619,19 @@ def test_a_wob_read_from_slack_off_drag_does_not_put_a_tripping_bit_on_bottom():
                             wob_N=np.where(t >= 60.0, 25e3, 0.0)), cfg())
     assert not np.any(states == SLIDING_ON_BOTTOM)
     assert np.all(states[70:] == TRIPPING)
+
+
+def test_depth_jitter_over_a_tiny_time_step_is_not_a_depth_reset():
+    """Issue 35 (fourth newcomer): DSATS segment 70, back-reaming, was withheld as a "depth
+    reset" because the bit depth changed 0.14 m in 0.02 s (timestamp jitter: 7 m/s). A reset
+    is judged by its size in metres (DEPTH_JUMP_MIN_M and a trip's travel in the time step),
+    not by a speed over a jittery dt; a real reset of 41 m is still one."""
+    t = np.arange(0.0, 120.0)
+    t[60] = t[59] + 0.02                          # jittered timestamp
+    depth = 2000.0 - 0.2 * t
+    depth[60] = depth[59] - 0.14
+    motion = axial_motion("back_reaming", depth, t)
+    assert "jumps" not in motion.withheld
+    assert motion.speed_m_s == pytest.approx(-0.2, rel=0.05)
+    reset = np.where(t < 60.0, depth, depth + 41.0)
+    assert "jumps by 40.7 m" in axial_motion("back_reaming", reset, t).withheld

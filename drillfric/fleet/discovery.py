@@ -2,7 +2,7 @@
 
 :func:`discover` names the wells of a folder (each data file with its sidecars, each
 sub-folder with ``well.toml`` or the numbered parts of a WITSML log) or of a ``.csv``/``.json``
-manifest (columns ``well, data, config, survey``) as :class:`WellSpec` — cheaply: no data
+manifest (columns ``well, data, config, survey, string``) as :class:`WellSpec` — cheaply: no data
 file is opened here (a name stored inside one is resolved by the worker that runs the well,
 docs/security.md), so no input can stop, crash or stall a night before it starts.
 """
@@ -24,7 +24,7 @@ _DATA_EXT = (".parquet", ".pq", ".csv", ".txt", ".h5", ".hdf5", ".las", ".xml", 
 _SIDECAR_TAGS = (".survey", ".truth", ".tubular")
 #: WITSML objects that are not surface data (read beside a log, never a well of their own).
 _NOT_WELLS = frozenset({"trajectory", "tubular", "bhaRun"})
-_MANIFEST_COLUMNS = ("well", "data", "config", "survey")
+_MANIFEST_COLUMNS = ("well", "data", "config", "survey", "string")
 
 
 @dataclass(frozen=True)
@@ -40,12 +40,16 @@ class WellSpec:
         Output name (OUT/NAME); None: the configuration's ``well.name``, else the stem.
     config, survey : Path or None
         Overrides of the sidecars (``--config``, manifest columns).
+    string : Path or None
+        The WITSML tubular read as the string (``--string``, manifest column ``string``),
+        instead of a ``NAME.tubular.xml`` sidecar.
     """
 
     data: Path
     name: str | None = None
     config: Path | None = None
     survey: Path | None = None
+    string: Path | None = None
 
 
 def discover(source, *, config=None) -> list[WellSpec]:
@@ -53,7 +57,7 @@ def discover(source, *, config=None) -> list[WellSpec]:
 
     A directory holds data files with their sidecars (``NAME.toml``, ``NAME.survey.csv``,
     ``NAME.truth.json`` are not wells) and well directories (holding ``well.toml``).
-    A manifest has columns/keys ``well, data, config, survey`` (``data`` required; relative
+    A manifest has columns/keys ``well, data, config, survey, string`` (``data`` required; relative
     paths are relative to the manifest). ``config`` (``--config``) applies to every well
     that does not name its own.
 
@@ -65,7 +69,7 @@ def discover(source, *, config=None) -> list[WellSpec]:
     source = Path(source)
     if not source.exists():
         raise InputError("not found", file=source, fix="give a directory of wells or a "
-                         "manifest (.csv/.json with columns well, data, config, survey)")
+                         "manifest (.csv/.json with columns well, data, config, survey, string)")
     if source.is_dir():
         specs = _discover_dir(source)
     else:
@@ -150,7 +154,7 @@ def _read_manifest(path: Path) -> list[WellSpec]:
         return None if not value else (path.parent / value).resolve()
 
     return [WellSpec(where(r["data"]), _name(r.get("well")), where(r.get("config")),
-                     where(r.get("survey"))) for r in rows]
+                     where(r.get("survey")), where(r.get("string"))) for r in rows]
 
 
 def _check_entry(row: dict, i: int, path: Path) -> None:

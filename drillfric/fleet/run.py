@@ -132,7 +132,7 @@ def _open_job(index: int, spec: WellSpec, out_root: Path, overrides: dict,
     fallback = printable(spec.name or spec.data.stem, 4096)
     try:
         files, name = find_well(spec.data, config=spec.config, survey=spec.survey,
-                                name=spec.name)
+                                name=spec.name, string=spec.string)
         dir_name = fallback if name is None else safe_name(name, files.config or files.data)
     except DrillfricError as exc:
         return _Job(index, fallback, fallback, None, {}, exc.message)
@@ -147,7 +147,7 @@ def _open_job(index: int, spec: WellSpec, out_root: Path, overrides: dict,
     task = WellTask(name, str(Path(spec.data).resolve()), _abs(spec.config),
                     _abs(spec.survey), str(out_root.resolve()), dict(overrides),
                     options.get("rate_hz"), options.get("pdf", False),
-                    options.get("report", True))
+                    options.get("report", True), string=_abs(spec.string))
     return _Job(index, name or fallback, dir_name, task, fingerprint, named=name is not None)
 
 

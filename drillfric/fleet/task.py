@@ -43,6 +43,7 @@ class WellTask:
     taken: frozenset = frozenset()
     run: str = ""
     resume: bool = True
+    string: str | None = None
 
 
 def process_well(task: WellTask) -> dict:
@@ -63,7 +64,7 @@ def process_well(task: WellTask) -> dict:
               "failed_segments": 0}
     try:
         well = open_well(task.data, config=task.config, survey=task.survey,
-                         overrides=task.overrides, name=task.name)
+                         overrides=task.overrides, name=task.name, string=task.string)
         record.update(well=well.name, dir_name=well.dir_name,
                       inputs={role: str(p.resolve()) for role, p in well.files.inputs.items()})
         if task.name is None:

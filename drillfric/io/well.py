@@ -275,7 +275,8 @@ class Well:
                              source_start_s=tracker.source_start_s,
                              conflicts_dropped=tracker.conflicts)
         files = {k: v for k, v in (("data", self.files.data), ("config", self.files.config),
-                                   ("survey", self.files.survey)) if v is not None}
+                                   ("survey", self.files.survey),
+                                   ("string", self.files.string)) if v is not None}
         return WellData(name=self.name, surface=surface, survey=self.survey,
                         config=self.config,
                         channels=_channel_infos(self.mappings, surface, tracker),
@@ -283,7 +284,8 @@ class Well:
 
 
 def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, survey=None,
-              overrides=None, name: str | None = None, header: bool = True) -> Well:
+              overrides=None, name: str | None = None, header: bool = True,
+              string=None) -> Well:
     """Open a well once: find its files, read its configuration and survey, map its channels.
 
     Parameters
@@ -307,6 +309,9 @@ def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, surv
         The well's name (a manifest's ``well`` column), overriding ``[well] name``.
     header : bool
         Open the data file and map its channels (False: configuration and survey only).
+    string : str or Path, optional
+        WITSML tubular file read as the string (``--string``; the ``NAME.tubular.xml``
+        sidecar is then not read), for a configuration without ``[[string.sections]]``.
 
     Raises
     ------
@@ -316,8 +321,8 @@ def open_well(path=None, *, frame: pd.DataFrame | None = None, config=None, surv
     if (path is None) == (frame is None):
         raise InputError("give a well's data file or its data in memory, one of the two",
                          fix="open_well('well.csv', ...) or open_well(frame=data, ...)")
-    files, raw = (resolve_files(path, config, survey) if frame is None else
-                  frame_files(config, survey))
+    files, raw = (resolve_files(path, config, survey, string=string) if frame is None else
+                  frame_files(config, survey, string))
     cfg = _config(files.config, raw, config, overrides, files.string)
     given = default_name(path, files.data) if frame is None else FRAME_NAME
     shown = printable(name or cfg.well.name or given, 4096)
@@ -342,14 +347,14 @@ def with_parts(well: Well, parts: tuple[Path, ...]) -> Well:
     return replace(well, files=files, source=source, mappings=mappings)
 
 
-def find_well(path, *, config=None, survey=None, name: str | None = None
+def find_well(path, *, config=None, survey=None, name: str | None = None, string=None
               ) -> tuple[WellFiles, str | None]:
     """A well's files and name from its paths and sidecars alone: no data file is opened
     (a fleet's parent prepares wells this way; its workers open them, docs/fleet.md).
 
     Parameters
     ----------
-    path, config, survey
+    path, config, survey, string
         As for :func:`open_well`.
     name : str, optional
         The well's name (a manifest's ``well`` column).
@@ -367,7 +372,7 @@ def find_well(path, *, config=None, survey=None, name: str | None = None
     InputError, ConfigError
         Missing files, an unreadable TOML configuration.
     """
-    files, raw = resolve_files(path, config, survey, peek=False)
+    files, raw = resolve_files(path, config, survey, peek=False, string=string)
     table = raw.get("well") if isinstance(raw.get("well"), dict) else {}
     given = name or table.get("name") or None
     if given is not None:

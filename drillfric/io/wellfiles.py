@@ -164,11 +164,13 @@ def resolve_well(path, *, config=None, survey=None) -> WellFiles:
     return resolve_files(path, config, survey)[0]
 
 
-def resolve_files(path, config, survey, peek: bool = True) -> tuple[WellFiles, dict]:
+def resolve_files(path, config, survey, peek: bool = True,
+                  string=None) -> tuple[WellFiles, dict]:
     """The files of a well and its raw configuration mapping, each file read once; a
     configuration or survey given in memory (a mapping, a table) stands for its file
     (``peek=False``: the data file is not opened, so a configuration, survey or tubular
-    stored inside it is not found)."""
+    stored inside it is not found). ``string`` (``--string``): the WITSML tubular read as
+    the string instead of a ``NAME.tubular.xml`` sidecar (:func:`given_string`)."""
     path = Path(path)
     if not path.exists():
         raise InputError("file not found", file=path, fix="check the path")
@@ -198,8 +200,29 @@ def resolve_files(path, config, survey, peek: bool = True) -> tuple[WellFiles, d
         data_path, config_path, raw, peek, confined=look)
     if survey_path is not None:
         require_file(survey_path, "survey file")
-    return WellFiles(data_path, config_path, survey_path, parts,
-                     find_string(data_path, raw, peek)), raw
+    string_path = given_string(string, raw) if string is not None else \
+        find_string(data_path, raw, peek)
+    return WellFiles(data_path, config_path, survey_path, parts, string_path), raw
+
+
+def given_string(string, raw: dict) -> Path:
+    """The tubular file ``--string`` names (read wherever it is, as ``--survey``: the user
+    named it), once it is a regular file and the configuration does not also give the
+    string's sections (one string, not two: which would be meant cannot be told).
+
+    Raises
+    ------
+    InputError, ConfigError
+        Not a regular file; a configuration with ``[[string.sections]]``.
+    """
+    path = require_file(Path(string), "string file (--string)",
+                        fix="give the WITSML tubular file of the well's string")
+    table = raw.get("string")
+    if isinstance(table, dict) and "sections" in table:
+        raise ConfigError("the configuration gives [[string.sections]] and --string names a "
+                          "tubular: which string is meant cannot be told", file=path,
+                          fix="drop --string, or the configuration's [[string.sections]]")
+    return path
 
 
 def arriving_data(path: Path) -> Path:
@@ -228,9 +251,9 @@ def arriving_data(path: Path) -> Path:
                           fix="let the files arrive inside the well directory")
 
 
-def frame_files(config, survey) -> tuple[WellFiles, dict]:
+def frame_files(config, survey, string=None) -> tuple[WellFiles, dict]:
     """The files of a well whose data is a DataFrame: only those given (a configuration
-    file's ``[survey] file`` too), never a sidecar."""
+    file's ``[survey] file`` too, ``string`` the tubular), never a sidecar."""
     config_path, raw = given_file(config), _mapping(config)
     if config_path is not None:
         require_file(config_path, "config file")
@@ -241,7 +264,9 @@ def frame_files(config, survey) -> tuple[WellFiles, dict]:
         config_path.parent / named if isinstance(named, str) and config_path else None)
     if survey_path is not None:
         require_file(survey_path, "survey file")
-    return WellFiles(FRAME_LABEL, config_path, survey_path, in_memory=True), raw
+    string_path = None if string is None else given_string(string, raw)
+    return WellFiles(FRAME_LABEL, config_path, survey_path, string=string_path,
+                     in_memory=True), raw
 
 
 def given_file(given) -> Path | None:

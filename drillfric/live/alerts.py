@@ -70,17 +70,61 @@ def open_view(record: SegmentRecord, folder: Path) -> dict:
             "mu_k_last": record.mu_k_last, "mu_k_drift_per_h": record.mu_k_drift_per_h}
 
 
-def severe_stick_slip(open_segment: dict) -> str:
+def severe_stick_slip(open_segment: dict, where: str = "the open segment") -> str:
     """The ``severe_stick_slip`` alert's message ("" when none): the open segment's severity
     at least :data:`SEVERE_STICK_SLIP`, or withheld as beyond its validated range (an
-    estimated severity ≥ 2.1, docs/bit_speed.md: severe by far)."""
+    estimated severity ≥ 2.1, docs/bit_speed.md: severe by far); ``where`` names the
+    segment (the newest closed one: ``"segment 3, closed"``)."""
     ssi = open_segment.get("stick_slip_severity")
     if ssi is not None and ssi >= SEVERE_STICK_SLIP:
-        return f"stick-slip severity {ssi:.2f} in the open segment (≥ {SEVERE_STICK_SLIP:g})"
+        return f"stick-slip severity {ssi:.2f} in {where} (≥ {SEVERE_STICK_SLIP:g})"
     if open_segment.get("stick_slip_beyond_validated"):
-        return ("severe stick-slip in the open segment: severity beyond its validated range "
+        return (f"severe stick-slip in {where}: severity beyond its validated range "
                 "(estimated ≥ 2.1; the number is withheld, docs/bit_speed.md)")
     return ""
+
+
+def closed_view(record: SegmentRecord | None) -> dict | None:
+    """What the live view keeps of the newest closed segment estimated (``ok``): its id,
+    end and stick-slip severity — its ``severe_stick_slip`` alert when no open segment was
+    published after it (a stand that stick-slipped and closed between two publications of
+    an open segment had raised none: issue 35)."""
+    if record is None or record.status is not Status.OK:
+        return None
+    return {"segment": record.id, "t_end_s": record.t_end_s,
+            "stick_slip_severity": record.stick_slip_severity,
+            "stick_slip_beyond_validated":
+                Flag.STICK_SLIP_BEYOND_VALIDATED in record.quality_flags}
+
+
+def behind(newest_s, through_s) -> float | None:
+    """live.json ``behind_s``: log seconds between the newest sample read (``newest_s``) and
+    the newest one the published estimates rest on (``through_s``: the rows handed to the
+    last publication made); computed from data times only, never the wall clock.
+
+    >>> behind(821.8, 672.0), behind(10.0, 10.0), behind(None, 3.0)
+    (149.8, 0.0, None)
+    """
+    try:
+        lag = round(max(float(newest_s) - float(through_s), 0.0), 1)
+    except (TypeError, ValueError):
+        return None
+    return lag if math.isfinite(lag) else None
+
+
+def behind_alert(behind_s: float | None, through_s) -> dict | None:
+    """The ``estimates_behind`` alert (raised when the publications are overdue: the
+    machine cannot keep up — loaded, or a fast replay): the published estimates rest on rows
+    more than :data:`OLD_S` log seconds older than the newest sample, so the open segment
+    and the alerts resting on it are not current, and an open segment not published yet
+    reads as unknown, not as none."""
+    if behind_s is None or behind_s <= OLD_S:
+        return None
+    return alert("estimates_behind", f"the estimates are {behind_s:.0f} s of log behind the "
+                 "newest sample (they rest on the rows up to log time "
+                 + ("—" if through_s is None else f"{float(through_s):.1f} s")
+                 + "): the open segment and its alerts are not current — the machine cannot "
+                 "keep up (loaded, or a fast replay)", through_s)
 
 
 def bit_speed_withheld(record: dict) -> str:

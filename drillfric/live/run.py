@@ -44,6 +44,9 @@ from drillfric.io.well import CHUNK_ROWS, Well
 from drillfric.live.alerts import (
     aged,
     alert,
+    behind,
+    behind_alert,
+    closed_view,
     ended,
     friction_rising,
     open_view,
@@ -73,6 +76,10 @@ STOP_WAIT_S = 30.0
 #: Share of a core that publications of an open segment may take on average (they come
 #: less often than every ``publish_every_s`` when one costs more).
 OPEN_SHARE = 0.1
+#: The longest wait between two publications of an open segment, in ``publish_every_s``: a
+#: costly one (a long open segment, a loaded machine) may take more than OPEN_SHARE of a core
+#: rather than leave the open segment unpublished for minutes (issue 35).
+MAX_OPEN_WAIT_FACTOR = 3.0
 #: Log seconds the estimated bit must have stayed stuck, at the end of the open segment while
 #: the top drive turns, for a ``bit_stalled`` alert: longer than the stick phase of ordinary
 #: stick-slip (1–3 s at 60–120 RPM: docs/live.md).
@@ -179,7 +186,9 @@ class LiveRun:
         self.view: dict = {"last_sample_time_s": None, "last_sample_utc": None,
                            "rig_state": None, "open_segment": None, "latest": None,
                            "trend_alert": None, "rising": None, "rows": 0,
-                           "segments_closed": 0, "resumed": None}
+                           "segments_closed": 0, "resumed": None, "closed": None,
+                           "first_sample_time_s": None, "estimated_through_s": None,
+                           "estimated_at": None}
 
     # ------------------------------------------------------------------ feed thread
     def work(self) -> None:
@@ -231,8 +240,10 @@ class LiveRun:
     def open_every_s(self) -> float:
         """Wall seconds between publications of an open segment: :attr:`publish_every_s`,
         longer when one costs more than :data:`OPEN_SHARE` of a core over that time (its
-        cost grows with the open segment's rows: each re-estimates it from its first row)."""
-        return max(self.publish_every_s, self.publish_cpu_s / OPEN_SHARE)
+        cost grows with the open segment's rows: each re-estimates it from its first row), but
+        at most :data:`MAX_OPEN_WAIT_FACTOR` times :attr:`publish_every_s`."""
+        every = self.publish_every_s
+        return max(every, min(self.publish_cpu_s / OPEN_SHARE, MAX_OPEN_WAIT_FACTOR * every))
 
     def _start(self) -> None:
         """Open the well and its engine: continued from OUT/NAME/state when it fits."""
@@ -246,6 +257,7 @@ class LiveRun:
         self.tail_fed, self.published_at, self.dirty = self.tail.end, self.clock(), False
         with self.lock:
             self.view["resumed"] = self.engine.resumed
+            self.view["estimated_at"] = self.published_at  # nothing estimated yet
 
     def _feed(self, end: int) -> bool:
         """Feed the rows read since the engine's source mark up to the tail's (``end``: how
@@ -272,6 +284,9 @@ class LiveRun:
         last = engine.tracker.state()["last"] if engine.tracker is not None else None
         states = engine.stream.last_states
         with self.lock:
+            if self.view["first_sample_time_s"] is None and last is not None:
+                # nothing published yet: the estimates are behind from the first sample
+                self.view["first_sample_time_s"] = last
             self.view.update(
                 last_sample_time_s=last,
                 rows=engine.check.rows + (engine.tracker.held_rows if engine.tracker else 0),
@@ -285,8 +300,10 @@ class LiveRun:
         cheap half: the fit thread adds its own, consistent once it estimated the segments
         handed before)."""
         snapshot = copy.deepcopy(self.engine.feed_state())
+        with self.lock:  # the data time the publication will rest on, and when handed
+            through = (self.view["last_sample_time_s"], self.clock())
         self.pending.set()
-        self.jobs.put(("final" if final else "publish", snapshot, self.well))
+        self.jobs.put(("final" if final else "publish", snapshot, self.well, through))
         self.published_at, self.dirty = self.clock(), False
 
     # ------------------------------------------------------------------ fit thread
@@ -312,16 +329,19 @@ class LiveRun:
                         self.engine.estimate(job[1], job[2])
                     elif i == newest:
                         self.pending.clear()
-                        self._publish(job[1], job[2], final=job[0] == "final")
+                        self._publish(job[1], job[2], final=job[0] == "final",
+                                      through=job[3])
         except BaseException as exc:  # noqa: BLE001 — handed to the caller's thread
             self._fail(exc)
         finally:
             self.fitted.set()
 
-    def _publish(self, feed_state: dict, well: Well, final: bool = False) -> None:
+    def _publish(self, feed_state: dict, well: Well, final: bool = False,
+                 through: tuple = (None, None)) -> None:
         """Close a copy of the engine (``feed_state`` and the fit thread's half; ``well`` as
-        the feed thread read it then) into OUT/NAME as ``drillfric run`` would (the final
-        results with the report)."""
+        the feed thread read it then; ``through``: its newest sample's log time and the wall
+        time it was handed) into OUT/NAME as ``drillfric run`` would (the final results with
+        the report)."""
         cpu = time.thread_time()
         state = feed_state | copy.deepcopy(self.engine.fit_state())
         memory = self.engine.sink
@@ -339,6 +359,8 @@ class LiveRun:
 
         result = deliver(well, self.out_root, run, self.report if final else None)
         self.publish_cpu_s = time.thread_time() - cpu
+        with self.lock:  # what live.json's behind_s is reckoned from (data times)
+            self.view["estimated_through_s"], self.view["estimated_at"] = through
         if final:
             self.result = result
             with self.lock:  # the end of the data closed every segment
@@ -356,6 +378,8 @@ class LiveRun:
                              {"segment": done[-1].id, "mu_k": done[-1].mu_k,
                               "mu_s": done[-1].mu_s, "t_end_s": done[-1].t_end_s},
                              trend_alert=trend_alert(done),
+                             closed=None if opened else closed_view(closed[-1] if closed
+                                                                    else None),
                              rising=friction_rising(opened[-1:] + [
                                  r for r in closed if r.status is Status.OK][-1:]))
 
@@ -378,6 +402,11 @@ class LiveRun:
             # 150-s-old segment's stick-slip as current)
             alerts.append(alert("severe_stick_slip", severe,
                                 (view["open_segment"] or {}).get("t_end_s")))
+        elif view["closed"] is not None and (severe := severe_stick_slip(
+                view["closed"], f"segment {view['closed']['segment']}, closed")):
+            # a stand that stick-slipped and closed before any publication of it open
+            # (issue 35: on a loaded machine the alert had come after the data ended)
+            alerts.append(alert("severe_stick_slip", severe, view["closed"]["t_end_s"]))
         stalled = (view["open_segment"] or {}).get("bit_stalled_s")
         if stalled is not None and stalled >= BIT_STALL_S:
             alerts.append(alert("bit_stalled", f"estimated bit speed at rest for the last "
@@ -388,6 +417,17 @@ class LiveRun:
         if view["rising"] is not None:
             alerts.append(view["rising"])
         newest = view["last_sample_time_s"]
+        through = view["estimated_through_s"] if view["estimated_through_s"] is not None \
+            else view["first_sample_time_s"]
+        lag = behind(newest, through)
+        # the alert when publications do not keep their schedule (a loaded machine): the
+        # estimates older than two intervals of an open segment's publications
+        overdue = view["estimated_at"] is not None and \
+            self.clock() - view["estimated_at"] > 2.0 * self.open_every_s()
+        if overdue and (late := behind_alert(lag, through)) is not None \
+                and not self.done.is_set():
+            first = int(bool(alerts) and alerts[0]["kind"] in ("run_failed", "run_ended"))
+            alerts.insert(first, late)  # after the run's end, before the rest
         # every value resting on older rows says how old (issue 35: open_segment and the
         # alerts of a segment that had ended read as current)
         alerts = [aged(a, a.get("time_s"), newest) for a in alerts]
@@ -397,6 +437,7 @@ class LiveRun:
         return {"source": str(self.path), "well": None if self.well is None else self.well.name,
                 "last_sample_time_s": newest,
                 "last_sample_utc": view["last_sample_utc"],
+                "estimated_through_s": view["estimated_through_s"], "behind_s": lag,
                 "updated_utc": datetime.now(UTC).isoformat(timespec="milliseconds"),
                 "rig_state": view["rig_state"], "open_segment": opened,
                 "latest": latest, "alerts": alerts, "rows": view["rows"],

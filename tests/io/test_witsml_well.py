@@ -106,6 +106,54 @@ def test_configured_string_wins_over_the_tubular_beside(tmp_path):
     assert well.files.string is None and [s["name"] for s in well.config.sections] == ["mine"]
 
 
+def test_string_option_names_a_tubular_kept_elsewhere(tmp_path):
+    """Issue 35 (fourth newcomer): a Volve WITSML log kept read-only could not have its
+    tubular placed beside it as NAME.tubular.xml. ``--string`` (open_well(string=), the
+    manifest's ``string`` column) names it wherever it is; it overrides a sidecar; a
+    missing file, a file that is no tubular, or a configuration that also gives sections is
+    one line, exit 2."""
+    logs, strings = tmp_path / "logs", tmp_path / "strings"
+    logs.mkdir(), strings.mkdir()
+    (logs / "w.xml").write_text(_surface_log(range(5)))
+    (strings / "run3.xml").write_text(_tubular())
+    well = open_well(logs / "w.xml", string=strings / "run3.xml")
+    sections = tubular_sections(strings / "run3.xml")
+    assert well.files.string == strings / "run3.xml"
+    assert well.files.inputs["string"] == strings / "run3.xml"
+    assert [s["name"] for s in well.config.sections] == [s["name"] for s in sections]
+    assert not any("drill string" in a for a in well.config.assumed)
+    (logs / "w.tubular.xml").write_text(_tubular().replace("drill collar", "drill pipe"))
+    assert open_well(logs / "w.xml", string=strings / "run3.xml").files.string \
+        == strings / "run3.xml"
+    out = CliRunner().invoke(cli, ["inspect", str(logs / "w.xml"), "--string",
+                                   str(strings / "run3.xml"), "--json"])
+    assert out.exit_code == 0, out.output
+    assert json.loads(out.output)["files"]["string"] == str(strings / "run3.xml")
+    (logs / "m.csv").write_text(f"data,string\n{logs / 'w.xml'},{strings / 'run3.xml'}\n")
+    assert discover(logs / "m.csv")[0].string == strings / "run3.xml"
+    (strings / "w.toml").write_text('[[string.sections]]\nname = "mine"\nod_m = 0.127\n'
+                                    "id_m = 0.1086\nlength_m = 3000.0\n")
+    for args, words in (([str(tmp_path / "none.xml")], "string file (--string) not found"),
+                        ([str(logs / "w.xml")], "holds no tubular"),
+                        ([str(strings / "run3.xml"), "--config", str(strings / "w.toml")],
+                         "gives [[string.sections]] and --string names a tubular")):
+        bad = CliRunner().invoke(cli, ["inspect", str(logs / "w.xml"), "--string", *args])
+        assert bad.exit_code == 2 and words in bad.output, bad.output
+        assert len(bad.output.strip().splitlines()) == 1
+
+
+def test_string_option_in_run(tmp_path):
+    """``run --string`` reads the tubular as the string: summary.json assumes no string."""
+    (tmp_path / "w.xml").write_text(_surface_log(range(5)))
+    (tmp_path / "s.xml").write_text(_tubular())
+    ran = CliRunner().invoke(cli, ["-q", "run", str(tmp_path / "w.xml"), "--string",
+                                   str(tmp_path / "s.xml"), "--out", str(tmp_path / "o"),
+                                   "--no-report"])
+    summary = json.loads((tmp_path / "o" / "w" / "summary.json").read_text())
+    assert ran.exit_code in (0, 1), ran.output
+    assert not any("drill string" in a for a in summary["assumed"])
+
+
 def test_lone_numbered_file_is_read_alone(tmp_path):
     (tmp_path / "run_3.xml").write_text(_surface_log(range(5)))
     (tmp_path / "run_4.csv").write_text("not a part")  # another extension: no sibling part
