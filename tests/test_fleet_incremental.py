@@ -70,6 +70,31 @@ def test_appended_rows_continue_from_the_state(stands, tmp_path):  # noqa: F811
         whole.segments.loc[whole.segments["status"] == "ok", "id"])
 
 
+def test_an_edited_survey_is_no_saved_state_to_continue(stands, tmp_path):  # noqa: F811
+    """Twelfth attack, F1: the survey edited between two nights (data unchanged, the
+    configuration naming the same file) re-ran the well from its saved state, keeping every
+    segment's numbers from the old well path (μ_k 0.2785 where the edited survey gives
+    0.2031), and live resumed the same way. The state keeps a digest of the survey's
+    stations; an edited, extended or newly given survey runs the well from its start."""
+    path, _ = stands
+    data = tmp_path / "wells" / path.name
+    _grow(path, data, 1.0)
+    out = tmp_path / "out"
+    run_many([WellSpec(data)], out, workers=1)
+    survey = data.with_suffix(".survey.csv")
+    stations = pd.read_csv(survey).astype(float)
+    deep = stations["md_m"] >= 1500.0  # a turn of 180° from 1500 m to the last station
+    turn = (stations["md_m"] - 1500.0) / (stations["md_m"].max() - 1500.0)
+    stations.loc[deep, "azi_deg"] = (stations.loc[deep, "azi_deg"] + 180.0 * turn[deep]) % 360.0
+    stations.to_csv(survey, index=False)
+    again = run_many([WellSpec(data)], out, workers=1)
+    assert again.count("ok") == 1, again.wells[0].message
+    resumed = _summary(out)["resumed"]
+    assert resumed["from_row"] == 0 and "the survey changed" in resumed["reason"]
+    fresh = run_well(open_well(data)).summary
+    assert _summary(out)["mu_k"] == pytest.approx(fresh["mu_k"], rel=1e-9, abs=1e-12)
+
+
 def test_changed_earlier_rows_are_redone_whole_with_the_reason(stands, tmp_path):  # noqa: F811
     path, whole = stands
     data = tmp_path / "wells" / path.name

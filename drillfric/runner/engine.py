@@ -25,12 +25,14 @@ continue after its results were written.
 from __future__ import annotations
 
 import copy
+import hashlib
 import json
 import time
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from drillfric._version import __version__
@@ -339,6 +341,7 @@ class Engine:
     def feed_state(self) -> dict:
         """The part of :meth:`state` that :meth:`segment_raw` changes."""
         return {"drillfric_version": __version__, "config": self.well.config.to_dict(),
+                "survey": survey_key(self.well),
                 "rate_hz": self.rate_hz, "raw_rows": self.raw_rows, "source": self.source,
                 "tracker": self.tracker.state(), "stream": self.stream.state(),
                 "check": self.check.state(),
@@ -433,14 +436,29 @@ class Engine:
 
 def mismatch(state: dict, well: Well, rate_hz: float | None) -> str:
     """Why ``state`` cannot continue ``well`` ("" when it can): another drillfric version,
-    configuration or rate."""
+    configuration, well path or rate."""
     if state.get("drillfric_version") != __version__:
         return f"saved by drillfric {state.get('drillfric_version')}, this is {__version__}"
     if _plain(state.get("config")) != _plain(well.config.to_dict()):
         return "the effective configuration changed"
+    if state.get("survey") != survey_key(well):
+        return "the survey changed"
     if state.get("rate_hz") != rate_hz:
         return f"the rate changed ({state.get('rate_hz')} → {rate_hz} Hz)"
     return ""
+
+
+def survey_key(well: Well) -> str | None:
+    """A digest of the well path's stations (None without a survey): the configuration
+    names the survey file, not what it holds, and a survey edited, extended or first given
+    between two runs had left every saved segment's numbers from the old path (μ_k 0.2785
+    where the new survey gives 0.2031; issue 30, twelfth attack)."""
+    path = well.survey
+    if path is None:
+        return None
+    stations = np.concatenate([np.asarray(a, dtype=np.float64) for a in
+                               (path.md_m, path.inc_rad, path.azi_rad)])
+    return hashlib.sha256(stations.tobytes()).hexdigest()
 
 
 def _plain(value):
