@@ -258,18 +258,30 @@ class Quantity(click.ParamType):
     unit : str
         The option's unit, a label of :data:`drillfric.units.LABEL_UNITS` (``"m"``,
         ``"N"``, ``"N·m"``, ``"RPM"``, ``"s"``, ``"Hz"``, ``"m/s"``).
+    limit : float, optional
+        Largest plausible magnitude in ``unit``: beyond it the value is a typo or a wrong
+        unit, refused naming the option (``td --wob "1e5 klbf"`` had printed a hook load of
+        −99 822 klbf, exit 0; issue 30, twelfth attack).
     """
 
     name = "quantity"
 
-    def __init__(self, unit: str):
+    def __init__(self, unit: str, limit: float | None = None):
         self.unit = unit
+        self.limit = limit
 
     def get_metavar(self, param, ctx=None) -> str:
         """The unit as the metavar (``--bit-depth M``, ``--rate HZ``), as docs/cli.md writes."""
         return {"N·m": "NM", "m/s": "M/S", "m³/s": "M3/S"}.get(self.unit, self.unit.upper())
 
     def convert(self, value, param, ctx):
+        converted = self._number(value, param, ctx)
+        if self.limit is not None and not abs(converted) <= self.limit:
+            self.fail(f"{value} is {converted:.4g} {self.unit}, beyond the {self.limit:g} "
+                      f"{self.unit} any rig reaches (a typo or a wrong unit?)", param, ctx)
+        return converted
+
+    def _number(self, value, param, ctx) -> float:
         if isinstance(value, int | float) and not isinstance(value, bool):
             return float(value)
         try:

@@ -136,13 +136,13 @@ def _write_table(frame, out: Path) -> None:
               type=click.Choice(["rotating_off_bottom", "rotating_on_bottom", "pick_up",
                                  "slack_off", "rotating_pick_up", "rotating_slack_off",
                                  "sliding"]))
-@click.option("--wob", type=Quantity("N"), default=0.0, show_default=True,
+@click.option("--wob", type=Quantity("N", limit=1e8), default=0.0, show_default=True,
               help="Weight on bit [N] (on-bottom cases), e.g. 150000 or \"35 klbf\".")
-@click.option("--bit-torque", type=Quantity("N·m"), default=0.0, show_default=True,
+@click.option("--bit-torque", type=Quantity("N·m", limit=1e7), default=0.0, show_default=True,
               help="Torque on bit [N·m] (on-bottom cases), e.g. \"3 kft.lbf\".")
-@click.option("--rpm", type=Quantity("RPM"), default=0.0,
+@click.option("--rpm", type=Quantity("RPM", limit=600.0), default=0.0,
               help="Rotary speed [RPM] (combined motion).")
-@click.option("--axial-speed", type=Quantity("m/s"), default=0.0,
+@click.option("--axial-speed", type=Quantity("m/s", limit=100.0), default=0.0,
               help="Trip speed [m/s] (combined motion), e.g. \"60 ft/min\".")
 @click.option("--element-length", type=Quantity("m"),
               help="Element length [m] (default: config).")

@@ -63,6 +63,9 @@ class Key:
     max: float | None = None
     min_exclusive: bool = False
     choices: tuple | None = None
+    #: ((low, high, unit), …): a bare number in [low, high] is taken for one in ``unit`` (a
+    #: mud density of 1.25 is a specific gravity, not 1.25 kg/m³) and refused, with the fix
+    bare_units: tuple = ()
 
     @property
     def upper(self) -> float | None:
@@ -88,6 +91,8 @@ class Key:
             text = "".join(c if c.isprintable() else "?" for c in value.strip()[:40])
             written = f" ('{text}')"
             value = quantity_value(value, self.unit, what=f"key '{where}'", file=file)
+        if not written and isinstance(value, (int, float)) and not isinstance(value, bool):
+            self._check_bare(value, where, file)
         if float in types and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if isinstance(value, bool) and bool not in types or not isinstance(value, types):
@@ -111,6 +116,18 @@ class Key:
                                       + (f" [{self.unit}]" if self.unit else ""))
         return value
 
+    def _check_bare(self, value: float, where: str, file: str | None) -> None:
+        """Refuse a bare number that reads as one in another unit (:attr:`bare_units`): a
+        mud density of ``1.25`` or ``10.4`` had been taken as kg/m³ — a string in a gas —
+        and put μ_k 15 % low with exit 0 (issue 30, twelfth attack)."""
+        for low, high, unit in self.bare_units:
+            if low <= value <= high:
+                raise ConfigError(
+                    f"key '{where}' = {value:g} [{self.unit}] is no drilling mud (water is "
+                    f"1000 kg/m³): is it in {unit}?", file=file,
+                    fix=f'write {where.split(".")[-1]} = "{value:g} {unit}" (or '
+                        f'"{value:g} kg/m3" for a gas)')
+
     def range_text(self) -> str:
         """Allowed range in words, e.g. ``(0, 2]`` or ``≥ 0``."""
         top = self.upper
@@ -123,6 +140,9 @@ class Key:
             return f"≤ {top:g}"
         return f"{lo}, {top:g}]"
 
+
+#: Bare mud densities that are a specific gravity or pounds per gallon without their unit.
+_MUD_BARE = ((0.5, 3.0, "sg"), (6.0, 25.0, "ppg"))
 
 _TYPE_NAMES = {float: "a number", int: "an integer", str: "text", bool: "true/false",
                list: "a list", dict: "a table"}
@@ -180,9 +200,12 @@ SCHEMA: dict[str, tuple[Key, ...]] = {
     ),
     "fluid": (
         Key("mud_density_kg_m3", float, 1200.0, "kg/m³", "Mud density in the annulus "
-            "(outside the string).", min=0.0, max=7849.0),
+            "(outside the string). A bare number of 0.5–3 or 6–25 is refused as a specific "
+            "gravity or ppg written without its unit (write \"1.25 sg\").", min=0.0,
+            max=7849.0, bare_units=_MUD_BARE),
         Key("inner_mud_density_kg_m3", float, None, "kg/m³", "Mud density inside the string "
-            "(default: same as mud_density_kg_m3).", min=0.0, max=7849.0),
+            "(default: same as mud_density_kg_m3).", min=0.0, max=7849.0,
+            bare_units=_MUD_BARE),
     ),
     "rig": (
         Key("top_drive_inertia_kg_m2", float, 2900.0, "kg·m²", "Top-drive rotating inertia "

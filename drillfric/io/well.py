@@ -607,7 +607,8 @@ def log_shaped(raw: RawSource, rows: int = 50) -> bool:
 
 def frame_source(frame: pd.DataFrame) -> RawSource:
     """A DataFrame read as a data file is: its columns (labels as text; an index that is not
-    a plain row number becomes a column), no stated units, rows in blocks.
+    a plain row number becomes a column; two levels are (name, unit), as a header and its
+    units row, else no stated units), rows in blocks.
 
     Raises
     ------
@@ -617,10 +618,17 @@ def frame_source(frame: pd.DataFrame) -> RawSource:
     if not isinstance(frame, pd.DataFrame):
         raise InputError(f"frame is a {type(frame).__name__}, not a pandas DataFrame",
                          file=FRAME_LABEL, fix="give the surface data as a DataFrame")
-    if frame.columns.nlevels > 1:
+    units: dict = {}
+    if frame.columns.nlevels == 2:  # (name, unit), as a header and its units row
+        pairs = [(str(a), str(b).strip()) for a, b in frame.columns]
+        units = {a: b for a, b in pairs if b and not b.startswith("Unnamed")}
+        frame = frame.set_axis([a for a, _ in pairs], axis=1)
+    elif frame.columns.nlevels > 2:
+        # the fix had been '_'.join of the levels: 'TORQUE_kft.lbf', a name no channel
+        # matches, its unit lost (issue 30, twelfth attack)
         raise InputError(f"the columns have {frame.columns.nlevels} levels (a MultiIndex)",
-                         file=FRAME_LABEL, fix="give one label per column, e.g. "
-                         "frame.columns = ['_'.join(map(str, c)) for c in frame.columns]")
+                         file=FRAME_LABEL, fix="give one label per column, or two levels "
+                         "(name, unit) read as a header and its units row")
     if not isinstance(frame.index, pd.RangeIndex):
         frame = frame.reset_index()
     frame = frame.set_axis([str(c) for c in frame.columns], axis=1)
@@ -633,7 +641,7 @@ def frame_source(frame: pd.DataFrame) -> RawSource:
         for start in range(0, len(frame), chunk_rows):
             yield frame.iloc[start:start + chunk_rows]
 
-    return RawSource(FRAME_LABEL, "frame", list(frame.columns), {}, len(frame), read)
+    return RawSource(FRAME_LABEL, "frame", list(frame.columns), units, len(frame), read)
 
 
 def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mapping]:

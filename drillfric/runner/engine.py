@@ -141,6 +141,12 @@ class Engine:
             Rows that cannot be meant as read (time going backwards, a log read in the
             wrong unit, …: docs/ingestion.md).
         """
+        expected = list(self.well.source.columns) if self.well.source is not None else []
+        if missing := [c for c in expected if c not in frame.columns]:
+            raise InputError(  # a raw KeyError had named only the canonical channel
+                f"the rows fed lack {plural(len(missing), 'column')} of the well's data: "
+                + ", ".join(repr(c) for c in missing[:5]), fix="feed rows with the columns "
+                "the well was opened with (Engine.feed, docs/api.md)")
         out = []
         for raw in frame_source(frame).chunks(max(len(frame), 1)):
             out += self.feed_raw(raw)
