@@ -26,6 +26,7 @@ nanoseconds that a microsecond column cannot hold.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -191,7 +192,11 @@ def origin_of(stamp: pd.Timestamp, seconds: float) -> pd.Timestamp:
     >>> origin_of(pd.Timestamp("2026-03-01T06:00:02.311670Z"), 2.31167)
     Timestamp('2026-03-01 06:00:00+0000', tz='UTC')
     """
-    return pd.Timestamp(stamp) - pd.Timedelta(int(np.round(float(seconds) * 1e9)), unit="ns")
+    seconds = float(seconds)
+    whole = math.floor(seconds)  # the fraction apart: seconds·10⁹ in one float product had
+    # lost the last nanosecond beyond ~26 days (48.6 days of log: origin 1 ns off)
+    nanoseconds = int(whole) * 1_000_000_000 + int(round((seconds - whole) * 1e9))
+    return pd.Timestamp(stamp) - pd.Timedelta(nanoseconds, unit="ns")
 
 
 #: Share of a log's timestamps that may be repeated with other values (all their rows

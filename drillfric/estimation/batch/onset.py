@@ -54,8 +54,10 @@ def onset_scan(model: Model, win: Window, mu_k: float,
 #: sticks depends on how the string is discretised and damped, and on a lumped plant of
 #: 25-m segments (benchmarks/plants/lumped.py) it stuck at μ_s up to 3.6 % below the
 #: highest μ_s at which drillfric's model did not — bounds of 0.26, 0.32, 0.38 over truths
-#: of 0.251, 0.314, 0.376 (docs/validation.md "The second plant family").
-ONSET_MODEL_MARGIN = 0.05
+#: of 0.251, 0.314, 0.376 (docs/validation.md "The second plant family"); with its top drive
+#: 2.5× the configured inertia (a gear change, the motor torque logged) up to 7.6 % below
+#: (0.3375 over 0.3135; docs/validation.md "Departures on the second plant family").
+ONSET_MODEL_MARGIN = 0.10
 
 
 @dataclass(frozen=True)
