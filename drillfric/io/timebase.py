@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.grouping import text_numbers
 from drillfric.io.source import NULL_VALUES
 from drillfric.io.text import printable
 from drillfric.segmentation import is_gap
@@ -631,7 +632,8 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
         out = values.to_numpy(dtype=float, na_value=np.nan)
     else:
         text = values.astype("string").str.strip()
-        out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+        # a decimal comma, '1 234,50' s (issue 30, twelfth attack F2): as other channels
+        out = text_numbers(text)
         unread = np.isnan(out) & _present(text)
         if unread.any():
             if (~unread & _present(text)).any() and not unread[np.argmax(_present(text))]:
