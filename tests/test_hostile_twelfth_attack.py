@@ -210,3 +210,22 @@ def test_f4_two_dot_groups_show_a_thousands_dot(tmp_path):
     path = _write(tmp_path / "dots.csv", lines)
     assert sniff_csv(path).decimal == ","
     assert _rows(path)["DEPTH"].iloc[0] == 2210
+
+
+# ---------------------------------------------------------------- the survey reader too
+@pytest.mark.parametrize("header, row", [
+    ('"MD, m","Inc, deg","Azi, deg"', "{md:.1f},{inc:.2f},{azi:.2f}"),
+    ('"MD, m";"Inc, deg";"Azi, deg"', "{md_fr};{inc_fr};{azi_fr}"),
+])
+def test_f2_f3_a_survey_with_quoted_names_and_grouped_depths_is_read(tmp_path, header, row):
+    """The survey reader split its header at a quoted comma too, and refused '2 210,00'."""
+    from drillfric.io.survey import read_survey_table
+
+    stations = [(0.0, 0.0, 0.0), (1000.0, 0.0, 0.0), (1500.0, 50.0, 30.0),
+                (2430.0, 50.0, 30.0)]
+    lines = [header] + [row.format(md=md, inc=inc, azi=azi, md_fr=_fr(md, " "),
+                                   inc_fr=_fr(inc, " "), azi_fr=_fr(azi, " "))
+                        for md, inc, azi in stations]
+    table = read_survey_table(_write(tmp_path / "s.csv", lines))
+    assert table.iloc[:, 0].tolist() == pytest.approx([0.0, 1000.0, 1500.0, 2430.0])
+    assert table.iloc[2, 1] == pytest.approx(50.0)

@@ -632,9 +632,12 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
         out = values.to_numpy(dtype=float, na_value=np.nan)
     else:
         text = values.astype("string").str.strip()
-        # a decimal comma, '1 234,50' s (issue 30, twelfth attack F2): as other channels
-        out = text_numbers(text)
+        out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
         unread = np.isnan(out) & _present(text)
+        if unread.any() and not _CLOCKLIKE.search(str(text.iloc[np.argmax(unread)])):
+            # a decimal comma, '1 234,50' s (issue 30, twelfth attack F2): as other channels
+            out = text_numbers(text)
+            unread = np.isnan(out) & _present(text)
         if unread.any():
             if (~unread & _present(text)).any() and not unread[np.argmax(_present(text))]:
                 raise UnreadNumber(int(np.argmax(unread)), str(text.iloc[np.argmax(unread)]))
@@ -642,6 +645,10 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
     out = out.copy()
     out[np.isin(out, NULL_VALUES) | np.isinf(out)] = np.nan  # an infinite time is no value
     return out
+
+
+#: Text that is a date or a clock time, not a number written with a decimal comma or groups.
+_CLOCKLIKE = re.compile(r"[:T/]|^\d{4}-")
 
 
 def _present(text: pd.Series) -> np.ndarray:
