@@ -229,3 +229,13 @@ def test_f2_f3_a_survey_with_quoted_names_and_grouped_depths_is_read(tmp_path, h
     table = read_survey_table(_write(tmp_path / "s.csv", lines))
     assert table.iloc[:, 0].tolist() == pytest.approx([0.0, 1000.0, 1500.0, 2430.0])
     assert table.iloc[2, 1] == pytest.approx(50.0)
+
+
+def test_f4_the_decimal_mark_is_voted_on_beyond_the_first_50_lines(tmp_path):
+    """A German log whose first dotted value ('1.050' N·m) comes at line 80, well inside the
+    64 KiB the layout is sniffed from, with a decimal comma at line 120: the comma decides."""
+    lines = ["TIME;RPM;TORQUE"] + [
+        f"{k};50;{'1.050' if k >= 80 else 900}{',5' if k == 120 else ''}" for k in range(200)]
+    path = _write(tmp_path / "late.csv", lines)
+    assert sniff_csv(path).decimal == ","
+    assert _rows(path)["TORQUE"].iloc[100] == 1050

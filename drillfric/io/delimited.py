@@ -139,7 +139,7 @@ def sniff_csv(path: Path) -> CsvLayout:
         raise _too_long(path)
     if len(lines) > 1 and cut:
         lines = lines[:-1]  # the last line may be cut by the sniff window
-    lines = lines[:50]
+    top, lines = lines, lines[:50]
     if not lines:
         raise InputError("file holds no data (only blank or # comment lines)", file=path,
                          fix="give a file with data rows")
@@ -152,7 +152,12 @@ def sniff_csv(path: Path) -> CsvLayout:
     n = len(rows[0])
     columns = [c or f"column {i}" for i, c in enumerate(rows[0])] if header else [
         str(i) for i in range(max(len(r) for r in rows))]
-    decimal = "." if delimiter == "," else _decimal_mark(body, columns, path)
+    # the decimal mark is voted on over the whole window (64 KiB), not the first 50 lines:
+    # a German log's first value ≥ 1000 ('1.050') may come after them (issue 30, twelfth
+    # attack F4)
+    decimal = "." if delimiter == "," else _decimal_mark(
+        body + [[f.strip().strip('"') for f in fields] for fields in
+                _fields(top[len(lines):], delimiter)], columns, path)
     if header and len(set(columns)) < n:
         raise InputError("duplicate column names in the header", file=path,
                          fix="give every column a distinct name")
@@ -167,7 +172,7 @@ def sniff_csv(path: Path) -> CsvLayout:
 
 #: A value only a decimal comma writes (``12,5``), and one only a decimal dot writes — a
 #: dot that cannot group thousands (``0.050``, ``2210.000``, ``12.5``; ``17.240`` can).
-_COMMA_DECIMAL = re.compile(r"[-+]?\d*,\d+")
+_COMMA_DECIMAL = re.compile(r"[-+]?(\d{1,3}(\.\d{3})+|\d*),\d+")  # 12,5 or 17.240,5
 _DOT_DECIMAL = re.compile(r"[-+]?\d*\.\d+")
 _DOT_GROUPED = re.compile(r"[-+]?[1-9]\d{0,2}(\.\d{3})+")
 #: Dots only a thousands grouping writes (``1.234.567``: two of them), and the fraction of a
