@@ -149,7 +149,7 @@ SUFFIX_UNITS = {"time": "s", "measured_depth": "m", "surface_rpm": "rpm",
                 "surface_torque_max": "N.m", "surface_rpm_min": "rpm", "surface_rpm_max": "rpm",
                 "hookload_min": "N", "hookload_max": "N"}
 
-_UNIT_IN_NAME = re.compile(r"^\s*(?P<name>.*?)\s*[\[(](?P<unit>[^\])]*)[\])]\s*$")
+_UNIT_IN_NAME = re.compile(r"^\s*(?P<name>.*?)\s*[\[({](?P<unit>[^\])}]*)[\])}]\s*$")
 
 
 def normalise(name: str) -> str:
@@ -331,15 +331,20 @@ def _rank(column: str, channel: Channel, extra: tuple[str, ...]) -> tuple[tuple,
         return (3, 0), None
     names = _normalised(extra + channel.mnemonics)
     base, unit = split_unit(column)
-    if normalise(base) in names:
-        return (2, -names.index(normalise(base))), unit
     words = str(column).split()
     head = normalise(" ".join(words[:-1]))
     if len(words) > 1 and head in names:
-        try:  # a trailing unit word, as in "Average Surface Torque kN.m"
+        try:  # a trailing unit word, as in "Average Surface Torque kN.m", "TIME / s"
             factor(words[-1], channel)
         except InputError:
-            return (), None
+            words = []
+    if normalise(base) in names:
+        # "TIME / s" and "Time, s" are also the mnemonic TIME_S: the unit they state is
+        # read all the same, as for "TORQUE / ft.lbf" (it had been "assumed unit of time_s
+        # … nothing in the file says": issue 30, twelfth attack F9)
+        said = unit or (words[-1] if len(words) > 1 and head in names else None)
+        return (2, -names.index(normalise(base))), said
+    if len(words) > 1 and head in names:
         return (1, -names.index(head)), words[-1]
     return (), None
 

@@ -13,6 +13,7 @@ length), and a file whose top is not text (NUL bytes, control characters) is ref
 from __future__ import annotations
 
 import codecs
+import csv
 import io
 import re
 import warnings
@@ -23,6 +24,7 @@ from pathlib import Path
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.grouping import ungroup
 from drillfric.io.source import NULL_VALUES, RawSource
 from drillfric.io.text import printable
 
@@ -137,12 +139,12 @@ def sniff_csv(path: Path) -> CsvLayout:
         raise _too_long(path)
     if len(lines) > 1 and cut:
         lines = lines[:-1]  # the last line may be cut by the sniff window
-    lines = lines[:50]
+    top, lines = lines, lines[:50]
     if not lines:
         raise InputError("file holds no data (only blank or # comment lines)", file=path,
                          fix="give a file with data rows")
     delimiter = max(_DELIMITERS, key=lambda d: _delimiter_score(lines, d))
-    rows = [[f.strip().strip('"') for f in ln.split(delimiter)] for ln in lines]
+    rows = [[f.strip().strip('"') for f in fields] for fields in _fields(lines, delimiter)]
     header = not all(_is_value(f) for f in rows[0])
     units_row = header and len(rows) > 1 and any(f for f in rows[1]) and not any(
         f and _is_value(f) for f in rows[1])
@@ -150,7 +152,12 @@ def sniff_csv(path: Path) -> CsvLayout:
     n = len(rows[0])
     columns = [c or f"column {i}" for i, c in enumerate(rows[0])] if header else [
         str(i) for i in range(max(len(r) for r in rows))]
-    decimal = "." if delimiter == "," else _decimal_mark(body, columns, path)
+    # the decimal mark is voted on over the whole window (64 KiB), not the first 50 lines:
+    # a German log's first value ≥ 1000 ('1.050') may come after them (issue 30, twelfth
+    # attack F4)
+    decimal = "." if delimiter == "," else _decimal_mark(
+        body + [[f.strip().strip('"') for f in fields] for fields in
+                _fields(top[len(lines):], delimiter)], columns, path)
     if header and len(set(columns)) < n:
         raise InputError("duplicate column names in the header", file=path,
                          fix="give every column a distinct name")
@@ -165,9 +172,13 @@ def sniff_csv(path: Path) -> CsvLayout:
 
 #: A value only a decimal comma writes (``12,5``), and one only a decimal dot writes — a
 #: dot that cannot group thousands (``0.050``, ``2210.000``, ``12.5``; ``17.240`` can).
-_COMMA_DECIMAL = re.compile(r"[-+]?\d*,\d+")
+_COMMA_DECIMAL = re.compile(r"[-+]?(\d{1,3}(\.\d{3})+|\d*),\d+")  # 12,5 or 17.240,5
 _DOT_DECIMAL = re.compile(r"[-+]?\d*\.\d+")
 _DOT_GROUPED = re.compile(r"[-+]?[1-9]\d{0,2}(\.\d{3})+")
+#: Dots only a thousands grouping writes (``1.234.567``: two of them), and the fraction of a
+#: clock time (``12:00:00,050``), whose mark is the file's decimal mark.
+_DOTS_GROUPED = re.compile(r"[-+]?[1-9]\d{0,2}(\.\d{3}){2,}")
+_CLOCK_FRACTION = re.compile(r"\d{2}:\d{2}:\d{2}([.,])\d+")
 
 
 def _decimal_mark(body: list[list[str]], columns: list[str], path: Path) -> str:
@@ -182,14 +193,30 @@ def _decimal_mark(body: list[list[str]], columns: list[str], path: Path) -> str:
     InputError
         As many columns write a decimal comma as a decimal dot.
     """
-    comma, dot = {}, {}
+    comma, dot, grouped = {}, {}, {}
     for row in body:
         for i, f in enumerate(row):
-            if _COMMA_DECIMAL.fullmatch(f):
+            f = ungroup(f)  # "2 210,00", "2'210.5": the mark after the groups is the decimal
+            clock = _CLOCK_FRACTION.search(f)
+            if _COMMA_DECIMAL.fullmatch(f) or _DOTS_GROUPED.fullmatch(f) or (
+                    clock and clock[1] == ","):
                 comma.setdefault(i, f)
-            elif _DOT_DECIMAL.fullmatch(f) and not _DOT_GROUPED.fullmatch(f):
+            elif (_DOT_DECIMAL.fullmatch(f) and not _DOT_GROUPED.fullmatch(f)) or clock:
                 dot.setdefault(i, f)
+            elif _DOT_GROUPED.fullmatch(f):
+                grouped.setdefault(i, f)
     comma = {i: f for i, f in comma.items() if i not in dot}  # "1.5" and "1,5": no vote
+    if not comma and not dot and grouped:
+        g = next(iter(grouped))
+        name = f"'{columns[g]}'" if g < len(columns) else f"column {g}"
+        raise InputError(
+            f"the decimal mark cannot be told: column {printable(name)} writes "
+            f"'{printable(grouped[g], 20)}', a dot before 3 digits in every value (a decimal "
+            f"point, or thousands grouped by a dot as a decimal-comma locale writes them: "
+            f"{grouped[g]} or {grouped[g].replace('.', '')}?), and no value in the file's "
+            "top shows a decimal mark", file=path,
+            fix="export the log with decimals (2.210,00 or 2210.00) or without thousands "
+                "separators")
     if not comma:
         return "."
     if len(comma) > len(dot):
@@ -297,8 +324,22 @@ class _CommentFree(io.TextIOBase):
         return "".join(lines)
 
 
+def _fields(lines: list[str], delimiter: str) -> list[list[str]]:
+    """The fields of each line as RFC 4180 quoting and pandas read them: a delimiter inside
+    a quoted field (``"Hook load, avg"``) does not split it — the header had been split
+    there and every later name moved one column right of its data (issue 30, twelfth
+    attack F3). A line is read alone (a quote left open ends with it)."""
+    out = []
+    for ln in lines:
+        try:
+            out.append(next(csv.reader([ln], delimiter=delimiter, skipinitialspace=True), [""]))
+        except csv.Error:  # a field beyond the csv module's limit (131 072 characters)
+            out.append(ln.split(delimiter))
+    return out
+
+
 def _delimiter_score(lines: list[str], delimiter: str) -> tuple[int, int]:
-    counts = [ln.count(delimiter) for ln in lines]
+    counts = [len(f) - 1 for f in _fields(lines, delimiter)]
     consistent = sum(c == counts[0] for c in counts)
     return (min(counts) > 0, consistent * (counts[0] > 0), counts[0])
 

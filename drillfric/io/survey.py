@@ -24,6 +24,7 @@ Recognised layouts
 
 from __future__ import annotations
 
+import csv
 import re
 import warnings
 from pathlib import Path
@@ -33,6 +34,7 @@ import pandas as pd
 
 from drillfric.errors import InputError
 from drillfric.files import require_file
+from drillfric.io.grouping import ungroup
 from drillfric.io.text import listing, printable
 from drillfric.units import conversion_factor
 from drillfric.wellpath import WellPath, minimum_curvature
@@ -231,16 +233,25 @@ def _text_columns(path: Path):
 
 
 def _delimiter(line: str) -> str | None:
-    """The delimiter of a header line; ``None`` means runs of whitespace (fixed width)."""
-    counts = {d: line.count(d) for d in (",", ";", "\t", "|")}
+    """The delimiter of a header line (outside double quotes: ``"MD, m";"Inc, deg"`` is
+    delimited by ``;``); ``None`` means runs of whitespace (fixed width)."""
+    bare = re.sub(r'"[^"]*"', "", line)
+    counts = {d: bare.count(d) for d in (",", ";", "\t", "|")}
     best = max(counts, key=counts.get)
     return best if counts[best] else None
 
 
 def _split(line: str, delim: str | None) -> list[str]:
+    """The fields of a line; a field in double quotes may hold the delimiter (RFC 4180:
+    ``"MD, m"`` had been split in two, every later name moved one column right of its
+    data — issue 30, twelfth attack F3, as in the log reader)."""
     if delim is None:
         return line.split()
-    return [f.strip().strip('"').strip("'") for f in line.split(delim)]
+    try:
+        fields = next(csv.reader([line], delimiter=delim, skipinitialspace=True), [""])
+    except csv.Error:  # a field beyond the csv module's limit
+        fields = line.split(delim)
+    return [f.strip().strip('"').strip("'") for f in fields]
 
 
 def _units_row(header_line: str, units_line: str, delim: str | None, n: int) -> list:
@@ -265,12 +276,15 @@ def _is_number(text: str) -> bool:
 
 def _name_and_unit(name: str) -> tuple[str | None, str | None]:
     """Canonical key and unit embedded in a column name (``MD (ft)``, ``md_ft``, ``TVD``)."""
-    m = re.fullmatch(r"\s*(.*?)\s*[\[(]\s*(.*?)\s*[\])]\s*", name)
+    m = re.fullmatch(r"\s*(.*?)\s*[\[({]\s*(.*?)\s*[\])}]\s*", name)
     if m:
         return _key(m.group(1)), m.group(2)
     key = _key(name)
     if key is not None:
         return key, None
+    m = re.fullmatch(r"\s*(.*?)\s*(?:,|\s/)\s*(\S+)\s*", name)  # "MD, m", "MD / ft"
+    if m and _key(m.group(1)) is not None:
+        return _key(m.group(1)), m.group(2)
     parts = name.strip().split("_")
     for i in range(len(parts) - 1, 0, -1):
         key = _key("_".join(parts[:i]))
@@ -308,7 +322,7 @@ def _canonical(names, units, data, file) -> pd.DataFrame:
 
 def _numbers(column, name: str, file) -> np.ndarray:
     """Floats of a column; empty cells and the nulls -999.25/-9999/-999 become NaN."""
-    text = pd.Series(column, dtype=object).astype(str).str.strip()
+    text = pd.Series(column, dtype=object).astype(str).str.strip().map(ungroup)  # 2 210,5
     text = text.str.replace(",", ".", regex=False)
     blank = text.isin(["", "nan", "NaN", "None", "<NA>"])
     values = pd.to_numeric(text.mask(blank), errors="coerce").to_numpy(float, copy=True)

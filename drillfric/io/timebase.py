@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from drillfric.errors import InputError
+from drillfric.io.grouping import text_numbers
 from drillfric.io.source import NULL_VALUES
 from drillfric.io.text import printable
 from drillfric.segmentation import is_gap
@@ -638,6 +639,10 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
         text = values.astype("string").str.strip()
         out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
         unread = np.isnan(out) & _present(text)
+        if unread.any() and not _CLOCKLIKE.search(str(text.iloc[np.argmax(unread)])):
+            # a decimal comma, '1 234,50' s (issue 30, twelfth attack F2): as other channels
+            out = text_numbers(text)
+            unread = np.isnan(out) & _present(text)
         if unread.any():
             if (~unread & _present(text)).any() and not unread[np.argmax(_present(text))]:
                 raise UnreadNumber(int(np.argmax(unread)), str(text.iloc[np.argmax(unread)]))
@@ -645,6 +650,10 @@ def _as_number(values: pd.Series) -> np.ndarray | None:
     out = out.copy()
     out[np.isin(out, NULL_VALUES) | np.isinf(out)] = np.nan  # an infinite time is no value
     return out
+
+
+#: Text that is a date or a clock time, not a number written with a decimal comma or groups.
+_CLOCKLIKE = re.compile(r"[:T/]|^\d{4}-")
 
 
 def _present(text: pd.Series) -> np.ndarray:

@@ -54,6 +54,8 @@ from drillfric.errors import DrillfricError, InputError
 from drillfric.files import require_file
 from drillfric.io import witsml, witsml_objects
 from drillfric.io.channels import Mapping, candidate_columns, log_index, map_channels, split_unit
+from drillfric.io.grouping import grouping_name, misgrouped
+from drillfric.io.grouping import text_numbers as _text_numbers
 from drillfric.io.parts import PART_ATTR, open_parts
 from drillfric.io.readers import open_source
 from drillfric.io.source import NULL_VALUES, RawSource
@@ -252,7 +254,7 @@ class Well:
         The rows of the chunk's last time are held back by ``tracker`` until the next
         chunk shows whether that time repeats (:meth:`~drillfric.io.timebase.TimeTracker.
         settle`); ``tracker.flush()`` hands them out at the end of the data."""
-        frame = _convert(raw, self.mappings, tracker)
+        frame = _convert(raw, self.mappings, tracker, self.files.data)
         return frame if tracker is None else tracker.settle(frame)
 
     def load(self, chunk_rows: int = CHUNK_ROWS) -> WellData:
@@ -557,7 +559,7 @@ def prefer_live(raw: RawSource, mappings: dict[str, Mapping], channels: dict, *,
         for col in wanted:
             if col in live or col not in chunk.columns:
                 continue
-            values = _numeric(chunk[col])
+            values = _numeric(chunk[col], col, file)
             values = values[np.isfinite(values)]
             if values.size:
                 ref = first.setdefault(col, float(values[0]))
@@ -661,53 +663,37 @@ def _clock_time(raw: RawSource, mappings: dict[str, Mapping]) -> dict[str, Mappi
     return mappings | {"time": replace(time, unit=CLOCK_UNIT, source="values")}
 
 
-def _numeric(values: pd.Series) -> np.ndarray:
+def _numeric(values: pd.Series, column=None, file=None) -> np.ndarray:
     """A source column as float64 with null markers, ±inf and magnitudes beyond float32 →
     NaN (text that is not a number → NaN): no rig sensor reads 10³⁹ of anything, and the
-    result files store float32, where such a value would become an infinity."""
+    result files store float32, where such a value would become an infinity.
+
+    Raises
+    ------
+    InputError
+        A cell's digits are split by a space or an apostrophe that does not group thousands
+        (``2 21,00``): no number can be told (:mod:`drillfric.io.grouping`).
+    """
     if pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values):
         out = values.to_numpy(dtype=float, na_value=np.nan).copy()
     else:
-        out = _text_numbers(values.astype("string").str.strip())
+        text = values.astype("string").str.strip()
+        out = _text_numbers(text)
+        bad = misgrouped(text, out)
+        if bad is not None:
+            where = f"column '{printable(column)}'" if column is not None else "a column"
+            raise InputError(f"{where} writes '{printable(bad, 20)}': digits split by "
+                             f"{grouping_name(bad)} that does not group thousands (groups of "
+                             "3 digits), so no number can be told", file=file,
+                             fix="export the log without thousands separators (or with "
+                                 "groups of exactly 3 digits)")
     out[np.isin(out, NULL_VALUES) | ~(np.abs(out) <= _FLOAT32_MAX)] = np.nan
     return out
 
 
 _FLOAT32_MAX = float(np.finfo(np.float32).max)
-_DECIMAL_COMMA = r"^-?(?:\d{1,3}(?:\.\d{3})+|\d+),\d+$"  # 17.730,5 or 1234,5
-#: Thousands commas where a cell shows them unambiguously: with a decimal point (16,111.8)
-#: or two groups or more (1,234,567); a lone 16,950 stays a decimal comma (16.95).
-_THOUSANDS_SURE = r"^-?\d{1,3}(?:(?:,\d{3})+\.\d+|(?:,\d{3}){2,}(?:\.\d+)?)$"
-
-
-def _text_numbers(text: pd.Series) -> np.ndarray:
-    """Numbers from text; a column read as text because of one bad token may still use a
-    decimal comma (and thousands dots), which are read as such (only the bad cell is NaN),
-    or thousands commas where a cell shows them unambiguously (a quoted "16,111.8" in a
-    comma-separated file was read as null: every segment skipped, exit 0).
-
-    Examples
-    --------
-    >>> _text_numbers(pd.Series(["1,5", "17.730,25", "***", "2.5"], dtype="string")).tolist()
-    [1.5, 17730.25, nan, 2.5]
-    >>> _text_numbers(pd.Series(["16,111.8", "1,234,567", "-200"], dtype="string")).tolist()
-    [16111.8, 1234567.0, -200.0]
-    """
-    out = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
-    grouped = text.str.fullmatch(_THOUSANDS_SURE).fillna(False).to_numpy(dtype=bool)
-    if grouped.any():  # cell by cell: the same in any chunking
-        out[grouped] = pd.to_numeric(text[grouped].str.replace(",", "", regex=False),
-                                     errors="coerce").to_numpy(dtype=float, na_value=np.nan)
-    comma = text.str.fullmatch(_DECIMAL_COMMA).fillna(False).to_numpy(dtype=bool) & ~grouped
-    if comma.any():
-        fixed = text[comma].str.replace(".", "", regex=False).str.replace(",", ".", regex=False)
-        out[comma] = pd.to_numeric(fixed, errors="coerce").to_numpy(dtype=float,
-                                                                    na_value=np.nan)
-    return out
-
-
 def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
-             tracker: TimeTracker | None) -> pd.DataFrame:
+             tracker: TimeTracker | None, file=None) -> pd.DataFrame:
     """Canonical SI columns of one raw chunk (time checked by ``tracker``; None: a depth
     log, every row kept)."""
     out: dict = {}
@@ -720,7 +706,7 @@ def _convert(chunk: pd.DataFrame, mappings: dict[str, Mapping],
             out["timestamp"] = stamps.array
     for key, m in mappings.items():
         if key != "time":
-            out[m.channel.name] = _numeric(chunk[m.column])[keep] * m.factor
+            out[m.channel.name] = _numeric(chunk[m.column], m.column, file)[keep] * m.factor
     return pd.DataFrame(out)
 
 
