@@ -239,3 +239,16 @@ def test_f4_the_decimal_mark_is_voted_on_beyond_the_first_50_lines(tmp_path):
     path = _write(tmp_path / "late.csv", lines)
     assert sniff_csv(path).decimal == ","
     assert _rows(path)["TORQUE"].iloc[100] == 1050
+
+
+@pytest.mark.parametrize("unit, scale", [("FTLB", 1.0), ("ft lb", 1.0), ("lb.ft", 1.0),
+                                         ("ft.lbs", 1.0), ("kft.lb", 1e3), ("klb.ft", 1e3)])
+def test_torque_written_with_lb_for_the_pound_of_force(unit, scale):
+    """Noticed during the twelfth attack: `FTLB` (pint: femto-troy-pounds), `lb.ft`,
+    `ft lb`, `ft.lbs`, `klb.ft`, `kft.lb` refused the log with exit 2 while `ft.lb` and
+    `kftlb` were read. On a torque channel "lb" is the pound of force (1 ft·lbf =
+    1.3558179483 N·m, exact)."""
+    from drillfric.io.channels import BY_KEY, factor
+
+    assert factor(unit, BY_KEY["surface_torque"]) == pytest.approx(
+        scale * 0.3048 * 4.4482216152605)

@@ -190,7 +190,15 @@ _COMMON = {
                      "kn.m": 1e3, "knm": 1e3, "kn·m": 1e3, "kn-m": 1e3, "kn*m": 1e3,
                      "ft.lbf": _FT * _LBF, "ft-lbf": _FT * _LBF, "ft·lbf": _FT * _LBF,
                      "lbf.ft": _FT * _LBF, "kft.lbf": 1e3 * _FT * _LBF,
-                     "kft-lbf": 1e3 * _FT * _LBF},
+                     "kft-lbf": 1e3 * _FT * _LBF,
+                     # rig spellings with the pound of force written "lb" (an EDR's FTLB
+                     # had been femto-troy-pounds to pint, the log refused: issue 30)
+                     **dict.fromkeys(("ftlb", "ft.lb", "ft-lb", "ft lb", "ft.lbs", "ft-lbs",
+                                      "ftlbs", "lb.ft", "lb-ft", "lbft", "lbf-ft", "ft lbf",
+                                      "ftlbf"), _FT * _LBF),
+                     **dict.fromkeys(("kftlb", "kft.lb", "kft-lb", "klb.ft", "klb-ft",
+                                      "kftlbf", "kft.lbs", "klbf.ft", "klbf-ft"),
+                                     1e3 * _FT * _LBF)},
     "newton": {"n": 1.0, "kn": 1e3, "dan": 10.0, "kdn": 1e4, "kdan": 1e4, "lbf": _LBF,
                "klbf": 1e3 * _LBF, "kgf": _KGF, "kkgf": 1e3 * _KGF},  # KDN: WITS kilo-daN
     "meter": {"m": 1.0, "ft": _FT, "cm": 1e-2, "mm": 1e-3, "in": 0.0254},
