@@ -243,7 +243,7 @@ def test_a_manual_run_into_a_fleets_out_is_redone_next_night_not_unchanged(tmp_p
     first = CliRunner().invoke(cli, fleet)
     assert "1 processed" in first.output, first.output
     again = CliRunner().invoke(cli, fleet)
-    assert "all 1 well ok (unchanged" in again.output, again.output
+    assert "1 ok (0 processed, 1 unchanged" in again.output, again.output
     other = _config(root / "other.toml", "[well]\nbit_depth_m = 1800.0\n")
     manual = CliRunner().invoke(cli, ["run", str(path), "--config", str(other), "--out",
                                       str(out)])
@@ -450,7 +450,8 @@ def test_damping_without_a_finite_kalman_design_is_a_model_error_naming_k_t():
 
 def test_units_pint_cannot_tokenize_are_unknown_units_and_multiindex_frames_are_refused():
     """open_well(frame=…) with MultiIndex columns gave tokenize.TokenError (its labels were
-    read as units); any text pint's parser chokes on is an unknown unit."""
+    read as units); any text pint's parser chokes on is an unknown unit. Two levels are
+    since read as (name, unit) (twelfth attack, F8); three are refused."""
     import numpy as np
     import pandas as pd
 
@@ -461,7 +462,7 @@ def test_units_pint_cannot_tokenize_are_unknown_units_and_multiindex_frames_are_
     with pytest.raises(InputError, match="unknown unit"):
         parse_unit("('a', 'b'")
     frame = pd.DataFrame(np.ones((10, 3)), columns=pd.MultiIndex.from_tuples(
-        [("time_s", "s"), ("surface_rpm", "rpm"), ("surface_torque_Nm", "Nm")]))
+        [("time_s", "s", "a"), ("surface_rpm", "rpm", "b"), ("surface_torque_Nm", "Nm", "c")]))
     with pytest.raises(InputError, match="MultiIndex"):
         drillfric.open_well(frame=frame)
 
