@@ -37,7 +37,12 @@ def _closing_line(result) -> str:
     ok, skipped, failed = (result.count(s) for s in ("ok", "skipped", "failed"))
     total = len(result.wells)
     redo = "; --force redoes them" if skipped and skipped == total else ""
-    parts = [f"{ok + skipped} ok ({ok} processed, {skipped} unchanged{redo})", f"{failed} failed"]
+    # a well with failed segments is "partial", as fleet.html calls it, not ok
+    partial = sum(w.status != "failed" and w.failed_segments > 0 for w in result.wells)
+    parts = [f"{ok + skipped - partial} ok ({ok} processed, {skipped} unchanged{redo})"]
+    if partial:
+        parts.append(f"{partial} partial")
+    parts.append(f"{failed} failed")
     empty = len(getattr(result, "nothing_estimated", ()))
     if empty:
         parts.append(f"{empty} with nothing estimated")

@@ -320,14 +320,18 @@ def test_fleet_last_line_names_manifest_or_folder_inconsistently(outcome):
     status = {"all ok": ["ok"] * 3, "all unchanged": ["skipped"] * 3,
               "partial": ["ok", "ok", "skipped"], "some failed": ["ok", "failed", "skipped"],
               "all failed": ["failed"] * 3, "nothing estimated": ["ok", "ok", "ok"]}[outcome]
-    wells = [SimpleNamespace(status=s, stale_dir=None) for s in status]
+    failing = 2 if outcome == "partial" else 0  # the first well's failed segments
+    wells = [SimpleNamespace(status=s, stale_dir=None, failed_segments=failing * (i == 0))
+             for i, s in enumerate(status)]
     result = SimpleNamespace(
         wells=wells, wall_s=2.0, manifest=Path("OUT/manifest.json"), out_root=Path("OUT"),
-        count=lambda s: status.count(s), failed_segments=2 if outcome == "partial" else 0,
+        count=lambda s: status.count(s), failed_segments=failing,
         nothing_estimated=("a", "b") if outcome == "nothing estimated" else ())
     line = _closing_line(result)
     assert re.fullmatch(r"fleet: 3 wells — \d ok \(\d processed, \d unchanged"
-                        r"(; --force redoes them)?\), \d failed(, [^—]+)? in 2\.0 s — "
-                        + re.escape(str(Path("OUT/manifest.json"))), line), line
+                        r"(; --force redoes them)?\)(, \d partial)?, \d failed(, [^—]+)? in "
+                        r"2\.0 s — " + re.escape(str(Path("OUT/manifest.json"))), line), line
+    # a well with failed segments is "partial", as fleet.html says, not counted ok
+    assert ("2 ok (2 processed, 1 unchanged), 1 partial" in line) is (outcome == "partial")
     result.manifest = None  # not recorded: the same path all the same
     assert _closing_line(result) == line
