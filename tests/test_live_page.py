@@ -415,6 +415,8 @@ def _check_open_segment(url: str) -> None:
 
     def check() -> bool:
         status, segs = _json(url + "live.json"), _json(url + "segments.json")
+        if _json(url + "live.json") != status:  # published between the two: ask again (a
+            return False  # loaded machine had compared a live.json with newer segments)
         opened = status["open_segment"]
         if opened is None or not segs["segments"]:
             return False
