@@ -415,8 +415,9 @@ def _check_open_segment(url: str) -> None:
 
     def check() -> bool:
         status, segs = _json(url + "live.json"), _json(url + "segments.json")
-        if _json(url + "live.json") != status:  # published between the two: ask again (a
-            return False  # loaded machine had compared a live.json with newer segments)
+        again = _json(url + "live.json")  # published between the two fetches: ask again (a
+        if again["last_sample_time_s"] != status["last_sample_time_s"]:  # loaded machine
+            return False  # had compared a live.json with newer segments)
         opened = status["open_segment"]
         if opened is None or not segs["segments"]:
             return False
