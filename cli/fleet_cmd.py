@@ -38,7 +38,8 @@ def _closing_line(result) -> str:
     total = len(result.wells)
     redo = "; --force redoes them" if skipped and skipped == total else ""
     # a well with failed segments is "partial", as fleet.html calls it, not ok
-    partial = sum(w.status != "failed" and w.failed_segments > 0 for w in result.wells)
+    partial = sum(w.status != WellStatus.FAILED and w.failed_segments > 0
+                  for w in result.wells)
     parts = [f"{ok + skipped - partial} ok ({ok} processed, {skipped} unchanged{redo})"]
     if partial:
         parts.append(f"{partial} partial")

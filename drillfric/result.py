@@ -314,7 +314,8 @@ class SegmentRecord:
                                             "level, before the ramp to rest that ends the "
                                             "rotation (a stop is not stick-slip)")
     mu_k_observer: float | None = _f("-", "observer consensus μ_k (first pass)")
-    mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass)")
+    mu_s_observer: float | None = _f("-", "observer consensus μ_s (first pass); null where "
+                                          "μ_s is not identifiable (mu_s_identifiable false)")
     mu_td: float | None = _f("-", "static torque-and-drag back-calculated friction factor")
     T_N_Nm: float | None = _f("N·m", "∫F_c dx at this depth: torque per unit friction factor")
     bit_rms_error_rpm: float | None = _f("RPM", "RMS error of the bit speed (synthetic truth)")

@@ -8,7 +8,9 @@
   const num = (a) => Float64Array.from(a || [], (v) => (v === null ? NaN : v));
   const scaled = (a, k) => num(a).map((v) => v * k);
   const known = (v) => v !== null && v !== undefined;
-  const fixed = (v, digits) => (known(v) ? Number(v).toFixed(digits) : "—");
+  // no "-0.0": a value that rounds to zero is 0 (a fifth newcomer read "bit speed -0.0 rpm")
+  const fixed = (v, digits) => (known(v) ? (Number(Number(v).toFixed(digits)) || 0).toFixed(digits)
+    : "—");
   let doc = null;
   let polls = 0;
 

@@ -25,7 +25,10 @@ def test_the_templates_count_with_the_same_helper():
 
 
 def _fleet(wells: int, failed_segments: int, stale: int):
-    rows = [SimpleNamespace(stale_dir="x" if i < stale else None) for i in range(wells)]
+    rows = [SimpleNamespace(stale_dir="x" if i < stale else None,
+                            status="failed" if i < stale else "ok",
+                            failed_segments=failed_segments if i == 0 else 0)
+            for i in range(wells)]
     return SimpleNamespace(wells=rows, failed_segments=failed_segments, wall_s=1.0,
                            manifest="OUT/manifest.json", out_root="OUT",
                            count=lambda s: {"ok": wells - stale, "failed": stale}.get(s, 0))

@@ -79,7 +79,10 @@ def segment_record(seg: Segment, depth: float, status: Status, message: str, row
         mu_k_spread=est.mu_k_spread, converged=est.converged, method=est.method,
         mu_k_damping_uncertainty=est.mu_k_damping,
         settling_time_s=est.settling_time_s, residual_rms_rpm=est.residual_rms_rpm,
-        mu_k_observer=est.mu_k_observer, mu_s_observer=est.mu_s_observer, mu_td=est.mu_td,
+        mu_k_observer=est.mu_k_observer,
+        # the observer's μ_s is no estimate where μ_s is not identifiable (a fifth newcomer
+        # read 0.648 beside "not identifiable" in summary.json): null, as a withheld factor
+        mu_s_observer=est.mu_s_observer if est.mu_s_identifiable else None, mu_td=est.mu_td,
         T_N_Nm=est.T_N_Nm, quality_flags=est.flags, starts=tuple(map(tuple, est.starts.tolist())),
         friction_zone=est.friction_zone, hookload_model_N=est.td.hookload_N,
         **_evidence_fields(est), **_bit_fields(est), **_torque_terms(est), **_skew(est),
