@@ -196,6 +196,30 @@ def test_parquet_rewritten_with_more_rows_continues_from_its_row_groups(stands, 
     assert "row group 0 differs" in _summary(out)["resumed"]["reason"]
 
 
+def test_a_parquet_unit_corrected_in_its_footer_is_no_state_to_continue(stands,  # noqa: F811
+                                                                       tmp_path):
+    """Thirteenth attack, F1: a Parquet log whose torque unit was corrected between two
+    nights — only its footer changed (a column renamed, its row groups' bytes the same) —
+    continued from the saved state with the old numbers (μ_k 0.2027 where a fresh run gives
+    0.2786). The mark keeps the columns and units: the well is redone from its start."""
+    path, _ = stands
+    frame = pd.read_csv(path)
+    data = tmp_path / "wells" / "three.parquet"
+    _grow(path, data.with_suffix(".csv"), 0.0)
+    data.with_suffix(".csv").unlink()
+    toml = data.with_suffix(".toml")
+    toml.write_text(toml.read_text().replace('data = "three.csv"', 'data = "three.parquet"'))
+    out = tmp_path / "out"
+    wrong = frame.rename(columns={"surface_torque_Nm": "TORQUE [kN.m]"})
+    wrong["TORQUE [kN.m]"] = frame["surface_torque_Nm"]  # N·m values under a kN·m name
+    _parquet(wrong, data)
+    run_many([WellSpec(data)], out, workers=1)
+    _parquet(wrong.rename(columns={"TORQUE [kN.m]": "TORQUE [N.m]"}), data)
+    assert run_many([WellSpec(data)], out, workers=1).count("ok") == 1
+    resumed = _summary(out)["resumed"]
+    assert resumed["from_row"] == 0 and "columns or units changed" in resumed["reason"]
+
+
 def test_folder_of_hourly_files_continues_with_the_grown_and_the_new_files(stands,  # noqa: F811
                                                                           tmp_path):
     """A well directory whose [well] data names a folder of hourly CSV files: the last file

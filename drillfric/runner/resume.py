@@ -52,7 +52,10 @@ def mark(well: Well) -> dict:
         last = len(source.parts) - 1
         return parts_mark(source, [{"name": p.path.name} | source_mark(p, whole=i < last)
                                    for i, p in enumerate(source.parts)])
-    return source_mark(source)
+    # the columns and units too: a Parquet log whose torque unit was corrected in its
+    # footer alone kept its row groups' bytes, and a night-2 run its old numbers (issue 30,
+    # thirteenth attack)
+    return source_mark(source) | {"columns": list(source.columns), "units": _units(source)}
 
 
 def parts_mark(source, parts: list[dict]) -> dict:
@@ -184,6 +187,9 @@ def _values_hash(source, start: int, stop: int) -> str:
 def changed(found: dict | None, well: Well) -> str:
     """Why the well's data does not continue what ``found`` recorded ("" when it does)."""
     if not well.source.parts:
+        if found and (found.get("columns") != list(well.source.columns)
+                      or found.get("units") != _units(well.source)):
+            return "the log's columns or units changed"
         return _source_changed(found, well.source)
     if not found or found.get("format") != "parts":
         return "the earlier run read another kind of data"
