@@ -187,8 +187,9 @@ def _values_hash(source, start: int, stop: int) -> str:
 def changed(found: dict | None, well: Well) -> str:
     """Why the well's data does not continue what ``found`` recorded ("" when it does)."""
     if not well.source.parts:
-        if found and (found.get("columns") != list(well.source.columns)
-                      or found.get("units") != _units(well.source)):
+        if found and "columns" in found and (  # (live's tail marks record no columns)
+                found["columns"] != list(well.source.columns)
+                or found.get("units") != _units(well.source)):
             return "the log's columns or units changed"
         return _source_changed(found, well.source)
     if not found or found.get("format") != "parts":
