@@ -165,6 +165,17 @@ def _parquet(frame: pd.DataFrame, path, group_rows: int = 7_000) -> None:
     frame.to_parquet(path, index=False, row_group_size=group_rows)
 
 
+def _parquet_well(src, tmp_path):
+    """wells/three.parquet's path, with ``src``'s sidecars, its config naming it (the
+    Parquet file itself is written by the test)."""
+    data = tmp_path / "wells" / "three.parquet"
+    _grow(src, data.with_suffix(".csv"), 0.0)
+    data.with_suffix(".csv").unlink()
+    toml = data.with_suffix(".toml")
+    toml.write_text(toml.read_text().replace('data = "three.csv"', 'data = "three.parquet"'))
+    return data
+
+
 def test_parquet_rewritten_with_more_rows_continues_from_its_row_groups(stands,  # noqa: F811
                                                                          tmp_path):
     """A Parquet file rewritten whole with more rows (its last row group now larger): the
@@ -173,11 +184,7 @@ def test_parquet_rewritten_with_more_rows_continues_from_its_row_groups(stands, 
     redone whole with the reason."""
     path, whole = stands
     frame = pd.read_csv(path)
-    data = tmp_path / "wells" / "three.parquet"
-    _grow(path, data.with_suffix(".csv"), 0.0)
-    data.with_suffix(".csv").unlink()
-    toml = data.with_suffix(".toml")
-    toml.write_text(toml.read_text().replace('data = "three.csv"', 'data = "three.parquet"'))
+    data = _parquet_well(path, tmp_path)
     out = tmp_path / "out"
     first = int(len(frame) * 0.55)  # not at a row-group boundary
     _parquet(frame.iloc[:first], data)
@@ -204,11 +211,7 @@ def test_a_parquet_unit_corrected_in_its_footer_is_no_state_to_continue(stands, 
     0.2786). The mark keeps the columns and units: the well is redone from its start."""
     path, _ = stands
     frame = pd.read_csv(path)
-    data = tmp_path / "wells" / "three.parquet"
-    _grow(path, data.with_suffix(".csv"), 0.0)
-    data.with_suffix(".csv").unlink()
-    toml = data.with_suffix(".toml")
-    toml.write_text(toml.read_text().replace('data = "three.csv"', 'data = "three.parquet"'))
+    data = _parquet_well(path, tmp_path)
     out = tmp_path / "out"
     wrong = frame.rename(columns={"surface_torque_Nm": "TORQUE [kN.m]"})
     wrong["TORQUE [kN.m]"] = frame["surface_torque_Nm"]  # N·m values under a kN·m name
